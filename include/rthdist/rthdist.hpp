@@ -1,0 +1,149 @@
+// rthdist — exact Hausdorff distance between two 3-D point sets on Vulkan
+// ray-tracing hardware (RT-HDIST: Kim, Lee, Kim 2025), with an exact CPU
+// backend.
+//
+// Contract
+//   h(A,B) = max_{a in A} min_{b in B} |a - b|,  H(A,B) = max(h(A,B), h(B,A)).
+//   The value is EXACT for the float32 input: it equals the brute force
+//   computed in double over the same float32 coordinates (float rounding of
+//   the squared-distance comparisons aside, within 1e-6 of the larger
+//   bounding-box diagonal), and the reported index pair realizes it. Final
+//   distances are recomputed in double on the host from the witness pair.
+//
+// Inputs: spans of glm::vec3, finite coordinates (NaN/Inf -> kInvalidArgument),
+//   at least one point per side (an empty set -> kInvalidArgument; H is
+//   undefined). Up to 2^31 - 1 points per side; device memory is the limit.
+//
+// Threading: an Engine owns one Vulkan device and is not thread-safe; use one
+//   Engine per thread. The free function hausdorff() creates a temporary
+//   Engine (device + pipelines) per call: embedders that call repeatedly
+//   should keep an Engine.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "rthdist/result.hpp"
+
+namespace rthdist {
+
+enum class Backend {
+    kAuto,        // ray-query if the device has it, else rt-pipeline, else error
+    kRayQuery,    // VK_KHR_ray_query in compute shaders
+    kRtPipeline,  // VK_KHR_ray_tracing_pipeline (raygen + intersection)
+    kCpu,         // exact multithreaded CPU implementation (no Vulkan)
+};
+
+[[nodiscard]] const char* backendName(Backend backend);
+// Parses "auto", "ray-query", "rt-pipeline", "cpu"; false when unknown.
+[[nodiscard]] bool parseBackend(const std::string& text, Backend& out);
+
+struct Options {
+    Backend backend = Backend::kAuto;
+    // Index-space bit count k (cells of edge L / 2^k). 0 = choose from the
+    // data (about kTargetPointsPerCell target points per occupied cell).
+    int bits = 0;
+    // true: compute only h(A,B); b_to_a is left empty.
+    bool directedOnly = false;
+    // Vulkan physical device index as listed by listDevices(); -1 = first usable.
+    int deviceIndex = -1;
+    // Enable VK_LAYER_KHRONOS_validation and count every message it emits
+    // (Result::validationMessages). For tests; slow.
+    bool validation = false;
+    // Radius growth factor between candidate-search iterations (> 1).
+    float radiusGrowth = 2.0f;
+    // CPU backend threads; 0 = all hardware threads.
+    int threads = 0;
+};
+
+// Counters of one direction: what the algorithm did.
+struct Counters {
+    uint32_t bits = 0;              // k actually used for the target index
+    uint64_t occupiedCells = 0;     // occupied cells of the target index
+    uint64_t queries = 0;           // query points
+    uint64_t culledByNeighbourhood = 0;  // queries resolved before any ray
+    uint64_t survivingQueries = 0;  // queries that entered candidate search
+    uint32_t iterations = 0;        // candidate-search radius iterations
+    uint64_t rays = 0;              // rays cast over all iterations
+    uint64_t candidatePairs = 0;    // (query, cell) pairs refined
+};
+
+// One directed distance h(Q,T) with its witness.
+struct Directed {
+    double distance = 0.0;       // recomputed in double from the pair
+    uint32_t queryIndex = 0;     // index into the query set
+    uint32_t targetIndex = 0;    // index into the target set (its nearest point)
+    glm::vec3 queryPoint{0.0f};
+    glm::vec3 targetPoint{0.0f};
+    Counters counters;
+};
+
+// Wall-clock milliseconds per stage, summed over both directions.
+struct Timings {
+    double setup = 0.0;   // device/pipeline creation (0 when an Engine is reused)
+    double upload = 0.0;  // host -> device copies
+    double index = 0.0;   // stage 1: bounding box, cell keys, sort, run-length encode
+    double cull = 0.0;    // neighbourhood pass: exact NN in the 3x3x3 cell block
+    double search = 0.0;  // stage 2: BLAS builds + ray traversal (candidate pairs)
+    double refine = 0.0;  // stage 3: exact scan of candidate cells, classification
+    double total = 0.0;   // everything inside the call
+};
+
+struct HausdorffResult {
+    double hausdorff = 0.0;  // max of both directions (or h(A,B) when directed)
+    Directed aToB;
+    Directed bToA;           // empty when Options::directedOnly
+    bool directedOnly = false;
+    Backend backend = Backend::kAuto;  // the backend that ran
+    std::string device;                // device name, or "cpu"
+    Timings timings;
+    uint64_t validationMessages = 0;   // with Options::validation
+};
+
+// A Vulkan physical device and what rthdist can do with it.
+struct DeviceInfo {
+    int index = 0;
+    std::string name;
+    std::string type;  // "discrete", "integrated", "cpu", "virtual", "other"
+    std::string driver;
+    bool rayQuery = false;    // the ray-query backend can run
+    bool rtPipeline = false;  // the rt-pipeline backend can run
+    std::vector<std::string> missing;  // why a backend is unusable
+};
+
+// Lists every Vulkan device; an error only when no Vulkan loader/ICD works.
+[[nodiscard]] Result<std::vector<DeviceInfo>> listDevices();
+
+// Owns a Vulkan device, its pipelines and scratch memory between calls.
+class Engine {
+public:
+    [[nodiscard]] static Result<Engine> create(const Options& options);
+    Engine(Engine&&) noexcept;
+    Engine& operator=(Engine&&) noexcept;
+    ~Engine();
+
+    [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a,
+                                                  std::span<const glm::vec3> b);
+    [[nodiscard]] const std::string& deviceName() const;
+    [[nodiscard]] Backend backend() const;
+
+    struct Impl;
+
+private:
+    explicit Engine(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> m_impl;
+};
+
+// One-shot convenience: creates an Engine (or runs the CPU backend) and computes.
+[[nodiscard]] Result<HausdorffResult> hausdorff(std::span<const glm::vec3> a,
+                                                std::span<const glm::vec3> b,
+                                                const Options& options = {});
+
+const char* versionString();
+
+}  // namespace rthdist

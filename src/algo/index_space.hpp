@@ -1,0 +1,56 @@
+// Index space of RT-HDIST (Kim, Lee, Kim 2025, Sec. 4.1): a cubic grid over the
+// target bounding volume, cell edge s = L / 2^k with L the longest side.
+// Shared by the GPU and CPU backends so both assign cells by the same rules.
+//
+// Rules (DESIGN §2): cell of t = floor((t - o) / s), clamped to [0, 2^k - 1]
+// per axis; o and s are computed in double on the host. When every target is
+// the same point (L = 0) s is 1, so nothing divides by zero.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <span>
+
+namespace rthdist::algo {
+
+// Largest bit count with a dense cell table (2^(3k) entries) that we allow.
+inline constexpr int kMaxBits = 8;
+inline constexpr int kMinBits = 1;
+// Auto bit count aims at about this many target points per occupied cell.
+inline constexpr double kTargetPointsPerCell = 6.0;
+
+struct Bounds {
+    glm::dvec3 lo{0.0};
+    glm::dvec3 hi{0.0};
+};
+
+struct GridSpec {
+    glm::dvec3 origin{0.0};  // min corner of the target bounds
+    double cellSize = 1.0;   // s = L / 2^bits (1 when L = 0)
+    int bits = 1;
+    uint32_t cellsPerAxis = 2;
+};
+
+[[nodiscard]] Bounds boundsOf(std::span<const glm::vec3> points);
+
+// bits <= 0 selects the bit count from the data (chooseBits).
+[[nodiscard]] GridSpec makeGrid(const Bounds& targetBounds, int bits);
+
+// Picks k so that occupied cells hold about kTargetPointsPerCell points, from
+// a strided sample's occupancy extrapolated to the full set (DESIGN §5).
+[[nodiscard]] int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds);
+
+// Interleaves the low 10 bits of x, y, z (x in bit 0).
+[[nodiscard]] uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z);
+
+// Cell coordinate of p on one axis, clamped to the grid.
+[[nodiscard]] inline uint32_t cellCoord(double p, double origin, double cellSize,
+                                        uint32_t cellsPerAxis) {
+    double c = (p - origin) / cellSize;
+    if (!(c > 0.0)) return 0;
+    if (c >= double(cellsPerAxis)) return cellsPerAxis - 1;
+    return uint32_t(c);
+}
+
+}  // namespace rthdist::algo

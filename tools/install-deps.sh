@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs what rthdist needs to build and test on Debian 12 (bookworm).
+# Mesa's lavapipe gained VK_KHR_ray_query in 24.1; bookworm ships 22.3, so the
+# Vulkan driver comes from bookworm-backports (25.0.x). Idempotent: packages
+# already present are left alone. Needs root or sudo.
+set -euo pipefail
+
+SUDO=""
+if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+
+BASE_PKGS=(cmake g++ make pkg-config libvulkan-dev glslang-tools libglm-dev
+  libtinygltf-dev libgtest-dev libnanoflann-dev zlib1g-dev vulkan-validationlayers
+  vulkan-tools nlohmann-json3-dev libstb-dev)
+EXTRA_PKGS=()
+if [ "${RTHDIST_BENCH_DEPS:-0}" = 1 ]; then
+  EXTRA_PKGS=(python3-scipy python3-numpy)
+fi
+
+have_all() {
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || return 1
+  done
+}
+
+mesa_ok() {
+  local v
+  v=$(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null || true)
+  [ -n "$v" ] && dpkg --compare-versions "$v" ge 24.1
+}
+
+if have_all "${BASE_PKGS[@]}" "${EXTRA_PKGS[@]}" && mesa_ok; then
+  exit 0
+fi
+
+export DEBIAN_FRONTEND=noninteractive
+if ! grep -rqs "bookworm-backports" /etc/apt/sources.list /etc/apt/sources.list.d/; then
+  echo "deb http://deb.debian.org/debian bookworm-backports main" |
+    $SUDO tee /etc/apt/sources.list.d/rthdist-backports.list >/dev/null
+fi
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${BASE_PKGS[@]}" "${EXTRA_PKGS[@]}" >/dev/null
+$SUDO apt-get install -y -qq --no-install-recommends -t bookworm-backports \
+  mesa-vulkan-drivers >/dev/null
+mesa_ok || { echo "install-deps: mesa-vulkan-drivers >= 24.1 is required (lavapipe ray queries)" >&2; exit 1; }
