@@ -1,0 +1,176 @@
+// CLI tests of the Vulkan backends (ray-query, rt-pipeline) through the
+// binary. They never skip: on a machine without a ray-tracing device they
+// fail, because CI must provide lavapipe (README "lavapipe").
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cli_runner.hpp"
+
+namespace rthdist::cli_test {
+namespace {
+
+using Json = nlohmann::json;
+using Points = std::vector<std::array<float, 3>>;
+
+// Deterministic points on a unit sphere with some jitter (fixed-seed LCG).
+Points spherePoints(size_t n, uint32_t seed) {
+    Points out;
+    uint32_t state = seed;
+    auto next = [&]() {
+        state = state * 1664525u + 1013904223u;
+        return double(state >> 8) / double(1u << 24);
+    };
+    for (size_t i = 0; i < n; ++i) {
+        const double z = 2.0 * next() - 1.0;
+        const double phi = 6.283185307179586 * next();
+        const double r = std::sqrt(1.0 - z * z) * (0.95 + 0.1 * next());
+        out.push_back({float(r * std::cos(phi)), float(r * std::sin(phi)), float(z)});
+    }
+    return out;
+}
+
+Points translated(Points p, float dx) {
+    for (auto& q : p) q[0] += dx;
+    return p;
+}
+
+std::string xyzText(const Points& points) {
+    std::string out;
+    char line[128];
+    for (const auto& p : points) {
+        std::snprintf(line, sizeof line, "%.9g %.9g %.9g\n", double(p[0]), double(p[1]), double(p[2]));
+        out += line;
+    }
+    return out;
+}
+
+class CliGpu : public ::testing::TestWithParam<const char*> {
+protected:
+    // Runs the backend under test with --json and --verify; asserts success.
+    Json runVerified(std::vector<std::string> args) {
+        args.insert(args.begin(), {"--backend", GetParam(), "--json", "--verify"});
+        const CliRun run = runCli(args);
+        EXPECT_EQ(run.exitCode, 0) << run;
+        if (run.exitCode != 0) return Json();
+        Json j = parseJson(run);
+        EXPECT_EQ(j["backend"], GetParam());
+        EXPECT_TRUE(j["verify"]["ok"].get<bool>()) << j["verify"];
+        EXPECT_TRUE(j["verify"]["mismatches"].empty());
+        return j;
+    }
+};
+
+TEST_P(CliGpu, SampleAgreesWithCpu) {
+    const Json j = runVerified({kSampleA, kSampleB});
+    if (j.is_null()) return;
+    EXPECT_NEAR(j["hausdorff"].get<double>(), j["verify"]["cpu"]["hausdorff"].get<double>(),
+                j["verify"]["tolerance"].get<double>());
+    EXPECT_GT(j["hausdorff"].get<double>(), 0.0);
+    EXPECT_FALSE(j["device"].get<std::string>().empty());
+    EXPECT_GT(j["counters"]["a_to_b"]["occupied_cells"].get<uint64_t>(), 0u);
+}
+
+TEST_P(CliGpu, SampleDirected) {
+    const Json j = runVerified({"--directed", kSampleA, kSampleB});
+    if (j.is_null()) return;
+    EXPECT_TRUE(j["b_to_a"].is_null());
+    EXPECT_EQ(j["hausdorff"].get<double>(), j["a_to_b"]["distance"].get<double>());
+}
+
+TEST_P(CliGpu, FixedBits) {
+    for (const char* bits : {"1", "3", "6"}) {
+        SCOPED_TRACE(std::string("--bits ") + bits);
+        const Json j = runVerified({"--bits", bits, kSampleA, kSampleB});
+        if (j.is_null()) continue;
+        EXPECT_EQ(j["bits"].get<int>(), std::stoi(bits));
+        EXPECT_EQ(j["bits_requested"].get<int>(), std::stoi(bits));
+    }
+}
+
+// Exact against a brute force done here, not only against the cpu backend.
+TEST_P(CliGpu, SmallFixturesExact) {
+    TempDir dir;
+    const Points a = spherePoints(500, 7u);
+    const Points b = spherePoints(300, 11u);
+    const std::vector<std::pair<Points, Points>> cases = {
+        {a, b},                    // overlapping
+        {a, translated(a, 1.0f)},  // translated by half the extent
+        {a, translated(b, 1e4f)},  // far apart: distance >> extent
+        {{{0, 0, 0}, {1, 0, 0}}, {{0, 0, 0}}},
+        {{{0.5f, 0, 0}}, {{1.99f, 0, 0}, {-0.1f, 0, 0}}},  // DESIGN §3 corner counterexample
+    };
+    for (size_t i = 0; i < cases.size(); ++i) {
+        SCOPED_TRACE("case " + std::to_string(i));
+        const std::string pa = dir.write("a" + std::to_string(i) + ".xyz", xyzText(cases[i].first));
+        const std::string pb = dir.write("b" + std::to_string(i) + ".xyz", xyzText(cases[i].second));
+        const Json j = runVerified({pa, pb});
+        if (j.is_null()) continue;
+        // The xyz text holds each float exactly (%.9g), so brute force here sees the same input.
+        const double hab = directedBrute(cases[i].first, cases[i].second);
+        const double hba = directedBrute(cases[i].second, cases[i].first);
+        const double tol = 1e-9 * (1.0 + std::max(hab, hba));
+        EXPECT_NEAR(j["a_to_b"]["distance"].get<double>(), hab, tol);
+        EXPECT_NEAR(j["b_to_a"]["distance"].get<double>(), hba, tol);
+        EXPECT_NEAR(j["hausdorff"].get<double>(), std::max(hab, hba), tol);
+    }
+}
+
+TEST_P(CliGpu, ValidationLayerIsSilent) {
+    const CliRun run = runCli({"--backend", GetParam(), "--json", "--validation", kSampleA, kSampleB});
+    ASSERT_EQ(run.exitCode, 0) << run;
+    const Json j = parseJson(run);
+    EXPECT_TRUE(j["validation"].get<bool>());
+    EXPECT_EQ(j["validation_messages"].get<uint64_t>(), 0u) << run.err;
+}
+
+TEST_P(CliGpu, DeviceIndexOutOfRangeIsNoDevice) {
+    const CliRun run = runCli({"--backend", GetParam(), "--device", "999", kSampleA, kSampleB});
+    EXPECT_EQ(run.exitCode, 4) << run;
+    EXPECT_EQ(run.err.rfind("rthdist: ", 0), 0u) << run;
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, CliGpu, ::testing::Values("ray-query", "rt-pipeline"),
+                         [](const auto& info) {
+                             std::string name = info.param;
+                             name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
+                             return name;
+                         });
+
+TEST(CliGpuAuto, PicksARayTracingBackend) {
+    const CliRun run = runCli({"--json", kSampleA, kSampleB});
+    ASSERT_EQ(run.exitCode, 0) << run;
+    const std::string backend = parseJson(run)["backend"].get<std::string>();
+    EXPECT_TRUE(backend == "ray-query" || backend == "rt-pipeline") << backend;
+}
+
+TEST(CliGpuDevices, ListJson) {
+    const CliRun run = runCli({"--list-devices", "--json"});
+    ASSERT_EQ(run.exitCode, 0) << run;
+    const Json j = parseJson(run);
+    ASSERT_TRUE(j["devices"].is_array());
+    ASSERT_FALSE(j["devices"].empty()) << "no Vulkan device: CI needs lavapipe";
+    bool anyRayQuery = false;
+    for (const Json& d : j["devices"]) {
+        for (const char* k : {"index", "name", "type", "driver", "ray_query", "rt_pipeline", "missing"}) {
+            EXPECT_TRUE(d.contains(k)) << "missing " << k << " in " << d;
+        }
+        anyRayQuery = anyRayQuery || d["ray_query"].get<bool>();
+        // Every unusable path says why.
+        if (!d["ray_query"].get<bool>() || !d["rt_pipeline"].get<bool>())
+            EXPECT_FALSE(d["missing"].empty()) << d;
+    }
+    EXPECT_TRUE(anyRayQuery) << "no ray-query device: " << j;
+}
+
+TEST(CliGpuDevices, ListText) {
+    const CliRun run = runCli({"--list-devices"});
+    ASSERT_EQ(run.exitCode, 0) << run;
+    EXPECT_NE(run.out.find("ray-query: "), std::string::npos) << run;
+    EXPECT_NE(run.out.find("rt-pipeline: "), std::string::npos) << run;
+}
+
+}  // namespace
+}  // namespace rthdist::cli_test
