@@ -1,5 +1,7 @@
 #include "algo/index_space.hpp"
 
+#include <glm/common.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <vector>

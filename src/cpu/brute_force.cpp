@@ -1,0 +1,76 @@
+#include "cpu/brute_force.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "cpu/parallel.hpp"
+
+namespace rthdist::cpu {
+namespace {
+
+struct Nearest {
+    double distanceSquared;
+    uint32_t targetIndex;
+};
+
+Nearest nearestOf(const glm::vec3& q, std::span<const glm::vec3> targets) {
+    const double qx = q.x, qy = q.y, qz = q.z;
+    Nearest best{std::numeric_limits<double>::infinity(), 0};
+    for (size_t j = 0; j < targets.size(); ++j) {
+        const double dx = qx - double(targets[j].x);
+        const double dy = qy - double(targets[j].y);
+        const double dz = qz - double(targets[j].z);
+        const double d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < best.distanceSquared) best = {d2, uint32_t(j)};  // strict: first index wins
+    }
+    return best;
+}
+
+constexpr size_t kChunk = 64;
+
+}  // namespace
+
+DirectedExact bruteForceDirected(std::span<const glm::vec3> queries,
+                                 std::span<const glm::vec3> targets, int threads) {
+    DirectedExact result;
+    if (queries.empty() || targets.empty()) return result;
+    const int workers = resolveThreads(threads, (queries.size() + kChunk - 1) / kChunk);
+    struct Best {
+        double d2 = -1.0;
+        uint32_t query = 0;
+        uint32_t target = 0;
+    };
+    std::vector<Best> perThread(static_cast<size_t>(workers));
+    parallelChunks(queries.size(), kChunk, workers, [&](size_t begin, size_t end, int t) {
+        Best& best = perThread[size_t(t)];
+        for (size_t i = begin; i < end; ++i) {
+            const Nearest n = nearestOf(queries[i], targets);
+            if (n.distanceSquared > best.d2 ||
+                (n.distanceSquared == best.d2 && uint32_t(i) < best.query)) {
+                best = {n.distanceSquared, uint32_t(i), n.targetIndex};
+            }
+        }
+    });
+    Best best;
+    for (const Best& b : perThread) {
+        if (b.d2 > best.d2 || (b.d2 == best.d2 && b.d2 >= 0.0 && b.query < best.query)) best = b;
+    }
+    result.distance = std::sqrt(best.d2);
+    result.queryIndex = best.query;
+    result.targetIndex = best.target;
+    return result;
+}
+
+std::vector<double> bruteForceNearest(std::span<const glm::vec3> queries,
+                                      std::span<const glm::vec3> targets, int threads) {
+    std::vector<double> out(queries.size(), std::numeric_limits<double>::infinity());
+    if (targets.empty()) return out;
+    parallelChunks(queries.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) {
+            out[i] = std::sqrt(nearestOf(queries[i], targets).distanceSquared);
+        }
+    });
+    return out;
+}
+
+}  // namespace rthdist::cpu

@@ -1,0 +1,46 @@
+// Exact Hausdorff distance on the CPU (Backend::kCpu).
+//
+// Algorithm per direction h(Q, T) (see cpu_hausdorff.cpp for the proofs):
+//   1. Index T: the shared RT-HDIST grid (Kim, Lee, Kim 2025), cells' points
+//      contiguous with tight boxes, cut into buckets under an 8-wide BVH.
+//   2. Lower bound M: exact NN of a strided sample of Q, and the largest
+//      distance from a query to BV(T) (no witness, so it is lowered by 1e-5
+//      relative before use and can never hide the maximizing query).
+//   3. Queries in Morton order, chunks pulled by std::threads: a query dies
+//      when a point of the previous query's nearest bucket or of its own cell
+//      is strictly closer than M (early break, Taha & Hanbury 2015);
+//      survivors run a best-first-ordered BVH search that still breaks as soon
+//      as a point closer than the running M appears, else ends with the exact
+//      nearest neighbour and raises M.
+//   4. The winning pair is recomputed in double.
+//
+// Contract: a and b non-empty, all coordinates finite (the caller checks).
+// Precision: squared distances are float differences of the raw float
+//   coordinates (no origin shift, so coordinates near 1e7 stay exact), and
+//   boxes are pruned only when farther than the best point by more than a
+//   relative 1e-5, so the search is exact in float; the reported distances
+//   are recomputed in double from the witness pairs. Inputs whose magnitudes
+//   would overflow or underflow squared floats are scaled by a power of two
+//   (exact).
+// Threading: options.threads workers (0 = all hardware threads); the result
+//   does not depend on the thread count (ties: smallest query index, then
+//   smallest target index among equal float distances).
+// Timings: index = target index + query ordering, cull = lower bound,
+//   search = the pass over all queries (neighbourhood kill and BVH search),
+//   refine = witness recomputation.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <span>
+
+#include "rthdist/result.hpp"
+#include "rthdist/rthdist.hpp"
+
+namespace rthdist::cpu {
+
+[[nodiscard]] Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a,
+                                                   std::span<const glm::vec3> b,
+                                                   const Options& options);
+
+}  // namespace rthdist::cpu

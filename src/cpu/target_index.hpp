@@ -1,0 +1,74 @@
+// Target index of the CPU backend: the shared RT-HDIST grid (algo/index_space,
+// Kim, Lee, Kim 2025, Sec. 4.1) with every occupied cell's points contiguous
+// and a tight box per cell, plus an implicit 8-wide bounding-volume hierarchy
+// over sub-cell buckets for exact nearest-neighbour search with early break
+// (Taha & Hanbury 2015).
+//
+// Layout: targets are sorted by a fine Morton key (2 bits per axis finer than
+// the grid, at most 10), so each grid cell is a contiguous run and, inside a
+// cell, points follow the Morton curve. Each cell is cut into buckets of at most
+// kBucketSize consecutive points (a bucket never crosses a cell); buckets are
+// the BVH leaves, and groups of 8 consecutive nodes (Morton order) form the
+// next level. Coordinates live in SoA float arrays padded with +inf so that the
+// 8-wide scans may read past a bucket's end (extra lanes are real targets or
+// +inf, never wrong).
+//
+// Precision: coordinates are the input floats times a power-of-two `scale`
+// (exact; 1 unless the magnitudes would overflow or underflow squared floats).
+#pragma once
+
+#include <glm/common.hpp>
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "algo/index_space.hpp"
+
+namespace rthdist::cpu {
+
+inline constexpr uint32_t kBucketSize = 8;  // points per BVH leaf (at most)
+inline constexpr uint32_t kFanout = 8;      // children per BVH node
+inline constexpr uint32_t kPad = 8;         // +inf entries after every SoA array
+
+// Boxes of one BVH level in SoA form, padded to a multiple of kFanout with
+// empty boxes (lo = +inf, hi = -inf: infinitely far from every point).
+struct BoxLevel {
+    std::vector<float> loX, loY, loZ, hiX, hiY, hiZ;
+    uint32_t count = 0;  // real boxes
+};
+
+struct TargetIndex {
+    algo::GridSpec grid;  // over the scaled targets
+    int fineBits = 1;     // bits of the sort key per axis (grid.bits + 2, <= 10)
+    float scale = 1.0f;
+
+    // Sorted targets (scaled), padded with kPad entries of +inf.
+    std::vector<float> x, y, z;
+    std::vector<uint32_t> original;  // sorted position -> input index
+    std::vector<uint32_t> bucketOf;  // sorted position -> bucket
+
+    // Occupied cells, ascending Morton key (grid.bits per axis).
+    std::vector<uint32_t> cellKey;
+    std::vector<uint32_t> cellFirst;  // cellCount + 1 offsets into the sorted points
+    std::vector<glm::vec3> cellLo, cellHi;  // tight boxes of the cells' points
+
+    // Buckets and the BVH: levels[0] holds the buckets, levels.back() one root.
+    std::vector<uint32_t> bucketFirst;  // bucketCount + 1 offsets
+    std::vector<BoxLevel> levels;
+
+    [[nodiscard]] uint32_t cellCount() const { return uint32_t(cellKey.size()); }
+    [[nodiscard]] uint32_t bucketCount() const { return levels.empty() ? 0 : levels[0].count; }
+};
+
+// Builds the index over `targets` (non-empty, finite) scaled by `scale`.
+// bits <= 0 picks the grid's bit count with algo::chooseBits.
+[[nodiscard]] TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale,
+                                           int bits, int threads);
+
+// Sorts (key << 32 | payload) values by their key bits [32, 32 + keyBits),
+// stably (LSD radix).
+void radixSortKeys(std::vector<uint64_t>& values, int keyBits);
+
+}  // namespace rthdist::cpu
