@@ -3,6 +3,8 @@
 # Mesa's lavapipe gained VK_KHR_ray_query in 24.1; bookworm ships 22.3, so the
 # Vulkan driver comes from bookworm-backports (25.0.x). Idempotent: packages
 # already present are left alone. Needs root or sudo.
+#   RTHDIST_BENCH_DEPS=1  also python3-scipy/numpy for tools/bench
+#   RTHDIST_LINT_DEPS=1   also clang-format for .ci/run
 set -euo pipefail
 
 SUDO=""
@@ -13,7 +15,11 @@ BASE_PKGS=(cmake g++ make pkg-config libvulkan-dev glslang-tools libglm-dev
   vulkan-tools nlohmann-json3-dev libstb-dev)
 EXTRA_PKGS=()
 if [ "${RTHDIST_BENCH_DEPS:-0}" = 1 ]; then
-  EXTRA_PKGS=(python3-scipy python3-numpy)
+  EXTRA_PKGS+=(python3 python3-scipy python3-numpy)
+fi
+# RTHDIST_LINT_DEPS=1: the formatter .ci/run checks with (Debian 12: clang-format 14).
+if [ "${RTHDIST_LINT_DEPS:-0}" = 1 ]; then
+  EXTRA_PKGS+=(clang-format)
 fi
 
 have_all() {
