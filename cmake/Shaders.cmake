@@ -1,6 +1,7 @@
 # Compiles GLSL to SPIR-V at build time and embeds it as a uint32_t array
 # (glslangValidator --vn). Headers land in ${PROJECT_BINARY_DIR}/shaders.
-function(rthdist_add_shader target source)
+# rthdist_add_shader appends the generated header to the variable named by out_list.
+function(rthdist_add_shader out_list source)
   get_filename_component(name ${source} NAME)
   string(REGEX REPLACE "[^A-Za-z0-9]" "_" var "k_spv_${name}")
   set(out ${PROJECT_BINARY_DIR}/shaders/${name}.h)
@@ -13,6 +14,5 @@ function(rthdist_add_shader target source)
     DEPFILE ${out}.d
     COMMENT "glslang ${name}"
     VERBATIM)
-  set_property(TARGET ${target} APPEND PROPERTY RTHDIST_SHADER_HEADERS ${out})
-  target_sources(${target} PRIVATE ${out})
+  set(${out_list} ${${out_list}} ${out} PARENT_SCOPE)
 endfunction()

@@ -1,0 +1,64 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Neighbourhood pass (before any ray): exact NN of each query within the
+// 3x3x3 block of target cells around its own cell. A target outside the block
+// is at least dOut away (distance from q to the block's faces, minus epsilon),
+// so a minimum m <= dOut is the exact NN. A point strictly closer than the
+// running maximum kills the query at once (early break, Taha & Hanbury 2015).
+#include "common.glsl"
+layout(local_size_x = RTHDIST_WG) in;
+layout(push_constant) uniform Push { CullPush pc; };
+
+void main() {
+    uint qi = gl_GlobalInvocationID.x;
+    if (qi >= pc.nq) return;
+    vec4 qv = Vec4Buf(pc.queries).v[qi];
+    vec3 q = qv.xyz;
+    ivec3 c = cellOfUnclamped(q, pc.grid);
+    float s = pc.grid.cellSize;
+    vec3 origin = gridOrigin(pc.grid);
+    vec3 blockLo = origin + vec3(c - 1) * s;
+    vec3 blockHi = origin + vec3(c + 2) * s;
+    vec3 toLo = q - blockLo, toHi = blockHi - q;
+    float dOut = min(min(min(toLo.x, toLo.y), toLo.z), min(min(toHi.x, toHi.y), toHi.z)) - pc.epsilon;
+
+    U64Buf maxPacked = U64Buf(pc.maxPacked);
+    float thr = deadThreshold(maxPacked, pc.lowerBound2);
+    Vec4Buf targets = Vec4Buf(pc.targets);
+    UintBuf dense = UintBuf(pc.dense);
+    int cpa = int(pc.grid.cellsPerAxis);
+    float best = uintBitsToFloat(0x7f800000u);
+    uint bestT = 0;
+    bool dead = false;
+    for (int j = 0; j < 27 && !dead; ++j) {
+        // j = 0 is the query's own cell, then the 26 neighbours.
+        int m = j == 0 ? 13 : (j <= 13 ? j - 1 : j);
+        ivec3 cc = c + ivec3(m % 3, (m / 3) % 3, m / 9) - 1;
+        if (any(lessThan(cc, ivec3(0))) || any(greaterThanEqual(cc, ivec3(cpa)))) continue;
+        uint key = mortonKey(uvec3(cc));
+        uint end = dense.v[key];
+        uint start = key == 0 ? 0u : dense.v[key - 1];
+        for (uint t = start; t < end; ++t) {
+            vec4 tv = targets.v[t];
+            float d2 = dist2(q, tv.xyz);
+            if (d2 < best) {
+                best = d2;
+                bestT = floatBitsToUint(tv.w);
+            }
+        }
+        if (best < thr) dead = true;
+        else if (j == 0) thr = deadThreshold(maxPacked, pc.lowerBound2);
+    }
+    QueryState st;
+    st.best = packDistIndex(best, bestT);
+    st.rLo = max(dOut, 0.0);
+    if (dead) {
+        st.status = RTHDIST_DEAD;
+    } else if (dOut > 0.0 && best <= dOut * dOut) {
+        st.status = RTHDIST_EXACT;
+        atomicMax(maxPacked.v[0], packDistIndex(best, qi));
+    } else {
+        st.status = RTHDIST_OPEN;
+    }
+    StateBuf(pc.state).v[qi] = st;
+}

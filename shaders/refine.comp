@@ -1,0 +1,33 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Stage 3: exact minimum over the points of each candidate (query, cell) pair,
+// breaking off once a point is strictly closer than the running maximum.
+#include "common.glsl"
+layout(local_size_x = RTHDIST_WG) in;
+layout(push_constant) uniform Push { RefinePush pc; };
+
+void main() {
+    uint p = gl_GlobalInvocationID.x;
+    uint numPairs = min(UintBuf(pc.counters).v[1], pc.pairCapacity);
+    if (p >= numPairs) return;
+    uvec2 pair = Uvec2Buf(pc.pairs).v[p];
+    uint qi = UintBuf(pc.activeList).v[pair.x];
+    StateBuf state = StateBuf(pc.state);
+    if (state.v[qi].status == RTHDIST_DEAD) return;
+    vec3 q = Vec4Buf(pc.queries).v[qi].xyz;
+    float thr = deadThreshold(U64Buf(pc.maxPacked), pc.lowerBound2);
+    Cell c = CellBuf(pc.cells).v[pair.y];
+    Vec4Buf targets = Vec4Buf(pc.targets);
+    float best = uintBitsToFloat(0x7f800000u);
+    uint bestT = 0;
+    for (uint t = c.first; t < c.first + c.count; ++t) {
+        vec4 tv = targets.v[t];
+        float d2 = dist2(q, tv.xyz);
+        if (d2 < best) {
+            best = d2;
+            bestT = floatBitsToUint(tv.w);
+            if (best < thr) break;
+        }
+    }
+    atomicMin(state.v[qi].best, packDistIndex(best, bestT));
+}

@@ -1,0 +1,28 @@
+// The exact per-candidate test shared by the ray-query and the ray-tracing
+// pipeline searches, so the two paths cannot diverge. Expects `pc` to be a
+// SearchPush. Returns true when the query is dead (stop its traversal).
+//
+// Invariant (DESIGN §3): every cell whose tight box lies within `radius` of q
+// is reported by the traversal (boxes are grown by radius + epsilon); cells
+// within rLo were scanned in an earlier pass and are skipped; the others
+// become (query, cell) pairs for the exact refinement, unless the cell's
+// representative (a real member point) is already closer than the running
+// maximum, which proves the query cannot raise h.
+bool visitCell(uint slot, uint qi, vec3 q, float rLo, float thr, uint cellIndex) {
+    Cell c = CellBuf(pc.cells).v[cellIndex];
+    float d2 = boxDist2(q, c.lo, c.hi);
+    if (d2 > pc.radius * pc.radius) return false;
+    if (d2 <= rLo * rLo) return false;
+    float r2 = dist2(q, Vec4Buf(pc.targets).v[c.first].xyz);
+    if (r2 < thr) {
+        StateBuf(pc.state).v[qi].status = RTHDIST_DEAD;
+        return true;
+    }
+    uint idx = atomicAdd(UintBuf(pc.counters).v[1], 1u);
+    if (idx < pc.pairCapacity) {
+        Uvec2Buf(pc.pairs).v[idx] = uvec2(slot, cellIndex);
+    } else {
+        StateBuf(pc.state).v[qi].status = RTHDIST_RETRY;
+    }
+    return false;
+}

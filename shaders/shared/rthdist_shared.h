@@ -1,0 +1,172 @@
+// Shared between C++ (src/algo, src/gpu) and GLSL (shaders/): push-constant
+// blocks, record layouts and constants. Every buffer is reached through its
+// device address (GL_EXT_buffer_reference), so shaders need no descriptor sets
+// except the TLAS of the ray-tracing stages (set 0, binding 0).
+#ifndef RTHDIST_SHARED_H
+#define RTHDIST_SHARED_H
+
+#ifdef __cplusplus
+#include <cstdint>
+namespace rthdist::shared {
+using uint = uint32_t;
+struct vec3f { float x, y, z; };
+#define RTHDIST_VEC3 vec3f
+#else
+#define RTHDIST_VEC3 vec3
+#endif
+
+// Workgroup size of every 1-D compute dispatch.
+#define RTHDIST_WG 128
+// Elements per scan block (one workgroup of RTHDIST_SCAN_WG threads, 2 each).
+#define RTHDIST_SCAN_WG 256
+#define RTHDIST_SCAN_BLOCK 512
+
+// Query status values.
+#define RTHDIST_OPEN 0u
+#define RTHDIST_EXACT 1u
+#define RTHDIST_DEAD 2u
+#define RTHDIST_RETRY 3u  // pairs were dropped (buffer full): redo at the same radius
+
+// One occupied cell: [first, first+count) in the cell-sorted points; lo/hi is
+// the tight box of its points. points[first] is the cell's representative.
+struct Cell {
+    RTHDIST_VEC3 lo;
+    uint first;
+    RTHDIST_VEC3 hi;
+    uint count;
+};
+
+// Grid of one index: origin and inverse cell size are rounded from the host's
+// double values; bounds used for exactness carry an epsilon (see shaders).
+struct GridParams {
+    float originX, originY, originZ;
+    float cellSize;
+    float invCellSize;
+    uint bits;
+    uint cellsPerAxis;
+    uint pad0;
+};
+
+// cell_keys.comp: key per point, histogram into the dense table.
+struct KeysPush {
+    uint64_t points;   // vec4[n] input (xyz, w unused)
+    uint64_t keys;     // uint[n] out
+    uint64_t dense;    // uint[2^(3 bits)] histogram (zeroed)
+    GridParams grid;
+    uint n;
+};
+
+// scan_block.comp / scan_add.comp: exclusive scan of uint[n] in place.
+struct ScanPush {
+    uint64_t data;
+    uint64_t blockSums;
+    uint n;
+};
+
+// scatter.comp: counting-sort scatter; dense[key] ends as the cell's end.
+struct ScatterPush {
+    uint64_t points;     // vec4[n] input
+    uint64_t keys;       // uint[n]
+    uint64_t dense;      // uint[] starts in, ends out
+    uint64_t sorted;     // vec4[n] out: xyz, w = original index (float bits)
+    uint64_t sortedKeys; // uint[n] out
+    uint n;
+};
+
+// cell_heads.comp writes flags (1 where a cell starts); after a scan
+// cell_build.comp writes one Cell per head.
+struct CellsPush {
+    uint64_t sorted;
+    uint64_t sortedKeys;
+    uint64_t flags;    // uint[n]: head flags, scanned in place between passes
+    uint64_t dense;    // cell ends by key
+    uint64_t cells;    // Cell[] out
+    uint64_t numCells; // uint[1] out
+    uint n;
+};
+
+// Per-query search state (one per query of a direction).
+struct QueryState {
+    uint64_t best;  // (bits of squared distance << 32) | target original index
+    float rLo;      // every target point within rLo of the query has been scanned
+    uint status;    // RTHDIST_OPEN / EXACT / DEAD / RETRY
+};
+
+// cull.comp: exact NN within the 3x3x3 block of cells around each query.
+struct CullPush {
+    uint64_t queries;   // vec4[nq] sorted queries (w = original index bits)
+    uint64_t targets;   // vec4[nt] cell-sorted targets
+    uint64_t dense;     // target cell ends by key
+    uint64_t state;     // QueryState[nq]
+    uint64_t maxPacked; // uint64[1]: (bits of d^2 << 32) | query original index
+    GridParams grid;
+    uint nq;
+    float lowerBound2;  // squared lower bound of h without witness
+    float epsilon;      // absolute slack for cell-geometry bounds (object units)
+};
+
+// compact.comp: appends OPEN queries whose best is not below the threshold.
+struct CompactPush {
+    uint64_t state;
+    uint64_t activeList;     // uint[] out: query slots
+    uint64_t counters;   // uint[4]: [0] active count
+    uint64_t maxPacked;
+    uint nq;
+    float lowerBound2;
+};
+
+// grow_boxes.comp: AABB per cell = tight box grown by radius (+ epsilon).
+struct BoxesPush {
+    uint64_t cells;
+    uint64_t aabbs;  // VkAabbPositionsKHR[numCells]
+    uint numCells;
+    float grow;
+};
+
+// search (ray query compute or raygen+intersection): candidate cells.
+struct SearchPush {
+    uint64_t queries;
+    uint64_t targets;
+    uint64_t cells;
+    uint64_t state;
+    uint64_t activeList;     // uint[numActive]
+    uint64_t pairs;      // uvec2[capacity]: (active slot, cell)
+    uint64_t counters;   // [0] active count, [1] pair count
+    uint64_t maxPacked;
+    uint numActive;
+    uint pairCapacity;
+    float radius;        // R: cells with box distance <= R are candidates
+    float lowerBound2;
+    float rayTMax;
+};
+
+// refine.comp: exact scan of the candidate pairs' cells.
+struct RefinePush {
+    uint64_t queries;
+    uint64_t targets;
+    uint64_t cells;
+    uint64_t state;
+    uint64_t activeList;
+    uint64_t pairs;
+    uint64_t counters;
+    uint64_t maxPacked;
+    uint pairCapacity;
+    float lowerBound2;
+};
+
+// resolve.comp: classifies active queries after an iteration, compacts the rest.
+struct ResolvePush {
+    uint64_t state;
+    uint64_t activeList;     // in
+    uint64_t nextActive; // out
+    uint64_t counters;   // [0] active count in, [2] next active count out
+    uint64_t maxPacked;
+    uint numActive;
+    float radius;
+    float lowerBound2;
+};
+
+#ifdef __cplusplus
+}  // namespace rthdist::shared
+#endif
+#endif

@@ -1,0 +1,140 @@
+// Public entry of rthdist: input validation, backend choice, and the Engine
+// that keeps a Vulkan device and its pipelines between calls.
+#include "rthdist/rthdist.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "algo/index_space.hpp"
+#include <string>
+
+#include "algo/gpu_hausdorff.hpp"
+#include "cpu/cpu_hausdorff.hpp"
+#include "gpu/context.hpp"
+
+namespace rthdist {
+
+const char* versionString() { return RTHDIST_VERSION; }
+
+const char* backendName(Backend backend) {
+    switch (backend) {
+        case Backend::kAuto: return "auto";
+        case Backend::kRayQuery: return "ray-query";
+        case Backend::kRtPipeline: return "rt-pipeline";
+        case Backend::kCpu: return "cpu";
+    }
+    return "?";
+}
+
+bool parseBackend(const std::string& text, Backend& out) {
+    for (Backend b : {Backend::kAuto, Backend::kRayQuery, Backend::kRtPipeline, Backend::kCpu}) {
+        if (text == backendName(b)) {
+            out = b;
+            return true;
+        }
+    }
+    return false;
+}
+
+namespace {
+
+std::optional<Error> validateSet(std::span<const glm::vec3> points, const char* name) {
+    if (points.empty()) {
+        return Error{ErrorCode::kInvalidArgument,
+                     std::string("point set ") + name + " is empty: the Hausdorff distance is undefined"};
+    }
+    if (points.size() > 0x7fffffffu) {
+        return Error{ErrorCode::kInvalidArgument,
+                     std::string("point set ") + name + " has more than 2^31-1 points"};
+    }
+    for (size_t i = 0; i < points.size(); ++i) {
+        const glm::vec3& p = points[i];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+            return Error{ErrorCode::kInvalidArgument, std::string("point set ") + name + ": point " +
+                                                          std::to_string(i) + " has a NaN or infinite coordinate"};
+        }
+    }
+    return std::nullopt;
+}
+
+std::optional<Error> validateOptions(const Options& o) {
+    if (o.bits < 0 || o.bits > algo::kMaxBits) {
+        return Error{ErrorCode::kInvalidArgument,
+                     "bits must be 0 (auto) or 1.." + std::to_string(algo::kMaxBits)};
+    }
+    if (!(o.radiusGrowth > 1.0f) || !std::isfinite(o.radiusGrowth)) {
+        return Error{ErrorCode::kInvalidArgument, "radiusGrowth must be a finite number > 1"};
+    }
+    if (o.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
+    return std::nullopt;
+}
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+struct Engine::Impl {
+    Options options;
+    std::unique_ptr<gpu::Context> context;       // null for the CPU backend
+    std::unique_ptr<algo::GpuHausdorff> gpu;     // null for the CPU backend
+    Backend backend = Backend::kCpu;
+    std::string deviceName = "cpu";
+    double setupMs = 0.0;
+};
+
+Engine::Engine(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
+Engine::Engine(Engine&&) noexcept = default;
+Engine& Engine::operator=(Engine&&) noexcept = default;
+Engine::~Engine() = default;
+
+Result<Engine> Engine::create(const Options& options) {
+    if (auto err = validateOptions(options)) return *err;
+    auto t0 = std::chrono::steady_clock::now();
+    auto impl = std::make_unique<Impl>();
+    impl->options = options;
+    if (options.backend == Backend::kCpu) {
+        impl->backend = Backend::kCpu;
+        return Engine(std::move(impl));
+    }
+    auto ctx = gpu::Context::create(options.backend, options.deviceIndex, options.validation);
+    if (!ctx) return ctx.error();
+    impl->context = std::move(ctx.value());
+    auto g = algo::GpuHausdorff::create(*impl->context);
+    if (!g) return g.error();
+    impl->gpu = std::move(g.value());
+    impl->backend = impl->context->backend();
+    impl->deviceName = impl->context->deviceName();
+    impl->setupMs = msSince(t0);
+    return Engine(std::move(impl));
+}
+
+const std::string& Engine::deviceName() const { return m_impl->deviceName; }
+Backend Engine::backend() const { return m_impl->backend; }
+
+Result<HausdorffResult> Engine::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
+    if (auto err = validateSet(a, "A")) return *err;
+    if (auto err = validateSet(b, "B")) return *err;
+    auto t0 = std::chrono::steady_clock::now();
+    Result<HausdorffResult> r = m_impl->gpu ? m_impl->gpu->compute(a, b, m_impl->options)
+                                            : cpu::cpuHausdorff(a, b, m_impl->options);
+    if (!r) return r;
+    r->timings.setup = m_impl->setupMs;
+    m_impl->setupMs = 0.0;  // only the first call pays for creation
+    r->timings.total = msSince(t0);
+    if (m_impl->context) r->validationMessages = m_impl->context->validationMessageCount();
+    return r;
+}
+
+Result<HausdorffResult> hausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                  const Options& options) {
+    if (auto err = validateSet(a, "A")) return *err;
+    if (auto err = validateSet(b, "B")) return *err;
+    auto engine = Engine::create(options);
+    if (!engine) return engine.error();
+    return engine->compute(a, b);
+}
+
+}  // namespace rthdist

@@ -1,0 +1,347 @@
+#include "algo/gpu_hausdorff.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <stdexcept>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <new>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "algo/index_space.hpp"
+#include "gpu/accel.hpp"
+#include "gpu/buffer.hpp"
+#include "gpu/context.hpp"
+#include "gpu/pipelines.hpp"
+#include "rthdist_shared.h"
+
+namespace rthdist::algo {
+
+using gpu::Buffer;
+using gpu::Kernel;
+using gpu::MemoryKind;
+namespace sh = rthdist::shared;
+
+static_assert(sizeof(sh::Cell) == 32 && offsetof(sh::Cell, hi) == 16 && offsetof(sh::Cell, count) == 28);
+static_assert(sizeof(sh::QueryState) == 16 && offsetof(sh::QueryState, rLo) == 8);
+static_assert(sizeof(sh::GridParams) == 32);
+static_assert(sizeof(sh::SearchPush) <= 128 && sizeof(sh::CullPush) <= 128 && sizeof(sh::RefinePush) <= 128);
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+constexpr uint64_t kMaxPairCapacity = uint64_t(1) << 26;  // 512 MiB of pairs at most
+constexpr uint32_t kMaxIterations = 4096;
+
+// A point set sorted into the cells of its own grid.
+struct PointIndex {
+    uint32_t n = 0;
+    GridSpec grid;
+    Bounds bounds;
+    Buffer sorted;      // vec4: xyz, w = original index bits (cell order)
+    Buffer dense;       // uint per key: end of the key's cell
+    Buffer cells;       // Cell per occupied cell
+    uint32_t numCells = 0;
+};
+
+sh::GridParams gridParams(const GridSpec& g) {
+    sh::GridParams p{};
+    p.originX = float(g.origin.x);
+    p.originY = float(g.origin.y);
+    p.originZ = float(g.origin.z);
+    p.cellSize = float(g.cellSize);
+    p.invCellSize = float(1.0 / g.cellSize);
+    p.bits = uint32_t(g.bits);
+    p.cellsPerAxis = g.cellsPerAxis;
+    return p;
+}
+
+}  // namespace
+
+struct GpuHausdorff::State {
+    gpu::Context& ctx;
+    gpu::Pipelines pipelines;
+    gpu::AccelStructures accel;
+    bool rayQuery;
+    bool tlasBound = false;
+    Buffer hostSmall;  // counters (uint[4]) at 0, maxPacked (uint64) at 16, read-backs after 32
+    Timings* timings = nullptr;
+
+    State(gpu::Context& c)
+        : ctx(c), pipelines(c, c.backend() == Backend::kRayQuery), accel(c),
+          rayQuery(c.backend() == Backend::kRayQuery) {
+        hostSmall = Buffer(ctx, 256, gpu::kStorageUsage, MemoryKind::kHost);
+    }
+
+    uint32_t* counters() { return static_cast<uint32_t*>(hostSmall.mapped()); }
+    uint64_t* maxPacked() { return reinterpret_cast<uint64_t*>(static_cast<char*>(hostSmall.mapped()) + 16); }
+    VkDeviceAddress countersAddr() const { return hostSmall.address(); }
+    VkDeviceAddress maxPackedAddr() const { return hostSmall.address() + 16; }
+    char* readback() { return static_cast<char*>(hostSmall.mapped()) + 32; }
+
+    void barrier(VkCommandBuffer cmd) { gpu::cmdShaderBarrier(cmd, pipelines.shaderStages()); }
+
+    template <class Push>
+    void dispatch(VkCommandBuffer cmd, Kernel k, const Push& push, uint64_t items, uint32_t groupSize = RTHDIST_WG) {
+        pipelines.cmdDispatch(cmd, k, &push, sizeof(Push), gpu::groupsFor(items, groupSize));
+    }
+
+    // Exclusive scan of uint[n] at `data`, recursively over block sums.
+    void cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, std::vector<Buffer>& scratch, size_t level) {
+        const uint32_t blocks = gpu::groupsFor(n, RTHDIST_SCAN_BLOCK);
+        if (scratch.size() <= level)
+            scratch.emplace_back(ctx, VkDeviceSize(blocks) * 4, gpu::kStorageUsage, MemoryKind::kDevice);
+        sh::ScanPush p{data, scratch[level].address(), n};
+        pipelines.cmdDispatch(cmd, Kernel::kScanBlock, &p, sizeof(p), blocks);
+        if (blocks > 1) {
+            barrier(cmd);
+            cmdScan(cmd, scratch[level].address(), blocks, scratch, level + 1);
+            barrier(cmd);
+            pipelines.cmdDispatch(cmd, Kernel::kScanAdd, &p, sizeof(p), blocks);
+        }
+    }
+
+    PointIndex buildIndex(std::span<const glm::vec3> pts, int bits) {
+        PointIndex ix;
+        ix.n = uint32_t(pts.size());
+        ix.bounds = boundsOf(pts);
+        ix.grid = makeGrid(ix.bounds, bits > 0 ? bits : chooseBits(pts, ix.bounds));
+
+        auto t0 = Clock::now();
+        const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
+        Buffer staging(ctx, bytes, gpu::kStorageUsage, MemoryKind::kHost);
+        auto* dst = static_cast<float*>(staging.mapped());
+        for (uint32_t i = 0; i < ix.n; ++i) {
+            dst[4 * i + 0] = pts[i].x;
+            dst[4 * i + 1] = pts[i].y;
+            dst[4 * i + 2] = pts[i].z;
+            dst[4 * i + 3] = 0.0f;
+        }
+        Buffer points(ctx, bytes, gpu::kStorageUsage, MemoryKind::kDevice);
+        VkCommandBuffer cmd = ctx.begin();
+        VkBufferCopy region{0, 0, bytes};
+        vkCmdCopyBuffer(cmd, staging.handle(), points.handle(), 1, &region);
+        ctx.submitAndWait(cmd);
+        timings->upload += msSince(t0);
+
+        t0 = Clock::now();
+        const uint32_t numKeys = 1u << (3 * ix.grid.bits);
+        Buffer keys(ctx, VkDeviceSize(ix.n) * 4, gpu::kStorageUsage, MemoryKind::kDevice);
+        Buffer sortedKeys(ctx, VkDeviceSize(ix.n) * 4, gpu::kStorageUsage, MemoryKind::kDevice);
+        Buffer flags(ctx, VkDeviceSize(ix.n) * 4, gpu::kStorageUsage, MemoryKind::kDevice);
+        ix.dense = Buffer(ctx, VkDeviceSize(numKeys) * 4, gpu::kStorageUsage, MemoryKind::kDevice);
+        ix.sorted = Buffer(ctx, bytes, gpu::kStorageUsage, MemoryKind::kDevice);
+        // Cells: at most one per point; sized exactly after the count is known
+        // would need another pass, so allocate the upper bound.
+        ix.cells = Buffer(ctx, VkDeviceSize(std::min<uint64_t>(ix.n, numKeys)) * sizeof(sh::Cell), gpu::kStorageUsage,
+                          MemoryKind::kDevice);
+        std::vector<Buffer> scanScratch;
+
+        cmd = ctx.begin();
+        vkCmdFillBuffer(cmd, ix.dense.handle(), 0, VK_WHOLE_SIZE, 0);
+        barrier(cmd);
+        sh::KeysPush kp{points.address(), keys.address(), ix.dense.address(), gridParams(ix.grid), ix.n};
+        dispatch(cmd, Kernel::kCellKeys, kp, ix.n);
+        barrier(cmd);
+        cmdScan(cmd, ix.dense.address(), numKeys, scanScratch, 0);
+        barrier(cmd);
+        sh::ScatterPush sp{points.address(), keys.address(), ix.dense.address(), ix.sorted.address(),
+                           sortedKeys.address(), ix.n};
+        dispatch(cmd, Kernel::kScatter, sp, ix.n);
+        barrier(cmd);
+        sh::CellsPush cp{ix.sorted.address(), sortedKeys.address(), flags.address(), ix.dense.address(),
+                         ix.cells.address(), countersAddr() + 12, ix.n};
+        dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
+        barrier(cmd);
+        cmdScan(cmd, flags.address(), ix.n, scanScratch, 0);
+        barrier(cmd);
+        dispatch(cmd, Kernel::kCellBuild, cp, ix.n);
+        ctx.submitAndWait(cmd);
+        ix.numCells = counters()[3];
+        timings->index += msSince(t0);
+        return ix;
+    }
+
+    // h(Q, T): Q's points in Q's cell order are the queries.
+    Directed direction(const PointIndex& Q, const PointIndex& T, std::span<const glm::vec3> qPts,
+                       std::span<const glm::vec3> tPts, const Options& options) {
+        Directed out;
+        Counters& cnt = out.counters;
+        cnt.bits = uint32_t(T.grid.bits);
+        cnt.occupiedCells = T.numCells;
+        cnt.queries = Q.n;
+
+        // Witness-less lower bound: the farthest query from BV(T), shrunk a
+        // little so float rounding never kills the query that realizes h.
+        double lb = 0.0;
+        for (const glm::vec3& q : qPts) {
+            glm::dvec3 d = glm::max(glm::max(T.bounds.lo - glm::dvec3(q), glm::dvec3(q) - T.bounds.hi), glm::dvec3(0.0));
+            lb = std::max(lb, d.x * d.x + d.y * d.y + d.z * d.z);
+        }
+        const float lowerBound2 = float(lb * (1.0 - 1e-5));
+        double maxAbs = 0.0;
+        for (const Bounds* b : {&Q.bounds, &T.bounds})
+            maxAbs = std::max({maxAbs, std::abs(b->lo.x), std::abs(b->lo.y), std::abs(b->lo.z), std::abs(b->hi.x),
+                               std::abs(b->hi.y), std::abs(b->hi.z)});
+        const float epsilon = float(maxAbs * 4e-7 + T.grid.cellSize * 1e-5);
+
+        auto t0 = Clock::now();
+        Buffer state(ctx, VkDeviceSize(Q.n) * sizeof(sh::QueryState), gpu::kStorageUsage, MemoryKind::kDevice);
+        Buffer active[2] = {Buffer(ctx, VkDeviceSize(Q.n) * 4, gpu::kStorageUsage, MemoryKind::kDevice),
+                            Buffer(ctx, VkDeviceSize(Q.n) * 4, gpu::kStorageUsage, MemoryKind::kDevice)};
+        std::memset(hostSmall.mapped(), 0, 32);
+        VkCommandBuffer cmd = ctx.begin();
+        sh::CullPush cull{Q.sorted.address(), T.sorted.address(), T.dense.address(), state.address(), maxPackedAddr(),
+                          gridParams(T.grid), Q.n, lowerBound2, epsilon};
+        dispatch(cmd, Kernel::kCull, cull, Q.n);
+        barrier(cmd);
+        sh::CompactPush comp{state.address(), active[0].address(), countersAddr(), maxPackedAddr(), Q.n, lowerBound2};
+        dispatch(cmd, Kernel::kCompact, comp, Q.n);
+        ctx.submitAndWait(cmd);
+        uint32_t numActive = counters()[0];
+        cnt.survivingQueries = numActive;
+        cnt.culledByNeighbourhood = Q.n - numActive;
+        timings->cull += msSince(t0);
+
+        auto threshold = [&] {
+            return std::max(double(lowerBound2), double(std::bit_cast<float>(uint32_t(*maxPacked() >> 32))));
+        };
+        double radius = std::max(std::sqrt(threshold()), 2.0 * T.grid.cellSize);
+        uint64_t pairCapacity = std::clamp<uint64_t>(uint64_t(T.numCells) * 4, 1u << 16, 1u << 22);
+        Buffer pairs;
+        const float rayTMax = float(T.grid.cellSize * 1e-3);
+        int cur = 0;
+        bool firstBuild = true;
+        Buffer aabbs(ctx, VkDeviceSize(T.numCells) * 24,
+                     gpu::kStorageUsage | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
+                     MemoryKind::kDevice);
+        while (numActive > 0) {
+            if (++cnt.iterations > kMaxIterations) throw std::runtime_error("candidate search did not converge");
+            if (!pairs) pairs = Buffer(ctx, pairCapacity * 8, gpu::kStorageUsage, MemoryKind::kDevice);
+            const float r = float(radius);
+            const float grow = r + epsilon + r * 1e-6f;
+
+            t0 = Clock::now();
+            counters()[1] = 0;
+            counters()[2] = 0;
+            cmd = ctx.begin();
+            sh::BoxesPush bp{T.cells.address(), aabbs.address(), T.numCells, grow};
+            dispatch(cmd, Kernel::kGrowBoxes, bp, T.numCells);
+            gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                            VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_SHADER_READ_BIT);
+            if (accel.cmdBuild(cmd, aabbs.address(), T.numCells, !firstBuild, pipelines.shaderStages()) || !tlasBound) {
+                pipelines.bindTlas(accel.tlas());
+                tlasBound = true;
+            }
+            firstBuild = false;
+            sh::SearchPush sp{Q.sorted.address(), T.sorted.address(), T.cells.address(), state.address(),
+                              active[cur].address(), pairs.address(), countersAddr(), maxPackedAddr(), numActive,
+                              uint32_t(pairCapacity), r, lowerBound2, rayTMax};
+            if (rayQuery) dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
+            else pipelines.cmdTraceRays(cmd, &sp, sizeof(sp), numActive);
+            ctx.submitAndWait(cmd);
+            const uint32_t pairCount = counters()[1];
+            cnt.rays += numActive;
+            timings->search += msSince(t0);
+
+            t0 = Clock::now();
+            const uint32_t used = uint32_t(std::min<uint64_t>(pairCount, pairCapacity));
+            cnt.candidatePairs += used;
+            cmd = ctx.begin();
+            sh::RefinePush rp{Q.sorted.address(), T.sorted.address(), T.cells.address(), state.address(),
+                              active[cur].address(), pairs.address(), countersAddr(), maxPackedAddr(),
+                              uint32_t(pairCapacity), lowerBound2};
+            dispatch(cmd, Kernel::kRefine, rp, used);
+            barrier(cmd);
+            sh::ResolvePush rs{state.address(), active[cur].address(), active[1 - cur].address(), countersAddr(),
+                               maxPackedAddr(), numActive, r, lowerBound2};
+            dispatch(cmd, Kernel::kResolve, rs, numActive);
+            ctx.submitAndWait(cmd);
+            numActive = counters()[2];
+            cur = 1 - cur;
+            timings->refine += msSince(t0);
+
+            if (pairCount > pairCapacity && pairCapacity < kMaxPairCapacity) {
+                // Some queries lost pairs: redo them at the same radius with room.
+                pairCapacity = std::min<uint64_t>(kMaxPairCapacity, std::max<uint64_t>(pairCount, pairCapacity * 2));
+                pairs.reset();
+            } else if (pairCount <= pairCapacity) {
+                radius = std::max(radius * double(options.radiusGrowth), std::sqrt(threshold()));
+            }
+        }
+
+        // Witness: the query slot in the low half of maxPacked; its target
+        // from the query's state.
+        const uint64_t packed = *maxPacked();
+        const uint32_t slot = uint32_t(packed & 0xffffffffu);
+        cmd = ctx.begin();
+        VkBufferCopy c1{VkDeviceSize(slot) * 16, 32, 16};
+        vkCmdCopyBuffer(cmd, Q.sorted.handle(), hostSmall.handle(), 1, &c1);
+        VkBufferCopy c2{VkDeviceSize(slot) * sizeof(sh::QueryState), 48, sizeof(sh::QueryState)};
+        vkCmdCopyBuffer(cmd, state.handle(), hostSmall.handle(), 1, &c2);
+        ctx.submitAndWait(cmd);
+        float qv[4];
+        std::memcpy(qv, readback(), 16);
+        sh::QueryState st;
+        std::memcpy(&st, readback() + 16, sizeof(st));
+        out.queryIndex = std::bit_cast<uint32_t>(qv[3]);
+        out.targetIndex = uint32_t(st.best & 0xffffffffu);
+        if (out.queryIndex >= qPts.size() || out.targetIndex >= tPts.size())
+            throw std::runtime_error("GPU witness out of range");
+        out.queryPoint = qPts[out.queryIndex];
+        out.targetPoint = tPts[out.targetIndex];
+        out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
+        return out;
+    }
+};
+
+GpuHausdorff::GpuHausdorff(std::unique_ptr<State> state) : m_state(std::move(state)) {}
+GpuHausdorff::~GpuHausdorff() = default;
+
+Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx) {
+    try {
+        return std::unique_ptr<GpuHausdorff>(new GpuHausdorff(std::make_unique<State>(ctx)));
+    } catch (const gpu::VulkanError& e) {
+        return Error{ErrorCode::kInternal, std::string("pipeline creation failed: ") + e.what()};
+    }
+}
+
+Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                              const Options& options) {
+    HausdorffResult res;
+    res.backend = m_state->ctx.backend();
+    res.device = m_state->ctx.deviceName();
+    res.directedOnly = options.directedOnly;
+    m_state->timings = &res.timings;
+    try {
+        // Each set is indexed once with its own grid: as targets for the other
+        // direction, and as cell-ordered (Morton) queries for its own.
+        PointIndex ia = m_state->buildIndex(a, options.bits);
+        PointIndex ib = m_state->buildIndex(b, options.bits);
+        res.aToB = m_state->direction(ia, ib, a, b, options);
+        res.hausdorff = res.aToB.distance;
+        if (!options.directedOnly) {
+            res.bToA = m_state->direction(ib, ia, b, a, options);
+            res.hausdorff = std::max(res.hausdorff, res.bToA.distance);
+        }
+    } catch (const gpu::VulkanError& e) {
+        m_state->accel.release();
+        m_state->tlasBound = false;
+        if (e.result() == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result() == VK_ERROR_OUT_OF_HOST_MEMORY)
+            return Error{ErrorCode::kOutOfMemory, std::string("the inputs do not fit the device: ") + e.what()};
+        return Error{ErrorCode::kInternal, e.what()};
+    } catch (const std::exception& e) {
+        m_state->accel.release();
+        m_state->tlasBound = false;
+        return Error{ErrorCode::kInternal, e.what()};
+    }
+    m_state->timings = nullptr;
+    return res;
+}
+
+}  // namespace rthdist::algo

@@ -1,0 +1,56 @@
+// Move-only owner of a VkBuffer with its own memory and device address.
+// Device buffers live in DEVICE_LOCAL memory; host buffers are HOST_VISIBLE |
+// HOST_COHERENT and stay mapped (staging and small read-backs).
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+
+namespace rthdist::gpu {
+
+class Context;
+
+enum class MemoryKind { kDevice, kHost };
+
+class Buffer {
+public:
+    Buffer() = default;
+    // size 0 allocates a 16-byte buffer so every buffer has an address.
+    Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind);
+    Buffer(Buffer&& o) noexcept { *this = static_cast<Buffer&&>(o); }
+    Buffer& operator=(Buffer&& o) noexcept;
+    Buffer(const Buffer&) = delete;
+    Buffer& operator=(const Buffer&) = delete;
+    ~Buffer() { reset(); }
+
+    void reset();
+    [[nodiscard]] VkBuffer handle() const { return m_buffer; }
+    [[nodiscard]] VkDeviceAddress address() const { return m_address; }
+    [[nodiscard]] VkDeviceSize size() const { return m_size; }
+    [[nodiscard]] void* mapped() const { return m_mapped; }
+    [[nodiscard]] explicit operator bool() const { return m_buffer != VK_NULL_HANDLE; }
+
+private:
+    VkDevice m_device = VK_NULL_HANDLE;
+    VkBuffer m_buffer = VK_NULL_HANDLE;
+    VkDeviceMemory m_memory = VK_NULL_HANDLE;
+    VkDeviceAddress m_address = 0;
+    VkDeviceSize m_size = 0;
+    void* m_mapped = nullptr;
+};
+
+// Usage flags every storage buffer of rthdist gets.
+inline constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                                    VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
+                                                    VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+
+// Global memory barrier between two groups of pipeline stages.
+void cmdBarrier(VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags srcAccess,
+                VkPipelineStageFlags dst, VkAccessFlags dstAccess);
+// Shader and transfer writes -> shader and transfer reads/writes, over the
+// given shader stages (compute, plus ray tracing where the device has it).
+void cmdShaderBarrier(VkCommandBuffer cmd, VkPipelineStageFlags shaderStages);
+
+}  // namespace rthdist::gpu

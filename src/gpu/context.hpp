@@ -1,0 +1,82 @@
+// Vulkan instance, device selection and the single compute queue of an Engine.
+// Device selection is headless, declares its requirements as data and records
+// why every rejected device was rejected (vk-bootstrap's habit).
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gpu/vk_check.hpp"
+#include "rthdist/rthdist.hpp"
+
+namespace rthdist::gpu {
+
+// Device-level entry points of the ray-tracing extensions: Debian 12's loader
+// (1.3.239) does not export them, so they are fetched with vkGetDeviceProcAddr.
+struct RtFunctions {
+    PFN_vkGetAccelerationStructureBuildSizesKHR getBuildSizes = nullptr;
+    PFN_vkCreateAccelerationStructureKHR createAccel = nullptr;
+    PFN_vkDestroyAccelerationStructureKHR destroyAccel = nullptr;
+    PFN_vkCmdBuildAccelerationStructuresKHR cmdBuildAccel = nullptr;
+    PFN_vkGetAccelerationStructureDeviceAddressKHR getAccelAddress = nullptr;
+    PFN_vkCreateRayTracingPipelinesKHR createRtPipelines = nullptr;
+    PFN_vkGetRayTracingShaderGroupHandlesKHR getGroupHandles = nullptr;
+    PFN_vkCmdTraceRaysKHR cmdTraceRays = nullptr;
+};
+
+class Context {
+public:
+    // backend: kAuto, kRayQuery or kRtPipeline. deviceIndex -1 = first usable.
+    [[nodiscard]] static Result<std::unique_ptr<Context>> create(Backend backend, int deviceIndex,
+                                                                 bool validation);
+    ~Context();
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+    [[nodiscard]] VkDevice device() const { return m_device; }
+    [[nodiscard]] VkPhysicalDevice physicalDevice() const { return m_physical; }
+    [[nodiscard]] VkQueue queue() const { return m_queue; }
+    [[nodiscard]] Backend backend() const { return m_backend; }
+    [[nodiscard]] const std::string& deviceName() const { return m_name; }
+    [[nodiscard]] const RtFunctions& rt() const { return m_rt; }
+    [[nodiscard]] const VkPhysicalDeviceRayTracingPipelinePropertiesKHR& rtProps() const { return m_rtProps; }
+    [[nodiscard]] const VkPhysicalDeviceAccelerationStructurePropertiesKHR& asProps() const { return m_asProps; }
+    [[nodiscard]] uint64_t validationMessageCount() const { return m_validationMessages.load(); }
+    [[nodiscard]] uint32_t memoryTypeIndex(uint32_t typeBits, VkMemoryPropertyFlags wanted) const;
+    [[nodiscard]] float timestampPeriodNs() const { return m_timestampPeriod; }
+
+    // One-shot command buffers: begin() returns a recording buffer;
+    // submitAndWait() submits it and blocks until the queue has executed it.
+    [[nodiscard]] VkCommandBuffer begin();
+    void submitAndWait(VkCommandBuffer cmd);
+
+    void countValidationMessage() { ++m_validationMessages; }
+
+private:
+    Context() = default;
+
+    VkInstance m_instance = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT m_messenger = VK_NULL_HANDLE;
+    VkPhysicalDevice m_physical = VK_NULL_HANDLE;
+    VkDevice m_device = VK_NULL_HANDLE;
+    VkQueue m_queue = VK_NULL_HANDLE;
+    uint32_t m_queueFamily = 0;
+    VkCommandPool m_pool = VK_NULL_HANDLE;
+    VkCommandBuffer m_cmd = VK_NULL_HANDLE;
+    VkFence m_fence = VK_NULL_HANDLE;
+    Backend m_backend = Backend::kRayQuery;
+    std::string m_name;
+    RtFunctions m_rt;
+    VkPhysicalDeviceRayTracingPipelinePropertiesKHR m_rtProps{};
+    VkPhysicalDeviceAccelerationStructurePropertiesKHR m_asProps{};
+    VkPhysicalDeviceMemoryProperties m_memProps{};
+    float m_timestampPeriod = 1.0f;
+    std::atomic<uint64_t> m_validationMessages{0};
+};
+
+}  // namespace rthdist::gpu
