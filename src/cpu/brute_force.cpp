@@ -13,13 +13,26 @@ struct Nearest {
     uint32_t targetIndex;
 };
 
-Nearest nearestOf(const glm::vec3& q, std::span<const glm::vec3> targets) {
+// Targets widened to double once, in SoA form (a plain copy, nothing clever).
+struct Targets {
+    std::vector<double> x, y, z;
+    explicit Targets(std::span<const glm::vec3> t) : x(t.size()), y(t.size()), z(t.size()) {
+        for (size_t j = 0; j < t.size(); ++j) {
+            x[j] = t[j].x;
+            y[j] = t[j].y;
+            z[j] = t[j].z;
+        }
+    }
+};
+
+Nearest nearestOf(const glm::vec3& q, const Targets& t) {
     const double qx = q.x, qy = q.y, qz = q.z;
+    const size_t n = t.x.size();
     Nearest best{std::numeric_limits<double>::infinity(), 0};
-    for (size_t j = 0; j < targets.size(); ++j) {
-        const double dx = qx - double(targets[j].x);
-        const double dy = qy - double(targets[j].y);
-        const double dz = qz - double(targets[j].z);
+    for (size_t j = 0; j < n; ++j) {
+        const double dx = qx - t.x[j];
+        const double dy = qy - t.y[j];
+        const double dz = qz - t.z[j];
         const double d2 = dx * dx + dy * dy + dz * dz;
         if (d2 < best.distanceSquared) best = {d2, uint32_t(j)};  // strict: first index wins
     }
@@ -40,11 +53,12 @@ DirectedExact bruteForceDirected(std::span<const glm::vec3> queries,
         uint32_t query = 0;
         uint32_t target = 0;
     };
+    const Targets soa(targets);
     std::vector<Best> perThread(static_cast<size_t>(workers));
     parallelChunks(queries.size(), kChunk, workers, [&](size_t begin, size_t end, int t) {
         Best& best = perThread[size_t(t)];
         for (size_t i = begin; i < end; ++i) {
-            const Nearest n = nearestOf(queries[i], targets);
+            const Nearest n = nearestOf(queries[i], soa);
             if (n.distanceSquared > best.d2 ||
                 (n.distanceSquared == best.d2 && uint32_t(i) < best.query)) {
                 best = {n.distanceSquared, uint32_t(i), n.targetIndex};
@@ -65,9 +79,10 @@ std::vector<double> bruteForceNearest(std::span<const glm::vec3> queries,
                                       std::span<const glm::vec3> targets, int threads) {
     std::vector<double> out(queries.size(), std::numeric_limits<double>::infinity());
     if (targets.empty()) return out;
+    const Targets soa(targets);
     parallelChunks(queries.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
-            out[i] = std::sqrt(nearestOf(queries[i], targets).distanceSquared);
+            out[i] = std::sqrt(nearestOf(queries[i], soa).distanceSquared);
         }
     });
     return out;
