@@ -48,7 +48,7 @@ constexpr float kPruneSlack = 1e-5f;
 // The witness-less box bound is lowered by this relative amount before use.
 constexpr double kBoundShrink = 1e-5;
 constexpr size_t kQueryChunk = 256;
-constexpr size_t kSampleSize = 1024;
+constexpr size_t kSampleSize = 256;
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point start) {
@@ -225,15 +225,17 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
     radixSortKeys(keyed, 3 * g.bits);
     std::vector<float> qx(nq), qy(nq), qz(nq);
     std::vector<uint32_t> qOriginal(nq), qKey(nq);
-    for (size_t i = 0; i < nq; ++i) {
-        const uint32_t src = uint32_t(keyed[i]);
-        const glm::vec3 p = queries[src] * scale;
-        qx[i] = p.x;
-        qy[i] = p.y;
-        qz[i] = p.z;
-        qOriginal[i] = src;
-        qKey[i] = uint32_t(keyed[i] >> 32);
-    }
+    parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) {
+            const uint32_t src = uint32_t(keyed[i]);
+            const glm::vec3 p = queries[src] * scale;
+            qx[i] = p.x;
+            qy[i] = p.y;
+            qz[i] = p.z;
+            qOriginal[i] = src;
+            qKey[i] = uint32_t(keyed[i] >> 32);
+        }
+    });
     std::vector<uint64_t>().swap(keyed);
     out.indexMs = msSince(start);
 
@@ -266,6 +268,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
         Winner& winner = winners[size_t(w)];
         SearchStats& stat = stats[size_t(w)];
         uint32_t hint = kNone;  // bucket of the previous query's nearest/killing point
+        uint32_t hintPos = kNone;  // that point (sorted position)
         const uint32_t* keys = t.cellKey.data();
         uint32_t cursor = uint32_t(std::lower_bound(keys, keys + cells, qKey[begin]) - keys);
         for (size_t i = begin; i < end; ++i) {
@@ -273,8 +276,16 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
             const Query q{splat(qx[i]), splat(qy[i]), splat(qz[i])};
             Best best;
             if (hint != kNone) {
+                // The previous query's point alone kills most Morton neighbours.
+                const float dx = qx[i] - t.x[hintPos], dy = qy[i] - t.y[hintPos], dz = qz[i] - t.z[hintPos];
+                if (dx * dx + dy * dy + dz * dz < k) {
+                    ++culled[size_t(w)];
+                    continue;
+                }
                 scanRange(t, t.bucketFirst[hint], t.bucketFirst[hint + 1], q, best);
                 if (best.d2 < k) {
+                    hintPos = best.pos;
+                    hint = t.bucketOf[best.pos];
                     ++culled[size_t(w)];
                     continue;
                 }
@@ -290,6 +301,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
             if (cursor < cells && keys[cursor] == key) {
                 scanRange(t, t.cellFirst[cursor], t.cellFirst[cursor + 1], q, best);
                 if (best.d2 < k) {
+                    hintPos = best.pos;
                     hint = t.bucketOf[best.pos];
                     ++culled[size_t(w)];
                     continue;
@@ -297,6 +309,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
             }
             ++surviving[size_t(w)];
             const bool dead = searchTree(t, q, k, best, stat);
+            hintPos = best.pos;
             hint = t.bucketOf[best.pos];
             if (dead) continue;
             winner.offer(best.d2, qOriginal[i], best.target);

@@ -27,20 +27,20 @@ void resizeLevel(BoxLevel& level, uint32_t count) {
 }  // namespace
 
 void radixSortKeys(std::vector<uint64_t>& values, int keyBits) {
-    constexpr int kDigit = 11;
-    constexpr size_t kBuckets = size_t(1) << kDigit;
+    constexpr int kDigit = 12;  // 16 KiB of counts: stays in L1
+    constexpr uint32_t kMask = (1u << kDigit) - 1;
     std::vector<uint64_t> scratch(values.size());
-    std::vector<size_t> histogram(kBuckets);
+    std::vector<uint32_t> histogram(size_t(1) << kDigit);
     for (int shift = 32; shift < 32 + keyBits; shift += kDigit) {
-        std::fill(histogram.begin(), histogram.end(), 0);
-        for (uint64_t v : values) ++histogram[(v >> shift) & (kBuckets - 1)];
-        size_t sum = 0;
-        for (size_t& h : histogram) {
-            const size_t c = h;
+        std::fill(histogram.begin(), histogram.end(), 0u);
+        for (uint64_t v : values) ++histogram[(v >> shift) & kMask];
+        uint32_t sum = 0;
+        for (uint32_t& h : histogram) {
+            const uint32_t c = h;
             h = sum;
             sum += c;
         }
-        for (uint64_t v : values) scratch[histogram[(v >> shift) & (kBuckets - 1)]++] = v;
+        for (uint64_t v : values) scratch[histogram[(v >> shift) & kMask]++] = v;
         values.swap(scratch);
     }
 }
@@ -105,14 +105,6 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale, in
         while (end < n && uint32_t(keyed[end] >> coarseShift) == key) ++end;
         index.cellKey.push_back(key);
         index.cellFirst.push_back(uint32_t(i));
-        glm::vec3 lo(kInf), hi(-kInf);
-        for (size_t j = i; j < end; ++j) {
-            const glm::vec3 p(index.x[j], index.y[j], index.z[j]);
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
-        }
-        index.cellLo.push_back(lo);
-        index.cellHi.push_back(hi);
         for (size_t b = i; b < end; b += kBucketSize) bucketFirst.push_back(uint32_t(b));
         i = end;
     }
@@ -147,6 +139,20 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale, in
     });
     padLevel(leaves);
     index.bucketFirst = std::move(bucketFirst);
+
+    // Tight cell boxes: the union of the cell's buckets.
+    const uint32_t cells = index.cellCount();
+    index.cellLo.resize(cells);
+    index.cellHi.resize(cells);
+    for (uint32_t c = 0, b = 0; c < cells; ++c) {
+        glm::vec3 lo(kInf), hi(-kInf);
+        for (; b < buckets && index.bucketFirst[b] < index.cellFirst[c + 1]; ++b) {
+            lo = glm::min(lo, glm::vec3(leaves.loX[b], leaves.loY[b], leaves.loZ[b]));
+            hi = glm::max(hi, glm::vec3(leaves.hiX[b], leaves.hiY[b], leaves.hiZ[b]));
+        }
+        index.cellLo[c] = lo;
+        index.cellHi[c] = hi;
+    }
 
     // Upper levels: node j covers children kFanout*j .. kFanout*j + 7. At least
     // one level above the leaves so the search always starts at an inner node.
