@@ -1,0 +1,255 @@
+// glTF 2.0 (Khronos, "glTF 2.0 Specification", 2021) through tinygltf; the
+// accessor reads and the node walk are ours, with every index and byte range
+// checked, because tinygltf leaves those checks to the caller.
+#define TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#include <tiny_gltf.h>
+
+#include "io/gltf_reader.hpp"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <glm/mat4x4.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+
+#include "io/io_error.hpp"
+#include "io/number_parse.hpp"
+#include "io/scalar_type.hpp"
+
+namespace rthdist::io {
+namespace {
+
+// Images are irrelevant to point sets: accept them without decoding.
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+    return true;
+}
+
+std::string trimmed(std::string s) {
+    while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+    for (char& c : s) {
+        if (c == '\n') c = ';';
+    }
+    return s;
+}
+
+glm::dmat4 localTransform(const tinygltf::Node& node) {
+    if (node.matrix.size() == 16) return glm::make_mat4(node.matrix.data());  // column-major, as glTF
+    glm::dmat4 m(1.0);
+    if (node.translation.size() == 3) {
+        m = glm::translate(m, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
+    }
+    if (node.rotation.size() == 4) {  // glTF stores x, y, z, w
+        m *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
+    }
+    if (node.scale.size() == 3) m = glm::scale(m, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+    return m;
+}
+
+std::optional<ScalarType> componentScalar(int componentType) {
+    switch (componentType) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: return ScalarType::kInt8;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return ScalarType::kUInt8;
+        case TINYGLTF_COMPONENT_TYPE_SHORT: return ScalarType::kInt16;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return ScalarType::kUInt16;
+        case TINYGLTF_COMPONENT_TYPE_INT: return ScalarType::kInt32;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return ScalarType::kUInt32;
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: return ScalarType::kFloat32;
+        case TINYGLTF_COMPONENT_TYPE_DOUBLE: return ScalarType::kFloat64;
+        default: return std::nullopt;
+    }
+}
+
+// Normalized integer components map to [-1, 1] or [0, 1] (glTF 3.11).
+double normalize(double v, ScalarType t) {
+    switch (t) {
+        case ScalarType::kInt8: return std::max(v / 127.0, -1.0);
+        case ScalarType::kUInt8: return v / 255.0;
+        case ScalarType::kInt16: return std::max(v / 32767.0, -1.0);
+        case ScalarType::kUInt16: return v / 65535.0;
+        default: return v;
+    }
+}
+
+class PointCollector {
+public:
+    PointCollector(const tinygltf::Model& model, const std::string& path) : m_model(model), m_path(path) {}
+
+    // Depth-first, parents before children, without recursion (a long chain
+    // of nodes must not exhaust the stack).
+    std::optional<Error> walk(int root) {
+        struct Pending {
+            int node;
+            glm::dmat4 parent;
+        };
+        std::vector<Pending> stack{{root, glm::dmat4(1.0)}};
+        size_t visited = 0;
+        while (!stack.empty()) {
+            const Pending top = stack.back();
+            stack.pop_back();
+            const std::string where = "node " + std::to_string(top.node);
+            if (top.node < 0 || static_cast<size_t>(top.node) >= m_model.nodes.size()) {
+                return badInput(m_path, where, "index out of range");
+            }
+            if (++visited > m_model.nodes.size()) return badInput(m_path, where, "cycle in the node hierarchy");
+            const tinygltf::Node& n = m_model.nodes[static_cast<size_t>(top.node)];
+            const glm::dmat4 world = top.parent * localTransform(n);
+            if (n.mesh >= 0) {
+                if (static_cast<size_t>(n.mesh) >= m_model.meshes.size()) {
+                    return badInput(m_path, where, "mesh index out of range");
+                }
+                for (const tinygltf::Primitive& prim : m_model.meshes[static_cast<size_t>(n.mesh)].primitives) {
+                    const auto it = prim.attributes.find("POSITION");
+                    if (it == prim.attributes.end()) continue;
+                    if (auto err = accessor(it->second, world)) return err;
+                }
+            }
+            for (auto child = n.children.rbegin(); child != n.children.rend(); ++child) {
+                stack.push_back({*child, world});
+            }
+        }
+        return std::nullopt;
+    }
+
+    std::vector<glm::vec3> take() { return std::move(m_points); }
+
+private:
+    std::optional<Error> accessor(int index, const glm::dmat4& world) {
+        const std::string where = "accessor " + std::to_string(index);
+        if (index < 0 || static_cast<size_t>(index) >= m_model.accessors.size()) {
+            return badInput(m_path, where, "index out of range");
+        }
+        const tinygltf::Accessor& acc = m_model.accessors[static_cast<size_t>(index)];
+        if (acc.sparse.isSparse) return badInput(m_path, where, "sparse POSITION accessors are not supported");
+        if (acc.type != TINYGLTF_TYPE_VEC3) return badInput(m_path, where, "POSITION is not VEC3");
+        const auto scalar = componentScalar(acc.componentType);
+        if (!scalar) return badInput(m_path, where, "unknown componentType " + std::to_string(acc.componentType));
+        if (acc.count == 0) return std::nullopt;
+        if (acc.bufferView < 0 || static_cast<size_t>(acc.bufferView) >= m_model.bufferViews.size()) {
+            return badInput(m_path, where, "bufferView missing or out of range");
+        }
+        const tinygltf::BufferView& view = m_model.bufferViews[static_cast<size_t>(acc.bufferView)];
+        if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= m_model.buffers.size()) {
+            return badInput(m_path, "bufferView " + std::to_string(acc.bufferView), "buffer index out of range");
+        }
+        const std::vector<unsigned char>& data = m_model.buffers[static_cast<size_t>(view.buffer)].data;
+        if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset) {
+            return badInput(m_path, "bufferView " + std::to_string(acc.bufferView),
+                            "byte range exceeds its buffer of " + std::to_string(data.size()) + " bytes");
+        }
+        const uint64_t elementSize = 3 * scalarSize(*scalar);
+        const uint64_t stride = view.byteStride != 0 ? view.byteStride : elementSize;
+        if (stride < elementSize) return badInput(m_path, where, "byteStride smaller than a VEC3");
+        // All of count * stride must lie inside the view: checked before allocating.
+        const uint64_t viewLength = view.byteLength;
+        if (acc.byteOffset > viewLength || viewLength - acc.byteOffset < elementSize ||
+            acc.count - 1 > (viewLength - acc.byteOffset - elementSize) / stride) {
+            return badInput(m_path, where,
+                            std::to_string(acc.count) + " elements do not fit bufferView " +
+                                std::to_string(acc.bufferView) + " (" + std::to_string(viewLength) + " bytes)");
+        }
+        const char* base = reinterpret_cast<const char*>(data.data()) + view.byteOffset + acc.byteOffset;
+        m_points.reserve(m_points.size() + acc.count);
+        for (size_t k = 0; k < acc.count; ++k) {
+            const char* p = base + k * stride;
+            glm::dvec4 v(0.0, 0.0, 0.0, 1.0);
+            for (int c = 0; c < 3; ++c) {
+                const double raw = loadScalar(p + c * scalarSize(*scalar), *scalar, false);
+                v[c] = acc.normalized ? normalize(raw, *scalar) : raw;
+            }
+            const glm::dvec4 w = world * v;
+            m_points.emplace_back(narrowToFloat(w.x), narrowToFloat(w.y), narrowToFloat(w.z));
+        }
+        return std::nullopt;
+    }
+
+    const tinygltf::Model& m_model;
+    const std::string& m_path;
+    std::vector<glm::vec3> m_points;
+};
+
+// The scene's root nodes: the default scene's, else every scene's, else (no
+// scenes at all) every node that is nobody's child.
+Result<std::vector<int>> rootNodes(const tinygltf::Model& model, const std::string& path) {
+    std::vector<int> parents(model.nodes.size(), 0);
+    for (size_t i = 0; i < model.nodes.size(); ++i) {
+        for (int child : model.nodes[i].children) {
+            if (child < 0 || static_cast<size_t>(child) >= model.nodes.size()) {
+                return badInput(path, "node " + std::to_string(i), "child index " + std::to_string(child) + " out of range");
+            }
+            if (++parents[static_cast<size_t>(child)] > 1) {
+                return badInput(path, "node " + std::to_string(child), "has more than one parent");
+            }
+        }
+    }
+    std::vector<int> roots;
+    auto addScene = [&](size_t s) -> std::optional<Error> {
+        for (int n : model.scenes[s].nodes) {
+            if (n < 0 || static_cast<size_t>(n) >= model.nodes.size()) {
+                return badInput(path, "scene " + std::to_string(s), "node index " + std::to_string(n) + " out of range");
+            }
+            if (parents[static_cast<size_t>(n)] != 0) {
+                return badInput(path, "scene " + std::to_string(s), "node " + std::to_string(n) + " is not a root node");
+            }
+            roots.push_back(n);
+        }
+        return std::nullopt;
+    };
+    if (model.defaultScene >= 0 && static_cast<size_t>(model.defaultScene) < model.scenes.size()) {
+        if (auto err = addScene(static_cast<size_t>(model.defaultScene))) return *err;
+    } else if (!model.scenes.empty()) {
+        for (size_t s = 0; s < model.scenes.size(); ++s) {
+            if (auto err = addScene(s)) return *err;
+        }
+    } else {
+        for (size_t i = 0; i < model.nodes.size(); ++i) {
+            if (parents[i] == 0) roots.push_back(static_cast<int>(i));
+        }
+    }
+    return roots;
+}
+
+}  // namespace
+
+Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::string& path) {
+    if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
+        return badInput(path, "file", "larger than 4 GiB, beyond what tinygltf reads");
+    }
+    const bool binary = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
+    std::string baseDir = std::filesystem::path(path).parent_path().string();
+    if (baseDir.empty()) baseDir = ".";
+
+    tinygltf::Model model;
+    std::string err;
+    std::string warn;
+    bool ok = false;
+    try {
+        tinygltf::TinyGLTF loader;
+        loader.SetImageLoader(&skipImage, nullptr);
+        if (binary) {
+            ok = loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+                                             static_cast<unsigned int>(bytes.size()), baseDir);
+        } else {
+            ok = loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()),
+                                            baseDir);
+        }
+    } catch (const std::exception& e) {
+        return badInput(path, "glTF", std::string("malformed: ") + e.what());
+    }
+    if (!ok) return badInput(path, "glTF", "malformed: " + (err.empty() ? std::string("tinygltf failed") : trimmed(err)));
+
+    auto roots = rootNodes(model, path);
+    if (!roots) return roots.error();
+    PointCollector collector(model, path);
+    for (int root : *roots) {
+        if (auto e = collector.walk(root)) return *e;
+    }
+    return collector.take();
+}
+
+}  // namespace rthdist::io

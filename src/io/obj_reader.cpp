@@ -1,0 +1,36 @@
+#include "io/obj_reader.hpp"
+
+#include <array>
+
+#include "io/io_error.hpp"
+#include "io/number_parse.hpp"
+#include "io/text_cursor.hpp"
+
+namespace rthdist::io {
+
+Result<std::vector<glm::vec3>> readObj(std::string_view bytes, const std::string& path) {
+    std::vector<glm::vec3> points;
+    TextCursor cursor(bytes);
+    std::string_view line;
+    while (cursor.nextLine(line)) {
+        const std::string_view body = trimBlank(line);
+        // Only geometric vertices: "v " and "v\t" (not vn, vt, vp).
+        if (body.size() < 2 || body[0] != 'v' || (body[1] != ' ' && body[1] != '\t')) continue;
+        std::array<std::string_view, 4> tok{};
+        const size_t n = splitTokens(body.substr(1), tok.data(), tok.size());
+        if (n < 3) {
+            return badInput(path, lineWhere(cursor.line()), "vertex line with " + std::to_string(n) + " coordinate(s)");
+        }
+        float v[3];
+        for (size_t axis = 0; axis < 3; ++axis) {
+            if (!parseFloat(tok[axis], v[axis])) {
+                return badInput(path, lineWhere(cursor.line()), notANumber(tok[axis]));
+            }
+        }
+        points.emplace_back(v[0], v[1], v[2]);
+    }
+    points.shrink_to_fit();
+    return points;
+}
+
+}  // namespace rthdist::io

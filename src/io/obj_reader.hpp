@@ -1,0 +1,17 @@
+// Wavefront OBJ: the "v x y z" lines; everything else is ignored.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rthdist/result.hpp"
+
+namespace rthdist::io {
+
+// bytes: the whole (already gunzipped) file; path names it in error messages.
+[[nodiscard]] Result<std::vector<glm::vec3>> readObj(std::string_view bytes, const std::string& path);
+
+}  // namespace rthdist::io

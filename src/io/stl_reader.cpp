@@ -1,0 +1,71 @@
+#include "io/stl_reader.hpp"
+
+#include <cstdint>
+
+#include "io/io_error.hpp"
+#include "io/number_parse.hpp"
+#include "io/scalar_type.hpp"
+#include "io/text_cursor.hpp"
+
+namespace rthdist::io {
+namespace {
+
+constexpr size_t kHeaderSize = 80;
+constexpr size_t kFacetSize = 50;  // normal, 3 vertices (float32 LE), uint16 attribute
+
+std::vector<glm::vec3> readBinary(std::string_view bytes, uint64_t facets) {
+    std::vector<glm::vec3> points(static_cast<size_t>(facets) * 3);
+    const char* p = bytes.data() + kHeaderSize + 4;
+    for (uint64_t f = 0; f < facets; ++f, p += kFacetSize) {
+        for (size_t c = 0; c < 3; ++c) {
+            const char* v = p + 12 + 12 * c;
+            points[f * 3 + c] = glm::vec3(static_cast<float>(loadScalar(v, ScalarType::kFloat32, false)),
+                                          static_cast<float>(loadScalar(v + 4, ScalarType::kFloat32, false)),
+                                          static_cast<float>(loadScalar(v + 8, ScalarType::kFloat32, false)));
+        }
+    }
+    return points;
+}
+
+Result<std::vector<glm::vec3>> readAscii(std::string_view bytes, const std::string& path) {
+    std::vector<glm::vec3> points;
+    TextCursor cursor(bytes);
+    for (std::string_view tok = cursor.nextToken(); !tok.empty(); tok = cursor.nextToken()) {
+        if (tok != "vertex") continue;
+        float v[3];
+        for (size_t axis = 0; axis < 3; ++axis) {
+            const std::string_view num = cursor.nextToken();
+            if (!parseFloat(num, v[axis])) {
+                return badInput(path, lineWhere(cursor.line()),
+                                num.empty() ? std::string("file ends inside a vertex")
+                                            : notANumber(num));
+            }
+        }
+        points.emplace_back(v[0], v[1], v[2]);
+    }
+    return points;
+}
+
+}  // namespace
+
+Result<std::vector<glm::vec3>> readStl(std::string_view bytes, const std::string& path) {
+    // Many binary STLs also start with "solid", so the size decides first.
+    if (bytes.size() >= kHeaderSize + 4) {
+        const uint64_t facets = static_cast<uint64_t>(loadScalar(bytes.data() + kHeaderSize, ScalarType::kUInt32, false));
+        const uint64_t need = kHeaderSize + 4 + facets * kFacetSize;
+        if (bytes.size() == need) return readBinary(bytes, facets);
+        if (!trimBlank(bytes.substr(0, 64)).starts_with("solid")) {
+            if (bytes.size() < need) {
+                return badInput(path, offsetWhere(kHeaderSize),
+                                "binary STL declares " + std::to_string(facets) + " facets (" + std::to_string(need) +
+                                    " bytes) but the file has " + std::to_string(bytes.size()) + " bytes");
+            }
+            return readBinary(bytes, facets);  // trailing bytes after the facets are ignored
+        }
+    } else if (!trimBlank(bytes.substr(0, 64)).starts_with("solid")) {
+        return badInput(path, offsetWhere(0), "neither ascii STL ('solid') nor a complete binary STL header");
+    }
+    return readAscii(bytes, path);
+}
+
+}  // namespace rthdist::io

@@ -1,0 +1,18 @@
+// STL, binary (chosen when the size matches 84 + 50 * facets) or ascii: every
+// facet vertex in file order, shared vertices repeated.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rthdist/result.hpp"
+
+namespace rthdist::io {
+
+// bytes: the whole (already gunzipped) file; path names it in error messages.
+[[nodiscard]] Result<std::vector<glm::vec3>> readStl(std::string_view bytes, const std::string& path);
+
+}  // namespace rthdist::io

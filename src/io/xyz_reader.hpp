@@ -1,0 +1,18 @@
+// XYZ text: one point per line, the first three columns (separated by blanks,
+// ',' or ';'); blank lines and lines starting with '#' or '//' are skipped.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rthdist/result.hpp"
+
+namespace rthdist::io {
+
+// bytes: the whole (already gunzipped) file; path names it in error messages.
+[[nodiscard]] Result<std::vector<glm::vec3>> readXyz(std::string_view bytes, const std::string& path);
+
+}  // namespace rthdist::io

@@ -1,0 +1,72 @@
+// STL: binary (also one whose header starts with "solid") and ascii.
+#include "io_test_support.hpp"
+
+namespace rthdist::io::test {
+namespace {
+
+using StlReader = TempDirTest;
+
+std::string binaryStl(const std::string& header80, const std::vector<glm::vec3>& corners, uint32_t declared) {
+    ByteBuilder b;
+    std::string header = header80;
+    header.resize(80, ' ');
+    b.text(header).put<uint32_t>(declared);
+    for (size_t f = 0; f + 2 < corners.size(); f += 3) {
+        b.put(0.0f).put(0.0f).put(1.0f);
+        for (size_t c = 0; c < 3; ++c) b.put(corners[f + c].x).put(corners[f + c].y).put(corners[f + c].z);
+        b.put<uint16_t>(0);
+    }
+    return b.str();
+}
+
+TEST_F(StlReader, BinaryKeepsEveryFacetVertex) {
+    std::vector<glm::vec3> corners = threePoints();
+    corners.insert(corners.end(), {{0, 0, 0}, {1, 0, 0}, {1.5f, -2.25f, 3.0f}});
+    auto r = loadPoints(write("a.stl", binaryStl("binary", corners, 2)));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, corners);
+}
+
+TEST_F(StlReader, BinaryWhoseHeaderSaysSolid) {
+    auto r = loadPoints(write("s.stl", binaryStl("solid exported by a careless tool", threePoints(), 1)));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, threePoints());
+}
+
+TEST_F(StlReader, Ascii) {
+    const std::string text = "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 1.5 -2.25 3\n"
+                             "   vertex 0 0.001 -7.5\n   vertex 100 200.5 -300.25\n  endloop\n endfacet\nendsolid t\n";
+    auto r = loadPoints(write("a.stl", text));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, threePoints());
+}
+
+TEST_F(StlReader, BinaryFacetCountLies) {
+    const std::string path = write("lie.stl", binaryStl("binary", threePoints(), 1000000));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "byte offset 80: binary STL declares 1000000 facets"));
+}
+
+TEST_F(StlReader, TooShort) {
+    const std::string path = write("short.stl", "abc");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "byte offset 0"));
+}
+
+TEST_F(StlReader, AsciiNonNumericNamesLine) {
+    const std::string path = write("bad.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3\nvertex 1 oops 3\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 5: 'oops' is not a number"));
+}
+
+TEST_F(StlReader, AsciiWithoutFacetsHasNoPoints) {
+    const std::string path = write("empty.stl", "solid t\nendsolid t\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "contains no points"));
+}
+
+TEST_F(StlReader, BinaryNanNamesVertex) {
+    std::vector<glm::vec3> corners = threePoints();
+    corners[2].x = std::numeric_limits<float>::infinity();
+    const std::string path = write("inf.stl", binaryStl("binary", corners, 1));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "vertex 2: coordinate x is infinite"));
+}
+
+}  // namespace
+}  // namespace rthdist::io::test

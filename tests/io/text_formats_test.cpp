@@ -1,0 +1,93 @@
+// XYZ, OBJ and OFF: round trips, what is skipped, and bad input.
+#include "io_test_support.hpp"
+
+namespace rthdist::io::test {
+namespace {
+
+using TextFormats = TempDirTest;
+
+TEST_F(TextFormats, XyzColumnsCommentsSeparators) {
+    const std::string text = "# x y z intensity\n\n1.5 -2.25 3 77\n0,0.001,-7.5\n  +100\t200.5;-300.25  \n// end\n";
+    auto r = loadPoints(write("a.xyz", text));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, threePoints());
+}
+
+TEST_F(TextFormats, TxtIsXyz) {
+    auto r = loadPoints(write("a.txt", "1 2 3"));  // no final newline
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, (std::vector<glm::vec3>{{1, 2, 3}}));
+}
+
+TEST_F(TextFormats, XyzNonNumericNamesLine) {
+    const std::string path = write("bad.xyz", "1 2 3\n# c\n4 5 six\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 3: 'six' is not a number"));
+}
+
+TEST_F(TextFormats, XyzTooFewColumnsNamesLine) {
+    const std::string path = write("two.xyz", "1 2 3\n4 5\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 2"));
+}
+
+TEST_F(TextFormats, XyzOnlyCommentsHasNoPoints) {
+    const std::string path = write("c.xyz", "# nothing\n\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "file: contains no points"));
+}
+
+TEST_F(TextFormats, XyzNanNamesVertex) {
+    const std::string path = write("nan.xyz", "1 2 3\n4 5 6\nnan 1 1\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "vertex 2: coordinate x is NaN"));
+}
+
+TEST_F(TextFormats, ObjVerticesOnly) {
+    const std::string text = "# exported\nmtllib a.mtl\no thing\nv 1.5 -2.25 3\nvn 0 0 1\nvt 0.5 0.5\n"
+                             "v 0 0.001 -7.5 1.0\nv\t100 200.5 -300.25 0.1 0.2 0.3\nf 1 2 3\nf 1/1/1 2/1/1 3/1/1\n";
+    auto r = loadPoints(write("a.obj", text));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, threePoints());
+}
+
+TEST_F(TextFormats, ObjBadVertexNamesLine) {
+    const std::string path = write("bad.obj", "v 1 2 3\nvn 1 1 1\nv 1 2\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 3"));
+    const std::string word = write("word.obj", "v 1 2 3\nv 1 x 3\n");
+    EXPECT_TRUE(isBadInput(loadPoints(word), word, "line 2: 'x' is not a number"));
+}
+
+TEST_F(TextFormats, ObjWithoutVerticesHasNoPoints) {
+    const std::string path = write("none.obj", "# only faces\nf 1 2 3\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "contains no points"));
+}
+
+TEST_F(TextFormats, OffVariantsAndComments) {
+    const std::string body = "1.5 -2.25 3\n0 0.001 -7.5 # comment\n\n100 200.5 -300.25 255 0 0 255\n3 0 1 2\n";
+    for (const std::string head : {"OFF\n3 1 0\n", "OFF 3 1 0\n", "# c\nCOFF\n# counts\n3 1 0\n", "NOFF\n3 1 0\n"}) {
+        auto r = loadPoints(write("a.off", head + body));
+        ASSERT_TRUE(r.ok()) << head << r.error().message;
+        EXPECT_EQ(*r, threePoints()) << head;
+    }
+}
+
+TEST_F(TextFormats, OffBadInput) {
+    const std::string notOff = write("n.off", "PLY\n3 1 0\n");
+    EXPECT_TRUE(isBadInput(loadPoints(notOff), notOff, "line 1"));
+    const std::string fourD = write("4.off", "4OFF\n1 0 0\n1 2 3 4\n");
+    EXPECT_TRUE(isBadInput(loadPoints(fourD), fourD, "line 1: unsupported OFF variant '4OFF'"));
+    const std::string binary = write("b.off", "OFF BINARY\n");
+    EXPECT_TRUE(isBadInput(loadPoints(binary), binary, "line 1"));
+    const std::string count = write("c.off", "OFF\nthree 1 0\n");
+    EXPECT_TRUE(isBadInput(loadPoints(count), count, "line 2: bad vertex count"));
+    const std::string huge = write("h.off", "OFF\n99999999999 1 0\n1 2 3\n");
+    EXPECT_TRUE(isBadInput(loadPoints(huge), huge, "line 2: declares 99999999999 vertices"));
+    const std::string shortFile = write("s.off", "OFF\n3 0 0\n1 2 3\n4 5 6\n            \n");
+    EXPECT_TRUE(isBadInput(loadPoints(shortFile), shortFile, "file ends at vertex 2 of 3"));
+    const std::string word = write("w.off", "OFF\n2 0 0\n1 2 3\n4 y 6\n");
+    EXPECT_TRUE(isBadInput(loadPoints(word), word, "line 4: 'y' is not a number"));
+    const std::string zero = write("z.off", "OFF\n0 0 0\n");
+    EXPECT_TRUE(isBadInput(loadPoints(zero), zero, "contains no points"));
+    const std::string inf = write("i.off", "OFF\n1 0 0\n1 2 1e39\n");
+    EXPECT_TRUE(isBadInput(loadPoints(inf), inf, "vertex 0: coordinate z"));
+}
+
+}  // namespace
+}  // namespace rthdist::io::test
