@@ -245,14 +245,18 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
     std::vector<SearchStats> stats(static_cast<size_t>(threads));
     const size_t samples = std::min(nq, kSampleSize);
     parallelChunks(samples, 32, threads, [&](size_t begin, size_t end, int w) {
+        Winner winner;
+        SearchStats stat;
         for (size_t s = begin; s < end; ++s) {
             const uint32_t i = uint32_t(s * nq / samples);
             const glm::vec3 p = queries[i] * scale;
             const Query q{splat(p.x), splat(p.y), splat(p.z)};
             Best best;
-            searchTree(t, q, 0.0f, best, stats[size_t(w)]);
-            winners[size_t(w)].offer(best.d2, i, best.target);
+            searchTree(t, q, 0.0f, best, stat);
+            winner.offer(best.d2, i, best.target);
         }
+        winners[size_t(w)].offer(winner.d2, winner.query, winner.target);
+        stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
     });
     float sampleMax = 0.0f;
     for (const Winner& w : winners) sampleMax = std::max(sampleMax, w.d2);
@@ -265,8 +269,10 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
     std::vector<uint64_t> culled(size_t(threads), 0), surviving(size_t(threads), 0);
     const uint32_t cells = t.cellCount();
     parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int w) {
-        Winner& winner = winners[size_t(w)];
-        SearchStats& stat = stats[size_t(w)];
+        // Chunk-local tallies, published once: per-thread slots share cache lines.
+        Winner winner = winners[size_t(w)];
+        SearchStats stat;
+        uint64_t culledHere = 0, survivingHere = 0;
         uint32_t hint = kNone;  // bucket of the previous query's nearest/killing point
         uint32_t hintPos = kNone;  // that point (sorted position)
         const uint32_t* keys = t.cellKey.data();
@@ -279,14 +285,14 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
                 // The previous query's point alone kills most Morton neighbours.
                 const float dx = qx[i] - t.x[hintPos], dy = qy[i] - t.y[hintPos], dz = qz[i] - t.z[hintPos];
                 if (dx * dx + dy * dy + dz * dz < k) {
-                    ++culled[size_t(w)];
+                    ++culledHere;
                     continue;
                 }
                 scanRange(t, t.bucketFirst[hint], t.bucketFirst[hint + 1], q, best);
                 if (best.d2 < k) {
                     hintPos = best.pos;
                     hint = t.bucketOf[best.pos];
-                    ++culled[size_t(w)];
+                    ++culledHere;
                     continue;
                 }
             }
@@ -303,11 +309,11 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
                 if (best.d2 < k) {
                     hintPos = best.pos;
                     hint = t.bucketOf[best.pos];
-                    ++culled[size_t(w)];
+                    ++culledHere;
                     continue;
                 }
             }
-            ++surviving[size_t(w)];
+            ++survivingHere;
             const bool dead = searchTree(t, q, k, best, stat);
             hintPos = best.pos;
             hint = t.bucketOf[best.pos];
@@ -315,6 +321,10 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
             winner.offer(best.d2, qOriginal[i], best.target);
             atomicMax(kill, best.d2);
         }
+        winners[size_t(w)] = winner;
+        stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
+        culled[size_t(w)] += culledHere;
+        surviving[size_t(w)] += survivingHere;
     });
     out.searchMs = msSince(start);
 
