@@ -15,7 +15,7 @@ if [ "${#skipped[@]}" = 0 ]; then
   exit 0
 fi
 mapfile -t gpu_tests < <(ctest --test-dir "$build_dir" -N -L 'gpu|cli' |
-  sed -n 's/^ *Test *#[0-9]*: \(.*\)$/\1/p' | sort -u)
+  sed -n 's/^ *Test *#[0-9]*: \([^ ]*\).*$/\1/p' | sort -u)
 
 bad=0
 for t in "${skipped[@]}"; do

@@ -174,13 +174,10 @@ JsonWriter& JsonWriter::value(double number) {
     return *this;
 }
 
-JsonWriter& JsonWriter::value(float number) {
-    if (!std::isfinite(number)) return null();
-    char buf[64];
-    const auto res = std::to_chars(buf, buf + sizeof buf, number);
-    writeRaw(std::string_view(buf, static_cast<size_t>(res.ptr - buf)));
-    return *this;
-}
+// A float is written as the shortest decimal of its exact double value, so a
+// reader parsing doubles gets the float32 coordinate exactly (recomputing a
+// distance from the written points gives the reported distance).
+JsonWriter& JsonWriter::value(float number) { return value(static_cast<double>(number)); }
 
 JsonWriter& JsonWriter::value(int64_t number) {
     char buf[32];

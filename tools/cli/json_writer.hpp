@@ -3,8 +3,8 @@
 // Strings are escaped per RFC 8259: '"', '\\' and every control character
 // below U+0020 are escaped, and bytes that are not well-formed UTF-8 (file
 // paths on Linux are arbitrary bytes) become U+FFFD, so the output always
-// parses. Non-finite numbers are written as null. Floats and doubles use the
-// shortest text that reads back to the same value.
+// parses. Non-finite numbers are written as null. Doubles use the shortest text
+// that reads back to the same value; floats are written as their exact double.
 #pragma once
 
 #include <cstdint>
