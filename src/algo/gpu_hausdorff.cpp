@@ -110,7 +110,13 @@ struct GpuHausdorff::State {
         PointIndex ix;
         ix.n = uint32_t(pts.size());
         ix.bounds = boundsOf(pts);
-        ix.grid = makeGrid(ix.bounds, bits > 0 ? bits : chooseBits(pts, ix.bounds));
+        if (bits <= 0) {
+            // The dense key table costs O(2^(3k)) to clear and scan: keep it
+            // within a few entries per point when the bit count is automatic.
+            bits = chooseBits(pts, ix.bounds);
+            while (bits > kMinBits && (uint64_t(1) << (3 * bits)) > 8 * uint64_t(ix.n) + 4096) --bits;
+        }
+        ix.grid = makeGrid(ix.bounds, bits);
 
         auto t0 = Clock::now();
         const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;

@@ -1,0 +1,137 @@
+// Named GPU tests: errors as values, degenerate shapes (DESIGN §6), the
+// paper's candidate-set gap (DESIGN §3), pair-buffer overflow, engine reuse.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "cpu/brute_force.hpp"
+#include "gpu_test_support.hpp"
+#include "common/oracle_cases.hpp"
+
+namespace rthdist::test {
+namespace {
+
+std::vector<glm::vec3> uniformCloud(size_t n, uint64_t seed, glm::vec3 offset, float extent = 1.0f) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, extent);
+    std::vector<glm::vec3> p(n);
+    for (auto& v : p) v = glm::vec3(u(rng), u(rng), u(rng)) + offset;
+    return p;
+}
+
+void expectExact(Engine& engine, const std::string& name, uint64_t seed, std::vector<glm::vec3> a,
+                 std::vector<glm::vec3> b) {
+    OracleCase c{name, seed, std::move(a), std::move(b)};
+    SCOPED_TRACE(name);
+    auto r = engine.compute(c.a, c.b);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    expectMatchesOracle(c, *r);
+    EXPECT_EQ(r->validationMessages, 0u);
+}
+
+TEST(GpuEngine, EmptySetIsAnErrorValue) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    std::vector<glm::vec3> a{{0, 0, 0}}, empty;
+    auto r = engine->compute(a, empty);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(r.error().message.find("empty"), std::string::npos);
+}
+
+TEST(GpuEngine, NanCoordinateIsAnErrorValueNamingThePoint) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    std::vector<glm::vec3> a{{0, 0, 0}, {1, std::numeric_limits<float>::quiet_NaN(), 0}}, b{{1, 1, 1}};
+    auto r = engine->compute(a, b);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(r.error().message.find("point 1"), std::string::npos) << r.error().message;
+}
+
+TEST(GpuEngine, OnePointEach) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    std::vector<glm::vec3> a{{1, 2, 3}}, b{{4, 6, 3}};
+    auto r = engine->compute(a, b);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_DOUBLE_EQ(r->hausdorff, 5.0);
+    EXPECT_EQ(r->aToB.queryIndex, 0u);
+    EXPECT_EQ(r->bToA.targetIndex, 0u);
+}
+
+TEST(GpuEngine, IdenticalSetsGiveZero) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    auto a = uniformCloud(3000, 11, glm::vec3(0.0f));
+    auto r = engine->compute(a, a);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->hausdorff, 0.0);
+}
+
+TEST(GpuEngine, PaperCornerTestCounterexample) {
+    // DESIGN §3: cell edge 1, q = 0.5, t1 = 1.99 (near corner), t2 = -0.1;
+    // the true NN is t2 at 0.6. Padding points fix the grid to unit cells.
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    std::vector<glm::vec3> a{{0.5f, 0, 0}};
+    std::vector<glm::vec3> b{{1.99f, 0, 0}, {-0.1f, 0, 0}, {-8.0f, 0, 0}, {8.0f, 0, 0}};
+    auto r = engine->compute(a, b);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_NEAR(r->aToB.distance, 0.6, 1e-6);
+    EXPECT_EQ(r->aToB.targetIndex, 1u);
+    expectExact(*engine, "corner-3d", 1, {{0.5f, 0.5f, 0.5f}},
+                {{1.99f, 1.99f, 1.99f}, {-0.1f, 0.5f, 0.5f}, {-8, -8, -8}, {8, 8, 8}});
+}
+
+TEST(GpuEngine, PairBufferOverflowStaysExact) {
+    // One bit per axis: 8 cells, every far query pairs with all of them, so
+    // the pair buffer overflows and queries are redone at the same radius.
+    Options o = gpuOptions();
+    o.bits = 1;
+    RTHDIST_REQUIRE_ENGINE(engine, o);
+    expectExact(*engine, "overflow", 5, uniformCloud(40000, 5, glm::vec3(0.0f)),
+                uniformCloud(30000, 6, glm::vec3(2.5f, 0.0f, 0.0f)));
+}
+
+TEST(GpuEngine, SlowRadiusGrowthGivesTheSameAnswer) {
+    Options o = gpuOptions();
+    o.radiusGrowth = 1.1f;
+    RTHDIST_REQUIRE_ENGINE(engine, o);
+    expectExact(*engine, "growth-1.1", 7, uniformCloud(5000, 7, glm::vec3(0.0f)),
+                uniformCloud(4000, 8, glm::vec3(0.6f, 0.1f, 0.0f)));
+}
+
+TEST(GpuEngine, LargeOffsetsSmallExtent) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    expectExact(*engine, "offset-1e7", 9, uniformCloud(4000, 9, glm::vec3(1.0e7f, -1.0e7f, 5.4e6f), 50.0f),
+                uniformCloud(3000, 10, glm::vec3(1.0e7f, -1.0e7f, 5.4e6f), 50.0f));
+}
+
+TEST(GpuEngine, ReusedEngineStaysExactAcrossSizes) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    const size_t sizes[][2] = {{20000, 10}, {10, 20000}, {1, 1}, {15000, 15000}, {700, 30}};
+    uint64_t seed = 100;
+    for (const auto& s : sizes) {
+        expectExact(*engine, "reuse-" + std::to_string(s[0]) + "x" + std::to_string(s[1]), seed,
+                    uniformCloud(s[0], seed, glm::vec3(0.0f)), uniformCloud(s[1], seed + 1, glm::vec3(0.3f)));
+        seed += 2;
+    }
+}
+
+TEST(GpuEngine, CountersDescribeTheWork) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    auto a = uniformCloud(8000, 21, glm::vec3(0.0f));
+    auto b = uniformCloud(6000, 22, glm::vec3(1.5f, 0.0f, 0.0f));
+    auto r = engine->compute(a, b);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    const Counters& c = r->aToB.counters;
+    EXPECT_EQ(c.queries, a.size());
+    EXPECT_EQ(c.culledByNeighbourhood + c.survivingQueries, c.queries);
+    EXPECT_GT(c.survivingQueries, 0u);  // the sets are apart: no query dies before a ray
+    EXPECT_GE(c.rays, c.survivingQueries);
+    EXPECT_GE(c.iterations, 1u);
+    EXPECT_GT(c.occupiedCells, 0u);
+    EXPECT_LE(c.occupiedCells, b.size());
+    EXPECT_GT(r->timings.total, 0.0);
+}
+
+}  // namespace
+}  // namespace rthdist::test

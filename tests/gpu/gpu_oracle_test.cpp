@@ -1,0 +1,54 @@
+// The oracle suite on the GPU backend named by RTHDIST_TEST_BACKEND: every
+// case of makeOracleCases() against the double brute force, with the
+// validation layer on and required silent.
+#include <gtest/gtest.h>
+
+#include "gpu_test_support.hpp"
+#include "common/oracle_cases.hpp"
+
+namespace rthdist::test {
+namespace {
+
+TEST(GpuOracle, EveryCaseMatchesBruteForce) {
+    Options options = gpuOptions();
+    RTHDIST_REQUIRE_ENGINE(engine, options);
+    const std::vector<OracleCase> cases = makeOracleCases();
+    ASSERT_GE(cases.size(), 300u);
+    std::printf("backend %s on %s: %zu oracle cases\n", backendName(engine->backend()), engine->deviceName().c_str(),
+                cases.size());
+    uint64_t lastMessages = 0;
+    for (const OracleCase& c : cases) {
+        SCOPED_TRACE("case " + c.name + " seed " + std::to_string(c.seed));
+        auto r = engine->compute(c.a, c.b);
+        ASSERT_TRUE(r.ok()) << r.error().message;
+        if (r->timings.total > 500.0)
+            std::printf("  slow case %s: %zu x %zu points, %.0f ms, iterations %u/%u\n", c.name.c_str(), c.a.size(),
+                        c.b.size(), r->timings.total, r->aToB.counters.iterations, r->bToA.counters.iterations);
+        EXPECT_EQ(r->backend, options.backend);
+        expectMatchesOracle(c, *r);
+        EXPECT_EQ(r->validationMessages, lastMessages) << "validation layer reported messages";
+        lastMessages = r->validationMessages;
+    }
+}
+
+TEST(GpuOracle, DirectedOnlyAndFixedBits) {
+    const std::vector<OracleCase> cases = makeOracleCases();
+    for (int bits : {1, 4, 6}) {
+        Options options = gpuOptions();
+        options.bits = bits;
+        options.directedOnly = bits == 4;
+        RTHDIST_REQUIRE_ENGINE(engine, options);
+        for (size_t i = 0; i < cases.size(); i += 7) {
+            const OracleCase& c = cases[i];
+            SCOPED_TRACE("bits " + std::to_string(bits) + " case " + c.name + " seed " + std::to_string(c.seed));
+            auto r = engine->compute(c.a, c.b);
+            ASSERT_TRUE(r.ok()) << r.error().message;
+            expectMatchesOracle(c, *r, options.directedOnly);
+            EXPECT_EQ(r->aToB.counters.bits, uint32_t(bits));
+            EXPECT_EQ(r->validationMessages, 0u);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace rthdist::test

@@ -1,0 +1,47 @@
+// GPU test helpers: the backend under test comes from RTHDIST_TEST_BACKEND
+// (ctest runs the suites once per backend); every engine runs with the
+// Khronos validation layer and every message it emits fails the test.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <optional>
+#include <string>
+
+#include "rthdist/rthdist.hpp"
+
+namespace rthdist::test {
+
+inline Backend backendUnderTest() {
+    const char* env = std::getenv("RTHDIST_TEST_BACKEND");
+    Backend b = Backend::kRayQuery;
+    if (env && !parseBackend(env, b)) ADD_FAILURE() << "unknown RTHDIST_TEST_BACKEND=" << env;
+    return b;
+}
+
+inline Options gpuOptions() {
+    Options o;
+    o.backend = backendUnderTest();
+    o.validation = true;
+    return o;
+}
+
+// Creates an engine or records why none could be created.
+inline std::optional<Engine> makeEngine(const Options& o, std::string& whyNot) {
+    auto e = Engine::create(o);
+    if (!e) {
+        whyNot = e.error().message;
+        return std::nullopt;
+    }
+    return std::move(e.value());
+}
+
+}  // namespace rthdist::test
+
+// Skips (CI turns any skip into a failure: lavapipe must be there) when no
+// device can run the backend, with the rejection reasons.
+#define RTHDIST_REQUIRE_ENGINE(engine, options)                                  \
+    std::string rthdist_why_;                                                    \
+    auto engine = ::rthdist::test::makeEngine(options, rthdist_why_);            \
+    if (!engine) GTEST_SKIP() << "no device for this backend: " << rthdist_why_
