@@ -27,7 +27,7 @@ void resizeLevel(BoxLevel& level, uint32_t count) {
 }  // namespace
 
 void radixSortKeys(std::vector<uint64_t>& values, int keyBits) {
-    constexpr int kDigit = 12;  // 16 KiB of counts: stays in L1
+    constexpr int kDigit = 12;  // 16 KiB of counts (8-bit digits measured slower)
     constexpr uint32_t kMask = (1u << kDigit) - 1;
     std::vector<uint64_t> scratch(values.size());
     std::vector<uint32_t> histogram(size_t(1) << kDigit);
