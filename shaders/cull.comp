@@ -49,6 +49,39 @@ void main() {
         if (best < thr) dead = true;
         else if (j == 0) thr = deadThreshold(maxPacked, pc.lowerBound2);
     }
+    // Coarse levels: a coarse cell (edge s * 2^j) is a contiguous run of the
+    // Morton-sorted targets, found in O(1) from the fine table. Its first
+    // point is a real member: one strictly closer than the threshold proves
+    // the query cannot raise h, with no ray cast. Levels stop once a coarse
+    // cell's reach exceeds the threshold radius (reps there rarely help).
+    if (!dead && !(dOut > 0.0 && best <= dOut * dOut)) {
+        thr = deadThreshold(maxPacked, pc.lowerBound2);
+        float reach = sqrt(thr);
+        for (uint j = 1; j < pc.grid.bits && !dead; ++j) {
+            float coarse = s * float(1u << j);
+            if (coarse > reach) break;
+            ivec3 cc0 = c >> int(j);
+            int cpaj = cpa >> int(j);
+            for (int m = 0; m < 27; ++m) {
+                ivec3 cc = cc0 + ivec3(m % 3, (m / 3) % 3, m / 9) - 1;
+                if (any(lessThan(cc, ivec3(0))) || any(greaterThanEqual(cc, ivec3(cpaj)))) continue;
+                uint firstKey = mortonKey(uvec3(cc)) << (3u * j);
+                uint lastKey = firstKey + (1u << (3u * j)) - 1u;
+                uint start = firstKey == 0 ? 0u : dense.v[firstKey - 1];
+                if (dense.v[lastKey] == start) continue;  // empty coarse cell
+                vec4 tv = targets.v[start];
+                float d2 = dist2(q, tv.xyz);
+                if (d2 < best) {
+                    best = d2;
+                    bestT = floatBitsToUint(tv.w);
+                }
+                if (best < thr) {
+                    dead = true;
+                    break;
+                }
+            }
+        }
+    }
     QueryState st;
     st.best = packDistIndex(best, bestT);
     st.rLo = max(dOut, 0.0);

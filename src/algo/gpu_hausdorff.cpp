@@ -217,7 +217,7 @@ struct GpuHausdorff::State {
         auto threshold = [&] {
             return std::max(double(lowerBound2), double(std::bit_cast<float>(uint32_t(*maxPacked() >> 32))));
         };
-        double radius = std::max(std::sqrt(threshold()), 2.0 * T.grid.cellSize);
+        double radius = 2.0 * T.grid.cellSize;
         uint64_t pairCapacity = std::clamp<uint64_t>(uint64_t(T.numCells) * 4, 1u << 16, 1u << 22);
         Buffer pairs;
         const float rayTMax = float(T.grid.cellSize * 1e-3);
@@ -277,7 +277,7 @@ struct GpuHausdorff::State {
                 pairCapacity = std::min<uint64_t>(kMaxPairCapacity, std::max<uint64_t>(pairCount, pairCapacity * 2));
                 pairs.reset();
             } else if (pairCount <= pairCapacity) {
-                radius = std::max(radius * double(options.radiusGrowth), std::sqrt(threshold()));
+                radius *= double(options.radiusGrowth);
             }
         }
 
