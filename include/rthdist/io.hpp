@@ -17,6 +17,13 @@
 // (where = line N, vertex N, byte offset N, element name...). Declared counts
 // are checked against the file size before anything is allocated, so a lying
 // header cannot cause a huge allocation.
+//
+// Precision: decimal text is converted straight to the nearest float
+// (std::from_chars); double and integer inputs are rounded to float.
+// Limits: PLY elements after the vertex element are not read; a glTF mesh
+// instanced by several nodes gives its points once per instance; NaN points
+// (e.g. in organized PCD clouds) are rejected, not dropped. Reentrant: no
+// shared state, safe to call from several threads.
 #pragma once
 
 #include <glm/vec3.hpp>
