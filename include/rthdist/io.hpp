@@ -38,7 +38,6 @@ namespace rthdist::io {
 [[nodiscard]] Result<std::vector<glm::vec3>> loadPoints(const std::string& path);
 
 // Writes a binary little-endian PLY with float x/y/z vertices only.
-[[nodiscard]] Result<bool> writePlyPoints(const std::string& path,
-                                          const std::vector<glm::vec3>& points);
+[[nodiscard]] Result<bool> writePlyPoints(const std::string& path, const std::vector<glm::vec3>& points);
 
 }  // namespace rthdist::io

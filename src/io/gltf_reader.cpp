@@ -26,7 +26,8 @@ namespace rthdist::io {
 namespace {
 
 // Images are irrelevant to point sets: accept them without decoding.
-bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+               void*) {
     return true;
 }
 
@@ -45,7 +46,8 @@ glm::dmat4 localTransform(const tinygltf::Node& node) {
         m = glm::translate(m, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
     }
     if (node.rotation.size() == 4) {  // glTF stores x, y, z, w
-        m *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
+        m *= glm::mat4_cast(
+            glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
     }
     if (node.scale.size() == 3) m = glm::scale(m, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
     return m;
@@ -96,14 +98,16 @@ public:
             if (top.node < 0 || static_cast<size_t>(top.node) >= m_model.nodes.size()) {
                 return badInput(m_path, where, "index out of range");
             }
-            if (++visited > m_model.nodes.size()) return badInput(m_path, where, "cycle in the node hierarchy");
+            if (++visited > m_model.nodes.size())
+                return badInput(m_path, where, "cycle in the node hierarchy");
             const tinygltf::Node& n = m_model.nodes[static_cast<size_t>(top.node)];
             const glm::dmat4 world = top.parent * localTransform(n);
             if (n.mesh >= 0) {
                 if (static_cast<size_t>(n.mesh) >= m_model.meshes.size()) {
                     return badInput(m_path, where, "mesh index out of range");
                 }
-                for (const tinygltf::Primitive& prim : m_model.meshes[static_cast<size_t>(n.mesh)].primitives) {
+                for (const tinygltf::Primitive& prim :
+                     m_model.meshes[static_cast<size_t>(n.mesh)].primitives) {
                     const auto it = prim.attributes.find("POSITION");
                     if (it == prim.attributes.end()) continue;
                     if (auto err = accessor(it->second, world)) return err;
@@ -125,17 +129,20 @@ private:
             return badInput(m_path, where, "index out of range");
         }
         const tinygltf::Accessor& acc = m_model.accessors[static_cast<size_t>(index)];
-        if (acc.sparse.isSparse) return badInput(m_path, where, "sparse POSITION accessors are not supported");
+        if (acc.sparse.isSparse)
+            return badInput(m_path, where, "sparse POSITION accessors are not supported");
         if (acc.type != TINYGLTF_TYPE_VEC3) return badInput(m_path, where, "POSITION is not VEC3");
         const auto scalar = componentScalar(acc.componentType);
-        if (!scalar) return badInput(m_path, where, "unknown componentType " + std::to_string(acc.componentType));
+        if (!scalar)
+            return badInput(m_path, where, "unknown componentType " + std::to_string(acc.componentType));
         if (acc.count == 0) return std::nullopt;
         if (acc.bufferView < 0 || static_cast<size_t>(acc.bufferView) >= m_model.bufferViews.size()) {
             return badInput(m_path, where, "bufferView missing or out of range");
         }
         const tinygltf::BufferView& view = m_model.bufferViews[static_cast<size_t>(acc.bufferView)];
         if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= m_model.buffers.size()) {
-            return badInput(m_path, "bufferView " + std::to_string(acc.bufferView), "buffer index out of range");
+            return badInput(m_path, "bufferView " + std::to_string(acc.bufferView),
+                            "buffer index out of range");
         }
         const std::vector<unsigned char>& data = m_model.buffers[static_cast<size_t>(view.buffer)].data;
         if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset) {
@@ -151,7 +158,8 @@ private:
             acc.count - 1 > (viewLength - acc.byteOffset - elementSize) / stride) {
             return badInput(m_path, where,
                             std::to_string(acc.count) + " elements do not fit bufferView " +
-                                std::to_string(acc.bufferView) + " (" + std::to_string(viewLength) + " bytes)");
+                                std::to_string(acc.bufferView) + " (" + std::to_string(viewLength) +
+                                " bytes)");
         }
         const char* base = reinterpret_cast<const char*>(data.data()) + view.byteOffset + acc.byteOffset;
         m_points.reserve(m_points.size() + acc.count);
@@ -180,7 +188,8 @@ Result<std::vector<int>> rootNodes(const tinygltf::Model& model, const std::stri
     for (size_t i = 0; i < model.nodes.size(); ++i) {
         for (int child : model.nodes[i].children) {
             if (child < 0 || static_cast<size_t>(child) >= model.nodes.size()) {
-                return badInput(path, "node " + std::to_string(i), "child index " + std::to_string(child) + " out of range");
+                return badInput(path, "node " + std::to_string(i),
+                                "child index " + std::to_string(child) + " out of range");
             }
             if (++parents[static_cast<size_t>(child)] > 1) {
                 return badInput(path, "node " + std::to_string(child), "has more than one parent");
@@ -191,10 +200,12 @@ Result<std::vector<int>> rootNodes(const tinygltf::Model& model, const std::stri
     auto addScene = [&](size_t s) -> std::optional<Error> {
         for (int n : model.scenes[s].nodes) {
             if (n < 0 || static_cast<size_t>(n) >= model.nodes.size()) {
-                return badInput(path, "scene " + std::to_string(s), "node index " + std::to_string(n) + " out of range");
+                return badInput(path, "scene " + std::to_string(s),
+                                "node index " + std::to_string(n) + " out of range");
             }
             if (parents[static_cast<size_t>(n)] != 0) {
-                return badInput(path, "scene " + std::to_string(s), "node " + std::to_string(n) + " is not a root node");
+                return badInput(path, "scene " + std::to_string(s),
+                                "node " + std::to_string(n) + " is not a root node");
             }
             roots.push_back(n);
         }
@@ -232,16 +243,19 @@ Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::strin
         tinygltf::TinyGLTF loader;
         loader.SetImageLoader(&skipImage, nullptr);
         if (binary) {
-            ok = loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+            ok = loader.LoadBinaryFromMemory(&model, &err, &warn,
+                                             reinterpret_cast<const unsigned char*>(bytes.data()),
                                              static_cast<unsigned int>(bytes.size()), baseDir);
         } else {
-            ok = loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()),
-                                            baseDir);
+            ok = loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
+                                            static_cast<unsigned int>(bytes.size()), baseDir);
         }
     } catch (const std::exception& e) {
         return badInput(path, "glTF", std::string("malformed: ") + e.what());
     }
-    if (!ok) return badInput(path, "glTF", "malformed: " + (err.empty() ? std::string("tinygltf failed") : trimmed(err)));
+    if (!ok)
+        return badInput(path, "glTF",
+                        "malformed: " + (err.empty() ? std::string("tinygltf failed") : trimmed(err)));
 
     auto roots = rootNodes(model, path);
     if (!roots) return roots.error();

@@ -37,8 +37,8 @@ private:
 size_t initialCapacity(std::string_view compressed) {
     if (compressed.size() < 18) return 4096;
     const auto* tail = reinterpret_cast<const unsigned char*>(compressed.data() + compressed.size() - 4);
-    const uint64_t hinted = uint64_t{tail[0]} | uint64_t{tail[1]} << 8 | uint64_t{tail[2]} << 16 |
-                            uint64_t{tail[3]} << 24;
+    const uint64_t hinted =
+        uint64_t{tail[0]} | uint64_t{tail[1]} << 8 | uint64_t{tail[2]} << 16 | uint64_t{tail[3]} << 24;
     const uint64_t bound = uint64_t{compressed.size()} * 1032;
     return static_cast<size_t>(std::clamp<uint64_t>(hinted, 4096, std::max<uint64_t>(bound, 4096)));
 }

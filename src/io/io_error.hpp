@@ -10,8 +10,7 @@ namespace rthdist::io {
 
 // where names the place inside the file: "line 12", "vertex 7",
 // "byte offset 96", "element face", "header"...
-[[nodiscard]] inline Error badInput(std::string_view path, std::string_view where,
-                                    std::string_view what) {
+[[nodiscard]] inline Error badInput(std::string_view path, std::string_view where, std::string_view what) {
     std::string message;
     message.reserve(path.size() + where.size() + what.size() + 4);
     message.append(path).append(": ").append(where).append(": ").append(what);

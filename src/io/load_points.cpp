@@ -42,7 +42,8 @@ Result<std::vector<glm::vec3>> loadPoints(const std::string& path) {
     if (ext == ".pcd") reader = &readPcd;
     if (reader == nullptr) {
         return badInput(path, "file",
-                        "unsupported extension '" + ext + "' (ply, xyz, txt, obj, gltf, glb, stl, off, pcd, optionally .gz)");
+                        "unsupported extension '" + ext +
+                            "' (ply, xyz, txt, obj, gltf, glb, stl, off, pcd, optionally .gz)");
     }
 
     auto bytes = readFileBytes(path);
@@ -57,8 +58,8 @@ Result<std::vector<glm::vec3>> loadPoints(const std::string& path) {
         for (int axis = 0; axis < 3; ++axis) {
             if (!std::isfinite(p[axis])) {
                 return badInput(path, "vertex " + std::to_string(i),
-                                std::string("coordinate ") + "xyz"[axis] + " is " + (std::isnan(p[axis]) ? "NaN" : "infinite") +
-                                    " (or beyond float range)");
+                                std::string("coordinate ") + "xyz"[axis] + " is " +
+                                    (std::isnan(p[axis]) ? "NaN" : "infinite") + " (or beyond float range)");
             }
         }
     }

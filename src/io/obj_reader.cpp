@@ -19,7 +19,8 @@ Result<std::vector<glm::vec3>> readObj(std::string_view bytes, const std::string
         std::array<std::string_view, 4> tok{};
         const size_t n = splitTokens(body.substr(1), tok.data(), tok.size());
         if (n < 3) {
-            return badInput(path, lineWhere(cursor.line()), "vertex line with " + std::to_string(n) + " coordinate(s)");
+            return badInput(path, lineWhere(cursor.line()),
+                            "vertex line with " + std::to_string(n) + " coordinate(s)");
         }
         float v[3];
         for (size_t axis = 0; axis < 3; ++axis) {

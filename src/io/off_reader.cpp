@@ -37,11 +37,13 @@ Result<std::vector<glm::vec3>> readOff(std::string_view bytes, const std::string
     const std::string_view keyword = tok[0];
     // [ST][C][N][4][n]OFF; 4-D and n-D vertices are not 3-D points.
     if (!keyword.ends_with("OFF")) {
-        return badInput(path, lineWhere(cursor.line()), "not an OFF file (header '" + std::string(keyword) + "')");
+        return badInput(path, lineWhere(cursor.line()),
+                        "not an OFF file (header '" + std::string(keyword) + "')");
     }
     const std::string_view prefix = keyword.substr(0, keyword.size() - 3);
     if (prefix.find_first_not_of("STCN") != std::string_view::npos) {
-        return badInput(path, lineWhere(cursor.line()), "unsupported OFF variant '" + std::string(keyword) + "'");
+        return badInput(path, lineWhere(cursor.line()),
+                        "unsupported OFF variant '" + std::string(keyword) + "'");
     }
     if (n >= 2 && tok[1] == "BINARY") {
         return badInput(path, lineWhere(cursor.line()), "binary OFF is not supported");
@@ -49,7 +51,8 @@ Result<std::vector<glm::vec3>> readOff(std::string_view bytes, const std::string
     // Counts follow on the same line or on the next content line.
     size_t first = 1;
     if (n < 2) {
-        if (!nextContentLine(cursor, line)) return badInput(path, lineWhere(cursor.line()), "no vertex/face counts");
+        if (!nextContentLine(cursor, line))
+            return badInput(path, lineWhere(cursor.line()), "no vertex/face counts");
         n = splitTokens(line, tok.data(), tok.size());
         first = 0;
     }
@@ -62,18 +65,22 @@ Result<std::vector<glm::vec3>> readOff(std::string_view bytes, const std::string
     if (vertexCount > (cursor.remaining() + 1) / 6) {
         return badInput(path, lineWhere(countLine),
                         "declares " + std::to_string(vertexCount) + " vertices but only " +
-                            std::to_string(cursor.remaining()) + " bytes follow (truncated file or wrong count)");
+                            std::to_string(cursor.remaining()) +
+                            " bytes follow (truncated file or wrong count)");
     }
 
     std::vector<glm::vec3> points(static_cast<size_t>(vertexCount));
     for (uint64_t k = 0; k < vertexCount; ++k) {
         if (!nextContentLine(cursor, line)) {
-            return badInput(path, lineWhere(cursor.line()),
-                            "file ends at vertex " + std::to_string(k) + " of " + std::to_string(vertexCount));
+            return badInput(
+                path, lineWhere(cursor.line()),
+                "file ends at vertex " + std::to_string(k) + " of " + std::to_string(vertexCount));
         }
         std::array<std::string_view, 3> xyz{};
         const size_t m = splitTokens(line, xyz.data(), xyz.size());
-        if (m < 3) return badInput(path, lineWhere(cursor.line()), "vertex line with " + std::to_string(m) + " value(s)");
+        if (m < 3)
+            return badInput(path, lineWhere(cursor.line()),
+                            "vertex line with " + std::to_string(m) + " value(s)");
         float v[3];
         for (size_t axis = 0; axis < 3; ++axis) {
             if (!parseFloat(xyz[axis], v[axis])) {

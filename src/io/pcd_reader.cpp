@@ -61,8 +61,9 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
         auto where = lineWhere(lineNo);
         auto perField = [&](const char* what) -> std::optional<Error> {
             if (n - 1 != fields.size()) {
-                return badInput(path, where, std::string(what) + " has " + std::to_string(n - 1) + " values for " +
-                                                 std::to_string(fields.size()) + " fields");
+                return badInput(path, where,
+                                std::string(what) + " has " + std::to_string(n - 1) + " values for " +
+                                    std::to_string(fields.size()) + " fields");
             }
             return std::nullopt;
         };
@@ -74,13 +75,15 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
             if (auto err = perField("SIZE")) return *err;
             for (size_t i = 1; i < n; ++i) {
                 uint64_t s = 0;
-                if (!parseUInt(tok[i], s) || s == 0 || s > 8) return badInput(path, where, "bad SIZE '" + std::string(tok[i]) + "'");
+                if (!parseUInt(tok[i], s) || s == 0 || s > 8)
+                    return badInput(path, where, "bad SIZE '" + std::string(tok[i]) + "'");
                 fields[i - 1].size = static_cast<size_t>(s);
             }
         } else if (key == "TYPE") {
             if (auto err = perField("TYPE")) return *err;
             for (size_t i = 1; i < n; ++i) {
-                if (tok[i].size() != 1) return badInput(path, where, "bad TYPE '" + std::string(tok[i]) + "'");
+                if (tok[i].size() != 1)
+                    return badInput(path, where, "bad TYPE '" + std::string(tok[i]) + "'");
                 fields[i - 1].type = tok[i][0];
             }
         } else if (key == "COUNT") {
@@ -94,7 +97,8 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
             }
         } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
             uint64_t v = 0;
-            if (n != 2 || !parseUInt(tok[1], v)) return badInput(path, where, "bad " + std::string(key) + " line");
+            if (n != 2 || !parseUInt(tok[1], v))
+                return badInput(path, where, "bad " + std::string(key) + " line");
             if (key == "WIDTH") width = v;
             if (key == "HEIGHT") height = v;
             if (key == "POINTS") points = v;
@@ -110,13 +114,14 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
         return badInput(path, lineWhere(dataLine), "unsupported DATA '" + data + "' (ascii or binary only)");
     }
     if (!points) {
-        if (height != 0 && width > UINT64_MAX / height) return badInput(path, "header", "WIDTH * HEIGHT overflows");
+        if (height != 0 && width > UINT64_MAX / height)
+            return badInput(path, "header", "WIDTH * HEIGHT overflows");
         points = width * height;
     }
 
     // Column of x, y, z (first element of each) and bytes/values per row.
-    std::array<std::optional<uint64_t>, 3> column{};      // ascii value index
-    std::array<uint64_t, 3> byteOffset{};                  // binary byte offset
+    std::array<std::optional<uint64_t>, 3> column{};  // ascii value index
+    std::array<uint64_t, 3> byteOffset{};             // binary byte offset
     std::array<ScalarType, 3> scalar{};
     uint64_t valuesPerRow = 0;
     uint64_t bytesPerRow = 0;
@@ -124,8 +129,9 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
     for (const PcdField& f : fields) {
         const auto type = pcdScalarType(f.type, f.size);
         if (!type) {
-            return badInput(path, "field " + f.name,
-                            "unsupported TYPE " + std::string(1, f.type) + " with SIZE " + std::to_string(f.size));
+            return badInput(
+                path, "field " + f.name,
+                "unsupported TYPE " + std::string(1, f.type) + " with SIZE " + std::to_string(f.size));
         }
         for (size_t axis = 0; axis < 3; ++axis) {
             if (f.name == kNames[axis] && !column[axis]) {
@@ -146,14 +152,16 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
     if (data == "binary") {
         if (*points > left / bytesPerRow) {
             return badInput(path, offsetWhere(cursor.offset()),
-                            "declares " + std::to_string(*points) + " points of " + std::to_string(bytesPerRow) +
-                                " bytes, but only " + std::to_string(left) + " bytes remain (truncated body or wrong count)");
+                            "declares " + std::to_string(*points) + " points of " +
+                                std::to_string(bytesPerRow) + " bytes, but only " + std::to_string(left) +
+                                " bytes remain (truncated body or wrong count)");
         }
         std::vector<glm::vec3> out(static_cast<size_t>(*points));
         const char* row = bytes.data() + cursor.offset();
         for (uint64_t k = 0; k < *points; ++k, row += bytesPerRow) {
             double v[3];
-            for (size_t axis = 0; axis < 3; ++axis) v[axis] = loadScalar(row + byteOffset[axis], scalar[axis], false);
+            for (size_t axis = 0; axis < 3; ++axis)
+                v[axis] = loadScalar(row + byteOffset[axis], scalar[axis], false);
             out[k] = glm::vec3(narrowToFloat(v[0]), narrowToFloat(v[1]), narrowToFloat(v[2]));
         }
         return out;
@@ -176,8 +184,9 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
         if (trimBlank(line).empty()) continue;
         const size_t n = splitTokens(line, tok.data(), tok.size());
         if (n < valuesPerRow) {
-            return badInput(path, lineWhere(cursor.line()),
-                            "row has " + std::to_string(n) + " values, fields need " + std::to_string(valuesPerRow));
+            return badInput(
+                path, lineWhere(cursor.line()),
+                "row has " + std::to_string(n) + " values, fields need " + std::to_string(valuesPerRow));
         }
         float v[3];
         for (size_t axis = 0; axis < 3; ++axis) {

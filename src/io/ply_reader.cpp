@@ -79,7 +79,8 @@ Result<PlyHeader> parseHeader(std::string_view bytes, const std::string& path) {
                 return badInput(path, lineWhere(lineNo), "unsupported format '" + std::string(tok[1]) + "'");
             }
             if (n >= 3 && tok[2] != "1.0" && tok[2] != "1") {
-                return badInput(path, lineWhere(lineNo), "unsupported PLY version '" + std::string(tok[2]) + "'");
+                return badInput(path, lineWhere(lineNo),
+                                "unsupported PLY version '" + std::string(tok[2]) + "'");
             }
             haveFormat = true;
             continue;
@@ -87,18 +88,21 @@ Result<PlyHeader> parseHeader(std::string_view bytes, const std::string& path) {
         if (key == "element") {
             uint64_t count = 0;
             if (n != 3 || !parseUInt(tok[2], count)) {
-                return badInput(path, lineWhere(lineNo), "malformed element line (want 'element <name> <count>')");
+                return badInput(path, lineWhere(lineNo),
+                                "malformed element line (want 'element <name> <count>')");
             }
             header.elements.push_back(PlyElement{std::string(tok[1]), count, lineNo, {}});
             continue;
         }
         if (key == "property") {
-            if (header.elements.empty()) return badInput(path, lineWhere(lineNo), "property before any element");
+            if (header.elements.empty())
+                return badInput(path, lineWhere(lineNo), "property before any element");
             PlyProperty prop;
             if (n >= 2 && tok[1] == "list") {
                 if (n != 5) {
-                    return badInput(path, lineWhere(lineNo),
-                                    "malformed list property (want 'property list <count type> <item type> <name>')");
+                    return badInput(
+                        path, lineWhere(lineNo),
+                        "malformed list property (want 'property list <count type> <item type> <name>')");
                 }
                 const auto countType = plyScalarType(tok[2]);
                 const auto itemType = plyScalarType(tok[3]);
@@ -107,13 +111,16 @@ Result<PlyHeader> parseHeader(std::string_view bytes, const std::string& path) {
                                     "unsupported list count type '" + std::string(tok[2]) + "'");
                 }
                 if (!itemType) {
-                    return badInput(path, lineWhere(lineNo), "unsupported property type '" + std::string(tok[3]) + "'");
+                    return badInput(path, lineWhere(lineNo),
+                                    "unsupported property type '" + std::string(tok[3]) + "'");
                 }
                 prop = PlyProperty{std::string(tok[4]), *itemType, true, *countType};
             } else {
                 if (n != 3) return badInput(path, lineWhere(lineNo), "malformed property line");
                 const auto type = plyScalarType(tok[1]);
-                if (!type) return badInput(path, lineWhere(lineNo), "unsupported property type '" + std::string(tok[1]) + "'");
+                if (!type)
+                    return badInput(path, lineWhere(lineNo),
+                                    "unsupported property type '" + std::string(tok[1]) + "'");
                 prop = PlyProperty{std::string(tok[2]), *type, false, ScalarType::kUInt8};
             }
             header.elements.back().properties.push_back(std::move(prop));
@@ -162,9 +169,9 @@ public:
         const uint64_t left = m_bytes.size() - m_pos;
         if (minSize != 0 && e.count > left / minSize) {
             return badInput(m_path, offsetWhere(m_pos),
-                            "element " + e.name + " declares " + std::to_string(e.count) + " items of at least " +
-                                std::to_string(minSize) + " bytes, but only " + std::to_string(left) +
-                                " bytes remain (truncated body or wrong count)");
+                            "element " + e.name + " declares " + std::to_string(e.count) +
+                                " items of at least " + std::to_string(minSize) + " bytes, but only " +
+                                std::to_string(left) + " bytes remain (truncated body or wrong count)");
         }
         return std::nullopt;
     }
@@ -178,7 +185,8 @@ public:
                 if (m_bytes.size() - m_pos < size) return truncated(e, index);
                 if (xyz != nullptr) {
                     for (size_t axis = 0; axis < 3; ++axis) {
-                        if (xyz->prop[axis] == i) values[axis] = loadScalar(m_bytes.data() + m_pos, p.type, m_bigEndian);
+                        if (xyz->prop[axis] == i)
+                            values[axis] = loadScalar(m_bytes.data() + m_pos, p.type, m_bigEndian);
                     }
                 }
                 m_pos += size;
@@ -188,11 +196,13 @@ public:
             if (m_bytes.size() - m_pos < countSize) return truncated(e, index);
             const double count = loadScalar(m_bytes.data() + m_pos, p.countType, m_bigEndian);
             if (count < 0) {
-                return badInput(m_path, offsetWhere(m_pos),
-                                "element " + e.name + " item " + std::to_string(index) + ": negative list length");
+                return badInput(
+                    m_path, offsetWhere(m_pos),
+                    "element " + e.name + " item " + std::to_string(index) + ": negative list length");
             }
             m_pos += countSize;
-            const uint64_t skip = static_cast<uint64_t>(count) * scalarSize(p.type);  // count < 2^32: no overflow
+            const uint64_t skip =
+                static_cast<uint64_t>(count) * scalarSize(p.type);  // count < 2^32: no overflow
             if (m_bytes.size() - m_pos < skip) return truncated(e, index);
             m_pos += skip;
         }
@@ -202,8 +212,9 @@ public:
 private:
     Error truncated(const PlyElement& e, uint64_t index) const {
         return badInput(m_path, offsetWhere(m_pos),
-                        "element " + e.name + " item " + std::to_string(index) + ": file ends inside the item (" +
-                            std::to_string(e.count) + " declared; truncated body)");
+                        "element " + e.name + " item " + std::to_string(index) +
+                            ": file ends inside the item (" + std::to_string(e.count) +
+                            " declared; truncated body)");
     }
 
     std::string_view m_bytes;
@@ -212,8 +223,9 @@ private:
     const std::string& m_path;
 };
 
-Result<std::vector<glm::vec3>> readBinaryBody(std::string_view bytes, const PlyHeader& header, size_t vertexElement,
-                                              const XyzIndex& xyz, const std::string& path) {
+Result<std::vector<glm::vec3>> readBinaryBody(std::string_view bytes, const PlyHeader& header,
+                                              size_t vertexElement, const XyzIndex& xyz,
+                                              const std::string& path) {
     BinaryBody body(bytes, header.bodyOffset, header.format == PlyFormat::kBinaryBigEndian, path);
     for (size_t ei = 0; ei < vertexElement; ++ei) {
         const PlyElement& e = header.elements[ei];
@@ -236,8 +248,9 @@ Result<std::vector<glm::vec3>> readBinaryBody(std::string_view bytes, const PlyH
 
 // ---- ascii bodies ----------------------------------------------------------
 
-Result<std::vector<glm::vec3>> readAsciiBody(std::string_view bytes, const PlyHeader& header, size_t vertexElement,
-                                             const XyzIndex& xyz, const std::string& path) {
+Result<std::vector<glm::vec3>> readAsciiBody(std::string_view bytes, const PlyHeader& header,
+                                             size_t vertexElement, const XyzIndex& xyz,
+                                             const std::string& path) {
     TextCursor cursor(bytes.substr(header.bodyOffset), header.bodyLine);
     auto endOfFile = [&](const PlyElement& e, uint64_t index) {
         return badInput(path, lineWhere(cursor.line()),
@@ -278,7 +291,8 @@ Result<std::vector<glm::vec3>> readAsciiBody(std::string_view bytes, const PlyHe
     if (vertex.count > (cursor.remaining() + 1) / minItemChars) {
         return badInput(path, "element vertex",
                         "declares " + std::to_string(vertex.count) + " vertices but only " +
-                            std::to_string(cursor.remaining()) + " bytes remain (truncated body or wrong count)");
+                            std::to_string(cursor.remaining()) +
+                            " bytes remain (truncated body or wrong count)");
     }
     std::vector<glm::vec3> points(static_cast<size_t>(vertex.count));
     for (uint64_t k = 0; k < vertex.count; ++k) {
@@ -298,8 +312,9 @@ Result<std::vector<glm::vec3>> readAsciiBody(std::string_view bytes, const PlyHe
             for (size_t axis = 0; axis < 3; ++axis) {
                 if (xyz.prop[axis] != i) continue;
                 if (!parseFloat(tok, v[axis])) {
-                    return badInput(path, lineWhere(cursor.line()),
-                                    "vertex " + std::to_string(k) + " property " + p.name + ": " + notANumber(tok));
+                    return badInput(
+                        path, lineWhere(cursor.line()),
+                        "vertex " + std::to_string(k) + " property " + p.name + ": " + notANumber(tok));
                 }
             }
         }

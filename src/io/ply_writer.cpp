@@ -22,9 +22,10 @@ Result<bool> writePlyPoints(const std::string& path, const std::vector<glm::vec3
     std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "wb"));
     if (!file) return badInput(path, "open", std::strerror(errno));
 
-    const std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by rthdist\nelement vertex " +
-                               std::to_string(points.size()) +
-                               "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    const std::string header =
+        "ply\nformat binary_little_endian 1.0\ncomment written by rthdist\nelement vertex " +
+        std::to_string(points.size()) +
+        "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
     std::vector<char> body(points.size() * 12);
     for (size_t i = 0; i < points.size(); ++i) {
         for (int axis = 0; axis < 3; ++axis) {

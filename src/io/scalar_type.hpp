@@ -11,7 +11,18 @@
 
 namespace rthdist::io {
 
-enum class ScalarType { kInt8, kUInt8, kInt16, kUInt16, kInt32, kUInt32, kInt64, kUInt64, kFloat32, kFloat64 };
+enum class ScalarType {
+    kInt8,
+    kUInt8,
+    kInt16,
+    kUInt16,
+    kInt32,
+    kUInt32,
+    kInt64,
+    kUInt64,
+    kFloat32,
+    kFloat64
+};
 
 [[nodiscard]] constexpr size_t scalarSize(ScalarType t) {
     switch (t) {

@@ -37,8 +37,7 @@ Result<std::vector<glm::vec3>> readAscii(std::string_view bytes, const std::stri
             const std::string_view num = cursor.nextToken();
             if (!parseFloat(num, v[axis])) {
                 return badInput(path, lineWhere(cursor.line()),
-                                num.empty() ? std::string("file ends inside a vertex")
-                                            : notANumber(num));
+                                num.empty() ? std::string("file ends inside a vertex") : notANumber(num));
             }
         }
         points.emplace_back(v[0], v[1], v[2]);
@@ -51,14 +50,16 @@ Result<std::vector<glm::vec3>> readAscii(std::string_view bytes, const std::stri
 Result<std::vector<glm::vec3>> readStl(std::string_view bytes, const std::string& path) {
     // Many binary STLs also start with "solid", so the size decides first.
     if (bytes.size() >= kHeaderSize + 4) {
-        const uint64_t facets = static_cast<uint64_t>(loadScalar(bytes.data() + kHeaderSize, ScalarType::kUInt32, false));
+        const uint64_t facets =
+            static_cast<uint64_t>(loadScalar(bytes.data() + kHeaderSize, ScalarType::kUInt32, false));
         const uint64_t need = kHeaderSize + 4 + facets * kFacetSize;
         if (bytes.size() == need) return readBinary(bytes, facets);
         if (!trimBlank(bytes.substr(0, 64)).starts_with("solid")) {
             if (bytes.size() < need) {
                 return badInput(path, offsetWhere(kHeaderSize),
-                                "binary STL declares " + std::to_string(facets) + " facets (" + std::to_string(need) +
-                                    " bytes) but the file has " + std::to_string(bytes.size()) + " bytes");
+                                "binary STL declares " + std::to_string(facets) + " facets (" +
+                                    std::to_string(need) + " bytes) but the file has " +
+                                    std::to_string(bytes.size()) + " bytes");
             }
             return readBinary(bytes, facets);  // trailing bytes after the facets are ignored
         }

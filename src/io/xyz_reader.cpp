@@ -20,7 +20,8 @@ Result<std::vector<glm::vec3>> readXyz(std::string_view bytes, const std::string
         std::array<std::string_view, 3> tok{};
         const size_t n = splitTokens(body, tok.data(), tok.size(), ",;");
         if (n < 3) {
-            return badInput(path, lineWhere(cursor.line()), "expected 'x y z', found " + std::to_string(n) + " column(s)");
+            return badInput(path, lineWhere(cursor.line()),
+                            "expected 'x y z', found " + std::to_string(n) + " column(s)");
         }
         float v[3];
         for (size_t axis = 0; axis < 3; ++axis) {

@@ -12,7 +12,8 @@ std::string base64(const std::string& in) {
     std::string out;
     size_t i = 0;
     for (; i + 2 < in.size(); i += 3) {
-        const uint32_t v = uint32_t(uint8_t(in[i])) << 16 | uint32_t(uint8_t(in[i + 1])) << 8 | uint8_t(in[i + 2]);
+        const uint32_t v =
+            uint32_t(uint8_t(in[i])) << 16 | uint32_t(uint8_t(in[i + 1])) << 8 | uint8_t(in[i + 2]);
         for (int s = 18; s >= 0; s -= 6) out += kAlphabet[(v >> s) & 63];
     }
     if (i + 1 == in.size()) {
@@ -20,7 +21,8 @@ std::string base64(const std::string& in) {
         out += std::string{kAlphabet[(v >> 18) & 63], kAlphabet[(v >> 12) & 63], '=', '='};
     } else if (i + 2 == in.size()) {
         const uint32_t v = uint32_t(uint8_t(in[i])) << 16 | uint32_t(uint8_t(in[i + 1])) << 8;
-        out += std::string{kAlphabet[(v >> 18) & 63], kAlphabet[(v >> 12) & 63], kAlphabet[(v >> 6) & 63], '='};
+        out +=
+            std::string{kAlphabet[(v >> 18) & 63], kAlphabet[(v >> 12) & 63], kAlphabet[(v >> 6) & 63], '='};
     }
     return out;
 }
@@ -41,17 +43,18 @@ struct GltfParts {
 };
 
 std::string gltfJson(const GltfParts& p) {
-    return R"({"asset":{"version":"2.0"},"buffers":[)" + p.bufferJson + R"(],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" +
-           std::to_string(p.byteLength) + R"(}],"accessors":[{"bufferView":0,"componentType":5126,"count":)" +
-           std::to_string(p.count) + R"(,"type":")" + p.accessorType +
-           R"("}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"mode":4}]}],"nodes":)" + p.nodes + "," + p.scenes +
-           "}";
+    return R"({"asset":{"version":"2.0"},"buffers":[)" + p.bufferJson +
+           R"(],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" + std::to_string(p.byteLength) +
+           R"(}],"accessors":[{"bufferView":0,"componentType":5126,"count":)" + std::to_string(p.count) +
+           R"(,"type":")" + p.accessorType +
+           R"("}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"mode":4}]}],"nodes":)" + p.nodes +
+           "," + p.scenes + "}";
 }
 
 std::string embedded(const std::vector<glm::vec3>& pts) {
     const std::string bin = positions(pts);
-    return R"({"byteLength":)" + std::to_string(bin.size()) + R"(,"uri":"data:application/octet-stream;base64,)" +
-           base64(bin) + R"("})";
+    return R"({"byteLength":)" + std::to_string(bin.size()) +
+           R"(,"uri":"data:application/octet-stream;base64,)" + base64(bin) + R"("})";
 }
 
 std::string glb(const std::string& json, const std::string& bin) {
@@ -69,7 +72,8 @@ std::string glb(const std::string& json, const std::string& bin) {
 void expectNear(const std::vector<glm::vec3>& got, const std::vector<glm::vec3>& want) {
     ASSERT_EQ(got.size(), want.size());
     for (size_t i = 0; i < got.size(); ++i) {
-        for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[i][a], want[i][a], 1e-4) << "point " << i << " axis " << a;
+        for (int a = 0; a < 3; ++a)
+            EXPECT_NEAR(got[i][a], want[i][a], 1e-4) << "point " << i << " axis " << a;
     }
 }
 
@@ -197,7 +201,8 @@ TEST_F(GltfReader, TruncatedGlb) {
 }
 
 TEST_F(GltfReader, NoMeshesHasNoPoints) {
-    const std::string path = write("empty.gltf", R"({"asset":{"version":"2.0"},"nodes":[{}],"scenes":[{"nodes":[0]}]})");
+    const std::string path =
+        write("empty.gltf", R"({"asset":{"version":"2.0"},"nodes":[{}],"scenes":[{"nodes":[0]}]})");
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "contains no points"));
 }
 

@@ -2,9 +2,9 @@
 // for binary formats, gzip, and the bad-input assertion every error test uses.
 #pragma once
 
-#include <glm/common.hpp>
 #include <gtest/gtest.h>
 #include <zlib.h>
+#include <glm/common.hpp>
 
 #include <bit>
 #include <cstdint>
@@ -92,7 +92,8 @@ template <class T>
         return ::testing::AssertionFailure() << "code is not kBadInput: " << r.error().message;
     }
     const std::string& msg = r.error().message;
-    if (msg.rfind(path + ": ", 0) != 0) return ::testing::AssertionFailure() << "message lacks the path prefix: " << msg;
+    if (msg.rfind(path + ": ", 0) != 0)
+        return ::testing::AssertionFailure() << "message lacks the path prefix: " << msg;
     if (msg.find(where) == std::string::npos) {
         return ::testing::AssertionFailure() << "message lacks '" << where << "': " << msg;
     }

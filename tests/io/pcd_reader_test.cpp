@@ -7,9 +7,10 @@ namespace {
 using PcdReader = TempDirTest;
 
 TEST_F(PcdReader, Ascii) {
-    const std::string text = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n"
-                             "WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n"
-                             "1.5 -2.25 3 4808703\n0 0.001 -7.5 0\n100 200.5 -300.25 1\n";
+    const std::string text =
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n"
+        "WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n"
+        "1.5 -2.25 3 4808703\n0 0.001 -7.5 0\n100 200.5 -300.25 1\n";
     auto r = loadPoints(write("a.pcd", text));
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(*r, threePoints());
@@ -18,8 +19,9 @@ TEST_F(PcdReader, Ascii) {
 TEST_F(PcdReader, BinaryMixedTypesAndCounts) {
     // normal (3 floats) first, then z as double, x as float, y as int16.
     ByteBuilder b;
-    b.text("VERSION .7\nFIELDS normal z x y\nSIZE 4 8 4 2\nTYPE F F F I\nCOUNT 3 1 1 1\nWIDTH 2\nHEIGHT 1\n"
-           "DATA binary\n");
+    b.text(
+        "VERSION .7\nFIELDS normal z x y\nSIZE 4 8 4 2\nTYPE F F F I\nCOUNT 3 1 1 1\nWIDTH 2\nHEIGHT 1\n"
+        "DATA binary\n");
     b.put(0.f).put(0.f).put(1.f).put(3.0).put(1.5f).put<int16_t>(-2);
     b.put(0.f).put(0.f).put(1.f).put(-7.5).put(0.25f).put<int16_t>(9);
     auto r = loadPoints(write("b.pcd", b.str()));
@@ -36,16 +38,19 @@ TEST_F(PcdReader, BinaryTruncated) {
 }
 
 TEST_F(PcdReader, CompressedUnsupported) {
-    const std::string path = write("c.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA binary_compressed\n");
+    const std::string path =
+        write("c.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA binary_compressed\n");
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 5: unsupported DATA 'binary_compressed'"));
 }
 
 TEST_F(PcdReader, HeaderErrors) {
     const std::string noZ = write("noz.pcd", "FIELDS x y\nSIZE 4 4\nTYPE F F\nPOINTS 1\nDATA ascii\n1 2\n");
     EXPECT_TRUE(isBadInput(loadPoints(noZ), noZ, "header: no field 'z'"));
-    const std::string sizes = write("sz.pcd", "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n1 2 3\n");
+    const std::string sizes =
+        write("sz.pcd", "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n1 2 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(sizes), sizes, "line 2"));
-    const std::string type = write("ty.pcd", "FIELDS x y z\nSIZE 4 4 2\nTYPE F F F\nPOINTS 1\nDATA ascii\n1 2 3\n");
+    const std::string type =
+        write("ty.pcd", "FIELDS x y z\nSIZE 4 4 2\nTYPE F F F\nPOINTS 1\nDATA ascii\n1 2 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(type), type, "field z: unsupported TYPE F with SIZE 2"));
     const std::string noData = write("nd.pcd", "FIELDS x y z\nSIZE 4 4 4\n");
     EXPECT_TRUE(isBadInput(loadPoints(noData), noData, "header: no DATA line"));

@@ -17,19 +17,22 @@ std::string header(const std::string& format, const std::string& body) {
 const std::string kXyzFloat = "property float x\nproperty float y\nproperty float z\n";
 
 TEST_F(PlyReader, AsciiWithExtraPropertiesFacesAndComments) {
-    const std::string text = "ply\nformat ascii 1.0\ncomment zipper output\nobj_info num_cols 512\n"
-                             "element vertex 3\n" + kXyzFloat +
-                             "property float confidence\nproperty float intensity\n"
-                             "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                             "1.5 -2.25 3 0.85 0.5\n0 0.001 -7.5 0.9 0.5\n100 200.5 -300.25 0.4 0.5\n3 0 1 2\n";
+    const std::string text =
+        "ply\nformat ascii 1.0\ncomment zipper output\nobj_info num_cols 512\n"
+        "element vertex 3\n" +
+        kXyzFloat +
+        "property float confidence\nproperty float intensity\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        "1.5 -2.25 3 0.85 0.5\n0 0.001 -7.5 0.9 0.5\n100 200.5 -300.25 0.4 0.5\n3 0 1 2\n";
     auto r = loadPoints(write("a.ply", text));
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(*r, threePoints());
 }
 
 TEST_F(PlyReader, CrLfHeaderAndBody) {
-    const std::string text = "ply\r\nformat ascii 1.0\r\nelement vertex 1\r\nproperty float x\r\nproperty float y\r\n"
-                             "property float z\r\nend_header\r\n1 2 3\r\n";
+    const std::string text =
+        "ply\r\nformat ascii 1.0\r\nelement vertex 1\r\nproperty float x\r\nproperty float y\r\n"
+        "property float z\r\nend_header\r\n1 2 3\r\n";
     auto r = loadPoints(write("crlf.ply", text));
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(*r, (std::vector<glm::vec3>{{1, 2, 3}}));
@@ -37,8 +40,9 @@ TEST_F(PlyReader, CrLfHeaderAndBody) {
 
 TEST_F(PlyReader, AsciiPropertyOrderAndVertexList) {
     // z before x, a list inside the vertex element, an unused property first.
-    const std::string text = header("ascii", "element vertex 2\nproperty uchar red\nproperty double z\n"
-                                             "property list uchar float normals\nproperty int x\nproperty short y\n") +
+    const std::string text = header("ascii",
+                                    "element vertex 2\nproperty uchar red\nproperty double z\n"
+                                    "property list uchar float normals\nproperty int x\nproperty short y\n") +
                              "255 3 2 0.5 0.5 1 2\n0 -6 0 4 5\n";
     auto r = loadPoints(write("order.ply", text));
     ASSERT_TRUE(r.ok()) << r.error().message;
@@ -48,18 +52,21 @@ TEST_F(PlyReader, AsciiPropertyOrderAndVertexList) {
 TEST_F(PlyReader, AsciiElementsBeforeVertexAreSkipped) {
     // range_grid as in the Stanford range scans, but placed before the vertices;
     // items spread over lines in any way the token stream allows.
-    const std::string text = header("ascii", "element range_grid 4\nproperty list uchar int vertex_indices\n"
-                                             "element face 2\nproperty list uchar int vertex_indices\nproperty uchar flags\n"
-                                             "element vertex 2\n" + kXyzFloat) +
-                             "0\n1 0\n0\n2 0 1\n3 0 1 1 7\n3 1 0 1\n8\n1 2 3\n4 5 6\n";
+    const std::string text =
+        header("ascii",
+               "element range_grid 4\nproperty list uchar int vertex_indices\n"
+               "element face 2\nproperty list uchar int vertex_indices\nproperty uchar flags\n"
+               "element vertex 2\n" +
+                   kXyzFloat) +
+        "0\n1 0\n0\n2 0 1\n3 0 1 1 7\n3 1 0 1\n8\n1 2 3\n4 5 6\n";
     auto r = loadPoints(write("before.ply", text));
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(*r, (std::vector<glm::vec3>{{1, 2, 3}, {4, 5, 6}}));
 }
 
 TEST_F(PlyReader, ElementWithoutPropertiesAndHugeCountIsSkippedInstantly) {
-    const std::string text = header("ascii", "element nothing 18446744073709551615\nelement vertex 1\n" + kXyzFloat) +
-                             "1 2 3\n";
+    const std::string text =
+        header("ascii", "element nothing 18446744073709551615\nelement vertex 1\n" + kXyzFloat) + "1 2 3\n";
     auto r = loadPoints(write("empty_element.ply", text));
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(r->size(), 1u);
@@ -72,10 +79,14 @@ std::string binaryPly(const std::string& typeName, bool bigEndian, const std::ve
     ByteBuilder b(bigEndian);
     b.text(header(bigEndian ? "binary_big_endian" : "binary_little_endian",
                   "comment typed\nelement tristrips 1\nproperty list int int vertex_indices\n"
-                  "element vertex " + std::to_string(xyz.size() / 3) + "\nproperty float confidence\n"
-                  "property " + typeName + " x\nproperty " + typeName + " y\nproperty " + typeName + " z\n"
-                  "property list uchar float extra\n"
-                  "element face 1\nproperty list uchar int vertex_indices\n"));
+                  "element vertex " +
+                      std::to_string(xyz.size() / 3) +
+                      "\nproperty float confidence\n"
+                      "property " +
+                      typeName + " x\nproperty " + typeName + " y\nproperty " + typeName +
+                      " z\n"
+                      "property list uchar float extra\n"
+                      "element face 1\nproperty list uchar int vertex_indices\n"));
     b.put<int32_t>(4).put<int32_t>(0).put<int32_t>(1).put<int32_t>(-1).put<int32_t>(2);
     for (size_t i = 0; i < xyz.size(); i += 3) {
         b.put<float>(0.5f);
@@ -90,12 +101,13 @@ std::string binaryPly(const std::string& typeName, bool bigEndian, const std::ve
 
 template <class T>
 void expectTypeRoundTrip(PlyReader& t, const std::string& typeName) {
-    const std::vector<T> xyz = std::is_signed_v<T> ? std::vector<T>{1, 2, 3, T(-4), 5, 127}
-                                                   : std::vector<T>{1, 2, 3, 4, 5, 127};
+    const std::vector<T> xyz =
+        std::is_signed_v<T> ? std::vector<T>{1, 2, 3, T(-4), 5, 127} : std::vector<T>{1, 2, 3, 4, 5, 127};
     const std::vector<glm::vec3> want = {{float(xyz[0]), float(xyz[1]), float(xyz[2])},
                                          {float(xyz[3]), float(xyz[4]), float(xyz[5])}};
     for (bool big : {false, true}) {
-        const std::string path = t.write(typeName + (big ? "_be.ply" : "_le.ply"), binaryPly<T>(typeName, big, xyz));
+        const std::string path =
+            t.write(typeName + (big ? "_be.ply" : "_le.ply"), binaryPly<T>(typeName, big, xyz));
         auto r = loadPoints(path);
         ASSERT_TRUE(r.ok()) << typeName << ": " << r.error().message;
         EXPECT_EQ(*r, want) << typeName << (big ? " big endian" : " little endian");
@@ -147,27 +159,36 @@ TEST_F(PlyReader, NotPly) {
 }
 
 TEST_F(PlyReader, BadFormatLine) {
-    const std::string path = write("fmt.ply", header("binary_middle_endian", "element vertex 1\n" + kXyzFloat) + "1 2 3\n");
+    const std::string path =
+        write("fmt.ply", header("binary_middle_endian", "element vertex 1\n" + kXyzFloat) + "1 2 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 2: unsupported format 'binary_middle_endian'"));
-    const std::string noFormat = write("nofmt.ply", "ply\nelement vertex 1\n" + kXyzFloat + "end_header\n1 2 3\n");
+    const std::string noFormat =
+        write("nofmt.ply", "ply\nelement vertex 1\n" + kXyzFloat + "end_header\n1 2 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(noFormat), noFormat, "header: no 'format' line"));
     const std::string empty = write("emptyfmt.ply", "ply\nformat\nend_header\n");
     EXPECT_TRUE(isBadInput(loadPoints(empty), empty, "line 2"));
 }
 
 TEST_F(PlyReader, UnsupportedPropertyType) {
-    const std::string path = write("type.ply", header("ascii", "element vertex 1\nproperty int128 x\n"
-                                                               "property float y\nproperty float z\n") + "1 2 3\n");
+    const std::string path = write("type.ply", header("ascii",
+                                                      "element vertex 1\nproperty int128 x\n"
+                                                      "property float y\nproperty float z\n") +
+                                                   "1 2 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 4: unsupported property type 'int128'"));
-    const std::string list = write("listtype.ply", header("ascii", "element face 1\nproperty list float int v\n"
-                                                                   "element vertex 1\n" + kXyzFloat) + "0\n1 2 3\n");
+    const std::string list = write("listtype.ply", header("ascii",
+                                                          "element face 1\nproperty list float int v\n"
+                                                          "element vertex 1\n" +
+                                                              kXyzFloat) +
+                                                       "0\n1 2 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(list), list, "line 4: unsupported list count type 'float'"));
 }
 
 TEST_F(PlyReader, MalformedHeaderLines) {
-    const std::string count = write("count.ply", header("ascii", "element vertex many\n" + kXyzFloat) + "1 2 3\n");
+    const std::string count =
+        write("count.ply", header("ascii", "element vertex many\n" + kXyzFloat) + "1 2 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(count), count, "line 3"));
-    const std::string keyword = write("kw.ply", header("ascii", "element vertex 1\n" + kXyzFloat + "colour red\n"));
+    const std::string keyword =
+        write("kw.ply", header("ascii", "element vertex 1\n" + kXyzFloat + "colour red\n"));
     EXPECT_TRUE(isBadInput(loadPoints(keyword), keyword, "line 7: unknown header keyword 'colour'"));
     const std::string orphan = write("orphan.ply", header("ascii", "property float x\n"));
     EXPECT_TRUE(isBadInput(loadPoints(orphan), orphan, "line 3"));
@@ -176,14 +197,17 @@ TEST_F(PlyReader, MalformedHeaderLines) {
 }
 
 TEST_F(PlyReader, MissingVertexElementOrCoordinate) {
-    const std::string noVertex = write("nov.ply", header("ascii", "element face 0\nproperty list uchar int v\n"));
+    const std::string noVertex =
+        write("nov.ply", header("ascii", "element face 0\nproperty list uchar int v\n"));
     EXPECT_TRUE(isBadInput(loadPoints(noVertex), noVertex, "no 'vertex' element"));
-    const std::string noZ = write("noz.ply", header("ascii", "element vertex 1\nproperty float x\nproperty float y\n") + "1 2\n");
+    const std::string noZ =
+        write("noz.ply", header("ascii", "element vertex 1\nproperty float x\nproperty float y\n") + "1 2\n");
     EXPECT_TRUE(isBadInput(loadPoints(noZ), noZ, "element vertex: no property 'z'"));
 }
 
 TEST_F(PlyReader, ZeroVertices) {
-    const std::string path = write("zero.ply", header("binary_little_endian", "element vertex 0\n" + kXyzFloat));
+    const std::string path =
+        write("zero.ply", header("binary_little_endian", "element vertex 0\n" + kXyzFloat));
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "file: contains no points"));
 }
 
@@ -203,14 +227,17 @@ TEST_F(PlyReader, HugeCountRejectedBeforeAllocating) {
     b.put(1.0f).put(2.0f).put(3.0f);
     const std::string path = write("huge.ply", b.str());
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "byte offset"));
-    const std::string ascii = write("hugea.ply", header("ascii", "element vertex 2305843009213693952\n" + kXyzFloat) + "1 2 3\n");
+    const std::string ascii =
+        write("hugea.ply", header("ascii", "element vertex 2305843009213693952\n" + kXyzFloat) + "1 2 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(ascii), ascii, "element vertex"));
 }
 
 TEST_F(PlyReader, TruncatedListElementBeforeVertex) {
     ByteBuilder b;
-    b.text(header("binary_little_endian", "element tristrips 1\nproperty list int int vertex_indices\n"
-                                          "element vertex 1\n" + kXyzFloat));
+    b.text(header("binary_little_endian",
+                  "element tristrips 1\nproperty list int int vertex_indices\n"
+                  "element vertex 1\n" +
+                      kXyzFloat));
     b.put<int32_t>(1000000).put<int32_t>(1).put<int32_t>(2);  // the list claims far more than the file holds
     const std::string path = write("strip.ply", b.str());
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "byte offset"));
@@ -219,7 +246,8 @@ TEST_F(PlyReader, TruncatedListElementBeforeVertex) {
 
 TEST_F(PlyReader, NegativeListLength) {
     ByteBuilder b;
-    b.text(header("binary_little_endian", "element face 1\nproperty list int int v\nelement vertex 1\n" + kXyzFloat));
+    b.text(header("binary_little_endian",
+                  "element face 1\nproperty list int int v\nelement vertex 1\n" + kXyzFloat));
     b.put<int32_t>(-3).put(1.0f).put(2.0f).put(3.0f);
     const std::string path = write("neg.ply", b.str());
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "negative list length"));
@@ -236,20 +264,25 @@ TEST_F(PlyReader, NanInBinaryNamesVertex) {
 }
 
 TEST_F(PlyReader, InfAndOverflowInAsciiNameVertex) {
-    const std::string inf = write("inf.ply", header("ascii", "element vertex 2\n" + kXyzFloat) + "1 2 3\n1 2 -inf\n");
+    const std::string inf =
+        write("inf.ply", header("ascii", "element vertex 2\n" + kXyzFloat) + "1 2 3\n1 2 -inf\n");
     EXPECT_TRUE(isBadInput(loadPoints(inf), inf, "vertex 1: coordinate z is infinite"));
-    const std::string big = write("big.ply", header("ascii", "element vertex 1\nproperty double x\nproperty double y\n"
-                                                             "property double z\n") + "1e300 2 3\n");
+    const std::string big = write("big.ply", header("ascii",
+                                                    "element vertex 1\nproperty double x\nproperty double y\n"
+                                                    "property double z\n") +
+                                                 "1e300 2 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(big), big, "vertex 0: coordinate x"));
 }
 
 TEST_F(PlyReader, NonNumericAsciiNamesLine) {
-    const std::string path = write("word.ply", header("ascii", "element vertex 2\n" + kXyzFloat) + "1 2 3\n1 two 3\n");
+    const std::string path =
+        write("word.ply", header("ascii", "element vertex 2\n" + kXyzFloat) + "1 2 3\n1 two 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 9: vertex 1 property y: 'two' is not a number"));
 }
 
 TEST_F(PlyReader, AsciiBodyEndsEarly) {
-    const std::string path = write("short.ply", header("ascii", "element vertex 3\n" + kXyzFloat) + "1 2 3\n4 5 6\n7 8            ");
+    const std::string path = write(
+        "short.ply", header("ascii", "element vertex 3\n" + kXyzFloat) + "1 2 3\n4 5 6\n7 8            ");
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 10: file ends inside element vertex item 2"));
 }
 

@@ -34,8 +34,9 @@ TEST_F(StlReader, BinaryWhoseHeaderSaysSolid) {
 }
 
 TEST_F(StlReader, Ascii) {
-    const std::string text = "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 1.5 -2.25 3\n"
-                             "   vertex 0 0.001 -7.5\n   vertex 100 200.5 -300.25\n  endloop\n endfacet\nendsolid t\n";
+    const std::string text =
+        "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 1.5 -2.25 3\n"
+        "   vertex 0 0.001 -7.5\n   vertex 100 200.5 -300.25\n  endloop\n endfacet\nendsolid t\n";
     auto r = loadPoints(write("a.stl", text));
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(*r, threePoints());
@@ -52,7 +53,8 @@ TEST_F(StlReader, TooShort) {
 }
 
 TEST_F(StlReader, AsciiNonNumericNamesLine) {
-    const std::string path = write("bad.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3\nvertex 1 oops 3\n");
+    const std::string path =
+        write("bad.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3\nvertex 1 oops 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 5: 'oops' is not a number"));
 }
 

@@ -7,7 +7,8 @@ namespace {
 using TextFormats = TempDirTest;
 
 TEST_F(TextFormats, XyzColumnsCommentsSeparators) {
-    const std::string text = "# x y z intensity\n\n1.5 -2.25 3 77\n0,0.001,-7.5\n  +100\t200.5;-300.25  \n// end\n";
+    const std::string text =
+        "# x y z intensity\n\n1.5 -2.25 3 77\n0,0.001,-7.5\n  +100\t200.5;-300.25  \n// end\n";
     auto r = loadPoints(write("a.xyz", text));
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(*r, threePoints());
@@ -40,8 +41,9 @@ TEST_F(TextFormats, XyzNanNamesVertex) {
 }
 
 TEST_F(TextFormats, ObjVerticesOnly) {
-    const std::string text = "# exported\nmtllib a.mtl\no thing\nv 1.5 -2.25 3\nvn 0 0 1\nvt 0.5 0.5\n"
-                             "v 0 0.001 -7.5 1.0\nv\t100 200.5 -300.25 0.1 0.2 0.3\nf 1 2 3\nf 1/1/1 2/1/1 3/1/1\n";
+    const std::string text =
+        "# exported\nmtllib a.mtl\no thing\nv 1.5 -2.25 3\nvn 0 0 1\nvt 0.5 0.5\n"
+        "v 0 0.001 -7.5 1.0\nv\t100 200.5 -300.25 0.1 0.2 0.3\nf 1 2 3\nf 1/1/1 2/1/1 3/1/1\n";
     auto r = loadPoints(write("a.obj", text));
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(*r, threePoints());
@@ -60,8 +62,10 @@ TEST_F(TextFormats, ObjWithoutVerticesHasNoPoints) {
 }
 
 TEST_F(TextFormats, OffVariantsAndComments) {
-    const std::string body = "1.5 -2.25 3\n0 0.001 -7.5 # comment\n\n100 200.5 -300.25 255 0 0 255\n3 0 1 2\n";
-    for (const std::string head : {"OFF\n3 1 0\n", "OFF 3 1 0\n", "# c\nCOFF\n# counts\n3 1 0\n", "NOFF\n3 1 0\n"}) {
+    const std::string body =
+        "1.5 -2.25 3\n0 0.001 -7.5 # comment\n\n100 200.5 -300.25 255 0 0 255\n3 0 1 2\n";
+    for (const std::string head :
+         {"OFF\n3 1 0\n", "OFF 3 1 0\n", "# c\nCOFF\n# counts\n3 1 0\n", "NOFF\n3 1 0\n"}) {
         auto r = loadPoints(write("a.off", head + body));
         ASSERT_TRUE(r.ok()) << head << r.error().message;
         EXPECT_EQ(*r, threePoints()) << head;
