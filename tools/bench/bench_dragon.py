@@ -7,7 +7,7 @@ Cases (the paper's decimation and translation scenarios, DESIGN.md section 7):
                     (float32 arithmetic, written as a binary PLY into a temp dir)
 
 For each case and backend, rthdist runs --json --repeat times; the table
-reports the median of timings_ms.total (the library call) and of the wall
+reports the median of timings_ms.total (the computation, without device setup) and of the wall
 time of the whole process (load + device setup + compute). cKDTree (SciPy,
 workers=-1) is timed on tree builds plus queries in both directions (exact H,
 no file loading), median over --repeat runs. Values are checked to agree
