@@ -92,6 +92,13 @@ struct Timings {
     double search = 0.0;  // stage 2: BLAS builds + ray traversal (candidate pairs)
     double refine = 0.0;  // stage 3: exact scan of candidate cells, classification
     double total = 0.0;   // everything inside the call
+    // Device time per stage from Vulkan timestamp queries (GPU backends only;
+    // 0 on the CPU backend). The wall-clock fields above include submission,
+    // waiting and the host work between the stages' submissions.
+    double gpuIndex = 0.0;
+    double gpuCull = 0.0;
+    double gpuSearch = 0.0;
+    double gpuRefine = 0.0;
 };
 
 struct HausdorffResult {

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <map>
+#include <string>
 #include <new>
 #include <vector>
 
@@ -43,9 +45,9 @@ struct PointIndex {
     uint32_t n = 0;
     GridSpec grid;
     Bounds bounds;
-    Buffer sorted;      // vec4: xyz, w = original index bits (cell order)
-    Buffer dense;       // uint per key: end of the key's cell
-    Buffer cells;       // Cell per occupied cell
+    Buffer* sorted = nullptr;  // vec4: xyz, w = original index bits (cell order)
+    Buffer* dense = nullptr;   // uint per key: end of the key's cell
+    Buffer* cells = nullptr;   // Cell per occupied cell
     uint32_t numCells = 0;
 };
 
@@ -71,6 +73,22 @@ struct GpuHausdorff::State {
     bool tlasBound = false;
     Buffer hostSmall;  // counters (uint[4]) at 0, maxPacked (uint64) at 16, read-backs after 32
     Timings* timings = nullptr;
+    // Buffers live across calls and only grow: allocation is a large share of
+    // a call's cost on discrete GPUs.
+    std::map<std::string, Buffer> pool;
+
+    // A buffer may be replaced only between submissions: every name is used by
+    // at most one purpose inside one command buffer.
+    Buffer& buf(const std::string& name, VkDeviceSize bytes, MemoryKind kind = MemoryKind::kDevice) {
+        Buffer& b = pool[name];
+        if (!b || b.size() < bytes) {
+            b.reset();
+            b = Buffer(ctx, std::max<VkDeviceSize>(bytes + bytes / 4, 256),
+                       gpu::kStorageUsage | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
+                       kind);
+        }
+        return b;
+    }
 
     State(gpu::Context& c)
         : ctx(c), pipelines(c, c.backend() == Backend::kRayQuery), accel(c),
@@ -92,21 +110,20 @@ struct GpuHausdorff::State {
     }
 
     // Exclusive scan of uint[n] at `data`, recursively over block sums.
-    void cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, std::vector<Buffer>& scratch, size_t level) {
+    void cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, const std::string& tag, size_t level) {
         const uint32_t blocks = gpu::groupsFor(n, RTHDIST_SCAN_BLOCK);
-        if (scratch.size() <= level)
-            scratch.emplace_back(ctx, VkDeviceSize(blocks) * 4, gpu::kStorageUsage, MemoryKind::kDevice);
-        sh::ScanPush p{data, scratch[level].address(), n};
+        const VkDeviceAddress sums = buf(tag + std::to_string(level), VkDeviceSize(blocks) * 4).address();
+        sh::ScanPush p{data, sums, n};
         pipelines.cmdDispatch(cmd, Kernel::kScanBlock, &p, sizeof(p), blocks);
         if (blocks > 1) {
             barrier(cmd);
-            cmdScan(cmd, scratch[level].address(), blocks, scratch, level + 1);
+            cmdScan(cmd, sums, blocks, tag, level + 1);
             barrier(cmd);
             pipelines.cmdDispatch(cmd, Kernel::kScanAdd, &p, sizeof(p), blocks);
         }
     }
 
-    PointIndex buildIndex(std::span<const glm::vec3> pts, int bits) {
+    PointIndex buildIndex(std::span<const glm::vec3> pts, int bits, const std::string& set) {
         PointIndex ix;
         ix.n = uint32_t(pts.size());
         ix.bounds = boundsOf(pts);
@@ -120,7 +137,7 @@ struct GpuHausdorff::State {
 
         auto t0 = Clock::now();
         const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
-        Buffer staging(ctx, bytes, gpu::kStorageUsage, MemoryKind::kHost);
+        Buffer& staging = buf("staging", bytes, MemoryKind::kHost);
         auto* dst = static_cast<float*>(staging.mapped());
         for (uint32_t i = 0; i < ix.n; ++i) {
             dst[4 * i + 0] = pts[i].x;
@@ -128,7 +145,7 @@ struct GpuHausdorff::State {
             dst[4 * i + 2] = pts[i].z;
             dst[4 * i + 3] = 0.0f;
         }
-        Buffer points(ctx, bytes, gpu::kStorageUsage, MemoryKind::kDevice);
+        Buffer& points = buf("points", bytes);
         VkCommandBuffer cmd = ctx.begin();
         VkBufferCopy region{0, 0, bytes};
         vkCmdCopyBuffer(cmd, staging.handle(), points.handle(), 1, &region);
@@ -137,37 +154,36 @@ struct GpuHausdorff::State {
 
         t0 = Clock::now();
         const uint32_t numKeys = 1u << (3 * ix.grid.bits);
-        Buffer keys(ctx, VkDeviceSize(ix.n) * 4, gpu::kStorageUsage, MemoryKind::kDevice);
-        Buffer sortedKeys(ctx, VkDeviceSize(ix.n) * 4, gpu::kStorageUsage, MemoryKind::kDevice);
-        Buffer flags(ctx, VkDeviceSize(ix.n) * 4, gpu::kStorageUsage, MemoryKind::kDevice);
-        ix.dense = Buffer(ctx, VkDeviceSize(numKeys) * 4, gpu::kStorageUsage, MemoryKind::kDevice);
-        ix.sorted = Buffer(ctx, bytes, gpu::kStorageUsage, MemoryKind::kDevice);
-        // Cells: at most one per point; sized exactly after the count is known
-        // would need another pass, so allocate the upper bound.
-        ix.cells = Buffer(ctx, VkDeviceSize(std::min<uint64_t>(ix.n, numKeys)) * sizeof(sh::Cell), gpu::kStorageUsage,
-                          MemoryKind::kDevice);
-        std::vector<Buffer> scanScratch;
+        Buffer& keys = buf("keys", VkDeviceSize(ix.n) * 4);
+        Buffer& sortedKeys = buf("sortedKeys", VkDeviceSize(ix.n) * 4);
+        Buffer& flags = buf("flags", VkDeviceSize(ix.n) * 4);
+        const VkDeviceSize denseBytes = VkDeviceSize(numKeys) * 4;
+        ix.dense = &buf(set + ".dense", denseBytes);
+        ix.sorted = &buf(set + ".sorted", bytes);
+        // Cells: at most one per point or key; the upper bound avoids a read-back.
+        ix.cells = &buf(set + ".cells", VkDeviceSize(std::min<uint64_t>(ix.n, numKeys)) * sizeof(sh::Cell));
 
         cmd = ctx.begin();
-        vkCmdFillBuffer(cmd, ix.dense.handle(), 0, VK_WHOLE_SIZE, 0);
+        vkCmdFillBuffer(cmd, ix.dense->handle(), 0, denseBytes, 0);
         barrier(cmd);
-        sh::KeysPush kp{points.address(), keys.address(), ix.dense.address(), gridParams(ix.grid), ix.n};
+        sh::KeysPush kp{points.address(), keys.address(), ix.dense->address(), gridParams(ix.grid), ix.n};
         dispatch(cmd, Kernel::kCellKeys, kp, ix.n);
         barrier(cmd);
-        cmdScan(cmd, ix.dense.address(), numKeys, scanScratch, 0);
+        cmdScan(cmd, ix.dense->address(), numKeys, "scanKeys", 0);
         barrier(cmd);
-        sh::ScatterPush sp{points.address(), keys.address(), ix.dense.address(), ix.sorted.address(),
+        sh::ScatterPush sp{points.address(), keys.address(), ix.dense->address(), ix.sorted->address(),
                            sortedKeys.address(), ix.n};
         dispatch(cmd, Kernel::kScatter, sp, ix.n);
         barrier(cmd);
-        sh::CellsPush cp{ix.sorted.address(), sortedKeys.address(), flags.address(), ix.dense.address(),
-                         ix.cells.address(), countersAddr() + 12, ix.n};
+        sh::CellsPush cp{ix.sorted->address(), sortedKeys.address(), flags.address(), ix.dense->address(),
+                         ix.cells->address(), countersAddr() + 12, ix.n};
         dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
         barrier(cmd);
-        cmdScan(cmd, flags.address(), ix.n, scanScratch, 0);
+        cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
         barrier(cmd);
         dispatch(cmd, Kernel::kCellBuild, cp, ix.n);
         ctx.submitAndWait(cmd);
+        timings->gpuIndex += ctx.lastGpuMs();
         ix.numCells = counters()[3];
         timings->index += msSince(t0);
         return ix;
@@ -197,18 +213,18 @@ struct GpuHausdorff::State {
         const float epsilon = float(maxAbs * 4e-7 + T.grid.cellSize * 1e-5);
 
         auto t0 = Clock::now();
-        Buffer state(ctx, VkDeviceSize(Q.n) * sizeof(sh::QueryState), gpu::kStorageUsage, MemoryKind::kDevice);
-        Buffer active[2] = {Buffer(ctx, VkDeviceSize(Q.n) * 4, gpu::kStorageUsage, MemoryKind::kDevice),
-                            Buffer(ctx, VkDeviceSize(Q.n) * 4, gpu::kStorageUsage, MemoryKind::kDevice)};
+        Buffer& state = buf("state", VkDeviceSize(Q.n) * sizeof(sh::QueryState));
+        Buffer* active[2] = {&buf("active0", VkDeviceSize(Q.n) * 4), &buf("active1", VkDeviceSize(Q.n) * 4)};
         std::memset(hostSmall.mapped(), 0, 32);
         VkCommandBuffer cmd = ctx.begin();
-        sh::CullPush cull{Q.sorted.address(), T.sorted.address(), T.dense.address(), state.address(), maxPackedAddr(),
+        sh::CullPush cull{Q.sorted->address(), T.sorted->address(), T.dense->address(), state.address(), maxPackedAddr(),
                           gridParams(T.grid), Q.n, lowerBound2, epsilon};
         dispatch(cmd, Kernel::kCull, cull, Q.n);
         barrier(cmd);
-        sh::CompactPush comp{state.address(), active[0].address(), countersAddr(), maxPackedAddr(), Q.n, lowerBound2};
+        sh::CompactPush comp{state.address(), active[0]->address(), countersAddr(), maxPackedAddr(), Q.n, lowerBound2};
         dispatch(cmd, Kernel::kCompact, comp, Q.n);
         ctx.submitAndWait(cmd);
+        timings->gpuCull += ctx.lastGpuMs();
         uint32_t numActive = counters()[0];
         cnt.survivingQueries = numActive;
         cnt.culledByNeighbourhood = Q.n - numActive;
@@ -219,16 +235,17 @@ struct GpuHausdorff::State {
         };
         double radius = 2.0 * T.grid.cellSize;
         uint64_t pairCapacity = std::clamp<uint64_t>(uint64_t(T.numCells) * 4, 1u << 16, 1u << 22);
-        Buffer pairs;
+        Buffer* pairs = nullptr;
         const float rayTMax = float(T.grid.cellSize * 1e-3);
         int cur = 0;
         bool firstBuild = true;
-        Buffer aabbs(ctx, VkDeviceSize(T.numCells) * 24,
-                     gpu::kStorageUsage | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
-                     MemoryKind::kDevice);
+        Buffer& aabbs = buf("aabbs", VkDeviceSize(T.numCells) * 24);
         while (numActive > 0) {
             if (++cnt.iterations > kMaxIterations) throw std::runtime_error("candidate search did not converge");
-            if (!pairs) pairs = Buffer(ctx, pairCapacity * 8, gpu::kStorageUsage, MemoryKind::kDevice);
+            if (!pairs) {
+                pairs = &buf("pairs", pairCapacity * 8);
+                pairCapacity = std::min<uint64_t>(pairs->size() / 8, kMaxPairCapacity);
+            }
             const float r = float(radius);
             const float grow = r + epsilon + r * 1e-6f;
 
@@ -236,7 +253,7 @@ struct GpuHausdorff::State {
             counters()[1] = 0;
             counters()[2] = 0;
             cmd = ctx.begin();
-            sh::BoxesPush bp{T.cells.address(), aabbs.address(), T.numCells, grow};
+            sh::BoxesPush bp{T.cells->address(), aabbs.address(), T.numCells, grow};
             dispatch(cmd, Kernel::kGrowBoxes, bp, T.numCells);
             gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                             VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_SHADER_READ_BIT);
@@ -245,12 +262,13 @@ struct GpuHausdorff::State {
                 tlasBound = true;
             }
             firstBuild = false;
-            sh::SearchPush sp{Q.sorted.address(), T.sorted.address(), T.cells.address(), state.address(),
-                              active[cur].address(), pairs.address(), countersAddr(), maxPackedAddr(), numActive,
+            sh::SearchPush sp{Q.sorted->address(), T.sorted->address(), T.cells->address(), state.address(),
+                              active[cur]->address(), pairs->address(), countersAddr(), maxPackedAddr(), numActive,
                               uint32_t(pairCapacity), r, lowerBound2, rayTMax};
             if (rayQuery) dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
             else pipelines.cmdTraceRays(cmd, &sp, sizeof(sp), numActive);
             ctx.submitAndWait(cmd);
+            timings->gpuSearch += ctx.lastGpuMs();
             const uint32_t pairCount = counters()[1];
             cnt.rays += numActive;
             timings->search += msSince(t0);
@@ -259,15 +277,16 @@ struct GpuHausdorff::State {
             const uint32_t used = uint32_t(std::min<uint64_t>(pairCount, pairCapacity));
             cnt.candidatePairs += used;
             cmd = ctx.begin();
-            sh::RefinePush rp{Q.sorted.address(), T.sorted.address(), T.cells.address(), state.address(),
-                              active[cur].address(), pairs.address(), countersAddr(), maxPackedAddr(),
+            sh::RefinePush rp{Q.sorted->address(), T.sorted->address(), T.cells->address(), state.address(),
+                              active[cur]->address(), pairs->address(), countersAddr(), maxPackedAddr(),
                               uint32_t(pairCapacity), lowerBound2};
             dispatch(cmd, Kernel::kRefine, rp, used);
             barrier(cmd);
-            sh::ResolvePush rs{state.address(), active[cur].address(), active[1 - cur].address(), countersAddr(),
+            sh::ResolvePush rs{state.address(), active[cur]->address(), active[1 - cur]->address(), countersAddr(),
                                maxPackedAddr(), numActive, r, lowerBound2};
             dispatch(cmd, Kernel::kResolve, rs, numActive);
             ctx.submitAndWait(cmd);
+            timings->gpuRefine += ctx.lastGpuMs();
             numActive = counters()[2];
             cur = 1 - cur;
             timings->refine += msSince(t0);
@@ -275,7 +294,7 @@ struct GpuHausdorff::State {
             if (pairCount > pairCapacity && pairCapacity < kMaxPairCapacity) {
                 // Some queries lost pairs: redo them at the same radius with room.
                 pairCapacity = std::min<uint64_t>(kMaxPairCapacity, std::max<uint64_t>(pairCount, pairCapacity * 2));
-                pairs.reset();
+                pairs = nullptr;
             } else if (pairCount <= pairCapacity) {
                 radius *= double(options.radiusGrowth);
             }
@@ -287,7 +306,7 @@ struct GpuHausdorff::State {
         const uint32_t slot = uint32_t(packed & 0xffffffffu);
         cmd = ctx.begin();
         VkBufferCopy c1{VkDeviceSize(slot) * 16, 32, 16};
-        vkCmdCopyBuffer(cmd, Q.sorted.handle(), hostSmall.handle(), 1, &c1);
+        vkCmdCopyBuffer(cmd, Q.sorted->handle(), hostSmall.handle(), 1, &c1);
         VkBufferCopy c2{VkDeviceSize(slot) * sizeof(sh::QueryState), 48, sizeof(sh::QueryState)};
         vkCmdCopyBuffer(cmd, state.handle(), hostSmall.handle(), 1, &c2);
         ctx.submitAndWait(cmd);
@@ -327,8 +346,8 @@ Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std:
     try {
         // Each set is indexed once with its own grid: as targets for the other
         // direction, and as cell-ordered (Morton) queries for its own.
-        PointIndex ia = m_state->buildIndex(a, options.bits);
-        PointIndex ib = m_state->buildIndex(b, options.bits);
+        PointIndex ia = m_state->buildIndex(a, options.bits, "A");
+        PointIndex ib = m_state->buildIndex(b, options.bits, "B");
         res.aToB = m_state->direction(ia, ib, a, b, options);
         res.hausdorff = res.aToB.distance;
         if (!options.directedOnly) {

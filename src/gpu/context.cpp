@@ -329,6 +329,15 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
         RTHDIST_VK_CHECK(vkAllocateCommandBuffers(d, &ai, &ctx->m_cmd));
         VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
         RTHDIST_VK_CHECK(vkCreateFence(d, &fci, nullptr, &ctx->m_fence));
+        VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+        qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+        qpi.queryCount = 2;
+        RTHDIST_VK_CHECK(vkCreateQueryPool(d, &qpi, nullptr, &ctx->m_timestamps));
+        uint32_t qn = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(chosenPd, &qn, nullptr);
+        std::vector<VkQueueFamilyProperties> qf(qn);
+        vkGetPhysicalDeviceQueueFamilyProperties(chosenPd, &qn, qf.data());
+        ctx->m_timestampBits = qf[ctx->m_queueFamily].timestampValidBits;
     } catch (const VulkanError& e) {
         return Error{ErrorCode::kNoDevice, e.what()};
     }
@@ -339,6 +348,7 @@ Context::~Context() {
     if (m_device) {
         vkDeviceWaitIdle(m_device);
         if (m_fence) vkDestroyFence(m_device, m_fence, nullptr);
+        if (m_timestamps) vkDestroyQueryPool(m_device, m_timestamps, nullptr);
         if (m_pool) vkDestroyCommandPool(m_device, m_pool, nullptr);
         vkDestroyDevice(m_device, nullptr);
     }
@@ -361,10 +371,13 @@ VkCommandBuffer Context::begin() {
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     RTHDIST_VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
+    vkCmdResetQueryPool(m_cmd, m_timestamps, 0, 2);
+    vkCmdWriteTimestamp(m_cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, m_timestamps, 0);
     return m_cmd;
 }
 
 void Context::submitAndWait(VkCommandBuffer cmd) {
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps, 1);
     RTHDIST_VK_CHECK(vkEndCommandBuffer(cmd));
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     si.commandBufferCount = 1;
@@ -376,6 +389,12 @@ void Context::submitAndWait(VkCommandBuffer cmd) {
     } while (r == VK_TIMEOUT);
     RTHDIST_VK_CHECK(r);
     RTHDIST_VK_CHECK(vkResetFences(m_device, 1, &m_fence));
+    uint64_t ts[2] = {0, 0};
+    r = vkGetQueryPoolResults(m_device, m_timestamps, 0, 2, sizeof(ts), ts, sizeof(uint64_t),
+                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+    RTHDIST_VK_CHECK(r);
+    const uint64_t mask = m_timestampBits >= 64 ? ~uint64_t(0) : ((uint64_t(1) << m_timestampBits) - 1);
+    m_lastGpuMs = double((ts[1] - ts[0]) & mask) * double(m_timestampPeriod) * 1e-6;
 }
 
 }  // namespace rthdist::gpu

@@ -54,6 +54,9 @@ public:
     // submitAndWait() submits it and blocks until the queue has executed it.
     [[nodiscard]] VkCommandBuffer begin();
     void submitAndWait(VkCommandBuffer cmd);
+    // Device milliseconds between begin() and the end of the last submitted
+    // command buffer (timestamp queries).
+    [[nodiscard]] double lastGpuMs() const { return m_lastGpuMs; }
 
     void countValidationMessage() { ++m_validationMessages; }
 
@@ -69,6 +72,9 @@ private:
     VkCommandPool m_pool = VK_NULL_HANDLE;
     VkCommandBuffer m_cmd = VK_NULL_HANDLE;
     VkFence m_fence = VK_NULL_HANDLE;
+    VkQueryPool m_timestamps = VK_NULL_HANDLE;
+    double m_lastGpuMs = 0.0;
+    uint32_t m_timestampBits = 64;
     Backend m_backend = Backend::kRayQuery;
     std::string m_name;
     RtFunctions m_rt;

@@ -1,0 +1,174 @@
+// rthdist-bench: times one case on one backend the way the benchmark notes
+// report it: W warm-up calls, then N timed calls on the same Engine; prints
+// one JSON object with the median of every stage (host wall clock and device
+// timestamps), the end-to-end wall time of the call, and the CPU backend's
+// value for agreement. Not a test: no thresholds.
+//
+//   rthdist-bench A B [--backend X] [--runs N] [--warmup W] [--translate F]
+//                     [--bits K] [--name NAME] [--no-verify]
+// --translate F moves B along x by F times B's x-extent (the paper's
+// translation scenario without writing a copy to disk).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "cli/json_writer.hpp"
+#include "rthdist/io.hpp"
+#include "rthdist/rthdist.hpp"
+
+using namespace rthdist;
+
+namespace {
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+int usage() {
+    std::fprintf(stderr,
+                 "usage: rthdist-bench A B [--backend auto|ray-query|rt-pipeline|cpu] [--runs N] [--warmup W]\n"
+                 "                     [--translate F] [--bits K] [--name NAME] [--no-verify]\n");
+    return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> files;
+    Options options;
+    int runs = 5, warmup = 2;
+    double translate = 0.0;
+    bool verify = true;
+    std::string name;
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
+        if (a == "--backend") {
+            const char* v = next();
+            if (!v || !parseBackend(v, options.backend)) return usage();
+        } else if (a == "--runs") {
+            const char* v = next();
+            if (!v || (runs = std::atoi(v)) < 1) return usage();
+        } else if (a == "--warmup") {
+            const char* v = next();
+            if (!v || (warmup = std::atoi(v)) < 0) return usage();
+        } else if (a == "--translate") {
+            const char* v = next();
+            if (!v) return usage();
+            translate = std::atof(v);
+        } else if (a == "--bits") {
+            const char* v = next();
+            if (!v) return usage();
+            options.bits = std::atoi(v);
+        } else if (a == "--name") {
+            const char* v = next();
+            if (!v) return usage();
+            name = v;
+        } else if (a == "--no-verify") {
+            verify = false;
+        } else if (!a.empty() && a[0] == '-') {
+            return usage();
+        } else {
+            files.push_back(a);
+        }
+    }
+    if (files.size() != 2) return usage();
+    auto t0 = std::chrono::steady_clock::now();
+    auto pa = io::loadPoints(files[0]);
+    if (!pa) return std::fprintf(stderr, "rthdist-bench: %s\n", pa.error().message.c_str()), 3;
+    auto pb = io::loadPoints(files[1]);
+    if (!pb) return std::fprintf(stderr, "rthdist-bench: %s\n", pb.error().message.c_str()), 3;
+    const double loadMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    std::vector<glm::vec3>& a = pa.value();
+    std::vector<glm::vec3>& b = pb.value();
+    if (translate != 0.0) {
+        float lo = b[0].x, hi = b[0].x;
+        for (const auto& p : b) lo = std::min(lo, p.x), hi = std::max(hi, p.x);
+        const float dx = float(translate * (double(hi) - double(lo)));
+        for (auto& p : b) p.x += dx;
+    }
+
+    t0 = std::chrono::steady_clock::now();
+    auto engine = Engine::create(options);
+    if (!engine) return std::fprintf(stderr, "rthdist-bench: %s\n", engine.error().message.c_str()), exitCodeFor(engine.error().code);
+    const double setupMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+    std::vector<double> wall, total, index, cull, search, refine, gIndex, gCull, gSearch, gRefine, upload;
+    HausdorffResult last;
+    for (int r = 0; r < warmup + runs; ++r) {
+        auto c0 = std::chrono::steady_clock::now();
+        auto res = engine->compute(a, b);
+        const double w = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count();
+        if (!res) return std::fprintf(stderr, "rthdist-bench: %s\n", res.error().message.c_str()), exitCodeFor(res.error().code);
+        if (r < warmup) continue;
+        const Timings& t = res->timings;
+        wall.push_back(w);
+        total.push_back(t.total);
+        upload.push_back(t.upload);
+        index.push_back(t.index);
+        cull.push_back(t.cull);
+        search.push_back(t.search);
+        refine.push_back(t.refine);
+        gIndex.push_back(t.gpuIndex);
+        gCull.push_back(t.gpuCull);
+        gSearch.push_back(t.gpuSearch);
+        gRefine.push_back(t.gpuRefine);
+        last = std::move(res.value());
+    }
+
+    bool agree = true;
+    double cpuH = -1.0, cpuMs = 0.0;
+    if (verify) {
+        Options co;
+        co.backend = Backend::kCpu;
+        auto c0 = std::chrono::steady_clock::now();
+        auto ref = hausdorff(a, b, co);
+        cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count();
+        if (!ref) return std::fprintf(stderr, "rthdist-bench: cpu: %s\n", ref.error().message.c_str()), 1;
+        cpuH = ref->hausdorff;
+        agree = std::abs(ref->aToB.distance - last.aToB.distance) <= 1e-6 * std::max(1e-30, ref->hausdorff) + 1e-9 &&
+                std::abs(ref->bToA.distance - last.bToA.distance) <= 1e-6 * std::max(1e-30, ref->hausdorff) + 1e-9;
+    }
+
+    cli::JsonWriter j(0);
+    j.beginObject();
+    j.key("case").value(name.empty() ? files[0] + " vs " + files[1] : name);
+    j.key("points").beginObject().key("a").value(uint64_t(a.size())).key("b").value(uint64_t(b.size())).endObject();
+    j.key("backend").value(backendName(last.backend));
+    j.key("device").value(last.device);
+    j.key("runs").value(runs).key("warmup").value(warmup);
+    j.key("hausdorff").value(last.hausdorff);
+    j.key("h_ab").value(last.aToB.distance).key("h_ba").value(last.bToA.distance);
+    j.key("bits").beginArray(true).value(uint64_t(last.aToB.counters.bits)).value(uint64_t(last.bToA.counters.bits)).endArray();
+    j.key("load_ms").value(loadMs).key("setup_ms").value(setupMs);
+    j.key("median_ms").beginObject();
+    j.key("wall").value(median(wall)).key("total").value(median(total)).key("upload").value(median(upload));
+    j.key("index").value(median(index)).key("cull").value(median(cull)).key("search").value(median(search));
+    j.key("refine").value(median(refine));
+    j.key("gpu_index").value(median(gIndex)).key("gpu_cull").value(median(gCull));
+    j.key("gpu_search").value(median(gSearch)).key("gpu_refine").value(median(gRefine));
+    j.key("gpu_sum").value(median(gIndex) + median(gCull) + median(gSearch) + median(gRefine));
+    j.endObject();
+    j.key("wall_ms_all").beginArray(true);
+    for (double w : wall) j.value(w);
+    j.endArray();
+    j.key("counters").beginArray();
+    for (const Directed* d : {&last.aToB, &last.bToA}) {
+        const Counters& c = d->counters;
+        j.beginObject().key("queries").value(c.queries).key("surviving").value(c.survivingQueries);
+        j.key("iterations").value(uint64_t(c.iterations)).key("rays").value(c.rays);
+        j.key("pairs").value(c.candidatePairs).key("cells").value(c.occupiedCells).endObject();
+    }
+    j.endArray();
+    j.key("cpu_hausdorff").value(cpuH).key("cpu_ms").value(cpuMs).key("agree").value(agree);
+    j.endObject();
+    std::printf("%s\n", j.str().c_str());
+    return agree ? 0 : 1;
+}
