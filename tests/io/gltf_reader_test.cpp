@@ -7,26 +7,6 @@ namespace {
 
 using GltfReader = TempDirTest;
 
-std::string base64(const std::string& in) {
-    static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    size_t i = 0;
-    for (; i + 2 < in.size(); i += 3) {
-        const uint32_t v =
-            uint32_t(uint8_t(in[i])) << 16 | uint32_t(uint8_t(in[i + 1])) << 8 | uint8_t(in[i + 2]);
-        for (int s = 18; s >= 0; s -= 6) out += kAlphabet[(v >> s) & 63];
-    }
-    if (i + 1 == in.size()) {
-        const uint32_t v = uint32_t(uint8_t(in[i])) << 16;
-        out += std::string{kAlphabet[(v >> 18) & 63], kAlphabet[(v >> 12) & 63], '=', '='};
-    } else if (i + 2 == in.size()) {
-        const uint32_t v = uint32_t(uint8_t(in[i])) << 16 | uint32_t(uint8_t(in[i + 1])) << 8;
-        out +=
-            std::string{kAlphabet[(v >> 18) & 63], kAlphabet[(v >> 12) & 63], kAlphabet[(v >> 6) & 63], '='};
-    }
-    return out;
-}
-
 std::string positions(const std::vector<glm::vec3>& pts) {
     ByteBuilder b;
     for (const glm::vec3& p : pts) b.put(p.x).put(p.y).put(p.z);
@@ -55,18 +35,6 @@ std::string embedded(const std::vector<glm::vec3>& pts) {
     const std::string bin = positions(pts);
     return R"({"byteLength":)" + std::to_string(bin.size()) +
            R"(,"uri":"data:application/octet-stream;base64,)" + base64(bin) + R"("})";
-}
-
-std::string glb(const std::string& json, const std::string& bin) {
-    std::string j = json;
-    while (j.size() % 4 != 0) j += ' ';
-    std::string b = bin;
-    while (b.size() % 4 != 0) b += '\0';
-    ByteBuilder out;
-    out.text("glTF").put<uint32_t>(2).put<uint32_t>(static_cast<uint32_t>(12 + 8 + j.size() + 8 + b.size()));
-    out.put<uint32_t>(static_cast<uint32_t>(j.size())).put<uint32_t>(0x4E4F534A).text(j);
-    out.put<uint32_t>(static_cast<uint32_t>(b.size())).put<uint32_t>(0x004E4942).text(b);
-    return out.str();
 }
 
 void expectNear(const std::vector<glm::vec3>& got, const std::vector<glm::vec3>& want) {
