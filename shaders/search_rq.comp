@@ -14,14 +14,16 @@ void main() {
     if (slot >= pc.numActive) return;
     uint qi = UintBuf(pc.activeList).v[slot];
     vec3 q = Vec4Buf(pc.queries).v[qi].xyz;
-    float rLo = StateBuf(pc.state).v[qi].rLo;
+    QueryState st = StateBuf(pc.state).v[qi];
+    float rLo = st.rLo;
+    float bestLocal = packedDist2(st.best);
     float thr = deadThreshold(U64Buf(pc.maxPacked), pc.lowerBound2);
     rayQueryEXT rq;
     rayQueryInitializeEXT(rq, u_tlas, gl_RayFlagsNoneEXT, 0xff, q, 0.0, vec3(1.0, 0.0, 0.0), pc.rayTMax);
     while (rayQueryProceedEXT(rq)) {
         if (rayQueryGetIntersectionTypeEXT(rq, false) == gl_RayQueryCandidateIntersectionAABBEXT) {
             uint cellIndex = rayQueryGetIntersectionPrimitiveIndexEXT(rq, false);
-            if (visitCell(slot, qi, q, rLo, thr, cellIndex)) rayQueryTerminateEXT(rq);
+            if (visitCell(slot, qi, q, rLo, thr, cellIndex, bestLocal)) rayQueryTerminateEXT(rq);
         }
     }
 }

@@ -7,17 +7,28 @@
 // within rLo were scanned in an earlier pass and are skipped; the others
 // become (query, cell) pairs for the exact refinement, unless the cell's
 // representative (a real member point) is already closer than the running
-// maximum, which proves the query cannot raise h.
-bool visitCell(uint slot, uint qi, vec3 q, float rLo, float thr, uint cellIndex) {
+// maximum, which proves the query cannot raise h. A cell whose box is farther
+// than the query's best distance so far (bestLocal: scanned points and
+// representatives seen) cannot hold its nearest neighbour and is skipped;
+// representatives lower the query's best at once (atomicMin), so a
+// one-point cell needs no pair.
+bool visitCell(uint slot, uint qi, vec3 q, float rLo, float thr, uint cellIndex, inout float bestLocal) {
     Cell c = CellBuf(pc.cells).v[cellIndex];
     float d2 = boxDist2(q, c.lo, c.hi);
     if (d2 > pc.radius * pc.radius) return false;
     if (d2 <= rLo * rLo) return false;
-    float r2 = dist2(q, Vec4Buf(pc.targets).v[c.first].xyz);
+    if (d2 > bestLocal) return false;
+    vec4 rep = Vec4Buf(pc.targets).v[c.first];
+    float r2 = dist2(q, rep.xyz);
     if (r2 < thr) {
         StateBuf(pc.state).v[qi].status = RTHDIST_DEAD;
         return true;
     }
+    if (r2 < bestLocal) {
+        bestLocal = r2;
+        atomicMin(StateBuf(pc.state).v[qi].best, packDistIndex(r2, floatBitsToUint(rep.w)));
+    }
+    if (c.count == 1) return false;
     uint idx = atomicAdd(UintBuf(pc.counters).v[1], 1u);
     if (idx < pc.pairCapacity) {
         Uvec2Buf(pc.pairs).v[idx] = uvec2(slot, cellIndex);

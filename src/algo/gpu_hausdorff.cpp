@@ -14,6 +14,7 @@
 #include <glm/glm.hpp>
 
 #include "algo/index_space.hpp"
+#include "cpu/parallel.hpp"
 #include "gpu/accel.hpp"
 #include "gpu/buffer.hpp"
 #include "gpu/context.hpp"
@@ -39,6 +40,7 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 
 constexpr uint64_t kMaxPairCapacity = uint64_t(1) << 26;  // 512 MiB of pairs at most
 constexpr uint32_t kMaxIterations = 4096;
+constexpr size_t kHostChunk = size_t(1) << 16;  // points per host work item
 
 // A point set sorted into the cells of its own grid.
 struct PointIndex {
@@ -126,7 +128,34 @@ struct GpuHausdorff::State {
     PointIndex buildIndex(std::span<const glm::vec3> pts, int bits, const std::string& set) {
         PointIndex ix;
         ix.n = uint32_t(pts.size());
-        ix.bounds = boundsOf(pts);
+        const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
+
+        // One parallel host pass: vec3 -> vec4 staging and the bounds.
+        auto t0 = Clock::now();
+        Buffer& staging = buf("staging", bytes, MemoryKind::kHost);
+        auto* dst = static_cast<float*>(staging.mapped());
+        const int threads = cpu::resolveThreads(0, ix.n / kHostChunk + 1);
+        std::vector<glm::vec3> lo(size_t(threads), pts[0]), hi(size_t(threads), pts[0]);
+        cpu::parallelChunks(ix.n, kHostChunk, threads, [&](size_t begin, size_t end, int t) {
+            glm::vec3 l = lo[size_t(t)], h = hi[size_t(t)];
+            for (size_t i = begin; i < end; ++i) {
+                const glm::vec3 p = pts[i];
+                dst[4 * i + 0] = p.x;
+                dst[4 * i + 1] = p.y;
+                dst[4 * i + 2] = p.z;
+                dst[4 * i + 3] = 0.0f;
+                l = glm::min(l, p);
+                h = glm::max(h, p);
+            }
+            lo[size_t(t)] = l;
+            hi[size_t(t)] = h;
+        });
+        for (int t = 1; t < threads; ++t) {
+            lo[0] = glm::min(lo[0], lo[size_t(t)]);
+            hi[0] = glm::max(hi[0], hi[size_t(t)]);
+        }
+        ix.bounds.lo = glm::dvec3(lo[0]);
+        ix.bounds.hi = glm::dvec3(hi[0]);
         if (bits <= 0) {
             // The dense key table costs O(2^(3k)) to clear and scan: keep it
             // within a few entries per point when the bit count is automatic.
@@ -135,16 +164,6 @@ struct GpuHausdorff::State {
         }
         ix.grid = makeGrid(ix.bounds, bits);
 
-        auto t0 = Clock::now();
-        const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
-        Buffer& staging = buf("staging", bytes, MemoryKind::kHost);
-        auto* dst = static_cast<float*>(staging.mapped());
-        for (uint32_t i = 0; i < ix.n; ++i) {
-            dst[4 * i + 0] = pts[i].x;
-            dst[4 * i + 1] = pts[i].y;
-            dst[4 * i + 2] = pts[i].z;
-            dst[4 * i + 3] = 0.0f;
-        }
         Buffer& points = buf("points", bytes);
         VkCommandBuffer cmd = ctx.begin();
         VkBufferCopy region{0, 0, bytes};
@@ -200,11 +219,18 @@ struct GpuHausdorff::State {
 
         // Witness-less lower bound: the farthest query from BV(T), shrunk a
         // little so float rounding never kills the query that realizes h.
-        double lb = 0.0;
-        for (const glm::vec3& q : qPts) {
-            glm::dvec3 d = glm::max(glm::max(T.bounds.lo - glm::dvec3(q), glm::dvec3(q) - T.bounds.hi), glm::dvec3(0.0));
-            lb = std::max(lb, d.x * d.x + d.y * d.y + d.z * d.z);
-        }
+        const int threads = cpu::resolveThreads(0, qPts.size() / kHostChunk + 1);
+        std::vector<double> lbs(size_t(threads), 0.0);
+        cpu::parallelChunks(qPts.size(), kHostChunk, threads, [&](size_t begin, size_t end, int t) {
+            double m = lbs[size_t(t)];
+            for (size_t i = begin; i < end; ++i) {
+                const glm::dvec3 q(qPts[i]);
+                const glm::dvec3 d = glm::max(glm::max(T.bounds.lo - q, q - T.bounds.hi), glm::dvec3(0.0));
+                m = std::max(m, d.x * d.x + d.y * d.y + d.z * d.z);
+            }
+            lbs[size_t(t)] = m;
+        });
+        const double lb = *std::max_element(lbs.begin(), lbs.end());
         const float lowerBound2 = float(lb * (1.0 - 1e-5));
         double maxAbs = 0.0;
         for (const Bounds* b : {&Q.bounds, &T.bounds})
