@@ -23,6 +23,7 @@
 #include <glm/vec3.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -59,6 +60,20 @@ struct Options {
     float radiusGrowth = 2.0f;
     // CPU backend threads; 0 = all hardware threads.
     int threads = 0;
+    // Also return every point's exact nearest-neighbour distance and index
+    // (HausdorffResult::aNearest / bNearest). Every query then needs its own
+    // NN, so the early break against the running maximum is off: slower.
+    bool perPointDistances = false;
+    // Called from the calling thread between stages and iterations with a
+    // stage name ("index", "cull", "search", "refine") and the fraction of
+    // the whole call done so far (0..1). Must not throw.
+    std::function<void(const char* stage, double fraction)> progress;
+};
+
+// Every point's nearest neighbour in the other set (perPointDistances).
+struct PerPoint {
+    std::vector<double> distance;  // recomputed in double from the pair
+    std::vector<uint32_t> nearest; // index of the nearest point in the other set
 };
 
 // Counters of one direction: what the algorithm did.
@@ -105,6 +120,8 @@ struct HausdorffResult {
     double hausdorff = 0.0;  // max of both directions (or h(A,B) when directed)
     Directed aToB;
     Directed bToA;           // empty when Options::directedOnly
+    PerPoint aNearest;       // A's points -> B, with Options::perPointDistances
+    PerPoint bNearest;       // B's points -> A (unless directedOnly)
     bool directedOnly = false;
     Backend backend = Backend::kAuto;  // the backend that ran
     std::string device;                // device name, or "cpu"
