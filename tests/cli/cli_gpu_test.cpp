@@ -156,8 +156,25 @@ INSTANTIATE_TEST_SUITE_P(Backends, CliGpu, ::testing::Values("ray-query", "rt-pi
                              return name;
                          });
 
-TEST(CliGpuAuto, PicksARayTracingBackend) {
+// auto: a hardware RT device runs ray-query (else rt-pipeline); with only a
+// software device (lavapipe, type "cpu") the CPU backend, which is faster there.
+TEST(CliGpuAuto, FollowsTheDeviceList) {
+    const CliRun list = runCli({"--list-devices", "--json"});
+    ASSERT_EQ(list.exitCode, 0) << list;
+    std::string expected = "cpu";
+    for (const Json& d : parseJson(list)["devices"]) {
+        if (d["type"] == "cpu" || !(d["ray_query"].get<bool>() || d["rt_pipeline"].get<bool>())) continue;
+        expected = d["ray_query"].get<bool>() ? "ray-query" : "rt-pipeline";
+        break;
+    }
     const CliRun run = runCli({"--json", kSampleA, kSampleB});
+    ASSERT_EQ(run.exitCode, 0) << run;
+    EXPECT_EQ(parseJson(run)["backend"].get<std::string>(), expected) << list.out;
+}
+
+// An explicit --device keeps auto on the Vulkan path, software device or not.
+TEST(CliGpuAuto, ExplicitDeviceKeepsVulkan) {
+    const CliRun run = runCli({"--json", "--device", "0", kSampleA, kSampleB});
     ASSERT_EQ(run.exitCode, 0) << run;
     const std::string backend = parseJson(run)["backend"].get<std::string>();
     EXPECT_TRUE(backend == "ray-query" || backend == "rt-pipeline") << backend;

@@ -42,7 +42,8 @@ Inputs: .ply .xyz .txt .obj .gltf .glb .stl .off .pcd (optionally .gz).
 Options:
   --json              print one JSON object instead of the summary
   --directed          compute only h(A,B)
-  --backend NAME      auto | ray-query | rt-pipeline | cpu   (default auto)
+  --backend NAME      auto | ray-query | rt-pipeline | cpu   (default auto: ray-query,
+                      else rt-pipeline, on a hardware RT device; else cpu)
   --device N          Vulkan device index from --list-devices (default: first usable)
   --bits K            index-space bit count, 0 = choose from the data (default 0)
   --radius-growth F   candidate-search radius factor per iteration, > 1 (default 2)
