@@ -88,4 +88,18 @@ std::vector<double> bruteForceNearest(std::span<const glm::vec3> queries,
     return out;
 }
 
+std::vector<NearestExact> bruteForceNearestIndexed(std::span<const glm::vec3> queries,
+                                                   std::span<const glm::vec3> targets, int threads) {
+    std::vector<NearestExact> out(queries.size(), {std::numeric_limits<double>::infinity(), 0});
+    if (targets.empty()) return out;
+    const Targets soa(targets);
+    parallelChunks(queries.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) {
+            const Nearest n = nearestOf(queries[i], soa);
+            out[i] = {std::sqrt(n.distanceSquared), n.targetIndex};
+        }
+    });
+    return out;
+}
+
 }  // namespace rthdist::cpu

@@ -31,4 +31,14 @@ struct DirectedExact {
                                                     std::span<const glm::vec3> targets,
                                                     int threads = 0);
 
+struct NearestExact {
+    double distance = 0.0;     // exact NN distance in double
+    uint32_t targetIndex = 0;  // smallest index among equally near targets
+};
+
+// Exact nearest neighbour (distance and index) of every query, in query order.
+[[nodiscard]] std::vector<NearestExact> bruteForceNearestIndexed(std::span<const glm::vec3> queries,
+                                                                 std::span<const glm::vec3> targets,
+                                                                 int threads = 0);
+
 }  // namespace rthdist::cpu

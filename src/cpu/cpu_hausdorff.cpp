@@ -28,6 +28,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -191,10 +192,83 @@ struct DirectedOutput {
     double indexMs = 0.0, cullMs = 0.0, searchMs = 0.0, refineMs = 0.0;
 };
 
+// Options::progress for one direction, which covers [base, base + span) of
+// the call. Only the calling thread (worker 0 of parallelChunks) reports, and
+// at most once per percent of the direction, so a callback that prints stays cheap.
+class Progress {
+public:
+    Progress(const Options& options, double base, double span)
+        : m_fn(options.progress ? &options.progress : nullptr), m_base(base), m_span(span) {}
+    // fraction: of this direction, 0..1.
+    void report(const char* stage, double fraction) {
+        if (m_fn == nullptr) return;
+        fraction = std::max(fraction, m_last);  // rounding must not step back
+        if (stage == m_stage && fraction < m_last + 0.01 && fraction < 1.0) return;
+        m_last = fraction;
+        m_stage = stage;
+        (*m_fn)(stage, m_base + m_span * std::clamp(fraction, 0.0, 1.0));
+    }
+
+private:
+    const std::function<void(const char*, double)>* m_fn;
+    double m_base, m_span;
+    double m_last = -1.0;
+    const char* m_stage = nullptr;
+};
+
+// Stage boundaries of one direction as fractions of it (search dominates).
+constexpr double kIndexDone = 0.1, kCullDone = 0.15, kSearchDone = 0.95;
+
+// Every query's exact float nearest neighbour (no early break): the previous
+// query's nearest bucket and the query's own cell seed the best distance, then
+// the BVH search runs to the end with kill = 0. Fills `nearest` (input order)
+// with the target index and the double distance recomputed from the pair.
+void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
+                  std::span<const glm::vec3> targets, const std::vector<float>& qx,
+                  const std::vector<float>& qy, const std::vector<float>& qz,
+                  const std::vector<uint32_t>& qOriginal, const std::vector<uint32_t>& qKey,
+                  int threads, PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress) {
+    const size_t nq = queries.size();
+    nearest.distance.assign(nq, 0.0);
+    nearest.nearest.assign(nq, 0);
+    const uint32_t cells = t.cellCount();
+    std::atomic<size_t> done{0};
+    parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int w) {
+        SearchStats stat;
+        uint32_t hint = kNone;
+        const uint32_t* keys = t.cellKey.data();
+        uint32_t cursor = uint32_t(std::lower_bound(keys, keys + cells, qKey[begin]) - keys);
+        for (size_t i = begin; i < end; ++i) {
+            const Query q{splat(qx[i]), splat(qy[i]), splat(qz[i])};
+            Best best;
+            if (hint != kNone) scanRange(t, t.bucketFirst[hint], t.bucketFirst[hint + 1], q, best);
+            const uint32_t key = qKey[i];
+            if (cursor < cells && keys[cursor] < key) {
+                cursor = uint32_t(std::lower_bound(keys + cursor, keys + cells, key) - keys);
+            }
+            if (cursor < cells && keys[cursor] == key) {
+                scanRange(t, t.cellFirst[cursor], t.cellFirst[cursor + 1], q, best);
+            }
+            searchTree(t, q, 0.0f, best, stat);  // kill 0: never breaks early
+            hint = t.bucketOf[best.pos];
+            const uint32_t src = qOriginal[i];
+            const glm::dvec3 diff = glm::dvec3(queries[src]) - glm::dvec3(targets[best.target]);
+            nearest.distance[src] = std::sqrt(diff.x * diff.x + diff.y * diff.y + diff.z * diff.z);
+            nearest.nearest[src] = best.target;
+        }
+        stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
+        const size_t finished = done.fetch_add(end - begin, std::memory_order_relaxed) + (end - begin);
+        if (w == 0) {
+            progress.report("search", kCullDone + (kSearchDone - kCullDone) * double(finished) / double(nq));
+        }
+    });
+}
+
 DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
                                  std::span<const glm::vec3> targets, float scale,
-                                 const Options& options) {
+                                 const Options& options, PerPoint* perPoint, Progress& progress) {
     DirectedOutput out;
+    progress.report("index", 0.0);
     const int threads = resolveThreads(options.threads);
     auto start = Clock::now();
 
@@ -238,6 +312,39 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
     });
     std::vector<uint64_t>().swap(keyed);
     out.indexMs = msSince(start);
+    progress.report("index", kIndexDone);
+
+    if (perPoint != nullptr) {
+        // Every query's NN: no lower bound, no kill. The witness is the
+        // largest double distance (smallest query index among ties), so it
+        // is consistent with the per-point array by construction.
+        start = Clock::now();
+        std::vector<SearchStats> stats(static_cast<size_t>(threads));
+        perPointPass(t, queries, targets, qx, qy, qz, qOriginal, qKey, threads, *perPoint, stats, progress);
+        out.searchMs = msSince(start);
+        progress.report("refine", kSearchDone);
+        start = Clock::now();
+        size_t win = 0;
+        for (size_t i = 1; i < nq; ++i) {
+            if (perPoint->distance[i] > perPoint->distance[win]) win = i;
+        }
+        Directed& d = out.directed;
+        d.queryIndex = uint32_t(win);
+        d.targetIndex = perPoint->nearest[win];
+        d.queryPoint = queries[d.queryIndex];
+        d.targetPoint = targets[d.targetIndex];
+        d.distance = perPoint->distance[win];
+        Counters& c = d.counters;
+        c.bits = uint32_t(g.bits);
+        c.occupiedCells = t.cellCount();
+        c.queries = nq;
+        c.survivingQueries = nq;
+        c.iterations = 1;
+        for (const SearchStats& s : stats) c.candidatePairs += s.bucketsScanned;
+        out.refineMs = msSince(start);
+        progress.report("refine", 1.0);
+        return out;
+    }
 
     // Lower bound: exact NN of a strided sample (witnessed) and the box bound.
     start = Clock::now();
@@ -263,6 +370,8 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
     const double bound2 = *std::max_element(boxBound.begin(), boxBound.end()) * (1.0 - kBoundShrink);
     std::atomic<uint32_t> kill{std::bit_cast<uint32_t>(std::max(sampleMax, float(bound2)))};
     out.cullMs = msSince(start);
+    progress.report("cull", kCullDone);
+    std::atomic<size_t> done{0};
 
     // The pass over all queries.
     start = Clock::now();
@@ -325,8 +434,13 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
         stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
         culled[size_t(w)] += culledHere;
         surviving[size_t(w)] += survivingHere;
+        const size_t finished = done.fetch_add(end - begin, std::memory_order_relaxed) + (end - begin);
+        if (w == 0) {
+            progress.report("search", kCullDone + (kSearchDone - kCullDone) * double(finished) / double(nq));
+        }
     });
     out.searchMs = msSince(start);
+    progress.report("refine", kSearchDone);
 
     start = Clock::now();
     Winner win;
@@ -351,6 +465,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
         c.candidatePairs += stats[size_t(w)].bucketsScanned;
     }
     out.refineMs = msSince(start);
+    progress.report("refine", 1.0);
     return out;
 }
 
@@ -390,12 +505,16 @@ Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<con
         r.timings.search += o.searchMs;
         r.timings.refine += o.refineMs;
     };
-    DirectedOutput ab = directedHausdorff(a, b, scale, options);
+    const bool perPoint = options.perPointDistances;
+    const double span = options.directedOnly ? 1.0 : 0.5;
+    Progress first(options, 0.0, span);
+    DirectedOutput ab = directedHausdorff(a, b, scale, options, perPoint ? &r.aNearest : nullptr, first);
     add(ab);
     r.aToB = ab.directed;
     r.hausdorff = r.aToB.distance;
     if (!options.directedOnly) {
-        DirectedOutput ba = directedHausdorff(b, a, scale, options);
+        Progress second(options, 0.5, 0.5);
+        DirectedOutput ba = directedHausdorff(b, a, scale, options, perPoint ? &r.bNearest : nullptr, second);
         add(ba);
         r.bToA = ba.directed;
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);

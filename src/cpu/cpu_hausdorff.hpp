@@ -13,6 +13,12 @@
 //      as a point closer than the running M appears, else ends with the exact
 //      nearest neighbour and raises M.
 //   4. The winning pair is recomputed in double.
+// With Options::perPointDistances, steps 2 and 3 become one pass that finds
+// every query's exact nearest neighbour (the same seeds and BVH search, never
+// breaking early); its distances are recomputed in double per pair, and the
+// witness is the query with the largest of them (smallest index among ties).
+// Progress: Options::progress is called from the calling thread at stage
+// boundaries and about every percent of the search.
 //
 // Contract: a and b non-empty, all coordinates finite (the caller checks).
 // Precision: squared distances are float differences of the raw float

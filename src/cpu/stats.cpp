@@ -1,0 +1,139 @@
+// Statistics of per-point nearest distances: rthdist/stats.hpp has the
+// definitions (nearest-rank percentiles, symmetric and pooled variants,
+// histogram binning, normalization by the diagonal of the union's box).
+#include "rthdist/stats.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rthdist {
+namespace {
+
+double diagonalOf(std::span<const glm::vec3> points, glm::dvec3& lo, glm::dvec3& hi) {
+    for (const glm::vec3& p : points) {
+        lo = glm::min(lo, glm::dvec3(p));
+        hi = glm::max(hi, glm::dvec3(p));
+    }
+    if (points.empty()) return 0.0;
+    const glm::dvec3 d = hi - lo;
+    return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+}
+
+double diagonalOf(std::span<const glm::vec3> points) {
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    return diagonalOf(points, lo, hi);
+}
+
+}  // namespace
+
+double percentileNearestRank(std::span<const double> sorted, double p) {
+    if (sorted.empty()) return 0.0;
+    const double n = double(sorted.size());
+    double rank = std::ceil(p * n / 100.0);
+    rank = std::clamp(rank, 1.0, n);
+    return sorted[size_t(rank) - 1];
+}
+
+DistanceStats distanceStats(std::span<const double> distances, const StatsOptions& options, double histogramLo,
+                            double histogramHi) {
+    DistanceStats s;
+    s.count = distances.size();
+    s.histogram.lo = histogramLo;
+    s.histogram.hi = histogramHi;
+    s.histogram.counts.assign(size_t(std::max(options.histogramBins, 1)), 0);
+    if (distances.empty()) return s;
+    std::vector<double> sorted(distances.begin(), distances.end());
+    std::sort(sorted.begin(), sorted.end());
+    s.min = sorted.front();
+    s.max = sorted.back();
+    double sum = 0.0, sumSquares = 0.0;
+    for (double d : sorted) {
+        sum += d;
+        sumSquares += d * d;
+    }
+    s.mean = sum / double(sorted.size());
+    s.rms = std::sqrt(sumSquares / double(sorted.size()));
+    for (double p : options.percentiles) s.percentiles.push_back({p, percentileNearestRank(sorted, p)});
+
+    Histogram& h = s.histogram;
+    const size_t bins = h.counts.size();
+    const double width = h.hi - h.lo;
+    for (double d : sorted) {
+        if (d < h.lo) {
+            ++h.below;
+        } else if (d > h.hi) {
+            ++h.above;
+        } else {
+            const double at = (d - h.lo) / width * double(bins);
+            ++h.counts[std::min(bins - 1, size_t(at))];
+        }
+    }
+    return s;
+}
+
+Result<HausdorffStats> hausdorffStats(const HausdorffResult& result, std::span<const glm::vec3> a,
+                                      std::span<const glm::vec3> b, const StatsOptions& options) {
+    if (result.aNearest.distance.size() != a.size() ||
+        (!result.directedOnly && result.bNearest.distance.size() != b.size())) {
+        return Error{ErrorCode::kInvalidArgument,
+                     "hausdorffStats: the result has no per-point distances for these sets "
+                     "(Options::perPointDistances)"};
+    }
+    if (options.histogramBins < 1) return Error{ErrorCode::kInvalidArgument, "hausdorffStats: histogramBins < 1"};
+    for (double p : options.percentiles) {
+        if (!(p >= 0.0 && p <= 100.0)) {
+            return Error{ErrorCode::kInvalidArgument, "hausdorffStats: percentile outside [0, 100]"};
+        }
+    }
+    const std::vector<double>& da = result.aNearest.distance;
+    const std::vector<double> empty;
+    const std::vector<double>& db = result.directedOnly ? empty : result.bNearest.distance;
+    std::vector<double> pooled;
+    if (!result.directedOnly) {
+        pooled.reserve(da.size() + db.size());
+        pooled.insert(pooled.end(), da.begin(), da.end());
+        pooled.insert(pooled.end(), db.begin(), db.end());
+    }
+
+    double lo = options.rangeLo, hi = options.rangeHi;
+    if (!(hi > lo)) {
+        lo = 0.0;
+        hi = 0.0;
+        for (double d : da) hi = std::max(hi, d);
+        for (double d : db) hi = std::max(hi, d);
+        if (!(hi > 0.0)) hi = 1.0;
+    }
+
+    HausdorffStats s;
+    s.aToB = distanceStats(da, options, lo, hi);
+    s.bToA = distanceStats(db, options, lo, hi);
+    s.pooled = distanceStats(pooled, options, lo, hi);
+    for (size_t i = 0; i < options.percentiles.size(); ++i) {
+        double v = s.aToB.percentiles[i].value;
+        if (!result.directedOnly) v = std::max(v, s.bToA.percentiles[i].value);
+        s.symmetric.push_back({options.percentiles[i], v});
+    }
+    glm::dvec3 ulo(std::numeric_limits<double>::infinity()), uhi(-std::numeric_limits<double>::infinity());
+    diagonalOf(a, ulo, uhi);
+    s.diagonal = diagonalOf(b, ulo, uhi);
+    s.diagonalA = diagonalOf(a);
+    s.diagonalB = diagonalOf(b);
+    return s;
+}
+
+bool percentileVariant(const HausdorffStats& stats, const std::string& variant, double p, double& out) {
+    const std::vector<Percentile>* list = nullptr;
+    if (variant == "max" || variant == "symmetric") list = &stats.symmetric;
+    if (variant == "pooled") list = &stats.pooled.percentiles;
+    if (list == nullptr) return false;
+    for (const Percentile& q : *list) {
+        if (q.p == p) {
+            out = q.value;
+            return true;
+        }
+    }
+    return false;
+}
+
+}  // namespace rthdist
