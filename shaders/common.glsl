@@ -64,7 +64,9 @@ float packedDist2(uint64_t p) { return uintBitsToFloat(uint(p >> 32)); }
 
 // The threshold below which a query cannot raise h: the larger of the exact
 // running maximum (has a witness) and the witness-less lower bound.
+// A negative lowerBound2 turns the early break off (per-point distances).
 float deadThreshold(U64Buf maxPacked, float lowerBound2) {
+    if (lowerBound2 < 0.0) return 0.0;
     uint64_t m = maxPacked.v[0];
     return max(packedDist2(m), lowerBound2);
 }

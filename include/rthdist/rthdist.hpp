@@ -34,7 +34,9 @@
 namespace rthdist {
 
 enum class Backend {
-    kAuto,        // ray-query if the device has it, else rt-pipeline, else error
+    kAuto,        // a hardware RT device: ray-query if it has it, else rt-pipeline;
+                  // no such device (none, or only a software one such as
+                  // lavapipe): the CPU backend, which is faster there
     kRayQuery,    // VK_KHR_ray_query in compute shaders
     kRtPipeline,  // VK_KHR_ray_tracing_pipeline (raygen + intersection)
     kCpu,         // exact multithreaded CPU implementation (no Vulkan)
@@ -106,7 +108,7 @@ struct Timings {
     double cull = 0.0;    // neighbourhood pass: exact NN in the 3x3x3 cell block
     double search = 0.0;  // stage 2: BLAS builds + ray traversal (candidate pairs)
     double refine = 0.0;  // stage 3: exact scan of candidate cells, classification
-    double total = 0.0;   // everything inside the call
+    double total = 0.0;   // the whole compute() call, device setup excluded
     // Device time per stage from Vulkan timestamp queries (GPU backends only;
     // 0 on the CPU backend). The wall-clock fields above include submission,
     // waiting and the host work between the stages' submissions.

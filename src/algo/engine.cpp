@@ -74,6 +74,24 @@ double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// auto picks a Vulkan backend only on a device with RT hardware paths that is
+// not a software rasterizer: on lavapipe (VK_PHYSICAL_DEVICE_TYPE_CPU) the
+// native CPU backend is 10-100x faster (docs/bench). An explicit --device
+// keeps the Vulkan path on whatever device it names.
+bool hardwareRtDevice(const Options& o) {
+    auto devices = listDevices();
+    if (!devices) return false;
+    for (const DeviceInfo& d : devices.value()) {
+        if (!(d.rayQuery || d.rtPipeline)) continue;
+        if (o.deviceIndex >= 0) {
+            if (d.index == o.deviceIndex) return true;
+            continue;
+        }
+        if (d.type != "cpu") return true;
+    }
+    return false;
+}
+
 }  // namespace
 
 struct Engine::Impl {
@@ -95,7 +113,7 @@ Result<Engine> Engine::create(const Options& options) {
     auto t0 = std::chrono::steady_clock::now();
     auto impl = std::make_unique<Impl>();
     impl->options = options;
-    if (options.backend == Backend::kCpu) {
+    if (options.backend == Backend::kCpu || (options.backend == Backend::kAuto && !hardwareRtDevice(options))) {
         impl->backend = Backend::kCpu;
         return Engine(std::move(impl));
     }

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <map>
 #include <string>
+#include <tuple>
 #include <new>
 #include <vector>
 
@@ -63,6 +64,27 @@ sh::GridParams gridParams(const GridSpec& g) {
     p.bits = uint32_t(g.bits);
     p.cellsPerAxis = g.cellsPerAxis;
     return p;
+}
+
+// 1 when the squared differences of these coordinates stay normal floats;
+// else the power of two that brings the largest magnitude near 2^20.
+float exactScaleFor(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
+    float maxAbs = 0.0f;
+    for (auto set : {a, b}) {
+        const int threads = cpu::resolveThreads(0, set.size() / kHostChunk + 1);
+        std::vector<float> m(size_t(threads), 0.0f);
+        cpu::parallelChunks(set.size(), kHostChunk, threads, [&](size_t begin, size_t end, int t) {
+            float v = m[size_t(t)];
+            for (size_t i = begin; i < end; ++i)
+                v = std::max({v, std::abs(set[i].x), std::abs(set[i].y), std::abs(set[i].z)});
+            m[size_t(t)] = v;
+        });
+        maxAbs = std::max(maxAbs, *std::max_element(m.begin(), m.end()));
+    }
+    if (maxAbs == 0.0f || (maxAbs < 0x1p60f && maxAbs > 0x1p-40f)) return 1.0f;
+    int e = 0;
+    std::frexp(maxAbs, &e);
+    return std::ldexp(1.0f, 20 - e);
 }
 
 }  // namespace
@@ -209,8 +231,14 @@ struct GpuHausdorff::State {
     }
 
     // h(Q, T): Q's points in Q's cell order are the queries.
+    // Reports progress; [from, to) is this direction's share of the call.
+    void report(const Options& options, const char* stage, double fraction) {
+        if (options.progress) options.progress(stage, std::clamp(fraction, 0.0, 1.0));
+    }
+
     Directed direction(const PointIndex& Q, const PointIndex& T, std::span<const glm::vec3> qPts,
-                       std::span<const glm::vec3> tPts, const Options& options) {
+                       std::span<const glm::vec3> tPts, const Options& options, PerPoint* perPoint,
+                       double progressFrom, double progressTo) {
         Directed out;
         Counters& cnt = out.counters;
         cnt.bits = uint32_t(T.grid.bits);
@@ -231,7 +259,9 @@ struct GpuHausdorff::State {
             lbs[size_t(t)] = m;
         });
         const double lb = *std::max_element(lbs.begin(), lbs.end());
-        const float lowerBound2 = float(lb * (1.0 - 1e-5));
+        // Per-point distances need every query's NN: a negative bound turns
+        // the early break off in every shader (deadThreshold returns 0).
+        const float lowerBound2 = perPoint ? -1.0f : float(lb * (1.0 - 1e-5));
         double maxAbs = 0.0;
         for (const Bounds* b : {&Q.bounds, &T.bounds})
             maxAbs = std::max({maxAbs, std::abs(b->lo.x), std::abs(b->lo.y), std::abs(b->lo.z), std::abs(b->hi.x),
@@ -255,6 +285,7 @@ struct GpuHausdorff::State {
         cnt.survivingQueries = numActive;
         cnt.culledByNeighbourhood = Q.n - numActive;
         timings->cull += msSince(t0);
+        report(options, "cull", progressFrom + 0.2 * (progressTo - progressFrom));
 
         auto threshold = [&] {
             return std::max(double(lowerBound2), double(std::bit_cast<float>(uint32_t(*maxPacked() >> 32))));
@@ -316,6 +347,9 @@ struct GpuHausdorff::State {
             numActive = counters()[2];
             cur = 1 - cur;
             timings->refine += msSince(t0);
+            report(options, "search",
+                   progressFrom + (progressTo - progressFrom) *
+                                      (0.2 + 0.8 * (1.0 - double(numActive) / double(std::max<uint64_t>(1, cnt.survivingQueries)))));
 
             if (pairCount > pairCapacity && pairCapacity < kMaxPairCapacity) {
                 // Some queries lost pairs: redo them at the same radius with room.
@@ -347,7 +381,34 @@ struct GpuHausdorff::State {
         out.queryPoint = qPts[out.queryIndex];
         out.targetPoint = tPts[out.targetIndex];
         out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
+        if (perPoint) readPerPoint(Q, state, qPts, tPts, *perPoint);
         return out;
+    }
+
+    // Every query is EXACT after a per-point run: its state holds its NN.
+    void readPerPoint(const PointIndex& Q, const Buffer& state, std::span<const glm::vec3> qPts,
+                      std::span<const glm::vec3> tPts, PerPoint& out) {
+        const VkDeviceSize stateBytes = VkDeviceSize(Q.n) * sizeof(sh::QueryState);
+        const VkDeviceSize pointBytes = VkDeviceSize(Q.n) * 16;
+        Buffer& host = buf("readback", stateBytes + pointBytes, MemoryKind::kHost);
+        VkCommandBuffer cmd = ctx.begin();
+        VkBufferCopy c1{0, 0, stateBytes};
+        vkCmdCopyBuffer(cmd, state.handle(), host.handle(), 1, &c1);
+        VkBufferCopy c2{0, stateBytes, pointBytes};
+        vkCmdCopyBuffer(cmd, Q.sorted->handle(), host.handle(), 1, &c2);
+        ctx.submitAndWait(cmd);
+        const auto* states = static_cast<const sh::QueryState*>(host.mapped());
+        const auto* sorted = reinterpret_cast<const float*>(static_cast<const char*>(host.mapped()) + stateBytes);
+        out.distance.assign(Q.n, 0.0);
+        out.nearest.assign(Q.n, 0);
+        for (uint32_t i = 0; i < Q.n; ++i) {
+            const uint32_t qi = std::bit_cast<uint32_t>(sorted[4 * i + 3]);
+            const uint32_t ti = uint32_t(states[i].best & 0xffffffffu);
+            if (qi >= qPts.size() || ti >= tPts.size() || states[i].status != RTHDIST_EXACT)
+                throw std::runtime_error("per-point read-back: query " + std::to_string(i) + " has no exact NN");
+            out.nearest[qi] = ti;
+            out.distance[qi] = glm::length(glm::dvec3(qPts[qi]) - glm::dvec3(tPts[ti]));
+        }
     }
 };
 
@@ -369,15 +430,32 @@ Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std:
     res.device = m_state->ctx.deviceName();
     res.directedOnly = options.directedOnly;
     m_state->timings = &res.timings;
+    // Squared distances are float on the device: coordinates so large (or so
+    // small) that they overflow (or underflow) are scaled by a power of two,
+    // which is exact; values and witnesses are recomputed from the inputs.
+    std::vector<glm::vec3> scaledA, scaledB;
+    const float scale = exactScaleFor(a, b);
+    if (scale != 1.0f) {
+        scaledA.assign(a.begin(), a.end());
+        scaledB.assign(b.begin(), b.end());
+        for (auto& p : scaledA) p *= scale;
+        for (auto& p : scaledB) p *= scale;
+    }
+    const std::span<const glm::vec3> ga = scale != 1.0f ? std::span<const glm::vec3>(scaledA) : a;
+    const std::span<const glm::vec3> gb = scale != 1.0f ? std::span<const glm::vec3>(scaledB) : b;
     try {
         // Each set is indexed once with its own grid: as targets for the other
         // direction, and as cell-ordered (Morton) queries for its own.
-        PointIndex ia = m_state->buildIndex(a, options.bits, "A");
-        PointIndex ib = m_state->buildIndex(b, options.bits, "B");
-        res.aToB = m_state->direction(ia, ib, a, b, options);
+        PointIndex ia = m_state->buildIndex(ga, options.bits, "A");
+        m_state->report(options, "index", 0.05);
+        PointIndex ib = m_state->buildIndex(gb, options.bits, "B");
+        m_state->report(options, "index", 0.1);
+        const bool pp = options.perPointDistances;
+        const double mid = options.directedOnly ? 1.0 : 0.55;
+        res.aToB = m_state->direction(ia, ib, ga, gb, options, pp ? &res.aNearest : nullptr, 0.1, mid);
         res.hausdorff = res.aToB.distance;
         if (!options.directedOnly) {
-            res.bToA = m_state->direction(ib, ia, b, a, options);
+            res.bToA = m_state->direction(ib, ia, gb, ga, options, pp ? &res.bNearest : nullptr, mid, 1.0);
             res.hausdorff = std::max(res.hausdorff, res.bToA.distance);
         }
     } catch (const gpu::VulkanError& e) {
@@ -390,6 +468,22 @@ Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std:
         m_state->accel.release();
         m_state->tlasBound = false;
         return Error{ErrorCode::kInternal, e.what()};
+    }
+    if (scale != 1.0f) {
+        auto restore = [](Directed& d, std::span<const glm::vec3> q, std::span<const glm::vec3> t) {
+            d.queryPoint = q[d.queryIndex];
+            d.targetPoint = t[d.targetIndex];
+            d.distance = glm::length(glm::dvec3(d.queryPoint) - glm::dvec3(d.targetPoint));
+        };
+        restore(res.aToB, a, b);
+        res.hausdorff = res.aToB.distance;
+        if (!options.directedOnly) {
+            restore(res.bToA, b, a);
+            res.hausdorff = std::max(res.hausdorff, res.bToA.distance);
+        }
+        for (auto [pp, q, t] : {std::tuple{&res.aNearest, a, b}, std::tuple{&res.bNearest, b, a}})
+            for (size_t i = 0; i < pp->nearest.size(); ++i)
+                pp->distance[i] = glm::length(glm::dvec3(q[i]) - glm::dvec3(t[pp->nearest[i]]));
     }
     m_state->timings = nullptr;
     return res;

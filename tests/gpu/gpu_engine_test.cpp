@@ -135,3 +135,22 @@ TEST(GpuEngine, CountersDescribeTheWork) {
 
 }  // namespace
 }  // namespace rthdist::test
+
+namespace rthdist::test {
+namespace {
+
+TEST(GpuEngine, HugeAndTinyMagnitudesAreScaledExactly) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    std::vector<glm::vec3> a{{1e30f, 0, 0}}, b{{-1e30f, 0, 0}, {0, 1e30f, 0}};
+    auto r = engine->compute(a, b);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_NEAR(r->aToB.distance, std::sqrt(2.0) * 1e30, 1e24);
+    EXPECT_EQ(r->aToB.targetIndex, 1u);
+    expectExact(*engine, "huge", 31, uniformCloud(2000, 31, glm::vec3(3e25f), 1e25f),
+                uniformCloud(1500, 32, glm::vec3(3.5e25f), 1e25f));
+    expectExact(*engine, "tiny", 33, uniformCloud(2000, 33, glm::vec3(0.0f), 1e-30f),
+                uniformCloud(1500, 34, glm::vec3(2e-31f), 1e-30f));
+}
+
+}  // namespace
+}  // namespace rthdist::test

@@ -3,6 +3,9 @@
 // validation layer on and required silent.
 #include <gtest/gtest.h>
 
+#include <glm/glm.hpp>
+
+#include "cpu/brute_force.hpp"
 #include "gpu_test_support.hpp"
 #include "common/oracle_cases.hpp"
 
@@ -47,6 +50,44 @@ TEST(GpuOracle, DirectedOnlyAndFixedBits) {
             EXPECT_EQ(r->aToB.counters.bits, uint32_t(bits));
             EXPECT_EQ(r->validationMessages, 0u);
         }
+    }
+}
+
+}  // namespace
+}  // namespace rthdist::test
+
+namespace rthdist::test {
+namespace {
+
+// Per-point nearest distances (no early break) against the brute force, for
+// every point of every fifth oracle case.
+TEST(GpuOracle, PerPointDistancesMatchBruteForce) {
+    Options options = gpuOptions();
+    options.perPointDistances = true;
+    RTHDIST_REQUIRE_ENGINE(engine, options);
+    const std::vector<OracleCase> cases = makeOracleCases();
+    for (size_t i = 0; i < cases.size(); i += 5) {
+        const OracleCase& c = cases[i];
+        SCOPED_TRACE("case " + c.name + " seed " + std::to_string(c.seed));
+        auto r = engine->compute(c.a, c.b);
+        ASSERT_TRUE(r.ok()) << r.error().message;
+        expectMatchesOracle(c, *r);
+        const double tol = oracleTolerance(c.a, c.b, r->hausdorff);
+        for (int dir = 0; dir < 2; ++dir) {
+            const auto& q = dir == 0 ? c.a : c.b;
+            const auto& t = dir == 0 ? c.b : c.a;
+            const PerPoint& pp = dir == 0 ? r->aNearest : r->bNearest;
+            ASSERT_EQ(pp.distance.size(), q.size());
+            ASSERT_EQ(pp.nearest.size(), q.size());
+            const std::vector<double> ref = cpu::bruteForceNearest(q, t);
+            size_t bad = 0;
+            for (size_t k = 0; k < q.size(); ++k) {
+                const double d = glm::length(glm::dvec3(q[k]) - glm::dvec3(t[pp.nearest[k]]));
+                if (std::abs(pp.distance[k] - ref[k]) > tol || d != pp.distance[k]) ++bad;
+            }
+            EXPECT_EQ(bad, 0u) << "direction " << dir;
+        }
+        EXPECT_EQ(r->validationMessages, 0u);
     }
 }
 
