@@ -51,6 +51,21 @@ Options:
   --verify            also run the CPU backend and compare (exit 1 on mismatch)
   --validation        enable the Vulkan validation layer, count its messages
   --list-devices      list Vulkan devices, the paths each supports, and why not
+  --quiet             no progress on stderr (progress is shown only on a terminal)
+
+Per-point distances (each of these implies --per-point):
+  --per-point         every point's exact nearest distance; statistics in the output
+  --percentile P      also report the P-th percentile, 0..100, repeatable
+                      (default 50 90 95 99; 95 is always reported: HD95)
+  --histogram-bins N  histogram bins (default 20)
+  --range MIN MAX     fixed distance range of the colour ramp and histogram
+                      (default 0 .. the largest distance)
+  --out-ply PREFIX    write PREFIX_a.ply and PREFIX_b.ply: points with float
+                      quality = distance and a red/green/blue colour ramp
+  --out-csv PREFIX    write PREFIX_a.csv and PREFIX_b.csv: index,x,y,z,distance,nearest
+  --png FILE          picture of both sets coloured by distance, with the
+                      Hausdorff segment (software renderer)
+  --histogram-png FILE  bar chart of the distance histograms
   --help, -h          print this help
   --version           print the version
 
@@ -141,6 +156,50 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
                 return usageError("option '--radius-growth' expects a number > 1, got '" + *v + "'");
             }
             out.options.radiusGrowth = *f;
+        } else if (name == "--quiet") {
+            error = flag(out.quiet);
+        } else if (name == "--per-point") {
+            error = flag(out.perPoint);
+        } else if (name == "--percentile") {
+            const auto v = takeValue();
+            if (!v) return usageError("option '--percentile' needs a value");
+            double p = 0.0;
+            const char* end = v->data() + v->size();
+            const auto res = std::from_chars(v->data(), end, p);
+            if (v->empty() || res.ec != std::errc() || res.ptr != end || !(p >= 0.0 && p <= 100.0)) {
+                return usageError("option '--percentile' expects a number in [0, 100], got '" + *v + "'");
+            }
+            out.percentiles.push_back(p);
+            out.perPoint = true;
+        } else if (name == "--histogram-bins") {
+            const auto v = takeValue();
+            if (!v) return usageError("option '--histogram-bins' needs a value");
+            const auto n = parseInt(*v, 1, 1 << 20);
+            if (!n) return usageError("option '--histogram-bins' expects an integer >= 1, got '" + *v + "'");
+            out.histogramBins = *n;
+            out.perPoint = true;
+        } else if (name == "--range") {
+            if (inlineValue) return usageError("option '--range' takes two values: --range MIN MAX");
+            if (i + 2 >= args.size()) return usageError("option '--range' needs two values MIN MAX");
+            const auto lo = parseFloat(args[i + 1]), hi = parseFloat(args[i + 2]);
+            if (!lo || !hi || !(*hi > *lo)) {
+                return usageError("option '--range' expects numbers MIN < MAX, got '" + args[i + 1] + "' '" +
+                                  args[i + 2] + "'");
+            }
+            i += 2;
+            out.hasRange = true;
+            out.rangeLo = *lo;
+            out.rangeHi = *hi;
+            out.perPoint = true;
+        } else if (name == "--out-ply" || name == "--out-csv" || name == "--png" || name == "--histogram-png") {
+            const auto v = takeValue();
+            if (!v || v->empty()) return usageError("option '" + name + "' needs a value");
+            std::string& target = name == "--out-ply" ? out.outPly
+                                  : name == "--out-csv" ? out.outCsv
+                                  : name == "--png"     ? out.png
+                                                        : out.histogramPng;
+            target = *v;
+            out.perPoint = true;
         } else {
             return usageError("unknown option '" + name + "'");
         }
@@ -155,6 +214,7 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
     if (positional.size() != 2) {
         return usageError("expected two input files A and B, got " + std::to_string(positional.size()));
     }
+    out.options.perPointDistances = out.perPoint;
     out.pathA = positional[0];
     out.pathB = positional[1];
     return out;

@@ -4,6 +4,7 @@
 
 #include <span>
 #include <string>
+#include <vector>
 
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
@@ -25,6 +26,19 @@ struct CliArgs {
     bool listDevices = false;  // --list-devices
     bool help = false;         // --help / -h
     bool version = false;      // --version
+
+    // Per-point distances and what is made of them (README "Per-point
+    // distances"). Every flag below except --quiet turns perPoint on.
+    bool perPoint = false;             // --per-point (sets options.perPointDistances)
+    std::vector<double> percentiles;   // --percentile P, repeatable; empty = defaults
+    int histogramBins = 20;            // --histogram-bins N
+    bool hasRange = false;             // --range MIN MAX (colour ramp and histogram)
+    double rangeLo = 0.0, rangeHi = 0.0;
+    std::string outPly;                // --out-ply PREFIX -> PREFIX_a.ply, PREFIX_b.ply
+    std::string outCsv;                // --out-csv PREFIX -> PREFIX_a.csv, PREFIX_b.csv
+    std::string png;                   // --png FILE (picture)
+    std::string histogramPng;          // --histogram-png FILE
+    bool quiet = false;                // --quiet: no progress on stderr
 };
 
 // Parses argv[1..]. Accepts "--flag value" and "--flag=value"; "--" ends the

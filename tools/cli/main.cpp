@@ -11,10 +11,13 @@
 #include <vector>
 
 #include "cli/args.hpp"
+#include "cli/per_point_outputs.hpp"
+#include "cli/progress_meter.hpp"
 #include "cli/report.hpp"
 #include "cli/verify.hpp"
 #include "rthdist/io.hpp"
 #include "rthdist/rthdist.hpp"
+#include "rthdist/stats.hpp"
 
 namespace rthdist::cli {
 namespace {
@@ -75,8 +78,27 @@ int run(const std::vector<std::string>& argv) {
     if (!b) return failWith(b.error());
     const double loadMs = msSince(loadStart);
 
-    Result<HausdorffResult> result = hausdorff(*a, *b, args.options);
+    // Progress only on a terminal, for runs longer than a second, and never with --quiet.
+    ProgressMeter meter(!args.quiet && ProgressMeter::stderrIsTerminal());
+    Options options = args.options;
+    options.progress = [&meter](const char* stage, double fraction) { meter.update(stage, fraction); };
+    Result<HausdorffResult> result = hausdorff(*a, *b, options);
+    meter.finish();
     if (!result) return failWith(result.error());
+
+    std::optional<HausdorffStats> stats;
+    if (args.perPoint) {
+        Result<HausdorffStats> s = hausdorffStats(*result, *a, *b, statsOptionsFrom(args));
+        if (!s) {
+            return fail(kExitInternal, std::string("the ") + backendName(result->backend) +
+                                           " backend returned no per-point distances: " + s.error().message);
+        }
+        stats = std::move(s).value();
+        meter.update("output", 0.0);
+        Result<bool> written = writePerPointOutputs(args, *a, *b, *result, *stats);
+        meter.finish();
+        if (!written) return failWith(written.error());
+    }
 
     std::optional<Verification> verification;
     if (args.verify) {
@@ -92,6 +114,7 @@ int run(const std::vector<std::string>& argv) {
     report.loadMs = loadMs;
     report.result = &*result;
     report.verification = verification ? &*verification : nullptr;
+    report.stats = stats ? &*stats : nullptr;
     report.wallMs = msSince(start);
     if (!writeStdout(args.json ? jsonReport(report) : summaryText(report))) {
         return fail(kExitInternal, "cannot write to stdout");

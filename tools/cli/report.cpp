@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "cli/json_writer.hpp"
+#include "cli/stats_report.hpp"
 
 namespace rthdist::cli {
 
@@ -118,6 +119,7 @@ std::string summaryText(const RunReport& report) {
             report.loadMs, t.setup, t.upload, t.index, t.cull, t.search, t.refine, t.total, report.wallMs);
     appendf(s, "counters   A->B %s\n", countersText(r.aToB.counters).c_str());
     if (!r.directedOnly) appendf(s, "           B->A %s\n", countersText(r.bToA.counters).c_str());
+    if (report.stats != nullptr) s += statsText(*report.stats, r.directedOnly);
     if (args.options.validation) {
         appendf(s, "validation messages: %llu\n", (unsigned long long)r.validationMessages);
     }
@@ -187,6 +189,7 @@ std::string jsonReport(const RunReport& report) {
         w.endArray();
         w.endObject();
     }
+    if (report.stats != nullptr) writeStatsJson(w, *report.stats, r.directedOnly);
     w.endObject();
     return w.str() + "\n";
 }

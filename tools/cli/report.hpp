@@ -8,7 +8,8 @@
 //   b_to_a {distance, b_index, a_index, b_point, a_point} | null,
 //   timings_ms {load, setup, upload, index, cull, search, refine, total, wall},
 //   counters {a_to_b {...}, b_to_a {...} | null}, validation_messages,
-//   verify {...} (only with --verify).
+//   verify {...} (only with --verify),
+//   per_point {...} (only with --per-point; cli/stats_report.hpp).
 #pragma once
 
 #include <cstddef>
@@ -18,6 +19,7 @@
 #include "cli/args.hpp"
 #include "cli/verify.hpp"
 #include "rthdist/rthdist.hpp"
+#include "rthdist/stats.hpp"
 
 namespace rthdist::cli {
 
@@ -29,6 +31,7 @@ struct RunReport {
     double wallMs = 0.0;  // the whole command up to printing
     const HausdorffResult* result = nullptr;
     const Verification* verification = nullptr;  // null without --verify
+    const HausdorffStats* stats = nullptr;       // null without --per-point
 };
 
 [[nodiscard]] std::string summaryText(const RunReport& report);

@@ -1,0 +1,16 @@
+// --histogram-png: a bar chart of the per-point distance histograms drawn in
+// software (cli/image.hpp): A->B and B->A bars side by side in each bin, the
+// x axis in distance units with the range's ticks, the y axis in points, and
+// vertical markers at HD95 (symmetric) and H.
+#pragma once
+
+#include <string>
+
+#include "cli/image.hpp"
+#include "rthdist/stats.hpp"
+
+namespace rthdist::cli {
+
+[[nodiscard]] Image plotHistogram(const HausdorffStats& stats, double hausdorff, bool directedOnly);
+
+}  // namespace rthdist::cli

@@ -1,0 +1,24 @@
+// Writes every per-point output the command line asked for (--out-ply,
+// --out-csv, --png, --histogram-png) from one finished run. The colour range
+// is --range when given, else [0, the largest per-point distance] (= H).
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <span>
+
+#include "cli/args.hpp"
+#include "rthdist/result.hpp"
+#include "rthdist/rthdist.hpp"
+#include "rthdist/stats.hpp"
+
+namespace rthdist::cli {
+
+// Statistics options from the command line (95 always among the percentiles).
+[[nodiscard]] StatsOptions statsOptionsFrom(const CliArgs& args);
+
+[[nodiscard]] Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3> a,
+                                                std::span<const glm::vec3> b, const HausdorffResult& result,
+                                                const HausdorffStats& stats);
+
+}  // namespace rthdist::cli

@@ -1,0 +1,188 @@
+#include "cli/point_render.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace rthdist::cli {
+namespace {
+
+constexpr Rgb kBackground{255, 255, 255}, kBlack{0, 0, 0}, kSegment{255, 0, 255}, kGrey{150, 150, 150};
+constexpr double kFar = std::numeric_limits<double>::infinity();
+
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.5g", v);
+    return buf;
+}
+
+struct View {
+    glm::dvec3 centre{0.0};
+    double cy = 1, sy = 0, cp = 1, sp = 0;
+    // Camera coordinates: x right, y up, z towards the viewer.
+    [[nodiscard]] glm::dvec3 apply(const glm::vec3& p) const {
+        const glm::dvec3 q = glm::dvec3(p) - centre;
+        const double x = cy * q.x + sy * q.z, z = -sy * q.x + cy * q.z;  // yaw about y
+        const double y = cp * q.y - sp * z, z2 = sp * q.y + cp * z;      // pitch about x
+        return {x, y, z2};
+    }
+};
+
+}  // namespace
+
+Image renderPicture(const RenderScene& scene, const RenderOptions& options) {
+    const int width = options.width, height = options.height;
+    Image img(width, height, kBackground);
+    const int legendW = 190, top = 90, margin = 30;
+    const int plotX = margin, plotY = top, plotW = width - legendW - 2 * margin, plotH = height - top - margin - 40;
+
+    View view;
+    glm::dvec3 lo(kFar), hi(-kFar);
+    for (auto set : {scene.a, scene.b}) {
+        for (const glm::vec3& p : set) {
+            lo = glm::min(lo, glm::dvec3(p));
+            hi = glm::max(hi, glm::dvec3(p));
+        }
+    }
+    view.centre = (lo + hi) * 0.5;
+    const double yaw = options.yawDegrees * M_PI / 180.0, pitch = options.pitchDegrees * M_PI / 180.0;
+    view.cy = std::cos(yaw);
+    view.sy = std::sin(yaw);
+    view.cp = std::cos(pitch);
+    view.sp = std::sin(pitch);
+
+    // Fit the rotated points into the plot area.
+    glm::dvec3 vlo(kFar), vhi(-kFar);
+    for (auto set : {scene.a, scene.b}) {
+        for (const glm::vec3& p : set) {
+            const glm::dvec3 v = view.apply(p);
+            vlo = glm::min(vlo, v);
+            vhi = glm::max(vhi, v);
+        }
+    }
+    const double extentX = std::max(vhi.x - vlo.x, 1e-30), extentY = std::max(vhi.y - vlo.y, 1e-30);
+    const double scale = std::min(plotW / extentX, plotH / extentY);
+    const double offX = plotX + (plotW - extentX * scale) * 0.5, offY = plotY + (plotH - extentY * scale) * 0.5;
+    const double depthExtent = std::max(vhi.z - vlo.z, 1e-30);
+    auto toScreen = [&](const glm::dvec3& v, double& sx, double& sy) {
+        sx = offX + (v.x - vlo.x) * scale;
+        sy = offY + (vhi.y - v.y) * scale;
+    };
+
+    const size_t total = scene.a.size() + scene.b.size();
+    double radius = options.pointRadius;
+    if (!(radius > 0.0)) radius = std::clamp(2.0 * std::sqrt(double(plotW) * plotH / double(std::max<size_t>(total, 1))), 1.5, 8.0);
+
+    // Splat into depth + colour buffers (depth: 0 near .. 1 far).
+    std::vector<double> depth(size_t(width) * size_t(height), kFar);
+    std::vector<Rgb> colour(depth.size(), kBackground);
+    auto splat = [&](std::span<const glm::vec3> set, std::span<const double> distance) {
+        for (size_t i = 0; i < set.size(); ++i) {
+            const glm::dvec3 v = view.apply(set[i]);
+            double sx = 0, sy = 0;
+            toScreen(v, sx, sy);
+            const double d = (vhi.z - v.z) / depthExtent;
+            const Rgb c = distance.size() == set.size() ? distanceColour(distance[i], scene.range) : kGrey;
+            const int x0 = int(std::floor(sx - radius)), x1 = int(std::ceil(sx + radius));
+            const int y0 = int(std::floor(sy - radius)), y1 = int(std::ceil(sy + radius));
+            for (int y = std::max(y0, 0); y <= std::min(y1, height - 1); ++y) {
+                for (int x = std::max(x0, 0); x <= std::min(x1, width - 1); ++x) {
+                    const double dx = x + 0.5 - sx, dy = y + 0.5 - sy;
+                    if (dx * dx + dy * dy > radius * radius) continue;
+                    const size_t at = size_t(y) * size_t(width) + size_t(x);
+                    if (d < depth[at]) {
+                        depth[at] = d;
+                        colour[at] = c;
+                    }
+                }
+            }
+        }
+    };
+    splat(scene.a, scene.aDistance);
+    splat(scene.b, scene.bDistance);
+
+    // Eye-dome lighting: darken a pixel by how far its neighbours (2 px away)
+    // are in front of it; background neighbours count as far behind.
+    const int step = 2;
+    const int nx[8] = {step, -step, 0, 0, step, -step, step, -step};
+    const int ny[8] = {0, 0, step, -step, step, step, -step, -step};
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            const size_t at = size_t(y) * size_t(width) + size_t(x);
+            if (depth[at] == kFar) continue;
+            double sum = 0.0;
+            for (int k = 0; k < 8; ++k) {
+                const int qx = x + nx[k], qy = y + ny[k];
+                double dn = 1.5;
+                if (qx >= 0 && qy >= 0 && qx < width && qy < height) {
+                    const double q = depth[size_t(qy) * size_t(width) + size_t(qx)];
+                    if (q != kFar) dn = q;
+                }
+                sum += std::max(0.0, depth[at] - dn) + 0.0;
+                if (dn == 1.5) sum += 0.02;  // silhouettes
+            }
+            const double shade = std::exp(-options.edlStrength * sum / 8.0) * (1.0 - 0.25 * depth[at]);
+            const Rgb c = colour[at];
+            img.set(x, y, {uint8_t(c.r * shade), uint8_t(c.g * shade), uint8_t(c.b * shade)});
+        }
+    }
+
+    // The Hausdorff segment, over everything.
+    double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    toScreen(view.apply(scene.segmentFrom), x0, y0);
+    toScreen(view.apply(scene.segmentTo), x1, y1);
+    img.drawLine(x0, y0, x1, y1, 7.0, kBlack);
+    img.drawLine(x0, y0, x1, y1, 4.0, kSegment);
+    for (auto [x, y] : {std::pair{x0, y0}, std::pair{x1, y1}}) {
+        img.fillDisc(x, y, 9.0, kBlack);
+        img.fillDisc(x, y, 6.0, kSegment);
+    }
+    const std::string hLabel = "H = " + number(scene.hausdorff);
+    // The label sits beside the segment's midpoint, off the segment: moved
+    // along the segment's normal (the side pointing up), then kept inside.
+    const int tw = Image::textWidth(hLabel, 3);
+    const double length = std::max(std::hypot(x1 - x0, y1 - y0), 1e-9);
+    double ux = -(y1 - y0) / length, uy = (x1 - x0) / length;
+    if (uy > 0) {
+        ux = -ux;
+        uy = -uy;
+    }
+    const double mx = (x0 + x1) * 0.5 + ux * 30.0, my = (y0 + y1) * 0.5 + uy * 30.0;
+    const int lx = std::clamp(int(std::lround(mx - tw * 0.5)), 4, width - tw - 8);
+    const int ly = std::clamp(int(std::lround(my - 13.0)), top, height - 40);
+    img.fillRect(lx - 4, ly - 4, lx + tw + 6, ly + 30, kBackground);
+    img.drawText(lx, ly, hLabel, kBlack, 3);
+
+    // Title and caption.
+    img.drawText(margin, 16, scene.title, kBlack, 3);
+    int cy = 52;
+    for (const std::string& line : scene.caption) {
+        img.drawText(margin, cy, line, kBlack, 2);
+        cy += 18;
+    }
+
+    // Colour bar.
+    const int barX = width - legendW + 20, barY = top + 40, barW = 34, barH = std::max(100, plotH - 140);
+    img.drawText(barX, barY - 36, "distance", kBlack, 2);
+    for (int y = 0; y < barH; ++y) {
+        const Rgb c = turbo(1.0 - double(y) / double(barH - 1));
+        img.fillRect(barX, barY + y, barX + barW, barY + y + 1, c);
+    }
+    img.fillRect(barX - 1, barY - 1, barX + barW + 1, barY, kBlack);
+    img.fillRect(barX - 1, barY + barH, barX + barW + 1, barY + barH + 1, kBlack);
+    img.fillRect(barX - 1, barY, barX, barY + barH, kBlack);
+    img.fillRect(barX + barW, barY, barX + barW + 1, barY + barH, kBlack);
+    for (int k = 0; k <= 4; ++k) {
+        const int y = barY + (barH - 1) * (4 - k) / 4;
+        const double v = scene.range.lo + (scene.range.hi - scene.range.lo) * k / 4;
+        img.fillRect(barX + barW, y, barX + barW + 8, y + 1, kBlack);
+        img.drawText(barX + barW + 12, y - 7, number(v), kBlack, 2);
+    }
+    img.fillRect(barX, barY + barH + 30, barX + 30, barY + barH + 36, kSegment);
+    img.drawText(barX, barY + barH + 44, "Hausdorff", kBlack, 2);
+    img.drawText(barX, barY + barH + 62, "segment", kBlack, 2);
+    return img;
+}
+
+}  // namespace rthdist::cli

@@ -1,0 +1,28 @@
+// The per-point statistics in the CLI's outputs: the "per_point" JSON object
+// and the summary lines (README "Per-point distances" documents both).
+//
+// JSON: per_point {
+//   diagonal, diagonal_a, diagonal_b,           bbox diagonals (normalizer: diagonal of A ∪ B)
+//   a_to_b | b_to_a | pooled: {count, min, max, mean, rms,
+//       percentiles: [{p, value}], normalized: {min, max, mean, rms, percentiles: [{p, value}]}}
+//       (b_to_a and pooled are null with --directed)
+//   percentiles: [{p, max, pooled, max_normalized, pooled_normalized}]   symmetric and pooled
+//   hd95: {max, pooled, max_normalized, pooled_normalized}
+//   histogram: {lo, hi, bins, a_to_b: [...], b_to_a: [...] | null, pooled: [...] | null,
+//               below: {a_to_b, b_to_a, pooled}, above: {...}} }
+#pragma once
+
+#include <string>
+
+#include "cli/json_writer.hpp"
+#include "rthdist/stats.hpp"
+
+namespace rthdist::cli {
+
+// Writes key "per_point" and its object into an open JSON object.
+void writeStatsJson(JsonWriter& w, const HausdorffStats& stats, bool directedOnly);
+
+// Summary lines (each ends with '\n').
+[[nodiscard]] std::string statsText(const HausdorffStats& stats, bool directedOnly);
+
+}  // namespace rthdist::cli
