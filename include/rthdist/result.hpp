@@ -13,11 +13,11 @@
 namespace rthdist {
 
 enum class ErrorCode {
-    kInvalidArgument,   // bad options or an empty point set (H is undefined)
-    kBadInput,          // unreadable or malformed input file, NaN/Inf coordinate
-    kNoDevice,          // no Vulkan device offers what the chosen backend needs
-    kOutOfMemory,       // inputs do not fit the device or host memory
-    kInternal,          // a Vulkan call failed or an invariant broke
+    kInvalidArgument,  // bad options or an empty point set (H is undefined)
+    kBadInput,         // unreadable or malformed input file, NaN/Inf coordinate
+    kNoDevice,         // no Vulkan device offers what the chosen backend needs
+    kOutOfMemory,      // inputs do not fit the device or host memory
+    kInternal,         // a Vulkan call failed or an invariant broke
 };
 
 struct Error {

@@ -74,27 +74,27 @@ struct Options {
 
 // Every point's nearest neighbour in the other set (perPointDistances).
 struct PerPoint {
-    std::vector<double> distance;  // recomputed in double from the pair
-    std::vector<uint32_t> nearest; // index of the nearest point in the other set
+    std::vector<double> distance;   // recomputed in double from the pair
+    std::vector<uint32_t> nearest;  // index of the nearest point in the other set
 };
 
 // Counters of one direction: what the algorithm did.
 struct Counters {
-    uint32_t bits = 0;              // k actually used for the target index
-    uint64_t occupiedCells = 0;     // occupied cells of the target index
-    uint64_t queries = 0;           // query points
+    uint32_t bits = 0;                   // k actually used for the target index
+    uint64_t occupiedCells = 0;          // occupied cells of the target index
+    uint64_t queries = 0;                // query points
     uint64_t culledByNeighbourhood = 0;  // queries resolved before any ray
-    uint64_t survivingQueries = 0;  // queries that entered candidate search
-    uint32_t iterations = 0;        // candidate-search radius iterations
-    uint64_t rays = 0;              // rays cast over all iterations
-    uint64_t candidatePairs = 0;    // (query, cell) pairs refined
+    uint64_t survivingQueries = 0;       // queries that entered candidate search
+    uint32_t iterations = 0;             // candidate-search radius iterations
+    uint64_t rays = 0;                   // rays cast over all iterations
+    uint64_t candidatePairs = 0;         // (query, cell) pairs refined
 };
 
 // One directed distance h(Q,T) with its witness.
 struct Directed {
-    double distance = 0.0;       // recomputed in double from the pair
-    uint32_t queryIndex = 0;     // index into the query set
-    uint32_t targetIndex = 0;    // index into the target set (its nearest point)
+    double distance = 0.0;     // recomputed in double from the pair
+    uint32_t queryIndex = 0;   // index into the query set
+    uint32_t targetIndex = 0;  // index into the target set (its nearest point)
     glm::vec3 queryPoint{0.0f};
     glm::vec3 targetPoint{0.0f};
     Counters counters;
@@ -121,14 +121,14 @@ struct Timings {
 struct HausdorffResult {
     double hausdorff = 0.0;  // max of both directions (or h(A,B) when directed)
     Directed aToB;
-    Directed bToA;           // empty when Options::directedOnly
-    PerPoint aNearest;       // A's points -> B, with Options::perPointDistances
-    PerPoint bNearest;       // B's points -> A (unless directedOnly)
+    Directed bToA;      // empty when Options::directedOnly
+    PerPoint aNearest;  // A's points -> B, with Options::perPointDistances
+    PerPoint bNearest;  // B's points -> A (unless directedOnly)
     bool directedOnly = false;
     Backend backend = Backend::kAuto;  // the backend that ran
     std::string device;                // device name, or "cpu"
     Timings timings;
-    uint64_t validationMessages = 0;   // with Options::validation
+    uint64_t validationMessages = 0;  // with Options::validation
 };
 
 // A Vulkan physical device and what rthdist can do with it.
@@ -137,8 +137,8 @@ struct DeviceInfo {
     std::string name;
     std::string type;  // "discrete", "integrated", "cpu", "virtual", "other"
     std::string driver;
-    bool rayQuery = false;    // the ray-query backend can run
-    bool rtPipeline = false;  // the rt-pipeline backend can run
+    bool rayQuery = false;             // the ray-query backend can run
+    bool rtPipeline = false;           // the rt-pipeline backend can run
     std::vector<std::string> missing;  // why a backend is unusable
 };
 
@@ -153,8 +153,7 @@ public:
     Engine& operator=(Engine&&) noexcept;
     ~Engine();
 
-    [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a,
-                                                  std::span<const glm::vec3> b);
+    [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b);
     [[nodiscard]] const std::string& deviceName() const;
     [[nodiscard]] Backend backend() const;
 
@@ -166,8 +165,7 @@ private:
 };
 
 // One-shot convenience: creates an Engine (or runs the CPU backend) and computes.
-[[nodiscard]] Result<HausdorffResult> hausdorff(std::span<const glm::vec3> a,
-                                                std::span<const glm::vec3> b,
+[[nodiscard]] Result<HausdorffResult> hausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                 const Options& options = {});
 
 const char* versionString();

@@ -9,7 +9,9 @@
 #include <cstdint>
 namespace rthdist::shared {
 using uint = uint32_t;
-struct vec3f { float x, y, z; };
+struct vec3f {
+    float x, y, z;
+};
 #define RTHDIST_VEC3 vec3f
 #else
 #define RTHDIST_VEC3 vec3
@@ -49,9 +51,9 @@ struct GridParams {
 
 // cell_keys.comp: key per point, histogram into the dense table.
 struct KeysPush {
-    uint64_t points;   // vec4[n] input (xyz, w unused)
-    uint64_t keys;     // uint[n] out
-    uint64_t dense;    // uint[2^(3 bits)] histogram (zeroed)
+    uint64_t points;  // vec4[n] input (xyz, w unused)
+    uint64_t keys;    // uint[n] out
+    uint64_t dense;   // uint[2^(3 bits)] histogram (zeroed)
     GridParams grid;
     uint n;
 };
@@ -65,11 +67,11 @@ struct ScanPush {
 
 // scatter.comp: counting-sort scatter; dense[key] ends as the cell's end.
 struct ScatterPush {
-    uint64_t points;     // vec4[n] input
-    uint64_t keys;       // uint[n]
-    uint64_t dense;      // uint[] starts in, ends out
-    uint64_t sorted;     // vec4[n] out: xyz, w = original index (float bits)
-    uint64_t sortedKeys; // uint[n] out
+    uint64_t points;      // vec4[n] input
+    uint64_t keys;        // uint[n]
+    uint64_t dense;       // uint[] starts in, ends out
+    uint64_t sorted;      // vec4[n] out: xyz, w = original index (float bits)
+    uint64_t sortedKeys;  // uint[n] out
     uint n;
 };
 
@@ -78,10 +80,10 @@ struct ScatterPush {
 struct CellsPush {
     uint64_t sorted;
     uint64_t sortedKeys;
-    uint64_t flags;    // uint[n]: head flags, scanned in place between passes
-    uint64_t dense;    // cell ends by key
-    uint64_t cells;    // Cell[] out
-    uint64_t numCells; // uint[1] out
+    uint64_t flags;     // uint[n]: head flags, scanned in place between passes
+    uint64_t dense;     // cell ends by key
+    uint64_t cells;     // Cell[] out
+    uint64_t numCells;  // uint[1] out
     uint n;
 };
 
@@ -94,11 +96,11 @@ struct QueryState {
 
 // cull.comp: exact NN within the 3x3x3 block of cells around each query.
 struct CullPush {
-    uint64_t queries;   // vec4[nq] sorted queries (w = original index bits)
-    uint64_t targets;   // vec4[nt] cell-sorted targets
-    uint64_t dense;     // target cell ends by key
-    uint64_t state;     // QueryState[nq]
-    uint64_t maxPacked; // uint64[1]: (bits of d^2 << 32) | query original index
+    uint64_t queries;    // vec4[nq] sorted queries (w = original index bits)
+    uint64_t targets;    // vec4[nt] cell-sorted targets
+    uint64_t dense;      // target cell ends by key
+    uint64_t state;      // QueryState[nq]
+    uint64_t maxPacked;  // uint64[1]: (bits of d^2 << 32) | query original index
     GridParams grid;
     uint nq;
     float lowerBound2;  // squared lower bound of h without witness
@@ -108,8 +110,8 @@ struct CullPush {
 // compact.comp: appends OPEN queries whose best is not below the threshold.
 struct CompactPush {
     uint64_t state;
-    uint64_t activeList;     // uint[] out: query slots
-    uint64_t counters;   // uint[4]: [0] active count
+    uint64_t activeList;  // uint[] out: query slots
+    uint64_t counters;    // uint[4]: [0] active count
     uint64_t maxPacked;
     uint nq;
     float lowerBound2;
@@ -129,13 +131,13 @@ struct SearchPush {
     uint64_t targets;
     uint64_t cells;
     uint64_t state;
-    uint64_t activeList;     // uint[numActive]
-    uint64_t pairs;      // uvec2[capacity]: (active slot, cell)
-    uint64_t counters;   // [0] active count, [1] pair count
+    uint64_t activeList;  // uint[numActive]
+    uint64_t pairs;       // uvec2[capacity]: (active slot, cell)
+    uint64_t counters;    // [0] active count, [1] pair count
     uint64_t maxPacked;
     uint numActive;
     uint pairCapacity;
-    float radius;        // R: cells with box distance <= R are candidates
+    float radius;  // R: cells with box distance <= R are candidates
     float lowerBound2;
     float rayTMax;
 };
@@ -157,9 +159,9 @@ struct RefinePush {
 // resolve.comp: classifies active queries after an iteration, compacts the rest.
 struct ResolvePush {
     uint64_t state;
-    uint64_t activeList;     // in
-    uint64_t nextActive; // out
-    uint64_t counters;   // [0] active count in, [2] next active count out
+    uint64_t activeList;  // in
+    uint64_t nextActive;  // out
+    uint64_t counters;    // [0] active count in, [2] next active count out
     uint64_t maxPacked;
     uint numActive;
     float radius;

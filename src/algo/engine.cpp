@@ -6,8 +6,8 @@
 #include <cmath>
 #include <optional>
 
-#include "algo/index_space.hpp"
 #include <string>
+#include "algo/index_space.hpp"
 
 #include "algo/gpu_hausdorff.hpp"
 #include "cpu/cpu_hausdorff.hpp"
@@ -52,7 +52,8 @@ std::optional<Error> validateSet(std::span<const glm::vec3> points, const char* 
         const glm::vec3& p = points[i];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
             return Error{ErrorCode::kInvalidArgument, std::string("point set ") + name + ": point " +
-                                                          std::to_string(i) + " has a NaN or infinite coordinate"};
+                                                          std::to_string(i) +
+                                                          " has a NaN or infinite coordinate"};
         }
     }
     return std::nullopt;
@@ -96,8 +97,8 @@ bool hardwareRtDevice(const Options& o) {
 
 struct Engine::Impl {
     Options options;
-    std::unique_ptr<gpu::Context> context;       // null for the CPU backend
-    std::unique_ptr<algo::GpuHausdorff> gpu;     // null for the CPU backend
+    std::unique_ptr<gpu::Context> context;    // null for the CPU backend
+    std::unique_ptr<algo::GpuHausdorff> gpu;  // null for the CPU backend
     Backend backend = Backend::kCpu;
     std::string deviceName = "cpu";
     double setupMs = 0.0;
@@ -113,7 +114,8 @@ Result<Engine> Engine::create(const Options& options) {
     auto t0 = std::chrono::steady_clock::now();
     auto impl = std::make_unique<Impl>();
     impl->options = options;
-    if (options.backend == Backend::kCpu || (options.backend == Backend::kAuto && !hardwareRtDevice(options))) {
+    if (options.backend == Backend::kCpu ||
+        (options.backend == Backend::kAuto && !hardwareRtDevice(options))) {
         impl->backend = Backend::kCpu;
         return Engine(std::move(impl));
     }
@@ -136,8 +138,8 @@ Result<HausdorffResult> Engine::compute(std::span<const glm::vec3> a, std::span<
     if (auto err = validateSet(a, "A")) return *err;
     if (auto err = validateSet(b, "B")) return *err;
     auto t0 = std::chrono::steady_clock::now();
-    Result<HausdorffResult> r = m_impl->gpu ? m_impl->gpu->compute(a, b, m_impl->options)
-                                            : cpu::cpuHausdorff(a, b, m_impl->options);
+    Result<HausdorffResult> r =
+        m_impl->gpu ? m_impl->gpu->compute(a, b, m_impl->options) : cpu::cpuHausdorff(a, b, m_impl->options);
     if (!r) return r;
     r->timings.setup = m_impl->setupMs;
     m_impl->setupMs = 0.0;  // only the first call pays for creation

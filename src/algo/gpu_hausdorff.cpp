@@ -2,14 +2,14 @@
 
 #include <algorithm>
 #include <bit>
-#include <stdexcept>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <new>
+#include <stdexcept>
 #include <string>
 #include <tuple>
-#include <new>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -37,7 +37,9 @@ static_assert(sizeof(sh::SearchPush) <= 128 && sizeof(sh::CullPush) <= 128 && si
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
 
 constexpr uint64_t kMaxPairCapacity = uint64_t(1) << 26;  // 512 MiB of pairs at most
 constexpr uint32_t kMaxIterations = 4096;
@@ -107,15 +109,18 @@ struct GpuHausdorff::State {
         Buffer& b = pool[name];
         if (!b || b.size() < bytes) {
             b.reset();
-            b = Buffer(ctx, std::max<VkDeviceSize>(bytes + bytes / 4, 256),
-                       gpu::kStorageUsage | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
-                       kind);
+            b = Buffer(
+                ctx, std::max<VkDeviceSize>(bytes + bytes / 4, 256),
+                gpu::kStorageUsage | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
+                kind);
         }
         return b;
     }
 
     State(gpu::Context& c)
-        : ctx(c), pipelines(c, c.backend() == Backend::kRayQuery), accel(c),
+        : ctx(c),
+          pipelines(c, c.backend() == Backend::kRayQuery),
+          accel(c),
           rayQuery(c.backend() == Backend::kRayQuery) {
         hostSmall = Buffer(ctx, 256, gpu::kStorageUsage, MemoryKind::kHost);
     }
@@ -129,12 +134,14 @@ struct GpuHausdorff::State {
     void barrier(VkCommandBuffer cmd) { gpu::cmdShaderBarrier(cmd, pipelines.shaderStages()); }
 
     template <class Push>
-    void dispatch(VkCommandBuffer cmd, Kernel k, const Push& push, uint64_t items, uint32_t groupSize = RTHDIST_WG) {
+    void dispatch(VkCommandBuffer cmd, Kernel k, const Push& push, uint64_t items,
+                  uint32_t groupSize = RTHDIST_WG) {
         pipelines.cmdDispatch(cmd, k, &push, sizeof(Push), gpu::groupsFor(items, groupSize));
     }
 
     // Exclusive scan of uint[n] at `data`, recursively over block sums.
-    void cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, const std::string& tag, size_t level) {
+    void cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, const std::string& tag,
+                 size_t level) {
         const uint32_t blocks = gpu::groupsFor(n, RTHDIST_SCAN_BLOCK);
         const VkDeviceAddress sums = buf(tag + std::to_string(level), VkDeviceSize(blocks) * 4).address();
         sh::ScanPush p{data, sums, n};
@@ -212,12 +219,17 @@ struct GpuHausdorff::State {
         barrier(cmd);
         cmdScan(cmd, ix.dense->address(), numKeys, "scanKeys", 0);
         barrier(cmd);
-        sh::ScatterPush sp{points.address(), keys.address(), ix.dense->address(), ix.sorted->address(),
-                           sortedKeys.address(), ix.n};
+        sh::ScatterPush sp{points.address(),     keys.address(),       ix.dense->address(),
+                           ix.sorted->address(), sortedKeys.address(), ix.n};
         dispatch(cmd, Kernel::kScatter, sp, ix.n);
         barrier(cmd);
-        sh::CellsPush cp{ix.sorted->address(), sortedKeys.address(), flags.address(), ix.dense->address(),
-                         ix.cells->address(), countersAddr() + 12, ix.n};
+        sh::CellsPush cp{ix.sorted->address(),
+                         sortedKeys.address(),
+                         flags.address(),
+                         ix.dense->address(),
+                         ix.cells->address(),
+                         countersAddr() + 12,
+                         ix.n};
         dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
         barrier(cmd);
         cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
@@ -264,8 +276,8 @@ struct GpuHausdorff::State {
         const float lowerBound2 = perPoint ? -1.0f : float(lb * (1.0 - 1e-5));
         double maxAbs = 0.0;
         for (const Bounds* b : {&Q.bounds, &T.bounds})
-            maxAbs = std::max({maxAbs, std::abs(b->lo.x), std::abs(b->lo.y), std::abs(b->lo.z), std::abs(b->hi.x),
-                               std::abs(b->hi.y), std::abs(b->hi.z)});
+            maxAbs = std::max({maxAbs, std::abs(b->lo.x), std::abs(b->lo.y), std::abs(b->lo.z),
+                               std::abs(b->hi.x), std::abs(b->hi.y), std::abs(b->hi.z)});
         const float epsilon = float(maxAbs * 4e-7 + T.grid.cellSize * 1e-5);
 
         auto t0 = Clock::now();
@@ -273,11 +285,19 @@ struct GpuHausdorff::State {
         Buffer* active[2] = {&buf("active0", VkDeviceSize(Q.n) * 4), &buf("active1", VkDeviceSize(Q.n) * 4)};
         std::memset(hostSmall.mapped(), 0, 32);
         VkCommandBuffer cmd = ctx.begin();
-        sh::CullPush cull{Q.sorted->address(), T.sorted->address(), T.dense->address(), state.address(), maxPackedAddr(),
-                          gridParams(T.grid), Q.n, lowerBound2, epsilon};
+        sh::CullPush cull{Q.sorted->address(),
+                          T.sorted->address(),
+                          T.dense->address(),
+                          state.address(),
+                          maxPackedAddr(),
+                          gridParams(T.grid),
+                          Q.n,
+                          lowerBound2,
+                          epsilon};
         dispatch(cmd, Kernel::kCull, cull, Q.n);
         barrier(cmd);
-        sh::CompactPush comp{state.address(), active[0]->address(), countersAddr(), maxPackedAddr(), Q.n, lowerBound2};
+        sh::CompactPush comp{state.address(), active[0]->address(), countersAddr(), maxPackedAddr(), Q.n,
+                             lowerBound2};
         dispatch(cmd, Kernel::kCompact, comp, Q.n);
         ctx.submitAndWait(cmd);
         timings->gpuCull += ctx.lastGpuMs();
@@ -298,7 +318,8 @@ struct GpuHausdorff::State {
         bool firstBuild = true;
         Buffer& aabbs = buf("aabbs", VkDeviceSize(T.numCells) * 24);
         while (numActive > 0) {
-            if (++cnt.iterations > kMaxIterations) throw std::runtime_error("candidate search did not converge");
+            if (++cnt.iterations > kMaxIterations)
+                throw std::runtime_error("candidate search did not converge");
             if (!pairs) {
                 pairs = &buf("pairs", pairCapacity * 8);
                 pairCapacity = std::min<uint64_t>(pairs->size() / 8, kMaxPairCapacity);
@@ -313,17 +334,31 @@ struct GpuHausdorff::State {
             sh::BoxesPush bp{T.cells->address(), aabbs.address(), T.numCells, grow};
             dispatch(cmd, Kernel::kGrowBoxes, bp, T.numCells);
             gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                            VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_SHADER_READ_BIT);
-            if (accel.cmdBuild(cmd, aabbs.address(), T.numCells, !firstBuild, pipelines.shaderStages()) || !tlasBound) {
+                            VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+                            VK_ACCESS_SHADER_READ_BIT);
+            if (accel.cmdBuild(cmd, aabbs.address(), T.numCells, !firstBuild, pipelines.shaderStages()) ||
+                !tlasBound) {
                 pipelines.bindTlas(accel.tlas());
                 tlasBound = true;
             }
             firstBuild = false;
-            sh::SearchPush sp{Q.sorted->address(), T.sorted->address(), T.cells->address(), state.address(),
-                              active[cur]->address(), pairs->address(), countersAddr(), maxPackedAddr(), numActive,
-                              uint32_t(pairCapacity), r, lowerBound2, rayTMax};
-            if (rayQuery) dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
-            else pipelines.cmdTraceRays(cmd, &sp, sizeof(sp), numActive);
+            sh::SearchPush sp{Q.sorted->address(),
+                              T.sorted->address(),
+                              T.cells->address(),
+                              state.address(),
+                              active[cur]->address(),
+                              pairs->address(),
+                              countersAddr(),
+                              maxPackedAddr(),
+                              numActive,
+                              uint32_t(pairCapacity),
+                              r,
+                              lowerBound2,
+                              rayTMax};
+            if (rayQuery)
+                dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
+            else
+                pipelines.cmdTraceRays(cmd, &sp, sizeof(sp), numActive);
             ctx.submitAndWait(cmd);
             timings->gpuSearch += ctx.lastGpuMs();
             const uint32_t pairCount = counters()[1];
@@ -334,13 +369,20 @@ struct GpuHausdorff::State {
             const uint32_t used = uint32_t(std::min<uint64_t>(pairCount, pairCapacity));
             cnt.candidatePairs += used;
             cmd = ctx.begin();
-            sh::RefinePush rp{Q.sorted->address(), T.sorted->address(), T.cells->address(), state.address(),
-                              active[cur]->address(), pairs->address(), countersAddr(), maxPackedAddr(),
-                              uint32_t(pairCapacity), lowerBound2};
+            sh::RefinePush rp{Q.sorted->address(), T.sorted->address(),    T.cells->address(),
+                              state.address(),     active[cur]->address(), pairs->address(),
+                              countersAddr(),      maxPackedAddr(),        uint32_t(pairCapacity),
+                              lowerBound2};
             dispatch(cmd, Kernel::kRefine, rp, used);
             barrier(cmd);
-            sh::ResolvePush rs{state.address(), active[cur]->address(), active[1 - cur]->address(), countersAddr(),
-                               maxPackedAddr(), numActive, r, lowerBound2};
+            sh::ResolvePush rs{state.address(),
+                               active[cur]->address(),
+                               active[1 - cur]->address(),
+                               countersAddr(),
+                               maxPackedAddr(),
+                               numActive,
+                               r,
+                               lowerBound2};
             dispatch(cmd, Kernel::kResolve, rs, numActive);
             ctx.submitAndWait(cmd);
             timings->gpuRefine += ctx.lastGpuMs();
@@ -348,12 +390,15 @@ struct GpuHausdorff::State {
             cur = 1 - cur;
             timings->refine += msSince(t0);
             report(options, "search",
-                   progressFrom + (progressTo - progressFrom) *
-                                      (0.2 + 0.8 * (1.0 - double(numActive) / double(std::max<uint64_t>(1, cnt.survivingQueries)))));
+                   progressFrom +
+                       (progressTo - progressFrom) *
+                           (0.2 + 0.8 * (1.0 - double(numActive) /
+                                                   double(std::max<uint64_t>(1, cnt.survivingQueries)))));
 
             if (pairCount > pairCapacity && pairCapacity < kMaxPairCapacity) {
                 // Some queries lost pairs: redo them at the same radius with room.
-                pairCapacity = std::min<uint64_t>(kMaxPairCapacity, std::max<uint64_t>(pairCount, pairCapacity * 2));
+                pairCapacity =
+                    std::min<uint64_t>(kMaxPairCapacity, std::max<uint64_t>(pairCount, pairCapacity * 2));
                 pairs = nullptr;
             } else if (pairCount <= pairCapacity) {
                 radius *= double(options.radiusGrowth);
@@ -398,14 +443,16 @@ struct GpuHausdorff::State {
         vkCmdCopyBuffer(cmd, Q.sorted->handle(), host.handle(), 1, &c2);
         ctx.submitAndWait(cmd);
         const auto* states = static_cast<const sh::QueryState*>(host.mapped());
-        const auto* sorted = reinterpret_cast<const float*>(static_cast<const char*>(host.mapped()) + stateBytes);
+        const auto* sorted =
+            reinterpret_cast<const float*>(static_cast<const char*>(host.mapped()) + stateBytes);
         out.distance.assign(Q.n, 0.0);
         out.nearest.assign(Q.n, 0);
         for (uint32_t i = 0; i < Q.n; ++i) {
             const uint32_t qi = std::bit_cast<uint32_t>(sorted[4 * i + 3]);
             const uint32_t ti = uint32_t(states[i].best & 0xffffffffu);
             if (qi >= qPts.size() || ti >= tPts.size() || states[i].status != RTHDIST_EXACT)
-                throw std::runtime_error("per-point read-back: query " + std::to_string(i) + " has no exact NN");
+                throw std::runtime_error("per-point read-back: query " + std::to_string(i) +
+                                         " has no exact NN");
             out.nearest[qi] = ti;
             out.distance[qi] = glm::length(glm::dvec3(qPts[qi]) - glm::dvec3(tPts[ti]));
         }
@@ -462,7 +509,8 @@ Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std:
         m_state->accel.release();
         m_state->tlasBound = false;
         if (e.result() == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result() == VK_ERROR_OUT_OF_HOST_MEMORY)
-            return Error{ErrorCode::kOutOfMemory, std::string("the inputs do not fit the device: ") + e.what()};
+            return Error{ErrorCode::kOutOfMemory,
+                         std::string("the inputs do not fit the device: ") + e.what()};
         return Error{ErrorCode::kInternal, e.what()};
     } catch (const std::exception& e) {
         m_state->accel.release();

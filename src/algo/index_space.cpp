@@ -79,7 +79,10 @@ int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds) {
         uint32_t last = ~0u;
         for (uint32_t key : keys) {
             uint32_t c = key >> shift;
-            if (c != last) { ++distinct; last = c; }
+            if (c != last) {
+                ++distinct;
+                last = c;
+            }
         }
         double occupied;
         if (sample / double(distinct) >= 8.0 || stride == 1) {
@@ -89,8 +92,10 @@ int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds) {
             occupied = estimate * growth;  // sample too thin: extrapolate
         }
         estimate = occupied;
-        if (double(n) / occupied >= kTargetPointsPerCell) chosen = k;
-        else break;
+        if (double(n) / occupied >= kTargetPointsPerCell)
+            chosen = k;
+        else
+            break;
     }
     return chosen;
 }

@@ -45,8 +45,7 @@ struct GridSpec {
 [[nodiscard]] uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z);
 
 // Cell coordinate of p on one axis, clamped to the grid.
-[[nodiscard]] inline uint32_t cellCoord(double p, double origin, double cellSize,
-                                        uint32_t cellsPerAxis) {
+[[nodiscard]] inline uint32_t cellCoord(double p, double origin, double cellSize, uint32_t cellsPerAxis) {
     double c = (p - origin) / cellSize;
     if (!(c > 0.0)) return 0;
     if (c >= double(cellsPerAxis)) return cellsPerAxis - 1;

@@ -14,13 +14,15 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
     RTHDIST_VK_CHECK(vkCreateBuffer(m_device, &bi, nullptr, &m_buffer));
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(m_device, m_buffer, &req);
-    VkMemoryPropertyFlags wanted = kind == MemoryKind::kDevice
-                                       ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
-                                       : (VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    VkMemoryPropertyFlags wanted =
+        kind == MemoryKind::kDevice
+            ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
+            : (VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
     uint32_t type = ctx.memoryTypeIndex(req.memoryTypeBits, wanted);
     if (type == ~0u) {
         reset();
-        throwVulkanError(VK_ERROR_FEATURE_NOT_PRESENT, "memoryTypeIndex (no suitable memory type)", __FILE__, __LINE__);
+        throwVulkanError(VK_ERROR_FEATURE_NOT_PRESENT, "memoryTypeIndex (no suitable memory type)", __FILE__,
+                         __LINE__);
     }
     VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
     flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
@@ -33,7 +35,8 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
         throwVulkanError(r, "vkAllocateMemory", __FILE__, __LINE__);
     }
     RTHDIST_VK_CHECK(vkBindBufferMemory(m_device, m_buffer, m_memory, 0));
-    if (kind == MemoryKind::kHost) RTHDIST_VK_CHECK(vkMapMemory(m_device, m_memory, 0, VK_WHOLE_SIZE, 0, &m_mapped));
+    if (kind == MemoryKind::kHost)
+        RTHDIST_VK_CHECK(vkMapMemory(m_device, m_memory, 0, VK_WHOLE_SIZE, 0, &m_mapped));
     VkBufferDeviceAddressInfo dai{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
     dai.buffer = m_buffer;
     m_address = vkGetBufferDeviceAddress(m_device, &dai);
@@ -67,8 +70,8 @@ void Buffer::reset() {
     m_size = 0;
 }
 
-void cmdBarrier(VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags srcAccess, VkPipelineStageFlags dst,
-                VkAccessFlags dstAccess) {
+void cmdBarrier(VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags srcAccess,
+                VkPipelineStageFlags dst, VkAccessFlags dstAccess) {
     VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     mb.srcAccessMask = srcAccess;
     mb.dstAccessMask = dstAccess;

@@ -8,7 +8,8 @@ namespace rthdist::gpu {
 
 const char* vkResultName(VkResult r) {
     switch (r) {
-#define RTHDIST_CASE(x) case x: return #x;
+#define RTHDIST_CASE(x) \
+    case x: return #x;
         RTHDIST_CASE(VK_SUCCESS)
         RTHDIST_CASE(VK_ERROR_OUT_OF_HOST_MEMORY)
         RTHDIST_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
@@ -77,8 +78,9 @@ Probe probeDevice(VkPhysicalDevice pd, int index) {
     }
     auto& missing = p.info.missing;
     if (props.apiVersion < VK_API_VERSION_1_2) {
-        missing.push_back("Vulkan 1.2 (device offers " + std::to_string(VK_API_VERSION_MAJOR(props.apiVersion)) +
-                          "." + std::to_string(VK_API_VERSION_MINOR(props.apiVersion)) + ")");
+        missing.push_back("Vulkan 1.2 (device offers " +
+                          std::to_string(VK_API_VERSION_MAJOR(props.apiVersion)) + "." +
+                          std::to_string(VK_API_VERSION_MINOR(props.apiVersion)) + ")");
         return p;
     }
     uint32_t n = 0;
@@ -94,8 +96,10 @@ Probe probeDevice(VkPhysicalDevice pd, int index) {
         }
     }
     VkPhysicalDeviceRayQueryFeaturesKHR rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
-    VkPhysicalDeviceRayTracingPipelineFeaturesKHR rtp{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR, &rq};
-    VkPhysicalDeviceAccelerationStructureFeaturesKHR as{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rtp};
+    VkPhysicalDeviceRayTracingPipelineFeaturesKHR rtp{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR, &rq};
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rtp};
     VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as};
     VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &v12};
     vkGetPhysicalDeviceFeatures2(pd, &f2);
@@ -129,7 +133,8 @@ Probe probeDevice(VkPhysicalDevice pd, int index) {
     bool hasRq = hasExtension(exts, VK_KHR_RAY_QUERY_EXTENSION_NAME) && rq.rayQuery;
     bool hasRtp = hasExtension(exts, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) && rtp.rayTracingPipeline;
     if (!hasRq) missing.push_back("ray-query: VK_KHR_ray_query with feature rayQuery");
-    if (!hasRtp) missing.push_back("rt-pipeline: VK_KHR_ray_tracing_pipeline with feature rayTracingPipeline");
+    if (!hasRtp)
+        missing.push_back("rt-pipeline: VK_KHR_ray_tracing_pipeline with feature rayTracingPipeline");
     p.info.rayQuery = common && hasRq;
     p.info.rtPipeline = common && hasRtp;
     return p;
@@ -180,8 +185,9 @@ Result<VkInstance> createInstance(bool validation) {
     VkInstance instance = VK_NULL_HANDLE;
     VkResult r = vkCreateInstance(&ci, nullptr, &instance);
     if (r != VK_SUCCESS)
-        return Error{ErrorCode::kNoDevice, std::string("no Vulkan driver could be loaded (vkCreateInstance: ") +
-                                               vkResultName(r) + "); install a Vulkan ICD, e.g. Mesa lavapipe"};
+        return Error{ErrorCode::kNoDevice,
+                     std::string("no Vulkan driver could be loaded (vkCreateInstance: ") + vkResultName(r) +
+                         "); install a Vulkan ICD, e.g. Mesa lavapipe"};
     return instance;
 }
 
@@ -205,7 +211,8 @@ Result<std::vector<DeviceInfo>> listDevices() {
     gpu::InstanceHolder holder{inst.value()};
     std::vector<DeviceInfo> out;
     int i = 0;
-    for (VkPhysicalDevice pd : gpu::physicalDevices(holder.instance)) out.push_back(gpu::probeDevice(pd, i++).info);
+    for (VkPhysicalDevice pd : gpu::physicalDevices(holder.instance))
+        out.push_back(gpu::probeDevice(pd, i++).info);
     return out;
 }
 
@@ -223,8 +230,10 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
             auto createMessenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
                 vkGetInstanceProcAddr(ctx->m_instance, "vkCreateDebugUtilsMessengerEXT"));
             VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-            mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-            mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+            mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                                 VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+            mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                             VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                              VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
             mi.pfnUserCallback = onDebugMessage;
             mi.pUserData = ctx.get();
@@ -251,16 +260,18 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
         }
         if (!chosenPd) {
             if (deviceIndex >= int(pds.size()))
-                return Error{ErrorCode::kNoDevice, "device " + std::to_string(deviceIndex) + " does not exist (" +
-                                                       std::to_string(pds.size()) + " device(s))"};
-            return Error{ErrorCode::kNoDevice,
-                         std::string("no Vulkan device can run backend ") + backendName(backend) + ":" + reasons};
+                return Error{ErrorCode::kNoDevice, "device " + std::to_string(deviceIndex) +
+                                                       " does not exist (" + std::to_string(pds.size()) +
+                                                       " device(s))"};
+            return Error{ErrorCode::kNoDevice, std::string("no Vulkan device can run backend ") +
+                                                   backendName(backend) + ":" + reasons};
         }
         ctx->m_physical = chosenPd;
         ctx->m_name = chosen.info.name;
         ctx->m_queueFamily = chosen.queueFamily;
-        ctx->m_backend = backend == Backend::kAuto ? (chosen.info.rayQuery ? Backend::kRayQuery : Backend::kRtPipeline)
-                                                   : backend;
+        ctx->m_backend = backend == Backend::kAuto
+                             ? (chosen.info.rayQuery ? Backend::kRayQuery : Backend::kRtPipeline)
+                             : backend;
         const bool useRq = ctx->m_backend == Backend::kRayQuery;
 
         std::vector<const char*> exts(std::begin(kCommonExtensions), std::end(kCommonExtensions));
@@ -268,9 +279,11 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
 
         VkPhysicalDeviceRayQueryFeaturesKHR rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
         rq.rayQuery = VK_TRUE;
-        VkPhysicalDeviceRayTracingPipelineFeaturesKHR rtp{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
+        VkPhysicalDeviceRayTracingPipelineFeaturesKHR rtp{
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
         rtp.rayTracingPipeline = VK_TRUE;
-        VkPhysicalDeviceAccelerationStructureFeaturesKHR as{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+        VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
         as.accelerationStructure = VK_TRUE;
         as.pNext = useRq ? static_cast<void*>(&rq) : static_cast<void*>(&rtp);
         VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as};
@@ -308,7 +321,8 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
         }
 #undef RTHDIST_LOAD
         if (!rt.getBuildSizes || !rt.createAccel || !rt.cmdBuildAccel || (!useRq && !rt.cmdTraceRays))
-            return Error{ErrorCode::kNoDevice, "the driver does not expose the acceleration-structure entry points"};
+            return Error{ErrorCode::kNoDevice,
+                         "the driver does not expose the acceleration-structure entry points"};
 
         ctx->m_rtProps.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR;
         ctx->m_asProps.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;

@@ -45,7 +45,9 @@ public:
     [[nodiscard]] const std::string& deviceName() const { return m_name; }
     [[nodiscard]] const RtFunctions& rt() const { return m_rt; }
     [[nodiscard]] const VkPhysicalDeviceRayTracingPipelinePropertiesKHR& rtProps() const { return m_rtProps; }
-    [[nodiscard]] const VkPhysicalDeviceAccelerationStructurePropertiesKHR& asProps() const { return m_asProps; }
+    [[nodiscard]] const VkPhysicalDeviceAccelerationStructurePropertiesKHR& asProps() const {
+        return m_asProps;
+    }
     [[nodiscard]] uint64_t validationMessageCount() const { return m_validationMessages.load(); }
     [[nodiscard]] uint32_t memoryTypeIndex(uint32_t typeBits, VkMemoryPropertyFlags wanted) const;
     [[nodiscard]] float timestampPeriodNs() const { return m_timestampPeriod; }

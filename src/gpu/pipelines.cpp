@@ -59,7 +59,8 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
     VkDevice d = ctx.device();
     VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT;
     if (!rayQuery) {
-        stages |= VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR;
+        stages |= VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_INTERSECTION_BIT_KHR |
+                  VK_SHADER_STAGE_MISS_BIT_KHR;
         m_shaderStages |= VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
     }
     VkDescriptorSetLayoutBinding b{};
@@ -91,10 +92,10 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
     RTHDIST_VK_CHECK(vkAllocateDescriptorSets(d, &da, &m_set));
 
     const Spirv compute[size_t(Kernel::kCount)] = {
-        spirv(k_spv_cell_keys_comp),  spirv(k_spv_scan_block_comp), spirv(k_spv_scan_add_comp),
-        spirv(k_spv_scatter_comp),    spirv(k_spv_cell_heads_comp), spirv(k_spv_cell_build_comp),
-        spirv(k_spv_cull_comp),       spirv(k_spv_compact_comp),    spirv(k_spv_grow_boxes_comp),
-        spirv(k_spv_search_rq_comp),  spirv(k_spv_refine_comp),     spirv(k_spv_resolve_comp),
+        spirv(k_spv_cell_keys_comp), spirv(k_spv_scan_block_comp), spirv(k_spv_scan_add_comp),
+        spirv(k_spv_scatter_comp),   spirv(k_spv_cell_heads_comp), spirv(k_spv_cell_build_comp),
+        spirv(k_spv_cull_comp),      spirv(k_spv_compact_comp),    spirv(k_spv_grow_boxes_comp),
+        spirv(k_spv_search_rq_comp), spirv(k_spv_refine_comp),     spirv(k_spv_resolve_comp),
     };
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !rayQuery) continue;
@@ -128,7 +129,8 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
     VkRayTracingShaderGroupCreateInfoKHR g[3]{};
     for (int i = 0; i < 3; ++i) {
         g[i] = {VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR};
-        g[i].generalShader = g[i].closestHitShader = g[i].anyHitShader = g[i].intersectionShader = VK_SHADER_UNUSED_KHR;
+        g[i].generalShader = g[i].closestHitShader = g[i].anyHitShader = g[i].intersectionShader =
+            VK_SHADER_UNUSED_KHR;
     }
     g[0].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
     g[0].generalShader = 0;
@@ -143,7 +145,8 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
     rci.pGroups = g;
     rci.maxPipelineRayRecursionDepth = 1;
     rci.layout = m_layout;
-    VkResult r = ctx.rt().createRtPipelines(d, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &rci, nullptr, &m_rtPipeline);
+    VkResult r =
+        ctx.rt().createRtPipelines(d, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &rci, nullptr, &m_rtPipeline);
     for (VkShaderModule m : mods) vkDestroyShaderModule(d, m, nullptr);
     RTHDIST_VK_CHECK(r);
 
@@ -178,7 +181,8 @@ Pipelines::~Pipelines() {
 }
 
 void Pipelines::bindTlas(VkAccelerationStructureKHR tlas) {
-    VkWriteDescriptorSetAccelerationStructureKHR as{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR};
+    VkWriteDescriptorSetAccelerationStructureKHR as{
+        VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR};
     as.accelerationStructureCount = 1;
     as.pAccelerationStructures = &tlas;
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, &as};
@@ -195,9 +199,10 @@ void Pipelines::cmdDispatch(VkCommandBuffer cmd, Kernel kernel, const void* push
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_compute[size_t(kernel)]);
     if (kernel == Kernel::kSearchRayQuery)
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_layout, 0, 1, &m_set, 0, nullptr);
-    vkCmdPushConstants(cmd, m_layout, m_rayQuery ? VK_SHADER_STAGE_COMPUTE_BIT
-                                                 : (VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_RAYGEN_BIT_KHR |
-                                                    VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR),
+    vkCmdPushConstants(cmd, m_layout,
+                       m_rayQuery ? VK_SHADER_STAGE_COMPUTE_BIT
+                                  : (VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_RAYGEN_BIT_KHR |
+                                     VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR),
                        0, pushSize, push);
     // Large 1-D dispatches are split to respect maxComputeWorkGroupCount[0]
     // (65535 is the guaranteed minimum); shaders see gl_WorkGroupID offsets

@@ -40,7 +40,8 @@ public:
     // Points set 0 binding 0 at this TLAS.
     void bindTlas(VkAccelerationStructureKHR tlas);
 
-    void cmdDispatch(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize, uint32_t groups) const;
+    void cmdDispatch(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize,
+                     uint32_t groups) const;
     // Ray-tracing pipeline: one ray-generation invocation per index in [0, width).
     void cmdTraceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize, uint32_t width) const;
 

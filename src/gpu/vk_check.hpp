@@ -24,9 +24,9 @@ const char* vkResultName(VkResult result);
 
 }  // namespace rthdist::gpu
 
-#define RTHDIST_VK_CHECK(expr)                                                        \
-    do {                                                                              \
-        VkResult rthdist_vk_result_ = (expr);                                         \
-        if (rthdist_vk_result_ < 0)                                                   \
+#define RTHDIST_VK_CHECK(expr)                                                               \
+    do {                                                                                     \
+        VkResult rthdist_vk_result_ = (expr);                                                \
+        if (rthdist_vk_result_ < 0)                                                          \
             ::rthdist::gpu::throwVulkanError(rthdist_vk_result_, #expr, __FILE__, __LINE__); \
     } while (0)

@@ -6,9 +6,9 @@
 #include <limits>
 #include <random>
 
+#include "common/oracle_cases.hpp"
 #include "cpu/brute_force.hpp"
 #include "gpu_test_support.hpp"
-#include "common/oracle_cases.hpp"
 
 namespace rthdist::test {
 namespace {

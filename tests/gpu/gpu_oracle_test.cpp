@@ -5,9 +5,9 @@
 
 #include <glm/glm.hpp>
 
+#include "common/oracle_cases.hpp"
 #include "cpu/brute_force.hpp"
 #include "gpu_test_support.hpp"
-#include "common/oracle_cases.hpp"
 
 namespace rthdist::test {
 namespace {
@@ -17,16 +17,17 @@ TEST(GpuOracle, EveryCaseMatchesBruteForce) {
     RTHDIST_REQUIRE_ENGINE(engine, options);
     const std::vector<OracleCase> cases = makeOracleCases();
     ASSERT_GE(cases.size(), 300u);
-    std::printf("backend %s on %s: %zu oracle cases\n", backendName(engine->backend()), engine->deviceName().c_str(),
-                cases.size());
+    std::printf("backend %s on %s: %zu oracle cases\n", backendName(engine->backend()),
+                engine->deviceName().c_str(), cases.size());
     uint64_t lastMessages = 0;
     for (const OracleCase& c : cases) {
         SCOPED_TRACE("case " + c.name + " seed " + std::to_string(c.seed));
         auto r = engine->compute(c.a, c.b);
         ASSERT_TRUE(r.ok()) << r.error().message;
         if (r->timings.total > 500.0)
-            std::printf("  slow case %s: %zu x %zu points, %.0f ms, iterations %u/%u\n", c.name.c_str(), c.a.size(),
-                        c.b.size(), r->timings.total, r->aToB.counters.iterations, r->bToA.counters.iterations);
+            std::printf("  slow case %s: %zu x %zu points, %.0f ms, iterations %u/%u\n", c.name.c_str(),
+                        c.a.size(), c.b.size(), r->timings.total, r->aToB.counters.iterations,
+                        r->bToA.counters.iterations);
         EXPECT_EQ(r->backend, options.backend);
         expectMatchesOracle(c, *r);
         EXPECT_EQ(r->validationMessages, lastMessages) << "validation layer reported messages";
@@ -43,7 +44,8 @@ TEST(GpuOracle, DirectedOnlyAndFixedBits) {
         RTHDIST_REQUIRE_ENGINE(engine, options);
         for (size_t i = 0; i < cases.size(); i += 7) {
             const OracleCase& c = cases[i];
-            SCOPED_TRACE("bits " + std::to_string(bits) + " case " + c.name + " seed " + std::to_string(c.seed));
+            SCOPED_TRACE("bits " + std::to_string(bits) + " case " + c.name + " seed " +
+                         std::to_string(c.seed));
             auto r = engine->compute(c.a, c.b);
             ASSERT_TRUE(r.ok()) << r.error().message;
             expectMatchesOracle(c, *r, options.directedOnly);

@@ -41,7 +41,7 @@ inline std::optional<Engine> makeEngine(const Options& o, std::string& whyNot) {
 
 // Skips (CI turns any skip into a failure: lavapipe must be there) when no
 // device can run the backend, with the rejection reasons.
-#define RTHDIST_REQUIRE_ENGINE(engine, options)                                  \
-    std::string rthdist_why_;                                                    \
-    auto engine = ::rthdist::test::makeEngine(options, rthdist_why_);            \
+#define RTHDIST_REQUIRE_ENGINE(engine, options)                       \
+    std::string rthdist_why_;                                         \
+    auto engine = ::rthdist::test::makeEngine(options, rthdist_why_); \
     if (!engine) GTEST_SKIP() << "no device for this backend: " << rthdist_why_

@@ -5,9 +5,14 @@
 // value for agreement. Not a test: no thresholds.
 //
 //   rthdist-bench A B [--backend X] [--runs N] [--warmup W] [--translate F]
-//                     [--bits K] [--name NAME] [--no-verify]
+//                     [--bits K] [--name NAME] [--no-verify] [--budget S]
 // --translate F moves B along x by F times B's x-extent (the paper's
 // translation scenario without writing a copy to disk).
+// --budget S (seconds; for slow devices such as lavapipe): warm-up calls stop
+// once they have taken S/2 in all, timed calls once the next one would take
+// the timed calls past S (at least one timed call); "runs" and "warmup" in the
+// output are the counts actually made. The output also has the process's
+// peak resident set size (max_rss_kb: inputs, index, device buffers).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -15,6 +20,8 @@
 #include <cstring>
 #include <string>
 #include <vector>
+
+#include <sys/resource.h>
 
 #include "cli/json_writer.hpp"
 #include "rthdist/io.hpp"
@@ -32,9 +39,10 @@ double median(std::vector<double> v) {
 }
 
 int usage() {
-    std::fprintf(stderr,
-                 "usage: rthdist-bench A B [--backend auto|ray-query|rt-pipeline|cpu] [--runs N] [--warmup W]\n"
-                 "                     [--translate F] [--bits K] [--name NAME] [--no-verify]\n");
+    std::fprintf(
+        stderr,
+        "usage: rthdist-bench A B [--backend auto|ray-query|rt-pipeline|cpu] [--runs N] [--warmup W]\n"
+        "                     [--translate F] [--bits K] [--name NAME] [--no-verify]\n");
     return 2;
 }
 
@@ -44,7 +52,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> files;
     Options options;
     int runs = 5, warmup = 2;
-    double translate = 0.0;
+    double translate = 0.0, budgetS = 0.0;
     bool verify = true;
     std::string name;
     for (int i = 1; i < argc; ++i) {
@@ -71,6 +79,9 @@ int main(int argc, char** argv) {
             const char* v = next();
             if (!v) return usage();
             name = v;
+        } else if (a == "--budget") {
+            const char* v = next();
+            if (!v || (budgetS = std::atof(v)) <= 0.0) return usage();
         } else if (a == "--no-verify") {
             verify = false;
         } else if (!a.empty() && a[0] == '-') {
@@ -85,7 +96,8 @@ int main(int argc, char** argv) {
     if (!pa) return std::fprintf(stderr, "rthdist-bench: %s\n", pa.error().message.c_str()), 3;
     auto pb = io::loadPoints(files[1]);
     if (!pb) return std::fprintf(stderr, "rthdist-bench: %s\n", pb.error().message.c_str()), 3;
-    const double loadMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double loadMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::vector<glm::vec3>& a = pa.value();
     std::vector<glm::vec3>& b = pb.value();
     if (translate != 0.0) {
@@ -97,18 +109,34 @@ int main(int argc, char** argv) {
 
     t0 = std::chrono::steady_clock::now();
     auto engine = Engine::create(options);
-    if (!engine) return std::fprintf(stderr, "rthdist-bench: %s\n", engine.error().message.c_str()), exitCodeFor(engine.error().code);
-    const double setupMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (!engine)
+        return std::fprintf(stderr, "rthdist-bench: %s\n", engine.error().message.c_str()),
+               exitCodeFor(engine.error().code);
+    const double setupMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
     std::vector<double> wall, total, index, cull, search, refine, gIndex, gCull, gSearch, gRefine, upload;
     HausdorffResult last;
+    const double budgetMs = budgetS * 1e3;
+    double warmMs = 0.0, timedMs = 0.0;
+    int warmDone = 0;
     for (int r = 0; r < warmup + runs; ++r) {
+        if (budgetMs > 0.0 && r < warmup && warmMs >= 0.5 * budgetMs) r = warmup;  // skip the other warm-ups
+        if (budgetMs > 0.0 && r > warmup && timedMs + wall.back() > budgetMs) break;
         auto c0 = std::chrono::steady_clock::now();
         auto res = engine->compute(a, b);
-        const double w = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count();
-        if (!res) return std::fprintf(stderr, "rthdist-bench: %s\n", res.error().message.c_str()), exitCodeFor(res.error().code);
-        if (r < warmup) continue;
+        const double w =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count();
+        if (!res)
+            return std::fprintf(stderr, "rthdist-bench: %s\n", res.error().message.c_str()),
+                   exitCodeFor(res.error().code);
+        if (r < warmup) {
+            warmMs += w;
+            ++warmDone;
+            continue;
+        }
         const Timings& t = res->timings;
+        timedMs += w;
         wall.push_back(w);
         total.push_back(t.total);
         upload.push_back(t.upload);
@@ -133,20 +161,32 @@ int main(int argc, char** argv) {
         cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count();
         if (!ref) return std::fprintf(stderr, "rthdist-bench: cpu: %s\n", ref.error().message.c_str()), 1;
         cpuH = ref->hausdorff;
-        agree = std::abs(ref->aToB.distance - last.aToB.distance) <= 1e-6 * std::max(1e-30, ref->hausdorff) + 1e-9 &&
-                std::abs(ref->bToA.distance - last.bToA.distance) <= 1e-6 * std::max(1e-30, ref->hausdorff) + 1e-9;
+        agree = std::abs(ref->aToB.distance - last.aToB.distance) <=
+                    1e-6 * std::max(1e-30, ref->hausdorff) + 1e-9 &&
+                std::abs(ref->bToA.distance - last.bToA.distance) <=
+                    1e-6 * std::max(1e-30, ref->hausdorff) + 1e-9;
     }
 
     cli::JsonWriter j(0);
     j.beginObject();
     j.key("case").value(name.empty() ? files[0] + " vs " + files[1] : name);
-    j.key("points").beginObject().key("a").value(uint64_t(a.size())).key("b").value(uint64_t(b.size())).endObject();
+    j.key("points")
+        .beginObject()
+        .key("a")
+        .value(uint64_t(a.size()))
+        .key("b")
+        .value(uint64_t(b.size()))
+        .endObject();
     j.key("backend").value(backendName(last.backend));
     j.key("device").value(last.device);
-    j.key("runs").value(runs).key("warmup").value(warmup);
+    j.key("runs").value(int(wall.size())).key("warmup").value(warmDone);
     j.key("hausdorff").value(last.hausdorff);
     j.key("h_ab").value(last.aToB.distance).key("h_ba").value(last.bToA.distance);
-    j.key("bits").beginArray(true).value(uint64_t(last.aToB.counters.bits)).value(uint64_t(last.bToA.counters.bits)).endArray();
+    j.key("bits")
+        .beginArray(true)
+        .value(uint64_t(last.aToB.counters.bits))
+        .value(uint64_t(last.bToA.counters.bits))
+        .endArray();
     j.key("load_ms").value(loadMs).key("setup_ms").value(setupMs);
     j.key("median_ms").beginObject();
     j.key("wall").value(median(wall)).key("total").value(median(total)).key("upload").value(median(upload));
@@ -167,6 +207,9 @@ int main(int argc, char** argv) {
         j.key("pairs").value(c.candidatePairs).key("cells").value(c.occupiedCells).endObject();
     }
     j.endArray();
+    struct rusage ru {};
+    getrusage(RUSAGE_SELF, &ru);
+    j.key("max_rss_kb").value(int64_t(ru.ru_maxrss));
     j.key("cpu_hausdorff").value(cpuH).key("cpu_ms").value(cpuMs).key("agree").value(agree);
     j.endObject();
     std::printf("%s\n", j.str().c_str());
