@@ -5,7 +5,7 @@
 // value for agreement. Not a test: no thresholds.
 //
 //   rthdist-bench A B [--backend X] [--runs N] [--warmup W] [--translate F]
-//                     [--bits K] [--name NAME] [--no-verify] [--budget S]
+//                     [--bits K] [--name NAME] [--no-verify] [--per-point] [--budget S]
 // --translate F moves B along x by F times B's x-extent (the paper's
 // translation scenario without writing a copy to disk).
 // --budget S (seconds; for slow devices such as lavapipe): warm-up calls stop
@@ -42,7 +42,7 @@ int usage() {
     std::fprintf(
         stderr,
         "usage: rthdist-bench A B [--backend auto|ray-query|rt-pipeline|cpu] [--runs N] [--warmup W]\n"
-        "                     [--translate F] [--bits K] [--name NAME] [--no-verify]\n");
+        "                     [--translate F] [--bits K] [--name NAME] [--no-verify] [--per-point]\n");
     return 2;
 }
 
@@ -82,6 +82,8 @@ int main(int argc, char** argv) {
         } else if (a == "--budget") {
             const char* v = next();
             if (!v || (budgetS = std::atof(v)) <= 0.0) return usage();
+        } else if (a == "--per-point") {
+            options.perPointDistances = true;
         } else if (a == "--no-verify") {
             verify = false;
         } else if (!a.empty() && a[0] == '-') {
@@ -178,6 +180,7 @@ int main(int argc, char** argv) {
         .value(uint64_t(b.size()))
         .endObject();
     j.key("backend").value(backendName(last.backend));
+    j.key("per_point").value(options.perPointDistances);
     j.key("device").value(last.device);
     j.key("runs").value(int(wall.size())).key("warmup").value(warmDone);
     j.key("hausdorff").value(last.hausdorff);
