@@ -5,7 +5,7 @@
 // value for agreement. Not a test: no thresholds.
 //
 //   rthdist-bench A B [--backend X] [--runs N] [--warmup W] [--translate F]
-//                     [--bits K] [--name NAME] [--no-verify] [--per-point] [--budget S]
+//                     [--bits K] [--name NAME] [--no-verify] [--per-point] [--growth G] [--budget S]
 // --translate F moves B along x by F times B's x-extent (the paper's
 // translation scenario without writing a copy to disk).
 // --budget S (seconds; for slow devices such as lavapipe): warm-up calls stop
@@ -42,7 +42,7 @@ int usage() {
     std::fprintf(
         stderr,
         "usage: rthdist-bench A B [--backend auto|ray-query|rt-pipeline|cpu] [--runs N] [--warmup W]\n"
-        "                     [--translate F] [--bits K] [--name NAME] [--no-verify] [--per-point]\n");
+        "                     [--translate F] [--bits K] [--name NAME] [--no-verify] [--per-point] [--growth G]\n");
     return 2;
 }
 
@@ -82,6 +82,10 @@ int main(int argc, char** argv) {
         } else if (a == "--budget") {
             const char* v = next();
             if (!v || (budgetS = std::atof(v)) <= 0.0) return usage();
+        } else if (a == "--growth") {
+            const char* v = next();
+            if (!v) return usage();
+            options.radiusGrowth = float(std::atof(v));
         } else if (a == "--per-point") {
             options.perPointDistances = true;
         } else if (a == "--no-verify") {
@@ -181,6 +185,7 @@ int main(int argc, char** argv) {
         .endObject();
     j.key("backend").value(backendName(last.backend));
     j.key("per_point").value(options.perPointDistances);
+    j.key("growth").value(double(options.radiusGrowth));
     j.key("device").value(last.device);
     j.key("runs").value(int(wall.size())).key("warmup").value(warmDone);
     j.key("hausdorff").value(last.hausdorff);
