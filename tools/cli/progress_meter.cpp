@@ -4,11 +4,16 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 namespace rthdist::cli {
 
 ProgressMeter::ProgressMeter(bool enabled, std::chrono::milliseconds delay)
-    : m_enabled(enabled), m_start(Clock::now()), m_delay(delay) {}
+    : m_enabled(enabled), m_start(Clock::now()), m_delay(delay) {
+    if (const char* env = std::getenv("RTHDIST_PROGRESS_DELAY_MS")) {
+        m_delay = std::chrono::milliseconds(std::strtol(env, nullptr, 10));
+    }
+}
 
 ProgressMeter::~ProgressMeter() { finish(); }
 

@@ -3,6 +3,8 @@
 // passed since construction (short runs print nothing), and at most every
 // 100 ms. finish() erases the line. Feeds from Options::progress, which the
 // library calls from the calling thread, so no locking is needed.
+// Test hook: the environment variable RTHDIST_PROGRESS_DELAY_MS overrides the
+// delay (tests/cli runs a tiny input under `script` with it set to 0).
 #pragma once
 
 #include <chrono>
