@@ -3,7 +3,7 @@
 rthdist. Prints one JSON object. Run by run_all.py in a subprocess with a
 time cap (a capped run is killed and reported as '> cap').
 
-  peers.py TOOL A.ply B.ply [--max-runs N] [--budget S] [--pcd-a A.pcd --pcd-b B.pcd]
+  peers.py TOOL A.ply B.ply [--max-runs N] [--budget S] [--cap S] [--pcd-a A.pcd --pcd-b B.pcd]
 
 TOOL: scipy-dh     scipy.spatial.distance.directed_hausdorff, both directions
                    (exact, double; early break + random shuffle, seed 0)
@@ -13,7 +13,12 @@ TOOL: scipy-dh     scipy.spatial.distance.directed_hausdorff, both directions
                    directions (KD-tree, double; OpenMP over queries)
       faiss        faiss.IndexFlatL2 (exact brute force, float32 GEMM
                    expansion): search k=1 both directions; the found
-                   neighbour's distance is recomputed in double
+                   neighbour's distance is recomputed in double. Brute force
+                   costs the same per query, so with --cap it first times a
+                   random subset of queries per direction and, when the
+                   linear projection exceeds the cap, reports
+                   {"capped": true, "projected_seconds": ...} instead of
+                   running for longer than the cap
       pcl          pcl_compute_hausdorff A.pcd B.pcd (the CLI of pcl-tools):
                    time = its own printed compute time (after loading: builds
                    the KD-trees, both directions, single thread); the
@@ -99,6 +104,23 @@ def tool_faiss(a, b):
         dab, ia, jb = directed(a32, b32)
         dba, ib, ja = directed(b32, a32)
         return {"h_ab": dab, "h_ba": dba, "pair_ab": [ia, jb], "pair_ba": [ib, ja]}
+
+    def project():
+        """Seconds the full run would take, from timed random query subsets."""
+        rng = np.random.default_rng(0)
+        total, probes = 0.0, []
+        for q, t in ((a32, b32), (b32, a32)):
+            n = int(min(len(q), max(256, 3e8 / len(t))))  # about 1-2 s per direction
+            sub = np.ascontiguousarray(q[rng.choice(len(q), n, replace=False)])
+            index = faiss.IndexFlatL2(3)
+            index.add(t)
+            t0 = time.perf_counter()
+            index.search(sub, 1)
+            dt = time.perf_counter() - t0
+            total += dt * len(q) / n
+            probes.append({"queries": n, "of": int(len(q)), "seconds": dt})
+        return total, probes
+    run.project = project
     return run
 
 
@@ -125,7 +147,7 @@ def tool_pcl(pcd_a, pcd_b):
 def main():
     args = sys.argv[1:]
     tool, a_path, b_path = args[0], args[1], args[2]
-    opts = {"--max-runs": "3", "--budget": "3", "--pcd-a": None, "--pcd-b": None}
+    opts = {"--max-runs": "3", "--budget": "3", "--cap": None, "--pcd-a": None, "--pcd-b": None}
     rest = args[3:]
     for i in range(0, len(rest), 2):
         opts[rest[i]] = rest[i + 1]
@@ -135,6 +157,11 @@ def main():
         a, b = read_ply(a_path), read_ply(b_path)
         run = {"scipy-dh": tool_scipy_dh, "ckdtree": tool_ckdtree, "open3d": tool_open3d,
                "faiss": tool_faiss}[tool](a, b)
+    if opts.get("--cap") and hasattr(run, "project"):
+        projected, probes = run.project()
+        if projected > float(opts["--cap"]):
+            print(json.dumps({"tool": tool, "capped": True, "projected_seconds": projected, "probes": probes}))
+            return
     times, walls, out = [], [], None
     spent = 0.0
     while True:
@@ -151,6 +178,9 @@ def main():
                 "hausdorff": max(out["h_ab"], out["h_ba"])})
     if walls:
         out["wall_seconds"] = statistics.median(walls)
+    import resource
+    out["max_rss_kb"] = max(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss,
+                            resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)
     print(json.dumps(out))
 
 
