@@ -45,16 +45,16 @@ namespace rthdist {
 
 struct StatsOptions {
     std::vector<double> percentiles{50.0, 90.0, 95.0, 99.0};  // each in [0, 100]
-    int histogramBins = 20;                                  // >= 1
+    int histogramBins = 20;                                   // >= 1
     // Fixed histogram range [rangeLo, rangeHi] when rangeHi > rangeLo; else auto.
     double rangeLo = 0.0;
     double rangeHi = 0.0;
 };
 
 struct Histogram {
-    double lo = 0.0, hi = 0.0;     // range; bin i covers [lo + i*w, lo + (i+1)*w)
-    std::vector<uint64_t> counts;  // one per bin
-    uint64_t below = 0, above = 0; // values outside [lo, hi]
+    double lo = 0.0, hi = 0.0;      // range; bin i covers [lo + i*w, lo + (i+1)*w)
+    std::vector<uint64_t> counts;   // one per bin
+    uint64_t below = 0, above = 0;  // values outside [lo, hi]
 };
 
 struct Percentile {

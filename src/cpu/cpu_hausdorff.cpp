@@ -226,8 +226,8 @@ constexpr double kIndexDone = 0.1, kCullDone = 0.15, kSearchDone = 0.95;
 void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
                   std::span<const glm::vec3> targets, const std::vector<float>& qx,
                   const std::vector<float>& qy, const std::vector<float>& qz,
-                  const std::vector<uint32_t>& qOriginal, const std::vector<uint32_t>& qKey,
-                  int threads, PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress) {
+                  const std::vector<uint32_t>& qOriginal, const std::vector<uint32_t>& qKey, int threads,
+                  PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress) {
     const size_t nq = queries.size();
     nearest.distance.assign(nq, 0.0);
     nearest.nearest.assign(nq, 0);
@@ -264,9 +264,9 @@ void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
     });
 }
 
-DirectedOutput directedHausdorff(std::span<const glm::vec3> queries,
-                                 std::span<const glm::vec3> targets, float scale,
-                                 const Options& options, PerPoint* perPoint, Progress& progress) {
+DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<const glm::vec3> targets,
+                                 float scale, const Options& options, PerPoint* perPoint,
+                                 Progress& progress) {
     DirectedOutput out;
     progress.report("index", 0.0);
     const int threads = resolveThreads(options.threads);

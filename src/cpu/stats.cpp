@@ -35,8 +35,8 @@ double percentileNearestRank(std::span<const double> sorted, double p) {
     return sorted[size_t(rank) - 1];
 }
 
-DistanceStats distanceStats(std::span<const double> distances, const StatsOptions& options, double histogramLo,
-                            double histogramHi) {
+DistanceStats distanceStats(std::span<const double> distances, const StatsOptions& options,
+                            double histogramLo, double histogramHi) {
     DistanceStats s;
     s.count = distances.size();
     s.histogram.lo = histogramLo;
@@ -80,7 +80,8 @@ Result<HausdorffStats> hausdorffStats(const HausdorffResult& result, std::span<c
                      "hausdorffStats: the result has no per-point distances for these sets "
                      "(Options::perPointDistances)"};
     }
-    if (options.histogramBins < 1) return Error{ErrorCode::kInvalidArgument, "hausdorffStats: histogramBins < 1"};
+    if (options.histogramBins < 1)
+        return Error{ErrorCode::kInvalidArgument, "hausdorffStats: histogramBins < 1"};
     for (double p : options.percentiles) {
         if (!(p >= 0.0 && p <= 100.0)) {
             return Error{ErrorCode::kInvalidArgument, "hausdorffStats: percentile outside [0, 100]"};

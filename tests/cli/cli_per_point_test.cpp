@@ -40,8 +40,8 @@ double percentileOf(const Json& list, double p) {
 }
 
 TEST_F(CliPerPoint, JsonStatistics) {
-    const CliRun run = runCli({"--backend", "cpu", "--json", "--per-point", "--percentile", "50", "--percentile",
-                               "100", "--histogram-bins", "3", m_a, m_b});
+    const CliRun run = runCli({"--backend", "cpu", "--json", "--per-point", "--percentile", "50",
+                               "--percentile", "100", "--histogram-bins", "3", m_a, m_b});
     ASSERT_EQ(run.exitCode, 0) << run;
     EXPECT_TRUE(run.err.empty()) << run;
     const Json j = parseJson(run);
@@ -58,8 +58,8 @@ TEST_F(CliPerPoint, JsonStatistics) {
     EXPECT_EQ(percentileOf(pp["pooled"]["percentiles"], 50), 1.0);  // {0,0,1,2,3}: rank 3
     EXPECT_EQ(pp["pooled"]["count"], 5);
     EXPECT_DOUBLE_EQ(pp["pooled"]["mean"].get<double>(), 6.0 / 5.0);
-    EXPECT_EQ(pp["hd95"]["max"], 3.0);      // max(P95 A->B = 3, P95 B->A = 2)
-    EXPECT_EQ(pp["hd95"]["pooled"], 3.0);   // rank ceil(4.75) = 5
+    EXPECT_EQ(pp["hd95"]["max"], 3.0);     // max(P95 A->B = 3, P95 B->A = 2)
+    EXPECT_EQ(pp["hd95"]["pooled"], 3.0);  // rank ceil(4.75) = 5
     // Union box (0,0,0)-(3,2,0): diagonal sqrt(13).
     EXPECT_DOUBLE_EQ(pp["diagonal"].get<double>(), std::sqrt(13.0));
     EXPECT_DOUBLE_EQ(pp["a_to_b"]["normalized"]["max"].get<double>(), 3.0 / std::sqrt(13.0));
@@ -115,7 +115,8 @@ TEST_F(CliPerPoint, PlyReadsBackWithQualityAndColours) {
         ASSERT_NE(end, std::string::npos);
         const std::string header = bytes.substr(0, end);
         EXPECT_NE(header.find("property float quality"), std::string::npos);
-        EXPECT_NE(header.find("property uchar red\nproperty uchar green\nproperty uchar blue"), std::string::npos);
+        EXPECT_NE(header.find("property uchar red\nproperty uchar green\nproperty uchar blue"),
+                  std::string::npos);
         const size_t body = end + std::strlen("end_header\n");
         ASSERT_EQ(bytes.size(), body + size_t(count) * 19);
     }
@@ -134,13 +135,15 @@ TEST_F(CliPerPoint, PlyReadsBackWithQualityAndColours) {
     EXPECT_NE(colour(0), colour(2));
     EXPECT_NE(colour(1), colour(2));
     EXPECT_GT(uint8_t(colour(2)[0]), uint8_t(colour(2)[2]));  // far is red, not blue
-    EXPECT_LT(int(uint8_t(colour(0)[0])) + uint8_t(colour(0)[1]) + uint8_t(colour(0)[2]), 150);  // near is dark
+    EXPECT_LT(int(uint8_t(colour(0)[0])) + uint8_t(colour(0)[1]) + uint8_t(colour(0)[2]),
+              150);  // near is dark
 }
 
 TEST_F(CliPerPoint, CsvRows) {
     const CliRun run = runCli({"--backend", "cpu", "--out-csv", path("d"), m_a, m_b});
     ASSERT_EQ(run.exitCode, 0) << run;
-    EXPECT_EQ(readFile(path("d_a.csv")), "index,x,y,z,distance,nearest\n0,0,0,0,0,0\n1,1,0,0,1,0\n2,3,0,0,3,0\n");
+    EXPECT_EQ(readFile(path("d_a.csv")),
+              "index,x,y,z,distance,nearest\n0,0,0,0,0,0\n1,1,0,0,1,0\n2,3,0,0,3,0\n");
     EXPECT_EQ(readFile(path("d_b.csv")), "index,x,y,z,distance,nearest\n0,0,0,0,0,0\n1,0,2,0,2,0\n");
 }
 
@@ -159,8 +162,8 @@ void expectPng(const std::string& file, uint32_t width, uint32_t height) {
 }
 
 TEST_F(CliPerPoint, PngFiles) {
-    const CliRun run = runCli({"--backend", "cpu", "--png", path("p.png"), "--histogram-png", path("h.png"),
-                               kSampleA, kSampleB});
+    const CliRun run = runCli(
+        {"--backend", "cpu", "--png", path("p.png"), "--histogram-png", path("h.png"), kSampleA, kSampleB});
     ASSERT_EQ(run.exitCode, 0) << run;
     expectPng(path("p.png"), 1600, 1000);
     expectPng(path("h.png"), 1000, 560);
@@ -174,9 +177,8 @@ TEST_F(CliPerPoint, UnwritableOutputIsAnError) {
 
 TEST_F(CliPerPoint, UsageErrors) {
     const std::vector<std::vector<std::string>> cases = {
-        {"--percentile", "101"}, {"--percentile", "-1"}, {"--percentile", "x"},
-        {"--histogram-bins", "0"}, {"--range", "2", "1"}, {"--range", "0"},
-        {"--out-ply", ""},       {"--png"},
+        {"--percentile", "101"}, {"--percentile", "-1"}, {"--percentile", "x"}, {"--histogram-bins", "0"},
+        {"--range", "2", "1"},   {"--range", "0"},       {"--out-ply", ""},     {"--png"},
     };
     for (const auto& c : cases) {
         std::vector<std::string> args{m_a, m_b};
@@ -222,7 +224,8 @@ TEST_F(CliPerPoint, ProgressOnATerminalUnlessQuiet) {
     EXPECT_NE(shown.find("\rrthdist: index"), std::string::npos) << shown;
     EXPECT_NE(shown.find("%"), std::string::npos) << shown;
     EXPECT_NE(shown.find("H(A,B) = "), std::string::npos) << shown;
-    const std::string quiet = runOnTerminal({"--backend", "cpu", "--per-point", "--quiet", kSampleA, kSampleB});
+    const std::string quiet =
+        runOnTerminal({"--backend", "cpu", "--per-point", "--quiet", kSampleA, kSampleB});
     EXPECT_EQ(quiet.find("rthdist: "), std::string::npos) << quiet;
     EXPECT_NE(quiet.find("H(A,B) = "), std::string::npos) << quiet;
 }

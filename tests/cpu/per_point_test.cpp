@@ -32,7 +32,8 @@ HausdorffResult runPerPoint(const std::vector<glm::vec3>& a, const std::vector<g
 }
 
 double pairDistance(const glm::vec3& p, const glm::vec3& q) {
-    const double dx = double(p.x) - double(q.x), dy = double(p.y) - double(q.y), dz = double(p.z) - double(q.z);
+    const double dx = double(p.x) - double(q.x), dy = double(p.y) - double(q.y),
+                 dz = double(p.z) - double(q.z);
     return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 

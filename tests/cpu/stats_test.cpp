@@ -21,7 +21,8 @@ double referencePercentile(const std::vector<double>& values, double p) {
     const double n = double(values.size());
     double best = INFINITY;
     for (double v : values) {
-        const double atOrBelow = double(std::count_if(values.begin(), values.end(), [&](double x) { return x <= v; }));
+        const double atOrBelow =
+            double(std::count_if(values.begin(), values.end(), [&](double x) { return x <= v; }));
         if (atOrBelow * 100.0 >= p * n && v < best) best = v;
     }
     return best;
@@ -43,7 +44,8 @@ void expectStatsMatch(const std::vector<double>& d, const DistanceStats& s, cons
     ASSERT_EQ(s.percentiles.size(), o.percentiles.size());
     for (size_t i = 0; i < o.percentiles.size(); ++i) {
         EXPECT_EQ(s.percentiles[i].p, o.percentiles[i]);
-        EXPECT_EQ(s.percentiles[i].value, referencePercentile(d, o.percentiles[i])) << "p " << o.percentiles[i];
+        EXPECT_EQ(s.percentiles[i].value, referencePercentile(d, o.percentiles[i]))
+            << "p " << o.percentiles[i];
     }
     const Histogram& h = s.histogram;
     ASSERT_EQ(h.counts.size(), size_t(o.histogramBins));
@@ -56,7 +58,8 @@ void expectStatsMatch(const std::vector<double>& d, const DistanceStats& s, cons
         uint64_t want = 0;
         for (double x : d) {
             if (x < h.lo || x > h.hi) continue;
-            size_t at = std::min(h.counts.size() - 1, size_t((x - h.lo) / (h.hi - h.lo) * double(h.counts.size())));
+            size_t at =
+                std::min(h.counts.size() - 1, size_t((x - h.lo) / (h.hi - h.lo) * double(h.counts.size())));
             if (at == bin) ++want;
         }
         EXPECT_EQ(h.counts[bin], want) << "bin " << bin << " from " << lo;
@@ -118,8 +121,9 @@ TEST(Stats, OracleCasesAgainstReference) {
                 hi = glm::max(hi, glm::dvec3(p));
             }
         }
-        EXPECT_DOUBLE_EQ(s->diagonal, std::sqrt((hi.x - lo.x) * (hi.x - lo.x) + (hi.y - lo.y) * (hi.y - lo.y) +
-                                                (hi.z - lo.z) * (hi.z - lo.z)));
+        EXPECT_DOUBLE_EQ(s->diagonal,
+                         std::sqrt((hi.x - lo.x) * (hi.x - lo.x) + (hi.y - lo.y) * (hi.y - lo.y) +
+                                   (hi.z - lo.z) * (hi.z - lo.z)));
         ++checked;
     }
     EXPECT_GE(checked, 20u);

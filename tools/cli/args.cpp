@@ -191,10 +191,11 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
             out.rangeLo = *lo;
             out.rangeHi = *hi;
             out.perPoint = true;
-        } else if (name == "--out-ply" || name == "--out-csv" || name == "--png" || name == "--histogram-png") {
+        } else if (name == "--out-ply" || name == "--out-csv" || name == "--png" ||
+                   name == "--histogram-png") {
             const auto v = takeValue();
             if (!v || v->empty()) return usageError("option '" + name + "' needs a value");
-            std::string& target = name == "--out-ply" ? out.outPly
+            std::string& target = name == "--out-ply"   ? out.outPly
                                   : name == "--out-csv" ? out.outCsv
                                   : name == "--png"     ? out.png
                                                         : out.histogramPng;

@@ -29,16 +29,16 @@ struct CliArgs {
 
     // Per-point distances and what is made of them (README "Per-point
     // distances"). Every flag below except --quiet turns perPoint on.
-    bool perPoint = false;             // --per-point (sets options.perPointDistances)
-    std::vector<double> percentiles;   // --percentile P, repeatable; empty = defaults
-    int histogramBins = 20;            // --histogram-bins N
-    bool hasRange = false;             // --range MIN MAX (colour ramp and histogram)
+    bool perPoint = false;            // --per-point (sets options.perPointDistances)
+    std::vector<double> percentiles;  // --percentile P, repeatable; empty = defaults
+    int histogramBins = 20;           // --histogram-bins N
+    bool hasRange = false;            // --range MIN MAX (colour ramp and histogram)
     double rangeLo = 0.0, rangeHi = 0.0;
-    std::string outPly;                // --out-ply PREFIX -> PREFIX_a.ply, PREFIX_b.ply
-    std::string outCsv;                // --out-csv PREFIX -> PREFIX_a.csv, PREFIX_b.csv
-    std::string png;                   // --png FILE (picture)
-    std::string histogramPng;          // --histogram-png FILE
-    bool quiet = false;                // --quiet: no progress on stderr
+    std::string outPly;        // --out-ply PREFIX -> PREFIX_a.ply, PREFIX_b.ply
+    std::string outCsv;        // --out-csv PREFIX -> PREFIX_a.csv, PREFIX_b.csv
+    std::string png;           // --png FILE (picture)
+    std::string histogramPng;  // --histogram-png FILE
+    bool quiet = false;        // --quiet: no progress on stderr
 };
 
 // Parses argv[1..]. Accepts "--flag value" and "--flag=value"; "--" ends the

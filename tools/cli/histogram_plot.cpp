@@ -74,7 +74,8 @@ Image plotHistogram(const HausdorffStats& stats, double hausdorff, bool directed
         if (d < ha.lo || d > ha.hi) return;
         const int x = int(std::lround(xOf(d)));
         for (int y = top; y < top + plotH; y += 8) img.fillRect(x - 1, y, x + 1, y + 5, kMarker);
-        img.drawText(std::min(x + 4, width - right - Image::textWidth(label)), top + 4 + 18 * row, label, kMarker);
+        img.drawText(std::min(x + 4, width - right - Image::textWidth(label)), top + 4 + 18 * row, label,
+                     kMarker);
     };
     if (hasHd95) marker(hd95, "HD95 " + number(hd95), 0);
     marker(hausdorff, "H " + number(hausdorff), 1);

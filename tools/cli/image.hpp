@@ -20,7 +20,7 @@ public:
     [[nodiscard]] int height() const { return m_height; }
     [[nodiscard]] Rgb at(int x, int y) const;
 
-    void set(int x, int y, Rgb c);  // ignored outside the image
+    void set(int x, int y, Rgb c);                         // ignored outside the image
     void fillRect(int x0, int y0, int x1, int y1, Rgb c);  // [x0, x1) x [y0, y1)
     void fillDisc(double cx, double cy, double radius, Rgb c);
     // Line of `thickness` pixels between two points (discs along the segment).

@@ -41,16 +41,17 @@ void appendLe(std::string& out, T v) {
 
 }  // namespace
 
-Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3> points, const PerPoint& nearest,
-                              const ColourRange& range) {
+Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3> points,
+                              const PerPoint& nearest, const ColourRange& range) {
     if (nearest.distance.size() != points.size()) {
         return Error{ErrorCode::kInvalidArgument, path + ": per-point distances missing"};
     }
     std::string out =
         "ply\nformat binary_little_endian 1.0\ncomment rthdist per-point nearest distance\n"
         "comment quality = exact distance to the nearest point of the other set\n"
-        "comment colour range " + std::to_string(range.lo) + " " + std::to_string(range.hi) +
-        "\nelement vertex " + std::to_string(points.size()) +
+        "comment colour range " +
+        std::to_string(range.lo) + " " + std::to_string(range.hi) + "\nelement vertex " +
+        std::to_string(points.size()) +
         "\nproperty float x\nproperty float y\nproperty float z\nproperty float quality\n"
         "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
     out.reserve(out.size() + points.size() * 19);
@@ -67,7 +68,8 @@ Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3
     return writeAll(path, out);
 }
 
-Result<bool> writeDistanceCsv(const std::string& path, std::span<const glm::vec3> points, const PerPoint& nearest) {
+Result<bool> writeDistanceCsv(const std::string& path, std::span<const glm::vec3> points,
+                              const PerPoint& nearest) {
     if (nearest.distance.size() != points.size() || nearest.nearest.size() != points.size()) {
         return Error{ErrorCode::kInvalidArgument, path + ": per-point distances missing"};
     }

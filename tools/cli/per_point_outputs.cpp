@@ -33,8 +33,9 @@ StatsOptions statsOptionsFrom(const CliArgs& args) {
     return o;
 }
 
-Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                  const HausdorffResult& r, const HausdorffStats& stats) {
+Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3> a,
+                                  std::span<const glm::vec3> b, const HausdorffResult& r,
+                                  const HausdorffStats& stats) {
     ColourRange range{stats.aToB.histogram.lo, stats.aToB.histogram.hi};
     const bool withB = !r.directedOnly;
     if (!args.outPly.empty()) {
@@ -71,8 +72,8 @@ Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3
         scene.segmentTo = d.targetPoint;
         scene.hausdorff = r.hausdorff;
         char line[256];
-        std::snprintf(line, sizeof line, "A %s (%zu points)   B %s (%zu points)", baseName(args.pathA).c_str(),
-                      a.size(), baseName(args.pathB).c_str(), b.size());
+        std::snprintf(line, sizeof line, "A %s (%zu points)   B %s (%zu points)",
+                      baseName(args.pathA).c_str(), a.size(), baseName(args.pathB).c_str(), b.size());
         scene.caption.push_back(line);
         double hd95 = 0.0;
         (void)percentileVariant(stats, "max", 95.0, hd95);

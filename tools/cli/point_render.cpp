@@ -35,7 +35,8 @@ Image renderPicture(const RenderScene& scene, const RenderOptions& options) {
     const int width = options.width, height = options.height;
     Image img(width, height, kBackground);
     const int legendW = 190, top = 90, margin = 30;
-    const int plotX = margin, plotY = top, plotW = width - legendW - 2 * margin, plotH = height - top - margin - 40;
+    const int plotX = margin, plotY = top, plotW = width - legendW - 2 * margin,
+              plotH = height - top - margin - 40;
 
     View view;
     glm::dvec3 lo(kFar), hi(-kFar);
@@ -63,7 +64,8 @@ Image renderPicture(const RenderScene& scene, const RenderOptions& options) {
     }
     const double extentX = std::max(vhi.x - vlo.x, 1e-30), extentY = std::max(vhi.y - vlo.y, 1e-30);
     const double scale = std::min(plotW / extentX, plotH / extentY);
-    const double offX = plotX + (plotW - extentX * scale) * 0.5, offY = plotY + (plotH - extentY * scale) * 0.5;
+    const double offX = plotX + (plotW - extentX * scale) * 0.5,
+                 offY = plotY + (plotH - extentY * scale) * 0.5;
     const double depthExtent = std::max(vhi.z - vlo.z, 1e-30);
     auto toScreen = [&](const glm::dvec3& v, double& sx, double& sy) {
         sx = offX + (v.x - vlo.x) * scale;
@@ -72,7 +74,9 @@ Image renderPicture(const RenderScene& scene, const RenderOptions& options) {
 
     const size_t total = scene.a.size() + scene.b.size();
     double radius = options.pointRadius;
-    if (!(radius > 0.0)) radius = std::clamp(2.0 * std::sqrt(double(plotW) * plotH / double(std::max<size_t>(total, 1))), 1.5, 8.0);
+    if (!(radius > 0.0))
+        radius =
+            std::clamp(2.0 * std::sqrt(double(plotW) * plotH / double(std::max<size_t>(total, 1))), 1.5, 8.0);
 
     // Splat into depth + colour buffers (depth: 0 near .. 1 far).
     std::vector<double> depth(size_t(width) * size_t(height), kFar);

@@ -121,8 +121,8 @@ std::string statsText(const HausdorffStats& s, bool directedOnly) {
     std::string out;
     char line[512];
     auto block = [&](const char* name, const DistanceStats& d) {
-        std::snprintf(line, sizeof line, "           %-6s min %.6g  mean %.6g  rms %.6g  max %.6g", name, d.min,
-                      d.mean, d.rms, d.max);
+        std::snprintf(line, sizeof line, "           %-6s min %.6g  mean %.6g  rms %.6g  max %.6g", name,
+                      d.min, d.mean, d.rms, d.max);
         out += line;
         for (const Percentile& p : d.percentiles) {
             std::snprintf(line, sizeof line, "  P%g %.6g", p.p, p.value);
