@@ -84,7 +84,7 @@ void main() {
     }
     QueryState st;
     st.best = packDistIndex(best, bestT);
-    st.rLo = max(dOut, 0.0);
+    st.rLo = pc.blockRLo != 0u ? max(dOut, 0.0) : 0.0;
     if (dead) {
         st.status = RTHDIST_DEAD;
     } else if (dOut > 0.0 && best <= dOut * dOut) {

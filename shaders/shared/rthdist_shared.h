@@ -105,6 +105,21 @@ struct CullPush {
     uint nq;
     float lowerBound2;  // squared lower bound of h without witness
     float epsilon;      // absolute slack for cell-geometry bounds (object units)
+    uint blockRLo;      // 1: rLo = distance to the block's faces (search on fine
+                        // cells); 0: rLo = 0 (search cells are coarser, so the
+                        // block does not cover whole search cells)
+};
+
+// coarsen.comp: search cells one level coarser than the fine cells (runs of
+// fine cells sharing key >> 3). mode 0 writes head flags, mode 1 the cells.
+struct CoarsenPush {
+    uint64_t fineCells;
+    uint64_t sortedKeys;   // fine key of every sorted point
+    uint64_t flags;        // uint[numFine]: head flags, scanned between the modes
+    uint64_t coarseCells;  // Cell[] out
+    uint64_t numCoarse;    // uint[1] out
+    uint numFine;
+    uint mode;
 };
 
 // compact.comp: appends OPEN queries whose best is not below the threshold.

@@ -54,6 +54,8 @@ struct PointIndex {
     Buffer* dense = nullptr;   // uint per key: end of the key's cell
     Buffer* cells = nullptr;   // Cell per occupied cell
     uint32_t numCells = 0;
+    Buffer* searchCells = nullptr;  // cells of edge 2s: the BLAS boxes
+    uint32_t numSearchCells = 0;
 };
 
 sh::GridParams gridParams(const GridSpec& g) {
@@ -238,6 +240,26 @@ struct GpuHausdorff::State {
         ctx.submitAndWait(cmd);
         timings->gpuIndex += ctx.lastGpuMs();
         ix.numCells = counters()[3];
+
+        // Search cells one level up (coarsen.comp): head flags, scan, build.
+        ix.searchCells = &buf(set + ".searchCells", VkDeviceSize(ix.numCells) * sizeof(sh::Cell));
+        cmd = ctx.begin();
+        sh::CoarsenPush co{ix.cells->address(),
+                           sortedKeys.address(),
+                           flags.address(),
+                           ix.searchCells->address(),
+                           countersAddr() + 12,
+                           ix.numCells,
+                           0};
+        dispatch(cmd, Kernel::kCoarsen, co, ix.numCells);
+        barrier(cmd);
+        cmdScan(cmd, flags.address(), ix.numCells, "scanCoarse", 0);
+        barrier(cmd);
+        co.mode = 1;
+        dispatch(cmd, Kernel::kCoarsen, co, ix.numCells);
+        ctx.submitAndWait(cmd);
+        timings->gpuIndex += ctx.lastGpuMs();
+        ix.numSearchCells = counters()[3];
         timings->index += msSince(t0);
         return ix;
     }
@@ -293,7 +315,8 @@ struct GpuHausdorff::State {
                           gridParams(T.grid),
                           Q.n,
                           lowerBound2,
-                          epsilon};
+                          epsilon,
+                          0u};  // search cells are coarser than the block's cells
         dispatch(cmd, Kernel::kCull, cull, Q.n);
         barrier(cmd);
         sh::CompactPush comp{state.address(), active[0]->address(), countersAddr(), maxPackedAddr(), Q.n,
@@ -311,12 +334,12 @@ struct GpuHausdorff::State {
             return std::max(double(lowerBound2), double(std::bit_cast<float>(uint32_t(*maxPacked() >> 32))));
         };
         double radius = 2.0 * T.grid.cellSize;
-        uint64_t pairCapacity = std::clamp<uint64_t>(uint64_t(T.numCells) * 4, 1u << 16, 1u << 22);
+        uint64_t pairCapacity = std::clamp<uint64_t>(uint64_t(T.numSearchCells) * 4, 1u << 16, 1u << 22);
         Buffer* pairs = nullptr;
         const float rayTMax = float(T.grid.cellSize * 1e-3);
         int cur = 0;
         bool firstBuild = true;
-        Buffer& aabbs = buf("aabbs", VkDeviceSize(T.numCells) * 24);
+        Buffer& aabbs = buf("aabbs", VkDeviceSize(T.numSearchCells) * 24);
         while (numActive > 0) {
             if (++cnt.iterations > kMaxIterations)
                 throw std::runtime_error("candidate search did not converge");
@@ -331,12 +354,13 @@ struct GpuHausdorff::State {
             counters()[1] = 0;
             counters()[2] = 0;
             cmd = ctx.begin();
-            sh::BoxesPush bp{T.cells->address(), aabbs.address(), T.numCells, grow};
-            dispatch(cmd, Kernel::kGrowBoxes, bp, T.numCells);
+            sh::BoxesPush bp{T.searchCells->address(), aabbs.address(), T.numSearchCells, grow};
+            dispatch(cmd, Kernel::kGrowBoxes, bp, T.numSearchCells);
             gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                             VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
                             VK_ACCESS_SHADER_READ_BIT);
-            if (accel.cmdBuild(cmd, aabbs.address(), T.numCells, !firstBuild, pipelines.shaderStages()) ||
+            if (accel.cmdBuild(cmd, aabbs.address(), T.numSearchCells, !firstBuild,
+                               pipelines.shaderStages()) ||
                 !tlasBound) {
                 pipelines.bindTlas(accel.tlas());
                 tlasBound = true;
@@ -344,7 +368,7 @@ struct GpuHausdorff::State {
             firstBuild = false;
             sh::SearchPush sp{Q.sorted->address(),
                               T.sorted->address(),
-                              T.cells->address(),
+                              T.searchCells->address(),
                               state.address(),
                               active[cur]->address(),
                               pairs->address(),
@@ -369,7 +393,7 @@ struct GpuHausdorff::State {
             const uint32_t used = uint32_t(std::min<uint64_t>(pairCount, pairCapacity));
             cnt.candidatePairs += used;
             cmd = ctx.begin();
-            sh::RefinePush rp{Q.sorted->address(), T.sorted->address(),    T.cells->address(),
+            sh::RefinePush rp{Q.sorted->address(), T.sorted->address(),    T.searchCells->address(),
                               state.address(),     active[cur]->address(), pairs->address(),
                               countersAddr(),      maxPackedAddr(),        uint32_t(pairCapacity),
                               lowerBound2};

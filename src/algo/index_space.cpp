@@ -45,7 +45,7 @@ uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z) {
     return spread(x) | (spread(y) << 1) | (spread(z) << 2);
 }
 
-int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds) {
+int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds, double targetPointsPerCell) {
     const size_t n = targets.size();
     if (n <= 1) return kMinBits;
     constexpr int kProbeBits = 10;
@@ -92,7 +92,7 @@ int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds) {
             occupied = estimate * growth;  // sample too thin: extrapolate
         }
         estimate = occupied;
-        if (double(n) / occupied >= kTargetPointsPerCell)
+        if (double(n) / occupied >= targetPointsPerCell)
             chosen = k;
         else
             break;

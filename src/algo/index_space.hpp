@@ -39,7 +39,8 @@ struct GridSpec {
 
 // Picks k so that occupied cells hold about kTargetPointsPerCell points, from
 // a strided sample's occupancy extrapolated to the full set (DESIGN §5).
-[[nodiscard]] int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds);
+[[nodiscard]] int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds,
+                             double targetPointsPerCell = kTargetPointsPerCell);
 
 // Interleaves the low 10 bits of x, y, z (x in bit 0).
 [[nodiscard]] uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z);

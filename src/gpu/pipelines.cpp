@@ -11,6 +11,7 @@
 #include "cell_build.comp.h"
 #include "cell_heads.comp.h"
 #include "cell_keys.comp.h"
+#include "coarsen.comp.h"
 #include "compact.comp.h"
 #include "cull.comp.h"
 #include "grow_boxes.comp.h"
@@ -96,6 +97,7 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
         spirv(k_spv_scatter_comp),   spirv(k_spv_cell_heads_comp), spirv(k_spv_cell_build_comp),
         spirv(k_spv_cull_comp),      spirv(k_spv_compact_comp),    spirv(k_spv_grow_boxes_comp),
         spirv(k_spv_search_rq_comp), spirv(k_spv_refine_comp),     spirv(k_spv_resolve_comp),
+        spirv(k_spv_coarsen_comp),
     };
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !rayQuery) continue;

@@ -27,6 +27,7 @@ enum class Kernel : uint32_t {
     kSearchRayQuery,  // only on the ray-query backend
     kRefine,
     kResolve,
+    kCoarsen,
     kCount
 };
 
