@@ -64,7 +64,9 @@ Per-point distances (each of these implies --per-point):
                       quality = distance and a red/green/blue colour ramp
   --out-csv PREFIX    write PREFIX_a.csv and PREFIX_b.csv: index,x,y,z,distance,nearest
   --png FILE          picture of both sets coloured by distance, with the
-                      Hausdorff segment (software renderer)
+                      Hausdorff segment
+  --render NAME       vulkan | software: how --png draws the points (default
+                      vulkan, headless; software when no Vulkan device works)
   --histogram-png FILE  bar chart of the distance histograms
   --help, -h          print this help
   --version           print the version
@@ -191,6 +193,12 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
             out.rangeLo = *lo;
             out.rangeHi = *hi;
             out.perPoint = true;
+        } else if (name == "--render") {
+            const auto v = takeValue();
+            if (!v) return usageError("option '--render' needs a value");
+            if (*v != "vulkan" && *v != "software")
+                return usageError("unknown renderer '" + *v + "' (expected vulkan or software)");
+            out.softwareRender = *v == "software";
         } else if (name == "--out-ply" || name == "--out-csv" || name == "--png" ||
                    name == "--histogram-png") {
             const auto v = takeValue();

@@ -34,11 +34,12 @@ struct CliArgs {
     int histogramBins = 20;           // --histogram-bins N
     bool hasRange = false;            // --range MIN MAX (colour ramp and histogram)
     double rangeLo = 0.0, rangeHi = 0.0;
-    std::string outPly;        // --out-ply PREFIX -> PREFIX_a.ply, PREFIX_b.ply
-    std::string outCsv;        // --out-csv PREFIX -> PREFIX_a.csv, PREFIX_b.csv
-    std::string png;           // --png FILE (picture)
-    std::string histogramPng;  // --histogram-png FILE
-    bool quiet = false;        // --quiet: no progress on stderr
+    std::string outPly;           // --out-ply PREFIX -> PREFIX_a.ply, PREFIX_b.ply
+    std::string outCsv;           // --out-csv PREFIX -> PREFIX_a.csv, PREFIX_b.csv
+    std::string png;              // --png FILE (picture)
+    bool softwareRender = false;  // --render software|vulkan: how --png splats (default vulkan)
+    std::string histogramPng;     // --histogram-png FILE
+    bool quiet = false;           // --quiet: no progress on stderr
 };
 
 // Parses argv[1..]. Accepts "--flag value" and "--flag=value"; "--" ends the

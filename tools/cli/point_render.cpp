@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "render/splat_renderer.hpp"
+
 namespace rthdist::cli {
 namespace {
 
@@ -29,9 +31,42 @@ struct View {
     }
 };
 
+// The Vulkan splat (src/render); fills depth and colour as the software splat
+// does, and leaves them untouched on an Error (no device, the pass failed).
+Result<bool> splatOnVulkan(const RenderScene& scene, const render::SplatCamera& camera,
+                           const RenderOptions& options, double radius, int width, int height,
+                           std::vector<double>& depth, std::vector<Rgb>& colour, RenderInfo& info) {
+    auto renderer = render::SplatRenderer::create(options.deviceIndex, options.validation);
+    if (!renderer) return renderer.error();
+    std::vector<glm::vec3> points;
+    std::vector<uint32_t> rgba;
+    points.reserve(scene.a.size() + scene.b.size());
+    rgba.reserve(points.capacity());
+    for (auto [set, distance] : {std::pair{scene.a, scene.aDistance}, std::pair{scene.b, scene.bDistance}}) {
+        for (size_t i = 0; i < set.size(); ++i) {
+            const Rgb c = distance.size() == set.size() ? distanceColour(distance[i], scene.range) : kGrey;
+            points.push_back(set[i]);
+            rgba.push_back(render::packRgba(c.r, c.g, c.b));
+        }
+    }
+    auto frame = (*renderer)->render(points, rgba, camera, width, height, float(radius));
+    if (!frame) return frame.error();
+    for (size_t at = 0; at < depth.size(); ++at) {
+        if (frame->depth[at] == std::numeric_limits<float>::infinity()) continue;
+        depth[at] = frame->depth[at];
+        const uint32_t c = frame->rgba[at];
+        colour[at] = Rgb{uint8_t(c), uint8_t(c >> 8), uint8_t(c >> 16)};
+    }
+    info.vulkan = true;
+    info.device = (*renderer)->deviceName();
+    info.validationMessages = (*renderer)->validationMessageCount();
+    return true;
+}
+
 }  // namespace
 
-Image renderPicture(const RenderScene& scene, const RenderOptions& options) {
+Image renderPicture(const RenderScene& scene, const RenderOptions& options, RenderInfo* infoOut) {
+    RenderInfo info;
     const int width = options.width, height = options.height;
     Image img(width, height, kBackground);
     const int legendW = 190, top = 90, margin = 30;
@@ -81,6 +116,23 @@ Image renderPicture(const RenderScene& scene, const RenderOptions& options) {
     // Splat into depth + colour buffers (depth: 0 near .. 1 far).
     std::vector<double> depth(size_t(width) * size_t(height), kFar);
     std::vector<Rgb> colour(depth.size(), kBackground);
+    if (options.vulkan) {
+        render::SplatCamera camera;
+        camera.centre = glm::vec3(view.centre);
+        camera.cosYaw = float(view.cy);
+        camera.sinYaw = float(view.sy);
+        camera.cosPitch = float(view.cp);
+        camera.sinPitch = float(view.sp);
+        camera.loX = float(vlo.x);
+        camera.hiY = float(vhi.y);
+        camera.hiZ = float(vhi.z);
+        camera.scale = float(scale);
+        camera.offX = float(offX);
+        camera.offY = float(offY);
+        camera.invDepthExtent = float(1.0 / depthExtent);
+        Result<bool> ok = splatOnVulkan(scene, camera, options, radius, width, height, depth, colour, info);
+        if (!ok) info.fallbackReason = ok.error().message;  // buffers untouched: splat in software
+    }
     auto splat = [&](std::span<const glm::vec3> set, std::span<const double> distance) {
         for (size_t i = 0; i < set.size(); ++i) {
             const glm::dvec3 v = view.apply(set[i]);
@@ -103,8 +155,10 @@ Image renderPicture(const RenderScene& scene, const RenderOptions& options) {
             }
         }
     };
-    splat(scene.a, scene.aDistance);
-    splat(scene.b, scene.bDistance);
+    if (!info.vulkan) {
+        splat(scene.a, scene.aDistance);
+        splat(scene.b, scene.bDistance);
+    }
 
     // Eye-dome lighting: darken a pixel by how far its neighbours (2 px away)
     // are in front of it; background neighbours count as far behind.
@@ -186,6 +240,7 @@ Image renderPicture(const RenderScene& scene, const RenderOptions& options) {
     img.fillRect(barX, barY + barH + 30, barX + 30, barY + barH + 36, kSegment);
     img.drawText(barX, barY + barH + 44, "Hausdorff", kBlack, 2);
     img.drawText(barX, barY + barH + 62, "segment", kBlack, 2);
+    if (infoOut) *infoOut = std::move(info);
     return img;
 }
 
