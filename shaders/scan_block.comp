@@ -2,45 +2,37 @@
 #extension GL_GOOGLE_include_directive : require
 // Exclusive scan of one block of RTHDIST_SCAN_BLOCK uints in place; the
 // block's total goes to blockSums (scanned recursively by the host's driver).
+// Each thread scans its RTHDIST_SCAN_PER_THREAD consecutive elements serially,
+// then the threads' totals are scanned in shared memory (Hillis-Steele).
 #include "common.glsl"
 layout(local_size_x = RTHDIST_SCAN_WG) in;
 layout(push_constant) uniform Push { ScanPush pc; };
-shared uint s_data[RTHDIST_SCAN_BLOCK];
+shared uint s_sums[RTHDIST_SCAN_WG];
 
 void main() {
     uint t = gl_LocalInvocationID.x;
-    uint base = gl_WorkGroupID.x * RTHDIST_SCAN_BLOCK;
+    uint base = gl_WorkGroupID.x * RTHDIST_SCAN_BLOCK + t * RTHDIST_SCAN_PER_THREAD;
     UintBuf data = UintBuf(pc.data);
-    uint i0 = base + 2 * t, i1 = base + 2 * t + 1;
-    s_data[2 * t] = i0 < pc.n ? data.v[i0] : 0u;
-    s_data[2 * t + 1] = i1 < pc.n ? data.v[i1] : 0u;
-    // Blelloch up-sweep.
-    uint offset = 1;
-    for (uint d = RTHDIST_SCAN_BLOCK >> 1; d > 0; d >>= 1) {
-        barrier();
-        if (t < d) {
-            uint ai = offset * (2 * t + 1) - 1, bi = offset * (2 * t + 2) - 1;
-            s_data[bi] += s_data[ai];
-        }
-        offset <<= 1;
+    uint local_[RTHDIST_SCAN_PER_THREAD];
+    uint sum = 0;
+    for (uint i = 0; i < RTHDIST_SCAN_PER_THREAD; ++i) {
+        uint idx = base + i;
+        uint v = idx < pc.n ? data.v[idx] : 0u;
+        local_[i] = sum;
+        sum += v;
     }
+    s_sums[t] = sum;
     barrier();
-    if (t == 0) {
-        UintBuf(pc.blockSums).v[gl_WorkGroupID.x] = s_data[RTHDIST_SCAN_BLOCK - 1];
-        s_data[RTHDIST_SCAN_BLOCK - 1] = 0u;
-    }
-    // Down-sweep.
-    for (uint d = 1; d < RTHDIST_SCAN_BLOCK; d <<= 1) {
-        offset >>= 1;
+    for (uint d = 1; d < RTHDIST_SCAN_WG; d <<= 1) {
+        uint add = t >= d ? s_sums[t - d] : 0u;
         barrier();
-        if (t < d) {
-            uint ai = offset * (2 * t + 1) - 1, bi = offset * (2 * t + 2) - 1;
-            uint x = s_data[ai];
-            s_data[ai] = s_data[bi];
-            s_data[bi] += x;
-        }
+        s_sums[t] += add;
+        barrier();
     }
-    barrier();
-    if (i0 < pc.n) data.v[i0] = s_data[2 * t];
-    if (i1 < pc.n) data.v[i1] = s_data[2 * t + 1];
+    uint offset = s_sums[t] - sum;
+    if (t == RTHDIST_SCAN_WG - 1) UintBuf(pc.blockSums).v[gl_WorkGroupID.x] = s_sums[t];
+    for (uint i = 0; i < RTHDIST_SCAN_PER_THREAD; ++i) {
+        uint idx = base + i;
+        if (idx < pc.n) data.v[idx] = local_[i] + offset;
+    }
 }

@@ -19,9 +19,12 @@ struct vec3f {
 
 // Workgroup size of every 1-D compute dispatch.
 #define RTHDIST_WG 128
-// Elements per scan block (one workgroup of RTHDIST_SCAN_WG threads, 2 each).
+// Elements per scan block: one workgroup of RTHDIST_SCAN_WG threads, each
+// scanning RTHDIST_SCAN_PER_THREAD consecutive elements serially (few
+// barriers: they dominate on lavapipe).
 #define RTHDIST_SCAN_WG 256
-#define RTHDIST_SCAN_BLOCK 512
+#define RTHDIST_SCAN_PER_THREAD 16
+#define RTHDIST_SCAN_BLOCK 4096
 
 // Query status values.
 #define RTHDIST_OPEN 0u
