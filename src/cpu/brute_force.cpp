@@ -43,8 +43,8 @@ constexpr size_t kChunk = 64;
 
 }  // namespace
 
-DirectedExact bruteForceDirected(std::span<const glm::vec3> queries,
-                                 std::span<const glm::vec3> targets, int threads) {
+DirectedExact bruteForceDirected(std::span<const glm::vec3> queries, std::span<const glm::vec3> targets,
+                                 int threads) {
     DirectedExact result;
     if (queries.empty() || targets.empty()) return result;
     const int workers = resolveThreads(threads, (queries.size() + kChunk - 1) / kChunk);
@@ -59,8 +59,7 @@ DirectedExact bruteForceDirected(std::span<const glm::vec3> queries,
         Best& best = perThread[size_t(t)];
         for (size_t i = begin; i < end; ++i) {
             const Nearest n = nearestOf(queries[i], soa);
-            if (n.distanceSquared > best.d2 ||
-                (n.distanceSquared == best.d2 && uint32_t(i) < best.query)) {
+            if (n.distanceSquared > best.d2 || (n.distanceSquared == best.d2 && uint32_t(i) < best.query)) {
                 best = {n.distanceSquared, uint32_t(i), n.targetIndex};
             }
         }
@@ -75,8 +74,8 @@ DirectedExact bruteForceDirected(std::span<const glm::vec3> queries,
     return result;
 }
 
-std::vector<double> bruteForceNearest(std::span<const glm::vec3> queries,
-                                      std::span<const glm::vec3> targets, int threads) {
+std::vector<double> bruteForceNearest(std::span<const glm::vec3> queries, std::span<const glm::vec3> targets,
+                                      int threads) {
     std::vector<double> out(queries.size(), std::numeric_limits<double>::infinity());
     if (targets.empty()) return out;
     const Targets soa(targets);

@@ -23,13 +23,11 @@ struct DirectedExact {
 };
 
 [[nodiscard]] DirectedExact bruteForceDirected(std::span<const glm::vec3> queries,
-                                               std::span<const glm::vec3> targets,
-                                               int threads = 0);
+                                               std::span<const glm::vec3> targets, int threads = 0);
 
 // Exact nearest-neighbour distance of every query (double), in query order.
 [[nodiscard]] std::vector<double> bruteForceNearest(std::span<const glm::vec3> queries,
-                                                    std::span<const glm::vec3> targets,
-                                                    int threads = 0);
+                                                    std::span<const glm::vec3> targets, int threads = 0);
 
 struct NearestExact {
     double distance = 0.0;     // exact NN distance in double

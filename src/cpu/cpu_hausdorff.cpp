@@ -95,8 +95,7 @@ inline void scan8(const TargetIndex& t, uint32_t pos, const Query& q, Best& best
     }
 }
 
-inline void scanRange(const TargetIndex& t, uint32_t first, uint32_t end, const Query& q,
-                      Best& best) {
+inline void scanRange(const TargetIndex& t, uint32_t first, uint32_t end, const Query& q, Best& best) {
     for (uint32_t pos = first; pos < end; pos += 8) scan8(t, pos, q, best);
 }
 
@@ -287,9 +286,10 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
         double farthest = 0.0;
         for (size_t i = begin; i < end; ++i) {
             const glm::dvec3 p = glm::dvec3(queries[i] * scale);
-            const uint32_t key = algo::mortonEncode(algo::cellCoord(p.x, g.origin.x, g.cellSize, g.cellsPerAxis),
-                                                    algo::cellCoord(p.y, g.origin.y, g.cellSize, g.cellsPerAxis),
-                                                    algo::cellCoord(p.z, g.origin.z, g.cellSize, g.cellsPerAxis));
+            const uint32_t key =
+                algo::mortonEncode(algo::cellCoord(p.x, g.origin.x, g.cellSize, g.cellsPerAxis),
+                                   algo::cellCoord(p.y, g.origin.y, g.cellSize, g.cellsPerAxis),
+                                   algo::cellCoord(p.z, g.origin.z, g.cellSize, g.cellsPerAxis));
             keyed[i] = (uint64_t(key) << 32) | uint64_t(i);
             const glm::dvec3 d = glm::max(glm::max(boxLo - p, p - boxHi), glm::dvec3(0.0));
             farthest = std::max(farthest, d.x * d.x + d.y * d.y + d.z * d.z);
@@ -382,7 +382,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
         Winner winner = winners[size_t(w)];
         SearchStats stat;
         uint64_t culledHere = 0, survivingHere = 0;
-        uint32_t hint = kNone;  // bucket of the previous query's nearest/killing point
+        uint32_t hint = kNone;     // bucket of the previous query's nearest/killing point
         uint32_t hintPos = kNone;  // that point (sorted position)
         const uint32_t* keys = t.cellKey.data();
         uint32_t cursor = uint32_t(std::lower_bound(keys, keys + cells, qKey[begin]) - keys);

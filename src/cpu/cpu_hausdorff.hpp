@@ -45,8 +45,7 @@
 
 namespace rthdist::cpu {
 
-[[nodiscard]] Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a,
-                                                   std::span<const glm::vec3> b,
+[[nodiscard]] Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                    const Options& options);
 
 }  // namespace rthdist::cpu

@@ -45,8 +45,7 @@ void radixSortKeys(std::vector<uint64_t>& values, int keyBits) {
     }
 }
 
-TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale, int bits,
-                             int threads) {
+TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale, int bits, int threads) {
     TargetIndex index;
     index.scale = scale;
     const size_t n = targets.size();

@@ -51,7 +51,7 @@ struct TargetIndex {
 
     // Occupied cells, ascending Morton key (grid.bits per axis).
     std::vector<uint32_t> cellKey;
-    std::vector<uint32_t> cellFirst;  // cellCount + 1 offsets into the sorted points
+    std::vector<uint32_t> cellFirst;        // cellCount + 1 offsets into the sorted points
     std::vector<glm::vec3> cellLo, cellHi;  // tight boxes of the cells' points
 
     // Buckets and the BVH: levels[0] holds the buckets, levels.back() one root.
@@ -64,8 +64,8 @@ struct TargetIndex {
 
 // Builds the index over `targets` (non-empty, finite) scaled by `scale`.
 // bits <= 0 picks the grid's bit count with algo::chooseBits.
-[[nodiscard]] TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale,
-                                           int bits, int threads);
+[[nodiscard]] TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale, int bits,
+                                           int threads);
 
 // Sorts (key << 32 | payload) values by their key bits [32, 32 + keyBits),
 // stably (LSD radix).

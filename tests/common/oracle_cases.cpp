@@ -159,7 +159,8 @@ std::vector<OracleCase> makeOracleCases() {
     });
     f.family("far_apart", 15, [](Rng& r, size_t i, Points& a, Points& b) {
         a = uniformBox(r, sizeAt(i + 5), {0, 0, 0}, {1, 1, 1});
-        b = translated(sphere(r, sizeAt(i + 9), {0, 0, 0}, 0.5), kAxes[i % 5] * std::pow(10.0, 2 + double(i % 3)));
+        b = translated(sphere(r, sizeAt(i + 9), {0, 0, 0}, 0.5),
+                       kAxes[i % 5] * std::pow(10.0, 2 + double(i % 3)));
     });
     f.family("far_1e6_cells", 10, [](Rng& r, size_t i, Points& a, Points& b) {
         // A cell is at most half the extent of B, so 5e5 extents >= 1e6 cell widths.

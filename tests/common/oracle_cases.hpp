@@ -38,8 +38,7 @@ struct OracleCase {
 // backend may pick a neighbour (or a maximizing query) whose double distance
 // differs from the true one by that much relative to h. It matters only when
 // h >> diagonal (far-apart sets); otherwise the first term dominates.
-[[nodiscard]] double oracleTolerance(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                     double h);
+[[nodiscard]] double oracleTolerance(std::span<const glm::vec3> a, std::span<const glm::vec3> b, double h);
 
 // gtest EXPECTs (with the case name and seed as SCOPED_TRACE):
 // - h(A,B) and, unless directedOnly, h(B,A) and H match bruteForceDirected

@@ -17,8 +17,7 @@ const std::vector<OracleCase>& cases() {
     return all;
 }
 
-HausdorffResult run(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b,
-                    Options options = {}) {
+HausdorffResult run(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b, Options options = {}) {
     options.backend = Backend::kCpu;
     Result<HausdorffResult> r = cpu::cpuHausdorff(a, b, options);
     EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
@@ -73,8 +72,8 @@ TEST(CpuHausdorff, OnePointEach) {
 }
 
 TEST(CpuHausdorff, AllIdenticalPoints) {
-    const OracleCase c = named("identical", std::vector<glm::vec3>(100, {1, 1, 1}),
-                               std::vector<glm::vec3>(50, {1, 1, 1}));
+    const OracleCase c =
+        named("identical", std::vector<glm::vec3>(100, {1, 1, 1}), std::vector<glm::vec3>(50, {1, 1, 1}));
     const HausdorffResult r = run(c.a, c.b);
     expectMatchesOracle(c, r);
     EXPECT_EQ(r.hausdorff, 0.0);
@@ -158,7 +157,8 @@ TEST(CpuHausdorff, LargeOffsetSmallExtent) {
     std::vector<glm::vec3> a, b;
     const glm::vec3 o(1.0e7f, -1.0e7f, 1.0e7f);
     for (int i = 0; i < 500; ++i) a.push_back(o + glm::vec3(float(i % 8), float(i / 8 % 8), float(i / 64)));
-    for (int i = 0; i < 100; ++i) b.push_back(o + glm::vec3(float(i % 5) * 2.0f, float(i / 5 % 5) * 2.0f, float(i / 25) * 2.0f));
+    for (int i = 0; i < 100; ++i)
+        b.push_back(o + glm::vec3(float(i % 5) * 2.0f, float(i / 5 % 5) * 2.0f, float(i / 25) * 2.0f));
     const OracleCase c = named("offset_1e7", a, b);
     const HausdorffResult r = run(c.a, c.b);
     expectMatchesOracle(c, r);
@@ -168,7 +168,8 @@ TEST(CpuHausdorff, ExtremeMagnitudesAreScaledExactly) {
     for (float s : {1e30f, 1e-30f}) {
         std::vector<glm::vec3> a, b;
         for (int i = 0; i < 300; ++i) a.emplace_back(float(i % 7) * s, float(i % 11) * s, float(i % 13) * s);
-        for (int i = 0; i < 50; ++i) b.emplace_back(float(i % 5) * 1.5f * s, float(i % 3) * s, float(i % 9) * s);
+        for (int i = 0; i < 50; ++i)
+            b.emplace_back(float(i % 5) * 1.5f * s, float(i % 3) * s, float(i % 9) * s);
         const OracleCase c = named(s > 1 ? "huge" : "tiny", a, b);
         const HausdorffResult r = run(c.a, c.b);
         expectMatchesOracle(c, r);

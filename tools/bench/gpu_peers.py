@@ -85,6 +85,12 @@ def main():
     for c in cases:
         a, b = load_case(c)
         tools = [("cupy_kdtree", cupy_kdtree)]
+        # Diagnostic: the Dragon has 2,100 duplicate vertices; CuPy's KDTree
+        # gave wrong maxima on it. The same sets without duplicates (H is
+        # unchanged by removing duplicates) tell whether duplicates are why.
+        ua, ub = np.unique(a, axis=0), np.unique(b, axis=0)
+        if len(ua) < len(a) or len(ub) < len(b):
+            tools.append(("cupy_kdtree_dedup", lambda a_, b_: cupy_kdtree(ua, ub)))
         if len(a) * len(b) <= BRUTE_CAP_PAIRS:
             tools.append(("torch_brute", torch_brute))
         for name, make in tools:

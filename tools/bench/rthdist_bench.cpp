@@ -42,7 +42,8 @@ int usage() {
     std::fprintf(
         stderr,
         "usage: rthdist-bench A B [--backend auto|ray-query|rt-pipeline|cpu] [--runs N] [--warmup W]\n"
-        "                     [--translate F] [--bits K] [--name NAME] [--no-verify] [--per-point] [--growth G]\n");
+        "                     [--translate F] [--bits K] [--name NAME] [--no-verify] [--per-point] [--growth "
+        "G]\n");
     return 2;
 }
 
