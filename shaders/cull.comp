@@ -41,9 +41,11 @@ void main() {
         for (uint t = start; t < end; ++t) {
             vec4 tv = targets.v[t];
             float d2 = dist2(q, tv.xyz);
-            if (d2 < best) {
+            uint t_ = floatBitsToUint(tv.w);
+            // Ties go to the smallest target index, as in the CPU backend.
+            if (d2 < best || (d2 == best && t_ < bestT)) {
                 best = d2;
-                bestT = floatBitsToUint(tv.w);
+                bestT = t_;
             }
         }
         if (best < thr) dead = true;
@@ -71,9 +73,10 @@ void main() {
                 if (dense.v[lastKey] == start) continue;  // empty coarse cell
                 vec4 tv = targets.v[start];
                 float d2 = dist2(q, tv.xyz);
-                if (d2 < best) {
+                uint t_ = floatBitsToUint(tv.w);
+                if (d2 < best || (d2 == best && t_ < bestT)) {
                     best = d2;
-                    bestT = floatBitsToUint(tv.w);
+                    bestT = t_;
                 }
                 if (best < thr) {
                     dead = true;

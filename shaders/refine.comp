@@ -23,9 +23,11 @@ void main() {
     for (uint t = c.first; t < c.first + c.count; ++t) {
         vec4 tv = targets.v[t];
         float d2 = dist2(q, tv.xyz);
-        if (d2 < best) {
+        uint t_ = floatBitsToUint(tv.w);
+        // Ties go to the smallest target index, as in the CPU backend.
+        if (d2 < best || (d2 == best && t_ < bestT)) {
             best = d2;
-            bestT = floatBitsToUint(tv.w);
+            bestT = t_;
             if (best < thr) break;
         }
     }
