@@ -162,7 +162,8 @@ TEST(CliGpuAuto, FollowsTheDeviceList) {
     const CliRun list = runCli({"--list-devices", "--json"});
     ASSERT_EQ(list.exitCode, 0) << list;
     std::string expected = "cpu";
-    for (const Json& d : parseJson(list)["devices"]) {
+    const Json listed = parseJson(list);  // keep it alive: the loop iterates a member
+    for (const Json& d : listed["devices"]) {
         if (d["type"] == "cpu" || !(d["ray_query"].get<bool>() || d["rt_pipeline"].get<bool>())) continue;
         expected = d["ray_query"].get<bool>() ? "ray-query" : "rt-pipeline";
         break;
