@@ -330,9 +330,9 @@ struct GpuHausdorff::State {
         timings->cull += msSince(t0);
         report(options, "cull", progressFrom + 0.2 * (progressTo - progressFrom));
 
-        auto threshold = [&] {
-            return std::max(double(lowerBound2), double(std::bit_cast<float>(uint32_t(*maxPacked() >> 32))));
-        };
+        // Small first radius, grown geometrically: measured against starting
+        // at the threshold's root, which makes every ray visit far more boxes
+        // (docs/bench/gpu.md, growth sweep).
         double radius = 2.0 * T.grid.cellSize;
         uint64_t pairCapacity = std::clamp<uint64_t>(uint64_t(T.numSearchCells) * 4, 1u << 16, 1u << 22);
         Buffer* pairs = nullptr;
