@@ -4,6 +4,9 @@ rthdist. Prints one JSON object. Run by run_all.py in a subprocess with a
 time cap (a capped run is killed and reported as '> cap').
 
   peers.py TOOL A.ply B.ply [--max-runs N] [--budget S] [--cap S] [--pcd-a A.pcd --pcd-b B.pcd]
+  peers.py faiss-precision A.ply B.ply    FAISS's neighbours for 2000 random points
+                                          of B vs the exact ones (cKDTree), raw and
+                                          with A's centroid subtracted first
 
 TOOL: scipy-dh     scipy.spatial.distance.directed_hausdorff, both directions
                    (exact, double; early break + random shuffle, seed 0)
@@ -144,8 +147,37 @@ def tool_pcl(pcd_a, pcd_b):
     return run
 
 
+def faiss_precision(a_path, b_path, n=2000):
+    """FAISS's float32 GEMM expansion on B's points that are ALSO points of A
+    (true NN distance 0): how many get a wrong neighbour, raw and centred."""
+    import faiss
+    a, b = read_ply(a_path), read_ply(b_path)
+    rng = np.random.default_rng(0)
+    sub = np.ascontiguousarray(b[rng.choice(len(b), min(n, len(b)), replace=False)])
+    out = {"queries": int(len(sub))}
+    a64 = a.astype(np.float64)
+    true = cKDTree_min(a64, sub.astype(np.float64))
+    out["true_nn_max"] = float(true.max())
+    for label, shift in (("raw", np.zeros(3, np.float32)), ("centred", a64.mean(axis=0).astype(np.float32))):
+        index = faiss.IndexFlatL2(3)
+        index.add(np.ascontiguousarray(a - shift))
+        D, I = index.search(np.ascontiguousarray(sub - shift), 1)
+        d = np.linalg.norm(sub.astype(np.float64) - a64[I[:, 0]], axis=1)
+        out[label] = {"wrong_neighbour": int((d > true + 1e-9).sum()), "max_error": float((d - true).max()),
+                      "faiss_reported_max": float(np.sqrt(max(0.0, float(D.max()))))}
+    return out
+
+
+def cKDTree_min(t, q):
+    from scipy.spatial import cKDTree
+    return cKDTree(t).query(q, k=1, workers=-1)[0]
+
+
 def main():
     args = sys.argv[1:]
+    if args[0] == "faiss-precision":
+        print(json.dumps(faiss_precision(args[1], args[2])))
+        return
     tool, a_path, b_path = args[0], args[1], args[2]
     opts = {"--max-runs": "3", "--budget": "3", "--cap": None, "--pcd-a": None, "--pcd-b": None}
     rest = args[3:]

@@ -55,7 +55,7 @@ PEERS = ["scipy-dh", "ckdtree", "open3d", "pcl", "faiss"]
 EXACT_PEERS = PEERS  # every peer computes the exact H (FAISS: exact argmin up to float32 GEMM rounding)
 SWEEP_SCENARIOS = ["dragon-res2", "dragon-t0.5"]
 SCALING_SIZES = [100_000, 250_000, 500_000, 1_000_000, 2_000_000, 5_000_000]
-SCALING_TOOLS = ["rthdist-cpu", "ckdtree", "open3d"]
+SCALING_TOOLS = ["rthdist-cpu", "ckdtree", "open3d", "pcl"]
 
 
 def log(msg):
@@ -187,8 +187,9 @@ def main():
     ap.add_argument("--out", default=os.path.join(REPO, "docs", "bench"))
     ap.add_argument("--build", default=os.path.join(REPO, "build-bench"), help="rthdist build dir (has rthdist-bench)")
     ap.add_argument("--work", default="/tmp/rthdist-bench-work", help="prepared scenario files (reused when present)")
-    ap.add_argument("--cap", type=float, default=120.0, help="time cap per peer run, seconds")
-    ap.add_argument("--gpu-cap", type=float, default=120.0, help="time cap per rthdist lavapipe process, seconds")
+    ap.add_argument("--cap", type=float, default=60.0, help="time cap per peer run, seconds")
+    ap.add_argument("--gpu-cap", type=float, default=120.0,
+                    help="time cap per rthdist lavapipe process (warm-up + timed calls), seconds")
     ap.add_argument("--scenarios", default=",".join(sc.SCENARIOS), help="comma-separated subset")
     ap.add_argument("--tools", default=",".join(["rthdist-" + b for b in BACKENDS] + PEERS))
     ap.add_argument("--gpu-skip", default="surface-5M", help="scenarios where the lavapipe backends are not run")
@@ -236,7 +237,7 @@ def main():
                     continue
                 cap = args.cap if be == "cpu" else args.gpu_cap
                 r = rthdist_row(bench, meta, be, 0, cap, runs=5 if be == "cpu" else 3,
-                                budget=8.0 if be == "cpu" else 10.0)
+                                budget=8.0 if be == "cpu" else 4.0)
             else:
                 r = peer_row(t, meta, args.cap)
             rows.append(r)
@@ -249,6 +250,15 @@ def main():
         entry["rows"] = rows
         results["scenarios"].append(entry)
         save()
+
+    # Evidence for FAISS's precision (its float32 GEMM expansion), cheap: 2000 queries.
+    for n in ("lidar-fsite8-red1", "dragon-res2"):
+        if n in metas and "faiss" in tools:
+            out, status, _ = run_json([PY, os.path.join(HERE, "peers.py"), "faiss-precision", metas[n]["a_ply"],
+                                       metas[n]["b_ply"]], args.cap)
+            results.setdefault("faiss_precision", {})[n] = dict(out, status=status)
+            log("faiss precision %s: %s" % (n, json.dumps(out)[:200]))
+    save()
 
     if not args.no_analyses:
         # Stage breakdown vs k (the paper's analysis figure) and the NoIS analogue (k = 1, 2).
@@ -264,15 +274,19 @@ def main():
                 results["sweeps"].append(r)
                 log("sweep %-12s ray-query k=%d %s" % (n, k, r.get("seconds", r["status"])))
             save()
-        # Auto k vs the best fixed k, every scenario (cpu backend).
+        # Auto k vs the best fixed k, every scenario (cpu backend); the automatic
+        # choice (k = 0 here) is timed again beside the fixed ones, same conditions.
+        # 1M+ points per side: k >= 5 only (k = 2..4 take minutes there).
         for n in names:
-            for k in range(2, 9):
-                if n in SWEEP_SCENARIOS:
+            big = min(metas[n]["points_a"], metas[n]["points_b"]) >= 1_000_000
+            ks = [0] + list(range(5 if big else 2, 9))
+            for k in ks:
+                if n in SWEEP_SCENARIOS and k > 0:
                     continue  # measured above
-                r = rthdist_row(bench, metas[n], "cpu", k, 60.0, runs=3, budget=3.0)
+                r = rthdist_row(bench, metas[n], "cpu", k, 60.0, runs=5, budget=3.0)
                 r.update({"scenario": n, "k": k})
                 results["sweeps"].append(r)
-            log("sweep %-18s cpu k=2..8 done" % n)
+            log("sweep %-18s cpu auto, k=%d..8 done" % (n, ks[1]))
             save()
 
     if not args.no_analyses and not args.no_scaling:
