@@ -8,7 +8,7 @@ would pick instead, every exact peer's value checked against rthdist's.
 
 Writes OUT/results.json (everything measured), OUT/README.md (tables and
 notes, by report.py) and OUT/*.png (plots). Builds rthdist-bench into --build
-(default build-bench) when it is missing. Takes about 25-35 minutes on a
+(default build-bench, incremental; --no-build to skip). Takes about 25-35 minutes on a
 2-core machine with lavapipe.
 
 Steps
@@ -104,14 +104,21 @@ def machine_info(bench):
     return info
 
 
-def ensure_build(build):
+def ensure_build(build, skip):
+    """Configures when needed and builds rthdist-bench incrementally (a no-op when up to date)."""
     bench = os.path.join(build, "rthdist-bench")
-    if not os.access(bench, os.X_OK):
-        log("building rthdist-bench in %s" % build)
+    if skip and os.access(bench, os.X_OK):
+        return bench
+    log("building rthdist-bench in %s" % build)
+    if not os.path.exists(os.path.join(build, "CMakeCache.txt")):
         subprocess.run(["cmake", "-S", REPO, "-B", build, "-DCMAKE_BUILD_TYPE=Release"], check=True,
                        stdout=subprocess.DEVNULL)
-        subprocess.run(["cmake", "--build", build, "--target", "rthdist_cli", "rthdist_bench", "-j2"], check=True,
-                       stdout=subprocess.DEVNULL)
+    p = subprocess.run(["cmake", "--build", build, "--target", "rthdist_cli", "rthdist_bench", "-j2"],
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        if not os.access(bench, os.X_OK):
+            sys.exit("run_all: build failed:\n" + p.stdout[-3000:] + p.stderr[-3000:])
+        log("WARNING: build failed, using the existing %s" % bench)
     return bench
 
 
@@ -196,12 +203,15 @@ def main():
     ap.add_argument("--no-analyses", action="store_true", help="skip the k sweeps and the scaling series")
     ap.add_argument("--no-scaling", action="store_true")
     ap.add_argument("--setup", action="store_true", help="run tools/bench/setup.sh first")
+    ap.add_argument("--no-build", action="store_true", help="use the existing rthdist-bench as is")
     args = ap.parse_args()
 
     t_start = time.time()
     if args.setup:
         subprocess.run(["bash", os.path.join(HERE, "setup.sh")], check=True)
-    bench = ensure_build(os.path.abspath(args.build))
+    t0 = time.time()
+    bench = ensure_build(os.path.abspath(args.build), args.no_build)
+    build_s = time.time() - t0
     names = [n for n in args.scenarios.split(",") if n]
     tools = [t for t in args.tools.split(",") if t]
     gpu_skip = set(x for x in args.gpu_skip.split(",") if x)
@@ -210,7 +220,7 @@ def main():
                "command": " ".join(["/usr/bin/python3", os.path.relpath(os.path.abspath(sys.argv[0]), REPO)]
                                    + sys.argv[1:]),
                "cap_s": args.cap, "gpu_cap_s": args.gpu_cap, "gpu_skip": sorted(gpu_skip),
-               "scenarios": [], "sweeps": [], "scaling": []}
+               "build_s": build_s, "scenarios": [], "sweeps": [], "scaling": []}
     out_json = os.path.join(args.out, "results.json")
 
     def save():
@@ -318,13 +328,16 @@ def main():
                 with open(os.path.join(d, "meta.json")) as f:
                     meta = json.load(f)
             main_rows = next((e["rows"] for e in results["scenarios"] if e["name"] == name), [])
+            size_rows = []
             for t in SCALING_TOOLS:
                 r = next((x for x in main_rows if x["tool"] == t), None)
                 if r is None:
                     r = rthdist_row(bench, meta, "cpu", 0, args.cap) if t == "rthdist-cpu" else peer_row(t, meta, args.cap)
                 r = dict(r, scenario=name, points=size)
-                results["scaling"].append(r)
+                size_rows.append(r)
                 log("scaling %-14s %-12s %s" % (name, t, r.get("seconds", r["status"])))
+            check(meta, size_rows)
+            results["scaling"] += size_rows
             save()
 
     results["machine"]["load_avg_end"] = os.getloadavg()
