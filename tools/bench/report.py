@@ -203,6 +203,7 @@ def markdown(res, pngs):
     L.append("- Time cap: %g s per peer run (FAISS: projected from timed query subsets, see below), %g s per "
              "rthdist lavapipe process; '> cap' rows are kept." % (res["cap_s"], res["gpu_cap_s"]))
     L.append("")
+    L += summary(res)
     L.append("## What is timed")
     L.append("")
     L.append("Seconds for the exact symmetric H = max(h(A,B), h(B,A)), both directions, inputs already in memory:")
@@ -214,8 +215,8 @@ def markdown(res, pngs):
     L.append("- **SciPy cKDTree**: tree build + `query(workers=-1)` per direction, float64.")
     L.append("- **Open3D** `compute_point_cloud_distance` per direction (KD-tree, OpenMP), float64; the "
              "PointCloud objects are built before timing.")
-    L.append("- **PCL** `pcl_compute_hausdorff A.pcd B.pcd`: the tool's own printed compute time (conversion "
-             "from the loaded PCLPointCloud2, two KD-tree builds, both directions, one thread). PCD loading is "
+    L.append("- **PCL** `pcl_compute_hausdorff A.pcd B.pcd`: the tool's own printed compute time (cloud "
+             "copies, two KD-tree builds, nearest-neighbour search in both directions, one thread). PCD loading is "
              "NOT in that figure; the whole process's wall time (loading included) is `wall_seconds` in "
              "results.json and in the PCL wall column below.")
     L.append("- **FAISS** `IndexFlatL2` (exact brute force, float32 GEMM expansion, OpenMP), `search(k=1)` per "
@@ -453,6 +454,38 @@ def markdown(res, pngs):
     L.append("")
     L += notes_section(res)
     return "\n".join(L)
+
+
+def summary(res):
+    ents = res["scenarios"]
+    L = ["## Summary", ""]
+    won, lost, ratios = [], [], []
+    for e in ents:
+        cpu, fp = row_of(e, "rthdist-cpu"), fastest_peer(e)
+        if not cpu or cpu["status"] != "ok" or not fp:
+            continue
+        x = cpu["seconds"] / fp["seconds"]
+        ratios.append((x, e["name"], SHORT[fp["tool"]]))
+        (won if x < 1 else lost).append(e["name"])
+    if ratios:
+        lo, hi = min(ratios), max(ratios)
+        L.append("- rthdist cpu is faster than the fastest peer on %d of %d scenarios; rthdist cpu / fastest peer "
+                 "ranges from %.2g (%s, vs %s) to %.2g (%s, vs %s)%s." % (
+                     len(won), len(ratios), lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
+                     "" if not lost else "; slower on " + ", ".join(lost)))
+    for t in ("rthdist-ray-query", "rthdist-rt-pipeline"):
+        rows = [(e, row_of(e, t), fastest_peer(e)) for e in ents]
+        ok = [(e, r, fp) for e, r, fp in rows if r and r["status"] == "ok" and fp]
+        if ok:
+            faster = [e["name"] for e, r, fp in ok if r["seconds"] < fp["seconds"]]
+            L.append("- %s is faster than the fastest peer on %d of %d scenarios run (%s)." % (
+                LABEL[t], len(faster), len(ok), ", ".join(faster) or "none"))
+    nbad = sum(1 for e in ents for r in e["rows"] if r.get("agree") is False)
+    nchk = sum(1 for e in ents for r in e["rows"] if "agree" in r)
+    L.append("- Values: %d of %d finished (tool, scenario) results agree with rthdist cpu within DESIGN §1's "
+             "tolerance%s." % (nchk - nbad, nchk, "" if not nbad else " (see Agreement for the others)"))
+    L.append("")
+    return L
 
 
 def notes_section(res):
