@@ -386,8 +386,8 @@ def markdown(res, pngs):
                  "one AABB per target point in the BVH; our cull, search and refinement are defined over cells). "
                  "The closest analogue is the coarsest grid: k = 1 (8 cells) and k = 2 (64 cells) make the index "
                  "space nearly useless, so the cpu rows at k = 1, 2 above show what the index space buys; on "
-                 "lavapipe k < 3 was not run (k = 1 took 94 s on dragon-res2 in a trial, against about 2.5 s at "
-                 "k = 3..8).")
+                 "lavapipe k < 3 is not run (in a trial, ray-query at k = 1 took 94 s on dragon-res2, against "
+                 "0.15-2.4 s at k = 3..8).")
         L.append("")
         for n in sorted(set(r["scenario"] for r in sweeps if r["tool"] == "rthdist-ray-query")):
             rows = {r["k"]: r for r in sweeps if r["scenario"] == n and r["tool"] == "rthdist-cpu"}
