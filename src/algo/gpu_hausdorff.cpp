@@ -115,6 +115,7 @@ struct GpuHausdorff::State {
                 ctx, std::max<VkDeviceSize>(bytes + bytes / 4, 256),
                 gpu::kStorageUsage | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
                 kind);
+            ctx.setDebugName(VK_OBJECT_TYPE_BUFFER, uint64_t(b.handle()), name.c_str());
         }
         return b;
     }

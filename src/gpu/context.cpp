@@ -238,6 +238,8 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
             mi.pfnUserCallback = onDebugMessage;
             mi.pUserData = ctx.get();
             RTHDIST_VK_CHECK(createMessenger(ctx->m_instance, &mi, nullptr, &ctx->m_messenger));
+            ctx->m_setObjectName = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+                vkGetInstanceProcAddr(ctx->m_instance, "vkSetDebugUtilsObjectNameEXT"));
         }
         std::vector<VkPhysicalDevice> pds = physicalDevices(ctx->m_instance);
         if (pds.empty()) return Error{ErrorCode::kNoDevice, "no Vulkan physical device found"};
@@ -372,6 +374,15 @@ Context::~Context() {
         if (destroy) destroy(m_instance, m_messenger, nullptr);
     }
     if (m_instance) vkDestroyInstance(m_instance, nullptr);
+}
+
+void Context::setDebugName(VkObjectType type, uint64_t handle, const char* name) const {
+    if (!m_setObjectName || !handle) return;
+    VkDebugUtilsObjectNameInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT};
+    info.objectType = type;
+    info.objectHandle = handle;
+    info.pObjectName = name;
+    m_setObjectName(m_device, &info);
 }
 
 uint32_t Context::memoryTypeIndex(uint32_t typeBits, VkMemoryPropertyFlags wanted) const {

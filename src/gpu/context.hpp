@@ -62,11 +62,16 @@ public:
 
     void countValidationMessage() { ++m_validationMessages; }
 
+    // Gives a Vulkan object a debug name (shown in validation messages and
+    // debuggers) when VK_EXT_debug_utils is on, i.e. with validation.
+    void setDebugName(VkObjectType type, uint64_t handle, const char* name) const;
+
 private:
     Context() = default;
 
     VkInstance m_instance = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT m_messenger = VK_NULL_HANDLE;
+    PFN_vkSetDebugUtilsObjectNameEXT m_setObjectName = nullptr;
     VkPhysicalDevice m_physical = VK_NULL_HANDLE;
     VkDevice m_device = VK_NULL_HANDLE;
     VkQueue m_queue = VK_NULL_HANDLE;

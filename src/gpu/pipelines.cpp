@@ -34,11 +34,12 @@ constexpr uint32_t kPushBytes = 128;
 struct Spirv {
     const uint32_t* code;
     size_t bytes;
+    const char* name;
 };
 
 template <size_t N>
-Spirv spirv(const uint32_t (&a)[N]) {
-    return {a, N * sizeof(uint32_t)};
+Spirv spirv(const uint32_t (&a)[N], const char* name) {
+    return {a, N * sizeof(uint32_t), name};
 }
 
 VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
@@ -93,11 +94,19 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
     RTHDIST_VK_CHECK(vkAllocateDescriptorSets(d, &da, &m_set));
 
     const Spirv compute[size_t(Kernel::kCount)] = {
-        spirv(k_spv_cell_keys_comp), spirv(k_spv_scan_block_comp), spirv(k_spv_scan_add_comp),
-        spirv(k_spv_scatter_comp),   spirv(k_spv_cell_heads_comp), spirv(k_spv_cell_build_comp),
-        spirv(k_spv_cull_comp),      spirv(k_spv_compact_comp),    spirv(k_spv_grow_boxes_comp),
-        spirv(k_spv_search_rq_comp), spirv(k_spv_refine_comp),     spirv(k_spv_resolve_comp),
-        spirv(k_spv_coarsen_comp),
+        spirv(k_spv_cell_keys_comp, "cell_keys"),
+        spirv(k_spv_scan_block_comp, "scan_block"),
+        spirv(k_spv_scan_add_comp, "scan_add"),
+        spirv(k_spv_scatter_comp, "scatter"),
+        spirv(k_spv_cell_heads_comp, "cell_heads"),
+        spirv(k_spv_cell_build_comp, "cell_build"),
+        spirv(k_spv_cull_comp, "cull"),
+        spirv(k_spv_compact_comp, "compact"),
+        spirv(k_spv_grow_boxes_comp, "grow_boxes"),
+        spirv(k_spv_search_rq_comp, "search_rq"),
+        spirv(k_spv_refine_comp, "refine"),
+        spirv(k_spv_resolve_comp, "resolve"),
+        spirv(k_spv_coarsen_comp, "coarsen"),
     };
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !rayQuery) continue;
@@ -112,6 +121,7 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
         VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &ci, nullptr, &m_compute[k]);
         vkDestroyShaderModule(d, m, nullptr);
         RTHDIST_VK_CHECK(r);
+        ctx.setDebugName(VK_OBJECT_TYPE_PIPELINE, uint64_t(m_compute[k]), compute[k].name);
     }
     if (rayQuery) return;
 
@@ -151,6 +161,7 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
         ctx.rt().createRtPipelines(d, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &rci, nullptr, &m_rtPipeline);
     for (VkShaderModule m : mods) vkDestroyShaderModule(d, m, nullptr);
     RTHDIST_VK_CHECK(r);
+    ctx.setDebugName(VK_OBJECT_TYPE_PIPELINE, uint64_t(m_rtPipeline), "search_rt_pipeline");
 
     // Shader binding table: raygen | miss | hit, each region aligned to the
     // base alignment; the buffer's address is rounded up, so over-allocate.
