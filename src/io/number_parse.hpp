@@ -1,10 +1,13 @@
 // Locale-free number parsing (std::from_chars) and float narrowing.
 #pragma once
 
+#include <glm/vec3.hpp>
+
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string_view>
 #include <system_error>
 
@@ -48,6 +51,15 @@ namespace rthdist::io {
     if (v > kMax) return std::numeric_limits<float>::infinity();
     if (v < -kMax) return -std::numeric_limits<float>::infinity();
     return static_cast<float>(v);
+}
+
+// Parses tok[0], tok[1], tok[2] as x, y, z (the text loaders' shared step).
+// Returns the first token that is not a number, for the caller's error.
+[[nodiscard]] inline std::optional<std::string_view> parsePoint(const std::string_view* tok, glm::vec3& out) {
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!parseFloat(tok[axis], out[axis])) return tok[axis];
+    }
+    return std::nullopt;
 }
 
 }  // namespace rthdist::io

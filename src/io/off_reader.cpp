@@ -81,13 +81,11 @@ Result<std::vector<glm::vec3>> readOff(std::string_view bytes, const std::string
         if (m < 3)
             return badInput(path, lineWhere(cursor.line()),
                             "vertex line with " + std::to_string(m) + " value(s)");
-        float v[3];
-        for (size_t axis = 0; axis < 3; ++axis) {
-            if (!parseFloat(xyz[axis], v[axis])) {
-                return badInput(path, lineWhere(cursor.line()), notANumber(xyz[axis]));
-            }
+        glm::vec3 p;
+        if (const auto bad = parsePoint(xyz.data(), p)) {
+            return badInput(path, lineWhere(cursor.line()), notANumber(*bad));
         }
-        points[k] = glm::vec3(v[0], v[1], v[2]);
+        points[k] = p;
     }
     return points;
 }

@@ -23,13 +23,11 @@ Result<std::vector<glm::vec3>> readXyz(std::string_view bytes, const std::string
             return badInput(path, lineWhere(cursor.line()),
                             "expected 'x y z', found " + std::to_string(n) + " column(s)");
         }
-        float v[3];
-        for (size_t axis = 0; axis < 3; ++axis) {
-            if (!parseFloat(tok[axis], v[axis])) {
-                return badInput(path, lineWhere(cursor.line()), notANumber(tok[axis]));
-            }
+        glm::vec3 p;
+        if (const auto bad = parsePoint(tok.data(), p)) {
+            return badInput(path, lineWhere(cursor.line()), notANumber(*bad));
         }
-        points.emplace_back(v[0], v[1], v[2]);
+        points.push_back(p);
     }
     points.shrink_to_fit();
     return points;
