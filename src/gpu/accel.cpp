@@ -13,6 +13,20 @@ VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * 
 
 }  // namespace
 
+VkAccelerationStructureKHR AccelStructures::createIn(Buffer& storage, VkDeviceSize size,
+                                                     VkAccelerationStructureTypeKHR type) {
+    if (storage.size() < size)
+        storage =
+            Buffer(m_ctx, size, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR, MemoryKind::kDevice);
+    VkAccelerationStructureCreateInfoKHR ci{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
+    ci.buffer = storage.handle();
+    ci.size = size;
+    ci.type = type;
+    VkAccelerationStructureKHR as = VK_NULL_HANDLE;
+    RTHDIST_VK_CHECK(m_ctx.rt().createAccel(m_ctx.device(), &ci, nullptr, &as));
+    return as;
+}
+
 void AccelStructures::release() {
     const RtFunctions& rt = m_ctx.rt();
     if (m_tlas) rt.destroyAccel(m_ctx.device(), m_tlas, nullptr);
@@ -69,15 +83,8 @@ bool AccelStructures::cmdBuild(VkCommandBuffer cmd, VkDeviceAddress aabbs, uint3
     if (!doUpdate) {
         if (m_blas) rt.destroyAccel(d, m_blas, nullptr);
         m_blas = VK_NULL_HANDLE;
-        if (m_blasBuffer.size() < sizes.accelerationStructureSize)
-            m_blasBuffer =
-                Buffer(m_ctx, sizes.accelerationStructureSize,
-                       VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR, MemoryKind::kDevice);
-        VkAccelerationStructureCreateInfoKHR ci{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
-        ci.buffer = m_blasBuffer.handle();
-        ci.size = sizes.accelerationStructureSize;
-        ci.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-        RTHDIST_VK_CHECK(rt.createAccel(d, &ci, nullptr, &m_blas));
+        m_blas = createIn(m_blasBuffer, sizes.accelerationStructureSize,
+                          VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR);
         m_count = count;
     }
     VkDeviceSize scratchNeed =
@@ -119,13 +126,8 @@ bool AccelStructures::cmdBuild(VkCommandBuffer cmd, VkDeviceAddress aabbs, uint3
     std::memcpy(m_instances.mapped(), &inst, sizeof(inst));
 
     if (!m_tlas) {
-        m_tlasBuffer = Buffer(m_ctx, tsizes.accelerationStructureSize,
-                              VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR, MemoryKind::kDevice);
-        VkAccelerationStructureCreateInfoKHR ci{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
-        ci.buffer = m_tlasBuffer.handle();
-        ci.size = tsizes.accelerationStructureSize;
-        ci.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
-        RTHDIST_VK_CHECK(rt.createAccel(d, &ci, nullptr, &m_tlas));
+        m_tlas = createIn(m_tlasBuffer, tsizes.accelerationStructureSize,
+                          VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR);
         rebound = true;
     }
     tgeom.geometry.instances.data.deviceAddress = m_instances.address();

@@ -29,6 +29,11 @@ public:
     void release();
 
 private:
+    // Creates an acceleration structure of `size` bytes in `storage`, which
+    // is (re)allocated when too small.
+    VkAccelerationStructureKHR createIn(Buffer& storage, VkDeviceSize size,
+                                        VkAccelerationStructureTypeKHR type);
+
     Context& m_ctx;
     VkAccelerationStructureKHR m_blas = VK_NULL_HANDLE, m_tlas = VK_NULL_HANDLE;
     Buffer m_blasBuffer, m_tlasBuffer, m_scratch, m_instances;
