@@ -1,15 +1,16 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Search cells: runs of fine cells with the same parent key (key >> 3), i.e.
-// cells of edge 2s. They are contiguous in the Morton-sorted points, so a
-// search cell is again [first, first + count) with the union of the fine
-// tight boxes. The cull keeps the fine cells (few points to scan); the BLAS
-// gets the coarse ones (fewer boxes per ray when the radius is large).
+// Search cells of level j: runs of level j-1 cells ("fine" here) with the same
+// key >> 3j, i.e. cells of edge s * 2^j. They are contiguous in the
+// Morton-sorted points, so a search cell is again [first, first + count) with
+// the union of the finer tight boxes. The cull keeps the finest cells (few
+// points to scan); the BLAS gets cells about half the search radius wide, so
+// a ray visits few boxes however large the radius grows.
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CoarsenPush pc; };
 
-uint parentKey(CellBuf fine, UintBuf keys, uint c) { return keys.v[fine.v[c].first] >> 3; }
+uint parentKey(CellBuf fine, UintBuf keys, uint c) { return keys.v[fine.v[c].first] >> pc.shift; }
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
@@ -36,5 +37,6 @@ void main() {
     }
     uint index = UintBuf(pc.flags).v[c];
     CellBuf(pc.coarseCells).v[index] = out_;
+    UintBuf(pc.fineFirst).v[index] = pc.shift == 3u ? c : UintBuf(pc.finerFineFirst).v[c];
     if (e == pc.numFine) UintBuf(pc.numCoarse).v[0] = index + 1;
 }

@@ -4,7 +4,8 @@
 //
 // Invariant (DESIGN §3): every cell whose tight box lies within `radius` of q
 // is reported by the traversal (boxes are grown by radius + epsilon); cells
-// within rLo were scanned in an earlier pass and are skipped; the others
+// within rLo were scanned in the previous iteration and are skipped when it
+// used the same cells (skipScanned); the others
 // become (query, cell) pairs for the exact refinement, unless the cell's
 // representative (a real member point) is already closer than the running
 // maximum, which proves the query cannot raise h. A cell whose box is farther
@@ -16,7 +17,7 @@ bool visitCell(uint slot, uint qi, vec3 q, float rLo, float thr, uint cellIndex,
     Cell c = CellBuf(pc.cells).v[cellIndex];
     float d2 = boxDist2(q, c.lo, c.hi);
     if (d2 > pc.radius * pc.radius) return false;
-    if (d2 <= rLo * rLo) return false;
+    if (pc.skipScanned != 0u && d2 <= rLo * rLo) return false;
     if (d2 > bestLocal) return false;
     vec4 rep = Vec4Buf(pc.targets).v[c.first];
     float r2 = dist2(q, rep.xyz);

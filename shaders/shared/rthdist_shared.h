@@ -113,16 +113,19 @@ struct CullPush {
                         // block does not cover whole search cells)
 };
 
-// coarsen.comp: search cells one level coarser than the fine cells (runs of
-// fine cells sharing key >> 3). mode 0 writes head flags, mode 1 the cells.
+// coarsen.comp: search cells of level j (edge s * 2^j) from those of level
+// j - 1 (runs sharing fine key >> 3j). mode 0 writes head flags, mode 1 the cells.
 struct CoarsenPush {
     uint64_t fineCells;
-    uint64_t sortedKeys;   // fine key of every sorted point
-    uint64_t flags;        // uint[numFine]: head flags, scanned between the modes
-    uint64_t coarseCells;  // Cell[] out
-    uint64_t numCoarse;    // uint[1] out
+    uint64_t sortedKeys;      // fine key of every sorted point
+    uint64_t flags;           // uint[numFine]: head flags, scanned between the modes
+    uint64_t coarseCells;     // Cell[] out
+    uint64_t numCoarse;       // uint[1] out
+    uint64_t finerFineFirst;  // uint per finer cell: its first level-0 cell (unused at level 1)
+    uint64_t fineFirst;       // uint per coarse cell out: its first level-0 cell
     uint numFine;
     uint mode;
+    uint shift;  // 3 * level: the parent key is a point's fine key >> shift
 };
 
 // compact.comp: appends OPEN queries whose best is not below the threshold.
@@ -158,6 +161,7 @@ struct SearchPush {
     float radius;  // R: cells with box distance <= R are candidates
     float lowerBound2;
     float rayTMax;
+    uint skipScanned;  // 1: cells within rLo were scanned at this same level
 };
 
 // refine.comp: exact scan of the candidate pairs' cells.
@@ -170,8 +174,12 @@ struct RefinePush {
     uint64_t pairs;
     uint64_t counters;
     uint64_t maxPacked;
+    uint64_t fineCells;  // level-0 cells: a search cell is scanned through them
+    uint64_t fineFirst;  // uint per search cell: its first level-0 cell
     uint pairCapacity;
     float lowerBound2;
+    uint numSearchCells;
+    uint numFineCells;
 };
 
 // resolve.comp: classifies active queries after an iteration, compacts the rest.

@@ -54,8 +54,15 @@ struct PointIndex {
     Buffer* dense = nullptr;   // uint per key: end of the key's cell
     Buffer* cells = nullptr;   // Cell per occupied cell
     uint32_t numCells = 0;
-    Buffer* searchCells = nullptr;  // cells of edge 2s: the BLAS boxes
-    uint32_t numSearchCells = 0;
+    Buffer* sortedKeys = nullptr;  // fine key per sorted point (builds coarser levels)
+    std::string name;              // "A" or "B": names its pooled buffers
+    // Search cells by level j >= 1 (edge s * 2^j), built on first use.
+    struct Level {
+        Buffer* cells = nullptr;
+        Buffer* fineFirst = nullptr;  // uint per cell: its first level-0 cell
+        uint32_t count = 0;
+    };
+    std::vector<Level> levels;
 };
 
 sh::GridParams gridParams(const GridSpec& g) {
@@ -206,7 +213,9 @@ struct GpuHausdorff::State {
         t0 = Clock::now();
         const uint32_t numKeys = 1u << (3 * ix.grid.bits);
         Buffer& keys = buf("keys", VkDeviceSize(ix.n) * 4);
-        Buffer& sortedKeys = buf("sortedKeys", VkDeviceSize(ix.n) * 4);
+        ix.name = set;
+        ix.sortedKeys = &buf(set + ".sortedKeys", VkDeviceSize(ix.n) * 4);
+        Buffer& sortedKeys = *ix.sortedKeys;
         Buffer& flags = buf("flags", VkDeviceSize(ix.n) * 4);
         const VkDeviceSize denseBytes = VkDeviceSize(numKeys) * 4;
         ix.dense = &buf(set + ".dense", denseBytes);
@@ -242,36 +251,57 @@ struct GpuHausdorff::State {
         timings->gpuIndex += ctx.lastGpuMs();
         ix.numCells = counters()[3];
 
-        // Search cells one level up (coarsen.comp): head flags, scan, build.
-        ix.searchCells = &buf(set + ".searchCells", VkDeviceSize(ix.numCells) * sizeof(sh::Cell));
-        cmd = ctx.begin();
-        sh::CoarsenPush co{ix.cells->address(),
-                           sortedKeys.address(),
-                           flags.address(),
-                           ix.searchCells->address(),
-                           countersAddr() + 12,
-                           ix.numCells,
-                           0};
-        dispatch(cmd, Kernel::kCoarsen, co, ix.numCells);
-        barrier(cmd);
-        cmdScan(cmd, flags.address(), ix.numCells, "scanCoarse", 0);
-        barrier(cmd);
-        co.mode = 1;
-        dispatch(cmd, Kernel::kCoarsen, co, ix.numCells);
-        ctx.submitAndWait(cmd);
-        timings->gpuIndex += ctx.lastGpuMs();
-        ix.numSearchCells = counters()[3];
         timings->index += msSince(t0);
         return ix;
     }
 
     // h(Q, T): Q's points in Q's cell order are the queries.
+    // Search cells of level `level` (>= 1) of T, coarsened from the level
+    // below on first use (coarsen.comp: head flags, scan, build).
+    const PointIndex::Level& searchLevel(PointIndex& T, int level) {
+        while (int(T.levels.size()) < level) {
+            const int j = int(T.levels.size()) + 1;
+            Buffer* finer = j == 1 ? T.cells : T.levels.back().cells;
+            Buffer* finerFineFirst = j == 1 ? T.cells : T.levels.back().fineFirst;  // unused at j = 1
+            const uint32_t numFiner = j == 1 ? T.numCells : T.levels.back().count;
+            const std::string tag = T.name + ".level" + std::to_string(j);
+            PointIndex::Level lv;
+            lv.cells = &buf(tag, VkDeviceSize(numFiner) * sizeof(sh::Cell));
+            lv.fineFirst = &buf(tag + ".fineFirst", VkDeviceSize(numFiner) * 4);
+            Buffer& flags = buf("coarseFlags", VkDeviceSize(numFiner) * 4);
+            auto t0 = Clock::now();
+            VkCommandBuffer cmd = ctx.begin();
+            sh::CoarsenPush co{finer->address(),
+                               T.sortedKeys->address(),
+                               flags.address(),
+                               lv.cells->address(),
+                               countersAddr() + 12,
+                               finerFineFirst->address(),
+                               lv.fineFirst->address(),
+                               numFiner,
+                               0,
+                               uint32_t(3 * j)};
+            dispatch(cmd, Kernel::kCoarsen, co, numFiner);
+            barrier(cmd);
+            cmdScan(cmd, flags.address(), numFiner, "scanCoarse", 0);
+            barrier(cmd);
+            co.mode = 1;
+            dispatch(cmd, Kernel::kCoarsen, co, numFiner);
+            ctx.submitAndWait(cmd);
+            timings->gpuIndex += ctx.lastGpuMs();
+            timings->index += msSince(t0);
+            lv.count = counters()[3];
+            T.levels.push_back(lv);
+        }
+        return T.levels[size_t(level - 1)];
+    }
+
     // Reports progress; [from, to) is this direction's share of the call.
     void report(const Options& options, const char* stage, double fraction) {
         if (options.progress) options.progress(stage, std::clamp(fraction, 0.0, 1.0));
     }
 
-    Directed direction(const PointIndex& Q, const PointIndex& T, std::span<const glm::vec3> qPts,
+    Directed direction(const PointIndex& Q, PointIndex& T, std::span<const glm::vec3> qPts,
                        std::span<const glm::vec3> tPts, const Options& options, PerPoint* perPoint,
                        double progressFrom, double progressTo) {
         Directed out;
@@ -298,7 +328,7 @@ struct GpuHausdorff::State {
         // the early break off in every shader (deadThreshold returns 0).
         const float lowerBound2 = perPoint ? -1.0f : float(lb * (1.0 - 1e-5));
         double maxAbs = 0.0;
-        for (const Bounds* b : {&Q.bounds, &T.bounds})
+        for (const Bounds* b : {&Q.bounds, static_cast<const Bounds*>(&T.bounds)})
             maxAbs = std::max({maxAbs, std::abs(b->lo.x), std::abs(b->lo.y), std::abs(b->lo.z),
                                std::abs(b->hi.x), std::abs(b->hi.y), std::abs(b->hi.z)});
         const float epsilon = float(maxAbs * 4e-7 + T.grid.cellSize * 1e-5);
@@ -335,12 +365,11 @@ struct GpuHausdorff::State {
         // at the threshold's root, which makes every ray visit far more boxes
         // (docs/bench/gpu.md, growth sweep).
         double radius = 2.0 * T.grid.cellSize;
-        uint64_t pairCapacity = std::clamp<uint64_t>(uint64_t(T.numSearchCells) * 4, 1u << 16, 1u << 22);
+        uint64_t pairCapacity = std::clamp<uint64_t>(uint64_t(T.numCells) * 4, 1u << 16, 1u << 22);
         Buffer* pairs = nullptr;
         const float rayTMax = float(T.grid.cellSize * 1e-3);
         int cur = 0;
-        bool firstBuild = true;
-        Buffer& aabbs = buf("aabbs", VkDeviceSize(T.numSearchCells) * 24);
+        int builtLevel = 0;  // level of the BLAS now built (0: none yet)
         while (numActive > 0) {
             if (++cnt.iterations > kMaxIterations)
                 throw std::runtime_error("candidate search did not converge");
@@ -350,26 +379,37 @@ struct GpuHausdorff::State {
             }
             const float r = float(radius);
             const float grow = r + epsilon + r * 1e-6f;
+            // Search cells about an eighth of the radius wide: level j with
+            // s * 2^j <= R / 8, at least 1, at most bits - 1. Wider cells mean
+            // fewer boxes per ray but longer scans in the refinement; R/2 and
+            // R/4 were slower overall on the lavapipe scenarios (README).
+            const int level = std::clamp(int(std::floor(std::log2(radius / (8.0 * T.grid.cellSize)))), 1,
+                                         std::max(1, T.grid.bits - 1));
+            const PointIndex::Level& lv = searchLevel(T, level);
+            Buffer* searchCells = lv.cells;
+            const uint32_t numSearchCells = lv.count;
+            const bool sameLevel = level == builtLevel;
+            Buffer& aabbs = buf("aabbs", VkDeviceSize(numSearchCells) * 24);
 
             t0 = Clock::now();
             counters()[1] = 0;
             counters()[2] = 0;
             cmd = ctx.begin();
-            sh::BoxesPush bp{T.searchCells->address(), aabbs.address(), T.numSearchCells, grow};
-            dispatch(cmd, Kernel::kGrowBoxes, bp, T.numSearchCells);
+            sh::BoxesPush bp{searchCells->address(), aabbs.address(), numSearchCells, grow};
+            dispatch(cmd, Kernel::kGrowBoxes, bp, numSearchCells);
             gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                             VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
                             VK_ACCESS_SHADER_READ_BIT);
-            if (accel.cmdBuild(cmd, aabbs.address(), T.numSearchCells, !firstBuild,
-                               pipelines.shaderStages()) ||
+            // Same cells: the boxes only grew, so refit; new level: rebuild.
+            if (accel.cmdBuild(cmd, aabbs.address(), numSearchCells, sameLevel, pipelines.shaderStages()) ||
                 !tlasBound) {
                 pipelines.bindTlas(accel.tlas());
                 tlasBound = true;
             }
-            firstBuild = false;
+            builtLevel = level;
             sh::SearchPush sp{Q.sorted->address(),
                               T.sorted->address(),
-                              T.searchCells->address(),
+                              searchCells->address(),
                               state.address(),
                               active[cur]->address(),
                               pairs->address(),
@@ -379,7 +419,8 @@ struct GpuHausdorff::State {
                               uint32_t(pairCapacity),
                               r,
                               lowerBound2,
-                              rayTMax};
+                              rayTMax,
+                              sameLevel ? 1u : 0u};
             if (rayQuery)
                 dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
             else
@@ -394,10 +435,13 @@ struct GpuHausdorff::State {
             const uint32_t used = uint32_t(std::min<uint64_t>(pairCount, pairCapacity));
             cnt.candidatePairs += used;
             cmd = ctx.begin();
-            sh::RefinePush rp{Q.sorted->address(), T.sorted->address(),    T.searchCells->address(),
-                              state.address(),     active[cur]->address(), pairs->address(),
-                              countersAddr(),      maxPackedAddr(),        uint32_t(pairCapacity),
-                              lowerBound2};
+            sh::RefinePush rp{Q.sorted->address(),    T.sorted->address(),
+                              searchCells->address(), state.address(),
+                              active[cur]->address(), pairs->address(),
+                              countersAddr(),         maxPackedAddr(),
+                              T.cells->address(),     lv.fineFirst->address(),
+                              uint32_t(pairCapacity), lowerBound2,
+                              numSearchCells,         T.numCells};
             dispatch(cmd, Kernel::kRefine, rp, used);
             barrier(cmd);
             sh::ResolvePush rs{state.address(),
