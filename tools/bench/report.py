@@ -198,8 +198,8 @@ def markdown(res, pngs):
                  m.get("scipy"), m["open3d"], m["pcl_tools"], m["faiss"], m.get("numpy")))
     la0, la1 = m["load_avg_start"], m.get("load_avg_end", [0, 0, 0])
     L.append("- Load average (1/5/15 min) at start %.2f / %.2f / %.2f, at end %.2f / %.2f / %.2f; each row's "
-             "1-min load at its start is in results.json (`load_avg_1m`). Other work shared the 2 cores, so "
-             "timings carry that noise." % (tuple(la0) + tuple(la1)))
+             "1-min load at its start is in results.json (`load_avg_1m`). The 2 cores are shared with other "
+             "work in this environment; timings carry that noise." % (tuple(la0) + tuple(la1)))
     L.append("- Time cap: %g s per peer run (FAISS: projected from timed query subsets, see below), %g s per "
              "rthdist lavapipe process; '> cap' rows are kept." % (res["cap_s"], res["gpu_cap_s"]))
     L.append("")
@@ -406,6 +406,17 @@ def markdown(res, pngs):
                  "timed again in the same series (median of up to 5 calls), so the columns are comparable; at "
                  "tens of milliseconds, differences of 10-30% are within this shared machine's noise.")
         L.append("")
+        rat = []
+        for e in res["scenarios"]:
+            rows = {r["k"]: r for r in sweeps if r["scenario"] == e["name"] and r["tool"] == "rthdist-cpu"}
+            ok = [r for k, r in rows.items() if k >= 2 and r["status"] == "ok"]
+            if ok and rows.get(0, {}).get("status") == "ok":
+                rat.append((rows[0]["seconds"] / min(r["seconds"] for r in ok), e["name"]))
+        if rat:
+            rat.sort()
+            L.append("Automatic k / best fixed k: median %.2f, from %.2f (%s) to %.2f (%s) over %d scenarios." % (
+                rat[len(rat) // 2][0], rat[0][0], rat[0][1], rat[-1][0], rat[-1][1], len(rat)))
+            L.append("")
         L.append("| scenario | auto k (A→B / B→A) | auto (s) | best fixed k | best (s) | auto / best | "
                  + " | ".join("k=%d" % k for k in range(2, 9)) + " |")
         L.append("|---|---|---:|---:|---:|---:|" + "---:|" * 7)
@@ -516,8 +527,8 @@ def notes_section(res):
                 if sv > 0]
         L.append("- lavapipe (ray-query, rt-pipeline): on %s the neighbourhood cull resolves every query and "
                  "no ray is cast; elsewhere the surviving queries go through radius iterations of BLAS builds "
-                 "and rays on llvmpipe (%s). That is the search stage that dominates those rows; the native cpu "
-                 "backend does the same search on a grid without Vulkan." % (", ".join(none) or "no scenario",
+                 "and rays on llvmpipe (%s); the stage shares of the slow rows are in 'Where rthdist is not the "
+                 "fastest'. The native cpu backend does the same search on a grid without Vulkan." % (", ".join(none) or "no scenario",
                                                                            "; ".join(some)))
     sw = res.get("sweeps", [])
     for n in sorted(set(r["scenario"] for r in sw if r["tool"] == "rthdist-ray-query")):

@@ -8,7 +8,7 @@ would pick instead, every exact peer's value checked against rthdist's.
 
 Writes OUT/results.json (everything measured), OUT/README.md (tables and
 notes, by report.py) and OUT/*.png (plots). Builds rthdist-bench into --build
-(default build-bench, incremental; --no-build to skip). Takes about 25-35 minutes on a
+(default build-bench, incremental; --no-build to skip). Takes about 15 minutes (up to ~35 on shared cores) on a
 2-core machine with lavapipe.
 
 Steps
@@ -199,7 +199,7 @@ def main():
                     help="time cap per rthdist lavapipe process (warm-up + timed calls), seconds")
     ap.add_argument("--scenarios", default=",".join(sc.SCENARIOS), help="comma-separated subset")
     ap.add_argument("--tools", default=",".join(["rthdist-" + b for b in BACKENDS] + PEERS))
-    ap.add_argument("--gpu-skip", default="surface-5M", help="scenarios where the lavapipe backends are not run")
+    ap.add_argument("--gpu-skip", default="", help="comma-separated scenarios where the lavapipe backends are not run")
     ap.add_argument("--no-analyses", action="store_true", help="skip the k sweeps and the scaling series")
     ap.add_argument("--no-scaling", action="store_true")
     ap.add_argument("--setup", action="store_true", help="run tools/bench/setup.sh first")
