@@ -160,6 +160,11 @@ public:
     struct Impl;
 
 private:
+    // The one-shot entry validates its inputs itself and calls the engine's
+    // core directly, so the points are scanned once.
+    friend Result<HausdorffResult> hausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                             const Options& options);
+
     explicit Engine(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> m_impl;
 };

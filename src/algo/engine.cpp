@@ -134,27 +134,39 @@ Result<Engine> Engine::create(const Options& options) {
 const std::string& Engine::deviceName() const { return m_impl->deviceName; }
 Backend Engine::backend() const { return m_impl->backend; }
 
+namespace {
+
+// The computation on inputs already validated (validateSet).
+Result<HausdorffResult> computeValidated(Engine::Impl& impl, std::span<const glm::vec3> a,
+                                         std::span<const glm::vec3> b) {
+    auto t0 = std::chrono::steady_clock::now();
+    Result<HausdorffResult> r =
+        impl.gpu ? impl.gpu->compute(a, b, impl.options) : cpu::cpuHausdorff(a, b, impl.options);
+    if (!r) return r;
+    r->timings.setup = impl.setupMs;
+    impl.setupMs = 0.0;  // only the first call pays for creation
+    r->timings.total = msSince(t0);
+    if (impl.context) r->validationMessages = impl.context->validationMessageCount();
+    return r;
+}
+
+}  // namespace
+
 Result<HausdorffResult> Engine::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
     if (auto err = validateSet(a, "A")) return *err;
     if (auto err = validateSet(b, "B")) return *err;
-    auto t0 = std::chrono::steady_clock::now();
-    Result<HausdorffResult> r =
-        m_impl->gpu ? m_impl->gpu->compute(a, b, m_impl->options) : cpu::cpuHausdorff(a, b, m_impl->options);
-    if (!r) return r;
-    r->timings.setup = m_impl->setupMs;
-    m_impl->setupMs = 0.0;  // only the first call pays for creation
-    r->timings.total = msSince(t0);
-    if (m_impl->context) r->validationMessages = m_impl->context->validationMessageCount();
-    return r;
+    return computeValidated(*m_impl, a, b);
 }
 
 Result<HausdorffResult> hausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                   const Options& options) {
     if (auto err = validateSet(a, "A")) return *err;
     if (auto err = validateSet(b, "B")) return *err;
+    // Validated before the engine exists: bad input is reported as such even
+    // where no device could be created.
     auto engine = Engine::create(options);
     if (!engine) return engine.error();
-    return engine->compute(a, b);
+    return computeValidated(*engine->m_impl, a, b);
 }
 
 }  // namespace rthdist
