@@ -39,8 +39,21 @@ if have_all "${BASE_PKGS[@]}" "${EXTRA_PKGS[@]}" && mesa_ok; then
 fi
 
 export DEBIAN_FRONTEND=noninteractive
+# The mirror for bookworm-backports is the one the machine's bookworm suite
+# already uses (deb822 .sources or one-line .list): no host is named here.
+debian_mirror() {
+  local f
+  for f in /etc/apt/sources.list.d/*.sources; do
+    [ -f "$f" ] || continue
+    awk '/^URIs:/ {u=$2} /^Suites:/ && / bookworm( |$)/ {print u; exit}' "$f"
+  done
+  cat /etc/apt/sources.list /etc/apt/sources.list.d/*.list 2>/dev/null |
+    awk '$1 == "deb" && $3 == "bookworm" {print $2}' || true
+}
 if ! grep -rqs "bookworm-backports" /etc/apt/sources.list /etc/apt/sources.list.d/; then
-  echo "deb http://deb.debian.org/debian bookworm-backports main" |
+  mirror=$(debian_mirror | grep -v security | head -n 1 || true)
+  [ -n "$mirror" ] || { echo "install-deps: no bookworm mirror in the apt sources to take bookworm-backports from" >&2; exit 1; }
+  echo "deb $mirror bookworm-backports main" |
     $SUDO tee /etc/apt/sources.list.d/rthdist-backports.list >/dev/null
 fi
 $SUDO apt-get update -qq
