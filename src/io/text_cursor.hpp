@@ -1,11 +1,18 @@
 // Forward scanning of text (whole file in memory) by line or by
 // whitespace-separated token, counting lines for error messages.
+//
+// Line ends are "\n", "\r\n" and a lone "\r" (classic Mac OS): a file saved
+// with CR-only line ends must not read as one long line. A UTF-8 byte order
+// mark at the start of a file is not text and is skipped.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <string_view>
 
 namespace rthdist::io {
+
+inline constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 
 [[nodiscard]] constexpr bool isBlank(char c) {
     return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';
@@ -16,6 +23,9 @@ namespace rthdist::io {
     while (!s.empty() && isBlank(s.back())) s.remove_suffix(1);
     return s;
 }
+
+// Bytes of a UTF-8 byte order mark at the start of text (0 or 3).
+[[nodiscard]] inline size_t bomLength(std::string_view text) { return text.starts_with(kUtf8Bom) ? 3 : 0; }
 
 // Splits s at blanks (and at any of extraSeparators) into at most maxTokens
 // tokens; returns how many were found, counting past maxTokens.
@@ -37,18 +47,21 @@ inline size_t splitTokens(std::string_view s, std::string_view* tokens, size_t m
 
 class TextCursor {
 public:
-    // firstLine: the line number of text's first character in the file.
-    explicit TextCursor(std::string_view text, size_t firstLine = 1)
+    // A whole file: a leading UTF-8 byte order mark is skipped (offsets stay
+    // offsets into file).
+    explicit TextCursor(std::string_view file) : m_text(file), m_pos(bomLength(file)) {}
+
+    // A part of a file; firstLine: the line number of text's first character.
+    TextCursor(std::string_view text, size_t firstLine)
         : m_text(text), m_nextLine(firstLine), m_line(firstLine) {}
 
-    // Next line without its terminator ("\n" or "\r\n"); false at the end.
+    // Next line without its terminator ("\n", "\r\n" or "\r"); false at the end.
     bool nextLine(std::string_view& line) {
         if (m_pos >= m_text.size()) return false;
-        const size_t nl = m_text.find('\n', m_pos);
-        const size_t end = nl == std::string_view::npos ? m_text.size() : nl;
+        const size_t end = std::min(m_text.find_first_of("\r\n", m_pos), m_text.size());
         line = m_text.substr(m_pos, end - m_pos);
-        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-        m_pos = nl == std::string_view::npos ? m_text.size() : nl + 1;
+        m_pos = end;
+        skipLineEnd();
         m_line = m_nextLine++;
         return true;
     }
@@ -56,8 +69,12 @@ public:
     // Next blank-separated token; empty at the end of the text.
     std::string_view nextToken() {
         while (m_pos < m_text.size() && isBlank(m_text[m_pos])) {
-            if (m_text[m_pos] == '\n') ++m_nextLine;
-            ++m_pos;
+            if (m_text[m_pos] == '\n' || m_text[m_pos] == '\r') {
+                skipLineEnd();
+                ++m_nextLine;
+            } else {
+                ++m_pos;
+            }
         }
         const size_t start = m_pos;
         while (m_pos < m_text.size() && !isBlank(m_text[m_pos])) ++m_pos;
@@ -71,10 +88,21 @@ public:
     [[nodiscard]] size_t remaining() const { return m_text.size() - m_pos; }
 
 private:
+    // At a line end (or the end of the text): steps over "\r\n", "\r" or "\n".
+    void skipLineEnd() {
+        if (m_pos >= m_text.size()) return;
+        if (m_text[m_pos] == '\r') {
+            ++m_pos;
+            if (m_pos < m_text.size() && m_text[m_pos] == '\n') ++m_pos;
+        } else if (m_text[m_pos] == '\n') {
+            ++m_pos;
+        }
+    }
+
     std::string_view m_text;
     size_t m_pos = 0;
-    size_t m_nextLine;
-    size_t m_line;
+    size_t m_nextLine = 1;
+    size_t m_line = 1;
 };
 
 }  // namespace rthdist::io

@@ -93,5 +93,56 @@ TEST_F(TextFormats, OffBadInput) {
     EXPECT_TRUE(isBadInput(loadPoints(inf), inf, "vertex 0: coordinate z"));
 }
 
+// ---- hardening (issue 15): byte order marks and CR-only line ends ------------
+
+TEST_F(TextFormats, Utf8BomBeforeTheFirstObjVertex) {
+    // The BOM glued to "v" used to drop the first vertex silently.
+    auto r = loadPoints(write("bom.obj", "\xEF\xBB\xBFv 1.5 -2.25 3\nv 0 0.001 -7.5\nv 100 200.5 -300.25\n"));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, threePoints());
+}
+
+TEST_F(TextFormats, Utf8BomInXyzOffAndPcd) {
+    // The BOM used to be reported as part of a number ("'\xEF\xBB\xBF1' is not a number").
+    const std::string bom = "\xEF\xBB\xBF";
+    auto xyz = loadPoints(write("bom.xyz", bom + "1 2 3\n4 5 6\n"));
+    ASSERT_TRUE(xyz.ok()) << xyz.error().message;
+    EXPECT_EQ(*xyz, (std::vector<glm::vec3>{{1, 2, 3}, {4, 5, 6}}));
+    auto off = loadPoints(write("bom.off", bom + "OFF\n1 0 0\n1 2 3\n"));
+    ASSERT_TRUE(off.ok()) << off.error().message;
+    EXPECT_EQ(*off, (std::vector<glm::vec3>{{1, 2, 3}}));
+    auto pcd =
+        loadPoints(write("bom.pcd", bom + "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                                          "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n"));
+    ASSERT_TRUE(pcd.ok()) << pcd.error().message;
+    EXPECT_EQ(*pcd, (std::vector<glm::vec3>{{1, 2, 3}}));
+}
+
+TEST_F(TextFormats, CrOnlyLineEndsReadEveryPoint) {
+    // Lone CR line ends used to make one line of the file: 1 point of 3.
+    const std::vector<glm::vec3> want = {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}};
+    auto obj = loadPoints(write("cr.obj", "v 1 2 3\rv 4 5 6\rv 7 8 9\r"));
+    ASSERT_TRUE(obj.ok()) << obj.error().message;
+    EXPECT_EQ(*obj, want);
+    auto xyz = loadPoints(write("cr.xyz", "1 2 3\r4 5 6\r7 8 9\r"));
+    ASSERT_TRUE(xyz.ok()) << xyz.error().message;
+    EXPECT_EQ(*xyz, want);
+    auto off = loadPoints(write("cr.off", "OFF\r3 0 0\r1 2 3\r4 5 6\r7 8 9\r"));
+    ASSERT_TRUE(off.ok()) << off.error().message;
+    EXPECT_EQ(*off, want);
+    auto pcd = loadPoints(write("cr.pcd",
+                                "FIELDS x y z\rSIZE 4 4 4\rTYPE F F F\rCOUNT 1 1 1\rWIDTH 3\r"
+                                "HEIGHT 1\rPOINTS 3\rDATA ascii\r1 2 3\r4 5 6\r7 8 9\r"));
+    ASSERT_TRUE(pcd.ok()) << pcd.error().message;
+    EXPECT_EQ(*pcd, want);
+}
+
+TEST_F(TextFormats, CrOnlyLineNumbersInMessages) {
+    const std::string path = write("crbad.xyz", "1 2 3\r4 5 6\r7 x 9\r");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 3: 'x' is not a number"));
+    const std::string mixed = write("mixed.obj", "v 1 2 3\r\nv 4 5 6\rv 7 8 9\nv 1 y 1\n");
+    EXPECT_TRUE(isBadInput(loadPoints(mixed), mixed, "line 4: 'y' is not a number"));
+}
+
 }  // namespace
 }  // namespace rthdist::io::test
