@@ -123,7 +123,14 @@ Result<PlyHeader> parseHeader(std::string_view bytes, const std::string& path) {
                                     "unsupported property type '" + std::string(tok[1]) + "'");
                 prop = PlyProperty{std::string(tok[2]), *type, false, ScalarType::kUInt8};
             }
-            header.elements.back().properties.push_back(std::move(prop));
+            PlyElement& element = header.elements.back();
+            for (const PlyProperty& seen : element.properties) {
+                if (seen.name == prop.name) {
+                    return badInput(path, lineWhere(lineNo),
+                                    "property '" + prop.name + "' declared twice in element " + element.name);
+                }
+            }
+            element.properties.push_back(std::move(prop));
             continue;
         }
         return badInput(path, lineWhere(lineNo), "unknown header keyword '" + std::string(key) + "'");
@@ -163,15 +170,25 @@ public:
     BinaryBody(std::string_view bytes, size_t offset, bool bigEndian, const std::string& path)
         : m_bytes(bytes), m_pos(offset), m_bigEndian(bigEndian), m_path(path) {}
 
-    // Rejects a count the remaining bytes cannot hold, before any allocation.
-    std::optional<Error> checkCount(const PlyElement& e) const {
-        const uint64_t minSize = e.minBinaryItemSize();
+    // Rejects elements[first, last) whose fixed-size parts alone (lists
+    // counted empty) need more bytes than remain: before any allocation, and
+    // so that a vertex count that is too high cannot take the bytes of the
+    // elements after it.
+    std::optional<Error> checkFit(const std::vector<PlyElement>& elements, size_t first, size_t last) const {
         const uint64_t left = m_bytes.size() - m_pos;
-        if (minSize != 0 && e.count > left / minSize) {
-            return badInput(m_path, offsetWhere(m_pos),
-                            "element " + e.name + " declares " + std::to_string(e.count) +
-                                " items of at least " + std::to_string(minSize) + " bytes, but only " +
-                                std::to_string(left) + " bytes remain (truncated body or wrong count)");
+        uint64_t need = 0;
+        for (size_t ei = first; ei < last; ++ei) {
+            const PlyElement& e = elements[ei];
+            const uint64_t minSize = e.minBinaryItemSize();
+            if (minSize == 0) continue;
+            if (e.count > (left - need) / minSize) {
+                return badInput(m_path, offsetWhere(m_pos),
+                                "element " + e.name + " declares " + std::to_string(e.count) +
+                                    " items of at least " + std::to_string(minSize) + " bytes, but only " +
+                                    std::to_string(left - need) + " of the " + std::to_string(left) +
+                                    " remaining bytes are left for it (truncated body or wrong count)");
+            }
+            need += e.count * minSize;
         }
         return std::nullopt;
     }
@@ -201,10 +218,31 @@ public:
                     "element " + e.name + " item " + std::to_string(index) + ": negative list length");
             }
             m_pos += countSize;
-            const uint64_t skip =
-                static_cast<uint64_t>(count) * scalarSize(p.type);  // count < 2^32: no overflow
-            if (m_bytes.size() - m_pos < skip) return truncated(e, index);
-            m_pos += skip;
+            // Compared as double first: a uint64 length may not fit size_t arithmetic.
+            const size_t itemSize = scalarSize(p.type);
+            if (count > static_cast<double>((m_bytes.size() - m_pos) / itemSize)) return truncated(e, index);
+            m_pos += static_cast<size_t>(count) * itemSize;
+        }
+        return std::nullopt;
+    }
+
+    std::optional<Error> skipElement(const PlyElement& e) {
+        if (e.properties.empty()) return std::nullopt;
+        for (uint64_t k = 0; k < e.count; ++k) {
+            if (auto err = item(e, k, nullptr, nullptr)) return err;
+        }
+        return std::nullopt;
+    }
+
+    // After the last element only padding (blanks, NUL bytes) may follow;
+    // anything else means a count or a list length did not match the data.
+    std::optional<Error> checkEnd() const {
+        for (size_t i = m_pos; i < m_bytes.size(); ++i) {
+            if (m_bytes[i] != '\0' && !isBlank(m_bytes[i])) {
+                return badInput(m_path, offsetWhere(m_pos),
+                                std::to_string(m_bytes.size() - m_pos) +
+                                    " bytes follow the last declared element (wrong count or list length)");
+            }
         }
         return std::nullopt;
     }
@@ -228,98 +266,157 @@ Result<std::vector<glm::vec3>> readBinaryBody(std::string_view bytes, const PlyH
                                               const std::string& path) {
     BinaryBody body(bytes, header.bodyOffset, header.format == PlyFormat::kBinaryBigEndian, path);
     for (size_t ei = 0; ei < vertexElement; ++ei) {
-        const PlyElement& e = header.elements[ei];
-        if (auto err = body.checkCount(e)) return *err;
-        if (e.properties.empty()) continue;
-        for (uint64_t k = 0; k < e.count; ++k) {
-            if (auto err = body.item(e, k, nullptr, nullptr)) return *err;
-        }
+        if (auto err = body.checkFit(header.elements, ei, ei + 1)) return *err;
+        if (auto err = body.skipElement(header.elements[ei])) return *err;
     }
+    if (auto err = body.checkFit(header.elements, vertexElement, header.elements.size())) return *err;
     const PlyElement& vertex = header.elements[vertexElement];
-    if (auto err = body.checkCount(vertex)) return *err;
     std::vector<glm::vec3> points(static_cast<size_t>(vertex.count));
     double v[3] = {0, 0, 0};
     for (uint64_t k = 0; k < vertex.count; ++k) {
         if (auto err = body.item(vertex, k, &xyz, v)) return *err;
         points[k] = glm::vec3(narrowToFloat(v[0]), narrowToFloat(v[1]), narrowToFloat(v[2]));
     }
+    for (size_t ei = vertexElement + 1; ei < header.elements.size(); ++ei) {
+        if (auto err = body.skipElement(header.elements[ei])) return *err;
+    }
+    if (auto err = body.checkEnd()) return *err;
     return points;
 }
 
 // ---- ascii bodies ----------------------------------------------------------
 
-Result<std::vector<glm::vec3>> readAsciiBody(std::string_view bytes, const PlyHeader& header,
-                                             size_t vertexElement, const XyzIndex& xyz,
-                                             const std::string& path) {
-    TextCursor cursor(bytes.substr(header.bodyOffset), header.bodyLine);
-    auto endOfFile = [&](const PlyElement& e, uint64_t index) {
-        return badInput(path, lineWhere(cursor.line()),
-                        "file ends inside element " + e.name + " item " + std::to_string(index) + " (" +
-                            std::to_string(e.count) + " declared)");
-    };
-    // Reads a list length token; on failure returns an error.
-    auto listLength = [&](const PlyElement& e, uint64_t index, uint64_t& count) -> std::optional<Error> {
-        const std::string_view tok = cursor.nextToken();
-        if (tok.empty()) return endOfFile(e, index);
-        if (!parseUInt(tok, count)) {
-            return badInput(path, lineWhere(cursor.line()),
-                            "element " + e.name + " item " + std::to_string(index) + ": bad list length '" +
-                                std::string(tok) + "'");
+// An ascii body holds one item per line (Turk: "each element on its own
+// line"), so a wrong count or a stray value cannot shift later items.
+class AsciiBody {
+public:
+    AsciiBody(std::string_view bytes, const PlyHeader& header, const std::string& path)
+        : m_cursor(bytes.substr(header.bodyOffset), header.bodyLine), m_path(path) {}
+
+    // Every declared item with properties needs its own non-blank line:
+    // checked for all elements (also those after the vertex element) before
+    // anything is allocated.
+    std::optional<Error> checkFit(const std::vector<PlyElement>& elements) const {
+        TextCursor counter = m_cursor;
+        uint64_t lines = 0;
+        std::string_view line;
+        while (counter.nextLine(line)) {
+            if (!trimBlank(line).empty()) ++lines;
+        }
+        uint64_t need = 0;
+        for (const PlyElement& e : elements) {
+            if (e.properties.empty()) continue;
+            if (e.count > lines - need) {
+                return badInput(m_path, "element " + e.name,
+                                "declares " + std::to_string(e.count) + " items (one per line), but only " +
+                                    std::to_string(lines - need) + " of the " + std::to_string(lines) +
+                                    " non-blank body lines are left for it (truncated body or wrong count)");
+            }
+            need += e.count;
         }
         return std::nullopt;
-    };
+    }
 
-    for (size_t ei = 0; ei < vertexElement; ++ei) {
-        const PlyElement& e = header.elements[ei];
-        if (e.properties.empty()) continue;
-        for (uint64_t k = 0; k < e.count; ++k) {
-            for (const PlyProperty& p : e.properties) {
-                uint64_t tokens = 1;
-                if (p.isList) {
-                    if (auto err = listLength(e, k, tokens)) return *err;
-                }
-                for (uint64_t t = 0; t < tokens; ++t) {
-                    if (cursor.nextToken().empty()) return endOfFile(e, k);
-                }
+    // Reads item `index` of e from its line; for the vertex element,
+    // values[axis] receives x/y/z.
+    std::optional<Error> item(const PlyElement& e, uint64_t index, const XyzIndex* xyz, float* values) {
+        std::string_view line;
+        do {
+            if (!m_cursor.nextLine(line)) {
+                return badInput(m_path, lineWhere(m_cursor.line()),
+                                "file ends before element " + e.name + " item " + std::to_string(index));
             }
-        }
-    }
-
-    const PlyElement& vertex = header.elements[vertexElement];
-    // Every property takes at least one character and one separator.
-    const uint64_t minItemChars = 2 * vertex.properties.size();
-    if (vertex.count > (cursor.remaining() + 1) / minItemChars) {
-        return badInput(path, "element vertex",
-                        "declares " + std::to_string(vertex.count) + " vertices but only " +
-                            std::to_string(cursor.remaining()) +
-                            " bytes remain (truncated body or wrong count)");
-    }
-    std::vector<glm::vec3> points(static_cast<size_t>(vertex.count));
-    for (uint64_t k = 0; k < vertex.count; ++k) {
-        float v[3] = {0, 0, 0};
-        for (size_t i = 0; i < vertex.properties.size(); ++i) {
-            const PlyProperty& p = vertex.properties[i];
+        } while (trimBlank(line).empty());
+        TextCursor tokens(line, m_cursor.line());
+        auto itemWhere = [&] { return "element " + e.name + " item " + std::to_string(index); };
+        size_t found = 0;
+        auto next = [&](std::string_view& tok) -> std::optional<Error> {
+            tok = tokens.nextToken();
+            if (tok.empty()) {
+                return badInput(m_path, lineWhere(m_cursor.line()),
+                                itemWhere() + ": the line ends after " + std::to_string(found) +
+                                    " values, the properties need more (one item per line)");
+            }
+            ++found;
+            return std::nullopt;
+        };
+        for (size_t i = 0; i < e.properties.size(); ++i) {
+            const PlyProperty& p = e.properties[i];
+            std::string_view tok;
+            if (auto err = next(tok)) return err;
             if (p.isList) {
-                uint64_t tokens = 0;
-                if (auto err = listLength(vertex, k, tokens)) return *err;
-                for (uint64_t t = 0; t < tokens; ++t) {
-                    if (cursor.nextToken().empty()) return endOfFile(vertex, k);
+                uint64_t length = 0;
+                if (!parseUInt(tok, length)) {
+                    return badInput(m_path, lineWhere(m_cursor.line()),
+                                    itemWhere() + ": bad list length '" + std::string(tok) + "'");
+                }
+                for (uint64_t t = 0; t < length; ++t) {
+                    if (auto err = next(tok)) return err;
                 }
                 continue;
             }
-            const std::string_view tok = cursor.nextToken();
-            if (tok.empty()) return endOfFile(vertex, k);
+            if (xyz == nullptr) continue;
             for (size_t axis = 0; axis < 3; ++axis) {
-                if (xyz.prop[axis] != i) continue;
-                if (!parseFloat(tok, v[axis])) {
+                if (xyz->prop[axis] != i) continue;
+                if (!parseFloat(tok, values[axis])) {
                     return badInput(
-                        path, lineWhere(cursor.line()),
-                        "vertex " + std::to_string(k) + " property " + p.name + ": " + notANumber(tok));
+                        m_path, lineWhere(m_cursor.line()),
+                        "vertex " + std::to_string(index) + " property " + p.name + ": " + notANumber(tok));
                 }
             }
         }
+        if (!tokens.nextToken().empty()) {
+            return badInput(m_path, lineWhere(m_cursor.line()),
+                            itemWhere() + ": more values than its " + std::to_string(found) +
+                                " declared ones (one item per line)");
+        }
+        return std::nullopt;
+    }
+
+    std::optional<Error> skipElement(const PlyElement& e) {
+        if (e.properties.empty()) return std::nullopt;
+        for (uint64_t k = 0; k < e.count; ++k) {
+            if (auto err = item(e, k, nullptr, nullptr)) return err;
+        }
+        return std::nullopt;
+    }
+
+    // After the last element only blank lines may follow.
+    std::optional<Error> checkEnd() {
+        std::string_view line;
+        while (m_cursor.nextLine(line)) {
+            if (!trimBlank(line).empty()) {
+                return badInput(m_path, lineWhere(m_cursor.line()),
+                                "text after the last declared element (wrong count)");
+            }
+        }
+        return std::nullopt;
+    }
+
+private:
+    TextCursor m_cursor;
+    const std::string& m_path;
+};
+
+Result<std::vector<glm::vec3>> readAsciiBody(std::string_view bytes, const PlyHeader& header,
+                                             size_t vertexElement, const XyzIndex& xyz,
+                                             const std::string& path) {
+    AsciiBody body(bytes, header, path);
+    if (auto err = body.checkFit(header.elements)) return *err;
+    for (size_t ei = 0; ei < vertexElement; ++ei) {
+        if (auto err = body.skipElement(header.elements[ei])) return *err;
+    }
+    const PlyElement& vertex = header.elements[vertexElement];
+    std::vector<glm::vec3> points(static_cast<size_t>(vertex.count));
+    for (uint64_t k = 0; k < vertex.count; ++k) {
+        float v[3] = {0, 0, 0};
+        if (auto err = body.item(vertex, k, &xyz, v)) return *err;
         points[k] = glm::vec3(v[0], v[1], v[2]);
     }
+    for (size_t ei = vertexElement + 1; ei < header.elements.size(); ++ei) {
+        if (auto err = body.skipElement(header.elements[ei])) return *err;
+    }
+    if (auto err = body.checkEnd()) return *err;
     return points;
 }
 

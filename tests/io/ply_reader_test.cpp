@@ -51,14 +51,14 @@ TEST_F(PlyReader, AsciiPropertyOrderAndVertexList) {
 
 TEST_F(PlyReader, AsciiElementsBeforeVertexAreSkipped) {
     // range_grid as in the Stanford range scans, but placed before the vertices;
-    // items spread over lines in any way the token stream allows.
+    // one item per line.
     const std::string text =
         header("ascii",
                "element range_grid 4\nproperty list uchar int vertex_indices\n"
                "element face 2\nproperty list uchar int vertex_indices\nproperty uchar flags\n"
                "element vertex 2\n" +
                    kXyzFloat) +
-        "0\n1 0\n0\n2 0 1\n3 0 1 1 7\n3 1 0 1\n8\n1 2 3\n4 5 6\n";
+        "0\n1 0\n0\n2 0 1\n3 0 1 1 7\n3 1 0 1 8\n1 2 3\n4 5 6\n";
     auto r = loadPoints(write("before.ply", text));
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(*r, (std::vector<glm::vec3>{{1, 2, 3}, {4, 5, 6}}));
@@ -283,7 +283,120 @@ TEST_F(PlyReader, NonNumericAsciiNamesLine) {
 TEST_F(PlyReader, AsciiBodyEndsEarly) {
     const std::string path = write(
         "short.ply", header("ascii", "element vertex 3\n" + kXyzFloat) + "1 2 3\n4 5 6\n7 8            ");
-    EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 10: file ends inside element vertex item 2"));
+    EXPECT_TRUE(
+        isBadInput(loadPoints(path), path, "line 10: element vertex item 2: the line ends after 2 values"));
+}
+
+// ---- hardening (issue 15): counts that do not match the body ---------------
+
+TEST_F(PlyReader, AsciiVertexCountOneTooHighDoesNotReadTheFace) {
+    // Read token by token, "3 0 1 2" became vertex (3, 0, 1).
+    const std::string text = header("ascii", "element vertex 4\n" + kXyzFloat +
+                                                 "element face 1\nproperty list uchar int vertex_indices\n") +
+                             "1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n";
+    const std::string path = write("count_high.ply", text);
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "element face: declares 1 items (one per line)"));
+    // Same with a face line of exactly three values.
+    const std::string three = write("count_high3.ply", header("ascii", "element vertex 3\n" + kXyzFloat +
+                                                                           "element face 1\nproperty list "
+                                                                           "uchar int vertex_indices\n") +
+                                                           "1 2 3\n4 5 6\n2 0 1\n");
+    EXPECT_TRUE(isBadInput(loadPoints(three), three, "element face"));
+}
+
+TEST_F(PlyReader, AsciiExtraValueOnAVertexLineIsAnError) {
+    // Read token by token, the stray 9 shifted every later vertex.
+    const std::string path =
+        write("extra.ply", header("ascii", "element vertex 2\n" + kXyzFloat) + "1 2 3 9\n4 5 6\n7 8 9\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 8: element vertex item 0: more values"));
+}
+
+TEST_F(PlyReader, AsciiTextAfterTheLastElementIsAnError) {
+    const std::string path =
+        write("low.ply", header("ascii", "element vertex 2\n" + kXyzFloat) + "1 2 3\n4 5 6\n7 8 9\n\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 10: text after the last declared element"));
+}
+
+TEST_F(PlyReader, BinaryVertexCountTooHighDoesNotReadFaceBytes) {
+    // 15-byte vertices (x y z float, r g b uchar) and two triangles: a count
+    // one too high took the first face and 2 bytes of the second as a vertex.
+    ByteBuilder b;
+    b.text(
+        header("binary_little_endian", "element vertex 4\n" + kXyzFloat +
+                                           "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                                           "element face 2\nproperty list uchar int vertex_indices\n"));
+    for (const glm::vec3& p : threePoints())
+        b.put(p.x).put(p.y).put(p.z).put<uint8_t>(1).put<uint8_t>(2).put<uint8_t>(3);
+    b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2);
+    b.put<uint8_t>(3).put<int32_t>(2).put<int32_t>(1).put<int32_t>(0);
+    const std::string path = write("count_high_bin.ply", b.str());
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "byte offset"));
+}
+
+TEST_F(PlyReader, BinaryCountTooHighForTheElementsAfterTheVertices) {
+    // The vertices fit; the face element after them cannot.
+    ByteBuilder b;
+    b.text(header("binary_little_endian", "element vertex 4\n" + kXyzFloat +
+                                              "element face 3\nproperty list uchar int vertex_indices\n"));
+    for (int i = 0; i < 4; ++i) b.put(1.0f).put(2.0f).put(3.0f);
+    b.put<uint8_t>(0);
+    const std::string path = write("faces_missing.ply", b.str());
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "element face declares 3 items"));
+}
+
+TEST_F(PlyReader, BinaryBytesAfterTheLastElementAreAnError) {
+    ByteBuilder b;
+    b.text(header("binary_little_endian", "element vertex 2\n" + kXyzFloat));
+    for (int i = 0; i < 3; ++i) b.put(1.0f).put(2.0f).put(3.0f);
+    const std::string path = write("count_low_bin.ply", b.str());
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "12 bytes follow the last declared element"));
+    // A final newline or NUL padding is tolerated.
+    ByteBuilder padded;
+    padded.text(header("binary_little_endian", "element vertex 1\n" + kXyzFloat))
+        .put(1.0f)
+        .put(2.0f)
+        .put(3.0f);
+    padded.text(std::string("\n\0\0", 3));
+    auto r = loadPoints(write("padded.ply", padded.str()));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->size(), 1u);
+}
+
+TEST_F(PlyReader, PropertyDeclaredTwiceIsAnError) {
+    // The last declaration used to win.
+    const std::string path = write(
+        "twice.ply", header("ascii", "element vertex 1\n" + kXyzFloat + "property float x\n") + "1 2 3 4\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 7: property 'x' declared twice in element vertex"));
+}
+
+TEST_F(PlyReader, Utf8BomBeforeTheHeader) {
+    const std::string text = "\xEF\xBB\xBF" + header("ascii", "element vertex 1\n" + kXyzFloat) + "1 2 3\n";
+    auto r = loadPoints(write("bom.ply", text));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, (std::vector<glm::vec3>{{1, 2, 3}}));
+    ByteBuilder b;
+    b.text("\xEF\xBB\xBF" + header("binary_little_endian", "element vertex 1\n" + kXyzFloat));
+    b.put(1.0f).put(2.0f).put(3.0f);
+    auto bin = loadPoints(write("bom_bin.ply", b.str()));
+    ASSERT_TRUE(bin.ok()) << bin.error().message;
+    EXPECT_EQ(*bin, (std::vector<glm::vec3>{{1, 2, 3}}));
+}
+
+TEST_F(PlyReader, CrOnlyLineEnds) {
+    const std::string text =
+        "ply\rformat ascii 1.0\relement vertex 2\rproperty float x\rproperty float y\rproperty float z\r"
+        "end_header\r1 2 3\r4 5 6\r";
+    auto r = loadPoints(write("cr.ply", text));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, (std::vector<glm::vec3>{{1, 2, 3}, {4, 5, 6}}));
+    ByteBuilder b;
+    b.text(
+        "ply\rformat binary_little_endian 1.0\relement vertex 1\rproperty float x\rproperty float y\r"
+        "property float z\rend_header\r");
+    b.put(1.0f).put(2.0f).put(0.01f);  // 0.01f has a 0x0A (LF) byte
+    auto bin = loadPoints(write("cr_bin.ply", b.str()));
+    ASSERT_TRUE(bin.ok()) << bin.error().message;
+    EXPECT_EQ(*bin, (std::vector<glm::vec3>{{1, 2, 0.01f}}));
 }
 
 }  // namespace
