@@ -48,22 +48,27 @@ Result<std::vector<glm::vec3>> readAscii(std::string_view bytes, const std::stri
 }  // namespace
 
 Result<std::vector<glm::vec3>> readStl(std::string_view bytes, const std::string& path) {
-    // Many binary STLs also start with "solid", so the size decides first.
+    // Many binary STLs also start with "solid", so the size decides first;
+    // then a NUL byte (binary STLs have them in every attribute word, text
+    // never) tells a binary STL of the wrong size from an ascii one.
+    const bool solid = trimBlank(bytes.substr(bomLength(bytes), 64)).starts_with("solid");
+    const bool text = solid && bytes.find('\0') == std::string_view::npos;
     if (bytes.size() >= kHeaderSize + 4) {
         const uint64_t facets =
             static_cast<uint64_t>(loadScalar(bytes.data() + kHeaderSize, ScalarType::kUInt32, false));
         const uint64_t need = kHeaderSize + 4 + facets * kFacetSize;
         if (bytes.size() == need) return readBinary(bytes, facets);
-        if (!trimBlank(bytes.substr(0, 64)).starts_with("solid")) {
+        if (!text) {
             if (bytes.size() < need) {
-                return badInput(path, offsetWhere(kHeaderSize),
-                                "binary STL declares " + std::to_string(facets) + " facets (" +
-                                    std::to_string(need) + " bytes) but the file has " +
-                                    std::to_string(bytes.size()) + " bytes");
+                return badInput(
+                    path, offsetWhere(kHeaderSize),
+                    "binary STL declares " + std::to_string(facets) + " facets (" + std::to_string(need) +
+                        " bytes) but the file has " + std::to_string(bytes.size()) + " bytes" +
+                        (solid ? " (its header starts with 'solid', but the file is not text)" : ""));
             }
             return readBinary(bytes, facets);  // trailing bytes after the facets are ignored
         }
-    } else if (!trimBlank(bytes.substr(0, 64)).starts_with("solid")) {
+    } else if (!solid) {
         return badInput(path, offsetWhere(0), "neither ascii STL ('solid') nor a complete binary STL header");
     }
     return readAscii(bytes, path);

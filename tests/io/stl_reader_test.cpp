@@ -70,5 +70,33 @@ TEST_F(StlReader, BinaryNanNamesVertex) {
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "vertex 2: coordinate x is infinite"));
 }
 
+// ---- hardening (issue 15) ----------------------------------------------------
+
+TEST_F(StlReader, BinaryWithSolidHeaderAndWrongSizeSaysBinary) {
+    // Used to go down the ascii path and report "contains no points".
+    const std::string path = write("solid_short.stl", binaryStl("solid exported", threePoints(), 2));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "byte offset 80: binary STL declares 2 facets"));
+}
+
+TEST_F(StlReader, BinaryWithSolidHeaderAndTrailingBytes) {
+    // Trailing bytes are ignored for binary STL, whatever the header says.
+    const std::string path =
+        write("solid_tail.stl", binaryStl("solid exported", threePoints(), 1) + std::string(7, '\0'));
+    auto r = loadPoints(path);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, threePoints());
+}
+
+TEST_F(StlReader, AsciiWithBomAndCrOnlyLineEnds) {
+    const std::string text =
+        "\xEF\xBB\xBFsolid t\r facet normal 0 0 1\r  outer loop\r   vertex 1.5 -2.25 3\r"
+        "   vertex 0 0.001 -7.5\r   vertex 100 200.5 -300.25\r  endloop\r endfacet\rendsolid t\r";
+    auto r = loadPoints(write("bom.stl", text));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, threePoints());
+    const std::string bad = write("crbad.stl", "solid t\rfacet normal 0 0 1\router loop\rvertex 1 q 3\r");
+    EXPECT_TRUE(isBadInput(loadPoints(bad), bad, "line 4: 'q' is not a number"));
+}
+
 }  // namespace
 }  // namespace rthdist::io::test
