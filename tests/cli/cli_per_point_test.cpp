@@ -169,9 +169,10 @@ TEST_F(CliPerPoint, PngFiles) {
     expectPng(path("h.png"), 1000, 560);
 }
 
+// Output failures are exit 5, not 3 (bad input); cli_output_test has the rest.
 TEST_F(CliPerPoint, UnwritableOutputIsAnError) {
     const CliRun run = runCli({"--backend", "cpu", "--out-csv", path("missing-dir/d"), m_a, m_b});
-    EXPECT_EQ(run.exitCode, 3) << run;
+    EXPECT_EQ(run.exitCode, 5) << run;
     EXPECT_NE(run.err.find("missing-dir/d_a.csv"), std::string::npos) << run;
 }
 

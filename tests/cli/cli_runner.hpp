@@ -84,11 +84,14 @@ inline std::ostream& operator<<(std::ostream& os, const CliRun& r) {
     return os << "exit " << r.exitCode << "\n--- stdout ---\n" << r.out << "--- stderr ---\n" << r.err;
 }
 
-inline CliRun runCli(const std::vector<std::string>& args) {
+// `shellPrefix` runs in the same /bin/sh before the CLI (e.g. "ulimit -f 8;");
+// `wrapper` is a command that runs the CLI (e.g. "timeout -s TERM 2").
+inline CliRun runCli(const std::vector<std::string>& args, const std::string& shellPrefix = "",
+                     const std::string& wrapper = "") {
     static int counter = 0;
     static const TempDir errDir;
     const std::string errPath = (errDir.path() / ("stderr-" + std::to_string(counter++))).string();
-    std::string command = shellQuote(kCli);
+    std::string command = shellPrefix + " exec " + wrapper + " " + shellQuote(kCli);
     for (const std::string& a : args) command += " " + shellQuote(a);
     command += " 2>" + shellQuote(errPath) + " </dev/null";
 

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "cli/output_file.hpp"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
@@ -86,10 +89,16 @@ int Image::textWidth(const std::string& text, int scale) {
 }
 
 Result<bool> Image::writePng(const std::string& path) const {
-    if (stbi_write_png(path.c_str(), m_width, m_height, 3, m_rgb.data(), m_width * 3) == 0) {
-        return Error{ErrorCode::kBadInput, path + ": cannot write PNG"};
+    // Encoded in memory, then written through writeOutputFile (temporary
+    // file, fsync, rename): stb's own file writer ignores fclose's result.
+    std::string png;
+    auto append = [](void* context, void* data, int size) {
+        static_cast<std::string*>(context)->append(static_cast<const char*>(data), size_t(size));
+    };
+    if (stbi_write_png_to_func(append, &png, m_width, m_height, 3, m_rgb.data(), m_width * 3) == 0) {
+        return Error{ErrorCode::kInternal, "cannot write output '" + path + "': PNG encoding failed"};
     }
-    return true;
+    return writeOutputFile(path, png);
 }
 
 }  // namespace rthdist::cli

@@ -29,7 +29,8 @@ public:
     void drawText(int x, int y, const std::string& text, Rgb c, int scale = 2);
     [[nodiscard]] static int textWidth(const std::string& text, int scale = 2);
 
-    // Writes an 8-bit RGB PNG; kBadInput naming the path when it cannot.
+    // Writes an 8-bit RGB PNG through writeOutputFile (cli/output_file.hpp):
+    // an Error naming the path and the reason when it cannot.
     [[nodiscard]] Result<bool> writePng(const std::string& path) const;
 
 private:

@@ -97,7 +97,7 @@ int run(const std::vector<std::string>& argv) {
         meter.update("output", 0.0);
         Result<bool> written = writePerPointOutputs(args, *a, *b, *result, *stats);
         meter.finish();
-        if (!written) return failWith(written.error());
+        if (!written) return fail(kExitOutput, written.error().message);
     }
 
     std::optional<Verification> verification;

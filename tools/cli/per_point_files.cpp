@@ -1,29 +1,14 @@
 #include "cli/per_point_files.hpp"
 
 #include <charconv>
-#include <cstdio>
 #include <cstring>
-#include <memory>
 #include <string>
 #include <vector>
 
+#include "cli/output_file.hpp"
+
 namespace rthdist::cli {
 namespace {
-
-struct FileCloser {
-    void operator()(std::FILE* f) const { std::fclose(f); }
-};
-using File = std::unique_ptr<std::FILE, FileCloser>;
-
-Error cannotWrite(const std::string& path) { return Error{ErrorCode::kBadInput, path + ": cannot write"}; }
-
-Result<bool> writeAll(const std::string& path, const std::string& bytes) {
-    File f(std::fopen(path.c_str(), "wb"));
-    if (!f) return cannotWrite(path);
-    if (std::fwrite(bytes.data(), 1, bytes.size(), f.get()) != bytes.size()) return cannotWrite(path);
-    if (std::fclose(f.release()) != 0) return cannotWrite(path);
-    return true;
-}
 
 template <class T>
 void appendNumber(std::string& out, T v) {
@@ -65,7 +50,7 @@ Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3
         out.push_back(char(c.g));
         out.push_back(char(c.b));
     }
-    return writeAll(path, out);
+    return writeOutputFile(path, out);
 }
 
 Result<bool> writeDistanceCsv(const std::string& path, std::span<const glm::vec3> points,
@@ -87,7 +72,7 @@ Result<bool> writeDistanceCsv(const std::string& path, std::span<const glm::vec3
         appendNumber(out, uint64_t(nearest.nearest[i]));
         out.push_back('\n');
     }
-    return writeAll(path, out);
+    return writeOutputFile(path, out);
 }
 
 }  // namespace rthdist::cli

@@ -1,4 +1,6 @@
-// Per-point distance files of the CLI (--out-ply, --out-csv).
+// Per-point distance files of the CLI (--out-ply, --out-csv), written through
+// writeOutputFile (cli/output_file.hpp): complete under their final name or
+// not replaced at all.
 //
 // PLY: binary_little_endian 1.0, one `vertex` element per input point, in input
 //   order: float x, y, z (the input floats), float quality (the exact NN

@@ -17,6 +17,10 @@ namespace rthdist::cli {
 // Statistics options from the command line (95 always among the percentiles).
 [[nodiscard]] StatsOptions statsOptionsFrom(const CliArgs& args);
 
+// Every file goes through writeOutputFile (cli/output_file.hpp); each Error
+// is an output that could not be written, its message naming the file and the
+// reason, and the CLI exits kExitOutput with it. Files written before the
+// failing one stay written.
 [[nodiscard]] Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3> a,
                                                 std::span<const glm::vec3> b, const HausdorffResult& result,
                                                 const HausdorffStats& stats);
