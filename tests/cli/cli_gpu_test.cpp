@@ -143,6 +143,24 @@ TEST_P(CliGpu, ValidationLayerIsSilent) {
     EXPECT_EQ(j["validation_messages"].get<uint64_t>(), 0u) << run.err;
 }
 
+// The smallest accepted --radius-growth (1.1, README) converges where the
+// radius must grow across many orders of magnitude: B is a sphere of radius
+// 1e-3 (tiny cells) 100 away from A (over 100 radii at 1.1). Before the
+// documented range, 1.001 was accepted and the search gave up after 4096.
+TEST_P(CliGpu, SmallestRadiusGrowthConverges) {
+    TempDir dir;
+    Points tiny = spherePoints(400, 21);
+    for (auto& p : tiny) {
+        for (float& c : p) c *= 1e-3f;
+    }
+    const std::string a = dir.write("a.xyz", xyzText(spherePoints(400, 22)));
+    const std::string b = dir.write("b.xyz", xyzText(translated(tiny, 100.0f)));
+    const Json j = runVerified({"--radius-growth", "1.1", a, b});
+    if (j.is_null()) return;
+    EXPECT_GT(j["hausdorff"].get<double>(), 98.0);
+    EXPECT_GT(j["counters"]["a_to_b"]["iterations"].get<uint64_t>(), 100u);
+}
+
 TEST_P(CliGpu, DeviceIndexOutOfRangeIsNoDevice) {
     const CliRun run = runCli({"--backend", GetParam(), "--device", "999", kSampleA, kSampleB});
     EXPECT_EQ(run.exitCode, 4) << run;

@@ -62,6 +62,87 @@ TEST_F(CliUsage, BadNumbers) {
     }
 }
 
+// Each numeric option outside its documented range (README "Usage"): exit 2,
+// the message naming the option, the value and the allowed range. Before
+// the ranges, --radius-growth 1.001 was accepted and failed after seconds
+// with "candidate search did not converge", and --bits 9 passed the CLI
+// and came back from the library as bad input (exit 3).
+TEST_F(CliUsage, OutOfRangeValuesNameTheRange) {
+    struct Case {
+        std::vector<std::string> args;
+        std::string range;
+    };
+    const std::vector<Case> cases = {
+        {{"--radius-growth", "1.001"}, "[1.1, 16]"},
+        {{"--radius-growth", "1.09"}, "[1.1, 16]"},
+        {{"--radius-growth", "16.5"}, "[1.1, 16]"},
+        {{"--radius-growth", "1e300"}, "[1.1, 16]"},
+        {{"--radius-growth=1"}, "[1.1, 16]"},
+        {{"--bits", "9"}, "[0, 8]"},
+        {{"--bits", "30"}, "[0, 8]"},
+        {{"--threads", "1025"}, "[0, 1024]"},
+        {{"--threads", "65536"}, "[0, 1024]"},
+        {{"--device", "1024"}, "[0, 1023]"},
+        {{"--histogram-bins", "0"}, "[1, 10000]"},
+        {{"--histogram-bins", "10001"}, "[1, 10000]"},
+        {{"--percentile", "100.5"}, "[0, 100]"},
+        {{"--percentile", "nan"}, "[0, 100]"},
+        {{"--range", "-1", "2"}, "0 <= MIN < MAX"},
+        {{"--range", "0", "1e999"}, "0 <= MIN < MAX"},
+        {{"--range", "1", "1"}, "0 <= MIN < MAX"},
+    };
+    for (const Case& c : cases) {
+        std::vector<std::string> args = c.args;
+        args.push_back(m_a);
+        args.push_back(m_b);
+        const std::string option = c.args[0].substr(0, c.args[0].find('='));
+        const std::string value =
+            c.args[0].find('=') != std::string::npos ? c.args[0].substr(c.args[0].find('=') + 1) : c.args[1];
+        SCOPED_TRACE(option + " " + value);
+        expectUsageError(args, option);
+        const CliRun run = runCli(args);
+        EXPECT_NE(run.err.find("'" + value + "'"), std::string::npos) << run;
+        EXPECT_NE(run.err.find(c.range), std::string::npos) << run;
+    }
+}
+
+// The ends of each documented range are accepted (the cpu backend ignores
+// --radius-growth and --device; the GPU suite runs the growth's minimum).
+TEST_F(CliUsage, RangeEndsAreAccepted) {
+    const std::vector<std::vector<std::string>> cases = {
+        {"--radius-growth", "1.1"},
+        {"--radius-growth", "16"},
+        {"--bits", "8"},
+        {"--bits", "0"},
+        {"--threads", "1024"},
+        {"--threads", "0"},
+        {"--device", "0"},
+        {"--histogram-bins", "1"},
+        {"--histogram-bins", "10000"},
+        {"--percentile", "0"},
+        {"--percentile", "100"},
+        {"--range", "0", "1e300"},
+    };
+    for (const auto& c : cases) {
+        std::vector<std::string> args = {"--backend", "cpu"};
+        args.insert(args.end(), c.begin(), c.end());
+        args.push_back(m_a);
+        args.push_back(m_b);
+        SCOPED_TRACE(c[0] + " " + c[1]);
+        const CliRun run = runCli(args);
+        EXPECT_EQ(run.exitCode, 0) << run;
+    }
+}
+
+// The help text lists the ranges and exit code 5.
+TEST(CliInfo, HelpNamesRangesAndExitCodes) {
+    const CliRun run = runCli({"--help"});
+    ASSERT_EQ(run.exitCode, 0) << run;
+    for (const char* text : {"1.1..16", "0..8", "0..1024", "1..10000", "0 <= MIN < MAX", "5 cannot write"}) {
+        EXPECT_NE(run.out.find(text), std::string::npos) << text << "\n" << run;
+    }
+}
+
 TEST(CliInfo, Help) {
     for (const char* flag : {"--help", "-h"}) {
         const CliRun run = runCli({flag});

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string_view>
 #include <vector>
@@ -12,6 +13,35 @@ namespace {
 
 Error usageError(std::string message) { return Error{ErrorCode::kInvalidArgument, std::move(message)}; }
 
+// Documented ranges of the numeric options (README "Usage", --help).
+//
+// --radius-growth: the candidate search starts at a radius of 2 cells and
+// gives up after 4096 iterations (kMaxIterations in src/algo/gpu_hausdorff.cpp),
+// so growth^4096 must cover the largest possible ratio of a nearest distance
+// to a cell: at most 2^130 (float range, sqrt(3) across) over 2^-157 (a
+// subnormal extent split into 2^8 cells), 2^287 in all. 1.05^4096 = 2^288
+// would leave no room for the iterations that re-run a radius with a larger
+// pair buffer; 1.1^4096 = 2^563 leaves half the iterations spare. Above 16
+// every ray reports most boxes from its second radius on: slower, no gain.
+constexpr double kMinRadiusGrowth = 1.1;
+constexpr double kMaxRadiusGrowth = 16.0;
+// --bits: the library's largest index bit count (kMaxBits in
+// src/algo/index_space.hpp; the library rejects more, with exit code 3).
+constexpr int kMaxBitsOption = 8;
+constexpr int kMaxDeviceIndex = 1023;
+constexpr int kMaxThreads = 1024;
+constexpr int kMaxHistogramBins = 10000;
+
+std::string rangeText(double lo, double hi) {
+    char text[64];
+    std::snprintf(text, sizeof text, "[%g, %g]", lo, hi);
+    return text;
+}
+
+Error outOfRange(const std::string& name, const std::string& value, const std::string& expected) {
+    return usageError("option '" + name + "' expects " + expected + ", got '" + value + "'");
+}
+
 // Whole-string integer in [lo, hi]; no sign other than a leading '-'.
 std::optional<int> parseInt(std::string_view text, int lo, int hi) {
     int v = 0;
@@ -21,12 +51,13 @@ std::optional<int> parseInt(std::string_view text, int lo, int hi) {
     return v;
 }
 
-std::optional<float> parseFloat(std::string_view text) {
+// Whole-string finite number (from_chars: no leading '+', no spaces).
+std::optional<double> parseNumber(std::string_view text) {
     double v = 0.0;
     const char* end = text.data() + text.size();
     const auto res = std::from_chars(text.data(), end, v);
     if (text.empty() || res.ec != std::errc() || res.ptr != end || !std::isfinite(v)) return std::nullopt;
-    return static_cast<float>(v);
+    return v;
 }
 
 }  // namespace
@@ -44,10 +75,11 @@ Options:
   --directed          compute only h(A,B)
   --backend NAME      auto | ray-query | rt-pipeline | cpu   (default auto: ray-query,
                       else rt-pipeline, on a hardware RT device; else cpu)
-  --device N          Vulkan device index from --list-devices (default: first usable)
-  --bits K            index-space bit count, 0 = choose from the data (default 0)
-  --radius-growth F   candidate-search radius factor per iteration, > 1 (default 2)
-  --threads N         CPU backend threads, 0 = all hardware threads (default 0)
+  --device N          Vulkan device index from --list-devices, 0..1023
+                      (default: first usable)
+  --bits K            index-space bit count 0..8, 0 = choose from the data (default 0)
+  --radius-growth F   candidate-search radius factor per iteration, 1.1..16 (default 2)
+  --threads N         CPU backend threads 0..1024, 0 = all hardware threads (default 0)
   --verify            also run the CPU backend and compare (exit 1 on mismatch)
   --validation        enable the Vulkan validation layer, count its messages
   --list-devices      list Vulkan devices, the paths each supports, and why not
@@ -57,9 +89,9 @@ Per-point distances (each of these implies --per-point):
   --per-point         every point's exact nearest distance; statistics in the output
   --percentile P      also report the P-th percentile, 0..100, repeatable
                       (default 50 90 95 99; 95 is always reported: HD95)
-  --histogram-bins N  histogram bins (default 20)
-  --range MIN MAX     fixed distance range of the colour ramp and histogram
-                      (default 0 .. the largest distance)
+  --histogram-bins N  histogram bins, 1..10000 (default 20)
+  --range MIN MAX     fixed distance range of the colour ramp and histogram,
+                      finite, 0 <= MIN < MAX (default 0 .. the largest distance)
   --out-ply PREFIX    write PREFIX_a.ply and PREFIX_b.ply: points with float
                       quality = distance and a red/green/blue colour ramp
   --out-csv PREFIX    write PREFIX_a.csv and PREFIX_b.csv: index,x,y,z,distance,nearest
@@ -71,9 +103,13 @@ Per-point distances (each of these implies --per-point):
   --help, -h          print this help
   --version           print the version
 
-Exit codes: 0 ok, 1 internal error or --verify mismatch, 2 usage error,
+Output files are written to a temporary file beside them and renamed into
+place when complete; an earlier file of the same name survives a failure.
+
+Exit codes: 0 ok, 1 internal error or --verify mismatch, 2 usage error
+            (unknown option, missing input, value out of range),
             3 bad input (unreadable/malformed file, empty set, NaN/Inf),
-            4 no usable Vulkan device.
+            4 no usable Vulkan device, 5 cannot write an output file.
 )";
 }
 
@@ -135,29 +171,30 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
         } else if (name == "--bits") {
             const auto v = takeValue();
             if (!v) return usageError("option '--bits' needs a value");
-            const auto n = parseInt(*v, 0, 30);
-            if (!n) return usageError("option '--bits' expects an integer in [0, 30], got '" + *v + "'");
+            const auto n = parseInt(*v, 0, kMaxBitsOption);
+            if (!n)
+                return outOfRange(name, *v, "an integer in " + rangeText(0, kMaxBitsOption) + " (0 = auto)");
             out.options.bits = *n;
         } else if (name == "--device") {
             const auto v = takeValue();
             if (!v) return usageError("option '--device' needs a value");
-            const auto n = parseInt(*v, 0, 1 << 20);
-            if (!n) return usageError("option '--device' expects a device index >= 0, got '" + *v + "'");
+            const auto n = parseInt(*v, 0, kMaxDeviceIndex);
+            if (!n) return outOfRange(name, *v, "a device index in " + rangeText(0, kMaxDeviceIndex));
             out.options.deviceIndex = *n;
         } else if (name == "--threads") {
             const auto v = takeValue();
             if (!v) return usageError("option '--threads' needs a value");
-            const auto n = parseInt(*v, 0, 1 << 16);
-            if (!n) return usageError("option '--threads' expects an integer >= 0, got '" + *v + "'");
+            const auto n = parseInt(*v, 0, kMaxThreads);
+            if (!n) return outOfRange(name, *v, "an integer in " + rangeText(0, kMaxThreads) + " (0 = all)");
             out.options.threads = *n;
         } else if (name == "--radius-growth") {
             const auto v = takeValue();
             if (!v) return usageError("option '--radius-growth' needs a value");
-            const auto f = parseFloat(*v);
-            if (!f || !(*f > 1.0f)) {
-                return usageError("option '--radius-growth' expects a number > 1, got '" + *v + "'");
+            const auto f = parseNumber(*v);
+            if (!f || !(*f >= kMinRadiusGrowth && *f <= kMaxRadiusGrowth)) {
+                return outOfRange(name, *v, "a number in " + rangeText(kMinRadiusGrowth, kMaxRadiusGrowth));
             }
-            out.options.radiusGrowth = *f;
+            out.options.radiusGrowth = float(*f);
         } else if (name == "--quiet") {
             error = flag(out.quiet);
         } else if (name == "--per-point") {
@@ -165,28 +202,25 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
         } else if (name == "--percentile") {
             const auto v = takeValue();
             if (!v) return usageError("option '--percentile' needs a value");
-            double p = 0.0;
-            const char* end = v->data() + v->size();
-            const auto res = std::from_chars(v->data(), end, p);
-            if (v->empty() || res.ec != std::errc() || res.ptr != end || !(p >= 0.0 && p <= 100.0)) {
-                return usageError("option '--percentile' expects a number in [0, 100], got '" + *v + "'");
-            }
-            out.percentiles.push_back(p);
+            const auto p = parseNumber(*v);
+            if (!p || !(*p >= 0.0 && *p <= 100.0)) return outOfRange(name, *v, "a number in [0, 100]");
+            out.percentiles.push_back(*p);
             out.perPoint = true;
         } else if (name == "--histogram-bins") {
             const auto v = takeValue();
             if (!v) return usageError("option '--histogram-bins' needs a value");
-            const auto n = parseInt(*v, 1, 1 << 20);
-            if (!n) return usageError("option '--histogram-bins' expects an integer >= 1, got '" + *v + "'");
+            const auto n = parseInt(*v, 1, kMaxHistogramBins);
+            if (!n) return outOfRange(name, *v, "an integer in " + rangeText(1, kMaxHistogramBins));
             out.histogramBins = *n;
             out.perPoint = true;
         } else if (name == "--range") {
             if (inlineValue) return usageError("option '--range' takes two values: --range MIN MAX");
             if (i + 2 >= args.size()) return usageError("option '--range' needs two values MIN MAX");
-            const auto lo = parseFloat(args[i + 1]), hi = parseFloat(args[i + 2]);
-            if (!lo || !hi || !(*hi > *lo)) {
-                return usageError("option '--range' expects numbers MIN < MAX, got '" + args[i + 1] + "' '" +
-                                  args[i + 2] + "'");
+            // Distances are >= 0; finite bounds keep MAX - MIN and every bin finite.
+            const auto lo = parseNumber(args[i + 1]), hi = parseNumber(args[i + 2]);
+            if (!lo || !hi || !(*lo >= 0.0 && *hi > *lo)) {
+                return usageError("option '--range' expects finite numbers 0 <= MIN < MAX, got '" +
+                                  args[i + 1] + "' '" + args[i + 2] + "'");
             }
             i += 2;
             out.hasRange = true;
