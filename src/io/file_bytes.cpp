@@ -7,7 +7,6 @@
 #include <cstring>
 #include <memory>
 
-#include "io/gzip_inflate.hpp"
 #include "io/io_error.hpp"
 
 namespace rthdist::io {
@@ -25,7 +24,7 @@ bool endsWithGz(const std::string& path) {
 
 }  // namespace
 
-Result<std::string> readFileBytes(const std::string& path) {
+Result<std::string> readFileBytes(const std::string& path, InflatedBound gzipBound) {
     struct stat st {};
     if (::stat(path.c_str(), &st) != 0) {
         return badInput(path, "open", std::strerror(errno));
@@ -51,7 +50,7 @@ Result<std::string> readFileBytes(const std::string& path) {
         bytes.resize(got);
     }
 
-    if (endsWithGz(path) && !bytes.empty()) return gunzip(bytes, path);
+    if (endsWithGz(path) && !bytes.empty()) return gunzip(bytes, path, gzipBound);
     return bytes;
 }
 

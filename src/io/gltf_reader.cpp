@@ -18,6 +18,9 @@
 #include <filesystem>
 #include <limits>
 
+#include "io/gltf_file_access.hpp"
+#include "io/gltf_json_limits.hpp"
+#include "io/gzip_inflate.hpp"
 #include "io/io_error.hpp"
 #include "io/number_parse.hpp"
 #include "io/scalar_type.hpp"
@@ -29,6 +32,22 @@ namespace {
 bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
                void*) {
     return true;
+}
+
+// tinygltf's FsCallbacks, all through GltfFileAccess (user data).
+bool fileExists(const std::string& path, void* access) {
+    return static_cast<GltfFileAccess*>(access)->exists(path);
+}
+std::string expandFilePath(const std::string& path, void*) { return path; }  // no "~", no $VAR
+bool readWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* access) {
+    std::string why;
+    const bool ok = static_cast<GltfFileAccess*>(access)->read(*out, why, path);
+    if (!ok && err != nullptr) *err = why;
+    return ok;
+}
+bool refuseWrite(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err != nullptr) *err = "writing is not supported";
+    return false;
 }
 
 std::string trimmed(std::string s) {
@@ -78,52 +97,116 @@ double normalize(double v, ScalarType t) {
     }
 }
 
+// Walks the node hierarchy twice: first counting the points every instance
+// adds (so the total is checked against kMaxGltfInstancedPoints and reserved
+// once, before anything is read), then reading them with the transforms.
 class PointCollector {
 public:
     PointCollector(const tinygltf::Model& model, const std::string& path) : m_model(model), m_path(path) {}
 
-    // Depth-first, parents before children, without recursion (a long chain
-    // of nodes must not exhaust the stack).
-    std::optional<Error> walk(int root) {
-        struct Pending {
-            int node;
-            glm::dmat4 parent;
-        };
-        std::vector<Pending> stack{{root, glm::dmat4(1.0)}};
-        size_t visited = 0;
-        while (!stack.empty()) {
-            const Pending top = stack.back();
-            stack.pop_back();
-            const std::string where = "node " + std::to_string(top.node);
-            if (top.node < 0 || static_cast<size_t>(top.node) >= m_model.nodes.size()) {
-                return badInput(m_path, where, "index out of range");
-            }
-            if (++visited > m_model.nodes.size())
-                return badInput(m_path, where, "cycle in the node hierarchy");
-            const tinygltf::Node& n = m_model.nodes[static_cast<size_t>(top.node)];
-            const glm::dmat4 world = top.parent * localTransform(n);
-            if (n.mesh >= 0) {
-                if (static_cast<size_t>(n.mesh) >= m_model.meshes.size()) {
-                    return badInput(m_path, where, "mesh index out of range");
+    // Pass 1: every accessor checked, the instanced points counted.
+    std::optional<Error> count(const std::vector<int>& roots) {
+        uint64_t total = 0;
+        return walk(roots,
+                    [&](int accessor, const glm::dmat4&, const std::string& where) -> std::optional<Error> {
+                        auto view = checkedAccessor(accessor);
+                        if (!view) return view.error();
+                        total += view->count;
+                        if (total > kMaxGltfInstancedPoints) {
+                            return badInput(m_path, where,
+                                            "the scene instances more than " +
+                                                std::to_string(kMaxGltfInstancedPoints) +
+                                                " points (limit of this loader)");
+                        }
+                        m_total = total;
+                        return std::nullopt;
+                    });
+    }
+
+    // Pass 2: the points, transformed.
+    std::optional<Error> read(const std::vector<int>& roots) {
+        m_points.reserve(static_cast<size_t>(m_total));
+        return walk(
+            roots, [&](int accessor, const glm::dmat4& world, const std::string&) -> std::optional<Error> {
+                auto view = checkedAccessor(accessor);
+                if (!view) return view.error();
+                for (size_t k = 0; k < view->count; ++k) {
+                    const char* p = view->base + k * view->stride;
+                    glm::dvec4 v(0.0, 0.0, 0.0, 1.0);
+                    for (int c = 0; c < 3; ++c) {
+                        const double raw = loadScalar(p + c * scalarSize(view->scalar), view->scalar, false);
+                        v[c] = view->normalized ? normalize(raw, view->scalar) : raw;
+                    }
+                    const glm::dvec4 w = world * v;
+                    m_points.emplace_back(narrowToFloat(w.x), narrowToFloat(w.y), narrowToFloat(w.z));
                 }
-                for (const tinygltf::Primitive& prim :
-                     m_model.meshes[static_cast<size_t>(n.mesh)].primitives) {
-                    const auto it = prim.attributes.find("POSITION");
-                    if (it == prim.attributes.end()) continue;
-                    if (auto err = accessor(it->second, world)) return err;
-                }
-            }
-            for (auto child = n.children.rbegin(); child != n.children.rend(); ++child) {
-                stack.push_back({*child, world});
-            }
-        }
-        return std::nullopt;
+                return std::nullopt;
+            });
     }
 
     std::vector<glm::vec3> take() { return std::move(m_points); }
 
 private:
-    std::optional<Error> accessor(int index, const glm::dmat4& world) {
+    struct AccessorView {
+        const char* base = nullptr;
+        uint64_t stride = 0;
+        size_t count = 0;
+        ScalarType scalar = ScalarType::kFloat32;
+        bool normalized = false;
+    };
+
+    // Depth-first, parents before children, without recursion (a long chain
+    // of nodes must not exhaust the stack); visit(accessor, world, where) for
+    // every POSITION of every primitive of every mesh instance. At most
+    // kMaxGltfNodeVisits node instances (a root listed by several scenes is
+    // walked once per scene).
+    template <class Visit>
+    std::optional<Error> walk(const std::vector<int>& roots, Visit&& visit) {
+        struct Pending {
+            int node;
+            glm::dmat4 parent;
+        };
+        uint64_t visited = 0;
+        for (int root : roots) {
+            std::vector<Pending> stack{{root, glm::dmat4(1.0)}};
+            size_t visitedHere = 0;
+            while (!stack.empty()) {
+                const Pending top = stack.back();
+                stack.pop_back();
+                const std::string where = "node " + std::to_string(top.node);
+                if (top.node < 0 || static_cast<size_t>(top.node) >= m_model.nodes.size()) {
+                    return badInput(m_path, where, "index out of range");
+                }
+                if (++visitedHere > m_model.nodes.size())
+                    return badInput(m_path, where, "cycle in the node hierarchy");
+                if (++visited > kMaxGltfNodeVisits) {
+                    return badInput(m_path, where,
+                                    "the scenes instance more than " + std::to_string(kMaxGltfNodeVisits) +
+                                        " nodes (limit of this loader)");
+                }
+                const tinygltf::Node& n = m_model.nodes[static_cast<size_t>(top.node)];
+                const glm::dmat4 world = top.parent * localTransform(n);
+                if (n.mesh >= 0) {
+                    if (static_cast<size_t>(n.mesh) >= m_model.meshes.size()) {
+                        return badInput(m_path, where, "mesh index out of range");
+                    }
+                    for (const tinygltf::Primitive& prim :
+                         m_model.meshes[static_cast<size_t>(n.mesh)].primitives) {
+                        const auto it = prim.attributes.find("POSITION");
+                        if (it == prim.attributes.end()) continue;
+                        if (auto err = visit(it->second, world, where)) return err;
+                    }
+                }
+                for (auto child = n.children.rbegin(); child != n.children.rend(); ++child) {
+                    stack.push_back({*child, world});
+                }
+            }
+        }
+        return std::nullopt;
+    }
+
+    // The accessor's elements, every index and byte range checked.
+    Result<AccessorView> checkedAccessor(int index) const {
         const std::string where = "accessor " + std::to_string(index);
         if (index < 0 || static_cast<size_t>(index) >= m_model.accessors.size()) {
             return badInput(m_path, where, "index out of range");
@@ -135,7 +218,7 @@ private:
         const auto scalar = componentScalar(acc.componentType);
         if (!scalar)
             return badInput(m_path, where, "unknown componentType " + std::to_string(acc.componentType));
-        if (acc.count == 0) return std::nullopt;
+        if (acc.count == 0) return AccessorView{};
         if (acc.bufferView < 0 || static_cast<size_t>(acc.bufferView) >= m_model.bufferViews.size()) {
             return badInput(m_path, where, "bufferView missing or out of range");
         }
@@ -161,23 +244,13 @@ private:
                                 std::to_string(acc.bufferView) + " (" + std::to_string(viewLength) +
                                 " bytes)");
         }
-        const char* base = reinterpret_cast<const char*>(data.data()) + view.byteOffset + acc.byteOffset;
-        m_points.reserve(m_points.size() + acc.count);
-        for (size_t k = 0; k < acc.count; ++k) {
-            const char* p = base + k * stride;
-            glm::dvec4 v(0.0, 0.0, 0.0, 1.0);
-            for (int c = 0; c < 3; ++c) {
-                const double raw = loadScalar(p + c * scalarSize(*scalar), *scalar, false);
-                v[c] = acc.normalized ? normalize(raw, *scalar) : raw;
-            }
-            const glm::dvec4 w = world * v;
-            m_points.emplace_back(narrowToFloat(w.x), narrowToFloat(w.y), narrowToFloat(w.z));
-        }
-        return std::nullopt;
+        return AccessorView{reinterpret_cast<const char*>(data.data()) + view.byteOffset + acc.byteOffset,
+                            stride, acc.count, *scalar, acc.normalized};
     }
 
     const tinygltf::Model& m_model;
     const std::string& m_path;
+    uint64_t m_total = 0;
     std::vector<glm::vec3> m_points;
 };
 
@@ -197,6 +270,7 @@ Result<std::vector<int>> rootNodes(const tinygltf::Model& model, const std::stri
         }
     }
     std::vector<int> roots;
+    std::vector<size_t> listed(model.nodes.size(), 0);  // 1 + the last scene that listed the node
     auto addScene = [&](size_t s) -> std::optional<Error> {
         for (int n : model.scenes[s].nodes) {
             if (n < 0 || static_cast<size_t>(n) >= model.nodes.size()) {
@@ -207,6 +281,11 @@ Result<std::vector<int>> rootNodes(const tinygltf::Model& model, const std::stri
                 return badInput(path, "scene " + std::to_string(s),
                                 "node " + std::to_string(n) + " is not a root node");
             }
+            if (listed[static_cast<size_t>(n)] == s + 1) {
+                return badInput(path, "scene " + std::to_string(s),
+                                "node " + std::to_string(n) + " is listed twice");
+            }
+            listed[static_cast<size_t>(n)] = s + 1;
             roots.push_back(n);
         }
         return std::nullopt;
@@ -225,6 +304,15 @@ Result<std::vector<int>> rootNodes(const tinygltf::Model& model, const std::stri
     return roots;
 }
 
+// The JSON text of a .gltf, or the JSON chunk of a .glb (the container's
+// own checks are tinygltf's), and its offset in the file.
+std::pair<std::string_view, size_t> jsonText(std::string_view bytes, bool binary) {
+    if (!binary) return {bytes, 0};
+    if (bytes.size() < 20) return {{}, 0};
+    const uint64_t length = static_cast<uint64_t>(loadScalar(bytes.data() + 12, ScalarType::kUInt32, false));
+    return {bytes.substr(20, static_cast<size_t>(std::min<uint64_t>(length, bytes.size() - 20))), 20};
+}
+
 }  // namespace
 
 Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::string& path) {
@@ -232,9 +320,10 @@ Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::strin
         return badInput(path, "file", "larger than 4 GiB, beyond what tinygltf reads");
     }
     const bool binary = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
-    std::string baseDir = std::filesystem::path(path).parent_path().string();
-    if (baseDir.empty()) baseDir = ".";
+    const auto [json, jsonOffset] = jsonText(bytes, binary);
+    if (auto err = checkGltfJsonLimits(json, jsonOffset, path)) return *err;
 
+    GltfFileAccess files(path);
     tinygltf::Model model;
     std::string err;
     std::string warn;
@@ -242,17 +331,20 @@ Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::strin
     try {
         tinygltf::TinyGLTF loader;
         loader.SetImageLoader(&skipImage, nullptr);
+        loader.SetFsCallbacks(
+            tinygltf::FsCallbacks{&fileExists, &expandFilePath, &readWholeFile, &refuseWrite, &files});
         if (binary) {
             ok = loader.LoadBinaryFromMemory(&model, &err, &warn,
                                              reinterpret_cast<const unsigned char*>(bytes.data()),
-                                             static_cast<unsigned int>(bytes.size()), baseDir);
+                                             static_cast<unsigned int>(bytes.size()), files.baseDir());
         } else {
             ok = loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
-                                            static_cast<unsigned int>(bytes.size()), baseDir);
+                                            static_cast<unsigned int>(bytes.size()), files.baseDir());
         }
     } catch (const std::exception& e) {
         return badInput(path, "glTF", std::string("malformed: ") + e.what());
     }
+    if (!ok && !files.refusal().empty()) return badInput(path, "glTF", "buffer " + files.refusal());
     if (!ok)
         return badInput(path, "glTF",
                         "malformed: " + (err.empty() ? std::string("tinygltf failed") : trimmed(err)));
@@ -260,10 +352,16 @@ Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::strin
     auto roots = rootNodes(model, path);
     if (!roots) return roots.error();
     PointCollector collector(model, path);
-    for (int root : *roots) {
-        if (auto e = collector.walk(root)) return *e;
-    }
+    if (auto e = collector.count(*roots)) return *e;
+    if (auto e = collector.read(*roots)) return *e;
     return collector.take();
+}
+
+Result<uint64_t> glbInflatedBound(std::string_view head, bool whole, const std::string& path) {
+    (void)whole;
+    (void)path;
+    if (head.size() < 12 || head.substr(0, 4) != "glTF") return kNoInflatedBound;  // .gltf JSON
+    return static_cast<uint64_t>(loadScalar(head.data() + 8, ScalarType::kUInt32, false));
 }
 
 }  // namespace rthdist::io

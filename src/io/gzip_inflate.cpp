@@ -43,9 +43,39 @@ size_t initialCapacity(std::string_view compressed) {
     return static_cast<size_t>(std::clamp<uint64_t>(hinted, 4096, std::max<uint64_t>(bound, 4096)));
 }
 
+// The most bytes the output may hold, and whether a format's header set it.
+struct OutputLimit {
+    uint64_t limit;
+    bool fromHeader = false;
+};
+
+Error tooLarge(const std::string& path, const OutputLimit& cap) {
+    if (cap.fromHeader) {
+        return badInput(path, "gzip",
+                        "inflates to more than the " + std::to_string(cap.limit) +
+                            " bytes its header accounts for (wrong count, or a decompression bomb)");
+    }
+    return badInput(path, "gzip",
+                    "inflates to more than " + std::to_string(cap.limit) + " bytes (over " +
+                        std::to_string(kMaxInflateRatio) +
+                        " times its compressed size: refused as a decompression bomb)");
+}
+
+// limit + 1 without wrapping: the output needs one byte of room past the cap
+// to notice a stream that exceeds it.
+uint64_t pastCap(uint64_t limit) { return limit == kNoInflatedBound ? limit : limit + 1; }
+
 }  // namespace
 
-Result<std::string> gunzip(std::string_view compressed, const std::string& path) {
+uint64_t inflateCap(uint64_t compressedSize) {
+    const uint64_t ratio = compressedSize > kNoInflatedBound / kMaxInflateRatio
+                               ? kNoInflatedBound
+                               : compressedSize * kMaxInflateRatio;
+    return std::max(kMinInflateCap, ratio);
+}
+
+Result<std::string> gunzip(std::string_view compressed, const std::string& path, InflatedBound bound,
+                           std::optional<uint64_t> maxBytes) {
     if (compressed.size() < 2 || static_cast<unsigned char>(compressed[0]) != 0x1f ||
         static_cast<unsigned char>(compressed[1]) != 0x8b) {
         return badInput(path, offsetWhere(0), "not a gzip stream (bad magic)");
@@ -54,18 +84,46 @@ Result<std::string> gunzip(std::string_view compressed, const std::string& path)
     if (!inflater.init()) return badInput(path, "gzip", "cannot initialise zlib");
     z_stream& zs = inflater.stream();
 
+    OutputLimit cap{maxBytes.value_or(inflateCap(compressed.size()))};
+    bool headChecked = bound == nullptr;
+    // Inflate only the head until the header has been checked; never
+    // allocate past the cap, whatever the trailer's size hint says.
+    const uint64_t hint = initialCapacity(compressed);
+    auto firstSize = [&] {
+        const uint64_t want = headChecked ? hint : std::min<uint64_t>(hint, kInflateHeadBytes);
+        return static_cast<size_t>(std::max<uint64_t>(1, std::min(want, pastCap(cap.limit))));
+    };
     std::string out;
-    out.resize(initialCapacity(compressed));
+    out.resize(firstSize());
     size_t produced = 0;
     size_t consumed = 0;
+    auto checkHead = [&](bool whole) -> std::optional<Error> {
+        headChecked = true;
+        auto b = bound(std::string_view(out.data(), produced), whole, path);
+        if (!b) return b.error();
+        if (*b != kNoInflatedBound && *b <= cap.limit - std::min(cap.limit, kInflatedSlack)) {
+            cap = OutputLimit{*b + kInflatedSlack, true};
+        }
+        if (out.size() < firstSize()) out.resize(firstSize());
+        return std::nullopt;
+    };
     constexpr size_t kChunk = std::numeric_limits<uInt>::max() / 2;
     for (;;) {
-        if (produced == out.size()) out.resize(out.size() * 2);
-        const size_t inLeft = compressed.size() - consumed;
+        if (!headChecked && produced >= kInflateHeadBytes) {
+            if (auto err = checkHead(false)) return *err;
+        }
+        if (produced > cap.limit) return tooLarge(path, cap);
+        // Output may go up to the head's end (header unchecked) or one byte
+        // past the cap (to notice a stream that exceeds it).
+        const uint64_t end = headChecked ? pastCap(cap.limit) : kInflateHeadBytes;
+        if (produced == out.size()) {
+            out.resize(static_cast<size_t>(std::min<uint64_t>(uint64_t{out.size()} * 2, end)));
+        }
+        const size_t room = static_cast<size_t>(std::min<uint64_t>(out.size(), end)) - produced;
         zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data() + consumed));
-        zs.avail_in = static_cast<uInt>(std::min(inLeft, kChunk));
+        zs.avail_in = static_cast<uInt>(std::min(compressed.size() - consumed, kChunk));
         zs.next_out = reinterpret_cast<Bytef*>(out.data() + produced);
-        zs.avail_out = static_cast<uInt>(std::min(out.size() - produced, kChunk));
+        zs.avail_out = static_cast<uInt>(std::min(room, kChunk));
         const uInt inBefore = zs.avail_in;
         const uInt outBefore = zs.avail_out;
         const int rc = inflate(&zs, Z_NO_FLUSH);
@@ -86,6 +144,10 @@ Result<std::string> gunzip(std::string_view compressed, const std::string& path)
         const char* why = zs.msg != nullptr ? zs.msg : "corrupt data";
         return badInput(path, offsetWhere(consumed), std::string("corrupt gzip stream: ") + why);
     }
+    if (!headChecked) {
+        if (auto err = checkHead(true)) return *err;
+    }
+    if (produced > cap.limit) return tooLarge(path, cap);
     out.resize(produced);
     out.shrink_to_fit();
     return out;

@@ -27,30 +27,40 @@ std::string formatExtension(const std::string& path) {
     return dot == std::string::npos ? std::string() : name.substr(dot);
 }
 
+// A reader and, for formats whose header bounds the file size, the check
+// that caps a .gz before it is inflated.
+struct Format {
+    Result<std::vector<glm::vec3>> (*read)(std::string_view, const std::string&) = nullptr;
+    InflatedBound gzipBound = nullptr;
+};
+
+Format formatFor(const std::string& ext) {
+    if (ext == ".ply") return {&readPly, &plyInflatedBound};
+    if (ext == ".xyz" || ext == ".txt") return {&readXyz};
+    if (ext == ".obj") return {&readObj};
+    if (ext == ".gltf" || ext == ".glb") return {&readGltf, &glbInflatedBound};
+    if (ext == ".stl") return {&readStl, &stlInflatedBound};
+    if (ext == ".off") return {&readOff};
+    if (ext == ".pcd") return {&readPcd};
+    return {};
+}
+
 }  // namespace
 
 Result<std::vector<glm::vec3>> loadPoints(const std::string& path) {
     const std::string ext = formatExtension(path);
-    using Reader = Result<std::vector<glm::vec3>> (*)(std::string_view, const std::string&);
-    Reader reader = nullptr;
-    if (ext == ".ply") reader = &readPly;
-    if (ext == ".xyz" || ext == ".txt") reader = &readXyz;
-    if (ext == ".obj") reader = &readObj;
-    if (ext == ".gltf" || ext == ".glb") reader = &readGltf;
-    if (ext == ".stl") reader = &readStl;
-    if (ext == ".off") reader = &readOff;
-    if (ext == ".pcd") reader = &readPcd;
-    if (reader == nullptr) {
+    const Format format = formatFor(ext);
+    if (format.read == nullptr) {
         return badInput(path, "file",
                         "unsupported extension '" + ext +
                             "' (ply, xyz, txt, obj, gltf, glb, stl, off, pcd, optionally .gz)");
     }
 
-    auto bytes = readFileBytes(path);
+    auto bytes = readFileBytes(path, format.gzipBound);
     if (!bytes) return bytes.error();
     if (bytes->empty()) return badInput(path, "file", "empty file");
 
-    auto points = reader(*bytes, path);
+    auto points = format.read(*bytes, path);
     if (!points) return points;
     if (points->empty()) return badInput(path, "file", "contains no points");
     for (size_t i = 0; i < points->size(); ++i) {

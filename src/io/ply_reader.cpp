@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "io/gzip_inflate.hpp"
 #include "io/io_error.hpp"
 #include "io/number_parse.hpp"
 #include "io/scalar_type.hpp"
@@ -35,6 +36,23 @@ struct PlyElement {
     [[nodiscard]] uint64_t minBinaryItemSize() const {
         uint64_t size = 0;
         for (const PlyProperty& p : properties) size += scalarSize(p.isList ? p.countType : p.type);
+        return size;
+    }
+
+    // Most bytes one item can take in a binary body (every list at the
+    // longest length its count type can state); saturates at UINT64_MAX.
+    [[nodiscard]] uint64_t maxBinaryItemSize() const {
+        uint64_t size = 0;
+        for (const PlyProperty& p : properties) {
+            uint64_t item = scalarSize(p.type);
+            if (p.isList) {
+                const size_t countBits = 8 * scalarSize(p.countType);
+                if (countBits >= 64) return UINT64_MAX;
+                item = scalarSize(p.countType) + ((uint64_t{1} << countBits) - 1) * scalarSize(p.type);
+            }
+            if (item > UINT64_MAX - size) return UINT64_MAX;
+            size += item;
+        }
         return size;
     }
 };
@@ -437,6 +455,21 @@ Result<std::vector<glm::vec3>> readPly(std::string_view bytes, const std::string
     if (!xyz) return xyz.error();
     if (header->format == PlyFormat::kAscii) return readAsciiBody(bytes, *header, vertexElement, *xyz, path);
     return readBinaryBody(bytes, *header, vertexElement, *xyz, path);
+}
+
+Result<uint64_t> plyInflatedBound(std::string_view head, bool whole, const std::string& path) {
+    // A header longer than the head: nothing to say yet (the reader decides).
+    if (!whole && head.find("end_header") == std::string_view::npos) return kNoInflatedBound;
+    auto header = parseHeader(head, path);
+    if (!header) return header.error();
+    if (header->format == PlyFormat::kAscii) return kNoInflatedBound;  // numbers have no longest spelling
+    uint64_t size = header->bodyOffset;
+    for (const PlyElement& e : header->elements) {
+        const uint64_t itemSize = e.maxBinaryItemSize();
+        if (itemSize != 0 && e.count > (UINT64_MAX - size) / itemSize) return kNoInflatedBound;
+        size += e.count * itemSize;
+    }
+    return size;
 }
 
 }  // namespace rthdist::io

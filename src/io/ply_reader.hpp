@@ -1,10 +1,12 @@
-// PLY (ascii, binary_little_endian, binary_big_endian): the x/y/z of the vertex element;
-// every other property, list and element is skipped. Elements after the
-// vertex element are not read.
+// PLY (ascii, binary_little_endian, binary_big_endian): the x/y/z of the
+// vertex element; every other property, list and element is skipped, but
+// every declared element must be in the file (ascii: one item per line with
+// its exact number of values; binary: item by item to the end of the file).
 #pragma once
 
 #include <glm/vec3.hpp>
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,5 +17,9 @@ namespace rthdist::io {
 
 // bytes: the whole (already gunzipped) file; path names it in error messages.
 [[nodiscard]] Result<std::vector<glm::vec3>> readPly(std::string_view bytes, const std::string& path);
+
+// The gunzip header check (gzip_inflate.hpp): a binary PLY inflates to at
+// most its header plus every declared item at its largest; ascii: no bound.
+[[nodiscard]] Result<uint64_t> plyInflatedBound(std::string_view head, bool whole, const std::string& path);
 
 }  // namespace rthdist::io

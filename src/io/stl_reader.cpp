@@ -2,6 +2,7 @@
 
 #include <cstdint>
 
+#include "io/gzip_inflate.hpp"
 #include "io/io_error.hpp"
 #include "io/number_parse.hpp"
 #include "io/scalar_type.hpp"
@@ -45,18 +46,28 @@ Result<std::vector<glm::vec3>> readAscii(std::string_view bytes, const std::stri
     return points;
 }
 
+// An ascii STL starts with "solid" and is text; binary STLs have NUL bytes
+// in every attribute word (and many also start with "solid").
+bool looksAscii(std::string_view bytes) {
+    return trimBlank(bytes.substr(bomLength(bytes), 64)).starts_with("solid") &&
+           bytes.find('\0') == std::string_view::npos;
+}
+
+uint64_t binarySize(std::string_view bytes, uint64_t& facets) {
+    facets = static_cast<uint64_t>(loadScalar(bytes.data() + kHeaderSize, ScalarType::kUInt32, false));
+    return kHeaderSize + 4 + facets * kFacetSize;
+}
+
 }  // namespace
 
 Result<std::vector<glm::vec3>> readStl(std::string_view bytes, const std::string& path) {
-    // Many binary STLs also start with "solid", so the size decides first;
-    // then a NUL byte (binary STLs have them in every attribute word, text
-    // never) tells a binary STL of the wrong size from an ascii one.
+    // The size decides first (84 + 50 * facets), then the NUL bytes tell a
+    // binary STL of the wrong size from an ascii one.
     const bool solid = trimBlank(bytes.substr(bomLength(bytes), 64)).starts_with("solid");
-    const bool text = solid && bytes.find('\0') == std::string_view::npos;
+    const bool text = looksAscii(bytes);
     if (bytes.size() >= kHeaderSize + 4) {
-        const uint64_t facets =
-            static_cast<uint64_t>(loadScalar(bytes.data() + kHeaderSize, ScalarType::kUInt32, false));
-        const uint64_t need = kHeaderSize + 4 + facets * kFacetSize;
+        uint64_t facets = 0;
+        const uint64_t need = binarySize(bytes, facets);
         if (bytes.size() == need) return readBinary(bytes, facets);
         if (!text) {
             if (bytes.size() < need) {
@@ -72,6 +83,14 @@ Result<std::vector<glm::vec3>> readStl(std::string_view bytes, const std::string
         return badInput(path, offsetWhere(0), "neither ascii STL ('solid') nor a complete binary STL header");
     }
     return readAscii(bytes, path);
+}
+
+Result<uint64_t> stlInflatedBound(std::string_view head, bool whole, const std::string& path) {
+    (void)whole;
+    (void)path;
+    if (head.size() < kHeaderSize + 4 || looksAscii(head)) return kNoInflatedBound;
+    uint64_t facets = 0;
+    return binarySize(head, facets);
 }
 
 }  // namespace rthdist::io

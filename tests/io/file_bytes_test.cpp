@@ -91,5 +91,63 @@ TEST_F(FileBytes, CorruptGzipIsBadInput) {
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "byte offset"));
 }
 
+// ---- hardening (issue 15): decompression bombs ------------------------------
+
+// A binary PLY of three points followed by `zeros` zero bytes, gzipped.
+std::string paddedPlyGz(size_t zeros) {
+    ByteBuilder b;
+    b.text(
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nend_header\n");
+    for (const glm::vec3& p : threePoints()) b.put(p.x).put(p.y).put(p.z);
+    return gzip(b.str() + std::string(zeros, '\0'));
+}
+
+TEST_F(FileBytes, GzipBeyondWhatThePlyHeaderDeclaresIsRefused) {
+    // Was inflated in full (3.9 GB from 3.9 MB) before the header was looked at.
+    const std::string path = write("bomb.ply.gz", paddedPlyGz(size_t{32} << 20));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path,
+                           "gzip: inflates to more than the 65687 bytes its header accounts for"));
+    // A little padding is fine.
+    auto r = loadPoints(write("padded.ply.gz", paddedPlyGz(100)));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, threePoints());
+}
+
+TEST_F(FileBytes, GzipPlyHeaderIsCheckedBeforeInflating) {
+    const std::string path = write(
+        "badhead.ply.gz",
+        gzip("ply\nformat binary_middle_endian 1.0\nend_header\n" + std::string(size_t{64} << 20, '\0')));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 2: unsupported format 'binary_middle_endian'"));
+}
+
+TEST_F(FileBytes, GzipInflationRatioCap) {
+    const std::string zeros = gzip(std::string(size_t{4} << 20, '0'));
+    const std::string path = file("zeros.xyz.gz");
+    auto capped = gunzip(zeros, path, nullptr, 1u << 20);
+    EXPECT_TRUE(isBadInput(capped, path, "gzip: inflates to more than 1048576 bytes"));
+    auto whole = gunzip(zeros, path, nullptr, 4u << 20);
+    ASSERT_TRUE(whole.ok()) << whole.error().message;
+    EXPECT_EQ(whole->size(), size_t{4} << 20);
+    EXPECT_EQ(inflateCap(1000), kMinInflateCap);
+    EXPECT_EQ(inflateCap(uint64_t{10} << 20), kMaxInflateRatio * (uint64_t{10} << 20));
+}
+
+TEST_F(FileBytes, GzipBeyondWhatTheGlbHeaderDeclaresIsRefused) {
+    const std::string glbBytes = glb(R"({"asset":{"version":"2.0"}})", "");
+    const std::string path = write("bomb.glb.gz", gzip(glbBytes + std::string(size_t{16} << 20, '\0')));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "its header accounts for"));
+}
+
+TEST_F(FileBytes, GzipBeyondWhatTheBinaryStlHeaderDeclaresIsRefused) {
+    ByteBuilder b;
+    b.text(std::string(80, ' ')).put<uint32_t>(1);
+    b.put(0.0f).put(0.0f).put(1.0f);
+    for (const glm::vec3& p : threePoints()) b.put(p.x).put(p.y).put(p.z);
+    b.put<uint16_t>(0);
+    const std::string path = write("bomb.stl.gz", gzip(b.str() + std::string(size_t{16} << 20, '\0')));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "its header accounts for"));
+}
+
 }  // namespace
 }  // namespace rthdist::io::test

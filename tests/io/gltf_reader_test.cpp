@@ -114,7 +114,7 @@ TEST_F(GltfReader, MissingExternalBuffer) {
     GltfParts p;
     p.bufferJson = R"({"byteLength":36,"uri":"missing.bin"})";
     const std::string path = write("m.gltf", gltfJson(p));
-    EXPECT_TRUE(isBadInput(loadPoints(path), path, "glTF: malformed"));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "glTF: buffer URI 'missing.bin': No such file"));
 }
 
 TEST_F(GltfReader, AccessorCountLies) {
@@ -172,6 +172,138 @@ TEST_F(GltfReader, NoMeshesHasNoPoints) {
     const std::string path =
         write("empty.gltf", R"({"asset":{"version":"2.0"},"nodes":[{}],"scenes":[{"nodes":[0]}]})");
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "contains no points"));
+}
+
+// ---- hardening (issue 15) ----------------------------------------------------
+
+TEST_F(GltfReader, DeeplyNestedJsonIsRefusedNotACrash) {
+    // 16,000 nested arrays overflowed the stack in tinygltf's recursive parser (exit 139).
+    const std::string json =
+        R"({"asset":{"version":"2.0","extras":)" + std::string(16000, '[') + std::string(16000, ']') + "}}";
+    const std::string path = write("deep.gltf", json);
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "byte offset 289: JSON nested deeper than 256 levels"));
+    const std::string bin = write("deep.glb", glb(json, ""));
+    EXPECT_TRUE(isBadInput(loadPoints(bin), bin, "byte offset 309: JSON nested deeper than 256 levels"));
+}
+
+TEST_F(GltfReader, NestingAtTheLimitLoads) {
+    GltfParts p;
+    p.bufferJson = embedded(threePoints());
+    std::string json = gltfJson(p);
+    json.insert(json.size() - 1, R"(,"extras":)" + std::string(254, '[') + std::string(254, ']'));
+    auto r = loadPoints(write("deep_ok.gltf", json));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, threePoints());
+}
+
+TEST_F(GltfReader, MillionsOfEmptyNodesAreRefusedBeforeParsing) {
+    // A 12 MB file of empty nodes took 2.2 GB inside tinygltf.
+    std::string nodes = "[{}";
+    for (int i = 0; i < 600000; ++i) nodes += ",{}";
+    nodes += "]";
+    const std::string path = write("nodes.gltf", R"({"asset":{"version":"2.0"},"nodes":)" + nodes + "}");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "more than 500000 glTF objects"));
+    std::string values = "[0";
+    for (int i = 0; i < 2100000; ++i) values += ",0";
+    values += "]";
+    const std::string extras = write("values.gltf", R"({"asset":{"version":"2.0","extras":)" + values + "}}");
+    EXPECT_TRUE(isBadInput(loadPoints(extras), extras, "more than 2000000 JSON values"));
+}
+
+// The points of pos.bin in a directory next to the glTF's.
+class GltfUris : public GltfReader {
+public:
+    void SetUp() override {
+        GltfReader::SetUp();
+        std::filesystem::create_directories(file("scene"));
+        std::filesystem::create_directories(file("scene/sub"));
+        write("pos.bin", positions(threePoints()));
+        write("scene/sub/pos.bin", positions(threePoints()));
+    }
+    std::string gltfWithUri(const std::string& name, const std::string& uri) {
+        GltfParts p;
+        p.bufferJson = R"({"byteLength":36,"uri":")" + uri + R"("})";
+        return write(name, gltfJson(p));
+    }
+};
+
+TEST_F(GltfUris, ParentDirectoryIsRefused) {
+    // "../pos.bin" was read, and its bytes came back out as points.
+    const std::string path = gltfWithUri("scene/up.gltf", "../pos.bin");
+    EXPECT_TRUE(
+        isBadInput(loadPoints(path), path, "buffer URI '../pos.bin': '..' leaves the glTF file's directory"));
+    const std::string encoded = gltfWithUri("scene/enc.gltf", "sub/%2e%2e/../pos.bin");
+    EXPECT_TRUE(isBadInput(loadPoints(encoded), encoded, "'..' leaves the glTF file's directory"));
+}
+
+TEST_F(GltfUris, AbsolutePathIsRefused) {
+    const std::string path = gltfWithUri("scene/abs.gltf", file("pos.bin"));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "absolute path"));
+}
+
+TEST_F(GltfUris, SubdirectoryIsAllowed) {
+    auto r = loadPoints(gltfWithUri("scene/down.gltf", "sub/pos.bin"));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, threePoints());
+}
+
+TEST_F(GltfUris, CurrentDirectoryIsNotSearched) {
+    // An unresolved URI was looked up in the current directory as well.
+    const std::string path = gltfWithUri("scene/cwd.gltf", "pos.bin");  // only in the parent and in sub/
+    const std::filesystem::path before = std::filesystem::current_path();
+    std::filesystem::current_path(file("scene/sub"));
+    auto r = loadPoints(path);
+    std::filesystem::current_path(before);
+    EXPECT_TRUE(isBadInput(r, path, "buffer URI 'pos.bin': No such file"));
+}
+
+TEST_F(GltfUris, DirectoryIsRefused) {
+    // A URI naming a directory made tinygltf attempt a 2^63-byte allocation.
+    const std::string path = gltfWithUri("scene/dir.gltf", "sub");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "buffer URI 'sub': not a regular file"));
+}
+
+// One accessor of `points` points, `primitives` primitives per mesh, `nodes` nodes.
+std::string instancedGlb(size_t points, size_t primitives, size_t nodes) {
+    std::string prims = "[";
+    for (size_t i = 0; i < primitives; ++i)
+        prims += std::string(i ? "," : "") + R"({"attributes":{"POSITION":0}})";
+    std::string nodeList = "[";
+    std::string sceneNodes = "[";
+    for (size_t i = 0; i < nodes; ++i) {
+        nodeList += std::string(i ? "," : "") + R"({"mesh":0})";
+        sceneNodes += std::string(i ? "," : "") + std::to_string(i);
+    }
+    const std::string bin = positions(std::vector<glm::vec3>(points, glm::vec3(1, 2, 3)));
+    const std::string json = R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":)" +
+                             std::to_string(bin.size()) + R"(}],"bufferViews":[{"buffer":0,"byteLength":)" +
+                             std::to_string(bin.size()) +
+                             R"(}],"accessors":[{"bufferView":0,"componentType":5126,"count":)" +
+                             std::to_string(points) + R"(,"type":"VEC3"}],"meshes":[{"primitives":)" + prims +
+                             R"(]}],"nodes":)" + nodeList + R"(],"scenes":[{"nodes":)" + sceneNodes + "]}]}";
+    return glb(json, bin);
+}
+
+TEST_F(GltfReader, InstancedPointsLoadInLinearTime) {
+    // A million instances of one point: the reserve per instance made this quadratic.
+    auto r = loadPoints(write("million.glb", instancedGlb(1, 1000, 1000)));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->size(), 1000000u);
+    EXPECT_EQ(r->back(), glm::vec3(1, 2, 3));
+}
+
+TEST_F(GltfReader, InstancedPointsBeyondTheLimitAreRefusedBeforeAllocating) {
+    // 1000 points x 100 primitives x 1001 nodes = 100.1 M points > kMaxGltfInstancedPoints.
+    const std::string path = write("bomb.glb", instancedGlb(1000, 100, 1001));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "the scene instances more than 100000000 points"));
+}
+
+TEST_F(GltfReader, SceneListingANodeTwiceIsAnError) {
+    GltfParts p;
+    p.bufferJson = embedded(threePoints());
+    p.scenes = R"("scenes":[{"nodes":[0,0]}],"scene":0)";
+    const std::string path = write("twice.gltf", gltfJson(p));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "scene 0: node 0 is listed twice"));
 }
 
 }  // namespace
