@@ -1,0 +1,84 @@
+// libFuzzer target for one point loader, chosen at build time by
+// RTHDIST_FUZZ_FORMAT (tests/fuzz/CMakeLists.txt builds one binary per
+// format). The readers take bytes, so most formats are fed in memory; "gz"
+// goes through a file and loadPoints, so that the bounded gunzip and the
+// format's header check before inflating are exercised too.
+//
+// Any input must give points or a kBadInput error; a crash, a sanitizer
+// report, a leak, a timeout or an allocation beyond -rss_limit_mb is a bug.
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+#include "io/gltf_reader.hpp"
+#include "io/obj_reader.hpp"
+#include "io/off_reader.hpp"
+#include "io/pcd_reader.hpp"
+#include "io/ply_reader.hpp"
+#include "io/stl_reader.hpp"
+#include "io/xyz_reader.hpp"
+#include "rthdist/io.hpp"
+
+#ifndef RTHDIST_FUZZ_FORMAT
+#error "RTHDIST_FUZZ_FORMAT must name the format (ply, xyz, obj, gltf, glb, stl, off, pcd, gz)"
+#endif
+
+namespace {
+
+constexpr std::string_view kFormat = RTHDIST_FUZZ_FORMAT;
+
+// A private directory per process, holding one regular file that a glTF
+// buffer URI may name ("pos.bin": three float points), so the URI resolver
+// is reached with files that exist and files that do not.
+const std::string& scratchDir() {
+    static const std::string dir = [] {
+        std::string tmpl = (std::filesystem::temp_directory_path() / "rthdist_fuzz_XXXXXX").string();
+        if (::mkdtemp(tmpl.data()) == nullptr) std::abort();
+        const float xyz[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+        std::ofstream(tmpl + "/pos.bin", std::ios::binary)
+            .write(reinterpret_cast<const char*>(xyz), sizeof xyz);
+        return tmpl;
+    }();
+    return dir;
+}
+
+void loadBytes(std::string_view bytes) {
+    using namespace rthdist::io;
+    if (kFormat == "ply") (void)readPly(bytes, "fuzz.ply");
+    if (kFormat == "xyz") (void)readXyz(bytes, "fuzz.xyz");
+    if (kFormat == "obj") (void)readObj(bytes, "fuzz.obj");
+    if (kFormat == "stl") (void)readStl(bytes, "fuzz.stl");
+    if (kFormat == "off") (void)readOff(bytes, "fuzz.off");
+    if (kFormat == "pcd") (void)readPcd(bytes, "fuzz.pcd");
+    if (kFormat == "gltf" || kFormat == "glb") {
+        (void)readGltf(bytes, scratchDir() + "/fuzz." + std::string(kFormat));
+    }
+}
+
+void loadThroughFile(std::string_view bytes) {
+    const std::string path = scratchDir() + "/fuzz.ply.gz";
+    {
+        std::ofstream out(path, std::ios::binary | std::ios::trunc);
+        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    }
+    (void)rthdist::io::loadPoints(path);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+    if (kFormat == "gz") {
+        loadThroughFile(bytes);
+    } else {
+        loadBytes(bytes);
+    }
+    return 0;
+}

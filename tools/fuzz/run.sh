@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (tests/fuzz) with clang-14 in build-fuzz/ and
+# runs each for RTHDIST_FUZZ_SECONDS (default 60) from the seed corpus in
+# tests/fuzz/corpus/<target>/ with the dictionary tests/fuzz/dict/<target>.dict.
+# Fails (exit 1) on any crash, sanitizer report, leak, timeout (-timeout=10)
+# or memory blow-up (-rss_limit_mb=2048) in any target; the reproducer is
+# left in build-fuzz/artifacts/<target>/.
+#
+#   tools/fuzz/run.sh                         # every target, 60 s each
+#   RTHDIST_FUZZ_SECONDS=45 tools/fuzz/run.sh # CI: 10 targets in about 10 min
+#   tools/fuzz/run.sh ply gltf                # some targets
+#
+# Environment: RTHDIST_FUZZ_SECONDS, RTHDIST_FUZZ_BUILD (build dir),
+# RTHDIST_FUZZ_JOBS (build parallelism, default 2). New inputs are kept in
+# build-fuzz/corpus/<target>/; the repo's seed corpus is only read.
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+seconds=${RTHDIST_FUZZ_SECONDS:-60}
+build=${RTHDIST_FUZZ_BUILD:-$root/build-fuzz}
+jobs=${RTHDIST_FUZZ_JOBS:-2}
+all_targets=(ply xyz obj gltf glb stl off pcd gz cli_args)
+targets=("$@")
+[ ${#targets[@]} -eq 0 ] && targets=("${all_targets[@]}")
+
+command -v clang++-14 >/dev/null || { echo "run.sh: clang++-14 not found (apt-get install clang-14 libclang-rt-14-dev)" >&2; exit 1; }
+
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
+    -DRTHDIST_FUZZ=ON -DRTHDIST_BUILD_TESTS=OFF -DRTHDIST_BUILD_TOOLS=OFF >/dev/null
+cmake --build "$build" -j"$jobs" --target "${targets[@]/#/fuzz_}"
+
+failed=()
+for t in "${targets[@]}"; do
+    seeds=$root/tests/fuzz/corpus/$t
+    work=$build/corpus/$t
+    artifacts=$build/artifacts/$t
+    mkdir -p "$work" "$artifacts"
+    dict=()
+    [ -f "$root/tests/fuzz/dict/$t.dict" ] && dict=(-dict="$root/tests/fuzz/dict/$t.dict")
+    echo "== fuzz_$t: ${seconds}s"
+    if ! "$build/tests/fuzz/fuzz_$t" "${dict[@]}" -max_total_time="$seconds" -timeout=10 \
+        -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$artifacts/" \
+        "$work" "$seeds" >"$build/fuzz_$t.log" 2>&1; then
+        failed+=("$t")
+        tail -n 60 "$build/fuzz_$t.log"
+    fi
+    execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$build/fuzz_$t.log" | grep -o '[0-9]*$' || echo '?')
+    echo "   executions: $execs, corpus: $(ls "$work" | wc -l) files"
+done
+
+if [ ${#failed[@]} -ne 0 ]; then
+    echo "run.sh: fuzzing found problems in: ${failed[*]} (reproducers in $build/artifacts/)" >&2
+    exit 1
+fi
+echo "run.sh: ${#targets[@]} targets, no crash, leak or timeout"
