@@ -9,15 +9,15 @@ layout(push_constant) uniform Push { CellsPush pc; };
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.n) return;
-    UintBuf keys = UintBuf(pc.sortedKeys);
-    uint key = keys.v[i];
-    if (i != 0 && keys.v[i - 1] == key) return;
-    uint cellIndex = UintBuf(pc.flags).v[i];
-    uint end = UintBuf(pc.dense).v[key];
-    Vec4Buf pts = Vec4Buf(pc.sorted);
-    vec3 lo = pts.v[i].xyz, hi = lo;
+    uint64_t keys = pc.sortedKeys;
+    uint key = uintAt(keys, i).v;
+    if (i != 0 && uintAt(keys, i - 1).v == key) return;
+    uint cellIndex = uintAt(pc.flags, i).v;
+    uint end = uintAt(pc.dense, key).v;
+    uint64_t pts = pc.sorted;
+    vec3 lo = vec4At(pts, i).v.xyz, hi = lo;
     for (uint j = i + 1; j < end; ++j) {
-        vec3 p = pts.v[j].xyz;
+        vec3 p = vec4At(pts, j).v.xyz;
         lo = min(lo, p);
         hi = max(hi, p);
     }
@@ -26,6 +26,6 @@ void main() {
     c.hi = hi;
     c.first = i;
     c.count = end - i;
-    CellBuf(pc.cells).v[cellIndex] = c;
-    if (end == pc.n) UintBuf(pc.numCells).v[0] = cellIndex + 1;
+    cellAt(pc.cells, cellIndex).v = c;
+    if (end == pc.n) uintAt(pc.numCells, 0).v = cellIndex + 1;
 }

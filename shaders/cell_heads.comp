@@ -8,6 +8,6 @@ layout(push_constant) uniform Push { CellsPush pc; };
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.n) return;
-    UintBuf keys = UintBuf(pc.sortedKeys);
-    UintBuf(pc.flags).v[i] = (i == 0 || keys.v[i] != keys.v[i - 1]) ? 1u : 0u;
+    uint64_t keys = pc.sortedKeys;
+    uintAt(pc.flags, i).v = (i == 0 || uintAt(keys, i).v != uintAt(keys, i - 1).v) ? 1u : 0u;
 }

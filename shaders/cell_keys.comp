@@ -8,8 +8,8 @@ layout(push_constant) uniform Push { KeysPush pc; };
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.n) return;
-    vec3 p = Vec4Buf(pc.points).v[i].xyz;
+    vec3 p = vec4At(pc.points, i).v.xyz;
     uint key = mortonKey(cellOfClamped(p, pc.grid));
-    UintBuf(pc.keys).v[i] = key;
-    atomicAdd(UintBuf(pc.dense).v[key], 1u);
+    uintAt(pc.keys, i).v = key;
+    atomicAdd(uintAt(pc.dense, key).v, 1u);
 }

@@ -10,33 +10,33 @@
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CoarsenPush pc; };
 
-uint parentKey(CellBuf fine, UintBuf keys, uint c) { return keys.v[fine.v[c].first] >> pc.shift; }
+uint parentKey(uint64_t fine, uint64_t keys, uint c) { return uintAt(keys, cellAt(fine, c).v.first).v >> pc.shift; }
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
     if (c >= pc.numFine) return;
-    CellBuf fine = CellBuf(pc.fineCells);
-    UintBuf keys = UintBuf(pc.sortedKeys);
+    uint64_t fine = pc.fineCells;
+    uint64_t keys = pc.sortedKeys;
     uint key = parentKey(fine, keys, c);
     bool head = c == 0 || parentKey(fine, keys, c - 1) != key;
     if (pc.mode == 0u) {
-        UintBuf(pc.flags).v[c] = head ? 1u : 0u;
+        uintAt(pc.flags, c).v = head ? 1u : 0u;
         return;
     }
     if (!head) return;
     Cell out_;
-    out_.lo = fine.v[c].lo;
-    out_.hi = fine.v[c].hi;
-    out_.first = fine.v[c].first;
-    out_.count = fine.v[c].count;
+    out_.lo = cellAt(fine, c).v.lo;
+    out_.hi = cellAt(fine, c).v.hi;
+    out_.first = cellAt(fine, c).v.first;
+    out_.count = cellAt(fine, c).v.count;
     uint e = c + 1;
     for (; e < pc.numFine && parentKey(fine, keys, e) == key; ++e) {
-        out_.lo = min(out_.lo, fine.v[e].lo);
-        out_.hi = max(out_.hi, fine.v[e].hi);
-        out_.count += fine.v[e].count;
+        out_.lo = min(out_.lo, cellAt(fine, e).v.lo);
+        out_.hi = max(out_.hi, cellAt(fine, e).v.hi);
+        out_.count += cellAt(fine, e).v.count;
     }
-    uint index = UintBuf(pc.flags).v[c];
-    CellBuf(pc.coarseCells).v[index] = out_;
-    UintBuf(pc.fineFirst).v[index] = pc.shift == 3u ? c : UintBuf(pc.finerFineFirst).v[c];
-    if (e == pc.numFine) UintBuf(pc.numCoarse).v[0] = index + 1;
+    uint index = uintAt(pc.flags, c).v;
+    cellAt(pc.coarseCells, index).v = out_;
+    uintAt(pc.fineFirst, index).v = pc.shift == 3u ? c : uintAt(pc.finerFineFirst, c).v;
+    if (e == pc.numFine) uintAt(pc.numCoarse, 0).v = index + 1;
 }

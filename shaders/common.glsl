@@ -10,13 +10,26 @@
 
 #include "rthdist_shared.h"
 
-layout(buffer_reference, std430, buffer_reference_align = 16) buffer Vec4Buf { vec4 v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 4) buffer UintBuf { uint v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 8) buffer Uvec2Buf { uvec2 v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 8) buffer U64Buf { uint64_t v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 16) buffer CellBuf { Cell v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 16) buffer StateBuf { QueryState v[]; };
-layout(buffer_reference, scalar, buffer_reference_align = 4) buffer AabbBuf { float v[]; };
+// Every record is reached at a 64-bit byte offset from its buffer's device
+// address: base + uint64_t(index) * size. An array index of a buffer reference
+// is a 32-bit access-chain operand, and drivers may form index * stride in 32
+// bits: with 16-byte records that wraps at 2^28 records (4 GiB), silently
+// reading and writing other records (issue: wrong H at 300M points on NVIDIA).
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Vec4Ref { vec4 v; };
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer UintRef { uint v; };
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer FloatRef { float v; };
+layout(buffer_reference, std430, buffer_reference_align = 8) buffer Uvec2Ref { uvec2 v; };
+layout(buffer_reference, std430, buffer_reference_align = 8) buffer U64Ref { uint64_t v; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer CellRef { Cell v; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer StateRef { QueryState v; };
+
+Vec4Ref vec4At(uint64_t base, uint i) { return Vec4Ref(base + uint64_t(i) * 16ul); }
+UintRef uintAt(uint64_t base, uint i) { return UintRef(base + uint64_t(i) * 4ul); }
+FloatRef floatAt(uint64_t base, uint64_t i) { return FloatRef(base + i * 4ul); }
+Uvec2Ref uvec2At(uint64_t base, uint i) { return Uvec2Ref(base + uint64_t(i) * 8ul); }
+U64Ref u64At(uint64_t base, uint i) { return U64Ref(base + uint64_t(i) * 8ul); }
+CellRef cellAt(uint64_t base, uint i) { return CellRef(base + uint64_t(i) * 32ul); }
+StateRef stateAt(uint64_t base, uint i) { return StateRef(base + uint64_t(i) * 16ul); }
 
 uint spreadBits(uint v) {
     v &= 0x3ffu;
@@ -65,8 +78,8 @@ float packedDist2(uint64_t p) { return uintBitsToFloat(uint(p >> 32)); }
 // The threshold below which a query cannot raise h: the larger of the exact
 // running maximum (has a witness) and the witness-less lower bound.
 // A negative lowerBound2 turns the early break off (per-point distances).
-float deadThreshold(U64Buf maxPacked, float lowerBound2) {
+float deadThreshold(uint64_t maxPacked, float lowerBound2) {
     if (lowerBound2 < 0.0) return 0.0;
-    uint64_t m = maxPacked.v[0];
+    uint64_t m = U64Ref(maxPacked).v;
     return max(packedDist2(m), lowerBound2);
 }

@@ -9,13 +9,13 @@ layout(push_constant) uniform Push { CompactPush pc; };
 void main() {
     uint qi = gl_GlobalInvocationID.x;
     if (qi >= pc.nq) return;
-    StateBuf state = StateBuf(pc.state);
-    if (state.v[qi].status != RTHDIST_OPEN) return;
-    float thr = deadThreshold(U64Buf(pc.maxPacked), pc.lowerBound2);
-    if (packedDist2(state.v[qi].best) < thr) {
-        state.v[qi].status = RTHDIST_DEAD;
+    uint64_t state = pc.state;
+    if (stateAt(state, qi).v.status != RTHDIST_OPEN) return;
+    float thr = deadThreshold(pc.maxPacked, pc.lowerBound2);
+    if (packedDist2(stateAt(state, qi).v.best) < thr) {
+        stateAt(state, qi).v.status = RTHDIST_DEAD;
         return;
     }
-    uint slot = atomicAdd(UintBuf(pc.counters).v[0], 1u);
-    UintBuf(pc.activeList).v[slot] = qi;
+    uint slot = atomicAdd(UintRef(pc.counters + RTHDIST_CTR_ACTIVE).v, 1u);
+    uintAt(pc.activeList, slot).v = qi;
 }

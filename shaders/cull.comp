@@ -12,7 +12,7 @@ layout(push_constant) uniform Push { CullPush pc; };
 void main() {
     uint qi = gl_GlobalInvocationID.x;
     if (qi >= pc.nq) return;
-    vec4 qv = Vec4Buf(pc.queries).v[qi];
+    vec4 qv = vec4At(pc.queries, qi).v;
     vec3 q = qv.xyz;
     ivec3 c = cellOfUnclamped(q, pc.grid);
     float s = pc.grid.cellSize;
@@ -22,10 +22,10 @@ void main() {
     vec3 toLo = q - blockLo, toHi = blockHi - q;
     float dOut = min(min(min(toLo.x, toLo.y), toLo.z), min(min(toHi.x, toHi.y), toHi.z)) - pc.epsilon;
 
-    U64Buf maxPacked = U64Buf(pc.maxPacked);
+    uint64_t maxPacked = pc.maxPacked;
     float thr = deadThreshold(maxPacked, pc.lowerBound2);
-    Vec4Buf targets = Vec4Buf(pc.targets);
-    UintBuf dense = UintBuf(pc.dense);
+    uint64_t targets = pc.targets;
+    uint64_t dense = pc.dense;
     int cpa = int(pc.grid.cellsPerAxis);
     float best = uintBitsToFloat(0x7f800000u);
     uint bestT = 0;
@@ -36,10 +36,10 @@ void main() {
         ivec3 cc = c + ivec3(m % 3, (m / 3) % 3, m / 9) - 1;
         if (any(lessThan(cc, ivec3(0))) || any(greaterThanEqual(cc, ivec3(cpa)))) continue;
         uint key = mortonKey(uvec3(cc));
-        uint end = dense.v[key];
-        uint start = key == 0 ? 0u : dense.v[key - 1];
+        uint end = uintAt(dense, key).v;
+        uint start = key == 0 ? 0u : uintAt(dense, key - 1).v;
         for (uint t = start; t < end; ++t) {
-            vec4 tv = targets.v[t];
+            vec4 tv = vec4At(targets, t).v;
             float d2 = dist2(q, tv.xyz);
             uint t_ = floatBitsToUint(tv.w);
             // Ties go to the smallest target index, as in the CPU backend.
@@ -69,9 +69,9 @@ void main() {
                 if (any(lessThan(cc, ivec3(0))) || any(greaterThanEqual(cc, ivec3(cpaj)))) continue;
                 uint firstKey = mortonKey(uvec3(cc)) << (3u * j);
                 uint lastKey = firstKey + (1u << (3u * j)) - 1u;
-                uint start = firstKey == 0 ? 0u : dense.v[firstKey - 1];
-                if (dense.v[lastKey] == start) continue;  // empty coarse cell
-                vec4 tv = targets.v[start];
+                uint start = firstKey == 0 ? 0u : uintAt(dense, firstKey - 1).v;
+                if (uintAt(dense, lastKey).v == start) continue;  // empty coarse cell
+                vec4 tv = vec4At(targets, start).v;
                 float d2 = dist2(q, tv.xyz);
                 uint t_ = floatBitsToUint(tv.w);
                 if (d2 < best || (d2 == best && t_ < bestT)) {
@@ -92,9 +92,9 @@ void main() {
         st.status = RTHDIST_DEAD;
     } else if (dOut > 0.0 && best <= dOut * dOut) {
         st.status = RTHDIST_EXACT;
-        atomicMax(maxPacked.v[0], packDistIndex(best, qi));
+        atomicMax(u64At(maxPacked, 0).v, packDistIndex(best, qi));
     } else {
         st.status = RTHDIST_OPEN;
     }
-    StateBuf(pc.state).v[qi] = st;
+    stateAt(pc.state, qi).v = st;
 }

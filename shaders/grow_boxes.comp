@@ -9,13 +9,13 @@ layout(push_constant) uniform Push { BoxesPush pc; };
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.numCells) return;
-    Cell c = CellBuf(pc.cells).v[i];
-    AabbBuf a = AabbBuf(pc.aabbs);
+    Cell c = cellAt(pc.cells, i).v;
+    uint64_t a = pc.aabbs;
     vec3 lo = c.lo - vec3(pc.grow), hi = c.hi + vec3(pc.grow);
-    a.v[6 * i + 0] = lo.x;
-    a.v[6 * i + 1] = lo.y;
-    a.v[6 * i + 2] = lo.z;
-    a.v[6 * i + 3] = hi.x;
-    a.v[6 * i + 4] = hi.y;
-    a.v[6 * i + 5] = hi.z;
+    floatAt(a, 6ul * i + 0ul).v = lo.x;
+    floatAt(a, 6ul * i + 1ul).v = lo.y;
+    floatAt(a, 6ul * i + 2ul).v = lo.z;
+    floatAt(a, 6ul * i + 3ul).v = hi.x;
+    floatAt(a, 6ul * i + 4ul).v = hi.y;
+    floatAt(a, 6ul * i + 5ul).v = hi.z;
 }

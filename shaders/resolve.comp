@@ -11,23 +11,23 @@ layout(push_constant) uniform Push { ResolvePush pc; };
 void main() {
     uint slot = gl_GlobalInvocationID.x;
     if (slot >= pc.numActive) return;
-    uint qi = UintBuf(pc.activeList).v[slot];
-    StateBuf state = StateBuf(pc.state);
-    QueryState st = state.v[qi];
+    uint qi = uintAt(pc.activeList, slot).v;
+    uint64_t state = pc.state;
+    QueryState st = stateAt(state, qi).v;
     float best = packedDist2(st.best);
-    U64Buf maxPacked = U64Buf(pc.maxPacked);
+    uint64_t maxPacked = pc.maxPacked;
     float thr = deadThreshold(maxPacked, pc.lowerBound2);
     if (st.status == RTHDIST_DEAD || best < thr) {
-        state.v[qi].status = RTHDIST_DEAD;
+        stateAt(state, qi).v.status = RTHDIST_DEAD;
         return;
     }
     if (st.status != RTHDIST_RETRY && best <= pc.radius * pc.radius) {
-        state.v[qi].status = RTHDIST_EXACT;
-        atomicMax(maxPacked.v[0], packDistIndex(best, qi));
+        stateAt(state, qi).v.status = RTHDIST_EXACT;
+        atomicMax(u64At(maxPacked, 0).v, packDistIndex(best, qi));
         return;
     }
-    if (st.status != RTHDIST_RETRY) state.v[qi].rLo = pc.radius;
-    state.v[qi].status = RTHDIST_OPEN;
-    uint next = atomicAdd(UintBuf(pc.counters).v[2], 1u);
-    UintBuf(pc.nextActive).v[next] = qi;
+    if (st.status != RTHDIST_RETRY) stateAt(state, qi).v.rLo = pc.radius;
+    stateAt(state, qi).v.status = RTHDIST_OPEN;
+    uint next = atomicAdd(UintRef(pc.counters + RTHDIST_CTR_NEXT_ACTIVE).v, 1u);
+    uintAt(pc.nextActive, next).v = qi;
 }

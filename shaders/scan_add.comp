@@ -7,11 +7,11 @@ layout(push_constant) uniform Push { ScanPush pc; };
 
 void main() {
     uint block = gl_WorkGroupID.x;
-    uint add = UintBuf(pc.blockSums).v[block];
+    uint add = uintAt(pc.blockSums, block).v;
     uint base = block * RTHDIST_SCAN_BLOCK;
-    UintBuf data = UintBuf(pc.data);
+    uint64_t data = pc.data;
     for (uint j = gl_LocalInvocationID.x; j < RTHDIST_SCAN_BLOCK; j += RTHDIST_SCAN_WG) {
         uint i = base + j;
-        if (i < pc.n) data.v[i] += add;
+        if (i < pc.n) uintAt(data, i).v += add;
     }
 }

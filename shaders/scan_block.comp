@@ -12,12 +12,12 @@ shared uint s_sums[RTHDIST_SCAN_WG];
 void main() {
     uint t = gl_LocalInvocationID.x;
     uint base = gl_WorkGroupID.x * RTHDIST_SCAN_BLOCK + t * RTHDIST_SCAN_PER_THREAD;
-    UintBuf data = UintBuf(pc.data);
+    uint64_t data = pc.data;
     uint local_[RTHDIST_SCAN_PER_THREAD];
     uint sum = 0;
     for (uint i = 0; i < RTHDIST_SCAN_PER_THREAD; ++i) {
         uint idx = base + i;
-        uint v = idx < pc.n ? data.v[idx] : 0u;
+        uint v = idx < pc.n ? uintAt(data, idx).v : 0u;
         local_[i] = sum;
         sum += v;
     }
@@ -30,9 +30,9 @@ void main() {
         barrier();
     }
     uint offset = s_sums[t] - sum;
-    if (t == RTHDIST_SCAN_WG - 1) UintBuf(pc.blockSums).v[gl_WorkGroupID.x] = s_sums[t];
+    if (t == RTHDIST_SCAN_WG - 1) uintAt(pc.blockSums, gl_WorkGroupID.x).v = s_sums[t];
     for (uint i = 0; i < RTHDIST_SCAN_PER_THREAD; ++i) {
         uint idx = base + i;
-        if (idx < pc.n) data.v[idx] = local_[i] + offset;
+        if (idx < pc.n) uintAt(data, idx).v = local_[i] + offset;
     }
 }

@@ -9,9 +9,9 @@ layout(push_constant) uniform Push { ScatterPush pc; };
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.n) return;
-    uint key = UintBuf(pc.keys).v[i];
-    uint pos = atomicAdd(UintBuf(pc.dense).v[key], 1u);
-    vec3 p = Vec4Buf(pc.points).v[i].xyz;
-    Vec4Buf(pc.sorted).v[pos] = vec4(p, uintBitsToFloat(i));
-    UintBuf(pc.sortedKeys).v[pos] = key;
+    uint key = uintAt(pc.keys, i).v;
+    uint pos = atomicAdd(uintAt(pc.dense, key).v, 1u);
+    vec3 p = vec4At(pc.points, i).v.xyz;
+    vec4At(pc.sorted, pos).v = vec4(p, uintBitsToFloat(i));
+    uintAt(pc.sortedKeys, pos).v = key;
 }

@@ -12,12 +12,12 @@ layout(set = 0, binding = 0) uniform accelerationStructureEXT u_tlas;
 void main() {
     uint slot = gl_GlobalInvocationID.x;
     if (slot >= pc.numActive) return;
-    uint qi = UintBuf(pc.activeList).v[slot];
-    vec3 q = Vec4Buf(pc.queries).v[qi].xyz;
-    QueryState st = StateBuf(pc.state).v[qi];
+    uint qi = uintAt(pc.activeList, slot).v;
+    vec3 q = vec4At(pc.queries, qi).v.xyz;
+    QueryState st = stateAt(pc.state, qi).v;
     float rLo = st.rLo;
     float bestLocal = packedDist2(st.best);
-    float thr = deadThreshold(U64Buf(pc.maxPacked), pc.lowerBound2);
+    float thr = deadThreshold(pc.maxPacked, pc.lowerBound2);
     rayQueryEXT rq;
     rayQueryInitializeEXT(rq, u_tlas, gl_RayFlagsNoneEXT, 0xff, q, 0.0, vec3(1.0, 0.0, 0.0), pc.rayTMax);
     while (rayQueryProceedEXT(rq)) {

@@ -14,27 +14,30 @@
 // representatives lower the query's best at once (atomicMin), so a
 // one-point cell needs no pair.
 bool visitCell(uint slot, uint qi, vec3 q, float rLo, float thr, uint cellIndex, inout float bestLocal) {
-    Cell c = CellBuf(pc.cells).v[cellIndex];
+    Cell c = cellAt(pc.cells, cellIndex).v;
     float d2 = boxDist2(q, c.lo, c.hi);
     if (d2 > pc.radius * pc.radius) return false;
     if (pc.skipScanned != 0u && d2 <= rLo * rLo) return false;
     if (d2 > bestLocal) return false;
-    vec4 rep = Vec4Buf(pc.targets).v[c.first];
+    vec4 rep = vec4At(pc.targets, c.first).v;
     float r2 = dist2(q, rep.xyz);
     if (r2 < thr) {
-        StateBuf(pc.state).v[qi].status = RTHDIST_DEAD;
+        // The killing point becomes the query's best: the self-check then
+        // sees every dead query below the final maximum.
+        atomicMin(stateAt(pc.state, qi).v.best, packDistIndex(r2, floatBitsToUint(rep.w)));
+        stateAt(pc.state, qi).v.status = RTHDIST_DEAD;
         return true;
     }
     if (r2 < bestLocal) {
         bestLocal = r2;
-        atomicMin(StateBuf(pc.state).v[qi].best, packDistIndex(r2, floatBitsToUint(rep.w)));
+        atomicMin(stateAt(pc.state, qi).v.best, packDistIndex(r2, floatBitsToUint(rep.w)));
     }
     if (c.count == 1) return false;
-    uint idx = atomicAdd(UintBuf(pc.counters).v[1], 1u);
-    if (idx < pc.pairCapacity) {
-        Uvec2Buf(pc.pairs).v[idx] = uvec2(slot, cellIndex);
+    uint64_t idx = atomicAdd(U64Ref(pc.counters + RTHDIST_CTR_PAIRS).v, 1ul);
+    if (idx < uint64_t(pc.pairCapacity)) {
+        uvec2At(pc.pairs, uint(idx)).v = uvec2(slot, cellIndex);
     } else {
-        StateBuf(pc.state).v[qi].status = RTHDIST_RETRY;
+        stateAt(pc.state, qi).v.status = RTHDIST_RETRY;
     }
     return false;
 }

@@ -27,6 +27,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rthdist/result.hpp"
@@ -140,6 +141,10 @@ struct DeviceInfo {
     bool rayQuery = false;             // the ray-query backend can run
     bool rtPipeline = false;           // the rt-pipeline backend can run
     std::vector<std::string> missing;  // why a backend is unusable
+    // The size limits rthdist checks every problem against (README, limits):
+    // max_buffer_bytes, max_allocation_bytes, device_heap_bytes,
+    // host_heap_bytes, max_work_groups_x, max_ray_dispatch, max_blas_primitives.
+    std::vector<std::pair<std::string, uint64_t>> limits;
 };
 
 // Lists every Vulkan device; an error only when no Vulkan loader/ICD works.

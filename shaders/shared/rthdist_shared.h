@@ -26,6 +26,18 @@ struct vec3f {
 #define RTHDIST_SCAN_PER_THREAD 16
 #define RTHDIST_SCAN_BLOCK 4096
 
+// The host-visible counter block (byte offsets; one block per engine, zeroed
+// by the host before the submissions that count into it).
+#define RTHDIST_CTR_ACTIVE 0       // uint: compact.comp, queries entering the search
+#define RTHDIST_CTR_NEXT_ACTIVE 8  // uint: resolve.comp, queries going on
+#define RTHDIST_CTR_CELLS 12       // uint: cell_build/coarsen, cells written
+#define RTHDIST_CTR_MAX_PACKED 16  // uint64: (bits of h^2 << 32) | query slot
+#define RTHDIST_CTR_PAIRS 24       // uint64: candidate pairs appended (64-bit: cannot wrap)
+#define RTHDIST_CTR_CHECK_SUM 32   // uint64: self-check, sum of original indices
+#define RTHDIST_CTR_CHECK_BAD 40   // uint64: self-check, records that broke an invariant
+#define RTHDIST_CTR_READBACK 48    // host read-back area after the counters
+#define RTHDIST_CTR_BYTES 256
+
 // Query status values.
 #define RTHDIST_OPEN 0u
 #define RTHDIST_EXACT 1u
@@ -132,7 +144,7 @@ struct CoarsenPush {
 struct CompactPush {
     uint64_t state;
     uint64_t activeList;  // uint[] out: query slots
-    uint64_t counters;    // uint[4]: [0] active count
+    uint64_t counters;    // the counter block (RTHDIST_CTR_ACTIVE)
     uint64_t maxPacked;
     uint nq;
     float lowerBound2;
@@ -154,7 +166,7 @@ struct SearchPush {
     uint64_t state;
     uint64_t activeList;  // uint[numActive]
     uint64_t pairs;       // uvec2[capacity]: (active slot, cell)
-    uint64_t counters;    // [0] active count, [1] pair count
+    uint64_t counters;    // the counter block (RTHDIST_CTR_PAIRS)
     uint64_t maxPacked;
     uint numActive;
     uint pairCapacity;
@@ -162,6 +174,20 @@ struct SearchPush {
     float lowerBound2;
     float rayTMax;
     uint skipScanned;  // 1: cells within rLo were scanned at this same level
+    uint slotBase;     // rt-pipeline: first active slot of this trace (traces are split by
+                       // maxRayDispatchInvocationCount); 0 for the ray-query dispatch
+};
+
+// check_index.comp / check_queries.comp: the self-check (every record visited
+// once, violations counted at RTHDIST_CTR_CHECK_BAD).
+struct CheckPush {
+    uint64_t sorted;      // check_index: vec4[n] cell-sorted points (w = original index)
+    uint64_t sortedKeys;  // check_index: uint[n]
+    uint64_t state;       // check_queries: QueryState[n]
+    uint64_t counters;    // the counter block
+    GridParams grid;      // check_index: the index's grid
+    uint n;
+    uint perPoint;  // check_queries: 1 = every query must be EXACT
 };
 
 // refine.comp: exact scan of the candidate pairs' cells.
@@ -187,7 +213,7 @@ struct ResolvePush {
     uint64_t state;
     uint64_t activeList;  // in
     uint64_t nextActive;  // out
-    uint64_t counters;    // [0] active count in, [2] next active count out
+    uint64_t counters;    // the counter block (RTHDIST_CTR_NEXT_ACTIVE)
     uint64_t maxPacked;
     uint numActive;
     float radius;

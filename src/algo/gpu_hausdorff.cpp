@@ -15,10 +15,12 @@
 #include <glm/glm.hpp>
 
 #include "algo/index_space.hpp"
+#include "algo/self_check.hpp"
 #include "cpu/parallel.hpp"
 #include "gpu/accel.hpp"
 #include "gpu/buffer.hpp"
 #include "gpu/context.hpp"
+#include "gpu/device_limits.hpp"
 #include "gpu/pipelines.hpp"
 #include "rthdist_shared.h"
 
@@ -42,6 +44,11 @@ double msSince(Clock::time_point t0) {
 }
 
 constexpr uint64_t kMaxPairCapacity = uint64_t(1) << 26;  // 512 MiB of pairs at most
+// Pooled buffers get this much room to grow (a quarter, at most 64 MiB, never
+// past the device's largest buffer).
+constexpr VkDeviceSize kMaxSlack = VkDeviceSize(64) << 20;
+// Query slots whose device records the self-check compares with the host.
+constexpr uint32_t kCheckSamples = 32;
 constexpr uint32_t kMaxIterations = 4096;
 constexpr size_t kHostChunk = size_t(1) << 16;  // points per host work item
 
@@ -77,9 +84,8 @@ sh::GridParams gridParams(const GridSpec& g) {
     return p;
 }
 
-// 1 when the squared differences of these coordinates stay normal floats;
-// else the power of two that brings the largest magnitude near 2^20.
-float exactScaleFor(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
+// The shared scaling rule (index_space.hpp) over both sets' largest magnitude.
+double exactScaleFor(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
     float maxAbs = 0.0f;
     for (auto set : {a, b}) {
         const int threads = cpu::resolveThreads(0, set.size() / kHostChunk + 1);
@@ -92,10 +98,18 @@ float exactScaleFor(std::span<const glm::vec3> a, std::span<const glm::vec3> b) 
         });
         maxAbs = std::max(maxAbs, *std::max_element(m.begin(), m.end()));
     }
-    if (maxAbs == 0.0f || (maxAbs < 0x1p60f && maxAbs > 0x1p-40f)) return 1.0f;
-    int e = 0;
-    std::frexp(maxAbs, &e);
-    return std::ldexp(1.0f, 20 - e);
+    return exactScale(double(maxAbs));
+}
+
+// Float copies of the points multiplied by a power of two in double (exact:
+// the rule keeps every product a normal float or zero).
+std::vector<glm::vec3> scaledCopy(std::span<const glm::vec3> pts, double scale) {
+    std::vector<glm::vec3> out(pts.size());
+    const int threads = cpu::resolveThreads(0, pts.size() / kHostChunk + 1);
+    cpu::parallelChunks(pts.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) out[i] = glm::vec3(glm::dvec3(pts[i]) * scale);
+    });
+    return out;
 }
 
 }  // namespace
@@ -106,7 +120,8 @@ struct GpuHausdorff::State {
     gpu::AccelStructures accel;
     bool rayQuery;
     bool tlasBound = false;
-    Buffer hostSmall;  // counters (uint[4]) at 0, maxPacked (uint64) at 16, read-backs after 32
+    Buffer hostSmall;  // the counter block (RTHDIST_CTR_*), read-backs after it
+    uint64_t maxPairCapacity = kMaxPairCapacity;
     Timings* timings = nullptr;
     // Buffers live across calls and only grow: allocation is a large share of
     // a call's cost on discrete GPUs.
@@ -118,8 +133,11 @@ struct GpuHausdorff::State {
         Buffer& b = pool[name];
         if (!b || b.size() < bytes) {
             b.reset();
+            const VkDeviceSize room =
+                std::min<VkDeviceSize>(bytes + std::min(bytes / 4, kMaxSlack),
+                                       std::max<VkDeviceSize>(bytes, ctx.limits().maxBufferBytes));
             b = Buffer(
-                ctx, std::max<VkDeviceSize>(bytes + bytes / 4, 256),
+                ctx, std::max<VkDeviceSize>(room, 256),
                 gpu::kStorageUsage | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
                 kind);
             ctx.setDebugName(VK_OBJECT_TYPE_BUFFER, uint64_t(b.handle()), name.c_str());
@@ -132,14 +150,20 @@ struct GpuHausdorff::State {
           pipelines(c, c.backend() == Backend::kRayQuery),
           accel(c),
           rayQuery(c.backend() == Backend::kRayQuery) {
-        hostSmall = Buffer(ctx, 256, gpu::kStorageUsage, MemoryKind::kHost);
+        hostSmall = Buffer(ctx, RTHDIST_CTR_READBACK + (kCheckSamples + 1) * 32, gpu::kStorageUsage,
+                           MemoryKind::kHost);
     }
 
-    uint32_t* counters() { return static_cast<uint32_t*>(hostSmall.mapped()); }
-    uint64_t* maxPacked() { return reinterpret_cast<uint64_t*>(static_cast<char*>(hostSmall.mapped()) + 16); }
+    // A counter of the block (offsets from rthdist_shared.h).
+    template <class T>
+    T& counter(size_t offset) {
+        return *reinterpret_cast<T*>(static_cast<char*>(hostSmall.mapped()) + offset);
+    }
+    uint64_t* maxPacked() { return &counter<uint64_t>(RTHDIST_CTR_MAX_PACKED); }
     VkDeviceAddress countersAddr() const { return hostSmall.address(); }
-    VkDeviceAddress maxPackedAddr() const { return hostSmall.address() + 16; }
-    char* readback() { return static_cast<char*>(hostSmall.mapped()) + 32; }
+    VkDeviceAddress maxPackedAddr() const { return hostSmall.address() + RTHDIST_CTR_MAX_PACKED; }
+    VkDeviceAddress cellsCounterAddr() const { return hostSmall.address() + RTHDIST_CTR_CELLS; }
+    char* readback() { return static_cast<char*>(hostSmall.mapped()) + RTHDIST_CTR_READBACK; }
 
     void barrier(VkCommandBuffer cmd) { gpu::cmdShaderBarrier(cmd, pipelines.shaderStages()); }
 
@@ -240,16 +264,18 @@ struct GpuHausdorff::State {
                          flags.address(),
                          ix.dense->address(),
                          ix.cells->address(),
-                         countersAddr() + 12,
+                         cellsCounterAddr(),
                          ix.n};
         dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
         barrier(cmd);
         cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
         barrier(cmd);
         dispatch(cmd, Kernel::kCellBuild, cp, ix.n);
+        cmdCheckIndex(cmd, ix);
         ctx.submitAndWait(cmd);
         timings->gpuIndex += ctx.lastGpuMs();
-        ix.numCells = counters()[3];
+        ix.numCells = counter<uint32_t>(RTHDIST_CTR_CELLS);
+        verifyIndex(ix, std::min<uint64_t>(ix.n, numKeys));
 
         timings->index += msSince(t0);
         return ix;
@@ -275,7 +301,7 @@ struct GpuHausdorff::State {
                                T.sortedKeys->address(),
                                flags.address(),
                                lv.cells->address(),
-                               countersAddr() + 12,
+                               cellsCounterAddr(),
                                finerFineFirst->address(),
                                lv.fineFirst->address(),
                                numFiner,
@@ -290,10 +316,77 @@ struct GpuHausdorff::State {
             ctx.submitAndWait(cmd);
             timings->gpuIndex += ctx.lastGpuMs();
             timings->index += msSince(t0);
-            lv.count = counters()[3];
+            lv.count = counter<uint32_t>(RTHDIST_CTR_CELLS);
             T.levels.push_back(lv);
         }
         return T.levels[size_t(level - 1)];
+    }
+
+    // One ray per active slot, in traces of at most maxRayDispatch rays
+    // (each trace sees its first slot in SearchPush::slotBase).
+    void cmdTraceRaysSplit(VkCommandBuffer cmd, sh::SearchPush sp) {
+        const uint64_t chunk = std::max<uint64_t>(1, ctx.limits().maxRayDispatch);
+        for (uint64_t first = 0; first < sp.numActive; first += chunk) {
+            sp.slotBase = uint32_t(first);
+            pipelines.cmdTraceRays(cmd, &sp, sizeof(sp),
+                                   uint32_t(std::min<uint64_t>(chunk, sp.numActive - first)));
+        }
+    }
+
+    // Self-check of an index, recorded after its build (check_index.comp);
+    // verifyIndex reads the verdict once the submission has completed.
+    void cmdCheckIndex(VkCommandBuffer cmd, const PointIndex& ix) {
+        counter<uint64_t>(RTHDIST_CTR_CHECK_SUM) = 0;
+        counter<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
+        sh::CheckPush cp{
+            ix.sorted->address(), ix.sortedKeys->address(), 0, countersAddr(), gridParams(ix.grid), ix.n, 0u};
+        dispatch(cmd, Kernel::kCheckIndex, cp, ix.n);
+    }
+    void verifyIndex(const PointIndex& ix, uint64_t cellCapacity) {
+        const uint64_t n = ix.n;
+        const uint64_t expectedSum = n % 2 == 0 ? (n / 2) * (n - 1) : n * ((n - 1) / 2);
+        std::string why = indexCheckFailure(n, counter<uint64_t>(RTHDIST_CTR_CHECK_BAD),
+                                            counter<uint64_t>(RTHDIST_CTR_CHECK_SUM), expectedSum,
+                                            ix.numCells, cellCapacity);
+        if (!why.empty()) throw SelfCheckError("index of " + ix.name + ": " + why);
+    }
+
+    // Self-check of a finished direction: every query settled below the
+    // final maximum (check_queries.comp), and a sample of query records,
+    // the witness's among them, agrees with the host's copy of the points.
+    // Returns the witness's records (the query slot of the maximum).
+    SampledQuery checkDirection(const PointIndex& Q, const Buffer& state, std::span<const glm::vec3> qPts,
+                                std::span<const glm::vec3> tPts, bool perPoint, const std::string& name) {
+        const uint64_t packed = *maxPacked();
+        std::vector<uint32_t> slots = sampleSlots(Q.n, kCheckSamples);
+        slots.push_back(uint32_t(packed & 0xffffffffu));
+        counter<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
+        VkCommandBuffer cmd = ctx.begin();
+        sh::CheckPush cp{0, 0, state.address(), countersAddr(), {}, Q.n, perPoint ? 1u : 0u};
+        dispatch(cmd, Kernel::kCheckQueries, cp, Q.n);
+        std::vector<VkBufferCopy> sortedCopies, stateCopies;
+        for (size_t k = 0; k < slots.size(); ++k) {
+            const VkDeviceSize at = RTHDIST_CTR_READBACK + VkDeviceSize(k) * 32;
+            sortedCopies.push_back({VkDeviceSize(slots[k]) * 16, at, 16});
+            stateCopies.push_back({VkDeviceSize(slots[k]) * sizeof(sh::QueryState), at + 16, 16});
+        }
+        vkCmdCopyBuffer(cmd, Q.sorted->handle(), hostSmall.handle(), uint32_t(sortedCopies.size()),
+                        sortedCopies.data());
+        vkCmdCopyBuffer(cmd, state.handle(), hostSmall.handle(), uint32_t(stateCopies.size()),
+                        stateCopies.data());
+        ctx.submitAndWait(cmd);
+        std::vector<SampledQuery> sampled(slots.size());
+        for (size_t k = 0; k < slots.size(); ++k) {
+            sampled[k].slot = slots[k];
+            std::memcpy(sampled[k].sorted, readback() + k * 32, 16);
+            std::memcpy(&sampled[k].state, readback() + k * 32 + 16, 16);
+        }
+        const uint64_t bad = counter<uint64_t>(RTHDIST_CTR_CHECK_BAD);
+        std::string why = bad != 0 ? std::to_string(bad) + " of " + std::to_string(Q.n) +
+                                         " queries ended unsettled or above the maximum"
+                                   : sampledQueryFailure(sampled, qPts, tPts, packed, perPoint);
+        if (!why.empty()) throw SelfCheckError(name + ": " + why);
+        return sampled.back();
     }
 
     // Reports progress; [from, to) is this direction's share of the call.
@@ -355,7 +448,7 @@ struct GpuHausdorff::State {
         dispatch(cmd, Kernel::kCompact, comp, Q.n);
         ctx.submitAndWait(cmd);
         timings->gpuCull += ctx.lastGpuMs();
-        uint32_t numActive = counters()[0];
+        uint32_t numActive = counter<uint32_t>(RTHDIST_CTR_ACTIVE);
         cnt.survivingQueries = numActive;
         cnt.culledByNeighbourhood = Q.n - numActive;
         timings->cull += msSince(t0);
@@ -365,7 +458,8 @@ struct GpuHausdorff::State {
         // at the threshold's root, which makes every ray visit far more boxes
         // (docs/bench/gpu.md, growth sweep).
         double radius = 2.0 * T.grid.cellSize;
-        uint64_t pairCapacity = std::clamp<uint64_t>(uint64_t(T.numCells) * 4, 1u << 16, 1u << 22);
+        uint64_t pairCapacity =
+            std::min(std::clamp<uint64_t>(uint64_t(T.numCells) * 4, 1u << 16, 1u << 22), maxPairCapacity);
         Buffer* pairs = nullptr;
         const float rayTMax = float(T.grid.cellSize * 1e-3);
         int cur = 0;
@@ -375,7 +469,7 @@ struct GpuHausdorff::State {
                 throw std::runtime_error("candidate search did not converge");
             if (!pairs) {
                 pairs = &buf("pairs", pairCapacity * 8);
-                pairCapacity = std::min<uint64_t>(pairs->size() / 8, kMaxPairCapacity);
+                pairCapacity = std::min<uint64_t>(pairs->size() / 8, maxPairCapacity);
             }
             const float r = float(radius);
             const float grow = r + epsilon + r * 1e-6f;
@@ -392,8 +486,8 @@ struct GpuHausdorff::State {
             Buffer& aabbs = buf("aabbs", VkDeviceSize(numSearchCells) * 24);
 
             t0 = Clock::now();
-            counters()[1] = 0;
-            counters()[2] = 0;
+            counter<uint64_t>(RTHDIST_CTR_PAIRS) = 0;
+            counter<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE) = 0;
             cmd = ctx.begin();
             sh::BoxesPush bp{searchCells->address(), aabbs.address(), numSearchCells, grow};
             dispatch(cmd, Kernel::kGrowBoxes, bp, numSearchCells);
@@ -420,19 +514,20 @@ struct GpuHausdorff::State {
                               r,
                               lowerBound2,
                               rayTMax,
-                              sameLevel ? 1u : 0u};
+                              sameLevel ? 1u : 0u,
+                              0u};
             if (rayQuery)
                 dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
             else
-                pipelines.cmdTraceRays(cmd, &sp, sizeof(sp), numActive);
+                cmdTraceRaysSplit(cmd, sp);
             ctx.submitAndWait(cmd);
             timings->gpuSearch += ctx.lastGpuMs();
-            const uint32_t pairCount = counters()[1];
+            const uint64_t pairCount = counter<uint64_t>(RTHDIST_CTR_PAIRS);
             cnt.rays += numActive;
             timings->search += msSince(t0);
 
             t0 = Clock::now();
-            const uint32_t used = uint32_t(std::min<uint64_t>(pairCount, pairCapacity));
+            const uint64_t used = std::min<uint64_t>(pairCount, pairCapacity);
             cnt.candidatePairs += used;
             cmd = ctx.begin();
             sh::RefinePush rp{Q.sorted->address(),    T.sorted->address(),
@@ -455,7 +550,7 @@ struct GpuHausdorff::State {
             dispatch(cmd, Kernel::kResolve, rs, numActive);
             ctx.submitAndWait(cmd);
             timings->gpuRefine += ctx.lastGpuMs();
-            numActive = counters()[2];
+            numActive = counter<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE);
             cur = 1 - cur;
             timings->refine += msSince(t0);
             report(options, "search",
@@ -464,37 +559,27 @@ struct GpuHausdorff::State {
                            (0.2 + 0.8 * (1.0 - double(numActive) /
                                                    double(std::max<uint64_t>(1, cnt.survivingQueries)))));
 
-            if (pairCount > pairCapacity && pairCapacity < kMaxPairCapacity) {
+            if (pairCount > pairCapacity && pairCapacity < maxPairCapacity) {
                 // Some queries lost pairs: redo them at the same radius with room.
                 pairCapacity =
-                    std::min<uint64_t>(kMaxPairCapacity, std::max<uint64_t>(pairCount, pairCapacity * 2));
+                    std::min<uint64_t>(maxPairCapacity, std::max<uint64_t>(pairCount, pairCapacity * 2));
                 pairs = nullptr;
             } else if (pairCount <= pairCapacity) {
                 radius *= double(options.radiusGrowth);
             }
         }
 
-        // Witness: the query slot in the low half of maxPacked; its target
-        // from the query's state.
-        const uint64_t packed = *maxPacked();
-        const uint32_t slot = uint32_t(packed & 0xffffffffu);
-        cmd = ctx.begin();
-        VkBufferCopy c1{VkDeviceSize(slot) * 16, 32, 16};
-        vkCmdCopyBuffer(cmd, Q.sorted->handle(), hostSmall.handle(), 1, &c1);
-        VkBufferCopy c2{VkDeviceSize(slot) * sizeof(sh::QueryState), 48, sizeof(sh::QueryState)};
-        vkCmdCopyBuffer(cmd, state.handle(), hostSmall.handle(), 1, &c2);
-        ctx.submitAndWait(cmd);
-        float qv[4];
-        std::memcpy(qv, readback(), 16);
-        sh::QueryState st;
-        std::memcpy(&st, readback() + 16, sizeof(st));
-        out.queryIndex = std::bit_cast<uint32_t>(qv[3]);
-        out.targetIndex = uint32_t(st.best & 0xffffffffu);
-        if (out.queryIndex >= qPts.size() || out.targetIndex >= tPts.size())
-            throw std::runtime_error("GPU witness out of range");
+        // Witness: the query slot in the low half of maxPacked, its target in
+        // the query's state; both read back (and checked) by the self-check.
+        const SampledQuery witness =
+            checkDirection(Q, state, qPts, tPts, perPoint != nullptr, Q.name + "->" + T.name);
+        out.queryIndex = std::bit_cast<uint32_t>(witness.sorted[3]);
+        out.targetIndex = uint32_t(witness.state.best & 0xffffffffu);
         out.queryPoint = qPts[out.queryIndex];
         out.targetPoint = tPts[out.targetIndex];
         out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
+        std::string why = witnessFailure(out.distance, *maxPacked(), std::sqrt(lb));
+        if (!why.empty()) throw SelfCheckError(Q.name + "->" + T.name + ": " + why);
         if (perPoint) readPerPoint(Q, state, qPts, tPts, *perPoint);
         return out;
     }
@@ -531,6 +616,10 @@ struct GpuHausdorff::State {
 GpuHausdorff::GpuHausdorff(std::unique_ptr<State> state) : m_state(std::move(state)) {}
 GpuHausdorff::~GpuHausdorff() = default;
 
+void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
+    m_state->maxPairCapacity = std::max<uint64_t>(1, pairs);
+}
+
 Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx) {
     try {
         return std::unique_ptr<GpuHausdorff>(new GpuHausdorff(std::make_unique<State>(ctx)));
@@ -549,16 +638,11 @@ Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std:
     // Squared distances are float on the device: coordinates so large (or so
     // small) that they overflow (or underflow) are scaled by a power of two,
     // which is exact; values and witnesses are recomputed from the inputs.
-    std::vector<glm::vec3> scaledA, scaledB;
-    const float scale = exactScaleFor(a, b);
-    if (scale != 1.0f) {
-        scaledA.assign(a.begin(), a.end());
-        scaledB.assign(b.begin(), b.end());
-        for (auto& p : scaledA) p *= scale;
-        for (auto& p : scaledB) p *= scale;
-    }
-    const std::span<const glm::vec3> ga = scale != 1.0f ? std::span<const glm::vec3>(scaledA) : a;
-    const std::span<const glm::vec3> gb = scale != 1.0f ? std::span<const glm::vec3>(scaledB) : b;
+    const double scale = exactScaleFor(a, b);
+    const std::vector<glm::vec3> scaledA = scale != 1.0 ? scaledCopy(a, scale) : std::vector<glm::vec3>();
+    const std::vector<glm::vec3> scaledB = scale != 1.0 ? scaledCopy(b, scale) : std::vector<glm::vec3>();
+    const std::span<const glm::vec3> ga = scale != 1.0 ? std::span<const glm::vec3>(scaledA) : a;
+    const std::span<const glm::vec3> gb = scale != 1.0 ? std::span<const glm::vec3>(scaledB) : b;
     try {
         // Each set is indexed once with its own grid: as targets for the other
         // direction, and as cell-ordered (Morton) queries for its own.
@@ -581,12 +665,16 @@ Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std:
             return Error{ErrorCode::kOutOfMemory,
                          std::string("the inputs do not fit the device: ") + e.what()};
         return Error{ErrorCode::kInternal, e.what()};
+    } catch (const gpu::LimitError& e) {
+        m_state->accel.release();
+        m_state->tlasBound = false;
+        return Error{ErrorCode::kOutOfMemory, std::string("the inputs do not fit the device: ") + e.what()};
     } catch (const std::exception& e) {
         m_state->accel.release();
         m_state->tlasBound = false;
         return Error{ErrorCode::kInternal, e.what()};
     }
-    if (scale != 1.0f) {
+    if (scale != 1.0) {
         auto restore = [](Directed& d, std::span<const glm::vec3> q, std::span<const glm::vec3> t) {
             d.queryPoint = q[d.queryIndex];
             d.targetPoint = t[d.targetIndex];

@@ -28,6 +28,9 @@ public:
     ~GpuHausdorff();
     [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                   const Options& options);
+    // Caps the candidate-pair buffer (default 2^26 pairs); tests shrink it
+    // so that queries must retry until their pairs fit.
+    void setMaxPairCapacity(uint64_t pairs);
 
     struct State;
 

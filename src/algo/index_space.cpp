@@ -33,6 +33,13 @@ GridSpec makeGrid(const Bounds& targetBounds, int bits) {
     return g;
 }
 
+double exactScale(double maxAbs) {
+    if (!(maxAbs > 0.0) || (maxAbs >= 0x1p-40 && maxAbs <= 0x1p40)) return 1.0;
+    int e = 0;
+    std::frexp(maxAbs, &e);
+    return std::ldexp(1.0, -e);
+}
+
 uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z) {
     auto spread = [](uint32_t v) {
         v &= 0x3ffu;

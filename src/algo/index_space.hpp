@@ -42,6 +42,16 @@ struct GridSpec {
 [[nodiscard]] int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds,
                              double targetPointsPerCell = kTargetPointsPerCell);
 
+// The one scaling rule of both backends (squared distances are float there):
+// 1 when the largest coordinate magnitude maxAbs lies in [2^-40, 2^40] (then
+// every squared difference of distinct coordinates near maxAbs is a normal
+// float and none overflows); else the power of two 2^-e with maxAbs in
+// [2^(e-1), 2^e), which brings maxAbs into [0.5, 1). Applied in double and
+// rounded to float, every scaled coordinate is exact or flushes to zero only
+// below 2^-126 * maxAbs-scale, far inside DESIGN §1's tolerance. Finite for
+// every finite maxAbs, subnormals included; 1 for maxAbs = 0.
+[[nodiscard]] double exactScale(double maxAbs);
+
 // Interleaves the low 10 bits of x, y, z (x in bit 0).
 [[nodiscard]] uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z);
 

@@ -264,7 +264,7 @@ void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
 }
 
 DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<const glm::vec3> targets,
-                                 float scale, const Options& options, PerPoint* perPoint,
+                                 double scale, const Options& options, PerPoint* perPoint,
                                  Progress& progress) {
     DirectedOutput out;
     progress.report("index", 0.0);
@@ -275,7 +275,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
     const algo::GridSpec& g = t.grid;
     const glm::dvec3 boxLo = g.origin;
     const algo::Bounds tb = algo::boundsOf(targets);
-    const glm::dvec3 boxHi = tb.hi * double(scale);
+    const glm::dvec3 boxHi = tb.hi * scale;
 
     // Queries in Morton order of the target grid (clamped outside it); the
     // same pass finds the largest distance from a query to BV(T).
@@ -285,7 +285,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
     parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int w) {
         double farthest = 0.0;
         for (size_t i = begin; i < end; ++i) {
-            const glm::dvec3 p = glm::dvec3(queries[i] * scale);
+            const glm::dvec3 p = glm::dvec3(scaled(queries[i], scale));
             const uint32_t key =
                 algo::mortonEncode(algo::cellCoord(p.x, g.origin.x, g.cellSize, g.cellsPerAxis),
                                    algo::cellCoord(p.y, g.origin.y, g.cellSize, g.cellsPerAxis),
@@ -302,7 +302,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
     parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
             const uint32_t src = uint32_t(keyed[i]);
-            const glm::vec3 p = queries[src] * scale;
+            const glm::vec3 p = scaled(queries[src], scale);
             qx[i] = p.x;
             qy[i] = p.y;
             qz[i] = p.z;
@@ -356,7 +356,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
         SearchStats stat;
         for (size_t s = begin; s < end; ++s) {
             const uint32_t i = uint32_t(s * nq / samples);
-            const glm::vec3 p = queries[i] * scale;
+            const glm::vec3 p = scaled(queries[i], scale);
             const Query q{splat(p.x), splat(p.y), splat(p.z)};
             Best best;
             searchTree(t, q, 0.0f, best, stat);
@@ -469,20 +469,15 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
     return out;
 }
 
-// Power of two bringing the largest magnitude near 1 when squared float
-// distances could overflow or lose everything to underflow; 1 otherwise.
-float chooseScale(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
+// The shared scaling rule (algo::exactScale) over both sets.
+double chooseScale(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
     float largest = 0.0f;
     for (auto set : {a, b}) {
         for (const glm::vec3& p : set) {
             largest = std::max({largest, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
         }
     }
-    if (!(largest > 0.0f)) return 1.0f;
-    int exponent = 0;
-    std::frexp(largest, &exponent);
-    if (exponent > 40 || exponent < -40) return std::ldexp(1.0f, -exponent);
-    return 1.0f;
+    return algo::exactScale(double(largest));
 }
 
 }  // namespace
@@ -497,7 +492,7 @@ Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<con
     r.backend = Backend::kCpu;
     r.device = "cpu";
     r.directedOnly = options.directedOnly;
-    const float scale = chooseScale(a, b);
+    const double scale = chooseScale(a, b);
 
     auto add = [&](const DirectedOutput& o) {
         r.timings.index += o.indexMs;

@@ -45,7 +45,7 @@ void radixSortKeys(std::vector<uint64_t>& values, int keyBits) {
     }
 }
 
-TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale, int bits, int threads) {
+TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, int bits, int threads) {
     TargetIndex index;
     index.scale = scale;
     const size_t n = targets.size();
@@ -53,8 +53,8 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale, in
     // Grid over the scaled targets; the bit count is scale invariant.
     const algo::Bounds raw = algo::boundsOf(targets);
     if (bits <= 0) bits = algo::chooseBits(targets, raw);
-    algo::Bounds scaled{raw.lo * double(scale), raw.hi * double(scale)};
-    index.grid = algo::makeGrid(scaled, bits);
+    algo::Bounds scaledBounds{raw.lo * scale, raw.hi * scale};
+    index.grid = algo::makeGrid(scaledBounds, bits);
     index.fineBits = std::min(index.grid.bits + 2, 10);
     const int extra = index.fineBits - index.grid.bits;
     // A fine cell is the grid cell split 2^extra times per axis. The fine cell
@@ -69,7 +69,7 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale, in
     std::vector<uint64_t> keyed(n);
     parallelChunks(n, 1 << 16, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
-            const glm::vec3 p = targets[i] * scale;
+            const glm::vec3 p = scaled(targets[i], scale);
             const uint32_t key =
                 algo::mortonEncode(algo::cellCoord(p.x, fine.origin.x, fine.cellSize, fine.cellsPerAxis),
                                    algo::cellCoord(p.y, fine.origin.y, fine.cellSize, fine.cellsPerAxis),
@@ -87,7 +87,7 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale, in
     parallelChunks(n, 1 << 16, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
             const uint32_t src = uint32_t(keyed[i]);
-            const glm::vec3 p = targets[src] * scale;
+            const glm::vec3 p = scaled(targets[src], scale);
             index.x[i] = p.x;
             index.y[i] = p.y;
             index.z[i] = p.z;

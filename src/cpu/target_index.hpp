@@ -42,7 +42,7 @@ struct BoxLevel {
 struct TargetIndex {
     algo::GridSpec grid;  // over the scaled targets
     int fineBits = 1;     // bits of the sort key per axis (grid.bits + 2, <= 10)
-    float scale = 1.0f;
+    double scale = 1.0;   // algo::exactScale
 
     // Sorted targets (scaled), padded with kPad entries of +inf.
     std::vector<float> x, y, z;
@@ -62,9 +62,15 @@ struct TargetIndex {
     [[nodiscard]] uint32_t bucketCount() const { return levels.empty() ? 0 : levels[0].count; }
 };
 
+// p * scale computed in double and rounded: exact for a power of two that
+// keeps the product a normal float (algo::exactScale), never inf or NaN.
+[[nodiscard]] inline glm::vec3 scaled(const glm::vec3& p, double scale) {
+    return glm::vec3(glm::dvec3(p) * scale);
+}
+
 // Builds the index over `targets` (non-empty, finite) scaled by `scale`.
 // bits <= 0 picks the grid's bit count with algo::chooseBits.
-[[nodiscard]] TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, float scale, int bits,
+[[nodiscard]] TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, int bits,
                                            int threads);
 
 // Sorts (key << 32 | payload) values by their key bits [32, 32 + keyBits),

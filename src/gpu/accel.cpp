@@ -41,6 +41,7 @@ void AccelStructures::release() {
 
 bool AccelStructures::cmdBuild(VkCommandBuffer cmd, VkDeviceAddress aabbs, uint32_t count, bool update,
                                VkPipelineStageFlags shaderStages) {
+    requireWithin(count, m_ctx.limits().maxPrimitives, "a BLAS of search cells", "maxPrimitiveCount");
     const RtFunctions& rt = m_ctx.rt();
     VkDevice d = m_ctx.device();
     const VkDeviceSize scratchAlign =

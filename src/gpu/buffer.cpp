@@ -1,5 +1,7 @@
 #include "gpu/buffer.hpp"
 
+#include <string>
+
 #include "gpu/context.hpp"
 
 namespace rthdist::gpu {
@@ -7,6 +9,7 @@ namespace rthdist::gpu {
 Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind) {
     m_device = ctx.device();
     m_size = size == 0 ? 16 : size;
+    requireWithin(m_size, ctx.limits().maxBufferBytes, "a buffer", "maxBufferSize");
     VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
     bi.size = m_size;
     bi.usage = usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
@@ -32,7 +35,12 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
     VkResult r = vkAllocateMemory(m_device, &ai, nullptr, &m_memory);
     if (r < 0) {
         reset();
-        throwVulkanError(r, "vkAllocateMemory", __FILE__, __LINE__);
+        const DeviceLimits& l = ctx.limits();
+        const std::string what = "vkAllocateMemory of " + std::to_string(req.size) +
+                                 " bytes (the device's maxMemoryAllocationSize is " +
+                                 std::to_string(l.maxAllocationBytes) + ", its largest device heap " +
+                                 std::to_string(l.deviceHeapBytes) + " bytes)";
+        throwVulkanError(r, what.c_str(), __FILE__, __LINE__);
     }
     RTHDIST_VK_CHECK(vkBindBufferMemory(m_device, m_buffer, m_memory, 0));
     if (kind == MemoryKind::kHost)

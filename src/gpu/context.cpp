@@ -130,6 +130,7 @@ Probe probeDevice(VkPhysicalDevice pd, int index) {
         common = false;
     }
     p.common = common;
+    p.info.limits = readDeviceLimits(pd).named();
     bool hasRq = hasExtension(exts, VK_KHR_RAY_QUERY_EXTENSION_NAME) && rq.rayQuery;
     bool hasRtp = hasExtension(exts, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) && rtp.rayTracingPipeline;
     if (!hasRq) missing.push_back("ray-query: VK_KHR_ray_query with feature rayQuery");
@@ -333,6 +334,7 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
         vkGetPhysicalDeviceProperties2(chosenPd, &p2);
         ctx->m_timestampPeriod = p2.properties.limits.timestampPeriod;
         vkGetPhysicalDeviceMemoryProperties(chosenPd, &ctx->m_memProps);
+        ctx->m_limits = readDeviceLimits(chosenPd);
 
         VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
         pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "gpu/device_limits.hpp"
 #include "gpu/vk_check.hpp"
 #include "rthdist/rthdist.hpp"
 
@@ -48,6 +49,11 @@ public:
     [[nodiscard]] const VkPhysicalDeviceAccelerationStructurePropertiesKHR& asProps() const {
         return m_asProps;
     }
+    // Size limits of the device (DESIGN §9); setLimits replaces them (tests
+    // shrink them to cross every split boundary with small inputs; a larger
+    // value than the device's would be unsafe).
+    [[nodiscard]] const DeviceLimits& limits() const { return m_limits; }
+    void setLimits(const DeviceLimits& limits) { m_limits = limits; }
     [[nodiscard]] uint64_t validationMessageCount() const { return m_validationMessages.load(); }
     [[nodiscard]] uint32_t memoryTypeIndex(uint32_t typeBits, VkMemoryPropertyFlags wanted) const;
     [[nodiscard]] float timestampPeriodNs() const { return m_timestampPeriod; }
@@ -88,6 +94,7 @@ private:
     VkPhysicalDeviceRayTracingPipelinePropertiesKHR m_rtProps{};
     VkPhysicalDeviceAccelerationStructurePropertiesKHR m_asProps{};
     VkPhysicalDeviceMemoryProperties m_memProps{};
+    DeviceLimits m_limits;
     float m_timestampPeriod = 1.0f;
     std::atomic<uint64_t> m_validationMessages{0};
 };

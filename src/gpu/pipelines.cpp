@@ -11,6 +11,8 @@
 #include "cell_build.comp.h"
 #include "cell_heads.comp.h"
 #include "cell_keys.comp.h"
+#include "check_index.comp.h"
+#include "check_queries.comp.h"
 #include "coarsen.comp.h"
 #include "compact.comp.h"
 #include "cull.comp.h"
@@ -107,6 +109,8 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
         spirv(k_spv_refine_comp, "refine"),
         spirv(k_spv_resolve_comp, "resolve"),
         spirv(k_spv_coarsen_comp, "coarsen"),
+        spirv(k_spv_check_index_comp, "check_index"),
+        spirv(k_spv_check_queries_comp, "check_queries"),
     };
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !rayQuery) continue;
@@ -218,11 +222,12 @@ void Pipelines::cmdDispatch(VkCommandBuffer cmd, Kernel kernel, const void* push
                                      VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR),
                        0, pushSize, push);
     // Large 1-D dispatches are split to respect maxComputeWorkGroupCount[0]
-    // (65535 is the guaranteed minimum); shaders see gl_WorkGroupID offsets
-    // through vkCmdDispatchBase.
-    constexpr uint32_t kMaxGroups = 65535;
-    for (uint32_t first = 0; first < groups; first += kMaxGroups)
-        vkCmdDispatchBase(cmd, first, 0, 0, std::min(kMaxGroups, groups - first), 1, 1);
+    // (the device's, or a smaller one a test set); shaders see
+    // gl_WorkGroupID offsets through vkCmdDispatchBase.
+    const uint32_t maxGroups = std::max<uint32_t>(1, m_ctx.limits().maxGroupsX);
+    for (uint64_t first = 0; first < groups; first += maxGroups)
+        vkCmdDispatchBase(cmd, uint32_t(first), 0, 0, uint32_t(std::min<uint64_t>(maxGroups, groups - first)),
+                          1, 1);
 }
 
 void Pipelines::cmdTraceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize, uint32_t width) const {

@@ -28,6 +28,8 @@ enum class Kernel : uint32_t {
     kRefine,
     kResolve,
     kCoarsen,
+    kCheckIndex,    // self-check of an index (check_index.comp)
+    kCheckQueries,  // self-check of a direction (check_queries.comp)
     kCount
 };
 

@@ -1,0 +1,21 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Self-check of one direction (costs one read of the query states): when the
+// search ends, every query is EXACT (its NN is known) or DEAD (a real target
+// point strictly closer than a value h reaches), and in both cases its best
+// squared distance is at most the final maximum. With per-point distances
+// every query must be EXACT. A query never visited, or one whose distance was
+// lost, breaks this.
+#include "common.glsl"
+layout(local_size_x = RTHDIST_WG) in;
+layout(push_constant) uniform Push { CheckPush pc; };
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= pc.n) return;
+    QueryState st = stateAt(pc.state, i).v;
+    float maxD2 = packedDist2(U64Ref(pc.counters + RTHDIST_CTR_MAX_PACKED).v);
+    bool settled = st.status == RTHDIST_EXACT || (st.status == RTHDIST_DEAD && pc.perPoint == 0u);
+    if (!settled || !(packedDist2(st.best) <= maxD2))
+        atomicAdd(U64Ref(pc.counters + RTHDIST_CTR_CHECK_BAD).v, 1ul);
+}

@@ -1,0 +1,164 @@
+// Sizes past 32 bits without the memory they would need (issue: wrong H at
+// 300M points): the shaders' record accessors form 64-bit offsets at 2^28,
+// 2^31 and 2^32 - 1 records (an address probe), and the engine stays exact
+// when every split of the work is forced small (dispatches of a few groups,
+// traces of a few rays, a pair buffer of a few dozen pairs), and refuses
+// with the limit named when a buffer or a BLAS is past the device's limit.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "address_probe.comp.h"
+#include "algo/gpu_hausdorff.hpp"
+#include "common/oracle_cases.hpp"
+#include "gpu/buffer.hpp"
+#include "gpu/context.hpp"
+#include "gpu_test_support.hpp"
+
+namespace rthdist::test {
+namespace {
+
+std::unique_ptr<gpu::Context> makeContext(std::string& whyNot) {
+    auto ctx = gpu::Context::create(backendUnderTest(), -1, true);
+    if (!ctx) {
+        whyNot = ctx.error().message;
+        return nullptr;
+    }
+    return std::move(ctx.value());
+}
+
+#define RTHDIST_REQUIRE_CONTEXT(ctx)      \
+    std::string rthdist_why_;             \
+    auto ctx = makeContext(rthdist_why_); \
+    if (!ctx) GTEST_SKIP() << "no device for this backend: " << rthdist_why_
+
+// Runs address_probe.comp once for `index` and returns the 7 addresses.
+std::vector<uint64_t> probeAddresses(gpu::Context& ctx, uint64_t base, uint32_t index) {
+    VkDevice d = ctx.device();
+    gpu::Buffer out(ctx, 7 * 8, gpu::kStorageUsage, gpu::MemoryKind::kHost);
+    VkShaderModuleCreateInfo mi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    mi.codeSize = sizeof(k_spv_address_probe_comp);
+    mi.pCode = k_spv_address_probe_comp;
+    VkShaderModule module = VK_NULL_HANDLE;
+    EXPECT_EQ(vkCreateShaderModule(d, &mi, nullptr, &module), VK_SUCCESS);
+    struct Push {
+        uint64_t base, out;
+        uint32_t index;
+    } push{base, out.address(), index};
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Push)};
+    VkPipelineLayoutCreateInfo li{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    li.pushConstantRangeCount = 1;
+    li.pPushConstantRanges = &range;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    EXPECT_EQ(vkCreatePipelineLayout(d, &li, nullptr, &layout), VK_SUCCESS);
+    VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    ci.stage.module = module;
+    ci.stage.pName = "main";
+    ci.layout = layout;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    EXPECT_EQ(vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline), VK_SUCCESS);
+    VkCommandBuffer cmd = ctx.begin();
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Push), &push);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    ctx.submitAndWait(cmd);
+    std::vector<uint64_t> addresses(7);
+    std::memcpy(addresses.data(), out.mapped(), 7 * 8);
+    vkDestroyPipeline(d, pipeline, nullptr);
+    vkDestroyPipelineLayout(d, layout, nullptr);
+    vkDestroyShaderModule(d, module, nullptr);
+    return addresses;
+}
+
+TEST(LargeSizes, RecordOffsetsAre64BitPast4GiB) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    const uint64_t base = uint64_t(1) << 40;  // never dereferenced
+    for (uint32_t i :
+         {(1u << 28) - 1, 1u << 28, (1u << 28) + 1, 1u << 30, (1u << 31) - 1, 1u << 31, 0xffffffffu}) {
+        SCOPED_TRACE(i);
+        const std::vector<uint64_t> a = probeAddresses(*ctx, base, i);
+        const uint64_t n = i;
+        EXPECT_EQ(a[0], base + 16 * n) << "vec4";
+        EXPECT_EQ(a[1], base + 4 * n) << "uint";
+        EXPECT_EQ(a[2], base + 8 * n) << "uvec2";
+        EXPECT_EQ(a[3], base + 8 * n) << "uint64";
+        EXPECT_EQ(a[4], base + 32 * n) << "Cell";
+        EXPECT_EQ(a[5], base + 16 * n) << "QueryState";
+        EXPECT_EQ(a[6], base + 4 * (6 * n + 5)) << "float of an AABB";
+    }
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// Every split boundary crossed with small inputs: dispatches of at most 3
+// workgroups, traces of at most 5 rays, a pair buffer of 600 pairs (queries
+// retry at the same radius until their pairs fit).
+TEST(LargeSizes, ExactWhenEverySplitIsForcedSmall) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    gpu::DeviceLimits limits = ctx->limits();
+    limits.maxGroupsX = 3;
+    limits.maxRayDispatch = 5;
+    ctx->setLimits(limits);
+    auto engine = algo::GpuHausdorff::create(*ctx);
+    ASSERT_TRUE(engine) << engine.error().message;
+    (*engine)->setMaxPairCapacity(600);
+    const std::vector<OracleCase> cases = makeOracleCases();
+    int run = 0;
+    for (size_t i = 0; i < cases.size(); i += 7) {
+        const OracleCase& c = cases[i];
+        if (c.a.size() + c.b.size() > 20000) continue;
+        SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed));
+        Options options;
+        auto r = (*engine)->compute(c.a, c.b, options);
+        ASSERT_TRUE(r) << r.error().message;
+        expectMatchesOracle(c, *r);
+        ++run;
+    }
+    EXPECT_GT(run, 30);
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+TEST(LargeSizes, BufferPastMaxBufferSizeIsRefusedWithTheLimitNamed) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    gpu::DeviceLimits limits = ctx->limits();
+    limits.maxBufferBytes = 64 << 10;  // 4096 points of 16 bytes
+    ctx->setLimits(limits);
+    auto engine = algo::GpuHausdorff::create(*ctx);
+    ASSERT_TRUE(engine) << engine.error().message;
+    std::vector<glm::vec3> a(10000), b(3);
+    for (size_t i = 0; i < a.size(); ++i) a[i] = glm::vec3(float(i % 100), float(i / 100), 0.0f);
+    b = {{0, 0, 1}, {5, 5, 1}, {50, 50, 1}};
+    auto r = (*engine)->compute(a, b, Options{});
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kOutOfMemory);
+    EXPECT_NE(r.error().message.find("maxBufferSize"), std::string::npos) << r.error().message;
+    // Small inputs still run on the same engine.
+    auto ok = (*engine)->compute(b, b, Options{});
+    ASSERT_TRUE(ok) << ok.error().message;
+    EXPECT_EQ(ok->hausdorff, 0.0);
+}
+
+TEST(LargeSizes, BlasPastMaxPrimitiveCountIsRefusedWithTheLimitNamed) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    gpu::DeviceLimits limits = ctx->limits();
+    limits.maxPrimitives = 2;
+    ctx->setLimits(limits);
+    auto engine = algo::GpuHausdorff::create(*ctx);
+    ASSERT_TRUE(engine) << engine.error().message;
+    // Far-apart sets: queries survive the neighbourhood pass and need rays.
+    std::vector<glm::vec3> a, b;
+    for (int i = 0; i < 400; ++i) {
+        a.push_back(glm::vec3(float(i % 20), float(i / 20), 0.0f));
+        b.push_back(glm::vec3(float(i % 20), float(i / 20), 0.0f) * 0.1f + glm::vec3(0.03f, 0.07f, 0.5f));
+    }
+    auto r = (*engine)->compute(a, b, Options{});
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kOutOfMemory);
+    EXPECT_NE(r.error().message.find("maxPrimitiveCount"), std::string::npos) << r.error().message;
+}
+
+}  // namespace
+}  // namespace rthdist::test
