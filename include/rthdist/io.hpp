@@ -3,27 +3,51 @@
 // Formats (chosen by extension, case-insensitive; ".gz" is unwrapped first):
 //   .ply  ascii, binary_little_endian, binary_big_endian; vertex x/y/z as any
 //         numeric type (float/double/int...); other vertex properties, list
-//         properties and other elements (faces, tristrips, range_grid) skipped.
+//         properties and other elements (faces, tristrips, range_grid) are
+//         skipped, but must be in the file as declared: ascii bodies hold one
+//         item per line with exactly its properties' values; binary bodies
+//         are walked item by item to the end of the file (only blank or NUL
+//         padding may follow). A property name may appear once per element.
 //   .xyz / .txt  one "x y z" per line (extra columns ignored, '#' comments).
 //   .obj  "v x y z" lines only.
 //   .gltf / .glb  POSITION of every primitive of every mesh instanced by the
-//         scene's nodes, with node transforms applied (tinygltf).
-//   .stl  ascii and binary (every facet vertex, duplicates kept)
+//         scene's nodes, with node transforms applied (tinygltf). External
+//         buffers are read only from regular files inside the glTF file's own
+//         directory (no absolute path, no "..", no current-directory lookup);
+//         data: URIs are decoded; images are never read.
+//   .stl  ascii and binary (every facet vertex, duplicates kept); binary when
+//         the size is 84 + 50 * facets or the file holds a NUL byte, whatever
+//         the header's first word.
 //   .off  OFF / COFF / NOFF headers, vertices only
 //   .pcd  ascii and binary (x y z fields, any size/type), not binary_compressed
+// Text (every format's text parts): a leading UTF-8 byte order mark is
+// skipped; "\n", "\r\n" and a lone "\r" all end a line.
 //
 // Contract: on success, at least one point and every coordinate finite. Every
 // failure is ErrorCode::kBadInput with a message "<path>: <where>: <what>"
-// (where = line N, vertex N, byte offset N, element name...). Declared counts
-// are checked against the file size before anything is allocated, so a lying
-// header cannot cause a huge allocation.
+// (where = line N, vertex N, byte offset N, element name, gzip, glTF...).
+// Declared counts are checked against the file before anything is allocated,
+// so a lying header cannot cause a huge allocation; for .gz files and glTF the
+// limits below do the same, each refused with kBadInput before the memory is
+// spent:
+//   .gz    the first 64 KiB are inflated and the format's header checked;
+//          a binary PLY, binary STL or .glb may then inflate to no more than
+//          its header declares (+ 64 KiB); and no file inflates past 64 times
+//          its compressed size or 256 MiB, whichever is larger.
+//   glTF   JSON nesting at most 256 deep, at most 2,000,000 JSON values and
+//          500,000 top-level objects (nodes, meshes, accessors...), checked
+//          before parsing; at most 100,000,000 instanced points and
+//          10,000,000 node instances over the scene, counted before any point
+//          is read; external buffer files at most 4 GiB.
 //
 // Precision: decimal text is converted straight to the nearest float
 // (std::from_chars); double and integer inputs are rounded to float.
-// Limits: PLY elements after the vertex element are not read; a glTF mesh
-// instanced by several nodes gives its points once per instance; NaN points
-// (e.g. in organized PCD clouds) are rejected, not dropped. Reentrant: no
-// shared state, safe to call from several threads.
+// Limits: a glTF mesh instanced by several nodes gives its points once per
+// instance; NaN points (e.g. in organized PCD clouds) are rejected, not
+// dropped; a binary PLY whose vertex count is one too high can go unnoticed
+// when the bytes it takes happen to leave a valid rest (e.g. 12-byte vertices
+// before uchar/int triangles). Reentrant: no shared state, safe to call from
+// several threads.
 #pragma once
 
 #include <glm/vec3.hpp>
