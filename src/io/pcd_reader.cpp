@@ -48,13 +48,15 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
     std::string data;
     size_t dataLine = 0;
     std::string_view line;
+    // Headers have a handful of fields in practice; 4096 bounds the work
+    // (refilled per line, only the first n are read).
+    std::array<std::string_view, 4096> headerTok{};
     while (data.empty()) {
         if (!cursor.nextLine(line)) return badInput(path, "header", "no DATA line");
         const size_t lineNo = cursor.line();
         const std::string_view body = trimBlank(line);
         if (body.empty() || body.front() == '#') continue;
-        // Headers have a handful of fields in practice; 4096 bounds the work.
-        std::array<std::string_view, 4096> tok{};
+        auto& tok = headerTok;
         const size_t n = splitTokens(body, tok.data(), tok.size());
         if (n > tok.size()) return badInput(path, lineWhere(lineNo), "too many header values");
         const std::string_view key = tok[0];
