@@ -1,8 +1,8 @@
 // libFuzzer target for one point loader, chosen at build time by
 // RTHDIST_FUZZ_FORMAT (tests/fuzz/CMakeLists.txt builds one binary per
-// format). The readers take bytes, so most formats are fed in memory; "gz"
-// goes through a file and loadPoints, so that the bounded gunzip and the
-// format's header check before inflating are exercised too.
+// format). The readers take bytes, so every format is fed in memory; "gz"
+// is a gzipped PLY: the bounded gunzip with the PLY header check, then the
+// PLY reader, as loadPoints does for a .ply.gz.
 //
 // Any input must give points or a kBadInput error; a crash, a sanitizer
 // report, a leak, a timeout or an allocation beyond -rss_limit_mb is a bug.
@@ -18,13 +18,13 @@
 #include <string_view>
 
 #include "io/gltf_reader.hpp"
+#include "io/gzip_inflate.hpp"
 #include "io/obj_reader.hpp"
 #include "io/off_reader.hpp"
 #include "io/pcd_reader.hpp"
 #include "io/ply_reader.hpp"
 #include "io/stl_reader.hpp"
 #include "io/xyz_reader.hpp"
-#include "rthdist/io.hpp"
 
 #ifndef RTHDIST_FUZZ_FORMAT
 #error "RTHDIST_FUZZ_FORMAT must name the format (ply, xyz, obj, gltf, glb, stl, off, pcd, gz)"
@@ -62,13 +62,10 @@ void loadBytes(std::string_view bytes) {
     }
 }
 
-void loadThroughFile(std::string_view bytes) {
-    const std::string path = scratchDir() + "/fuzz.ply.gz";
-    {
-        std::ofstream out(path, std::ios::binary | std::ios::trunc);
-        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    }
-    (void)rthdist::io::loadPoints(path);
+void loadGzippedPly(std::string_view bytes) {
+    using namespace rthdist::io;
+    auto inflated = gunzip(bytes, "fuzz.ply.gz", &plyInflatedBound);
+    if (inflated) (void)readPly(*inflated, "fuzz.ply.gz");
 }
 
 }  // namespace
@@ -76,7 +73,7 @@ void loadThroughFile(std::string_view bytes) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::string_view bytes(reinterpret_cast<const char*>(data), size);
     if (kFormat == "gz") {
-        loadThroughFile(bytes);
+        loadGzippedPly(bytes);
     } else {
         loadBytes(bytes);
     }
