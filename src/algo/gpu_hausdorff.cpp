@@ -271,12 +271,11 @@ struct GpuHausdorff::State {
         cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
         barrier(cmd);
         dispatch(cmd, Kernel::kCellBuild, cp, ix.n);
-        cmdCheckIndex(cmd, ix);
+        cmdCheckIndex(cmd, ix);  // in the same submission: no extra wait
         ctx.submitAndWait(cmd);
         timings->gpuIndex += ctx.lastGpuMs();
         ix.numCells = counter<uint32_t>(RTHDIST_CTR_CELLS);
         verifyIndex(ix, std::min<uint64_t>(ix.n, numKeys));
-
         timings->index += msSince(t0);
         return ix;
     }
@@ -571,6 +570,7 @@ struct GpuHausdorff::State {
 
         // Witness: the query slot in the low half of maxPacked, its target in
         // the query's state; both read back (and checked) by the self-check.
+        const auto checkStart = Clock::now();
         const SampledQuery witness =
             checkDirection(Q, state, qPts, tPts, perPoint != nullptr, Q.name + "->" + T.name);
         out.queryIndex = std::bit_cast<uint32_t>(witness.sorted[3]);
@@ -580,6 +580,7 @@ struct GpuHausdorff::State {
         out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
         std::string why = witnessFailure(out.distance, *maxPacked(), std::sqrt(lb));
         if (!why.empty()) throw SelfCheckError(Q.name + "->" + T.name + ": " + why);
+        timings->check += msSince(checkStart);
         if (perPoint) readPerPoint(Q, state, qPts, tPts, *perPoint);
         return out;
     }

@@ -292,7 +292,7 @@ void expectRunShape(const Json& j) {
         EXPECT_DOUBLE_EQ(j["hausdorff"].get<double>(), std::max(j["a_to_b"]["distance"].get<double>(),
                                                                 j["b_to_a"]["distance"].get<double>()));
     }
-    for (const char* k : {"load", "setup", "upload", "index", "cull", "search", "refine", "total", "wall"}) {
+    for (const char* k : {"load", "setup", "upload", "index", "cull", "search", "refine", "check", "total", "wall"}) {
         ASSERT_TRUE(j["timings_ms"].contains(k)) << "missing timings_ms." << k;
         EXPECT_GE(j["timings_ms"][k].get<double>(), 0.0) << k;
     }

@@ -122,7 +122,8 @@ int main(int argc, char** argv) {
     const double setupMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
-    std::vector<double> wall, total, index, cull, search, refine, gIndex, gCull, gSearch, gRefine, upload;
+    std::vector<double> wall, total, index, cull, search, refine, check, gIndex, gCull, gSearch, gRefine,
+        upload;
     HausdorffResult last;
     const double budgetMs = budgetS * 1e3;
     double warmMs = 0.0, timedMs = 0.0;
@@ -151,6 +152,7 @@ int main(int argc, char** argv) {
         cull.push_back(t.cull);
         search.push_back(t.search);
         refine.push_back(t.refine);
+        check.push_back(t.check);
         gIndex.push_back(t.gpuIndex);
         gCull.push_back(t.gpuCull);
         gSearch.push_back(t.gpuSearch);
@@ -200,7 +202,7 @@ int main(int argc, char** argv) {
     j.key("median_ms").beginObject();
     j.key("wall").value(median(wall)).key("total").value(median(total)).key("upload").value(median(upload));
     j.key("index").value(median(index)).key("cull").value(median(cull)).key("search").value(median(search));
-    j.key("refine").value(median(refine));
+    j.key("refine").value(median(refine)).key("check").value(median(check));
     j.key("gpu_index").value(median(gIndex)).key("gpu_cull").value(median(gCull));
     j.key("gpu_search").value(median(gSearch)).key("gpu_refine").value(median(gRefine));
     j.key("gpu_sum").value(median(gIndex) + median(gCull) + median(gSearch) + median(gRefine));

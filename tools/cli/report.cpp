@@ -115,8 +115,9 @@ std::string summaryText(const RunReport& report) {
     const Timings& t = r.timings;
     appendf(s,
             "time (ms)  load %.2f | setup %.2f | upload %.2f | index %.2f | cull %.2f | search %.2f | "
-            "refine %.2f | total %.2f | wall %.2f\n",
-            report.loadMs, t.setup, t.upload, t.index, t.cull, t.search, t.refine, t.total, report.wallMs);
+            "refine %.2f | check %.2f | total %.2f | wall %.2f\n",
+            report.loadMs, t.setup, t.upload, t.index, t.cull, t.search, t.refine, t.check, t.total,
+            report.wallMs);
     appendf(s, "counters   A->B %s\n", countersText(r.aToB.counters).c_str());
     if (!r.directedOnly) appendf(s, "           B->A %s\n", countersText(r.bToA.counters).c_str());
     if (report.stats != nullptr) s += statsText(*report.stats, r.directedOnly);
@@ -161,6 +162,7 @@ std::string jsonReport(const RunReport& report) {
         .field("cull", t.cull)
         .field("search", t.search)
         .field("refine", t.refine)
+        .field("check", t.check)
         .field("total", t.total)
         .field("wall", report.wallMs)
         .endObject();
@@ -203,6 +205,10 @@ std::string devicesText(const std::vector<DeviceInfo>& devices) {
         appendf(s, "    ray-query: %s, rt-pipeline: %s\n", d.rayQuery ? "yes" : "no",
                 d.rtPipeline ? "yes" : "no");
         for (const std::string& why : d.missing) appendf(s, "    - %s\n", why.c_str());
+        std::string limits;
+        for (const auto& [name, value] : d.limits)
+            appendf(limits, " %s %llu", name.c_str(), (unsigned long long)value);
+        if (!limits.empty()) appendf(s, "    limits:%s\n", limits.c_str());
     }
     return s;
 }
@@ -220,7 +226,10 @@ std::string devicesJson(const std::vector<DeviceInfo>& devices) {
             .field("rt_pipeline", d.rtPipeline);
         w.key("missing").beginArray();
         for (const std::string& why : d.missing) w.value(why);
-        w.endArray().endObject();
+        w.endArray();
+        w.key("limits").beginObject();
+        for (const auto& [name, value] : d.limits) w.field(name.c_str(), value);
+        w.endObject().endObject();
     }
     w.endArray().endObject();
     return w.str() + "\n";
