@@ -188,6 +188,9 @@ struct Winner {
 
 struct DirectedOutput {
     Directed directed;
+    // A query whose search found no target (impossible for finite, scaled
+    // input; kept as an internal error rather than a read past the arrays).
+    bool lostQuery = false;
     double indexMs = 0.0, cullMs = 0.0, searchMs = 0.0, refineMs = 0.0;
 };
 
@@ -226,7 +229,8 @@ void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
                   std::span<const glm::vec3> targets, const std::vector<float>& qx,
                   const std::vector<float>& qy, const std::vector<float>& qz,
                   const std::vector<uint32_t>& qOriginal, const std::vector<uint32_t>& qKey, int threads,
-                  PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress) {
+                  PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress,
+                  std::atomic<bool>& lost) {
     const size_t nq = queries.size();
     nearest.distance.assign(nq, 0.0);
     nearest.nearest.assign(nq, 0);
@@ -249,6 +253,11 @@ void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
                 scanRange(t, t.cellFirst[cursor], t.cellFirst[cursor + 1], q, best);
             }
             searchTree(t, q, 0.0f, best, stat);  // kill 0: never breaks early
+            if (best.pos == kNone) {
+                lost.store(true, std::memory_order_relaxed);
+                hint = kNone;
+                continue;
+            }
             hint = t.bucketOf[best.pos];
             const uint32_t src = qOriginal[i];
             const glm::dvec3 diff = glm::dvec3(queries[src]) - glm::dvec3(targets[best.target]);
@@ -320,7 +329,10 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
         // is consistent with the per-point array by construction.
         start = Clock::now();
         std::vector<SearchStats> stats(static_cast<size_t>(threads));
-        perPointPass(t, queries, targets, qx, qy, qz, qOriginal, qKey, threads, *perPoint, stats, progress);
+        std::atomic<bool> lost{false};
+        perPointPass(t, queries, targets, qx, qy, qz, qOriginal, qKey, threads, *perPoint, stats, progress,
+                     lost);
+        out.lostQuery = lost.load();
         out.searchMs = msSince(start);
         progress.report("refine", kSearchDone);
         start = Clock::now();
@@ -368,6 +380,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
     float sampleMax = 0.0f;
     for (const Winner& w : winners) sampleMax = std::max(sampleMax, w.d2);
     const double bound2 = *std::max_element(boxBound.begin(), boxBound.end()) * (1.0 - kBoundShrink);
+    std::atomic<bool> lost{false};
     std::atomic<uint32_t> kill{std::bit_cast<uint32_t>(std::max(sampleMax, float(bound2)))};
     out.cullMs = msSince(start);
     progress.report("cull", kCullDone);
@@ -424,6 +437,11 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
             }
             ++survivingHere;
             const bool dead = searchTree(t, q, k, best, stat);
+            if (best.pos == kNone) {
+                lost.store(true, std::memory_order_relaxed);
+                hint = kNone;
+                continue;
+            }
             hintPos = best.pos;
             hint = t.bucketOf[best.pos];
             if (dead) continue;
@@ -440,6 +458,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
         }
     });
     out.searchMs = msSince(start);
+    out.lostQuery = lost.load();
     progress.report("refine", kSearchDone);
 
     start = Clock::now();
@@ -505,12 +524,14 @@ Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<con
     Progress first(options, 0.0, span);
     DirectedOutput ab = directedHausdorff(a, b, scale, options, perPoint ? &r.aNearest : nullptr, first);
     add(ab);
+    if (ab.lostQuery) return Error{ErrorCode::kInternal, "CPU backend: a query of A found no target"};
     r.aToB = ab.directed;
     r.hausdorff = r.aToB.distance;
     if (!options.directedOnly) {
         Progress second(options, 0.5, 0.5);
         DirectedOutput ba = directedHausdorff(b, a, scale, options, perPoint ? &r.bNearest : nullptr, second);
         add(ba);
+        if (ba.lostQuery) return Error{ErrorCode::kInternal, "CPU backend: a query of B found no target"};
         r.bToA = ba.directed;
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
     }

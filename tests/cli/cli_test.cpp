@@ -292,7 +292,8 @@ void expectRunShape(const Json& j) {
         EXPECT_DOUBLE_EQ(j["hausdorff"].get<double>(), std::max(j["a_to_b"]["distance"].get<double>(),
                                                                 j["b_to_a"]["distance"].get<double>()));
     }
-    for (const char* k : {"load", "setup", "upload", "index", "cull", "search", "refine", "check", "total", "wall"}) {
+    for (const char* k :
+         {"load", "setup", "upload", "index", "cull", "search", "refine", "check", "total", "wall"}) {
         ASSERT_TRUE(j["timings_ms"].contains(k)) << "missing timings_ms." << k;
         EXPECT_GE(j["timings_ms"][k].get<double>(), 0.0) << k;
     }
@@ -398,6 +399,26 @@ TEST(CliJson, EscapesFileNames) {
     EXPECT_EQ(j["files"]["a"].get<std::string>(), weird);
     const std::string bName = j["files"]["b"].get<std::string>();
     EXPECT_NE(bName.find("\xEF\xBF\xBD"), std::string::npos) << "invalid bytes become U+FFFD";
+}
+
+// Issue 15, finding 1: every coordinate tiny but not zero crashed the CPU
+// backend (an infinite float scale, NaN queries, a read past the arrays),
+// on the default path and under --verify; subnormal coordinates gave a pair
+// that is not the nearest on the GPU backends.
+TEST(CliCpu, TinyAndSubnormalCoordinatesAreExact) {
+    TempDir dir;
+    const std::string tiny = dir.write("tiny.xyz", "1e-40 0 0\n");
+    const std::string zero = dir.write("zero.xyz", "0 0 0\n");
+    const std::string sub = dir.write("sub.xyz", "1.4e-44 0 0\n2.8e-44 0 0\n7e-45 1.4e-45 0\n");
+    for (const std::string& backend : {"auto", "cpu", "ray-query", "rt-pipeline"}) {
+        SCOPED_TRACE(backend);
+        const CliRun run = runCli({"--backend", backend, "--verify", "--json", tiny, zero});
+        ASSERT_EQ(run.exitCode, 0) << run;
+        EXPECT_EQ(parseJson(run)["hausdorff"].get<double>(), double(1e-40f));
+        const CliRun subRun = runCli({"--backend", backend, "--verify", "--json", sub, zero});
+        ASSERT_EQ(subRun.exitCode, 0) << subRun;
+        EXPECT_EQ(parseJson(subRun)["hausdorff"].get<double>(), double(2.8e-44f));
+    }
 }
 
 }  // namespace

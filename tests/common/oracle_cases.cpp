@@ -265,6 +265,36 @@ std::vector<OracleCase> makeOracleCases() {
         a = cauchy(sizeAt(i + 8));
         b = i % 2 ? cauchy(sizeAt(i + 10)) : gaussianBlobs(r, sizeAt(i + 10), 8, 100.0, 0.01);
     });
+    // The whole float range (issue 15: a crash at 1e-40, wrong pairs for
+    // subnormal coordinates, H = 0 for a 0 / 1e-30 / 1e30 mix): subnormal
+    // lattices, tiny and huge magnitudes, mixes, coordinates near FLT_MAX
+    // (whose differences overflow float).
+    f.family("float_range", 18, [](Rng& r, size_t i, Points& a, Points& b) {
+        const size_t n = 20 + i * 7;
+        auto box = [&r](size_t count, double half) {
+            Points p(count);
+            for (glm::vec3& v : p)
+                for (int k = 0; k < 3; ++k) v[k] = float((2.0 * r.uniform() - 1.0) * half);
+            return p;
+        };
+        switch (i % 6) {
+            case 0:  // multiples of the smallest subnormal
+                for (size_t k = 0; k < n; ++k) {
+                    a.emplace_back(float(r.index(1000)) * 1.4e-45f, float(r.index(1000)) * 1.4e-45f, 0.0f);
+                    b.emplace_back(float(r.index(1000)) * 1.4e-45f, 0.0f, float(r.index(1000)) * 1.4e-45f);
+                }
+                break;
+            case 1: a = box(n, 1e-40), b = box(n + 3, 1e-40); break;
+            case 2: a = box(n, 1e-30), b = box(n + 3, 1e-30); break;
+            case 3:  // 0, 1e-30 and 1e30 together
+                a = {{0, 0, 0}, {1e-30f, 0, 0}, {1e30f, 0, 0}, {0, 1.0f, 0}};
+                b = {{1e-30f, 0, 0}, {0, 0, 0}, {1e30f, 1.0f, 0}, {0, 0, 1e-30f}};
+                for (size_t k = 0; k < n; ++k) a.push_back(a[k % 4] * float(1 + r.index(3)));
+                break;
+            case 4: a = box(n, 3e38), b = box(n + 3, 3e38); break;
+            default: a = box(n, 1e30), b = box(n + 3, 1e30); break;
+        }
+    });
     f.family("large", 5, [](Rng& r, size_t i, Points& a, Points& b) {
         const size_t na[] = {50000, 20000, 10000, 50000, 30000};
         const size_t nb[] = {500, 5000, 10000, 2000, 3000};
