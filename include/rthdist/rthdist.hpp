@@ -12,7 +12,16 @@
 //
 // Inputs: spans of glm::vec3, finite coordinates (NaN/Inf -> kInvalidArgument),
 //   at least one point per side (an empty set -> kInvalidArgument; H is
-//   undefined). Up to 2^31 - 1 points per side; device memory is the limit.
+//   undefined). Up to 2^31 - 1 points per side (more -> kInvalidArgument);
+//   a buffer past the device's maxBufferSize, a BLAS past maxPrimitiveCount
+//   or a failed allocation -> kOutOfMemory naming the limit (README, limits).
+//   Dispatches and traces are split by the device's limits.
+//
+// Self-check (GPU backends, every call): the index of each set is a
+//   permutation under its own cell keys, every query ends exact or dominated
+//   below the final maximum, sampled device records and the witness agree
+//   with the input points, and h is not below its witness-less lower bound.
+//   A failure returns kInternal with the reason instead of a value.
 //
 // Threading: an Engine owns one Vulkan device and is not thread-safe; use one
 //   Engine per thread. The free function hausdorff() creates a temporary
