@@ -4,13 +4,27 @@
 //
 // Contract
 //   h(A,B) = max_{a in A} min_{b in B} |a - b|,  H(A,B) = max(h(A,B), h(B,A)).
-//   The value is EXACT for the float32 input: it equals the brute force
-//   computed in double over the same float32 coordinates (float rounding of
-//   the squared-distance comparisons aside, within 1e-6 of the larger
-//   bounding-box diagonal), and the reported index pair realizes it. Final
-//   distances are recomputed in double on the host from the witness pair.
+//   The value is EXACT for the input as the caller gave it (float or double,
+//   point_view.hpp): it equals the brute force computed in double over those
+//   coordinates within 1e-6 of the diagonal D of the union's bounding box
+//   (the extent, not the magnitude of the coordinates), and the reported
+//   index pair realizes it. Final distances and witness points come from the
+//   original coordinates, in double.
 //
-// Inputs: spans of glm::vec3, finite coordinates (NaN/Inf -> kInvalidArgument),
+// Precision (DESIGN §8): when an input is double, both sets are shifted by
+//   one origin o chosen in double (the centre of the union's bounding box,
+//   HausdorffResult::origin) and the search runs on p - o rounded to float32.
+//   Each coordinate then moves by at most 2^-24 * D / 2, so every distance by
+//   at most eps = sqrt(3) * 2^-24 * D (about 1e-7 D) and the float search
+//   finds, for every query, a neighbour within 2 eps of its true nearest
+//   neighbour: the reported h is within 2 eps (< 1e-6 D) of the double truth,
+//   realized by a real pair, for coordinates of any magnitude (UTM, ECEF).
+//   Float inputs are searched as they are (o = 0): their differences are
+//   exact in float. Squared distances that would overflow or vanish in float
+//   are handled by an exact power-of-two scale (algo::exactScale).
+//
+// Inputs: PointView (float or double, any stride; spans and vectors of
+//   glm::vec3 or glm::dvec3 convert), finite coordinates (NaN/Inf -> kInvalidArgument),
 //   at least one point per side (an empty set -> kInvalidArgument; H is
 //   undefined). Up to 2^31 - 1 points per side (more -> kInvalidArgument);
 //   a buffer past the device's maxBufferSize, a BLAS past maxPrimitiveCount
@@ -39,6 +53,7 @@
 #include <utility>
 #include <vector>
 
+#include "rthdist/point_view.hpp"
 #include "rthdist/result.hpp"
 
 namespace rthdist {
@@ -102,11 +117,11 @@ struct Counters {
 
 // One directed distance h(Q,T) with its witness.
 struct Directed {
-    double distance = 0.0;     // recomputed in double from the pair
-    uint32_t queryIndex = 0;   // index into the query set
-    uint32_t targetIndex = 0;  // index into the target set (its nearest point)
-    glm::vec3 queryPoint{0.0f};
-    glm::vec3 targetPoint{0.0f};
+    double distance = 0.0;       // recomputed in double from the pair
+    uint32_t queryIndex = 0;     // index into the query set
+    uint32_t targetIndex = 0;    // index into the target set (its nearest point)
+    glm::dvec3 queryPoint{0.0};  // the input's coordinates (double; exact for float input)
+    glm::dvec3 targetPoint{0.0};
     Counters counters;
 };
 
@@ -140,6 +155,9 @@ struct HausdorffResult {
     bool directedOnly = false;
     Backend backend = Backend::kAuto;  // the backend that ran
     std::string device;                // device name, or "cpu"
+    // Subtracted from both sets before the float32 search (0 when every input
+    // is float; the centre of the union's bounding box when one is double).
+    glm::dvec3 origin{0.0};
     Timings timings;
     uint64_t validationMessages = 0;  // with Options::validation
 };
@@ -170,7 +188,7 @@ public:
     Engine& operator=(Engine&&) noexcept;
     ~Engine();
 
-    [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b);
+    [[nodiscard]] Result<HausdorffResult> compute(PointView a, PointView b);
     [[nodiscard]] const std::string& deviceName() const;
     [[nodiscard]] Backend backend() const;
 
@@ -179,16 +197,14 @@ public:
 private:
     // The one-shot entry validates its inputs itself and calls the engine's
     // core directly, so the points are scanned once.
-    friend Result<HausdorffResult> hausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                             const Options& options);
+    friend Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& options);
 
     explicit Engine(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> m_impl;
 };
 
 // One-shot convenience: creates an Engine (or runs the CPU backend) and computes.
-[[nodiscard]] Result<HausdorffResult> hausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                                const Options& options = {});
+[[nodiscard]] Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& options = {});
 
 const char* versionString();
 

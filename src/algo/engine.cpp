@@ -10,6 +10,7 @@
 #include "algo/index_space.hpp"
 
 #include "algo/gpu_hausdorff.hpp"
+#include "algo/input_frame.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 #include "gpu/context.hpp"
 
@@ -38,26 +39,6 @@ bool parseBackend(const std::string& text, Backend& out) {
 }
 
 namespace {
-
-std::optional<Error> validateSet(std::span<const glm::vec3> points, const char* name) {
-    if (points.empty()) {
-        return Error{ErrorCode::kInvalidArgument,
-                     std::string("point set ") + name + " is empty: the Hausdorff distance is undefined"};
-    }
-    if (points.size() > 0x7fffffffu) {
-        return Error{ErrorCode::kInvalidArgument,
-                     std::string("point set ") + name + " has more than 2^31-1 points"};
-    }
-    for (size_t i = 0; i < points.size(); ++i) {
-        const glm::vec3& p = points[i];
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-            return Error{ErrorCode::kInvalidArgument, std::string("point set ") + name + ": point " +
-                                                          std::to_string(i) +
-                                                          " has a NaN or infinite coordinate"};
-        }
-    }
-    return std::nullopt;
-}
 
 std::optional<Error> validateOptions(const Options& o) {
     if (o.bits < 0 || o.bits > algo::kMaxBits) {
@@ -136,13 +117,31 @@ Backend Engine::backend() const { return m_impl->backend; }
 
 namespace {
 
-// The computation on inputs already validated (validateSet).
-Result<HausdorffResult> computeValidated(Engine::Impl& impl, std::span<const glm::vec3> a,
-                                         std::span<const glm::vec3> b) {
-    auto t0 = std::chrono::steady_clock::now();
-    Result<HausdorffResult> r =
-        impl.gpu ? impl.gpu->compute(a, b, impl.options) : cpu::cpuHausdorff(a, b, impl.options);
+// The computation: one pass per set checks the coordinates and takes its box
+// (input_frame.hpp); the backends search float32 sets (shifted when an input
+// is double); witnesses and distances come back in the original coordinates.
+struct CheckedInputs {
+    algo::Bounds boxA, boxB;
+};
+
+Result<CheckedInputs> checkInputs(const PointView& a, const PointView& b) {
+    Result<algo::Bounds> boxA = algo::summarizeSet(a, "A");
+    if (!boxA) return boxA.error();
+    Result<algo::Bounds> boxB = algo::summarizeSet(b, "B");
+    if (!boxB) return boxB.error();
+    return CheckedInputs{*boxA, *boxB};
+}
+
+Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, const PointView& b,
+                                     const CheckedInputs& checked, std::chrono::steady_clock::time_point t0) {
+    const glm::dvec3 origin = algo::searchOrigin(a, b, checked.boxA, checked.boxB);
+    const algo::FloatSet fa(a, origin), fb(b, origin);
+    Result<HausdorffResult> r = impl.gpu ? impl.gpu->compute(fa.span(), fb.span(), impl.options)
+                                         : cpu::cpuHausdorff(fa.span(), fb.span(), impl.options);
     if (!r) return r;
+    const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
+    if (copied) algo::restoreOriginal(*r, a, b);
+    r->origin = origin;
     r->timings.setup = impl.setupMs;
     impl.setupMs = 0.0;  // only the first call pays for creation
     r->timings.total = msSince(t0);
@@ -152,21 +151,21 @@ Result<HausdorffResult> computeValidated(Engine::Impl& impl, std::span<const glm
 
 }  // namespace
 
-Result<HausdorffResult> Engine::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
-    if (auto err = validateSet(a, "A")) return *err;
-    if (auto err = validateSet(b, "B")) return *err;
-    return computeValidated(*m_impl, a, b);
+Result<HausdorffResult> Engine::compute(PointView a, PointView b) {
+    const auto t0 = std::chrono::steady_clock::now();
+    Result<CheckedInputs> checked = checkInputs(a, b);
+    if (!checked) return checked.error();
+    return computeViews(*m_impl, a, b, *checked, t0);
 }
 
-Result<HausdorffResult> hausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                  const Options& options) {
-    if (auto err = validateSet(a, "A")) return *err;
-    if (auto err = validateSet(b, "B")) return *err;
-    // Validated before the engine exists: bad input is reported as such even
-    // where no device could be created.
+Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& options) {
+    // Checked before the engine exists: bad input is reported as such even
+    // where no device could be created; the points are read once.
+    Result<CheckedInputs> checked = checkInputs(a, b);
+    if (!checked) return checked.error();
     auto engine = Engine::create(options);
     if (!engine) return engine.error();
-    return computeValidated(*engine->m_impl, a, b);
+    return computeViews(*engine->m_impl, a, b, *checked, std::chrono::steady_clock::now());
 }
 
 }  // namespace rthdist

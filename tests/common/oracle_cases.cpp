@@ -9,39 +9,11 @@
 #include <numbers>
 #include <sstream>
 
+#include "common/rng.hpp"
 #include "cpu/brute_force.hpp"
 
 namespace rthdist::test {
 namespace {
-
-// Portable generator (std distributions differ between standard libraries).
-class Rng {
-public:
-    explicit Rng(uint64_t seed) : m_state(seed * 0x9e3779b97f4a7c15ull + 0x632be59bd9b4e019ull) {}
-    uint64_t next() {  // splitmix64
-        uint64_t z = (m_state += 0x9e3779b97f4a7c15ull);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        return z ^ (z >> 31);
-    }
-    double uniform() { return double(next() >> 11) * 0x1.0p-53; }
-    double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-    size_t index(size_t n) { return size_t(next() % n); }
-    double gauss() {
-        const double u = std::max(uniform(), 1e-300), v = uniform();
-        return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * std::numbers::pi * v);
-    }
-    glm::dvec3 direction() {
-        for (;;) {
-            glm::dvec3 d(gauss(), gauss(), gauss());
-            const double l = glm::length(d);
-            if (l > 1e-9) return d / l;
-        }
-    }
-
-private:
-    uint64_t m_state;
-};
 
 using Points = std::vector<glm::vec3>;
 
@@ -325,8 +297,8 @@ void expectDirected(const char* what, std::span<const glm::vec3> q, std::span<co
     EXPECT_NEAR(d.distance, oracle, tolerance);
     ASSERT_LT(d.queryIndex, q.size());
     ASSERT_LT(d.targetIndex, t.size());
-    EXPECT_EQ(d.queryPoint, q[d.queryIndex]);
-    EXPECT_EQ(d.targetPoint, t[d.targetIndex]);
+    EXPECT_EQ(d.queryPoint, glm::dvec3(q[d.queryIndex]));
+    EXPECT_EQ(d.targetPoint, glm::dvec3(t[d.targetIndex]));
     const double pair = glm::length(glm::dvec3(q[d.queryIndex]) - glm::dvec3(t[d.targetIndex]));
     EXPECT_NEAR(pair, d.distance, 1e-12 * std::max(1.0, pair)) << "the witness pair does not realize it";
     const std::vector<double> nn = cpu::bruteForceNearest(q.subspan(d.queryIndex, 1), t, 1);

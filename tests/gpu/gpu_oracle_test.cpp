@@ -5,6 +5,7 @@
 
 #include <glm/glm.hpp>
 
+#include "common/geo_cases.hpp"
 #include "common/oracle_cases.hpp"
 #include "cpu/brute_force.hpp"
 #include "gpu_test_support.hpp"
@@ -94,4 +95,17 @@ TEST(GpuOracle, PerPointDistancesMatchBruteForce) {
 }
 
 }  // namespace
+// Issue 10: double coordinates far from the origin (UTM, Earth-centred),
+// against the double brute force on the backend under test.
+TEST(GpuOracle, GeoreferencedDoublesMatchTheDoubleBruteForce) {
+    Options options = gpuOptions();
+    RTHDIST_REQUIRE_ENGINE(engine, options);
+    for (const GeoCase& c : makeGeoCases()) {
+        auto r = engine->compute(c.a, c.b);
+        ASSERT_TRUE(r) << c.name << ": " << r.error().message;
+        expectMatchesGeoOracle(c, *r);
+    }
+    EXPECT_EQ(engine->compute(makeGeoCases()[0].a, makeGeoCases()[0].b)->validationMessages, 0u);
+}
+
 }  // namespace rthdist::test

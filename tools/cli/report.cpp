@@ -1,5 +1,6 @@
 #include "cli/report.hpp"
 
+#include <charconv>
 #include <cstdarg>
 #include <cstdio>
 
@@ -26,13 +27,21 @@ namespace {
     va_end(again);
 }
 
-std::string pointText(const glm::vec3& p) {
-    std::string s;
-    appendf(s, "(%.9g, %.9g, %.9g)", double(p.x), double(p.y), double(p.z));
-    return s;
+// The shortest decimal that reads back as the coordinate: as a float when
+// the value is one (float inputs), else as a double.
+std::string coordinateText(double v) {
+    char buf[64];
+    const float f = float(v);
+    const auto res =
+        double(f) == v ? std::to_chars(buf, buf + sizeof buf, f) : std::to_chars(buf, buf + sizeof buf, v);
+    return std::string(buf, res.ptr);
 }
 
-void writePoint(JsonWriter& w, const glm::vec3& p) {
+std::string pointText(const glm::dvec3& p) {
+    return "(" + coordinateText(p.x) + ", " + coordinateText(p.y) + ", " + coordinateText(p.z) + ")";
+}
+
+void writePoint(JsonWriter& w, const glm::dvec3& p) {
     w.beginArray(true).value(p.x).value(p.y).value(p.z).endArray();
 }
 
@@ -145,6 +154,14 @@ std::string jsonReport(const RunReport& report) {
         .field("a", uint64_t(report.pointsA))
         .field("b", uint64_t(report.pointsB))
         .endObject();
+    auto precision = [](Scalar s) { return s == Scalar::kFloat64 ? "float64" : "float32"; };
+    w.key("precision")
+        .beginObject()
+        .field("a", precision(report.scalarA))
+        .field("b", precision(report.scalarB))
+        .endObject();
+    w.key("origin");
+    writePoint(w, r.origin);
     w.field("backend", backendName(r.backend));
     w.field("device", r.device);
     w.field("bits", r.aToB.counters.bits);

@@ -27,6 +27,8 @@ struct RunReport {
     const CliArgs* args = nullptr;
     size_t pointsA = 0;
     size_t pointsB = 0;
+    Scalar scalarA = Scalar::kFloat32;  // the precision each file was read in
+    Scalar scalarB = Scalar::kFloat32;
     double loadMs = 0.0;  // both files, measured by the CLI
     double wallMs = 0.0;  // the whole command up to printing
     const HausdorffResult* result = nullptr;

@@ -1,0 +1,109 @@
+#include "algo/input_frame.hpp"
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "cpu/parallel.hpp"
+
+namespace rthdist::algo {
+
+namespace {
+
+constexpr size_t kChunk = size_t(1) << 16;
+constexpr size_t kMaxPoints = 0x7fffffffu;
+
+struct ChunkSummary {
+    glm::dvec3 lo{0.0}, hi{0.0};
+    size_t firstBad = ~size_t(0);
+    bool any = false;
+};
+
+Error setError(const char* name, const std::string& what) {
+    return Error{ErrorCode::kInvalidArgument, std::string("point set ") + name + what};
+}
+
+}  // namespace
+
+Result<Bounds> summarizeSet(const PointView& points, const char* name) {
+    if (points.empty()) return setError(name, " is empty: the Hausdorff distance is undefined");
+    if (points.count > kMaxPoints) return setError(name, " has more than 2^31-1 points");
+    const size_t scalar = scalarBytes(points.scalar);
+    if (points.data == nullptr || points.strideBytes < 3 * scalar || points.strideBytes % scalar != 0)
+        return setError(name, ": a stride of " + std::to_string(points.strideBytes) +
+                                  " bytes cannot hold three " + (scalar == 8 ? "doubles" : "floats") +
+                                  " per point (or the data pointer is null)");
+    const int threads = cpu::resolveThreads(0, points.count / kChunk + 1);
+    std::vector<ChunkSummary> parts(static_cast<size_t>(threads));
+    cpu::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int t) {
+        ChunkSummary& s = parts[size_t(t)];
+        for (size_t i = begin; i < end; ++i) {
+            const glm::dvec3 p = points.at(i);
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+                s.firstBad = std::min(s.firstBad, i);
+                continue;
+            }
+            s.lo = s.any ? glm::min(s.lo, p) : p;
+            s.hi = s.any ? glm::max(s.hi, p) : p;
+            s.any = true;
+        }
+    });
+    size_t firstBad = ~size_t(0);
+    Bounds box;
+    bool any = false;
+    for (const ChunkSummary& s : parts) {
+        firstBad = std::min(firstBad, s.firstBad);
+        if (!s.any) continue;
+        box.lo = any ? glm::min(box.lo, s.lo) : s.lo;
+        box.hi = any ? glm::max(box.hi, s.hi) : s.hi;
+        any = true;
+    }
+    if (firstBad != ~size_t(0))
+        return setError(name, ": point " + std::to_string(firstBad) + " has a NaN or infinite coordinate");
+    return box;
+}
+
+glm::dvec3 searchOrigin(const PointView& a, const PointView& b, const Bounds& boxA, const Bounds& boxB) {
+    if (a.scalar == Scalar::kFloat32 && b.scalar == Scalar::kFloat32) return glm::dvec3(0.0);
+    return 0.5 * (glm::min(boxA.lo, boxB.lo) + glm::max(boxA.hi, boxB.hi));
+}
+
+FloatSet::FloatSet(const PointView& points, const glm::dvec3& origin) {
+    if (points.packedFloat() && origin == glm::dvec3(0.0)) {
+        m_span = std::span<const glm::vec3>(static_cast<const glm::vec3*>(points.data), points.count);
+        return;
+    }
+    m_copy.resize(points.count);
+    const int threads = cpu::resolveThreads(0, points.count / kChunk + 1);
+    cpu::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) m_copy[i] = glm::vec3(points.at(i) - origin);
+    });
+    m_span = m_copy;
+}
+
+void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b) {
+    auto restore = [](Directed& d, const PointView& q, const PointView& t) {
+        d.queryPoint = q.at(d.queryIndex);
+        d.targetPoint = t.at(d.targetIndex);
+        d.distance = glm::length(d.queryPoint - d.targetPoint);
+    };
+    restore(r.aToB, a, b);
+    r.hausdorff = r.aToB.distance;
+    if (!r.directedOnly) {
+        restore(r.bToA, b, a);
+        r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
+    }
+    auto perPoint = [](PerPoint& pp, const PointView& q, const PointView& t) {
+        const int threads = cpu::resolveThreads(0, pp.nearest.size() / kChunk + 1);
+        cpu::parallelChunks(pp.nearest.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
+            for (size_t i = begin; i < end; ++i) pp.distance[i] = glm::length(q.at(i) - t.at(pp.nearest[i]));
+        });
+    };
+    perPoint(r.aNearest, a, b);
+    perPoint(r.bNearest, b, a);
+}
+
+}  // namespace rthdist::algo

@@ -1,0 +1,46 @@
+// From the caller's point views to the float32 sets the backends search, and
+// back (DESIGN §8): one pass per set checks every coordinate and takes the
+// bounding box in double; when an input is double the origin is the centre
+// of the union's box and both sets are shifted by it and rounded to float
+// (the error bound is in rthdist.hpp); packed float inputs are searched in
+// place. Afterwards witnesses and per-point distances are taken from the
+// original coordinates in double.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "algo/index_space.hpp"
+#include "rthdist/rthdist.hpp"
+
+namespace rthdist::algo {
+
+// Bounds of one set, or the error naming the first bad point (NaN/Inf, an
+// empty set, a stride that cannot hold a point, too many points).
+[[nodiscard]] Result<Bounds> summarizeSet(const PointView& points, const char* name);
+
+// The origin subtracted before the float search: zero when both inputs are
+// float, else the centre of the union of both boxes.
+[[nodiscard]] glm::dvec3 searchOrigin(const PointView& a, const PointView& b, const Bounds& boxA,
+                                      const Bounds& boxB);
+
+// The float32 points a backend searches: the caller's memory when it is
+// packed float and the origin is zero, else a shifted, rounded copy.
+class FloatSet {
+public:
+    FloatSet(const PointView& points, const glm::dvec3& origin);
+    [[nodiscard]] std::span<const glm::vec3> span() const { return m_span; }
+
+private:
+    std::vector<glm::vec3> m_copy;
+    std::span<const glm::vec3> m_span;
+};
+
+// Replaces a backend's witnesses and per-point distances (float coordinates
+// after the shift) by those of the original coordinates, in double.
+void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b);
+
+}  // namespace rthdist::algo
