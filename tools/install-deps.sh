@@ -5,6 +5,7 @@
 # already present are left alone. Needs root or sudo.
 #   RTHDIST_BENCH_DEPS=1  also python3-scipy/numpy for tools/bench
 #   RTHDIST_LINT_DEPS=1   also clang-format for .ci/run
+#   RTHDIST_FUZZ_DEPS=1   also clang-14 and its libFuzzer runtime (tools/fuzz/run.sh)
 set -euo pipefail
 
 SUDO=""
@@ -12,7 +13,7 @@ if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 
 BASE_PKGS=(cmake g++ make pkg-config libvulkan-dev glslang-tools libglm-dev
   libtinygltf-dev libgtest-dev libnanoflann-dev zlib1g-dev vulkan-validationlayers
-  vulkan-tools nlohmann-json3-dev libstb-dev)
+  vulkan-tools nlohmann-json3-dev libstb-dev strace)
 EXTRA_PKGS=()
 if [ "${RTHDIST_BENCH_DEPS:-0}" = 1 ]; then
   EXTRA_PKGS+=(python3 python3-scipy python3-numpy)
@@ -20,6 +21,9 @@ fi
 # RTHDIST_LINT_DEPS=1: the formatter .ci/run checks with (Debian 12: clang-format 14).
 if [ "${RTHDIST_LINT_DEPS:-0}" = 1 ]; then
   EXTRA_PKGS+=(clang-format)
+fi
+if [ "${RTHDIST_FUZZ_DEPS:-0}" = 1 ]; then
+  EXTRA_PKGS+=(clang-14 libclang-rt-14-dev)
 fi
 
 have_all() {
