@@ -39,17 +39,23 @@ Result<Bounds> summarizeSet(const PointView& points, const char* name) {
     const int threads = cpu::resolveThreads(0, points.count / kChunk + 1);
     std::vector<ChunkSummary> parts(static_cast<size_t>(threads));
     cpu::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int t) {
-        ChunkSummary& s = parts[size_t(t)];
+        // Locals in the loop, one write per chunk: the per-thread summaries
+        // share cache lines.
+        ChunkSummary s = parts[size_t(t)];
         for (size_t i = begin; i < end; ++i) {
             const glm::dvec3 p = points.at(i);
             if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
                 s.firstBad = std::min(s.firstBad, i);
                 continue;
             }
-            s.lo = s.any ? glm::min(s.lo, p) : p;
-            s.hi = s.any ? glm::max(s.hi, p) : p;
-            s.any = true;
+            if (!s.any) {
+                s.lo = s.hi = p;
+                s.any = true;
+            }
+            s.lo = glm::min(s.lo, p);
+            s.hi = glm::max(s.hi, p);
         }
+        parts[size_t(t)] = s;
     });
     size_t firstBad = ~size_t(0);
     Bounds box;
