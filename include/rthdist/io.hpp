@@ -20,10 +20,19 @@
 //         the header's first word.
 //   .off  OFF / COFF / NOFF headers, vertices only
 //   .pcd  ascii and binary (x y z fields, any size/type), not binary_compressed
+//   .las  LAS 1.0-1.4, point data formats 0-10 (las_reader.hpp): X/Y/Z int32
+//         times scale plus offset, in double; variable-length records are
+//         skipped (the points start at the header's offset to point data);
+//         1.4's 64-bit point count. LoadOptions::lasClasses keeps only the
+//         points of those classification values. Compressed LAS (.laz) is
+//         refused with kBadInput saying how to decompress it (Debian 12 has
+//         no LAZ library): `laszip -i in.laz -o out.las` or
+//         `pdal translate in.laz out.las`.
 // Text (every format's text parts): a leading UTF-8 byte order mark is
 // skipped; "\n", "\r\n" and a lone "\r" all end a line.
 //
-// Contract: on success, at least one point and every coordinate finite. Every
+// Contract: on success, at least one point and every coordinate finite (in
+// the cloud's precision: a double beyond the float range is finite). Every
 // failure is ErrorCode::kBadInput with a message "<path>: <where>: <what>"
 // (where = line N, vertex N, byte offset N, element name, gzip, glTF...).
 // Declared counts are checked against the file before anything is allocated,
@@ -40,9 +49,20 @@
 //          10,000,000 node instances over the scene, counted before any point
 //          is read; external buffer files at most 4 GiB.
 //
-// Precision: decimal text is converted straight to the nearest float
-// (std::from_chars); double and integer inputs are rounded to float.
-// Limits: a glTF mesh instanced by several nodes gives its points once per
+// Precision: loadPointCloud keeps the file's precision. Decimal text (ascii
+// PLY, XYZ/TXT, OBJ, OFF, ascii STL, ascii PCD) is converted straight to the
+// nearest double (std::from_chars); binary PLY and PCD whose x, y or z is a
+// double or a 32/64-bit integer are read as double (64-bit integers rounded
+// to the nearest double), other binary types (float, 8/16-bit integers) as
+// float; LAS is double (scale and offset applied in double); binary STL and
+// glTF are float. A double cloud takes 24 bytes per point, a float one 12.
+// loadPoints rounds a double cloud to the nearest floats (a coordinate beyond
+// the float range is then an error): kept for callers that want float32.
+// Limits: a LAS file is read whole into memory like every other format (its
+// point records plus the cloud, 24 bytes per point); a LAS header's point
+// count times its record length must fit the file; extended VLRs and
+// waveform data after the points are not read. A glTF mesh instanced by
+// several nodes gives its points once per
 // instance; NaN points (e.g. in organized PCD clouds) are rejected, not
 // dropped; a binary PLY whose vertex count is one too high can go unnoticed
 // when the bytes it takes happen to leave a valid rest (e.g. 12-byte vertices
@@ -55,10 +75,35 @@
 #include <string>
 #include <vector>
 
+#include "rthdist/point_view.hpp"
 #include "rthdist/result.hpp"
 
 namespace rthdist::io {
 
+// A loaded point set in the precision of its file: exactly one of floats
+// (scalar kFloat32) and doubles (kFloat64) holds the points.
+struct PointCloud {
+    Scalar scalar = Scalar::kFloat32;
+    std::vector<glm::vec3> floats;
+    std::vector<glm::dvec3> doubles;
+
+    [[nodiscard]] size_t size() const;
+    // A view of the points for hausdorff() / Engine::compute(); valid while
+    // this cloud lives and is not modified.
+    [[nodiscard]] PointView view() const;
+};
+
+struct LoadOptions {
+    // LAS only: keep the points whose classification is one of these
+    // (0..255; formats 0-5 store 0..31). Empty: every point. Other formats
+    // have no classification and ignore it. A filter that keeps no point is
+    // kBadInput naming the classes.
+    std::vector<int> lasClasses;
+};
+
+[[nodiscard]] Result<PointCloud> loadPointCloud(const std::string& path, const LoadOptions& options = {});
+
+// The points rounded to float32 (earlier releases' loader).
 [[nodiscard]] Result<std::vector<glm::vec3>> loadPoints(const std::string& path);
 
 // Writes a binary little-endian PLY with float x/y/z vertices only.

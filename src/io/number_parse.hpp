@@ -13,25 +13,35 @@
 
 namespace rthdist::io {
 
-// Parses the WHOLE token as a decimal number straight to float: one correctly
-// rounded conversion (going through double could round twice). "+1.5e3",
-// "nan" and "inf" are accepted; the finiteness check is the caller's.
-[[nodiscard]] inline bool parseFloat(std::string_view token, float& out) {
+namespace detail {
+template <class Real>
+bool parseReal(std::string_view token, Real& out) {
     if (!token.empty() && token.front() == '+') token.remove_prefix(1);
     if (token.empty()) return false;
     const char* end = token.data() + token.size();
     const auto [ptr, ec] = std::from_chars(token.data(), end, out);
     if (ec == std::errc::result_out_of_range && ptr == end) {
         // Overflow becomes an infinity (reported as a non-finite coordinate);
-        // underflow becomes zero, as strtof would give.
+        // underflow becomes zero, as strtof/strtod would give.
         const size_t e = token.find_first_of("eE");
         const bool tiny = e != std::string_view::npos && e + 1 < token.size() && token[e + 1] == '-';
-        const float inf = std::numeric_limits<float>::infinity();
-        out = tiny ? 0.0f : (token.front() == '-' ? -inf : inf);
-        if (tiny && token.front() == '-') out = -0.0f;
+        const Real inf = std::numeric_limits<Real>::infinity();
+        out = tiny ? Real(0) : (token.front() == '-' ? -inf : inf);
+        if (tiny && token.front() == '-') out = -Real(0);
         return true;
     }
     return ec == std::errc() && ptr == end;
+}
+}  // namespace detail
+
+// Parses the WHOLE token as a decimal number straight to float (or double):
+// one correctly rounded conversion (float through double could round twice).
+// "+1.5e3", "nan" and "inf" are accepted; the finiteness check is the caller's.
+[[nodiscard]] inline bool parseFloat(std::string_view token, float& out) {
+    return detail::parseReal(token, out);
+}
+[[nodiscard]] inline bool parseDouble(std::string_view token, double& out) {
+    return detail::parseReal(token, out);
 }
 
 // Parses the whole token as a non-negative decimal integer.
@@ -55,9 +65,10 @@ namespace rthdist::io {
 
 // Parses tok[0], tok[1], tok[2] as x, y, z (the text loaders' shared step).
 // Returns the first token that is not a number, for the caller's error.
-[[nodiscard]] inline std::optional<std::string_view> parsePoint(const std::string_view* tok, glm::vec3& out) {
+[[nodiscard]] inline std::optional<std::string_view> parsePoint(const std::string_view* tok,
+                                                                glm::dvec3& out) {
     for (int axis = 0; axis < 3; ++axis) {
-        if (!parseFloat(tok[axis], out[axis])) return tok[axis];
+        if (!parseDouble(tok[axis], out[axis])) return tok[axis];
     }
     return std::nullopt;
 }

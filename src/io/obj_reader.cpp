@@ -8,8 +8,8 @@
 
 namespace rthdist::io {
 
-Result<std::vector<glm::vec3>> readObj(std::string_view bytes, const std::string& path) {
-    std::vector<glm::vec3> points;
+Result<PointCloud> readObj(std::string_view bytes, const std::string& path) {
+    std::vector<glm::dvec3> points;
     TextCursor cursor(bytes);
     std::string_view line;
     while (cursor.nextLine(line)) {
@@ -22,14 +22,14 @@ Result<std::vector<glm::vec3>> readObj(std::string_view bytes, const std::string
             return badInput(path, lineWhere(cursor.line()),
                             "vertex line with " + std::to_string(n) + " coordinate(s)");
         }
-        glm::vec3 p;
+        glm::dvec3 p;
         if (const auto bad = parsePoint(tok.data(), p)) {
             return badInput(path, lineWhere(cursor.line()), notANumber(*bad));
         }
         points.push_back(p);
     }
     points.shrink_to_fit();
-    return points;
+    return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }
 
 }  // namespace rthdist::io

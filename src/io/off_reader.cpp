@@ -27,7 +27,7 @@ bool nextContentLine(TextCursor& cursor, std::string_view& out) {
 
 }  // namespace
 
-Result<std::vector<glm::vec3>> readOff(std::string_view bytes, const std::string& path) {
+Result<PointCloud> readOff(std::string_view bytes, const std::string& path) {
     TextCursor cursor(bytes);
     std::string_view line;
     if (!nextContentLine(cursor, line)) return badInput(path, lineWhere(1), "no OFF header");
@@ -69,7 +69,7 @@ Result<std::vector<glm::vec3>> readOff(std::string_view bytes, const std::string
                             " bytes follow (truncated file or wrong count)");
     }
 
-    std::vector<glm::vec3> points(static_cast<size_t>(vertexCount));
+    std::vector<glm::dvec3> points(static_cast<size_t>(vertexCount));
     for (uint64_t k = 0; k < vertexCount; ++k) {
         if (!nextContentLine(cursor, line)) {
             return badInput(
@@ -81,13 +81,13 @@ Result<std::vector<glm::vec3>> readOff(std::string_view bytes, const std::string
         if (m < 3)
             return badInput(path, lineWhere(cursor.line()),
                             "vertex line with " + std::to_string(m) + " value(s)");
-        glm::vec3 p;
+        glm::dvec3 p;
         if (const auto bad = parsePoint(xyz.data(), p)) {
             return badInput(path, lineWhere(cursor.line()), notANumber(*bad));
         }
         points[k] = p;
     }
-    return points;
+    return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }
 
 }  // namespace rthdist::io

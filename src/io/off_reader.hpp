@@ -7,11 +7,12 @@
 #include <string_view>
 #include <vector>
 
+#include "rthdist/io.hpp"
 #include "rthdist/result.hpp"
 
 namespace rthdist::io {
 
 // bytes: the whole (already gunzipped) file; path names it in error messages.
-[[nodiscard]] Result<std::vector<glm::vec3>> readOff(std::string_view bytes, const std::string& path);
+[[nodiscard]] Result<PointCloud> readOff(std::string_view bytes, const std::string& path);
 
 }  // namespace rthdist::io

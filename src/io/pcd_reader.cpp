@@ -39,7 +39,7 @@ std::optional<ScalarType> pcdScalarType(char type, size_t size) {
 
 }  // namespace
 
-Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string& path) {
+Result<PointCloud> readPcd(std::string_view bytes, const std::string& path) {
     TextCursor cursor(bytes);
     std::vector<PcdField> fields;
     std::optional<uint64_t> points;
@@ -149,7 +149,7 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
         if (!column[axis]) return badInput(path, "header", "no field '" + std::string(kNames[axis]) + "'");
     }
 
-    if (*points == 0) return std::vector<glm::vec3>{};
+    if (*points == 0) return PointCloud{};
     const uint64_t left = cursor.remaining();
     if (data == "binary") {
         if (*points > left / bytesPerRow) {
@@ -158,13 +158,24 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
                                 std::to_string(bytesPerRow) + " bytes, but only " + std::to_string(left) +
                                 " bytes remain (truncated body or wrong count)");
         }
-        std::vector<glm::vec3> out(static_cast<size_t>(*points));
+        PointCloud out;
+        out.scalar =
+            std::any_of(scalar.begin(), scalar.end(), needsDouble) ? Scalar::kFloat64 : Scalar::kFloat32;
+        if (out.scalar == Scalar::kFloat64) {
+            out.doubles.resize(static_cast<size_t>(*points));
+        } else {
+            out.floats.resize(static_cast<size_t>(*points));
+        }
         const char* row = bytes.data() + cursor.offset();
         for (uint64_t k = 0; k < *points; ++k, row += bytesPerRow) {
             double v[3];
             for (size_t axis = 0; axis < 3; ++axis)
                 v[axis] = loadScalar(row + byteOffset[axis], scalar[axis], false);
-            out[k] = glm::vec3(narrowToFloat(v[0]), narrowToFloat(v[1]), narrowToFloat(v[2]));
+            if (out.scalar == Scalar::kFloat64) {
+                out.doubles[k] = glm::dvec3(v[0], v[1], v[2]);
+            } else {
+                out.floats[k] = glm::vec3(narrowToFloat(v[0]), narrowToFloat(v[1]), narrowToFloat(v[2]));
+            }
         }
         return out;
     }
@@ -175,7 +186,7 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
                         "declares " + std::to_string(*points) + " points but only " + std::to_string(left) +
                             " bytes follow (truncated body or wrong count)");
     }
-    std::vector<glm::vec3> out(static_cast<size_t>(*points));
+    std::vector<glm::dvec3> out(static_cast<size_t>(*points));
     const uint64_t lastColumn = std::max({*column[0], *column[1], *column[2]});
     std::vector<std::string_view> tok(static_cast<size_t>(lastColumn + 1));
     for (uint64_t k = 0; k < *points;) {
@@ -190,17 +201,17 @@ Result<std::vector<glm::vec3>> readPcd(std::string_view bytes, const std::string
                 path, lineWhere(cursor.line()),
                 "row has " + std::to_string(n) + " values, fields need " + std::to_string(valuesPerRow));
         }
-        float v[3];
+        double v[3];
         for (size_t axis = 0; axis < 3; ++axis) {
             const std::string_view t = tok[static_cast<size_t>(*column[axis])];
-            if (!parseFloat(t, v[axis])) {
+            if (!parseDouble(t, v[axis])) {
                 return badInput(path, lineWhere(cursor.line()), notANumber(t));
             }
         }
-        out[k] = glm::vec3(v[0], v[1], v[2]);
+        out[k] = glm::dvec3(v[0], v[1], v[2]);
         ++k;
     }
-    return out;
+    return PointCloud{Scalar::kFloat64, {}, std::move(out)};
 }
 
 }  // namespace rthdist::io

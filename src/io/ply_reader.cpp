@@ -279,9 +279,17 @@ private:
     const std::string& m_path;
 };
 
-Result<std::vector<glm::vec3>> readBinaryBody(std::string_view bytes, const PlyHeader& header,
-                                              size_t vertexElement, const XyzIndex& xyz,
-                                              const std::string& path) {
+// x, y or z stored as double or as a 32/64-bit integer: the points are kept
+// in double; otherwise (float, 8/16-bit integers) float holds them exactly.
+Scalar binaryPrecision(const PlyElement& vertex, const XyzIndex& xyz) {
+    for (size_t axis = 0; axis < 3; ++axis) {
+        if (needsDouble(vertex.properties[xyz.prop[axis]].type)) return Scalar::kFloat64;
+    }
+    return Scalar::kFloat32;
+}
+
+Result<PointCloud> readBinaryBody(std::string_view bytes, const PlyHeader& header, size_t vertexElement,
+                                  const XyzIndex& xyz, const std::string& path) {
     BinaryBody body(bytes, header.bodyOffset, header.format == PlyFormat::kBinaryBigEndian, path);
     for (size_t ei = 0; ei < vertexElement; ++ei) {
         if (auto err = body.checkFit(header.elements, ei, ei + 1)) return *err;
@@ -289,11 +297,22 @@ Result<std::vector<glm::vec3>> readBinaryBody(std::string_view bytes, const PlyH
     }
     if (auto err = body.checkFit(header.elements, vertexElement, header.elements.size())) return *err;
     const PlyElement& vertex = header.elements[vertexElement];
-    std::vector<glm::vec3> points(static_cast<size_t>(vertex.count));
+    PointCloud points;
+    points.scalar = binaryPrecision(vertex, xyz);
+    const bool doubles = points.scalar == Scalar::kFloat64;
+    if (doubles) {
+        points.doubles.resize(static_cast<size_t>(vertex.count));
+    } else {
+        points.floats.resize(static_cast<size_t>(vertex.count));
+    }
     double v[3] = {0, 0, 0};
     for (uint64_t k = 0; k < vertex.count; ++k) {
         if (auto err = body.item(vertex, k, &xyz, v)) return *err;
-        points[k] = glm::vec3(narrowToFloat(v[0]), narrowToFloat(v[1]), narrowToFloat(v[2]));
+        if (doubles) {
+            points.doubles[k] = glm::dvec3(v[0], v[1], v[2]);
+        } else {
+            points.floats[k] = glm::vec3(narrowToFloat(v[0]), narrowToFloat(v[1]), narrowToFloat(v[2]));
+        }
     }
     for (size_t ei = vertexElement + 1; ei < header.elements.size(); ++ei) {
         if (auto err = body.skipElement(header.elements[ei])) return *err;
@@ -337,7 +356,7 @@ public:
 
     // Reads item `index` of e from its line; for the vertex element,
     // values[axis] receives x/y/z.
-    std::optional<Error> item(const PlyElement& e, uint64_t index, const XyzIndex* xyz, float* values) {
+    std::optional<Error> item(const PlyElement& e, uint64_t index, const XyzIndex* xyz, double* values) {
         std::string_view line;
         do {
             if (!m_cursor.nextLine(line)) {
@@ -376,7 +395,7 @@ public:
             if (xyz == nullptr) continue;
             for (size_t axis = 0; axis < 3; ++axis) {
                 if (xyz->prop[axis] != i) continue;
-                if (!parseFloat(tok, values[axis])) {
+                if (!parseDouble(tok, values[axis])) {
                     return badInput(
                         m_path, lineWhere(m_cursor.line()),
                         "vertex " + std::to_string(index) + " property " + p.name + ": " + notANumber(tok));
@@ -416,31 +435,30 @@ private:
     const std::string& m_path;
 };
 
-Result<std::vector<glm::vec3>> readAsciiBody(std::string_view bytes, const PlyHeader& header,
-                                             size_t vertexElement, const XyzIndex& xyz,
-                                             const std::string& path) {
+Result<PointCloud> readAsciiBody(std::string_view bytes, const PlyHeader& header, size_t vertexElement,
+                                 const XyzIndex& xyz, const std::string& path) {
     AsciiBody body(bytes, header, path);
     if (auto err = body.checkFit(header.elements)) return *err;
     for (size_t ei = 0; ei < vertexElement; ++ei) {
         if (auto err = body.skipElement(header.elements[ei])) return *err;
     }
     const PlyElement& vertex = header.elements[vertexElement];
-    std::vector<glm::vec3> points(static_cast<size_t>(vertex.count));
+    std::vector<glm::dvec3> points(static_cast<size_t>(vertex.count));
     for (uint64_t k = 0; k < vertex.count; ++k) {
-        float v[3] = {0, 0, 0};
+        double v[3] = {0, 0, 0};
         if (auto err = body.item(vertex, k, &xyz, v)) return *err;
-        points[k] = glm::vec3(v[0], v[1], v[2]);
+        points[k] = glm::dvec3(v[0], v[1], v[2]);
     }
     for (size_t ei = vertexElement + 1; ei < header.elements.size(); ++ei) {
         if (auto err = body.skipElement(header.elements[ei])) return *err;
     }
     if (auto err = body.checkEnd()) return *err;
-    return points;
+    return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }
 
 }  // namespace
 
-Result<std::vector<glm::vec3>> readPly(std::string_view bytes, const std::string& path) {
+Result<PointCloud> readPly(std::string_view bytes, const std::string& path) {
     auto header = parseHeader(bytes, path);
     if (!header) return header.error();
     size_t vertexElement = header->elements.size();

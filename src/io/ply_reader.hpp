@@ -11,12 +11,13 @@
 #include <string_view>
 #include <vector>
 
+#include "rthdist/io.hpp"
 #include "rthdist/result.hpp"
 
 namespace rthdist::io {
 
 // bytes: the whole (already gunzipped) file; path names it in error messages.
-[[nodiscard]] Result<std::vector<glm::vec3>> readPly(std::string_view bytes, const std::string& path);
+[[nodiscard]] Result<PointCloud> readPly(std::string_view bytes, const std::string& path);
 
 // The gunzip header check (gzip_inflate.hpp): a binary PLY inflates to at
 // most its header plus every declared item at its largest; ascii: no bound.

@@ -44,6 +44,13 @@ enum class ScalarType {
     return t != ScalarType::kFloat32 && t != ScalarType::kFloat64;
 }
 
+// True for the types a float cannot hold exactly (double, 32/64-bit
+// integers): a binary x/y/z of one of these makes the loader keep doubles.
+[[nodiscard]] constexpr bool needsDouble(ScalarType t) {
+    return t == ScalarType::kFloat64 || t == ScalarType::kInt32 || t == ScalarType::kUInt32 ||
+           t == ScalarType::kInt64 || t == ScalarType::kUInt64;
+}
+
 // PLY type names: char uchar short ushort int uint float double and the
 // int8 uint8 int16 uint16 int32 uint32 float32 float64 aliases.
 [[nodiscard]] std::optional<ScalarType> plyScalarType(std::string_view name);

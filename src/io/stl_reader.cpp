@@ -14,7 +14,7 @@ namespace {
 constexpr size_t kHeaderSize = 80;
 constexpr size_t kFacetSize = 50;  // normal, 3 vertices (float32 LE), uint16 attribute
 
-std::vector<glm::vec3> readBinary(std::string_view bytes, uint64_t facets) {
+PointCloud readBinary(std::string_view bytes, uint64_t facets) {
     std::vector<glm::vec3> points(static_cast<size_t>(facets) * 3);
     const char* p = bytes.data() + kHeaderSize + 4;
     for (uint64_t f = 0; f < facets; ++f, p += kFacetSize) {
@@ -25,25 +25,25 @@ std::vector<glm::vec3> readBinary(std::string_view bytes, uint64_t facets) {
                                           static_cast<float>(loadScalar(v + 8, ScalarType::kFloat32, false)));
         }
     }
-    return points;
+    return PointCloud{Scalar::kFloat32, std::move(points), {}};
 }
 
-Result<std::vector<glm::vec3>> readAscii(std::string_view bytes, const std::string& path) {
-    std::vector<glm::vec3> points;
+Result<PointCloud> readAscii(std::string_view bytes, const std::string& path) {
+    std::vector<glm::dvec3> points;
     TextCursor cursor(bytes);
     for (std::string_view tok = cursor.nextToken(); !tok.empty(); tok = cursor.nextToken()) {
         if (tok != "vertex") continue;
-        float v[3];
+        double v[3];
         for (size_t axis = 0; axis < 3; ++axis) {
             const std::string_view num = cursor.nextToken();
-            if (!parseFloat(num, v[axis])) {
+            if (!parseDouble(num, v[axis])) {
                 return badInput(path, lineWhere(cursor.line()),
                                 num.empty() ? std::string("file ends inside a vertex") : notANumber(num));
             }
         }
         points.emplace_back(v[0], v[1], v[2]);
     }
-    return points;
+    return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }
 
 // An ascii STL starts with "solid" and is text; binary STLs have NUL bytes
@@ -60,7 +60,7 @@ uint64_t binarySize(std::string_view bytes, uint64_t& facets) {
 
 }  // namespace
 
-Result<std::vector<glm::vec3>> readStl(std::string_view bytes, const std::string& path) {
+Result<PointCloud> readStl(std::string_view bytes, const std::string& path) {
     // The size decides first (84 + 50 * facets), then the NUL bytes tell a
     // binary STL of the wrong size from an ascii one.
     const bool solid = trimBlank(bytes.substr(bomLength(bytes), 64)).starts_with("solid");

@@ -10,12 +10,13 @@
 #include <string_view>
 #include <vector>
 
+#include "rthdist/io.hpp"
 #include "rthdist/result.hpp"
 
 namespace rthdist::io {
 
 // bytes: the whole (already gunzipped) file; path names it in error messages.
-[[nodiscard]] Result<std::vector<glm::vec3>> readStl(std::string_view bytes, const std::string& path);
+[[nodiscard]] Result<PointCloud> readStl(std::string_view bytes, const std::string& path);
 
 // The gunzip header check (gzip_inflate.hpp): a binary STL inflates to
 // 84 + 50 * facets bytes; ascii: no bound.

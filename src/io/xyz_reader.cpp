@@ -8,8 +8,8 @@
 
 namespace rthdist::io {
 
-Result<std::vector<glm::vec3>> readXyz(std::string_view bytes, const std::string& path) {
-    std::vector<glm::vec3> points;
+Result<PointCloud> readXyz(std::string_view bytes, const std::string& path) {
+    std::vector<glm::dvec3> points;
     // Shortest point line: "0 0 0\n".
     points.reserve(bytes.size() / 6 + 1);
     TextCursor cursor(bytes);
@@ -23,14 +23,14 @@ Result<std::vector<glm::vec3>> readXyz(std::string_view bytes, const std::string
             return badInput(path, lineWhere(cursor.line()),
                             "expected 'x y z', found " + std::to_string(n) + " column(s)");
         }
-        glm::vec3 p;
+        glm::dvec3 p;
         if (const auto bad = parsePoint(tok.data(), p)) {
             return badInput(path, lineWhere(cursor.line()), notANumber(*bad));
         }
         points.push_back(p);
     }
     points.shrink_to_fit();
-    return points;
+    return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }
 
 }  // namespace rthdist::io

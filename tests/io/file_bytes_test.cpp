@@ -32,8 +32,8 @@ TEST_F(FileBytes, EmptyGzipIsBadInput) {
 }
 
 TEST_F(FileBytes, UnsupportedExtensionIsBadInput) {
-    const std::string path = write("points.las", "1 2 3\n");
-    EXPECT_TRUE(isBadInput(loadPoints(path), path, "unsupported extension '.las'"));
+    const std::string path = write("points.e57", "1 2 3\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "unsupported extension '.e57'"));
 }
 
 TEST_F(FileBytes, ExtensionIsCaseInsensitive) {

@@ -1,0 +1,13 @@
+// PointCloud: a loaded set in its file's precision, seen as a PointView.
+#include "rthdist/io.hpp"
+
+namespace rthdist::io {
+
+size_t PointCloud::size() const { return scalar == Scalar::kFloat64 ? doubles.size() : floats.size(); }
+
+PointView PointCloud::view() const {
+    if (scalar == Scalar::kFloat64) return PointView(doubles);
+    return PointView(floats);
+}
+
+}  // namespace rthdist::io
