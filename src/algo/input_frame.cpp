@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "cpu/parallel.hpp"
@@ -26,6 +27,45 @@ Error setError(const char* name, const std::string& what) {
     return Error{ErrorCode::kInvalidArgument, std::string("point set ") + name + what};
 }
 
+// One chunk of a set with scalars T: min/max per axis in T (exact), the
+// first non-finite point. Reads the caller's memory once, in place.
+template <class T>
+ChunkSummary summarizeChunk(const char* base, size_t stride, size_t begin, size_t end) {
+    // Branch-free over the points (vectorizes); a chunk with a bad point is
+    // scanned again for its first one.
+    T lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    bool finite = true;
+    for (size_t i = begin; i < end; ++i) {
+        T v[3];
+        std::memcpy(v, base + i * stride, sizeof(v));
+        for (int k = 0; k < 3; ++k) {
+            finite &= v[k] - v[k] == 0;  // 0 for finite values, NaN otherwise
+            lo[k] = v[k] < lo[k] ? v[k] : lo[k];
+            hi[k] = v[k] > hi[k] ? v[k] : hi[k];
+        }
+    }
+    ChunkSummary s;
+    s.any = true;
+    s.lo = glm::dvec3(lo[0], lo[1], lo[2]);
+    s.hi = glm::dvec3(hi[0], hi[1], hi[2]);
+    if (!finite) {
+        for (size_t i = begin; i < end && s.firstBad == ~size_t(0); ++i) {
+            T v[3];
+            std::memcpy(v, base + i * stride, sizeof(v));
+            if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]))) s.firstBad = i;
+        }
+    }
+    return s;
+}
+
+void merge(ChunkSummary& into, const ChunkSummary& part) {
+    into.firstBad = std::min(into.firstBad, part.firstBad);
+    if (!part.any) return;
+    into.lo = into.any ? glm::min(into.lo, part.lo) : part.lo;
+    into.hi = into.any ? glm::max(into.hi, part.hi) : part.hi;
+    into.any = true;
+}
+
 }  // namespace
 
 Result<Bounds> summarizeSet(const PointView& points, const char* name) {
@@ -36,40 +76,20 @@ Result<Bounds> summarizeSet(const PointView& points, const char* name) {
         return setError(name, ": a stride of " + std::to_string(points.strideBytes) +
                                   " bytes cannot hold three " + (scalar == 8 ? "doubles" : "floats") +
                                   " per point (or the data pointer is null)");
+    const char* base = static_cast<const char*>(points.data);
     const int threads = cpu::resolveThreads(0, points.count / kChunk + 1);
     std::vector<ChunkSummary> parts(static_cast<size_t>(threads));
     cpu::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int t) {
-        // Locals in the loop, one write per chunk: the per-thread summaries
-        // share cache lines.
-        ChunkSummary s = parts[size_t(t)];
-        for (size_t i = begin; i < end; ++i) {
-            const glm::dvec3 p = points.at(i);
-            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-                s.firstBad = std::min(s.firstBad, i);
-                continue;
-            }
-            if (!s.any) {
-                s.lo = s.hi = p;
-                s.any = true;
-            }
-            s.lo = glm::min(s.lo, p);
-            s.hi = glm::max(s.hi, p);
-        }
-        parts[size_t(t)] = s;
+        merge(parts[size_t(t)], points.scalar == Scalar::kFloat64
+                                    ? summarizeChunk<double>(base, points.strideBytes, begin, end)
+                                    : summarizeChunk<float>(base, points.strideBytes, begin, end));
     });
-    size_t firstBad = ~size_t(0);
-    Bounds box;
-    bool any = false;
-    for (const ChunkSummary& s : parts) {
-        firstBad = std::min(firstBad, s.firstBad);
-        if (!s.any) continue;
-        box.lo = any ? glm::min(box.lo, s.lo) : s.lo;
-        box.hi = any ? glm::max(box.hi, s.hi) : s.hi;
-        any = true;
-    }
-    if (firstBad != ~size_t(0))
-        return setError(name, ": point " + std::to_string(firstBad) + " has a NaN or infinite coordinate");
-    return box;
+    ChunkSummary all;
+    for (const ChunkSummary& part : parts) merge(all, part);
+    if (all.firstBad != ~size_t(0))
+        return setError(name,
+                        ": point " + std::to_string(all.firstBad) + " has a NaN or infinite coordinate");
+    return Bounds{all.lo, all.hi};
 }
 
 glm::dvec3 searchOrigin(const PointView& a, const PointView& b, const Bounds& boxA, const Bounds& boxB) {
