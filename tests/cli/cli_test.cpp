@@ -410,14 +410,27 @@ TEST(CliCpu, TinyAndSubnormalCoordinatesAreExact) {
     const std::string tiny = dir.write("tiny.xyz", "1e-40 0 0\n");
     const std::string zero = dir.write("zero.xyz", "0 0 0\n");
     const std::string sub = dir.write("sub.xyz", "1.4e-44 0 0\n2.8e-44 0 0\n7e-45 1.4e-45 0\n");
+    // The same in float32 files: the float path, searched as it is.
+    const std::string tinyF =
+        dir.write("tiny.ply", plyHeader("binary_little_endian", 1, kXyzProps) + floatsLE({1e-40f, 0, 0}));
+    const std::string subF =
+        dir.write("sub.ply", plyHeader("binary_little_endian", 3, kXyzProps) +
+                                 floatsLE({1.4e-44f, 0, 0, 2.8e-44f, 0, 0, 7e-45f, 1.4e-45f, 0}));
     for (const std::string& backend : {"auto", "cpu", "ray-query", "rt-pipeline"}) {
         SCOPED_TRACE(backend);
         const CliRun run = runCli({"--backend", backend, "--verify", "--json", tiny, zero});
         ASSERT_EQ(run.exitCode, 0) << run;
-        EXPECT_EQ(parseJson(run)["hausdorff"].get<double>(), double(1e-40f));
+        // Text is read in double (issue 10): H is that of the decimals as written.
+        EXPECT_EQ(parseJson(run)["hausdorff"].get<double>(), 1e-40);
         const CliRun subRun = runCli({"--backend", backend, "--verify", "--json", sub, zero});
         ASSERT_EQ(subRun.exitCode, 0) << subRun;
-        EXPECT_EQ(parseJson(subRun)["hausdorff"].get<double>(), double(2.8e-44f));
+        EXPECT_EQ(parseJson(subRun)["hausdorff"].get<double>(), 2.8e-44);
+        const CliRun floatRun = runCli({"--backend", backend, "--verify", "--json", tinyF, zero});
+        ASSERT_EQ(floatRun.exitCode, 0) << floatRun;
+        EXPECT_EQ(parseJson(floatRun)["hausdorff"].get<double>(), double(1e-40f));
+        const CliRun subFloatRun = runCli({"--backend", backend, "--verify", "--json", subF, zero});
+        ASSERT_EQ(subFloatRun.exitCode, 0) << subFloatRun;
+        EXPECT_EQ(parseJson(subFloatRun)["hausdorff"].get<double>(), double(2.8e-44f));
     }
 }
 

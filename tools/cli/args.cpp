@@ -1,5 +1,6 @@
 #include "cli/args.hpp"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -31,6 +32,8 @@ constexpr int kMaxBitsOption = 8;
 constexpr int kMaxDeviceIndex = 1023;
 constexpr int kMaxThreads = 1024;
 constexpr int kMaxHistogramBins = 10000;
+// LAS classification values are one byte (formats 0-5 use 0..31 of them).
+constexpr int kMaxLasClass = 255;
 
 std::string rangeText(double lo, double hi) {
     char text[64];
@@ -60,6 +63,26 @@ std::optional<double> parseNumber(std::string_view text) {
     return v;
 }
 
+// "2,6,9": comma-separated integers in [0, kMaxLasClass], at least one.
+std::optional<std::vector<int>> parseClassList(std::string_view text) {
+    std::vector<int> classes;
+    for (;;) {
+        const size_t comma = text.find(',');
+        const auto n = parseInt(text.substr(0, comma), 0, kMaxLasClass);
+        if (!n) return std::nullopt;
+        classes.push_back(*n);
+        if (comma == std::string_view::npos) return classes;
+        text.remove_prefix(comma + 1);
+    }
+}
+
+// A LAS file by its name: ".las", optionally ".gz" (case-insensitive).
+bool isLasPath(std::string path) {
+    for (char& c : path) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (path.ends_with(".gz")) path.resize(path.size() - 3);
+    return path.ends_with(".las");
+}
+
 }  // namespace
 
 std::string usageText() {
@@ -68,7 +91,8 @@ std::string usageText() {
 
 Exact Hausdorff distance H(A,B) = max(h(A,B), h(B,A)) between two 3-D point
 sets, h(A,B) = max over a in A of the distance to its nearest point of B.
-Inputs: .ply .xyz .txt .obj .gltf .glb .stl .off .pcd (optionally .gz).
+Inputs: .ply .xyz .txt .obj .gltf .glb .stl .off .pcd .las (optionally .gz);
+compressed LAS (.laz) must be decompressed first (laszip, pdal translate).
 
 Options:
   --json              print one JSON object instead of the summary
@@ -84,6 +108,9 @@ Options:
   --validation        enable the Vulkan validation layer, count its messages
   --list-devices      list Vulkan devices, the paths each supports, and why not
   --quiet             no progress on stderr (progress is shown only on a terminal)
+  --las-classes LIST  read only the LAS points of these classification values,
+                      comma-separated integers 0..255 (e.g. 2,6: ground and
+                      buildings); needs a .las input, other formats are read whole
 
 Per-point distances (each of these implies --per-point):
   --per-point         every point's exact nearest distance; statistics in the output
@@ -195,6 +222,15 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
                 return outOfRange(name, *v, "a number in " + rangeText(kMinRadiusGrowth, kMaxRadiusGrowth));
             }
             out.options.radiusGrowth = float(*f);
+        } else if (name == "--las-classes") {
+            const auto v = takeValue();
+            if (!v) return usageError("option '--las-classes' needs a value");
+            const auto classes = parseClassList(*v);
+            if (!classes) {
+                return outOfRange(
+                    name, *v, "comma-separated integers in " + rangeText(0, kMaxLasClass) + " (e.g. 2,6)");
+            }
+            out.lasClasses = *classes;
         } else if (name == "--quiet") {
             error = flag(out.quiet);
         } else if (name == "--per-point") {
@@ -256,6 +292,9 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
     }
     if (positional.size() != 2) {
         return usageError("expected two input files A and B, got " + std::to_string(positional.size()));
+    }
+    if (!out.lasClasses.empty() && !isLasPath(positional[0]) && !isLasPath(positional[1])) {
+        return usageError("option '--las-classes' filters LAS files, but neither input is .las");
     }
     out.options.perPointDistances = out.perPoint;
     out.pathA = positional[0];

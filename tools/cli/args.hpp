@@ -42,6 +42,7 @@ struct CliArgs {
     bool softwareRender = false;  // --render software|vulkan: how --png splats (default vulkan)
     std::string histogramPng;     // --histogram-png FILE
     bool quiet = false;           // --quiet: no progress on stderr
+    std::vector<int> lasClasses;  // --las-classes 2,6: LAS classification filter (empty = all)
 };
 
 // Parses argv[1..]. Accepts "--flag value" and "--flag=value"; "--" ends the

@@ -3,8 +3,10 @@
 // Every failure ends in "rthdist: <message>" on stderr and an exit code
 // (cli/args.hpp, rthdist/result.hpp exitCodeFor); nothing escapes main().
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <new>
 #include <optional>
 #include <string>
@@ -41,16 +43,32 @@ bool writeStdout(const std::string& text) {
     return std::fwrite(text.data(), 1, text.size(), stdout) == text.size() && std::fflush(stdout) == 0;
 }
 
-// Loads one input; the message always names the file.
-Result<std::vector<glm::vec3>> load(const std::string& path) {
-    Result<std::vector<glm::vec3>> points = io::loadPoints(path);
+// Loads one input in its file's precision; the message always names the file.
+Result<io::PointCloud> load(const std::string& path, const io::LoadOptions& options) {
+    Result<io::PointCloud> points = io::loadPointCloud(path, options);
     if (!points) {
         Error e = points.error();
         if (e.message.find(path) == std::string::npos) e.message = path + ": " + e.message;
         return e;
     }
-    if (points->empty()) return Error{ErrorCode::kBadInput, path + ": no points"};
+    if (points->size() == 0) return Error{ErrorCode::kBadInput, path + ": no points"};
     return points;
+}
+
+// The per-point outputs and their statistics work on float32 points: a
+// double cloud is rounded (its distances stay those of the double input).
+std::vector<glm::vec3> floatPoints(const io::PointCloud& cloud) {
+    if (cloud.scalar == Scalar::kFloat32) return cloud.floats;
+    constexpr double kMax = std::numeric_limits<float>::max();
+    auto narrow = [](double v) {  // beyond the float range: an infinity, not undefined behaviour
+        return v > kMax ? INFINITY : v < -kMax ? -INFINITY : static_cast<float>(v);
+    };
+    std::vector<glm::vec3> out(cloud.doubles.size());
+    for (size_t i = 0; i < out.size(); ++i) {
+        const glm::dvec3& p = cloud.doubles[i];
+        out[i] = glm::vec3(narrow(p.x), narrow(p.y), narrow(p.z));
+    }
+    return out;
 }
 
 int listDevicesCommand(const CliArgs& args) {
@@ -72,9 +90,11 @@ int run(const std::vector<std::string>& argv) {
     if (args.listDevices) return listDevicesCommand(args);
 
     const Clock::time_point loadStart = Clock::now();
-    Result<std::vector<glm::vec3>> a = load(args.pathA);
+    io::LoadOptions loadOptions;
+    loadOptions.lasClasses = args.lasClasses;
+    Result<io::PointCloud> a = load(args.pathA, loadOptions);
     if (!a) return failWith(a.error());
-    Result<std::vector<glm::vec3>> b = load(args.pathB);
+    Result<io::PointCloud> b = load(args.pathB, loadOptions);
     if (!b) return failWith(b.error());
     const double loadMs = msSince(loadStart);
 
@@ -82,27 +102,29 @@ int run(const std::vector<std::string>& argv) {
     ProgressMeter meter(!args.quiet && ProgressMeter::stderrIsTerminal());
     Options options = args.options;
     options.progress = [&meter](const char* stage, double fraction) { meter.update(stage, fraction); };
-    Result<HausdorffResult> result = hausdorff(*a, *b, options);
+    Result<HausdorffResult> result = hausdorff(a->view(), b->view(), options);
     meter.finish();
     if (!result) return failWith(result.error());
 
     std::optional<HausdorffStats> stats;
     if (args.perPoint) {
-        Result<HausdorffStats> s = hausdorffStats(*result, *a, *b, statsOptionsFrom(args));
+        const std::vector<glm::vec3> floatsA = floatPoints(*a);
+        const std::vector<glm::vec3> floatsB = floatPoints(*b);
+        Result<HausdorffStats> s = hausdorffStats(*result, floatsA, floatsB, statsOptionsFrom(args));
         if (!s) {
             return fail(kExitInternal, std::string("the ") + backendName(result->backend) +
                                            " backend returned no per-point distances: " + s.error().message);
         }
         stats = std::move(s).value();
         meter.update("output", 0.0);
-        Result<bool> written = writePerPointOutputs(args, *a, *b, *result, *stats);
+        Result<bool> written = writePerPointOutputs(args, floatsA, floatsB, *result, *stats);
         meter.finish();
         if (!written) return fail(kExitOutput, written.error().message);
     }
 
     std::optional<Verification> verification;
     if (args.verify) {
-        Result<Verification> v = verifyAgainstCpu(*a, *b, args.options, *result);
+        Result<Verification> v = verifyAgainstCpu(a->view(), b->view(), args.options, *result);
         if (!v) return failWith(v.error());
         verification = std::move(v).value();
     }
@@ -111,6 +133,8 @@ int run(const std::vector<std::string>& argv) {
     report.args = &args;
     report.pointsA = a->size();
     report.pointsB = b->size();
+    report.scalarA = a->scalar;
+    report.scalarB = b->scalar;
     report.loadMs = loadMs;
     report.result = &*result;
     report.verification = verification ? &*verification : nullptr;

@@ -7,19 +7,20 @@
 
 namespace rthdist::cli {
 
-double bboxDiagonal(std::span<const glm::vec3> points) {
+double bboxDiagonal(const PointView& points) {
     if (points.empty()) return 0.0;
-    glm::dvec3 lo(points[0]), hi(points[0]);
-    for (const glm::vec3& p : points) {
-        lo = glm::min(lo, glm::dvec3(p));
-        hi = glm::max(hi, glm::dvec3(p));
+    glm::dvec3 lo(points.at(0)), hi(points.at(0));
+    for (size_t i = 0; i < points.size(); ++i) {
+        const glm::dvec3 p = points.at(i);
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
     }
     const glm::dvec3 d = hi - lo;
     return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
 }
 
-Result<Verification> verifyAgainstCpu(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                      const Options& options, const HausdorffResult& result) {
+Result<Verification> verifyAgainstCpu(PointView a, PointView b, const Options& options,
+                                      const HausdorffResult& result) {
     Options cpuOptions = options;
     cpuOptions.backend = Backend::kCpu;
     cpuOptions.validation = false;

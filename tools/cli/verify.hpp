@@ -22,13 +22,13 @@ struct Verification {
     std::vector<std::string> mismatches;  // one line per value out of tolerance
 };
 
-// Length of the diagonal of the axis-aligned bounding box (0 for no points).
-[[nodiscard]] double bboxDiagonal(std::span<const glm::vec3> points);
+// Length of the diagonal of the axis-aligned bounding box, in double (0 for
+// no points).
+[[nodiscard]] double bboxDiagonal(const PointView& points);
 
 // Runs the CPU backend with `options` and compares it with `result`. An Error
 // only when the CPU run itself fails.
-[[nodiscard]] Result<Verification> verifyAgainstCpu(std::span<const glm::vec3> a,
-                                                    std::span<const glm::vec3> b, const Options& options,
+[[nodiscard]] Result<Verification> verifyAgainstCpu(PointView a, PointView b, const Options& options,
                                                     const HausdorffResult& result);
 
 }  // namespace rthdist::cli
