@@ -20,10 +20,15 @@
 //         the header's first word.
 //   .off  OFF / COFF / NOFF headers, vertices only
 //   .pcd  ascii and binary (x y z fields, any size/type), not binary_compressed
-//   .las  LAS 1.0-1.4, point data formats 0-10 (las_reader.hpp): X/Y/Z int32
-//         times scale plus offset, in double; variable-length records are
-//         skipped (the points start at the header's offset to point data);
-//         1.4's 64-bit point count. LoadOptions::lasClasses keeps only the
+//   .las  LAS 1.0-1.4, point data formats 0-10 (src/io/las_reader.hpp): X/Y/Z
+//         int32 times scale plus offset, in double; variable-length records
+//         are skipped (the points start at the header's offset to point
+//         data); 1.4's 64-bit point count. The header size, the offset to the
+//         points, the record length (at least the format's size) and the
+//         point count times the record length are checked against the file;
+//         a scale of 0, a non-finite scale or offset, and a coordinate that
+//         is NaN or infinite after scaling are refused, each naming the byte
+//         offset (or point). LoadOptions::lasClasses keeps only the
 //         points of those classification values. Compressed LAS (.laz) is
 //         refused with kBadInput saying how to decompress it (Debian 12 has
 //         no LAZ library): `laszip -i in.laz -o out.las` or
@@ -57,17 +62,17 @@
 // float; LAS is double (scale and offset applied in double); binary STL and
 // glTF are float. A double cloud takes 24 bytes per point, a float one 12.
 // loadPoints rounds a double cloud to the nearest floats (a coordinate beyond
-// the float range is then an error): kept for callers that want float32.
+// the float range is then an error): kept for callers that want float32;
+// for decimal text it can differ from a direct float conversion by one unit
+// in the last place when the decimal lies almost halfway between two floats.
 // Limits: a LAS file is read whole into memory like every other format (its
-// point records plus the cloud, 24 bytes per point); a LAS header's point
-// count times its record length must fit the file; extended VLRs and
+// point records plus the cloud, 24 bytes per point); extended VLRs and
 // waveform data after the points are not read. A glTF mesh instanced by
-// several nodes gives its points once per
-// instance; NaN points (e.g. in organized PCD clouds) are rejected, not
-// dropped; a binary PLY whose vertex count is one too high can go unnoticed
-// when the bytes it takes happen to leave a valid rest (e.g. 12-byte vertices
-// before uchar/int triangles). Reentrant: no shared state, safe to call from
-// several threads.
+// several nodes gives its points once per instance; NaN points (e.g. in
+// organized PCD clouds) are rejected, not dropped; a binary PLY whose vertex
+// count is one too high can go unnoticed when the bytes it takes happen to
+// leave a valid rest (e.g. 12-byte vertices before uchar/int triangles).
+// Reentrant: no shared state, safe to call from several threads.
 #pragma once
 
 #include <glm/vec3.hpp>
