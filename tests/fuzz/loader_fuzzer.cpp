@@ -19,6 +19,7 @@
 
 #include "io/gltf_reader.hpp"
 #include "io/gzip_inflate.hpp"
+#include "io/las_reader.hpp"
 #include "io/obj_reader.hpp"
 #include "io/off_reader.hpp"
 #include "io/pcd_reader.hpp"
@@ -27,7 +28,7 @@
 #include "io/xyz_reader.hpp"
 
 #ifndef RTHDIST_FUZZ_FORMAT
-#error "RTHDIST_FUZZ_FORMAT must name the format (ply, xyz, obj, gltf, glb, stl, off, pcd, gz)"
+#error "RTHDIST_FUZZ_FORMAT must name the format (ply, xyz, obj, gltf, glb, stl, off, pcd, las, gz)"
 #endif
 
 namespace {
@@ -57,6 +58,10 @@ void loadBytes(std::string_view bytes) {
     if (kFormat == "stl") (void)readStl(bytes, "fuzz.stl");
     if (kFormat == "off") (void)readOff(bytes, "fuzz.off");
     if (kFormat == "pcd") (void)readPcd(bytes, "fuzz.pcd");
+    if (kFormat == "las") {
+        (void)readLas(bytes, "fuzz.las", {});
+        (void)readLas(bytes, "fuzz.las", {2, 6});  // the classification filter's two passes
+    }
     if (kFormat == "gltf" || kFormat == "glb") {
         (void)readGltf(bytes, scratchDir() + "/fuzz." + std::string(kFormat));
     }
