@@ -55,7 +55,7 @@ std::string xyzText(const Points& points) {
     std::string out;
     char line[128];
     for (const auto& p : points) {
-        std::snprintf(line, sizeof line, "%.9g %.9g %.9g\n", double(p[0]), double(p[1]), double(p[2]));
+        std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", double(p[0]), double(p[1]), double(p[2]));
         out += line;
     }
     return out;
@@ -122,7 +122,8 @@ TEST_P(CliGpu, SmallFixturesExact) {
         const std::string pb = dir.write("b" + std::to_string(i) + ".xyz", xyzText(cases[i].second));
         const Json j = runVerified({pa, pb});
         if (j.is_null()) continue;
-        // The xyz text holds each float exactly (%.9g), so brute force here sees the same input.
+        // Text is read in double: %.17g gives back each float exactly, so brute force here sees the same
+        // input.
         const double hab = directedBrute(cases[i].first, cases[i].second);
         const double hba = directedBrute(cases[i].second, cases[i].first);
         // Float comparisons of near-tied squared distances may pick another pair: the
