@@ -19,8 +19,9 @@
 //   finds, for every query, a neighbour within 2 eps of its true nearest
 //   neighbour: the reported h is within 2 eps (< 1e-6 D) of the double truth,
 //   realized by a real pair, for coordinates of any magnitude (UTM, ECEF).
-//   Float inputs are searched as they are (o = 0): their differences are
-//   exact in float. Squared distances that would overflow or vanish in float
+//   Inputs whose every coordinate is a float32 value (float views, and double
+//   views holding float values, e.g. text written from floats) are searched
+//   as they are (o = 0). Squared distances that would overflow or vanish in float
 //   are handled by an exact power-of-two scale (algo::exactScale).
 //
 // Inputs: PointView (float or double, any stride; spans and vectors of
@@ -53,6 +54,7 @@
 #include <utility>
 #include <vector>
 
+#include "rthdist/export.hpp"
 #include "rthdist/point_view.hpp"
 #include "rthdist/result.hpp"
 
@@ -67,9 +69,9 @@ enum class Backend {
     kCpu,         // exact multithreaded CPU implementation (no Vulkan)
 };
 
-[[nodiscard]] const char* backendName(Backend backend);
+[[nodiscard]] RTHDIST_API const char* backendName(Backend backend);
 // Parses "auto", "ray-query", "rt-pipeline", "cpu"; false when unknown.
-[[nodiscard]] bool parseBackend(const std::string& text, Backend& out);
+[[nodiscard]] RTHDIST_API bool parseBackend(const std::string& text, Backend& out);
 
 struct Options {
     Backend backend = Backend::kAuto;
@@ -155,8 +157,8 @@ struct HausdorffResult {
     bool directedOnly = false;
     Backend backend = Backend::kAuto;  // the backend that ran
     std::string device;                // device name, or "cpu"
-    // Subtracted from both sets before the float32 search (0 when every input
-    // is float; the centre of the union's bounding box when one is double).
+    // Subtracted from both sets before the float32 search: 0 when every
+    // coordinate is a float32 value, else the centre of the union's box.
     glm::dvec3 origin{0.0};
     Timings timings;
     uint64_t validationMessages = 0;  // with Options::validation
@@ -178,10 +180,10 @@ struct DeviceInfo {
 };
 
 // Lists every Vulkan device; an error only when no Vulkan loader/ICD works.
-[[nodiscard]] Result<std::vector<DeviceInfo>> listDevices();
+[[nodiscard]] RTHDIST_API Result<std::vector<DeviceInfo>> listDevices();
 
 // Owns a Vulkan device, its pipelines and scratch memory between calls.
-class Engine {
+class RTHDIST_API Engine {
 public:
     [[nodiscard]] static Result<Engine> create(const Options& options);
     Engine(Engine&&) noexcept;
@@ -197,15 +199,16 @@ public:
 private:
     // The one-shot entry validates its inputs itself and calls the engine's
     // core directly, so the points are scanned once.
-    friend Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& options);
+    friend RTHDIST_API Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& options);
 
     explicit Engine(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> m_impl;
 };
 
 // One-shot convenience: creates an Engine (or runs the CPU backend) and computes.
-[[nodiscard]] Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& options = {});
+[[nodiscard]] RTHDIST_API Result<HausdorffResult> hausdorff(PointView a, PointView b,
+                                                            const Options& options = {});
 
-const char* versionString();
+RTHDIST_API const char* versionString();
 
 }  // namespace rthdist

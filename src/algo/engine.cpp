@@ -121,20 +121,20 @@ namespace {
 // (input_frame.hpp); the backends search float32 sets (shifted when an input
 // is double); witnesses and distances come back in the original coordinates.
 struct CheckedInputs {
-    algo::Bounds boxA, boxB;
+    algo::SetSummary a, b;
 };
 
 Result<CheckedInputs> checkInputs(const PointView& a, const PointView& b) {
-    Result<algo::Bounds> boxA = algo::summarizeSet(a, "A");
-    if (!boxA) return boxA.error();
-    Result<algo::Bounds> boxB = algo::summarizeSet(b, "B");
-    if (!boxB) return boxB.error();
-    return CheckedInputs{*boxA, *boxB};
+    Result<algo::SetSummary> sa = algo::summarizeSet(a, "A");
+    if (!sa) return sa.error();
+    Result<algo::SetSummary> sb = algo::summarizeSet(b, "B");
+    if (!sb) return sb.error();
+    return CheckedInputs{*sa, *sb};
 }
 
 Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, const PointView& b,
                                      const CheckedInputs& checked, std::chrono::steady_clock::time_point t0) {
-    const glm::dvec3 origin = algo::searchOrigin(a, b, checked.boxA, checked.boxB);
+    const glm::dvec3 origin = algo::searchOrigin(checked.a, checked.b);
     const algo::FloatSet fa(a, origin), fb(b, origin);
     Result<HausdorffResult> r = impl.gpu ? impl.gpu->compute(fa.span(), fb.span(), impl.options)
                                          : cpu::cpuHausdorff(fa.span(), fb.span(), impl.options);

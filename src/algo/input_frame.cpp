@@ -21,6 +21,7 @@ struct ChunkSummary {
     glm::dvec3 lo{0.0}, hi{0.0};
     size_t firstBad = ~size_t(0);
     bool any = false;
+    bool floatExact = true;
 };
 
 Error setError(const char* name, const std::string& what) {
@@ -34,18 +35,20 @@ ChunkSummary summarizeChunk(const char* base, size_t stride, size_t begin, size_
     // Branch-free over the points (vectorizes); a chunk with a bad point is
     // scanned again for its first one.
     T lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    bool finite = true;
+    bool finite = true, floatExact = true;
     for (size_t i = begin; i < end; ++i) {
         T v[3];
         std::memcpy(v, base + i * stride, sizeof(v));
         for (int k = 0; k < 3; ++k) {
             finite &= v[k] - v[k] == 0;  // 0 for finite values, NaN otherwise
+            floatExact &= T(float(v[k])) == v[k];
             lo[k] = v[k] < lo[k] ? v[k] : lo[k];
             hi[k] = v[k] > hi[k] ? v[k] : hi[k];
         }
     }
     ChunkSummary s;
     s.any = true;
+    s.floatExact = floatExact;
     s.lo = glm::dvec3(lo[0], lo[1], lo[2]);
     s.hi = glm::dvec3(hi[0], hi[1], hi[2]);
     if (!finite) {
@@ -60,6 +63,7 @@ ChunkSummary summarizeChunk(const char* base, size_t stride, size_t begin, size_
 
 void merge(ChunkSummary& into, const ChunkSummary& part) {
     into.firstBad = std::min(into.firstBad, part.firstBad);
+    into.floatExact = into.floatExact && part.floatExact;
     if (!part.any) return;
     into.lo = into.any ? glm::min(into.lo, part.lo) : part.lo;
     into.hi = into.any ? glm::max(into.hi, part.hi) : part.hi;
@@ -68,7 +72,7 @@ void merge(ChunkSummary& into, const ChunkSummary& part) {
 
 }  // namespace
 
-Result<Bounds> summarizeSet(const PointView& points, const char* name) {
+Result<SetSummary> summarizeSet(const PointView& points, const char* name) {
     if (points.empty()) return setError(name, " is empty: the Hausdorff distance is undefined");
     if (points.count > kMaxPoints) return setError(name, " has more than 2^31-1 points");
     const size_t scalar = scalarBytes(points.scalar);
@@ -89,12 +93,12 @@ Result<Bounds> summarizeSet(const PointView& points, const char* name) {
     if (all.firstBad != ~size_t(0))
         return setError(name,
                         ": point " + std::to_string(all.firstBad) + " has a NaN or infinite coordinate");
-    return Bounds{all.lo, all.hi};
+    return SetSummary{Bounds{all.lo, all.hi}, all.floatExact};
 }
 
-glm::dvec3 searchOrigin(const PointView& a, const PointView& b, const Bounds& boxA, const Bounds& boxB) {
-    if (a.scalar == Scalar::kFloat32 && b.scalar == Scalar::kFloat32) return glm::dvec3(0.0);
-    return 0.5 * (glm::min(boxA.lo, boxB.lo) + glm::max(boxA.hi, boxB.hi));
+glm::dvec3 searchOrigin(const SetSummary& a, const SetSummary& b) {
+    if (a.floatExact && b.floatExact) return glm::dvec3(0.0);
+    return 0.5 * (glm::min(a.box.lo, b.box.lo) + glm::max(a.box.hi, b.box.hi));
 }
 
 FloatSet::FloatSet(const PointView& points, const glm::dvec3& origin) {

@@ -18,14 +18,22 @@
 
 namespace rthdist::algo {
 
-// Bounds of one set, or the error naming the first bad point (NaN/Inf, an
-// empty set, a stride that cannot hold a point, too many points).
-[[nodiscard]] Result<Bounds> summarizeSet(const PointView& points, const char* name);
+struct SetSummary {
+    Bounds box;
+    // Every coordinate is a float32 value (always for float views; for a
+    // double view, e.g. text written from floats): searched without a shift.
+    bool floatExact = true;
+};
 
-// The origin subtracted before the float search: zero when both inputs are
-// float, else the centre of the union of both boxes.
-[[nodiscard]] glm::dvec3 searchOrigin(const PointView& a, const PointView& b, const Bounds& boxA,
-                                      const Bounds& boxB);
+// Box and precision of one set, or the error naming the first bad point
+// (NaN/Inf, an empty set, a stride that cannot hold a point, too many points).
+[[nodiscard]] Result<SetSummary> summarizeSet(const PointView& points, const char* name);
+
+// The origin subtracted before the float search: zero when every coordinate
+// of both sets is a float32 value (their differences are then as exact as
+// the float search can be, whatever the magnitude), else the centre of the
+// union of both boxes.
+[[nodiscard]] glm::dvec3 searchOrigin(const SetSummary& a, const SetSummary& b);
 
 // The float32 points a backend searches: the caller's memory when it is
 // packed float and the origin is zero, else a shifted, rounded copy.
