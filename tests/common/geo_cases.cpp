@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include <cmath>
+#include <cstdio>
 
 #include "common/rng.hpp"
 
@@ -112,6 +113,9 @@ DirectedDouble bruteForceDirectedDouble(std::span<const glm::dvec3> q, std::span
 }
 
 void expectMatchesGeoOracle(const GeoCase& c, const HausdorffResult& r) {
+    std::printf("  %-14s seed %-20llu %5zu x %-5zu H %.17g origin (%.17g, %.17g, %.17g)\n", c.name.c_str(),
+                static_cast<unsigned long long>(c.seed), c.a.size(), c.b.size(), r.hausdorff, r.origin.x,
+                r.origin.y, r.origin.z);
     SCOPED_TRACE("case " + c.name + " seed " + std::to_string(c.seed) + " |A|=" + std::to_string(c.a.size()) +
                  " |B|=" + std::to_string(c.b.size()));
     const double tolerance = 1e-6 * diagonal(c.a, c.b);

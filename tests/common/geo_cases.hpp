@@ -36,9 +36,9 @@ struct DirectedDouble {
 [[nodiscard]] DirectedDouble bruteForceDirectedDouble(std::span<const glm::dvec3> q,
                                                       std::span<const glm::dvec3> t);
 
-// EXPECTs: both directed values and H within 1e-6 of the union's diagonal
-// of the double brute force; witness points are the input doubles exactly
-// and their double distance is the reported one.
+// Prints the case's name, seed, sizes, H and origin; EXPECTs: both directed values and H within 1e-6 of the
+// union's diagonal of the double brute force; witness points are the input doubles exactly and their double
+// distance is the reported one.
 void expectMatchesGeoOracle(const GeoCase& c, const HausdorffResult& r);
 
 }  // namespace rthdist::test
