@@ -80,6 +80,7 @@
 #include <string>
 #include <vector>
 
+#include "rthdist/export.hpp"
 #include "rthdist/point_view.hpp"
 #include "rthdist/result.hpp"
 
@@ -87,7 +88,7 @@ namespace rthdist::io {
 
 // A loaded point set in the precision of its file: exactly one of floats
 // (scalar kFloat32) and doubles (kFloat64) holds the points.
-struct PointCloud {
+struct RTHDIST_IO_API PointCloud {
     Scalar scalar = Scalar::kFloat32;
     std::vector<glm::vec3> floats;
     std::vector<glm::dvec3> doubles;
@@ -106,12 +107,14 @@ struct LoadOptions {
     std::vector<int> lasClasses;
 };
 
-[[nodiscard]] Result<PointCloud> loadPointCloud(const std::string& path, const LoadOptions& options = {});
+[[nodiscard]] RTHDIST_IO_API Result<PointCloud> loadPointCloud(const std::string& path,
+                                                               const LoadOptions& options = {});
 
 // The points rounded to float32 (earlier releases' loader).
-[[nodiscard]] Result<std::vector<glm::vec3>> loadPoints(const std::string& path);
+[[nodiscard]] RTHDIST_IO_API Result<std::vector<glm::vec3>> loadPoints(const std::string& path);
 
 // Writes a binary little-endian PLY with float x/y/z vertices only.
-[[nodiscard]] Result<bool> writePlyPoints(const std::string& path, const std::vector<glm::vec3>& points);
+[[nodiscard]] RTHDIST_IO_API Result<bool> writePlyPoints(const std::string& path,
+                                                         const std::vector<glm::vec3>& points);
 
 }  // namespace rthdist::io

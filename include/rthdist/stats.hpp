@@ -38,6 +38,7 @@
 #include <string>
 #include <vector>
 
+#include "rthdist/export.hpp"
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
 
@@ -77,20 +78,21 @@ struct HausdorffStats {
 };
 
 // Nearest-rank percentile of ascending `sorted` (non-empty), p in [0, 100].
-[[nodiscard]] double percentileNearestRank(std::span<const double> sorted, double p);
+[[nodiscard]] RTHDIST_API double percentileNearestRank(std::span<const double> sorted, double p);
 
 // Statistics of one set of distances (any order); empty -> count 0.
-[[nodiscard]] DistanceStats distanceStats(std::span<const double> distances, const StatsOptions& options,
-                                          double histogramLo, double histogramHi);
+[[nodiscard]] RTHDIST_API DistanceStats distanceStats(std::span<const double> distances,
+                                                      const StatsOptions& options, double histogramLo,
+                                                      double histogramHi);
 
-[[nodiscard]] Result<HausdorffStats> hausdorffStats(const HausdorffResult& result,
-                                                    std::span<const glm::vec3> a,
-                                                    std::span<const glm::vec3> b,
-                                                    const StatsOptions& options = {});
+[[nodiscard]] RTHDIST_API Result<HausdorffStats> hausdorffStats(const HausdorffResult& result,
+                                                                std::span<const glm::vec3> a,
+                                                                std::span<const glm::vec3> b,
+                                                                const StatsOptions& options = {});
 
 // Symmetric ("max") or pooled ("pooled") percentile p by variant name; false
 // when the name is unknown or p was not among StatsOptions::percentiles.
-[[nodiscard]] bool percentileVariant(const HausdorffStats& stats, const std::string& variant, double p,
-                                     double& out);
+[[nodiscard]] RTHDIST_API bool percentileVariant(const HausdorffStats& stats, const std::string& variant,
+                                                 double p, double& out);
 
 }  // namespace rthdist
