@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# The installed package, as a user gets it: for a static and a shared build
+# (build-pkg-static/, build-pkg-shared/; library only), `cmake --install` to a
+# temporary prefix, then tests/package/consumer built and run against it
+#   1. with CMake (find_package(rthdist [COMPONENTS io]); the compiler's
+#      default C++ standard, so the targets must carry cxx_std_20),
+#   2. with pkg-config (g++ -std=c++20 $(pkg-config --cflags --libs rthdist)).
+# The shared libraries must export rthdist's public API only.
+# RTHDIST_JOBS sets the build parallelism (default 2).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs=${RTHDIST_JOBS:-2}
+consumer=tests/package/consumer
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+for kind in static shared; do
+  echo "== package ($kind)"
+  build=build-pkg-$kind
+  shared=OFF
+  [[ $kind == shared ]] && shared=ON
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DBUILD_SHARED_LIBS=$shared \
+    -DRTHDIST_BUILD_TESTS=OFF -DRTHDIST_BUILD_TOOLS=OFF > "$work/configure-$kind.log" 2>&1 ||
+    { cat "$work/configure-$kind.log"; exit 1; }
+  cmake --build "$build" -j "$jobs"
+  prefix=$work/$kind
+  cmake --install "$build" --prefix "$prefix" > /dev/null
+
+  echo "-- CMake consumer"
+  cmake -S "$consumer" -B "$work/consumer-$kind" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" > /dev/null
+  cmake --build "$work/consumer-$kind" -j "$jobs"
+  "$work/consumer-$kind/app"
+  "$work/consumer-$kind/app_io"
+
+  echo "-- pkg-config consumer"
+  pcdir=$(dirname "$(find "$prefix" -name rthdist.pc)")
+  export PKG_CONFIG_PATH=$pcdir
+  libdir=$(pkg-config --variable=libdir rthdist)
+  # shellcheck disable=SC2046  # pkg-config's output is a list of flags
+  g++ -std=c++20 -o "$work/app-pc-$kind" "$consumer/main.cpp" $(pkg-config --cflags --libs rthdist)
+  # shellcheck disable=SC2046
+  g++ -std=c++20 -o "$work/app-io-pc-$kind" "$consumer/io_main.cpp" $(pkg-config --cflags --libs rthdist-io rthdist)
+  LD_LIBRARY_PATH=$libdir "$work/app-pc-$kind"
+  LD_LIBRARY_PATH=$libdir "$work/app-io-pc-$kind"
+  unset PKG_CONFIG_PATH
+
+  if [[ $kind == shared ]]; then
+    echo "-- exported symbols"
+    for lib in "$libdir/librthdist.so" "$libdir/librthdist_io.so"; do
+      exported=$(nm -DC --defined-only "$lib" | grep 'rthdist::' || true)
+      echo "$(basename "$lib"): $(grep -c . <<< "$exported") rthdist symbols exported"
+      # Only the public API: nothing from the internal namespaces or the
+      # loaders' per-format readers.
+      if leaked=$(grep -E 'rthdist::(gpu|cpu|algo|render)::|rthdist::io::[a-z]+[A-Z][A-Za-z]*Reader|\(anonymous' <<< "$exported"); then
+        echo "internal symbols exported from $lib:"
+        echo "$leaked"
+        exit 1
+      fi
+    done
+  fi
+done
+echo "== package test passed (static, shared; CMake and pkg-config)"
