@@ -5,7 +5,8 @@
 #   1. with CMake (find_package(rthdist [COMPONENTS io]); the compiler's
 #      default C++ standard, so the targets must carry cxx_std_20),
 #   2. with pkg-config (g++ -std=c++20 $(pkg-config --cflags --libs rthdist)).
-# The shared libraries must export rthdist's public API only.
+# The shared libraries must export rthdist's public API only, and README.md's
+# C++ example must be the consumer's main.cpp.
 # RTHDIST_JOBS sets the build parallelism (default 2).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,6 +14,13 @@ jobs=${RTHDIST_JOBS:-2}
 consumer=tests/package/consumer
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+
+# The README's C++ example is the consumer's source, verbatim.
+awk '/^## Library \(C\+\+\)$/ { section = 1; next }
+     section && /^```cpp$/ { code = 1; next }
+     code && /^```$/ { exit }
+     code { print }' README.md | diff -u - "$consumer/main.cpp" ||
+  { echo "README.md: the code block under '## Library (C++)' is not $consumer/main.cpp"; exit 1; }
 
 for kind in static shared; do
   echo "== package ($kind)"
