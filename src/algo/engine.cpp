@@ -1,6 +1,7 @@
 // Public entry of rthdist: input validation, backend choice, and the Engine
 // that keeps a Vulkan device and its pipelines between calls.
 #include "rthdist/rthdist.hpp"
+#include "rthdist/version.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -16,7 +17,7 @@
 
 namespace rthdist {
 
-const char* versionString() { return RTHDIST_VERSION; }
+const char* versionString() { return RTHDIST_VERSION_STRING; }
 
 const char* backendName(Backend backend) {
     switch (backend) {
