@@ -9,12 +9,12 @@
 #include <new>
 #include <stdexcept>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "algo/index_space.hpp"
+#include "algo/input_frame.hpp"
 #include "algo/self_check.hpp"
 #include "cpu/parallel.hpp"
 #include "gpu/accel.hpp"
@@ -675,22 +675,8 @@ Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std:
         m_state->tlasBound = false;
         return Error{ErrorCode::kInternal, e.what()};
     }
-    if (scale != 1.0) {
-        auto restore = [](Directed& d, std::span<const glm::vec3> q, std::span<const glm::vec3> t) {
-            d.queryPoint = q[d.queryIndex];
-            d.targetPoint = t[d.targetIndex];
-            d.distance = glm::length(glm::dvec3(d.queryPoint) - glm::dvec3(d.targetPoint));
-        };
-        restore(res.aToB, a, b);
-        res.hausdorff = res.aToB.distance;
-        if (!options.directedOnly) {
-            restore(res.bToA, b, a);
-            res.hausdorff = std::max(res.hausdorff, res.bToA.distance);
-        }
-        for (auto [pp, q, t] : {std::tuple{&res.aNearest, a, b}, std::tuple{&res.bNearest, b, a}})
-            for (size_t i = 0; i < pp->nearest.size(); ++i)
-                pp->distance[i] = glm::length(glm::dvec3(q[i]) - glm::dvec3(t[pp->nearest[i]]));
-    }
+    // Witnesses and per-point distances from the unscaled inputs, in double.
+    if (scale != 1.0) restoreOriginal(res, a, b);
     m_state->timings = nullptr;
     return res;
 }
