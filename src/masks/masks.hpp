@@ -1,0 +1,165 @@
+// rthdist masks — Hausdorff distance, HD-p, ASSD/MSD and surface Dice between
+// two segmentation masks (NIfTI-1/2 or NumPy volumes), exact, in the
+// convention of a named tool (../shared/MASKS.md, README "Segmentation masks").
+//
+// Pipeline per label: select the label's voxels in each volume, extract the
+// convention's point set (boundary voxels under a stated connectivity, or all
+// foreground voxels), convert voxel centres to coordinates in double, then
+// the exact engine (rthdist.hpp, per-point distances) for every point's
+// nearest distance in the other set; the convention's percentile rule and
+// combination of the two directions make the numbers.
+//
+// Conventions (Convention; conventionName/parseConvention):
+//   rthdist     boundary = foreground voxels with a background (or outside
+//               the volume) neighbour under `connectivity` (default 6);
+//               coordinates = the voxel-to-world affine (a shear counts);
+//               HD-p = max of the two directed nearest-rank percentiles
+//               (rthdist/stats.hpp percentileNearestRank); empty -> status, no value.
+//   monai       boundary = mask XOR erosion (6-connected cross); spacing only;
+//               HD-p = max of the two directed linear percentiles
+//               (torch.quantile); empty: both -> NaN, one -> HD inf, HD-p NaN.
+//   medpy       boundary as monai (connectivity 6 by default); HD-p = linear
+//               percentile of the POOLED distances of both directions;
+//               HD = max; empty -> undefined (MedPy raises).
+//   plastimatch boundary voxels (6-connected); HD-p per direction = the k-th
+//               smallest, k = floor(f n - 1) clamped to [0, n-1], f = p/100;
+//               HD-p = MEAN of the two; "average" = mean of the directed means;
+//               both empty -> 0.
+//   itk         ALL foreground voxels (HausdorffDistanceImageFilter): a voxel
+//               inside the other mask counts 0; no percentile; "average" =
+//               mean of the directed means (AverageHausdorffDistance).
+// Every convention but rthdist measures with the voxel spacing only (the
+// column norms of the affine's 3x3 part), as those tools do; for an
+// orthonormal direction matrix the distances equal the world ones.
+//
+// Precision: coordinates in double; distances are the engine's exact values
+// (within 1e-6 of the union's bounding-box diagonal of the brute force in
+// double, rthdist.hpp), so every order statistic is as well.
+// Threading: extraction uses options.threads (0 = all); the Engine passed in is
+// not thread-safe (one per thread). Functions are otherwise reentrant.
+// Limits: volumes up to 2^31 - 1 selected points per mask (engine limit);
+// labels are int32 values (wider or non-integral values -> kBadInput).
+#pragma once
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rthdist/result.hpp"
+#include "rthdist/rthdist.hpp"
+
+namespace rthdist::masks {
+
+// A label volume on a grid: voxel (i, j, k) is labels[i + nx * (j + ny * k)]
+// (NIfTI order, i fastest), its centre at voxelToWorld * (i, j, k, 1).
+struct Volume {
+    std::string path;  // the file it came from ("" for arrays)
+    std::array<int64_t, 3> dims{0, 0, 0};
+    glm::dmat4 voxelToWorld{1.0};       // column-major (glm): world = M * (i, j, k, 1)
+    std::string transform = "spacing";  // "sform", "qform", "pixdim", "spacing", "affine"
+    std::vector<int32_t> labels;
+
+    [[nodiscard]] uint64_t voxelCount() const {
+        return uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
+    }
+    // Column norms of the affine's 3x3 part (the spacing tools such as MONAI use).
+    [[nodiscard]] glm::dvec3 spacing() const;
+};
+
+// Reads a NIfTI-1 or NIfTI-2 file (.nii, .nii.gz) through libnifti2. The
+// transform is the sform when sform_code > 0, else the qform when
+// qform_code > 0, else diag(pixdim[1..3]) with origin 0. scl_slope/scl_inter
+// are applied when the slope is finite and non-zero. A 4-D file must have
+// one volume. Errors (kBadInput) name the file.
+[[nodiscard]] Result<Volume> loadNifti(const std::string& path);
+
+// Reads a NumPy .npy file (3-D; bool, int8..int64, uint8..uint64, float32,
+// float64; C or Fortran order). Array axes 0, 1, 2 are i, j, k; the voxel
+// spacing along them is `spacing` (origin 0) unless `affine` (a 4x4 whose
+// last row is 0 0 0 1) is given.
+[[nodiscard]] Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing,
+                                     const std::optional<glm::dmat4>& affine = std::nullopt);
+
+// Loads by extension: .nii / .nii.gz through loadNifti, .npy through loadNpy.
+[[nodiscard]] Result<Volume> loadVolume(const std::string& path, glm::dvec3 spacing = glm::dvec3(1.0),
+                                        const std::optional<glm::dmat4>& affine = std::nullopt);
+
+// Empty when a and b share a grid (same dims, affines equal within 1e-5 of
+// an entry's magnitude, at least 1e-6); else the reason, naming both files.
+// Nothing is resampled.
+[[nodiscard]] std::optional<Error> checkSameGrid(const Volume& a, const Volume& b);
+
+// Sorted distinct non-zero labels present in the volume.
+[[nodiscard]] std::vector<int32_t> labelsPresent(const Volume& v);
+
+enum class Convention { kRthdist, kMonai, kMedpy, kPlastimatch, kItk };
+inline constexpr std::array<Convention, 5> kAllConventions{
+    Convention::kRthdist, Convention::kMonai, Convention::kMedpy, Convention::kPlastimatch, Convention::kItk};
+[[nodiscard]] const char* conventionName(Convention c);
+[[nodiscard]] bool parseConvention(const std::string& text, Convention& out);
+// One line naming the point set, the metric, the percentile rule and the combination.
+[[nodiscard]] const char* conventionRule(Convention c);
+
+// Which voxels form a mask: label == value, or (anyNonZero) label != 0.
+struct LabelSelect {
+    int32_t value = 1;
+    bool anyNonZero = true;
+};
+
+struct MaskOptions {
+    Convention convention = Convention::kRthdist;
+    // 6, 18 or 26; 0 = the convention's (6). Ignored by itk (all voxels).
+    int connectivity = 0;
+    std::vector<double> percentiles{95.0};  // each in [0, 100]
+    double tolerance = 1.0;                 // surface Dice tolerance, in mm (>= 0)
+    int threads = 0;                        // boundary extraction; 0 = all hardware threads
+};
+
+enum class EmptyStatus { kNone, kBothEmpty, kAEmpty, kBEmpty };
+[[nodiscard]] const char* emptyStatusName(EmptyStatus s);  // "ok", "both_empty", "a_empty", "b_empty"
+
+// One direction X -> Y.
+struct DirectedMask {
+    uint64_t points = 0;  // X's points under the convention (boundary voxels or all voxels)
+    double hd = 0.0;      // max over X of the nearest distance to Y
+    double mean = 0.0;
+    std::vector<double> percentiles;               // this direction's percentile per MaskOptions::percentiles
+                                                   // (the convention's rule; medpy: the pooled values)
+    std::array<int64_t, 3> voxel{0, 0, 0};         // X's voxel realizing hd
+    std::array<int64_t, 3> nearestVoxel{0, 0, 0};  // its nearest voxel of Y
+    glm::dvec3 point{0.0}, nearestPoint{0.0};      // their centres in world coordinates
+};
+
+struct MaskResult {
+    Convention convention = Convention::kRthdist;
+    int connectivity = 6;  // 0 for itk (all voxels)
+    EmptyStatus empty = EmptyStatus::kNone;
+    // With empty != kNone: no number below is valid; what the convention
+    // itself would report, as text ("nan", "inf", "0", "undefined").
+    std::string emptyHd, emptyHdPercentile;
+    double hd = 0.0;
+    std::vector<double> percentiles;   // the requested p values
+    std::vector<double> hdPercentile;  // combined per the convention (empty for itk)
+    double assd = 0.0;                 // (sum of both directions' distances) / (n_a + n_b)
+    double msd = 0.0;                  // mean of the two directed means (itk/plastimatch "average HD")
+    double surfaceDice = 0.0;  // (#{d_ab <= tol} + #{d_ba <= tol}) / (n_a + n_b); itk: not defined (NaN)
+    DirectedMask aToB, bToA;
+    double extractMs = 0.0, distanceMs = 0.0, totalMs = 0.0;
+};
+
+// Compares label `selectA` of `a` with `selectB` of `b` (same grid: checked).
+// `engine` must have been created with perPointDistances and directedOnly set
+// (makeMaskEngine); each direction is one compute() call.
+[[nodiscard]] Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect selectA,
+                                              const Volume& b, LabelSelect selectB,
+                                              const MaskOptions& options);
+
+// An Engine configured for compareMasks from the caller's options.
+[[nodiscard]] Result<Engine> makeMaskEngine(Options options);
+
+}  // namespace rthdist::masks

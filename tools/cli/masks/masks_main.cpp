@@ -1,0 +1,414 @@
+// rthdist-masks — HD, HD-p, ASSD/MSD and surface Dice between two
+// segmentation masks (NIfTI-1/2 .nii/.nii.gz, NumPy .npy) in a named tool's
+// convention (src/masks/masks.hpp; README "Segmentation masks").
+//
+//   rthdist-masks A B [--label N | --labels all] [--convention NAME|all]
+//                 [--percentile P]... [--connectivity 6|18|26] [--tolerance MM]
+//                 [--spacing X,Y,Z] [--backend B] [--device N] [--threads N]
+//                 [--json | --csv]
+//
+// A separate executable from `rthdist` (tools/cli/main.cpp) so that the point
+// CLI's parser stays as it is. Exit codes are the point CLI's (cli/args.hpp):
+// 0 ok, 1 internal, 2 usage, 3 bad input (unreadable file, grids that
+// differ), 4 no device. Every error names the file it concerns.
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <new>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cli/args.hpp"
+#include "cli/json_writer.hpp"
+#include "masks/masks.hpp"
+
+namespace rthdist::cli {
+namespace {
+
+using masks::Convention;
+using masks::MaskResult;
+
+struct MasksArgs {
+    std::string pathA, pathB;
+    std::optional<int32_t> label;  // --label N (both volumes)
+    bool allLabels = false;        // --labels all
+    std::vector<Convention> conventions{Convention::kRthdist};
+    std::vector<double> percentiles;
+    int connectivity = 0;
+    double tolerance = 1.0;
+    glm::dvec3 spacing{1.0};
+    Options options;
+    bool json = false, csv = false, help = false, version = false;
+};
+
+const char* kUsage =
+    "usage: rthdist-masks A B [options]\n"
+    "Hausdorff distance, HD-p, ASSD/MSD and surface Dice between two segmentation masks\n"
+    "(.nii, .nii.gz: NIfTI-1/2 with sform, else qform, else pixdim; .npy with --spacing).\n"
+    "  --label N            compare label N in both volumes (default: every non-zero voxel)\n"
+    "  --labels all         one row per label present in either volume\n"
+    "  --convention NAME    rthdist (default), monai, medpy, plastimatch, itk, or all (one row each)\n"
+    "  --percentile P       HD-p to report, repeatable (default 95)\n"
+    "  --connectivity C     boundary connectivity 6, 18 or 26 (default 6; itk uses all voxels)\n"
+    "  --tolerance MM       surface Dice tolerance in mm (default 1)\n"
+    "  --spacing X,Y,Z      voxel spacing of .npy inputs along axes 0,1,2 (default 1,1,1)\n"
+    "  --backend B          auto, cpu, ray-query, rt-pipeline (default auto)\n"
+    "  --device N           Vulkan device index;  --threads N  CPU threads (0 = all)\n"
+    "  --json | --csv       output format (default: text)\n"
+    "Exit codes: 0 ok, 1 internal error, 2 usage, 3 bad input or different grids, 4 no device.\n";
+
+Error usage(const std::string& m) { return Error{ErrorCode::kInvalidArgument, m}; }
+
+std::optional<double> number(std::string_view t) {
+    double v = 0;
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (t.empty() || r.ec != std::errc() || r.ptr != t.data() + t.size() || !std::isfinite(v))
+        return std::nullopt;
+    return v;
+}
+
+std::optional<int64_t> integer(std::string_view t) {
+    int64_t v = 0;
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (t.empty() || r.ec != std::errc() || r.ptr != t.data() + t.size()) return std::nullopt;
+    return v;
+}
+
+Result<MasksArgs> parse(const std::vector<std::string>& argv) {
+    MasksArgs a;
+    std::vector<std::string> files;
+    bool conventionSet = false;
+    for (size_t i = 0; i < argv.size(); ++i) {
+        std::string arg = argv[i];
+        std::string value;
+        bool hasValue = false;
+        if (arg.rfind("--", 0) == 0) {
+            const size_t eq = arg.find('=');
+            if (eq != std::string::npos) {
+                value = arg.substr(eq + 1);
+                arg = arg.substr(0, eq);
+                hasValue = true;
+            }
+        }
+        auto need = [&]() -> std::optional<std::string> {
+            if (hasValue) return value;
+            if (i + 1 >= argv.size()) return std::nullopt;
+            return argv[++i];
+        };
+        if (arg == "--help" || arg == "-h") {
+            a.help = true;
+        } else if (arg == "--version") {
+            a.version = true;
+        } else if (arg == "--json") {
+            a.json = true;
+        } else if (arg == "--csv") {
+            a.csv = true;
+        } else if (arg == "--label" || arg == "--labels" || arg == "--convention" || arg == "--percentile" ||
+                   arg == "--connectivity" || arg == "--tolerance" || arg == "--spacing" ||
+                   arg == "--backend" || arg == "--device" || arg == "--threads") {
+            const auto v = need();
+            if (!v) return usage("option '" + arg + "' needs a value");
+            if (arg == "--label") {
+                const auto n = integer(*v);
+                if (!n || *n < INT32_MIN || *n > INT32_MAX)
+                    return usage("--label expects an int32, got '" + *v + "'");
+                a.label = int32_t(*n);
+            } else if (arg == "--labels") {
+                if (*v != "all") return usage("--labels expects 'all', got '" + *v + "'");
+                a.allLabels = true;
+            } else if (arg == "--convention") {
+                if (!conventionSet) a.conventions.clear();
+                conventionSet = true;
+                if (*v == "all") {
+                    a.conventions.assign(masks::kAllConventions.begin(), masks::kAllConventions.end());
+                } else {
+                    Convention c;
+                    if (!masks::parseConvention(*v, c))
+                        return usage(
+                            "--convention expects rthdist, monai, medpy, plastimatch, itk or all, got '" +
+                            *v + "'");
+                    a.conventions.push_back(c);
+                }
+            } else if (arg == "--percentile") {
+                const auto p = number(*v);
+                if (!p || *p < 0 || *p > 100)
+                    return usage("--percentile expects a number in [0, 100], got '" + *v + "'");
+                a.percentiles.push_back(*p);
+            } else if (arg == "--connectivity") {
+                const auto n = integer(*v);
+                if (!n || (*n != 6 && *n != 18 && *n != 26))
+                    return usage("--connectivity expects 6, 18 or 26, got '" + *v + "'");
+                a.connectivity = int(*n);
+            } else if (arg == "--tolerance") {
+                const auto t = number(*v);
+                if (!t || *t < 0) return usage("--tolerance expects a number >= 0, got '" + *v + "'");
+                a.tolerance = *t;
+            } else if (arg == "--spacing") {
+                double s[3];
+                size_t at = 0;
+                for (int k = 0; k < 3; ++k) {
+                    const size_t end = k < 2 ? v->find(',', at) : v->size();
+                    if (end == std::string::npos) return usage("--spacing expects X,Y,Z, got '" + *v + "'");
+                    const auto x = number(std::string_view(*v).substr(at, end - at));
+                    if (!x || *x <= 0)
+                        return usage("--spacing expects three positive numbers, got '" + *v + "'");
+                    s[k] = *x;
+                    at = end + 1;
+                }
+                a.spacing = {s[0], s[1], s[2]};
+            } else if (arg == "--backend") {
+                if (!parseBackend(*v, a.options.backend))
+                    return usage("--backend expects auto, cpu, ray-query or rt-pipeline, got '" + *v + "'");
+            } else if (arg == "--device") {
+                const auto n = integer(*v);
+                if (!n || *n < 0 || *n > 1023)
+                    return usage("--device expects an index in [0, 1023], got '" + *v + "'");
+                a.options.deviceIndex = int(*n);
+            } else {
+                const auto n = integer(*v);
+                if (!n || *n < 0 || *n > 1024) return usage("--threads expects [0, 1024], got '" + *v + "'");
+                a.options.threads = int(*n);
+            }
+        } else if (arg.size() > 1 && arg[0] == '-') {
+            return usage("unknown option '" + arg + "'");
+        } else {
+            files.push_back(arg);
+        }
+    }
+    if (a.help || a.version) return a;
+    if (files.size() != 2) return usage("expected two mask files A B, got " + std::to_string(files.size()));
+    if (a.label && a.allLabels) return usage("--label and --labels all exclude each other");
+    if (a.json && a.csv) return usage("--json and --csv exclude each other");
+    a.pathA = files[0];
+    a.pathB = files[1];
+    if (a.percentiles.empty()) a.percentiles.push_back(95.0);
+    return a;
+}
+
+struct Row {
+    std::string label;  // "nonzero" or the label value
+    MaskResult r;
+};
+
+std::string num(double v) {
+    if (std::isnan(v)) return "";
+    char t[64];
+    std::snprintf(t, sizeof t, "%.17g", v);
+    return t;
+}
+
+void voxelJson(JsonWriter& w, const char* key, const std::array<int64_t, 3>& v) {
+    w.key(key).beginArray(true);
+    for (int64_t x : v) w.value(x);
+    w.endArray();
+}
+
+void pointJson(JsonWriter& w, const char* key, const glm::dvec3& p) {
+    w.key(key).beginArray(true).value(p.x).value(p.y).value(p.z).endArray();
+}
+
+void volumeJson(JsonWriter& w, const char* key, const masks::Volume& v) {
+    w.key(key).beginObject().field("path", v.path);
+    voxelJson(w, "dims", v.dims);
+    w.field("transform", v.transform);
+    w.key("affine").beginArray();
+    for (int r = 0; r < 3; ++r) {
+        w.beginArray(true);
+        for (int c = 0; c < 4; ++c) w.value(v.voxelToWorld[c][r]);
+        w.endArray();
+    }
+    w.endArray();
+    const glm::dvec3 s = v.spacing();
+    pointJson(w, "spacing", s);
+    w.endObject();
+}
+
+void directedJson(JsonWriter& w, const char* key, const masks::DirectedMask& d, const MaskResult& r,
+                  bool ok) {
+    w.key(key).beginObject().field("points", d.points);
+    if (!ok) {
+        w.endObject();
+        return;
+    }
+    w.field("hd", d.hd).field("mean", d.mean);
+    w.key("percentiles").beginArray();
+    for (size_t i = 0; i < d.percentiles.size(); ++i)
+        w.beginObject().field("p", r.percentiles[i]).field("value", d.percentiles[i]).endObject();
+    w.endArray();
+    voxelJson(w, "voxel", d.voxel);
+    pointJson(w, "point", d.point);
+    voxelJson(w, "nearest_voxel", d.nearestVoxel);
+    pointJson(w, "nearest_point", d.nearestPoint);
+    w.endObject();
+}
+
+std::string jsonReport(const MasksArgs& args, const masks::Volume& a, const masks::Volume& b,
+                       const Engine& engine, const std::vector<Row>& rows) {
+    JsonWriter w;
+    w.beginObject().field("tool", "rthdist-masks").field("version", versionString());
+    volumeJson(w, "a", a);
+    volumeJson(w, "b", b);
+    w.field("backend", backendName(engine.backend())).field("device", engine.deviceName());
+    w.field("tolerance_mm", args.tolerance);
+    w.key("results").beginArray();
+    for (const Row& row : rows) {
+        const MaskResult& r = row.r;
+        const bool ok = r.empty == masks::EmptyStatus::kNone;
+        w.beginObject().field("label", row.label).field("convention", masks::conventionName(r.convention));
+        w.field("rule", masks::conventionRule(r.convention)).field("connectivity", r.connectivity);
+        w.field("geometry", r.convention == Convention::kRthdist ? "world" : "spacing");
+        w.field("status", masks::emptyStatusName(r.empty));
+        if (!ok)
+            w.key("convention_value")
+                .beginObject()
+                .field("hd", r.emptyHd)
+                .field("hd_percentile", r.emptyHdPercentile)
+                .endObject();
+        w.field("hd", r.hd);
+        w.key("hd_percentile").beginArray();
+        for (size_t i = 0; i < r.hdPercentile.size(); ++i)
+            w.beginObject().field("p", r.percentiles[i]).field("value", r.hdPercentile[i]).endObject();
+        w.endArray();
+        w.field("assd", r.assd).field("msd", r.msd).field("surface_dice", r.surfaceDice);
+        directedJson(w, "a_to_b", r.aToB, r, ok);
+        directedJson(w, "b_to_a", r.bToA, r, ok);
+        w.key("timings_ms")
+            .beginObject()
+            .field("extract", r.extractMs)
+            .field("distance", r.distanceMs)
+            .field("total", r.totalMs)
+            .endObject();
+        w.endObject();
+    }
+    w.endArray().endObject();
+    return w.str() + "\n";
+}
+
+std::string csvReport(const MasksArgs& args, const std::vector<Row>& rows) {
+    std::string out = "label,convention,status,hd";
+    for (double p : args.percentiles) out += ",hd" + num(p);
+    out += ",assd,msd,surface_dice,a_to_b_hd,b_to_a_hd,a_points,b_points,total_ms\n";
+    for (const Row& row : rows) {
+        const MaskResult& r = row.r;
+        out += row.label + "," + masks::conventionName(r.convention) + "," + masks::emptyStatusName(r.empty) +
+               "," + num(r.hd);
+        for (size_t i = 0; i < args.percentiles.size(); ++i)
+            out += "," + (i < r.hdPercentile.size() ? num(r.hdPercentile[i]) : "");
+        out += "," + num(r.assd) + "," + num(r.msd) + "," + num(r.surfaceDice) + "," + num(r.aToB.hd) + "," +
+               num(r.bToA.hd) + "," + std::to_string(r.aToB.points) + "," + std::to_string(r.bToA.points) +
+               "," + num(r.totalMs) + "\n";
+    }
+    return out;
+}
+
+std::string textReport(const MasksArgs& args, const Engine& engine, const std::vector<Row>& rows) {
+    std::string out =
+        std::string("backend ") + backendName(engine.backend()) + " (" + engine.deviceName() + ")\n";
+    char line[512];
+    for (const Row& row : rows) {
+        const MaskResult& r = row.r;
+        std::snprintf(line, sizeof line, "label %s  %-11s ", row.label.c_str(),
+                      masks::conventionName(r.convention));
+        out += line;
+        if (r.empty != masks::EmptyStatus::kNone) {
+            out += std::string(masks::emptyStatusName(r.empty)) + ": the convention reports HD " + r.emptyHd +
+                   ", HD-p " + r.emptyHdPercentile + "\n";
+            continue;
+        }
+        std::snprintf(line, sizeof line, "HD %.6f", r.hd);
+        out += line;
+        for (size_t i = 0; i < r.hdPercentile.size(); ++i) {
+            std::snprintf(line, sizeof line, "  HD%g %.6f", args.percentiles[i], r.hdPercentile[i]);
+            out += line;
+        }
+        if (!std::isnan(r.assd)) {
+            std::snprintf(line, sizeof line, "  ASSD %.6f", r.assd);
+            out += line;
+        }
+        std::snprintf(line, sizeof line, "  MSD %.6f", r.msd);
+        out += line;
+        if (!std::isnan(r.surfaceDice)) {
+            std::snprintf(line, sizeof line, "  SurfDice@%g %.6f", args.tolerance, r.surfaceDice);
+            out += line;
+        }
+        std::snprintf(line, sizeof line, "  (%llu / %llu points, %.1f ms)\n",
+                      (unsigned long long)r.aToB.points, (unsigned long long)r.bToA.points, r.totalMs);
+        out += line;
+    }
+    return out;
+}
+
+int fail(int code, const std::string& message) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "rthdist-masks: %s\n", message.c_str());
+    return code;
+}
+
+int run(int argc, char** argv) {
+    std::vector<std::string> list(argv + 1, argv + argc);
+    Result<MasksArgs> parsed = parse(list);
+    if (!parsed) return fail(kExitUsage, parsed.error().message + "\nTry 'rthdist-masks --help'.");
+    const MasksArgs& args = *parsed;
+    if (args.help) return std::fputs(kUsage, stdout) >= 0 ? kExitOk : kExitInternal;
+    if (args.version) return std::printf("rthdist-masks %s\n", versionString()) > 0 ? kExitOk : kExitInternal;
+
+    Result<masks::Volume> a = masks::loadVolume(args.pathA, args.spacing);
+    if (!a) return fail(exitCodeFor(a.error().code), a.error().message);
+    Result<masks::Volume> b = masks::loadVolume(args.pathB, args.spacing);
+    if (!b) return fail(exitCodeFor(b.error().code), b.error().message);
+    if (auto e = masks::checkSameGrid(*a, *b)) return fail(exitCodeFor(e->code), e->message);
+
+    std::vector<std::pair<std::string, masks::LabelSelect>> selections;
+    if (args.allLabels) {
+        std::set<int32_t> labels;
+        for (int32_t l : masks::labelsPresent(*a)) labels.insert(l);
+        for (int32_t l : masks::labelsPresent(*b)) labels.insert(l);
+        for (int32_t l : labels) selections.push_back({std::to_string(l), masks::LabelSelect{l, false}});
+        if (selections.empty()) selections.push_back({"nonzero", masks::LabelSelect{1, true}});
+    } else if (args.label) {
+        selections.push_back({std::to_string(*args.label), masks::LabelSelect{*args.label, false}});
+    } else {
+        selections.push_back({"nonzero", masks::LabelSelect{1, true}});
+    }
+
+    Result<Engine> engine = masks::makeMaskEngine(args.options);
+    if (!engine) return fail(exitCodeFor(engine.error().code), engine.error().message);
+
+    std::vector<Row> rows;
+    for (const auto& [name, select] : selections) {
+        for (Convention c : args.conventions) {
+            masks::MaskOptions mo;
+            mo.convention = c;
+            mo.connectivity = args.connectivity;
+            mo.percentiles = args.percentiles;
+            mo.tolerance = args.tolerance;
+            mo.threads = args.options.threads;
+            Result<MaskResult> r = masks::compareMasks(*engine, *a, select, *b, select, mo);
+            if (!r) return fail(exitCodeFor(r.error().code), "label " + name + ": " + r.error().message);
+            rows.push_back({name, std::move(*r)});
+        }
+    }
+    const std::string text = args.json  ? jsonReport(args, *a, *b, *engine, rows)
+                             : args.csv ? csvReport(args, rows)
+                                        : textReport(args, *engine, rows);
+    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
+        return fail(kExitInternal, "cannot write to stdout");
+    return kExitOk;
+}
+
+}  // namespace
+}  // namespace rthdist::cli
+
+int main(int argc, char** argv) {
+    try {
+        return rthdist::cli::run(argc, argv);
+    } catch (const std::bad_alloc&) {
+        return rthdist::cli::fail(rthdist::cli::kExitInternal, "out of host memory");
+    } catch (const std::exception& e) {
+        return rthdist::cli::fail(rthdist::cli::kExitInternal, e.what());
+    }
+}
