@@ -6,6 +6,8 @@
 #   RTHDIST_BENCH_DEPS=1  also python3-scipy/numpy for tools/bench
 #   RTHDIST_LINT_DEPS=1   also clang-format for .ci/run
 #   RTHDIST_FUZZ_DEPS=1   also clang-14 and its libFuzzer runtime (tools/fuzz/run.sh)
+#   RTHDIST_MASKS_DEPS=0  skip the Python oracle of tests/masks (numpy, scipy, scikit-image,
+#                         nibabel; on by default: ctest runs it)
 set -euo pipefail
 
 SUDO=""
@@ -13,8 +15,11 @@ if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 
 BASE_PKGS=(cmake g++ make pkg-config libvulkan-dev glslang-tools libglm-dev
   libtinygltf-dev libgtest-dev libnanoflann-dev zlib1g-dev vulkan-validationlayers
-  vulkan-tools nlohmann-json3-dev libstb-dev strace)
+  vulkan-tools nlohmann-json3-dev libstb-dev strace libnifti2-dev)
 EXTRA_PKGS=()
+if [ "${RTHDIST_MASKS_DEPS:-1}" = 1 ]; then
+  EXTRA_PKGS+=(python3 python3-numpy python3-scipy python3-skimage python3-nibabel)
+fi
 if [ "${RTHDIST_BENCH_DEPS:-0}" = 1 ]; then
   EXTRA_PKGS+=(python3 python3-scipy python3-numpy)
 fi
