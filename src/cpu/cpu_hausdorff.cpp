@@ -13,10 +13,24 @@
 // more than float rounding. A query dies only when it has a point with float
 // squared distance strictly below K, which the query realizing f* never has;
 // so it is searched to the end and wins. Every other finished query reports
-// its own f(q) <= f*. The BVH prunes a box only when its float distance exceeds
-// the best point by a relative 1e-5 (float box distances never exceed the
-// float distance of a point inside, as rounding is monotone), so finished
-// searches return f(q) exactly, with the smallest target index among ties.
+// its own f(q) <= f*. The search is over the adaptive-order BVH of
+// target_index.hpp (whose header shows that a box is never farther than a
+// target below it and that the collapse of identical copies keeps every
+// minimum and its smallest index); it prunes a box only when its float
+// distance exceeds the best point by a relative 1e-5, so finished searches
+// return f(q) exactly, with the smallest target index among ties at a
+// nonzero distance. A best distance of 0 ends a search at once: no target is
+// closer, and the target reported is one at float distance 0 (a copy of the
+// query point), not necessarily the smallest index among several.
+// The seeds before the search (the previous query's bucket, the query's own
+// grid cell when it holds at most kMaxCellScan targets) only lower the best
+// distance with real targets; skipping them (a denser cell) changes the cost,
+// never the result, so no query ever scans more than a bounded number of
+// points before the BVH takes over. Queries are in adaptive Morton order
+// (cpu/adaptive_order.hpp) with copies adjacent, ties in input order: a query
+// equal to the previous one has the same f(q) and a larger index, so it can
+// neither die later nor win, and is skipped (per-point: it takes the previous
+// query's target).
 #include "cpu/cpu_hausdorff.hpp"
 
 #include <glm/common.hpp>
@@ -32,6 +46,7 @@
 #include <limits>
 #include <vector>
 
+#include "cpu/adaptive_order.hpp"
 #include "cpu/parallel.hpp"
 #include "cpu/target_index.hpp"
 
@@ -50,6 +65,9 @@ constexpr float kPruneSlack = 1e-5f;
 constexpr double kBoundShrink = 1e-5;
 constexpr size_t kQueryChunk = 256;
 constexpr size_t kSampleSize = 256;
+// A query scans its own grid cell only when it holds at most this many
+// targets (one refinement run); a denser cell is left to the BVH search.
+constexpr uint32_t kMaxCellScan = kRefineRun;
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point start) {
@@ -118,13 +136,41 @@ inline v8f boxDistance8(const BoxLevel& level, uint32_t base, const Query& q) {
 }
 
 struct SearchStats {
-    uint64_t bucketsScanned = 0;
+    uint64_t bucketsScanned = 0;  // (query, 8 targets) scans: hint, own cell and BVH buckets
 };
+
+// The query's own grid cell when it is small enough to scan (kMaxCellScan).
+// cursor walks the ascending cell keys forward (queries come in key order).
+inline void scanOwnCell(const TargetIndex& t, uint32_t key, uint32_t& cursor, const Query& q, Best& best,
+                        SearchStats& stats) {
+    const uint32_t cells = t.cellCount();
+    const uint32_t* keys = t.cellKey.data();
+    if (cursor < cells && keys[cursor] < key) {  // gallop
+        uint32_t step = 1;
+        while (cursor + step < cells && keys[cursor + step] < key) step *= 2;
+        const uint32_t hi = std::min(cells, cursor + step + 1);
+        cursor = uint32_t(std::lower_bound(keys + cursor, keys + hi, key) - keys);
+    }
+    if (cursor >= cells || keys[cursor] != key) return;
+    const uint32_t first = t.cellFirst[cursor], end = t.cellFirst[cursor + 1];
+    if (end - first > kMaxCellScan) return;
+    stats.bucketsScanned += (end - first + 7) / 8;
+    scanRange(t, first, end, q, best);
+}
+
+inline bool sameQuery(const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z,
+                      size_t i) {
+    return x[i] == x[i - 1] && y[i] == y[i - 1] && z[i] == z[i - 1];
+}
 
 // Depth-first BVH search, nearest child first. Returns true as soon as a point
 // strictly closer than `kill` is found (the query cannot raise the maximum);
-// otherwise best holds the exact float nearest neighbour on return.
+// otherwise best holds the exact float nearest neighbour on return. A best
+// distance of 0 ends the search at once (nothing is closer; among several
+// targets at distance 0 the first found is kept).
 bool searchTree(const TargetIndex& t, const Query& q, float kill, Best& best, SearchStats& stats) {
+    if (best.d2 < kill) return true;
+    if (best.d2 == 0.0f) return false;
     struct Entry {
         float d2;
         uint32_t level;
@@ -161,6 +207,7 @@ bool searchTree(const TargetIndex& t, const Query& q, float kill, Best& best, Se
                 const uint32_t bucket = children[k].node;
                 scanRange(t, t.bucketFirst[bucket], t.bucketFirst[bucket + 1], q, best);
                 if (best.d2 < kill) return true;
+                if (best.d2 == 0.0f) return false;
             }
         } else {
             for (int k = count - 1; k >= 0; --k) stack[top++] = children[k];
@@ -222,8 +269,9 @@ private:
 constexpr double kIndexDone = 0.1, kCullDone = 0.15, kSearchDone = 0.95;
 
 // Every query's exact float nearest neighbour (no early break): the previous
-// query's nearest bucket and the query's own cell seed the best distance, then
-// the BVH search runs to the end with kill = 0. Fills `nearest` (input order)
+// query's nearest bucket and the query's own cell (when small) seed the best
+// distance, then the BVH search runs to the end with kill = 0. A query equal
+// to the previous one takes its nearest target. Fills `nearest` (input order)
 // with the target index and the double distance recomputed from the pair.
 void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
                   std::span<const glm::vec3> targets, const std::vector<float>& qx,
@@ -239,30 +287,31 @@ void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
     parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int w) {
         SearchStats stat;
         uint32_t hint = kNone;
+        uint32_t target = kNone;  // the previous query's nearest target (input index)
         const uint32_t* keys = t.cellKey.data();
         uint32_t cursor = uint32_t(std::lower_bound(keys, keys + cells, qKey[begin]) - keys);
         for (size_t i = begin; i < end; ++i) {
-            const Query q{splat(qx[i]), splat(qy[i]), splat(qz[i])};
-            Best best;
-            if (hint != kNone) scanRange(t, t.bucketFirst[hint], t.bucketFirst[hint + 1], q, best);
-            const uint32_t key = qKey[i];
-            if (cursor < cells && keys[cursor] < key) {
-                cursor = uint32_t(std::lower_bound(keys + cursor, keys + cells, key) - keys);
-            }
-            if (cursor < cells && keys[cursor] == key) {
-                scanRange(t, t.cellFirst[cursor], t.cellFirst[cursor + 1], q, best);
-            }
-            searchTree(t, q, 0.0f, best, stat);  // kill 0: never breaks early
-            if (best.pos == kNone) {
-                lost.store(true, std::memory_order_relaxed);
-                hint = kNone;
-                continue;
-            }
-            hint = t.bucketOf[best.pos];
             const uint32_t src = qOriginal[i];
-            const glm::dvec3 diff = glm::dvec3(queries[src]) - glm::dvec3(targets[best.target]);
+            if (!(i > begin && hint != kNone && sameQuery(qx, qy, qz, i))) {
+                const Query q{splat(qx[i]), splat(qy[i]), splat(qz[i])};
+                Best best;
+                if (hint != kNone) {
+                    ++stat.bucketsScanned;
+                    scanRange(t, t.bucketFirst[hint], t.bucketFirst[hint + 1], q, best);
+                }
+                scanOwnCell(t, qKey[i], cursor, q, best, stat);
+                searchTree(t, q, 0.0f, best, stat);  // kill 0: never breaks early
+                if (best.pos == kNone) {
+                    lost.store(true, std::memory_order_relaxed);
+                    hint = kNone;
+                    continue;
+                }
+                hint = t.bucketOf[best.pos];
+                target = best.target;
+            }
+            const glm::dvec3 diff = glm::dvec3(queries[src]) - glm::dvec3(targets[target]);
             nearest.distance[src] = std::sqrt(diff.x * diff.x + diff.y * diff.y + diff.z * diff.z);
-            nearest.nearest[src] = best.target;
+            nearest.nearest[src] = target;
         }
         stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
         const size_t finished = done.fetch_add(end - begin, std::memory_order_relaxed) + (end - begin);
@@ -306,6 +355,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
         boxBound[size_t(w)] = std::max(boxBound[size_t(w)], farthest);
     });
     radixSortKeys(keyed, 3 * g.bits);
+    refineOrder(keyed, queries, scale, threads);  // dense cells: neighbours stay consecutive
     std::vector<float> qx(nq), qy(nq), qz(nq);
     std::vector<uint32_t> qOriginal(nq), qKey(nq);
     parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int) {
@@ -401,6 +451,12 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
         uint32_t cursor = uint32_t(std::lower_bound(keys, keys + cells, qKey[begin]) - keys);
         for (size_t i = begin; i < end; ++i) {
             const float k = std::bit_cast<float>(kill.load(std::memory_order_relaxed));
+            if (i > begin && hint != kNone && sameQuery(qx, qy, qz, i)) {
+                // A copy of the previous query (smaller input index, same
+                // nearest distance) was killed or offered already.
+                ++culledHere;
+                continue;
+            }
             const Query q{splat(qx[i]), splat(qy[i]), splat(qz[i])};
             Best best;
             if (hint != kNone) {
@@ -410,6 +466,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
                     ++culledHere;
                     continue;
                 }
+                ++stat.bucketsScanned;
                 scanRange(t, t.bucketFirst[hint], t.bucketFirst[hint + 1], q, best);
                 if (best.d2 < k) {
                     hintPos = best.pos;
@@ -418,22 +475,12 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
                     continue;
                 }
             }
-            // Own cell: gallop forward over the sorted cell keys.
-            const uint32_t key = qKey[i];
-            if (cursor < cells && keys[cursor] < key) {
-                uint32_t step = 1;
-                while (cursor + step < cells && keys[cursor + step] < key) step *= 2;
-                const uint32_t hi = std::min(cells, cursor + step + 1);
-                cursor = uint32_t(std::lower_bound(keys + cursor, keys + hi, key) - keys);
-            }
-            if (cursor < cells && keys[cursor] == key) {
-                scanRange(t, t.cellFirst[cursor], t.cellFirst[cursor + 1], q, best);
-                if (best.d2 < k) {
-                    hintPos = best.pos;
-                    hint = t.bucketOf[best.pos];
-                    ++culledHere;
-                    continue;
-                }
+            scanOwnCell(t, qKey[i], cursor, q, best, stat);
+            if (best.d2 < k) {
+                hintPos = best.pos;
+                hint = t.bucketOf[best.pos];
+                ++culledHere;
+                continue;
             }
             ++survivingHere;
             const bool dead = searchTree(t, q, k, best, stat);

@@ -4,6 +4,7 @@
 #include <cassert>
 #include <limits>
 
+#include "cpu/adaptive_order.hpp"
 #include "cpu/parallel.hpp"
 
 namespace rthdist::cpu {
@@ -78,13 +79,31 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, i
         }
     });
     radixSortKeys(keyed, 3 * index.fineBits);
+    // Overfull fine cells ordered by their own boxes, and all-identical runs
+    // collapsed to their first point (the smallest input index among the
+    // copies: the one the tie rule reports anyway).
+    std::vector<IdenticalRun> identical;
+    refineOrder(keyed, targets, scale, threads, &identical);
+    if (!identical.empty()) {
+        size_t kept = 0, next = 0;
+        for (size_t i = 0; i < n; ++i) {
+            if (next < identical.size() && i > identical[next].first && i < identical[next].end) {
+                if (i + 1 == identical[next].end) ++next;
+                continue;
+            }
+            keyed[kept++] = keyed[i];
+        }
+        keyed.resize(kept);
+    }
+    const size_t m = keyed.size();
+    index.collapsed = n - m;
 
-    index.x.resize(n + kPad, kInf);
-    index.y.resize(n + kPad, kInf);
-    index.z.resize(n + kPad, kInf);
-    index.original.resize(n + kPad, std::numeric_limits<uint32_t>::max());
-    index.bucketOf.resize(n);
-    parallelChunks(n, 1 << 16, threads, [&](size_t begin, size_t end, int) {
+    index.x.resize(m + kPad, kInf);
+    index.y.resize(m + kPad, kInf);
+    index.z.resize(m + kPad, kInf);
+    index.original.resize(m + kPad, std::numeric_limits<uint32_t>::max());
+    index.bucketOf.resize(m);
+    parallelChunks(m, 1 << 16, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
             const uint32_t src = uint32_t(keyed[i]);
             const glm::vec3 p = scaled(targets[src], scale);
@@ -98,17 +117,17 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, i
     // Cells (runs of the coarse key) and buckets (pieces of a cell).
     const int coarseShift = 32 + 3 * extra;
     std::vector<uint32_t> bucketFirst;
-    for (size_t i = 0; i < n;) {
+    for (size_t i = 0; i < m;) {
         const uint32_t key = uint32_t(keyed[i] >> coarseShift);
         size_t end = i + 1;
-        while (end < n && uint32_t(keyed[end] >> coarseShift) == key) ++end;
+        while (end < m && uint32_t(keyed[end] >> coarseShift) == key) ++end;
         index.cellKey.push_back(key);
         index.cellFirst.push_back(uint32_t(i));
         for (size_t b = i; b < end; b += kBucketSize) bucketFirst.push_back(uint32_t(b));
         i = end;
     }
-    index.cellFirst.push_back(uint32_t(n));
-    bucketFirst.push_back(uint32_t(n));
+    index.cellFirst.push_back(uint32_t(m));
+    bucketFirst.push_back(uint32_t(m));
     std::vector<uint64_t>().swap(keyed);
 
     // Level 0: tight bucket boxes.

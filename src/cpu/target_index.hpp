@@ -6,12 +6,34 @@
 //
 // Layout: targets are sorted by a fine Morton key (2 bits per axis finer than
 // the grid, at most 10), so each grid cell is a contiguous run and, inside a
-// cell, points follow the Morton curve. Each cell is cut into buckets of at most
+// cell, points follow the Morton curve. A run of more than kRefineRun equal
+// fine keys (a dense cluster in a box stretched by a stray point, a heavy
+// tail) is ordered again by a Morton key over its own tight box, recursively
+// (cpu/adaptive_order.hpp), so the order follows the points at every density:
+// consecutive points are spatial neighbours and the boxes built over them are
+// tight whatever the bounding box. Each cell is cut into buckets of at most
 // kBucketSize consecutive points (a bucket never crosses a cell); buckets are
-// the BVH leaves, and groups of 8 consecutive nodes (Morton order) form the
-// next level. Coordinates live in SoA float arrays padded with +inf so that the
-// 8-wide scans may read past a bucket's end (extra lanes are real targets or
-// +inf, never wrong).
+// the BVH leaves, and groups of 8 consecutive nodes (adaptive Morton order)
+// form the next level: an LBVH with bounded leaves, O(log n) levels. A run of
+// identical points longer than kRefineRun is stored once (its first point,
+// the smallest input index among the copies), so heavy duplication costs no
+// per-copy work in any search. Coordinates live in SoA float arrays padded
+// with +inf so that the 8-wide scans may read past a bucket's end (extra
+// lanes are real targets or +inf, never wrong).
+//
+// Why a search over it is exact (DESIGN §3 restated for this structure):
+// every stored target lies in the bucket that holds its sorted position, every
+// bucket's box is the float min/max of its points, and every node's box the
+// min/max of its children's, so the float distance from a query to a node's
+// box never exceeds the float distance to any target below it (rounding is
+// monotone; cpu_hausdorff.cpp computes both with the same operations). A
+// search that skips only nodes farther than its best point therefore skips no
+// closer target. The targets dropped by the collapse have a stored copy with
+// the same float coordinates and a smaller input index, so the minimum over
+// the stored targets equals the minimum over all of them, and so does the
+// smallest index among the nearest. The order itself (sort, refinement) moves
+// points between buckets but never loses one: the refinement only permutes
+// runs, the collapse only drops copies.
 //
 // Precision: coordinates are the input floats times a power-of-two `scale`
 // (exact; 1 unless the magnitudes would overflow or underflow squared floats).
@@ -40,13 +62,14 @@ struct BoxLevel {
 };
 
 struct TargetIndex {
-    algo::GridSpec grid;  // over the scaled targets
-    int fineBits = 1;     // bits of the sort key per axis (grid.bits + 2, <= 10)
-    double scale = 1.0;   // algo::exactScale
+    algo::GridSpec grid;   // over the scaled targets
+    int fineBits = 1;      // bits of the sort key per axis (grid.bits + 2, <= 10)
+    double scale = 1.0;    // algo::exactScale
+    size_t collapsed = 0;  // copies of identical points not stored (targets - stored)
 
     // Sorted targets (scaled), padded with kPad entries of +inf.
     std::vector<float> x, y, z;
-    std::vector<uint32_t> original;  // sorted position -> input index
+    std::vector<uint32_t> original;  // sorted position -> input index (of the first copy)
     std::vector<uint32_t> bucketOf;  // sorted position -> bucket
 
     // Occupied cells, ascending Morton key (grid.bits per axis).
@@ -60,6 +83,7 @@ struct TargetIndex {
 
     [[nodiscard]] uint32_t cellCount() const { return uint32_t(cellKey.size()); }
     [[nodiscard]] uint32_t bucketCount() const { return levels.empty() ? 0 : levels[0].count; }
+    [[nodiscard]] uint32_t size() const { return uint32_t(x.size() - kPad); }  // stored targets
 };
 
 // p * scale computed in double and rounded: exact for a power of two that
@@ -74,7 +98,7 @@ struct TargetIndex {
                                            int threads);
 
 // Sorts (key << 32 | payload) values by their key bits [32, 32 + keyBits),
-// stably (LSD radix).
+// stably (LSD radix, one thread).
 void radixSortKeys(std::vector<uint64_t>& values, int keyBits);
 
 }  // namespace rthdist::cpu
