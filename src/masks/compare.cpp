@@ -56,7 +56,12 @@ struct Direction {
     double sum = 0.0;
 };
 
-int defaultConnectivity(Convention) { return 6; }
+// MONAI and plastimatch have no connectivity parameter (SciPy's default cross;
+// plastimatch's face neighbours): 6 whatever is asked. rthdist and MedPy take one.
+int connectivityOf(Convention c, int requested) {
+    const bool configurable = c == Convention::kRthdist || c == Convention::kMedpy;
+    return configurable && requested != 0 ? requested : 6;
+}
 
 glm::dvec3 worldOf(const Volume& v, std::array<int64_t, 3> ijk) {
     return glm::dvec3(v.voxelToWorld * glm::dvec4(double(ijk[0]), double(ijk[1]), double(ijk[2]), 1.0));
@@ -196,8 +201,8 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
     if (auto e = checkSameGrid(a, b)) return *e;
     if (a.labels.size() != a.voxelCount() || b.labels.size() != b.voxelCount())
         return Error{ErrorCode::kInvalidArgument, "masks: label array size differs from the dimensions"};
-    int conn = options.connectivity == 0 ? defaultConnectivity(options.convention) : options.connectivity;
-    if (conn != 6 && conn != 18 && conn != 26)
+    if (options.connectivity != 0 && options.connectivity != 6 && options.connectivity != 18 &&
+        options.connectivity != 26)
         return Error{ErrorCode::kInvalidArgument, "masks: connectivity must be 6, 18 or 26"};
     for (double p : options.percentiles)
         if (!(p >= 0.0 && p <= 100.0))
@@ -206,6 +211,7 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
         return Error{ErrorCode::kInvalidArgument, "masks: tolerance must be >= 0"};
 
     const Convention c = options.convention;
+    const int conn = connectivityOf(c, options.connectivity);
     const bool itk = c == Convention::kItk;
     MaskResult r;
     r.convention = c;

@@ -113,7 +113,8 @@ struct LabelSelect {
 
 struct MaskOptions {
     Convention convention = Convention::kRthdist;
-    // 6, 18 or 26; 0 = the convention's (6). Ignored by itk (all voxels).
+    // 6, 18 or 26; 0 = 6. Used by rthdist and medpy; monai and plastimatch
+    // always use 6 (their tools take none), itk all voxels.
     int connectivity = 0;
     std::vector<double> percentiles{95.0};  // each in [0, 100]
     double tolerance = 1.0;                 // surface Dice tolerance, in mm (>= 0)

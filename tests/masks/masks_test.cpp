@@ -1,0 +1,251 @@
+// rthdist_masks: loaders, grid checks, boundary extraction against a brute
+// force, and compareMasks on every backend against the CPU backend. The
+// conventions' numbers are checked against NumPy/SciPy in oracle_masks.py.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include "masks/boundary.hpp"
+#include "masks/masks.hpp"
+
+namespace rthdist::masks {
+namespace {
+
+const std::string kNifti = RTHDIST_SHARED_NIFTI_DIR;
+
+Backend backendUnderTest() {
+    const char* env = std::getenv("RTHDIST_TEST_BACKEND");
+    Backend b = Backend::kCpu;
+    if (env && !parseBackend(env, b)) ADD_FAILURE() << "unknown RTHDIST_TEST_BACKEND=" << env;
+    return b;
+}
+
+std::string tempPath(const std::string& name) {
+    const char* dir = std::getenv("TMPDIR");
+    return std::string(dir ? dir : "/tmp") + "/rthdist_masks_test_" + std::to_string(::getpid()) + "_" + name;
+}
+
+// A .npy (format 1.0) of int16 with the given shape and order.
+void writeNpy(const std::string& path, const std::vector<int16_t>& data, int64_t n0, int64_t n1, int64_t n2,
+              bool fortran) {
+    std::string header = "{'descr': '<i2', 'fortran_order': " + std::string(fortran ? "True" : "False") +
+                         ", 'shape': (" + std::to_string(n0) + ", " + std::to_string(n1) + ", " +
+                         std::to_string(n2) + "), }";
+    while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+    header += '\n';
+    std::ofstream f(path, std::ios::binary);
+    f.write("\x93NUMPY\x01\x00", 8);
+    const uint16_t len = uint16_t(header.size());
+    f.put(char(len & 0xff)).put(char(len >> 8));
+    f.write(header.data(), std::streamsize(header.size()));
+    f.write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size() * 2));
+}
+
+Volume makeVolume(std::array<int64_t, 3> dims, glm::dvec3 spacing) {
+    Volume v;
+    v.path = "synthetic";
+    v.dims = dims;
+    v.voxelToWorld = glm::dmat4(1.0);
+    v.voxelToWorld[0][0] = spacing.x;
+    v.voxelToWorld[1][1] = spacing.y;
+    v.voxelToWorld[2][2] = spacing.z;
+    v.labels.assign(size_t(dims[0] * dims[1] * dims[2]), 0);
+    return v;
+}
+
+void ball(Volume& v, glm::dvec3 c, double r, int32_t label) {
+    const glm::dvec3 s = v.spacing();
+    for (int64_t k = 0; k < v.dims[2]; ++k)
+        for (int64_t j = 0; j < v.dims[1]; ++j)
+            for (int64_t i = 0; i < v.dims[0]; ++i) {
+                const glm::dvec3 d = (glm::dvec3(double(i), double(j), double(k)) - c) * s;
+                if (glm::dot(d, d) <= r * r) v.labels[size_t(i + v.dims[0] * (j + v.dims[1] * k))] = label;
+            }
+}
+
+TEST(MasksLoad, MissingFileNamesIt) {
+    Result<Volume> v = loadNifti("/nonexistent/mask.nii.gz");
+    ASSERT_FALSE(v.ok());
+    EXPECT_EQ(v.error().code, ErrorCode::kBadInput);
+    EXPECT_NE(v.error().message.find("/nonexistent/mask.nii.gz"), std::string::npos) << v.error().message;
+}
+
+TEST(MasksLoad, NotNiftiNamesIt) {
+    const std::string path = tempPath("garbage.nii");
+    {
+        std::ofstream f(path);
+        f << "this is not a NIfTI header";
+    }
+    Result<Volume> v = loadNifti(path);
+    ASSERT_FALSE(v.ok());
+    EXPECT_EQ(v.error().code, ErrorCode::kBadInput);
+    EXPECT_NE(v.error().message.find(path), std::string::npos) << v.error().message;
+    std::remove(path.c_str());
+}
+
+TEST(MasksLoad, UnknownExtension) {
+    Result<Volume> v = loadVolume("mask.mha");
+    ASSERT_FALSE(v.ok());
+    EXPECT_NE(v.error().message.find("mask.mha"), std::string::npos);
+}
+
+TEST(MasksLoad, AtlasSformAndLabels) {
+    Result<Volume> v = loadNifti(kNifti + "/aal.nii.gz");
+    ASSERT_TRUE(v.ok()) << v.error().message;
+    EXPECT_EQ(v->dims, (std::array<int64_t, 3>{181, 217, 181}));
+    EXPECT_EQ(v->transform, "sform");
+    EXPECT_DOUBLE_EQ(v->voxelToWorld[3][0], -90.0);
+    EXPECT_DOUBLE_EQ(v->spacing().x, 1.0);
+    EXPECT_EQ(labelsPresent(*v).size(), 116u);
+}
+
+TEST(MasksLoad, GridMismatchNamesBothFiles) {
+    Result<Volume> a = loadNifti(kNifti + "/HarvardOxford-cort-maxprob-thr0-1mm.nii.gz");
+    Result<Volume> b = loadNifti(kNifti + "/JHU-WhiteMatter-labels-1mm.nii.gz");
+    ASSERT_TRUE(a.ok() && b.ok());
+    std::optional<Error> e = checkSameGrid(*a, *b);
+    ASSERT_TRUE(e.has_value());
+    EXPECT_EQ(e->code, ErrorCode::kBadInput);
+    EXPECT_NE(e->message.find("HarvardOxford"), std::string::npos) << e->message;
+    EXPECT_NE(e->message.find("JHU"), std::string::npos) << e->message;
+    EXPECT_FALSE(checkSameGrid(*a, *a).has_value());
+}
+
+TEST(MasksLoad, NpyCAndFortranOrder) {
+    const int64_t n0 = 3, n1 = 4, n2 = 5;
+    std::vector<int16_t> c(size_t(n0 * n1 * n2)), f(c.size());
+    for (int64_t i = 0; i < n0; ++i)
+        for (int64_t j = 0; j < n1; ++j)
+            for (int64_t k = 0; k < n2; ++k) {
+                const int16_t value = int16_t(100 * i + 10 * j + k);
+                c[size_t((i * n1 + j) * n2 + k)] = value;
+                f[size_t(i + n0 * (j + n1 * k))] = value;
+            }
+    for (bool fortran : {false, true}) {
+        const std::string path = tempPath(fortran ? "f.npy" : "c.npy");
+        writeNpy(path, fortran ? f : c, n0, n1, n2, fortran);
+        Result<Volume> v = loadNpy(path, glm::dvec3(0.5, 0.7, 3.0));
+        ASSERT_TRUE(v.ok()) << v.error().message;
+        EXPECT_EQ(v->dims, (std::array<int64_t, 3>{n0, n1, n2}));
+        EXPECT_EQ(v->labels[size_t(2 + n0 * (3 + n1 * 4))], 234) << "fortran " << fortran;
+        EXPECT_DOUBLE_EQ(v->spacing().z, 3.0);
+        std::remove(path.c_str());
+    }
+}
+
+TEST(MasksBoundary, MatchesBruteForce) {
+    const detail::Dims dims{9, 8, 7};
+    std::mt19937 rng(13);
+    std::vector<uint8_t> mask(size_t(9 * 8 * 7));
+    for (auto& m : mask) m = (rng() % 100) < 60;
+    for (int conn : {6, 18, 26}) {
+        const std::vector<uint64_t> got = detail::boundaryVoxels(mask, dims, conn, 2);
+        std::vector<uint64_t> want;
+        for (int64_t k = 0; k < 7; ++k)
+            for (int64_t j = 0; j < 8; ++j)
+                for (int64_t i = 0; i < 9; ++i) {
+                    const size_t at = size_t(i + 9 * (j + 8 * k));
+                    if (!mask[at]) continue;
+                    bool edge = false;
+                    for (int dz = -1; dz <= 1; ++dz)
+                        for (int dy = -1; dy <= 1; ++dy)
+                            for (int dx = -1; dx <= 1; ++dx) {
+                                const int l1 = std::abs(dx) + std::abs(dy) + std::abs(dz);
+                                if (l1 == 0 || l1 > (conn == 6 ? 1 : conn == 18 ? 2 : 3)) continue;
+                                const int64_t x = i + dx, y = j + dy, z = k + dz;
+                                if (x < 0 || y < 0 || z < 0 || x >= 9 || y >= 8 || z >= 7 ||
+                                    !mask[size_t(x + 9 * (y + 8 * z))])
+                                    edge = true;
+                            }
+                    if (edge) want.push_back(at);
+                }
+        EXPECT_EQ(got, want) << "connectivity " << conn;
+    }
+}
+
+TEST(MasksCompare, InvalidOptions) {
+    Options o;
+    o.backend = Backend::kCpu;
+    Result<Engine> engine = makeMaskEngine(o);
+    ASSERT_TRUE(engine.ok());
+    Volume v = makeVolume({6, 6, 6}, glm::dvec3(1.0));
+    ball(v, glm::dvec3(3.0), 2.0, 1);
+    MaskOptions mo;
+    mo.connectivity = 7;
+    EXPECT_EQ(compareMasks(*engine, v, {}, v, {}, mo).error().code, ErrorCode::kInvalidArgument);
+    mo.connectivity = 0;
+    mo.percentiles = {101.0};
+    EXPECT_EQ(compareMasks(*engine, v, {}, v, {}, mo).error().code, ErrorCode::kInvalidArgument);
+}
+
+// Every convention on the backend under test equals the CPU backend's values.
+TEST(MasksBackend, AllConventionsMatchCpu) {
+    Options o;
+    o.backend = backendUnderTest();
+    Result<Engine> engine = makeMaskEngine(o);
+    ASSERT_TRUE(engine.ok()) << engine.error().message;
+    Options oc;
+    oc.backend = Backend::kCpu;
+    Result<Engine> cpu = makeMaskEngine(oc);
+    ASSERT_TRUE(cpu.ok());
+    Volume a = makeVolume({30, 28, 10}, glm::dvec3(0.5, 0.7, 3.0));
+    Volume b = a;
+    ball(a, glm::dvec3(14, 13, 5), 6.0, 1);
+    ball(b, glm::dvec3(16, 12, 4.5), 7.0, 1);
+    a.labels[size_t(1 + 30 * (1 + 28 * 1))] = 1;  // an outlier voxel
+    const double diag = glm::length(glm::dvec3(29 * 0.5, 27 * 0.7, 9 * 3.0));
+    for (Convention c : kAllConventions) {
+        MaskOptions mo;
+        mo.convention = c;
+        mo.percentiles = {95.0, 50.0};
+        Result<MaskResult> r = compareMasks(*engine, a, {}, b, {}, mo);
+        Result<MaskResult> w = compareMasks(*cpu, a, {}, b, {}, mo);
+        ASSERT_TRUE(r.ok() && w.ok()) << conventionName(c);
+        EXPECT_NEAR(r->hd, w->hd, 1e-6 * diag) << conventionName(c);
+        EXPECT_NEAR(r->msd, w->msd, 1e-6 * diag) << conventionName(c);
+        ASSERT_EQ(r->hdPercentile.size(), w->hdPercentile.size());
+        for (size_t i = 0; i < r->hdPercentile.size(); ++i)
+            EXPECT_NEAR(r->hdPercentile[i], w->hdPercentile[i], 1e-6 * diag) << conventionName(c);
+        EXPECT_EQ(r->aToB.points, w->aToB.points);
+        EXPECT_GT(r->hd, 6.0);  // the outlier voxel (about 8 mm from b)
+    }
+}
+
+TEST(MasksBackend, EmptyMasksHaveAStatus) {
+    Options o;
+    o.backend = backendUnderTest();
+    Result<Engine> engine = makeMaskEngine(o);
+    ASSERT_TRUE(engine.ok()) << engine.error().message;
+    Volume empty = makeVolume({8, 8, 8}, glm::dvec3(1.0));
+    Volume full = empty;
+    ball(full, glm::dvec3(4.0), 2.5, 1);
+    MaskOptions mo;
+    mo.convention = Convention::kMonai;
+    Result<MaskResult> both = compareMasks(*engine, empty, {}, empty, {}, mo);
+    ASSERT_TRUE(both.ok());
+    EXPECT_EQ(both->empty, EmptyStatus::kBothEmpty);
+    EXPECT_EQ(both->emptyHd, "nan");
+    Result<MaskResult> one = compareMasks(*engine, full, {}, empty, {}, mo);
+    ASSERT_TRUE(one.ok());
+    EXPECT_EQ(one->empty, EmptyStatus::kBEmpty);
+    EXPECT_EQ(one->emptyHd, "inf");
+    EXPECT_TRUE(std::isnan(one->hd));  // never a number folded into a mean
+    // One voxel each: HD is their distance.
+    Volume v1 = empty, v2 = empty;
+    v1.labels[0] = 1;
+    v2.labels[size_t(3 + 8 * (4 + 8 * 5))] = 1;
+    mo.convention = Convention::kRthdist;
+    Result<MaskResult> r = compareMasks(*engine, v1, {}, v2, {}, mo);
+    ASSERT_TRUE(r.ok());
+    EXPECT_NEAR(r->hd, std::sqrt(9.0 + 16.0 + 25.0), 1e-9);
+    EXPECT_EQ(r->aToB.nearestVoxel, (std::array<int64_t, 3>{3, 4, 5}));
+}
+
+}  // namespace
+}  // namespace rthdist::masks

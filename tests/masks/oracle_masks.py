@@ -1,0 +1,350 @@
+#!/usr/bin/env python3
+"""Oracle test of rthdist-masks: every convention recomputed here from its
+definition (../shared/MASKS.md; src/masks/masks.hpp) with NumPy/SciPy, on
+synthetic masks and on the atlases of ../shared/data/nifti, compared with the
+CLI's JSON to 1e-6 of the volume's world diagonal.
+
+  oracle_masks.py --cli build/rthdist-masks --backend cpu [--data DIR] [--quick]
+
+The oracles:
+  boundary(m, c)  m AND NOT binary_erosion(m, generate_binary_structure(3, c'),
+                  border_value=0)   (c' = 1, 2, 3 for connectivity 6, 18, 26)
+  spacing metric  scipy.ndimage.distance_transform_edt(~Y, sampling=spacing)
+                  read at X's voxels (MONAI, MedPy, plastimatch, ITK)
+  world metric    cKDTree over voxel centres mapped by the affine (rthdist)
+  percentiles     numpy.percentile (linear); nearest rank x[ceil(p n/100)-1];
+                  plastimatch x[clamp(floor(p/100 n - 1))]
+Exit status 0 when every value matches; otherwise every mismatch is printed.
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+import nibabel as nib
+import numpy as np
+from scipy import ndimage as ndi
+from scipy.spatial import cKDTree
+
+CONVENTIONS = ["rthdist", "monai", "medpy", "plastimatch", "itk"]
+FAILURES = []
+
+
+def boundary(m, conn):
+    st = ndi.generate_binary_structure(3, {6: 1, 18: 2, 26: 3}[conn])
+    return m & ~ndi.binary_erosion(m, structure=st, border_value=0)
+
+
+def spacing_of(affine):
+    return np.linalg.norm(affine[:3, :3], axis=0)
+
+
+def edt_directed(x, y, spacing):
+    """Distances of X's voxels to the nearest voxel of Y (spacing metric)."""
+    return ndi.distance_transform_edt(~y, sampling=spacing)[x]
+
+
+def world_directed(x, y, affine):
+    px = nib.affines.apply_affine(affine, np.argwhere(x))
+    py = nib.affines.apply_affine(affine, np.argwhere(y))
+    d, _ = cKDTree(py).query(px)
+    return d
+
+
+def nearest_rank(s, p):
+    n = len(s)
+    r = min(max(math.ceil(p * n / 100.0), 1), n)
+    return s[r - 1]
+
+
+def plastimatch_pct(s, p):
+    k = int(min(max(math.floor(p / 100.0 * len(s) - 1.0), 0), len(s) - 1))
+    return s[k]
+
+
+def oracle(conv, a, b, affine, percentiles, conn, tol):
+    """Expected numbers of one convention (None where the convention has none)."""
+    sp = spacing_of(affine)
+    na, nb = int(a.sum()), int(b.sum())
+    if na == 0 or nb == 0:
+        return {"status": "both_empty" if na == nb else ("a_empty" if na == 0 else "b_empty")}
+    if conv == "itk":
+        da, db = edt_directed(a, b, sp), edt_directed(b, a, sp)
+    else:
+        c = conn if conv in ("rthdist", "medpy") else 6
+        ea, eb = boundary(a, c), boundary(b, c)
+        if conv == "rthdist":
+            da, db = world_directed(ea, eb, affine), world_directed(eb, ea, affine)
+        else:
+            da, db = edt_directed(ea, eb, sp), edt_directed(eb, ea, sp)
+    sa, sb = np.sort(da), np.sort(db)
+    out = {"status": "ok", "hd": max(sa[-1], sb[-1]), "a_hd": sa[-1], "b_hd": sb[-1],
+           "a_points": len(sa), "b_points": len(sb), "msd": 0.5 * (sa.mean() + sb.mean())}
+    if conv != "itk":
+        out["assd"] = (sa.sum() + sb.sum()) / (len(sa) + len(sb))
+        out["surface_dice"] = (np.count_nonzero(sa <= tol) + np.count_nonzero(sb <= tol)) / (len(sa) + len(sb))
+        hp = []
+        for p in percentiles:
+            if conv == "rthdist":
+                hp.append(max(nearest_rank(sa, p), nearest_rank(sb, p)))
+            elif conv == "monai":
+                hp.append(max(np.percentile(sa, p), np.percentile(sb, p)))
+            elif conv == "medpy":
+                hp.append(np.percentile(np.concatenate([sa, sb]), p))
+            else:
+                hp.append(0.5 * (plastimatch_pct(sa, p) + plastimatch_pct(sb, p)))
+        out["hd_percentile"] = hp
+    return out
+
+
+EMPTY_VALUES = {  # what each convention itself reports (status both_empty / one empty)
+    "rthdist": ("undefined", "undefined"), "monai": ("nan", "inf"), "medpy": ("error", "error"),
+    "plastimatch": ("0", "undefined"), "itk": ("undefined", "undefined"),
+}
+
+
+def diagonal(shape, affine):
+    corners = np.array([[i, j, k] for i in (0, shape[0] - 1) for j in (0, shape[1] - 1) for k in (0, shape[2] - 1)])
+    w = nib.affines.apply_affine(affine, corners)
+    return float(np.linalg.norm(w.max(0) - w.min(0)))
+
+
+def close(name, got, want, tol):
+    if got is None or want is None or not (abs(got - want) <= tol):
+        FAILURES.append(f"{name}: got {got}, expected {want} (tolerance {tol:.3g})")
+
+
+def check_witness(name, d, x_set, y_set, affine, conv, expect_hd, tol):
+    """The reported voxels realize the directed HD and belong to the right sets."""
+    v, nv = tuple(d["voxel"]), tuple(d["nearest_voxel"])
+    if not x_set[v] or not y_set[nv]:
+        if expect_hd > 0:
+            FAILURES.append(f"{name}: witness voxels {v} -> {nv} not in the point sets")
+        return
+    if conv == "rthdist":
+        dist = np.linalg.norm(nib.affines.apply_affine(affine, np.array(v)) - nib.affines.apply_affine(affine, np.array(nv)))
+    else:
+        dist = np.linalg.norm((np.array(v) - np.array(nv)) * spacing_of(affine))
+    close(name + " witness distance", dist, expect_hd, tol)
+    w = nib.affines.apply_affine(affine, np.array(v))
+    close(name + " witness point", float(np.linalg.norm(np.array(d["point"]) - w)), 0.0, tol)
+
+
+def run_cli(cli, backend, a_path, b_path, extra):
+    cmd = [cli, a_path, b_path, "--json", "--convention", "all", "--backend", backend, "--percentile", "95",
+           "--percentile", "50", "--percentile", "100"] + extra
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        FAILURES.append(f"{' '.join(cmd)}: exit {p.returncode}: {p.stderr.strip()}")
+        return None
+    return json.loads(p.stdout)
+
+
+def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_volumes=None, npy=False):
+    """Writes the pair (label volumes or binary masks), runs every convention, compares."""
+    percentiles = [95.0, 50.0, 100.0]
+    va = label_volumes[0] if label_volumes else a.astype(np.uint8)
+    vb = label_volumes[1] if label_volumes else b.astype(np.uint8)
+    if npy:
+        a_path, b_path = os.path.join(tmp, name + "_a.npy"), os.path.join(tmp, name + "_b.npy")
+        np.save(a_path, va)
+        np.save(b_path, np.asfortranarray(vb))  # one C-order, one Fortran-order array
+        sp = spacing_of(affine)
+        extra = ["--spacing", f"{sp[0]!r},{sp[1]!r},{sp[2]!r}"]
+    else:
+        a_path, b_path = os.path.join(tmp, name + "_a.nii.gz"), os.path.join(tmp, name + "_b.nii.gz")
+        nib.save(nib.Nifti1Image(va, affine), a_path)
+        nib.save(nib.Nifti1Image(vb, affine), b_path)
+        # NIfTI stores the sform in float32: compare against what the file holds.
+        affine = nib.load(a_path).affine
+        extra = []
+    extra += ["--connectivity", str(conn), "--tolerance", repr(tol)]
+    if label_volumes:
+        extra += ["--labels", "all"]
+    out = run_cli(cli, backend, a_path, b_path, extra)
+    if out is None:
+        return
+    eps = 1e-6 * diagonal(a.shape, affine)
+    for row in out["results"]:
+        conv = row["convention"]
+        if label_volumes:
+            lab = int(row["label"])
+            xa, xb = label_volumes[0] == lab, label_volumes[1] == lab
+        else:
+            xa, xb = a, b
+        want = oracle(conv, xa, xb, affine, percentiles, conn, tol)
+        tag = f"[{backend}] {name} label {row['label']} {conv}"
+        if row["status"] != want["status"]:
+            FAILURES.append(f"{tag}: status {row['status']}, expected {want['status']}")
+            continue
+        if want["status"] != "ok":
+            both, one = EMPTY_VALUES[conv]
+            expect = both if want["status"] == "both_empty" else one
+            if row["convention_value"]["hd"] != expect or row["hd"] is not None:
+                FAILURES.append(f"{tag}: empty value {row['convention_value']} / hd {row['hd']}, expected {expect}")
+            continue
+        close(tag + " hd", row["hd"], want["hd"], eps)
+        close(tag + " a_to_b hd", row["a_to_b"]["hd"], want["a_hd"], eps)
+        close(tag + " b_to_a hd", row["b_to_a"]["hd"], want["b_hd"], eps)
+        close(tag + " msd", row["msd"], want["msd"], eps)
+        if row["a_to_b"]["points"] != want["a_points"] or row["b_to_a"]["points"] != want["b_points"]:
+            FAILURES.append(f"{tag}: points {row['a_to_b']['points']}/{row['b_to_a']['points']}, "
+                            f"expected {want['a_points']}/{want['b_points']}")
+        if conv != "itk":
+            close(tag + " assd", row["assd"], want["assd"], eps)
+            close(tag + " surface_dice", row["surface_dice"], want["surface_dice"], 1e-12)
+            for got, exp in zip(row["hd_percentile"], want["hd_percentile"]):
+                close(tag + f" hd{got['p']:g}", got["value"], exp, eps)
+            c = conn if conv in ("rthdist", "medpy") else 6
+            sa, sb = boundary(xa, c), boundary(xb, c)
+        else:
+            if row["hd_percentile"]:
+                FAILURES.append(f"{tag}: itk reports no percentile")
+            sa, sb = xa, xb
+        check_witness(tag + " a_to_b", row["a_to_b"], sa, sb, affine, conv, want["a_hd"], eps)
+        check_witness(tag + " b_to_a", row["b_to_a"], sb, sa, affine, conv, want["b_hd"], eps)
+    print(f"{name}: {len(out['results'])} rows checked")
+
+
+def ball(shape, centre, radius, spacing=(1, 1, 1)):
+    g = np.indices(shape).astype(float)
+    d2 = sum(((g[i] - centre[i]) * spacing[i]) ** 2 for i in range(3))
+    return d2 <= radius * radius
+
+
+def rotation(ax, ay, az):
+    cx, sx, cy, sy, cz, sz = math.cos(ax), math.sin(ax), math.cos(ay), math.sin(ay), math.cos(az), math.sin(az)
+    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def synthetic_cases(cli, backend, tmp, quick):
+    aniso = np.diag([0.5, 0.7, 3.0, 1.0])
+    shape = (40, 36, 12)
+    sp = (0.5, 0.7, 3.0)
+    a = ball(shape, (19, 17, 6), 7.0, sp)
+    b = ball(shape, (21, 16, 5.5), 8.5, sp)
+    check_case("spheres_aniso", cli, backend, tmp, a, b, aniso)
+    shell = ball(shape, (20, 18, 6), 9.0, sp) & ~ball(shape, (20, 18, 6), 6.0, sp)
+    check_case("shell_vs_sphere", cli, backend, tmp, shell, b, aniso, tol=2.0)
+    oblique = np.eye(4)
+    oblique[:3, :3] = rotation(0.3, -0.5, 1.1) @ np.diag(sp)
+    oblique[:3, 3] = [-12.25, 40.5, 7.0]
+    check_case("spheres_oblique", cli, backend, tmp, a, b, oblique)
+    thin_a = np.zeros(shape, bool)
+    thin_a[5:35, 18, 6] = True  # a one-voxel line
+    thin_b = np.zeros(shape, bool)
+    thin_b[8:30, 10:26, 7] = True  # a one-voxel plate
+    check_case("thin_structures", cli, backend, tmp, thin_a, thin_b, aniso)
+    one_a = np.zeros(shape, bool)
+    one_a[3, 4, 5] = True
+    one_b = np.zeros(shape, bool)
+    one_b[30, 20, 9] = True
+    check_case("one_voxel", cli, backend, tmp, one_a, one_b, aniso)
+    check_case("one_voxel_vs_sphere", cli, backend, tmp, one_a, b, aniso)
+    empty = np.zeros(shape, bool)
+    check_case("both_empty", cli, backend, tmp, empty, empty, aniso)
+    check_case("a_empty", cli, backend, tmp, empty, b, aniso)
+    check_case("b_empty", cli, backend, tmp, a, empty, aniso)
+    rng = np.random.default_rng(13)
+    noisy_a = (rng.random((20, 18, 16)) < 0.35) | ball((20, 18, 16), (10, 9, 8), 5)
+    noisy_b = (rng.random((20, 18, 16)) < 0.05) | ball((20, 18, 16), (9, 9, 7), 6)
+    check_case("noisy", cli, backend, tmp, noisy_a, noisy_b, np.diag([0.8, 0.8, 2.5, 1.0]))
+    check_case("spheres_conn26", cli, backend, tmp, a, b, aniso, conn=26)
+    if not quick:
+        check_case("noisy_conn18", cli, backend, tmp, noisy_a, noisy_b, np.diag([0.8, 0.8, 2.5, 1.0]), conn=18)
+        check_case("spheres_npy", cli, backend, tmp, a, b, aniso, npy=True)
+    # Several labels, one row per label; label 3 only in A (b_empty).
+    la = np.zeros(shape, np.int16)
+    lb = np.zeros(shape, np.int16)
+    la[a] = 1
+    lb[b] = 1
+    la[ball(shape, (8, 8, 3), 3.0, (1, 1, 1))] = 2
+    lb[ball(shape, (9, 7, 3), 3.5, (1, 1, 1))] = 2
+    la[30:33, 28:31, 9:11] = 3
+    check_case("labels_all", cli, backend, tmp, la > 0, lb > 0, aniso, label_volumes=(la, lb))
+
+
+def crop_pair(a, b, margin=2):
+    """Crops both masks to their union's box plus a background margin (the
+    boundaries and distances are unchanged: outside counts as background)."""
+    idx = np.argwhere(a | b)
+    lo = np.maximum(idx.min(0) - margin, 0)
+    hi = idx.max(0) + margin + 1
+    s = tuple(slice(l, h) for l, h in zip(lo, hi))
+    return a[s], b[s], lo
+
+
+def atlas_cases(cli, backend, tmp, data):
+    aal_path = os.path.join(data, "aal.nii.gz")
+    img = nib.load(aal_path)
+    lab = np.asarray(img.dataobj)
+    aff = img.affine
+    st = ndi.generate_binary_structure(3, 1)
+    pairs = [("aal_l1_vs_dilated", lab == 1, ndi.binary_dilation(lab == 1, st, iterations=2)),
+             ("aal_l37_vs_eroded", lab == 37, ndi.binary_erosion(lab == 37, st)),
+             ("aal_l1_vs_l2", lab == 1, lab == 2)]
+    for name, a, b in pairs:
+        a_path, b_path = os.path.join(tmp, name + "_a.nii.gz"), os.path.join(tmp, name + "_b.nii.gz")
+        nib.save(nib.Nifti1Image(a.astype(np.uint8), aff, img.header), a_path)
+        nib.save(nib.Nifti1Image(b.astype(np.uint8), aff, img.header), b_path)
+        out = run_cli(cli, backend, a_path, b_path, [])
+        if out is None:
+            continue
+        ca, cb, lo = crop_pair(a, b)
+        shifted = aff.copy()
+        shifted[:3, 3] = nib.affines.apply_affine(aff, lo)
+        eps = 1e-6 * diagonal(lab.shape, aff)
+        for row in out["results"]:
+            conv = row["convention"]
+            want = oracle(conv, ca, cb, shifted, [95.0, 50.0, 100.0], 6, 1.0)
+            tag = f"[{backend}] {name} {conv}"
+            close(tag + " hd", row["hd"], want["hd"], eps)
+            close(tag + " msd", row["msd"], want["msd"], eps)
+            if conv != "itk":
+                close(tag + " assd", row["assd"], want["assd"], eps)
+                close(tag + " surface_dice", row["surface_dice"], want["surface_dice"], 1e-12)
+                for got, exp in zip(row["hd_percentile"], want["hd_percentile"]):
+                    close(tag + f" hd{got['p']:g}", got["value"], exp, eps)
+        print(f"{name}: {len(out['results'])} rows checked")
+    # Grids that differ: same dims, flipped x axis (HarvardOxford vs JHU), and other dims (aal vs JHU).
+    for x, y, what in [("HarvardOxford-cort-maxprob-thr0-1mm.nii.gz", "JHU-WhiteMatter-labels-1mm.nii.gz", "affine"),
+                       ("aal.nii.gz", "JHU-WhiteMatter-labels-1mm.nii.gz", "voxels")]:
+        p = subprocess.run([cli, os.path.join(data, x), os.path.join(data, y), "--backend", backend],
+                           capture_output=True, text=True)
+        if p.returncode != 3 or "different grids" not in p.stderr or what not in p.stderr or x not in p.stderr:
+            FAILURES.append(f"grid mismatch {x} vs {y}: exit {p.returncode}, stderr {p.stderr.strip()!r}")
+        else:
+            print(f"grid mismatch {x} vs {y}: exit 3, {p.stderr.strip()}")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--cli", required=True)
+    ap.add_argument("--backend", default="cpu")
+    ap.add_argument("--data", default=os.path.join(os.path.dirname(__file__), "..", "..", "..", "shared", "data", "nifti"))
+    ap.add_argument("--quick", action="store_true", help="fewer synthetic cases, no atlas")
+    args = ap.parse_args()
+    with tempfile.TemporaryDirectory(prefix="rthdist_masks_") as tmp:
+        synthetic_cases(args.cli, args.backend, tmp, args.quick)
+        if not args.quick:
+            if os.path.isdir(args.data):
+                atlas_cases(args.cli, args.backend, tmp, args.data)
+            else:
+                FAILURES.append(f"atlas directory {args.data} not found")
+    if FAILURES:
+        print(f"{len(FAILURES)} mismatches:")
+        for f in FAILURES[:200]:
+            print("  " + f)
+        return 1
+    print("all conventions match the oracle")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
