@@ -82,7 +82,7 @@ public:
             parallelChunks(count, 1 << 14, threads, [&](size_t begin, size_t end, int) {
                 for (size_t i = begin; i < end; ++i) sorted[i] = keyOf(values[i]);
             });
-            radixSortKeys(sorted, 30);  // stable: ties keep the run's ascending index order
+            radixSortKeys(sorted, 30, threads);  // stable: ties keep the run's ascending index order
             collectRuns(sorted, run.first, run.depth + 1, children);
             parallelChunks(count, 1 << 14, threads, [&](size_t begin, size_t end, int) {
                 for (size_t i = begin; i < end; ++i) values[i] = runKey | (sorted[i] & kIndexMask);

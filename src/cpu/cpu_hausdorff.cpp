@@ -68,6 +68,8 @@ constexpr size_t kSampleSize = 256;
 // A query scans its own grid cell only when it holds at most this many
 // targets (one refinement run); a denser cell is left to the BVH search.
 constexpr uint32_t kMaxCellScan = kRefineRun;
+// Level of the local subtree searched before the whole tree (8^2 buckets).
+constexpr uint32_t kLocalLevel = 2;
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point start) {
@@ -117,19 +119,21 @@ inline void scanRange(const TargetIndex& t, uint32_t first, uint32_t end, const 
     for (uint32_t pos = first; pos < end; pos += 8) scan8(t, pos, q, best);
 }
 
-// Squared float distance from q to 8 consecutive boxes of a level, with the
-// same operation order as scan8 (so a box is never farther than its points).
-inline v8f boxDistance8(const BoxLevel& level, uint32_t base, const Query& q) {
+// Squared float distance from q to the 8 child boxes of `node` (boxes
+// 8 node .. 8 node + 7 of `level`), with the same operation order as scan8
+// (so a box is never farther than its points).
+inline v8f boxDistance8(const BoxLevel& level, uint32_t node, const Query& q) {
+    const float* b = level.block(node);
     const v8f zero = splat(0.0f);
-    v8f lo = load8(&level.loX[base]) - q.x, hi = q.x - load8(&level.hiX[base]);
+    v8f lo = load8(b) - q.x, hi = q.x - load8(b + 24);
     v8f dx = lo > hi ? lo : hi;
     dx = dx > zero ? dx : zero;
-    lo = load8(&level.loY[base]) - q.y;
-    hi = q.y - load8(&level.hiY[base]);
+    lo = load8(b + 8) - q.y;
+    hi = q.y - load8(b + 32);
     v8f dy = lo > hi ? lo : hi;
     dy = dy > zero ? dy : zero;
-    lo = load8(&level.loZ[base]) - q.z;
-    hi = q.z - load8(&level.hiZ[base]);
+    lo = load8(b + 16) - q.z;
+    hi = q.z - load8(b + 40);
     v8f dz = lo > hi ? lo : hi;
     dz = dz > zero ? dz : zero;
     return dx * dx + dy * dy + dz * dz;
@@ -168,9 +172,14 @@ inline bool sameQuery(const std::vector<float>& x, const std::vector<float>& y, 
 // otherwise best holds the exact float nearest neighbour on return. A best
 // distance of 0 ends the search at once (nothing is closer; among several
 // targets at distance 0 the first found is kept).
-bool searchTree(const TargetIndex& t, const Query& q, float kill, Best& best, SearchStats& stats) {
+// The search covers the subtree of node `node` of level `level` >= 1 (its
+// children are on level - 1); level 0 (the default) means the root, i.e.
+// every target.
+bool searchTree(const TargetIndex& t, const Query& q, float kill, Best& best, SearchStats& stats,
+                uint32_t level = 0, uint32_t node = 0) {
     if (best.d2 < kill) return true;
     if (best.d2 == 0.0f) return false;
+    if (level == 0) level = uint32_t(t.levels.size() - 1);
     struct Entry {
         float d2;
         uint32_t level;
@@ -178,15 +187,15 @@ bool searchTree(const TargetIndex& t, const Query& q, float kill, Best& best, Se
     };
     std::array<Entry, 8 * 40> stack;
     int top = 0;
-    stack[top++] = {0.0f, uint32_t(t.levels.size() - 1), 0};
+    stack[top++] = {0.0f, level, node};
     while (top > 0) {
         const Entry e = stack[--top];
         if (e.d2 > best.d2 * (1.0f + kPruneSlack)) continue;
         const uint32_t childLevel = e.level - 1;
-        const BoxLevel& level = t.levels[childLevel];
+        const BoxLevel& children8 = t.levels[childLevel];
         const uint32_t base = e.node * kFanout;
-        const uint32_t real = std::min<uint32_t>(kFanout, level.count - base);
-        const v8f d2 = boxDistance8(level, base, q);
+        const uint32_t real = std::min<uint32_t>(kFanout, children8.count - base);
+        const v8f d2 = boxDistance8(children8, e.node, q);
         const float limit = best.d2 * (1.0f + kPruneSlack);
         Entry children[kFanout];
         int count = 0;
@@ -354,7 +363,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
         }
         boxBound[size_t(w)] = std::max(boxBound[size_t(w)], farthest);
     });
-    radixSortKeys(keyed, 3 * g.bits);
+    radixSortKeys(keyed, 3 * g.bits, threads);
     refineOrder(keyed, queries, scale, threads);  // dense cells: neighbours stay consecutive
     std::vector<float> qx(nq), qy(nq), qz(nq);
     std::vector<uint32_t> qOriginal(nq), qKey(nq);
@@ -476,7 +485,10 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
                 }
             }
             scanOwnCell(t, qKey[i], cursor, q, best, stat);
-            if (best.d2 < k) {
+            // The subtree around the previous query's nearest bucket (its
+            // ancestor kLocalLevel levels up) kills most of the others, in cache.
+            if (best.d2 < k || (hint != kNone && kLocalLevel + 1 < t.levels.size() &&
+                                searchTree(t, q, k, best, stat, kLocalLevel, hint >> (3 * kLocalLevel)))) {
                 hintPos = best.pos;
                 hint = t.bucketOf[best.pos];
                 ++culledHere;

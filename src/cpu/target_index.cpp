@@ -12,36 +12,53 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-void padLevel(BoxLevel& level) {
-    const size_t padded = (size_t(level.count) + kFanout - 1) / kFanout * kFanout;
-    for (std::vector<float>* v : {&level.loX, &level.loY, &level.loZ}) v->resize(padded, kInf);
-    for (std::vector<float>* v : {&level.hiX, &level.hiY, &level.hiZ}) v->resize(padded, -kInf);
-}
+}  // namespace
 
-void resizeLevel(BoxLevel& level, uint32_t count) {
-    level.count = count;
-    for (std::vector<float>* v : {&level.loX, &level.loY, &level.loZ, &level.hiX, &level.hiY, &level.hiZ}) {
-        v->assign(count, 0.0f);
+void BoxLevel::resize(uint32_t n) {
+    count = n;
+    const size_t blocks = (size_t(n) + kFanout - 1) / kFanout;
+    boxes.assign(blocks * kBlock, kInf);
+    for (size_t g = 0; g < blocks; ++g) {
+        std::fill_n(boxes.begin() + ptrdiff_t(g * kBlock + 3 * kFanout), 3 * kFanout, -kInf);
     }
 }
 
-}  // namespace
-
-void radixSortKeys(std::vector<uint64_t>& values, int keyBits) {
+void radixSortKeys(std::vector<uint64_t>& values, int keyBits, int threads) {
     constexpr int kDigit = 12;  // 16 KiB of counts (8-bit digits measured slower)
-    constexpr uint32_t kMask = (1u << kDigit) - 1;
-    std::vector<uint64_t> scratch(values.size());
-    std::vector<uint32_t> histogram(size_t(1) << kDigit);
+    constexpr uint32_t kDigits = 1u << kDigit;
+    constexpr size_t kMinPerPart = 1 << 16;
+    const size_t n = values.size();
+    // Parts: contiguous ranges counted and scattered independently; a digit's
+    // slots are handed out in part order, so every pass stays stable.
+    const size_t parts = std::clamp<size_t>(n / kMinPerPart, 1, size_t(resolveThreads(threads)) * 2);
+    const size_t partSize = (n + parts - 1) / parts;
+    std::vector<uint64_t> scratch(n);
+    std::vector<uint32_t> histogram(parts * kDigits);
     for (int shift = 32; shift < 32 + keyBits; shift += kDigit) {
         std::fill(histogram.begin(), histogram.end(), 0u);
-        for (uint64_t v : values) ++histogram[(v >> shift) & kMask];
+        auto digit = [shift](uint64_t v) { return uint32_t(v >> shift) & (kDigits - 1); };
+        parallelChunks(parts, 1, threads, [&](size_t p, size_t, int) {
+            uint32_t* h = &histogram[p * kDigits];
+            for (size_t i = p * partSize; i < std::min(n, (p + 1) * partSize); ++i) ++h[digit(values[i])];
+        });
         uint32_t sum = 0;
-        for (uint32_t& h : histogram) {
-            const uint32_t c = h;
-            h = sum;
-            sum += c;
+        bool oneDigit = false;  // every value has the same digit: the pass is the identity
+        for (uint32_t d = 0; d < kDigits; ++d) {
+            const uint32_t before = sum;
+            for (size_t p = 0; p < parts; ++p) {
+                const uint32_t c = histogram[p * kDigits + d];
+                histogram[p * kDigits + d] = sum;
+                sum += c;
+            }
+            oneDigit = oneDigit || sum - before == n;
         }
-        for (uint64_t v : values) scratch[histogram[(v >> shift) & kMask]++] = v;
+        if (oneDigit) continue;
+        parallelChunks(parts, 1, threads, [&](size_t p, size_t, int) {
+            uint32_t* h = &histogram[p * kDigits];
+            for (size_t i = p * partSize; i < std::min(n, (p + 1) * partSize); ++i) {
+                scratch[h[digit(values[i])]++] = values[i];
+            }
+        });
         values.swap(scratch);
     }
 }
@@ -78,7 +95,7 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, i
             keyed[i] = (uint64_t(key) << 32) | uint64_t(i);
         }
     });
-    radixSortKeys(keyed, 3 * index.fineBits);
+    radixSortKeys(keyed, 3 * index.fineBits, threads);
     // Overfull fine cells ordered by their own boxes, and all-identical runs
     // collapsed to their first point (the smallest input index among the
     // copies: the one the tie rule reports anyway).
@@ -134,28 +151,19 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, i
     const uint32_t buckets = uint32_t(bucketFirst.size() - 1);
     index.levels.emplace_back();
     BoxLevel& leaves = index.levels.back();
-    resizeLevel(leaves, buckets);
+    leaves.resize(buckets);
     parallelChunks(buckets, 4096, threads, [&](size_t begin, size_t end, int) {
         for (size_t b = begin; b < end; ++b) {
-            float lx = kInf, ly = kInf, lz = kInf, hx = -kInf, hy = -kInf, hz = -kInf;
+            glm::vec3 lo(kInf), hi(-kInf);
             for (uint32_t j = bucketFirst[b]; j < bucketFirst[b + 1]; ++j) {
-                lx = std::min(lx, index.x[j]);
-                ly = std::min(ly, index.y[j]);
-                lz = std::min(lz, index.z[j]);
-                hx = std::max(hx, index.x[j]);
-                hy = std::max(hy, index.y[j]);
-                hz = std::max(hz, index.z[j]);
+                const glm::vec3 p(index.x[j], index.y[j], index.z[j]);
+                lo = glm::min(lo, p);
+                hi = glm::max(hi, p);
                 index.bucketOf[j] = uint32_t(b);
             }
-            leaves.loX[b] = lx;
-            leaves.loY[b] = ly;
-            leaves.loZ[b] = lz;
-            leaves.hiX[b] = hx;
-            leaves.hiY[b] = hy;
-            leaves.hiZ[b] = hz;
+            leaves.set(uint32_t(b), lo, hi);
         }
     });
-    padLevel(leaves);
     index.bucketFirst = std::move(bucketFirst);
 
     // Tight cell boxes: the union of the cell's buckets.
@@ -165,8 +173,8 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, i
     for (uint32_t c = 0, b = 0; c < cells; ++c) {
         glm::vec3 lo(kInf), hi(-kInf);
         for (; b < buckets && index.bucketFirst[b] < index.cellFirst[c + 1]; ++b) {
-            lo = glm::min(lo, glm::vec3(leaves.loX[b], leaves.loY[b], leaves.loZ[b]));
-            hi = glm::max(hi, glm::vec3(leaves.hiX[b], leaves.hiY[b], leaves.hiZ[b]));
+            lo = glm::min(lo, leaves.lo(b));
+            hi = glm::max(hi, leaves.hi(b));
         }
         index.cellLo[c] = lo;
         index.cellHi[c] = hi;
@@ -178,25 +186,18 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, i
         const BoxLevel& child = index.levels.back();
         const uint32_t parents = (child.count + kFanout - 1) / kFanout;
         BoxLevel level;
-        resizeLevel(level, parents);
-        for (uint32_t j = 0; j < parents; ++j) {
-            float lx = kInf, ly = kInf, lz = kInf, hx = -kInf, hy = -kInf, hz = -kInf;
-            for (uint32_t c = j * kFanout; c < (j + 1) * kFanout; ++c) {  // padding is empty
-                lx = std::min(lx, child.loX[c]);
-                ly = std::min(ly, child.loY[c]);
-                lz = std::min(lz, child.loZ[c]);
-                hx = std::max(hx, child.hiX[c]);
-                hy = std::max(hy, child.hiY[c]);
-                hz = std::max(hz, child.hiZ[c]);
+        level.resize(parents);
+        parallelChunks(parents, 4096, threads, [&](size_t begin, size_t end, int) {
+            for (size_t j = begin; j < end; ++j) {
+                glm::vec3 lo(kInf), hi(-kInf);
+                for (uint32_t c = uint32_t(j) * kFanout; c < (uint32_t(j) + 1) * kFanout;
+                     ++c) {  // padding is empty
+                    lo = glm::min(lo, child.lo(c));
+                    hi = glm::max(hi, child.hi(c));
+                }
+                level.set(uint32_t(j), lo, hi);
             }
-            level.loX[j] = lx;
-            level.loY[j] = ly;
-            level.loZ[j] = lz;
-            level.hiX[j] = hx;
-            level.hiY[j] = hy;
-            level.hiZ[j] = hz;
-        }
-        padLevel(level);
+        });
         index.levels.push_back(std::move(level));
     } while (index.levels.back().count > 1);
     return index;

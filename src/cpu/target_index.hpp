@@ -54,11 +54,31 @@ inline constexpr uint32_t kBucketSize = 8;  // points per BVH leaf (at most)
 inline constexpr uint32_t kFanout = 8;      // children per BVH node
 inline constexpr uint32_t kPad = 8;         // +inf entries after every SoA array
 
-// Boxes of one BVH level in SoA form, padded to a multiple of kFanout with
+// Boxes of one BVH level, in blocks of kFanout (the children of one parent
+// node): block g holds loX, loY, loZ, hiX, hiY, hiZ of boxes 8g .. 8g + 7,
+// eight floats each, so one node's children are 192 contiguous bytes (three
+// cache lines) for the 8-wide distance test. The last block is padded with
 // empty boxes (lo = +inf, hi = -inf: infinitely far from every point).
 struct BoxLevel {
-    std::vector<float> loX, loY, loZ, hiX, hiY, hiZ;
+    static constexpr uint32_t kBlock = 6 * kFanout;  // floats per block
+    std::vector<float> boxes;
     uint32_t count = 0;  // real boxes
+
+    void resize(uint32_t n);  // n empty boxes
+    void set(uint32_t j, const glm::vec3& lo, const glm::vec3& hi) {
+        float* b = &boxes[size_t(j / kFanout) * kBlock + j % kFanout];
+        b[0] = lo.x, b[8] = lo.y, b[16] = lo.z, b[24] = hi.x, b[32] = hi.y, b[40] = hi.z;
+    }
+    [[nodiscard]] glm::vec3 lo(uint32_t j) const {
+        const float* b = &boxes[size_t(j / kFanout) * kBlock + j % kFanout];
+        return {b[0], b[8], b[16]};
+    }
+    [[nodiscard]] glm::vec3 hi(uint32_t j) const {
+        const float* b = &boxes[size_t(j / kFanout) * kBlock + j % kFanout];
+        return {b[24], b[32], b[40]};
+    }
+    // The block of node `node`'s children (boxes kFanout * node ..).
+    [[nodiscard]] const float* block(uint32_t node) const { return &boxes[size_t(node) * kBlock]; }
 };
 
 struct TargetIndex {
@@ -98,7 +118,7 @@ struct TargetIndex {
                                            int threads);
 
 // Sorts (key << 32 | payload) values by their key bits [32, 32 + keyBits),
-// stably (LSD radix, one thread).
-void radixSortKeys(std::vector<uint64_t>& values, int keyBits);
+// stably (LSD radix; `threads` workers count and scatter contiguous parts).
+void radixSortKeys(std::vector<uint64_t>& values, int keyBits, int threads = 1);
 
 }  // namespace rthdist::cpu
