@@ -4,6 +4,7 @@
 #include "masks/boundary.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cstdlib>
 
 #include "cpu/parallel.hpp"
@@ -24,26 +25,61 @@ std::vector<uint64_t> joinSlabs(std::vector<std::vector<uint64_t>>& slabs) {
     return out;
 }
 
-constexpr size_t kChunkVoxels = size_t(1) << 20;
-
 }  // namespace
 
-std::vector<uint8_t> selectMask(const Volume& v, LabelSelect select, int threads) {
-    std::vector<uint8_t> mask(v.labels.size());
+Selection selectMask(const Volume& v, LabelSelect select, int threads) {
+    Selection s;
+    s.mask.resize(v.labels.size());
+    const int64_t nx = v.dims[0], ny = v.dims[1], nz = v.dims[2];
+    struct Slab {
+        uint64_t count = 0;
+        Dims lo{INT64_MAX, INT64_MAX, INT64_MAX}, hi{-1, -1, -1};  // hi inclusive here
+    };
+    std::vector<Slab> slabs(size_t(std::max<int64_t>(nz, 0)));
     const int32_t* in = v.labels.data();
-    uint8_t* out = mask.data();
-    cpu::parallelChunks(mask.size(), kChunkVoxels, threads, [&](size_t b, size_t e, int) {
-        if (select.anyNonZero) {
-            for (size_t i = b; i < e; ++i) out[i] = in[i] != 0;
-        } else {
-            for (size_t i = b; i < e; ++i) out[i] = in[i] == select.value;
+    uint8_t* out = s.mask.data();
+    cpu::parallelChunks(size_t(nz), 1, threads, [&](size_t zb, size_t ze, int) {
+        for (int64_t z = int64_t(zb); z < int64_t(ze); ++z) {
+            Slab& slab = slabs[size_t(z)];
+            for (int64_t y = 0; y < ny; ++y) {
+                const size_t row = size_t((y + ny * z) * nx);
+                const int32_t* r = in + row;
+                uint8_t* o = out + row;
+                unsigned rowCount = 0;
+                if (select.anyNonZero) {
+                    for (int64_t x = 0; x < nx; ++x) rowCount += (o[x] = r[x] != 0);
+                } else {
+                    const int32_t value = select.value;
+                    for (int64_t x = 0; x < nx; ++x) rowCount += (o[x] = r[x] == value);
+                }
+                if (rowCount == 0) continue;
+                slab.count += rowCount;
+                int64_t first = 0, last = nx - 1;
+                while (!o[first]) ++first;
+                while (!o[last]) --last;
+                slab.lo = {std::min(slab.lo[0], first), std::min(slab.lo[1], y), std::min(slab.lo[2], z)};
+                slab.hi = {std::max(slab.hi[0], last), std::max(slab.hi[1], y), std::max(slab.hi[2], z)};
+            }
         }
     });
-    return mask;
+    Dims lo{INT64_MAX, INT64_MAX, INT64_MAX}, hi{-1, -1, -1};
+    for (const Slab& slab : slabs) {
+        if (slab.count == 0) continue;
+        s.count += slab.count;
+        for (int d = 0; d < 3; ++d) {
+            lo[d] = std::min(lo[d], slab.lo[d]);
+            hi[d] = std::max(hi[d], slab.hi[d]);
+        }
+    }
+    if (s.count > 0) {
+        s.lo = lo;
+        s.hi = {hi[0] + 1, hi[1] + 1, hi[2] + 1};
+    }
+    return s;
 }
 
-std::vector<uint64_t> boundaryVoxels(const std::vector<uint8_t>& mask, Dims dims, int connectivity,
-                                     int threads) {
+std::vector<uint64_t> boundaryVoxels(const Selection& s, Dims dims, int connectivity, int threads) {
+    if (s.count == 0) return {};
     const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
     const int64_t sy = nx, sz = nx * ny;
     // Neighbour offsets of the connectivity: |dx| + |dy| + |dz| <= 1, 2 or 3.
@@ -56,15 +92,16 @@ std::vector<uint64_t> boundaryVoxels(const std::vector<uint8_t>& mask, Dims dims
                 if (l1 == 0 || l1 > maxL1) continue;
                 offsets.push_back(dx + dy * sy + dz * sz);
             }
-    std::vector<std::vector<uint64_t>> slabs(size_t(std::max<int64_t>(nz, 0)));
-    const uint8_t* m = mask.data();
-    cpu::parallelChunks(size_t(nz), 1, threads, [&](size_t zb, size_t ze, int) {
-        for (int64_t z = int64_t(zb); z < int64_t(ze); ++z) {
-            std::vector<uint64_t>& out = slabs[size_t(z)];
-            for (int64_t y = 0; y < ny; ++y) {
+    const int64_t z0 = s.lo[2], z1 = s.hi[2];
+    std::vector<std::vector<uint64_t>> slabs(size_t(z1 - z0));
+    const uint8_t* m = s.mask.data();
+    cpu::parallelChunks(size_t(z1 - z0), 1, threads, [&](size_t zb, size_t ze, int) {
+        for (int64_t z = z0 + int64_t(zb); z < z0 + int64_t(ze); ++z) {
+            std::vector<uint64_t>& out = slabs[size_t(z - z0)];
+            for (int64_t y = s.lo[1]; y < s.hi[1]; ++y) {
                 const int64_t row = y * sy + z * sz;
                 const bool edgeRow = y == 0 || y == ny - 1 || z == 0 || z == nz - 1;
-                for (int64_t x = 0; x < nx; ++x) {
+                for (int64_t x = s.lo[0]; x < s.hi[0]; ++x) {
                     const int64_t at = row + x;
                     if (!m[at]) continue;
                     bool boundary = edgeRow || x == 0 || x == nx - 1;
@@ -84,31 +121,24 @@ std::vector<uint64_t> boundaryVoxels(const std::vector<uint8_t>& mask, Dims dims
     return joinSlabs(slabs);
 }
 
-std::vector<uint64_t> differenceVoxels(const std::vector<uint8_t>& mask, const std::vector<uint8_t>& other,
-                                       int threads) {
-    const size_t n = mask.size();
-    const size_t chunks = (n + kChunkVoxels - 1) / kChunkVoxels;
-    std::vector<std::vector<uint64_t>> slabs(chunks);
-    cpu::parallelChunks(n, kChunkVoxels, threads, [&](size_t b, size_t e, int) {
-        std::vector<uint64_t>& out = slabs[b / kChunkVoxels];
-        for (size_t i = b; i < e; ++i)
-            if (mask[i] && !other[i]) out.push_back(i);
+std::vector<uint64_t> differenceVoxels(const Selection& s, const Selection& other, Dims dims, int threads) {
+    if (s.count == 0) return {};
+    const int64_t nx = dims[0], ny = dims[1];
+    const int64_t z0 = s.lo[2], z1 = s.hi[2];
+    std::vector<std::vector<uint64_t>> slabs(size_t(z1 - z0));
+    const uint8_t* m = s.mask.data();
+    const uint8_t* o = other.mask.data();
+    cpu::parallelChunks(size_t(z1 - z0), 1, threads, [&](size_t zb, size_t ze, int) {
+        for (int64_t z = z0 + int64_t(zb); z < z0 + int64_t(ze); ++z) {
+            std::vector<uint64_t>& out = slabs[size_t(z - z0)];
+            for (int64_t y = s.lo[1]; y < s.hi[1]; ++y) {
+                const int64_t row = (y + ny * z) * nx;
+                for (int64_t x = s.lo[0]; x < s.hi[0]; ++x)
+                    if (m[row + x] && !o[row + x]) out.push_back(uint64_t(row + x));
+            }
+        }
     });
     return joinSlabs(slabs);
-}
-
-uint64_t countVoxels(const std::vector<uint8_t>& mask, int threads) {
-    const size_t n = mask.size();
-    const size_t chunks = (n + kChunkVoxels - 1) / kChunkVoxels;
-    std::vector<uint64_t> counts(chunks, 0);
-    cpu::parallelChunks(n, kChunkVoxels, threads, [&](size_t b, size_t e, int) {
-        uint64_t c = 0;
-        for (size_t i = b; i < e; ++i) c += mask[i] != 0;
-        counts[b / kChunkVoxels] = c;
-    });
-    uint64_t total = 0;
-    for (uint64_t c : counts) total += c;
-    return total;
 }
 
 }  // namespace rthdist::masks::detail

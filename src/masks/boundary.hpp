@@ -17,19 +17,23 @@ namespace rthdist::masks::detail {
 
 using Dims = std::array<int64_t, 3>;
 
-// 1 where the volume's label matches `select`, else 0.
-[[nodiscard]] std::vector<uint8_t> selectMask(const Volume& v, LabelSelect select, int threads);
+// A selected mask: 1 where the volume's label matches, else 0, with the
+// number of set voxels and their bounding box [lo, hi) (lo = hi = 0 when none).
+struct Selection {
+    std::vector<uint8_t> mask;
+    uint64_t count = 0;
+    Dims lo{0, 0, 0}, hi{0, 0, 0};
+};
 
-// Ascending linear indices of the boundary voxels of `mask`.
-[[nodiscard]] std::vector<uint64_t> boundaryVoxels(const std::vector<uint8_t>& mask, Dims dims,
-                                                   int connectivity, int threads);
+[[nodiscard]] Selection selectMask(const Volume& v, LabelSelect select, int threads);
 
-// Ascending linear indices of voxels set in `mask` and not in `other`.
-[[nodiscard]] std::vector<uint64_t> differenceVoxels(const std::vector<uint8_t>& mask,
-                                                     const std::vector<uint8_t>& other, int threads);
+// Ascending linear indices of the boundary voxels of `s` (scans its box only).
+[[nodiscard]] std::vector<uint64_t> boundaryVoxels(const Selection& s, Dims dims, int connectivity,
+                                                   int threads);
 
-// Number of set voxels.
-[[nodiscard]] uint64_t countVoxels(const std::vector<uint8_t>& mask, int threads);
+// Ascending linear indices of voxels set in `s` and not in `other`.
+[[nodiscard]] std::vector<uint64_t> differenceVoxels(const Selection& s, const Selection& other, Dims dims,
+                                                     int threads);
 
 [[nodiscard]] inline std::array<int64_t, 3> voxelOf(uint64_t linear, Dims dims) {
     const int64_t i = int64_t(linear % uint64_t(dims[0]));

@@ -221,9 +221,9 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
     const bool world = c == Convention::kRthdist;
 
     auto t0 = Clock::now();
-    const std::vector<uint8_t> ma = detail::selectMask(a, selectA, threads);
-    const std::vector<uint8_t> mb = detail::selectMask(b, selectB, threads);
-    const uint64_t na = detail::countVoxels(ma, threads), nb = detail::countVoxels(mb, threads);
+    const detail::Selection ma = detail::selectMask(a, selectA, threads);
+    const detail::Selection mb = detail::selectMask(b, selectB, threads);
+    const uint64_t na = ma.count, nb = mb.count;
     if (na == 0 || nb == 0) {
         r.empty = na == 0 && nb == 0 ? EmptyStatus::kBothEmpty
                   : na == 0          ? EmptyStatus::kAEmpty
@@ -246,14 +246,14 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
     ta = bb;  // A -> B targets
     tb = ba;
     if (itk) {
-        qa = detail::differenceVoxels(ma, mb, threads);
-        qb = detail::differenceVoxels(mb, ma, threads);
+        qa = detail::differenceVoxels(ma, mb, a.dims, threads);
+        qb = detail::differenceVoxels(mb, ma, a.dims, threads);
         za = na - qa.size();
         zb = nb - qb.size();
         // A zero-distance witness: a voxel in both masks.
         if (za > 0 || zb > 0) {
-            for (size_t i = 0; i < ma.size(); ++i)
-                if (ma[i] && mb[i]) {
+            for (size_t i = 0; i < ma.mask.size(); ++i)
+                if (ma.mask[i] && mb.mask[i]) {
                     zwa = zwb = i;
                     break;
                 }

@@ -3,6 +3,7 @@
 // conventions' numbers are checked against NumPy/SciPy in oracle_masks.py.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -142,10 +143,13 @@ TEST(MasksLoad, NpyCAndFortranOrder) {
 TEST(MasksBoundary, MatchesBruteForce) {
     const detail::Dims dims{9, 8, 7};
     std::mt19937 rng(13);
-    std::vector<uint8_t> mask(size_t(9 * 8 * 7));
-    for (auto& m : mask) m = (rng() % 100) < 60;
+    Volume v = makeVolume(dims, glm::dvec3(1.0));
+    for (auto& l : v.labels) l = (rng() % 100) < 60 ? 3 : 0;
+    const detail::Selection s = detail::selectMask(v, LabelSelect{3, false}, 2);
+    const std::vector<uint8_t>& mask = s.mask;
+    EXPECT_EQ(s.count, uint64_t(std::count(mask.begin(), mask.end(), 1)));
     for (int conn : {6, 18, 26}) {
-        const std::vector<uint64_t> got = detail::boundaryVoxels(mask, dims, conn, 2);
+        const std::vector<uint64_t> got = detail::boundaryVoxels(s, dims, conn, 2);
         std::vector<uint64_t> want;
         for (int64_t k = 0; k < 7; ++k)
             for (int64_t j = 0; j < 8; ++j)
