@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <climits>
 #include <cstdlib>
+#include <limits>
 
 #include "cpu/parallel.hpp"
 
@@ -27,29 +28,37 @@ std::vector<uint64_t> joinSlabs(std::vector<std::vector<uint64_t>>& slabs) {
 
 }  // namespace
 
-Selection selectMask(const Volume& v, LabelSelect select, int threads) {
+namespace {
+
+template <class T>
+Selection selectFrom(const T* in, Dims dims, LabelSelect select, int threads) {
     Selection s;
-    s.mask.resize(v.labels.size());
-    const int64_t nx = v.dims[0], ny = v.dims[1], nz = v.dims[2];
+    const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
+    s.mask.resize(size_t(nx * ny * nz));
     struct Slab {
         uint64_t count = 0;
         Dims lo{INT64_MAX, INT64_MAX, INT64_MAX}, hi{-1, -1, -1};  // hi inclusive here
     };
     std::vector<Slab> slabs(size_t(std::max<int64_t>(nz, 0)));
-    const int32_t* in = v.labels.data();
     uint8_t* out = s.mask.data();
+    // A label outside T's range selects nothing (the volume cannot hold it).
+    const bool representable =
+        select.anyNonZero || (int64_t(select.value) >= int64_t(std::numeric_limits<T>::min()) &&
+                              int64_t(select.value) <= int64_t(std::numeric_limits<T>::max()));
+    const T value = representable && !select.anyNonZero ? T(select.value) : T(0);
     cpu::parallelChunks(size_t(nz), 1, threads, [&](size_t zb, size_t ze, int) {
         for (int64_t z = int64_t(zb); z < int64_t(ze); ++z) {
             Slab& slab = slabs[size_t(z)];
             for (int64_t y = 0; y < ny; ++y) {
                 const size_t row = size_t((y + ny * z) * nx);
-                const int32_t* r = in + row;
+                const T* r = in + row;
                 uint8_t* o = out + row;
                 unsigned rowCount = 0;
-                if (select.anyNonZero) {
+                if (!representable) {
+                    continue;
+                } else if (select.anyNonZero) {
                     for (int64_t x = 0; x < nx; ++x) rowCount += (o[x] = r[x] != 0);
                 } else {
-                    const int32_t value = select.value;
                     for (int64_t x = 0; x < nx; ++x) rowCount += (o[x] = r[x] == value);
                 }
                 if (rowCount == 0) continue;
@@ -76,6 +85,13 @@ Selection selectMask(const Volume& v, LabelSelect select, int threads) {
         s.hi = {hi[0] + 1, hi[1] + 1, hi[2] + 1};
     }
     return s;
+}
+
+}  // namespace
+
+Selection selectMask(const Volume& v, LabelSelect select, int threads) {
+    if (!v.labels8.empty()) return selectFrom(v.labels8.data(), v.dims, select, threads);
+    return selectFrom(v.labels.data(), v.dims, select, threads);
 }
 
 std::vector<uint64_t> boundaryVoxels(const Selection& s, Dims dims, int connectivity, int threads) {

@@ -199,7 +199,7 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
                                 LabelSelect selectB, const MaskOptions& options) {
     const auto start = Clock::now();
     if (auto e = checkSameGrid(a, b)) return *e;
-    if (a.labels.size() != a.voxelCount() || b.labels.size() != b.voxelCount())
+    if (a.storedVoxels() != a.voxelCount() || b.storedVoxels() != b.voxelCount())
         return Error{ErrorCode::kInvalidArgument, "masks: label array size differs from the dimensions"};
     if (options.connectivity != 0 && options.connectivity != 6 && options.connectivity != 18 &&
         options.connectivity != 26)

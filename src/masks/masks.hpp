@@ -62,7 +62,13 @@ struct Volume {
     std::array<int64_t, 3> dims{0, 0, 0};
     glm::dmat4 voxelToWorld{1.0};       // column-major (glm): world = M * (i, j, k, 1)
     std::string transform = "spacing";  // "sform", "qform", "pixdim", "spacing", "affine"
+    // The voxels' labels: exactly one of the two holds them. The loaders use
+    // labels8 for 8-bit unsigned data (bool, uint8: a quarter of the bytes to
+    // scan), labels otherwise.
     std::vector<int32_t> labels;
+    std::vector<uint8_t> labels8;
+
+    [[nodiscard]] size_t storedVoxels() const { return labels8.empty() ? labels.size() : labels8.size(); }
 
     [[nodiscard]] uint64_t voxelCount() const {
         return uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);

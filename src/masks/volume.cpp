@@ -133,6 +133,11 @@ Result<Volume> loadNifti(const std::string& path) {
         std::isfinite(slope) && slope != 0.0 && std::isfinite(inter) && (slope != 1.0 || inter != 0.0);
     const size_t n = size_t(nim->nvox);
     std::optional<Error> e;
+    if (nim->datatype == DT_UINT8 && !scale) {
+        const uint8_t* raw = static_cast<const uint8_t*>(nim->data);
+        v.labels8.assign(raw, raw + n);
+        return v;
+    }
     switch (nim->datatype) {
         case DT_UINT8: e = toLabels<uint8_t>(nim->data, n, scale, slope, inter, path, v.labels); break;
         case DT_INT8: e = toLabels<int8_t>(nim->data, n, scale, slope, inter, path, v.labels); break;
@@ -244,6 +249,7 @@ Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing, const std::o
                              std::to_string(n) + " voxels of " + std::to_string(itemBytes) + " bytes)");
     std::vector<int32_t> flat;
     const void* raw = bytes.data() + dataAt;
+    const bool bytesOnly = kind == "b1" || kind == "u1";
     std::optional<Error> e;
     if (kind == "b1" || kind == "u1")
         e = toLabels<uint8_t>(raw, n, false, 1, 0, path, flat);
@@ -269,7 +275,19 @@ Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing, const std::o
     Volume v;
     v.path = path;
     v.dims = {dims[0], dims[1], dims[2]};
-    if (fortran) {
+    if (bytesOnly) {
+        const uint8_t* b8 = reinterpret_cast<const uint8_t*>(bytes.data() + dataAt);
+        v.labels8.resize(n);
+        const int64_t n0 = dims[0], n1 = dims[1], n2 = dims[2];
+        if (fortran) {
+            std::copy(b8, b8 + n, v.labels8.begin());
+        } else {
+            for (int64_t i = 0; i < n0; ++i)
+                for (int64_t j = 0; j < n1; ++j)
+                    for (int64_t k = 0; k < n2; ++k)
+                        v.labels8[size_t(i + n0 * (j + n1 * k))] = b8[size_t((i * n1 + j) * n2 + k)];
+        }
+    } else if (fortran) {
         v.labels = std::move(flat);  // already i fastest
     } else {
         // C order: (i, j, k) at (i * n1 + j) * n2 + k; store i fastest.
@@ -332,6 +350,7 @@ std::optional<Error> checkSameGrid(const Volume& a, const Volume& b) {
 std::vector<int32_t> labelsPresent(const Volume& v) {
     std::vector<uint8_t> small(256, 0);
     std::set<int32_t> other;
+    for (uint8_t l : v.labels8) small[l] = 1;
     for (int32_t l : v.labels) {
         if (l > 0 && l < 256)
             small[size_t(l)] = 1;
