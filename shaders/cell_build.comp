@@ -1,7 +1,8 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // Stage 1c, part 2: one Cell per run (flags scanned into cell indices), with
-// the tight box of its points; the first point is the representative.
+// the tight box of its points; the first point is the representative. The
+// largest count of a cell that can split (not all one point) goes to maxCount.
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CellsPush pc; };
@@ -27,5 +28,6 @@ void main() {
     c.first = i;
     c.count = end - i;
     cellAt(pc.cells, cellIndex).v = c;
+    if (any(notEqual(lo, hi))) atomicMax(UintRef(pc.maxCount).v, c.count);
     if (end == pc.n) uintAt(pc.numCells, 0).v = cellIndex + 1;
 }

@@ -3,7 +3,10 @@
 // Neighbourhood pass (before any ray): exact NN of each query within the
 // 3x3x3 block of target cells around its own cell. A target outside the block
 // is at least dOut away (distance from q to the block's faces, minus epsilon),
-// so a minimum m <= dOut is the exact NN. A point strictly closer than the
+// so a minimum m <= dOut is the exact NN, provided every cell of the block was
+// scanned: a cell of more than scanMax points contributes only its first
+// point (bounded work per query; the candidate search settles the query), and
+// a minimum of 0 is exact whatever was skipped. A point strictly closer than the
 // running maximum kills the query at once (early break, Taha & Hanbury 2015).
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
@@ -30,7 +33,8 @@ void main() {
     float best = uintBitsToFloat(0x7f800000u);
     uint bestT = 0;
     bool dead = false;
-    for (int j = 0; j < 27 && !dead; ++j) {
+    bool complete = true;  // every point of the block was scanned
+    for (int j = 0; j < 27 && !dead && best > 0.0; ++j) {
         // j = 0 is the query's own cell, then the 26 neighbours.
         int m = j == 0 ? 13 : (j <= 13 ? j - 1 : j);
         ivec3 cc = c + ivec3(m % 3, (m / 3) % 3, m / 9) - 1;
@@ -38,7 +42,13 @@ void main() {
         uint key = mortonKey(uvec3(cc));
         uint end = uintAt(dense, key).v;
         uint start = key == 0 ? 0u : uintAt(dense, key - 1).v;
-        for (uint t = start; t < end; ++t) {
+        if (end - start > pc.scanMax) {
+            // A crowded cell (the index split it into leaves for the search):
+            // its first point still bounds the query, the rest is left to it.
+            complete = false;
+            end = start + 1u;
+        }
+        for (uint t = start; t < end && best > 0.0; ++t) {
             vec4 tv = vec4At(targets, t).v;
             float d2 = dist2(q, tv.xyz);
             uint t_ = floatBitsToUint(tv.w);
@@ -56,7 +66,8 @@ void main() {
     // point is a real member: one strictly closer than the threshold proves
     // the query cannot raise h, with no ray cast. Levels stop once a coarse
     // cell's reach exceeds the threshold radius (reps there rarely help).
-    if (!dead && !(dOut > 0.0 && best <= dOut * dOut)) {
+    bool settled = best == 0.0 || (complete && dOut > 0.0 && best <= dOut * dOut);
+    if (!dead && !settled) {
         thr = deadThreshold(maxPacked, pc.lowerBound2);
         float reach = sqrt(thr);
         for (uint j = 1; j < pc.grid.bits && !dead; ++j) {
@@ -90,7 +101,7 @@ void main() {
     st.rLo = pc.blockRLo != 0u ? max(dOut, 0.0) : 0.0;
     if (dead) {
         st.status = RTHDIST_DEAD;
-    } else if (dOut > 0.0 && best <= dOut * dOut) {
+    } else if (best == 0.0 || (complete && dOut > 0.0 && best <= dOut * dOut)) {
         st.status = RTHDIST_EXACT;
         atomicMax(u64At(maxPacked, 0).v, packDistIndex(best, qi));
     } else {

@@ -21,17 +21,24 @@ void main() {
     // farther than the best distance known for q (from earlier pairs, the
     // representatives, or this scan) cannot hold q's NN and is skipped.
     float bound = packedDist2(stateAt(state, qi).v.best);
-    uint f0 = uintAt(pc.fineFirst, pair.y).v;
-    uint f1 = pair.y + 1u < pc.numSearchCells ? uintAt(pc.fineFirst, pair.y + 1u).v : pc.numFineCells;
+    uint f0 = pair.y, f1 = pair.y + 1u;  // level 0: the search cell is a level-0 cell
+    if (pc.fineFirst != 0ul) {
+        f0 = uintAt(pc.fineFirst, pair.y).v;
+        f1 = pair.y + 1u < pc.numSearchCells ? uintAt(pc.fineFirst, pair.y + 1u).v : pc.numFineCells;
+    }
     uint64_t fine = pc.fineCells;
     uint64_t targets = pc.targets;
     float best = uintBitsToFloat(0x7f800000u);
     uint bestT = 0;
     bool dead = false;
-    for (uint f = f0; f < f1 && !dead; ++f) {
+    // A point at distance 0 ends the scan: nothing can be closer (with
+    // duplicates, the reported target is one of the query's copies).
+    for (uint f = f0; f < f1 && !dead && best > 0.0; ++f) {
         Cell c = cellAt(fine, f).v;
         if (boxDist2(q, c.lo, c.hi) > min(bound, best)) continue;
-        for (uint t = c.first; t < c.first + c.count; ++t) {
+        // Copies of one point: the first stands for all (no per-copy work).
+        uint end = all(equal(c.lo, c.hi)) ? c.first + 1u : c.first + c.count;
+        for (uint t = c.first; t < end; ++t) {
             vec4 tv = vec4At(targets, t).v;
             float d2 = dist2(q, tv.xyz);
             uint t_ = floatBitsToUint(tv.w);
@@ -43,6 +50,7 @@ void main() {
                     dead = true;
                     break;
                 }
+                if (best == 0.0) break;
             }
         }
     }

@@ -12,8 +12,10 @@
 // than the query's best distance so far (bestLocal: scanned points and
 // representatives seen) cannot hold its nearest neighbour and is skipped;
 // representatives lower the query's best at once (atomicMin), so a
-// one-point cell needs no pair.
+// one-point cell needs no pair, and neither does any cell once the query's
+// best is 0 (a copy of the query: nothing can be closer).
 bool visitCell(uint slot, uint qi, vec3 q, float rLo, float thr, uint cellIndex, inout float bestLocal) {
+    if (bestLocal == 0.0) return false;  // a copy of q was found: nothing is closer
     Cell c = cellAt(pc.cells, cellIndex).v;
     float d2 = boxDist2(q, c.lo, c.hi);
     if (d2 > pc.radius * pc.radius) return false;
@@ -32,7 +34,9 @@ bool visitCell(uint slot, uint qi, vec3 q, float rLo, float thr, uint cellIndex,
         bestLocal = r2;
         atomicMin(stateAt(pc.state, qi).v.best, packDistIndex(r2, floatBitsToUint(rep.w)));
     }
-    if (c.count == 1) return false;
+    // One point, copies of one point (the representative stands for all), or
+    // a copy of q: the representative was all the cell could offer.
+    if (c.count == 1 || r2 == 0.0 || all(equal(c.lo, c.hi))) return false;
     uint64_t idx = atomicAdd(U64Ref(pc.counters + RTHDIST_CTR_PAIRS).v, 1ul);
     if (idx < uint64_t(pc.pairCapacity)) {
         uvec2At(pc.pairs, uint(idx)).v = uvec2(slot, cellIndex);

@@ -29,13 +29,15 @@ struct vec3f {
 // The host-visible counter block (byte offsets; one block per engine, zeroed
 // by the host before the submissions that count into it).
 #define RTHDIST_CTR_ACTIVE 0       // uint: compact.comp, queries entering the search
+#define RTHDIST_CTR_MAX_COUNT 4    // uint: cell_build, points of the largest cell that can split
 #define RTHDIST_CTR_NEXT_ACTIVE 8  // uint: resolve.comp, queries going on
 #define RTHDIST_CTR_CELLS 12       // uint: cell_build/coarsen, cells written
 #define RTHDIST_CTR_MAX_PACKED 16  // uint64: (bits of h^2 << 32) | query slot
 #define RTHDIST_CTR_PAIRS 24       // uint64: candidate pairs appended (64-bit: cannot wrap)
 #define RTHDIST_CTR_CHECK_SUM 32   // uint64: self-check, sum of original indices
 #define RTHDIST_CTR_CHECK_BAD 40   // uint64: self-check, records that broke an invariant
-#define RTHDIST_CTR_READBACK 48    // host read-back area after the counters
+#define RTHDIST_CTR_MIN_EDGE 48    // float bits: leaf_slots, the narrowest sub-cell edge of a split
+#define RTHDIST_CTR_READBACK 64    // host read-back area after the counters
 #define RTHDIST_CTR_BYTES 256
 
 // Query status values.
@@ -99,7 +101,33 @@ struct CellsPush {
     uint64_t dense;     // cell ends by key
     uint64_t cells;     // Cell[] out
     uint64_t numCells;  // uint[1] out
+    uint64_t maxCount;  // uint[1]: atomicMax of the count of every cell that can split
+                        // (more than one distinct point)
     uint n;
+};
+
+// Leaf splitting (density-robust index): a cell holding more than `leafMax`
+// points that are not all identical is cut into 8^k sub-cells of its own tight
+// box, k from its count, and its points are re-sorted by sub-cell (a counting
+// sort over slots: one slot per unsplit cell, 8^k per split one). Rounds repeat
+// until no cell that can split holds more than leafMax points.
+// leaf_slots.comp: slots per cell (scanned in place into each cell's first slot).
+// leaf_keys.comp: slot of every sorted point, histogram into `dense`.
+// leaf_scatter.comp: counting-sort scatter by slot (points, grid keys, slots).
+struct SplitPush {
+    uint64_t cells;        // Cell[numCells] of the current order
+    uint64_t slotBase;     // uint[numCells]: slots, then (scanned) the first slot
+    uint64_t sorted;       // vec4[n] in (w = original index bits)
+    uint64_t gridKeys;     // uint[n] in: grid key of every sorted point
+    uint64_t dense;        // uint[slots] histogram / starts / ends
+    uint64_t slotKeys;     // uint[n]: leaf_keys out, leaf_scatter in
+    uint64_t outSorted;    // vec4[n] out (leaf_scatter)
+    uint64_t outGridKeys;  // uint[n] out (leaf_scatter)
+    uint64_t outSlotKeys;  // uint[n] out (leaf_scatter)
+    uint64_t minEdge;      // uint[1]: atomicMin of the float bits of split sub-cell edges
+    uint numCells;
+    uint n;
+    uint leafMax;
 };
 
 // Per-query search state (one per query of a direction).
@@ -123,6 +151,8 @@ struct CullPush {
     uint blockRLo;      // 1: rLo = distance to the block's faces (search on fine
                         // cells); 0: rLo = 0 (search cells are coarser, so the
                         // block does not cover whole search cells)
+    uint scanMax;       // a cell of more points is not scanned (only its first point):
+                        // the query then cannot be settled by this pass
 };
 
 // coarsen.comp: search cells of level j (edge s * 2^j) from those of level
@@ -151,11 +181,15 @@ struct CompactPush {
 };
 
 // grow_boxes.comp: AABB per cell = tight box grown by radius (+ epsilon).
+// The epsilon is per box, relative to the box's own magnitude: a box near the
+// origin needs far less slack than the largest coordinate of the set.
 struct BoxesPush {
     uint64_t cells;
     uint64_t aabbs;  // VkAabbPositionsKHR[numCells]
     uint numCells;
-    float grow;
+    float grow;    // the radius (plus its own rounding slack)
+    float relEps;  // slack per unit of the box's largest |coordinate| + grow
+    float absEps;  // absolute slack (the grid's rounding)
 };
 
 // search (ray query compute or raygen+intersection): candidate cells.
@@ -201,7 +235,8 @@ struct RefinePush {
     uint64_t counters;
     uint64_t maxPacked;
     uint64_t fineCells;  // level-0 cells: a search cell is scanned through them
-    uint64_t fineFirst;  // uint per search cell: its first level-0 cell
+    uint64_t fineFirst;  // uint per search cell: its first level-0 cell; 0 when the
+                         // search cells are the level-0 cells themselves
     uint pairCapacity;
     float lowerBound2;
     uint numSearchCells;

@@ -51,6 +51,16 @@ constexpr VkDeviceSize kMaxSlack = VkDeviceSize(64) << 20;
 constexpr uint32_t kCheckSamples = 32;
 constexpr uint32_t kMaxIterations = 4096;
 constexpr size_t kHostChunk = size_t(1) << 16;  // points per host work item
+// Density-robust index (issue 17): a uniform grid over the bounding box puts a
+// dense cluster into a few cells when a stray point stretches the box. A cell
+// of more than kCrowdedCell points (not all one point) switches the index to
+// leaves: crowded cells are cut into sub-cells of their own tight box until no
+// leaf that can split holds more than kLeafMax points. The neighbourhood pass
+// scans at most kCrowdedCell points of a cell, so no stage's work per query
+// depends on how many points share a grid cell.
+constexpr uint32_t kCrowdedCell = 128;
+constexpr uint32_t kLeafMax = 32;
+constexpr int kMaxSplitRounds = 12;  // each round narrows a leaf >= 2x per axis; past it: bigger leaves
 
 // A point set sorted into the cells of its own grid.
 struct PointIndex {
@@ -63,6 +73,11 @@ struct PointIndex {
     uint32_t numCells = 0;
     Buffer* sortedKeys = nullptr;  // fine key per sorted point (builds coarser levels)
     std::string name;              // "A" or "B": names its pooled buffers
+    // Leaves: `cells` are sub-cells of crowded grid cells (still contiguous
+    // runs inside their grid cells), searched directly while the radius is
+    // small; minEdge is the narrowest split sub-cell's edge (first radius).
+    bool split = false;
+    double minEdge = 0.0;
     // Search cells by level j >= 1 (edge s * 2^j), built on first use.
     struct Level {
         Buffer* cells = nullptr;
@@ -163,6 +178,7 @@ struct GpuHausdorff::State {
     VkDeviceAddress countersAddr() const { return hostSmall.address(); }
     VkDeviceAddress maxPackedAddr() const { return hostSmall.address() + RTHDIST_CTR_MAX_PACKED; }
     VkDeviceAddress cellsCounterAddr() const { return hostSmall.address() + RTHDIST_CTR_CELLS; }
+    VkDeviceAddress maxCountAddr() const { return hostSmall.address() + RTHDIST_CTR_MAX_COUNT; }
     char* readback() { return static_cast<char*>(hostSmall.mapped()) + RTHDIST_CTR_READBACK; }
 
     void barrier(VkCommandBuffer cmd) { gpu::cmdShaderBarrier(cmd, pipelines.shaderStages()); }
@@ -247,6 +263,7 @@ struct GpuHausdorff::State {
         // Cells: at most one per point or key; the upper bound avoids a read-back.
         ix.cells = &buf(set + ".cells", VkDeviceSize(std::min<uint64_t>(ix.n, numKeys)) * sizeof(sh::Cell));
 
+        counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
         cmd = ctx.begin();
         vkCmdFillBuffer(cmd, ix.dense->handle(), 0, denseBytes, 0);
         barrier(cmd);
@@ -259,13 +276,8 @@ struct GpuHausdorff::State {
                            ix.sorted->address(), sortedKeys.address(), ix.n};
         dispatch(cmd, Kernel::kScatter, sp, ix.n);
         barrier(cmd);
-        sh::CellsPush cp{ix.sorted->address(),
-                         sortedKeys.address(),
-                         flags.address(),
-                         ix.dense->address(),
-                         ix.cells->address(),
-                         cellsCounterAddr(),
-                         ix.n};
+        sh::CellsPush cp{ix.sorted->address(), sortedKeys.address(), flags.address(), ix.dense->address(),
+                         ix.cells->address(),  cellsCounterAddr(),   maxCountAddr(),  ix.n};
         dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
         barrier(cmd);
         cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
@@ -276,8 +288,85 @@ struct GpuHausdorff::State {
         timings->gpuIndex += ctx.lastGpuMs();
         ix.numCells = counter<uint32_t>(RTHDIST_CTR_CELLS);
         verifyIndex(ix, std::min<uint64_t>(ix.n, numKeys));
+        if (counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) > kCrowdedCell) splitLeaves(ix);
         timings->index += msSince(t0);
         return ix;
+    }
+
+    // Cuts the crowded cells of `ix` into leaves (leaf_*.comp), round by
+    // round, then checks the index again. Each round is one submission: a
+    // counting sort by slot inside every cell, and the cells of the new order.
+    void splitLeaves(PointIndex& ix) {
+        const VkDeviceSize n = ix.n;
+        const std::string& s = ix.name;
+        Buffer* sorted[2] = {ix.sorted, &buf(s + ".sorted2", n * 16)};
+        Buffer* gridKeys[2] = {ix.sortedKeys, &buf(s + ".sortedKeys2", n * 4)};
+        Buffer* leaves[2] = {&buf(s + ".leaves0", n * sizeof(sh::Cell)),
+                             &buf(s + ".leaves1", n * sizeof(sh::Cell))};
+        Buffer& slotKeys = buf("slotKeys", n * 4);
+        Buffer& outSlotKeys = buf("outSlotKeys", n * 4);
+        Buffer& flags = buf("flags", n * 4);
+        Buffer* cells = ix.cells;
+        int cur = 0;
+        counter<uint32_t>(RTHDIST_CTR_MIN_EDGE) = 0x7f800000u;  // +inf
+        for (int round = 0; round < kMaxSplitRounds; ++round) {
+            // All slots together: one per kept cell, 8^k <= count per split one.
+            const uint64_t numSlots = uint64_t(ix.n) + ix.numCells;
+            gpu::requireWithin(numSlots, uint64_t(UINT32_MAX), "slots of a leaf split", "2^32 - 1");
+            Buffer& slotBase = buf("slotBase", VkDeviceSize(ix.numCells) * 4);
+            Buffer& dense = buf("slotDense", VkDeviceSize(numSlots) * 4);
+            Buffer* outCells = leaves[round % 2];
+            counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
+            VkCommandBuffer cmd = ctx.begin();
+            sh::SplitPush sp{cells->address(),
+                             slotBase.address(),
+                             sorted[cur]->address(),
+                             gridKeys[cur]->address(),
+                             dense.address(),
+                             slotKeys.address(),
+                             sorted[1 - cur]->address(),
+                             gridKeys[1 - cur]->address(),
+                             outSlotKeys.address(),
+                             hostSmall.address() + RTHDIST_CTR_MIN_EDGE,
+                             ix.numCells,
+                             ix.n,
+                             kLeafMax};
+            dispatch(cmd, Kernel::kLeafSlots, sp, ix.numCells);
+            vkCmdFillBuffer(cmd, dense.handle(), 0, VkDeviceSize(numSlots) * 4, 0);
+            barrier(cmd);
+            cmdScan(cmd, slotBase.address(), ix.numCells, "scanSlots", 0);
+            barrier(cmd);
+            dispatch(cmd, Kernel::kLeafKeys, sp, ix.n);
+            barrier(cmd);
+            cmdScan(cmd, dense.address(), uint32_t(numSlots), "scanDense", 0);
+            barrier(cmd);
+            dispatch(cmd, Kernel::kLeafScatter, sp, ix.n);
+            barrier(cmd);
+            sh::CellsPush cp{
+                sorted[1 - cur]->address(), outSlotKeys.address(), flags.address(), dense.address(),
+                outCells->address(),        cellsCounterAddr(),    maxCountAddr(),  ix.n};
+            dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
+            barrier(cmd);
+            cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
+            barrier(cmd);
+            dispatch(cmd, Kernel::kCellBuild, cp, ix.n);
+            ctx.submitAndWait(cmd);
+            timings->gpuIndex += ctx.lastGpuMs();
+            cur = 1 - cur;
+            cells = outCells;
+            ix.numCells = counter<uint32_t>(RTHDIST_CTR_CELLS);
+            if (counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) <= kLeafMax) break;
+        }
+        ix.sorted = sorted[cur];
+        ix.sortedKeys = gridKeys[cur];
+        ix.cells = cells;
+        ix.split = true;
+        const float edge = std::bit_cast<float>(counter<uint32_t>(RTHDIST_CTR_MIN_EDGE));
+        ix.minEdge = std::isfinite(edge) ? double(edge) : 0.0;
+        VkCommandBuffer cmd = ctx.begin();
+        cmdCheckIndex(cmd, ix);
+        ctx.submitAndWait(cmd);
+        verifyIndex(ix, ix.n);
     }
 
     // h(Q, T): Q's points in Q's cell order are the queries.
@@ -439,7 +528,8 @@ struct GpuHausdorff::State {
                           Q.n,
                           lowerBound2,
                           epsilon,
-                          0u};  // search cells are coarser than the block's cells
+                          0u,  // search cells are coarser than the block's cells
+                          kCrowdedCell};
         dispatch(cmd, Kernel::kCull, cull, Q.n);
         barrier(cmd);
         sh::CompactPush comp{state.address(), active[0]->address(), countersAddr(), maxPackedAddr(), Q.n,
@@ -457,12 +547,21 @@ struct GpuHausdorff::State {
         // at the threshold's root, which makes every ray visit far more boxes
         // (docs/bench/gpu.md, growth sweep).
         double radius = 2.0 * T.grid.cellSize;
+        // Leaves: start at half the narrowest split sub-cell's edge, about the
+        // nearest-neighbour spacing of ~8 points per sub-cell (measured on
+        // lavapipe, cluster + outlier: 2x the edge made rays visit ~4x more
+        // leaves, 1/4 cost an iteration); the growth reaches the grid's scale
+        // in a few iterations.
+        if (T.split && T.minEdge > 0.0) radius = std::min(radius, 0.5 * T.minEdge);
+        // Room for ~4 pairs per cell, or per query when a split index sends
+        // the crowded regions' queries to the search (a full buffer costs a
+        // repeated iteration).
+        const uint64_t pairBase = std::max<uint64_t>(T.numCells, T.split ? numActive : 0u);
         uint64_t pairCapacity =
-            std::min(std::clamp<uint64_t>(uint64_t(T.numCells) * 4, 1u << 16, 1u << 22), maxPairCapacity);
+            std::min(std::clamp<uint64_t>(pairBase * 4, 1u << 16, 1u << 22), maxPairCapacity);
         Buffer* pairs = nullptr;
-        const float rayTMax = float(T.grid.cellSize * 1e-3);
         int cur = 0;
-        int builtLevel = 0;  // level of the BLAS now built (0: none yet)
+        int builtLevel = -1;  // level of the BLAS now built (-1: none yet)
         while (numActive > 0) {
             if (++cnt.iterations > kMaxIterations)
                 throw std::runtime_error("candidate search did not converge");
@@ -471,14 +570,18 @@ struct GpuHausdorff::State {
                 pairCapacity = std::min<uint64_t>(pairs->size() / 8, maxPairCapacity);
             }
             const float r = float(radius);
-            const float grow = r + epsilon + r * 1e-6f;
+            // The ray only has to start inside the grown boxes: a short one
+            // crosses few other boxes (leaves are far smaller than grid cells).
+            const float rayTMax = float(std::min(T.grid.cellSize, T.split ? radius : T.grid.cellSize) * 1e-3);
             // Search cells about an eighth of the radius wide: level j with
             // s * 2^j <= R / 8, at least 1, at most bits - 1. Wider cells mean
             // fewer boxes per ray but longer scans in the refinement; R/2 and
             // R/4 were slower overall on the lavapipe scenarios (README).
-            const int level = std::clamp(int(std::floor(std::log2(radius / (8.0 * T.grid.cellSize)))), 1,
-                                         std::max(1, T.grid.bits - 1));
-            const PointIndex::Level& lv = searchLevel(T, level);
+            // A split index searches its leaves (level 0) until level 1 is due.
+            const int wanted = int(std::floor(std::log2(radius / (8.0 * T.grid.cellSize))));
+            const int level = T.split && wanted < 1 ? 0 : std::clamp(wanted, 1, std::max(1, T.grid.bits - 1));
+            PointIndex::Level lv{T.cells, nullptr, T.numCells};
+            if (level > 0) lv = searchLevel(T, level);
             Buffer* searchCells = lv.cells;
             const uint32_t numSearchCells = lv.count;
             const bool sameLevel = level == builtLevel;
@@ -488,7 +591,12 @@ struct GpuHausdorff::State {
             counter<uint64_t>(RTHDIST_CTR_PAIRS) = 0;
             counter<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE) = 0;
             cmd = ctx.begin();
-            sh::BoxesPush bp{searchCells->address(), aabbs.address(), numSearchCells, grow};
+            // Per-box slack: float rounding at the box's magnitude (the old
+            // global epsilon used the largest coordinate of both sets) plus,
+            // for a grid index, the grid's absolute term.
+            sh::BoxesPush bp{
+                searchCells->address(), aabbs.address(), numSearchCells,
+                r + r * 1e-6f,          4e-7f,           T.split ? 0.0f : float(T.grid.cellSize * 1e-5)};
             dispatch(cmd, Kernel::kGrowBoxes, bp, numSearchCells);
             gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                             VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
@@ -533,7 +641,7 @@ struct GpuHausdorff::State {
                               searchCells->address(), state.address(),
                               active[cur]->address(), pairs->address(),
                               countersAddr(),         maxPackedAddr(),
-                              T.cells->address(),     lv.fineFirst->address(),
+                              T.cells->address(),     level > 0 ? lv.fineFirst->address() : 0,
                               uint32_t(pairCapacity), lowerBound2,
                               numSearchCells,         T.numCells};
             dispatch(cmd, Kernel::kRefine, rp, used);

@@ -17,6 +17,9 @@
 #include "compact.comp.h"
 #include "cull.comp.h"
 #include "grow_boxes.comp.h"
+#include "leaf_keys.comp.h"
+#include "leaf_scatter.comp.h"
+#include "leaf_slots.comp.h"
 #include "refine.comp.h"
 #include "resolve.comp.h"
 #include "scan_add.comp.h"
@@ -111,6 +114,9 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
         spirv(k_spv_coarsen_comp, "coarsen"),
         spirv(k_spv_check_index_comp, "check_index"),
         spirv(k_spv_check_queries_comp, "check_queries"),
+        spirv(k_spv_leaf_slots_comp, "leaf_slots"),
+        spirv(k_spv_leaf_keys_comp, "leaf_keys"),
+        spirv(k_spv_leaf_scatter_comp, "leaf_scatter"),
     };
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !rayQuery) continue;

@@ -30,6 +30,9 @@ enum class Kernel : uint32_t {
     kCoarsen,
     kCheckIndex,    // self-check of an index (check_index.comp)
     kCheckQueries,  // self-check of a direction (check_queries.comp)
+    kLeafSlots,     // leaf split of crowded cells (leaf_*.comp)
+    kLeafKeys,
+    kLeafScatter,
     kCount
 };
 
