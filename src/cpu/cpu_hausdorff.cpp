@@ -46,7 +46,6 @@
 #include <limits>
 #include <vector>
 
-#include "cpu/adaptive_order.hpp"
 #include "cpu/parallel.hpp"
 #include "cpu/target_index.hpp"
 
@@ -143,19 +142,30 @@ struct SearchStats {
     uint64_t bucketsScanned = 0;  // (query, 8 targets) scans: hint, own cell and BVH buckets
 };
 
-// The query's own grid cell when it is small enough to scan (kMaxCellScan).
-// cursor walks the ascending cell keys forward (queries come in key order).
-inline void scanOwnCell(const TargetIndex& t, uint32_t key, uint32_t& cursor, const Query& q, Best& best,
-                        SearchStats& stats) {
+// Moves cursor (a position in [0, cells]) to the first cell key >= key by
+// galloping from where it is, either way (consecutive queries are neighbours,
+// so their cells are near in key order); true when that cell is key's.
+inline bool findCell(const TargetIndex& t, uint32_t key, uint32_t& cursor) {
     const uint32_t cells = t.cellCount();
     const uint32_t* keys = t.cellKey.data();
-    if (cursor < cells && keys[cursor] < key) {  // gallop
+    if (cursor < cells && keys[cursor] < key) {
         uint32_t step = 1;
         while (cursor + step < cells && keys[cursor + step] < key) step *= 2;
         const uint32_t hi = std::min(cells, cursor + step + 1);
         cursor = uint32_t(std::lower_bound(keys + cursor, keys + hi, key) - keys);
+    } else if (cursor > 0 && keys[cursor - 1] >= key) {
+        uint32_t step = 1;
+        while (step < cursor && keys[cursor - step - 1] >= key) step *= 2;
+        const uint32_t lo = step < cursor ? cursor - step - 1 : 0;
+        cursor = uint32_t(std::lower_bound(keys + lo, keys + cursor, key) - keys);
     }
-    if (cursor >= cells || keys[cursor] != key) return;
+    return cursor < cells && keys[cursor] == key;
+}
+
+// The query's own grid cell when it is small enough to scan (kMaxCellScan).
+inline void scanOwnCell(const TargetIndex& t, uint32_t key, uint32_t& cursor, const Query& q, Best& best,
+                        SearchStats& stats) {
+    if (!findCell(t, key, cursor)) return;
     const uint32_t first = t.cellFirst[cursor], end = t.cellFirst[cursor + 1];
     if (end - first > kMaxCellScan) return;
     stats.bucketsScanned += (end - first + 7) / 8;
@@ -331,54 +341,42 @@ void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
 }
 
 DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<const glm::vec3> targets,
-                                 double scale, const Options& options, PerPoint* perPoint,
-                                 Progress& progress) {
+                                 const SetOrder& qOrder, const SetOrder& tOrder, double scale,
+                                 const Options& options, PerPoint* perPoint, Progress& progress) {
     DirectedOutput out;
     progress.report("index", 0.0);
     const int threads = resolveThreads(options.threads);
     auto start = Clock::now();
 
-    const TargetIndex t = buildTargetIndex(targets, scale, options.bits, threads);
+    const TargetIndex t = buildTargetIndex(targets, scale, tOrder, threads);
     const algo::GridSpec& g = t.grid;
-    const glm::dvec3 boxLo = g.origin;
-    const algo::Bounds tb = algo::boundsOf(targets);
-    const glm::dvec3 boxHi = tb.hi * scale;
+    const glm::dvec3 boxLo = tOrder.bounds.lo, boxHi = tOrder.bounds.hi;
 
-    // Queries in Morton order of the target grid (clamped outside it); the
-    // same pass finds the largest distance from a query to BV(T).
+    // Queries in their own adaptive order, each with its cell key in the
+    // target grid (clamped outside it); the same pass finds the largest
+    // distance from a query to BV(T).
     const size_t nq = queries.size();
-    std::vector<uint64_t> keyed(nq);
+    std::vector<float> qx(nq), qy(nq), qz(nq);
+    std::vector<uint32_t> qOriginal(nq), qKey(nq);
     std::vector<double> boxBound(size_t(threads), 0.0);
     parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int w) {
         double farthest = 0.0;
         for (size_t i = begin; i < end; ++i) {
-            const glm::dvec3 p = glm::dvec3(scaled(queries[i], scale));
-            const uint32_t key =
-                algo::mortonEncode(algo::cellCoord(p.x, g.origin.x, g.cellSize, g.cellsPerAxis),
-                                   algo::cellCoord(p.y, g.origin.y, g.cellSize, g.cellsPerAxis),
-                                   algo::cellCoord(p.z, g.origin.z, g.cellSize, g.cellsPerAxis));
-            keyed[i] = (uint64_t(key) << 32) | uint64_t(i);
-            const glm::dvec3 d = glm::max(glm::max(boxLo - p, p - boxHi), glm::dvec3(0.0));
-            farthest = std::max(farthest, d.x * d.x + d.y * d.y + d.z * d.z);
-        }
-        boxBound[size_t(w)] = std::max(boxBound[size_t(w)], farthest);
-    });
-    radixSortKeys(keyed, 3 * g.bits, threads);
-    refineOrder(keyed, queries, scale, threads);  // dense cells: neighbours stay consecutive
-    std::vector<float> qx(nq), qy(nq), qz(nq);
-    std::vector<uint32_t> qOriginal(nq), qKey(nq);
-    parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) {
-            const uint32_t src = uint32_t(keyed[i]);
+            const uint32_t src = uint32_t(qOrder.keyed[i]);
             const glm::vec3 p = scaled(queries[src], scale);
             qx[i] = p.x;
             qy[i] = p.y;
             qz[i] = p.z;
             qOriginal[i] = src;
-            qKey[i] = uint32_t(keyed[i] >> 32);
+            const glm::dvec3 dp(p);
+            qKey[i] = algo::mortonEncode(algo::cellCoord(dp.x, g.origin.x, g.cellSize, g.cellsPerAxis),
+                                         algo::cellCoord(dp.y, g.origin.y, g.cellSize, g.cellsPerAxis),
+                                         algo::cellCoord(dp.z, g.origin.z, g.cellSize, g.cellsPerAxis));
+            const glm::dvec3 d = glm::max(glm::max(boxLo - dp, dp - boxHi), glm::dvec3(0.0));
+            farthest = std::max(farthest, d.x * d.x + d.y * d.y + d.z * d.z);
         }
+        boxBound[size_t(w)] = std::max(boxBound[size_t(w)], farthest);
     });
-    std::vector<uint64_t>().swap(keyed);
     out.indexMs = msSince(start);
     progress.report("index", kIndexDone);
 
@@ -581,14 +579,23 @@ Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<con
     const bool perPoint = options.perPointDistances;
     const double span = options.directedOnly ? 1.0 : 0.5;
     Progress first(options, 0.0, span);
-    DirectedOutput ab = directedHausdorff(a, b, scale, options, perPoint ? &r.aNearest : nullptr, first);
+    first.report("index", 0.0);
+    // Each set ordered once: the layout of its index and its query order.
+    auto orderStart = Clock::now();
+    const int threads = resolveThreads(options.threads);
+    const SetOrder orderA = orderSet(a, scale, options.bits, threads);
+    const SetOrder orderB = orderSet(b, scale, options.bits, threads);
+    r.timings.index += msSince(orderStart);
+    DirectedOutput ab =
+        directedHausdorff(a, b, orderA, orderB, scale, options, perPoint ? &r.aNearest : nullptr, first);
     add(ab);
     if (ab.lostQuery) return Error{ErrorCode::kInternal, "CPU backend: a query of A found no target"};
     r.aToB = ab.directed;
     r.hausdorff = r.aToB.distance;
     if (!options.directedOnly) {
         Progress second(options, 0.5, 0.5);
-        DirectedOutput ba = directedHausdorff(b, a, scale, options, perPoint ? &r.bNearest : nullptr, second);
+        DirectedOutput ba =
+            directedHausdorff(b, a, orderB, orderA, scale, options, perPoint ? &r.bNearest : nullptr, second);
         add(ba);
         if (ba.lostQuery) return Error{ErrorCode::kInternal, "CPU backend: a query of B found no target"};
         r.bToA = ba.directed;

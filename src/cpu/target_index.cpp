@@ -63,31 +63,31 @@ void radixSortKeys(std::vector<uint64_t>& values, int keyBits, int threads) {
     }
 }
 
-TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, int bits, int threads) {
-    TargetIndex index;
-    index.scale = scale;
-    const size_t n = targets.size();
+SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int threads) {
+    SetOrder order;
+    const size_t n = points.size();
 
-    // Grid over the scaled targets; the bit count is scale invariant.
-    const algo::Bounds raw = algo::boundsOf(targets);
-    if (bits <= 0) bits = algo::chooseBits(targets, raw);
-    algo::Bounds scaledBounds{raw.lo * scale, raw.hi * scale};
-    index.grid = algo::makeGrid(scaledBounds, bits);
-    index.fineBits = std::min(index.grid.bits + 2, 10);
-    const int extra = index.fineBits - index.grid.bits;
+    // Grid over the scaled points; the bit count is scale invariant.
+    const algo::Bounds raw = algo::boundsOf(points);
+    if (bits <= 0) bits = algo::chooseBits(points, raw);
+    order.bounds = algo::Bounds{raw.lo * scale, raw.hi * scale};
+    order.grid = algo::makeGrid(order.bounds, bits);
+    order.fineBits = std::min(order.grid.bits + 2, 10);
+    const int extra = order.fineBits - order.grid.bits;
     // A fine cell is the grid cell split 2^extra times per axis. The fine cell
     // size differs from the grid's by a power of two, so (p - o) / s scales
     // exactly and fine >> extra equals algo::cellCoord of the grid (clamping
     // included): the grid's cells are contiguous runs of the fine order.
-    algo::GridSpec fine = index.grid;
-    fine.bits = index.fineBits;
+    algo::GridSpec fine = order.grid;
+    fine.bits = order.fineBits;
     fine.cellsPerAxis = 1u << fine.bits;
-    fine.cellSize = index.grid.cellSize / double(1u << extra);
+    fine.cellSize = order.grid.cellSize / double(1u << extra);
 
-    std::vector<uint64_t> keyed(n);
+    std::vector<uint64_t>& keyed = order.keyed;
+    keyed.resize(n);
     parallelChunks(n, 1 << 16, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
-            const glm::vec3 p = scaled(targets[i], scale);
+            const glm::vec3 p = scaled(points[i], scale);
             const uint32_t key =
                 algo::mortonEncode(algo::cellCoord(p.x, fine.origin.x, fine.cellSize, fine.cellsPerAxis),
                                    algo::cellCoord(p.y, fine.origin.y, fine.cellSize, fine.cellsPerAxis),
@@ -95,23 +95,39 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, i
             keyed[i] = (uint64_t(key) << 32) | uint64_t(i);
         }
     });
-    radixSortKeys(keyed, 3 * index.fineBits, threads);
-    // Overfull fine cells ordered by their own boxes, and all-identical runs
-    // collapsed to their first point (the smallest input index among the
-    // copies: the one the tie rule reports anyway).
-    std::vector<IdenticalRun> identical;
-    refineOrder(keyed, targets, scale, threads, &identical);
-    if (!identical.empty()) {
-        size_t kept = 0, next = 0;
+    radixSortKeys(keyed, 3 * order.fineBits, threads);
+    // Overfull fine cells ordered by their own boxes.
+    refineOrder(keyed, points, scale, threads, &order.identical);
+    return order;
+}
+
+TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, const SetOrder& order,
+                             int threads) {
+    TargetIndex index;
+    index.scale = scale;
+    index.grid = order.grid;
+    index.fineBits = order.fineBits;
+    const int extra = order.fineBits - order.grid.bits;
+    const size_t n = targets.size();
+
+    // All-identical runs collapsed to their first point (the smallest input
+    // index among the copies: the one the tie rule reports anyway).
+    const std::vector<uint64_t>* stored = &order.keyed;
+    std::vector<uint64_t> compact;
+    if (!order.identical.empty()) {
+        compact.reserve(n);
+        size_t next = 0;
         for (size_t i = 0; i < n; ++i) {
-            if (next < identical.size() && i > identical[next].first && i < identical[next].end) {
-                if (i + 1 == identical[next].end) ++next;
+            const IdenticalRun* run = next < order.identical.size() ? &order.identical[next] : nullptr;
+            if (run != nullptr && i > run->first && i < run->end) {
+                if (i + 1 == run->end) ++next;
                 continue;
             }
-            keyed[kept++] = keyed[i];
+            compact.push_back(order.keyed[i]);
         }
-        keyed.resize(kept);
+        stored = &compact;
     }
+    const std::vector<uint64_t>& keyed = *stored;
     const size_t m = keyed.size();
     index.collapsed = n - m;
 
@@ -145,7 +161,7 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, i
     }
     index.cellFirst.push_back(uint32_t(m));
     bucketFirst.push_back(uint32_t(m));
-    std::vector<uint64_t>().swap(keyed);
+    std::vector<uint64_t>().swap(compact);
 
     // Level 0: tight bucket boxes.
     const uint32_t buckets = uint32_t(bucketFirst.size() - 1);

@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "algo/index_space.hpp"
+#include "cpu/adaptive_order.hpp"
 
 namespace rthdist::cpu {
 
@@ -112,10 +113,26 @@ struct TargetIndex {
     return glm::vec3(glm::dvec3(p) * scale);
 }
 
-// Builds the index over `targets` (non-empty, finite) scaled by `scale`.
-// bits <= 0 picks the grid's bit count with algo::chooseBits.
-[[nodiscard]] TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, int bits,
-                                           int threads);
+// A set's adaptive Morton order: the layout of its target index and, the
+// same order, the order in which it is queried (neighbours consecutive, copies
+// adjacent, ties in input order). Computed once per set and call.
+struct SetOrder {
+    algo::Bounds bounds;                  // of the scaled points
+    algo::GridSpec grid;                  // over them
+    int fineBits = 1;                     // bits of the sort key per axis (grid.bits + 2, <= 10)
+    std::vector<uint64_t> keyed;          // (fine key << 32 | input index), every point, in order
+    std::vector<IdenticalRun> identical;  // all-identical runs of that order (refineOrder)
+};
+
+// Orders `points` (non-empty, finite) scaled by `scale`: the fine Morton key
+// over the grid, then refineOrder. bits <= 0 picks the grid's bit count with
+// algo::chooseBits.
+[[nodiscard]] SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int threads);
+
+// Builds the index over `targets` in their order (from orderSet on the same
+// points and scale).
+[[nodiscard]] TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale,
+                                           const SetOrder& order, int threads);
 
 // Sorts (key << 32 | payload) values by their key bits [32, 32 + keyBits),
 // stably (LSD radix; `threads` workers count and scatter contiguous parts).
