@@ -221,9 +221,9 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
     const bool world = c == Convention::kRthdist;
 
     auto t0 = Clock::now();
-    const detail::Selection ma = detail::selectMask(a, selectA, threads);
-    const detail::Selection mb = detail::selectMask(b, selectB, threads);
-    const uint64_t na = ma.count, nb = mb.count;
+    const detail::Extraction ea = detail::extractBoundary(a, selectA, itk ? 6 : conn, threads);
+    const detail::Extraction eb = detail::extractBoundary(b, selectB, itk ? 6 : conn, threads);
+    const uint64_t na = ea.count, nb = eb.count;
     if (na == 0 || nb == 0) {
         r.empty = na == 0 && nb == 0 ? EmptyStatus::kBothEmpty
                   : na == 0          ? EmptyStatus::kAEmpty
@@ -239,41 +239,33 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
     }
 
     // Queries (possibly non-zero), zero count and targets per direction.
-    std::vector<uint64_t> qa, qb, ta, tb;
+    const std::vector<uint64_t>& ba = ea.boundary;
+    const std::vector<uint64_t>& bb = eb.boundary;
+    std::vector<uint64_t> qa, qb;
     uint64_t za = 0, zb = 0, zwa = 0, zwb = 0;
-    const std::vector<uint64_t> ba = detail::boundaryVoxels(ma, a.dims, itk ? 6 : conn, threads);
-    const std::vector<uint64_t> bb = detail::boundaryVoxels(mb, b.dims, itk ? 6 : conn, threads);
-    ta = bb;  // A -> B targets
-    tb = ba;
     if (itk) {
-        qa = detail::differenceVoxels(ma, mb, a.dims, threads);
-        qb = detail::differenceVoxels(mb, ma, a.dims, threads);
+        qa = detail::differenceVoxels(a, selectA, b, selectB, threads);
+        qb = detail::differenceVoxels(b, selectB, a, selectA, threads);
         za = na - qa.size();
         zb = nb - qb.size();
         // A zero-distance witness: a voxel in both masks.
-        if (za > 0 || zb > 0) {
-            for (size_t i = 0; i < ma.mask.size(); ++i)
-                if (ma.mask[i] && mb.mask[i]) {
-                    zwa = zwb = i;
-                    break;
-                }
-        }
+        if (za > 0 || zb > 0) zwa = zwb = detail::firstCommonVoxel(a, selectA, b, selectB).value_or(0);
     } else {
         std::set_difference(ba.begin(), ba.end(), bb.begin(), bb.end(), std::back_inserter(qa));
         std::set_difference(bb.begin(), bb.end(), ba.begin(), ba.end(), std::back_inserter(qb));
         za = ba.size() - qa.size();
         zb = bb.size() - qb.size();
-        std::vector<uint64_t> common;
         if (za > 0 || zb > 0) {
+            std::vector<uint64_t> common;
             std::set_intersection(ba.begin(), ba.end(), bb.begin(), bb.end(), std::back_inserter(common));
             zwa = zwb = common.front();
         }
     }
     r.extractMs = msSince(t0);
 
-    Result<Direction> ab = directed(engine, a, qa, za, zwa, ta, world, threads, r.extractMs, r.distanceMs);
+    Result<Direction> ab = directed(engine, a, qa, za, zwa, bb, world, threads, r.extractMs, r.distanceMs);
     if (!ab) return ab.error();
-    Result<Direction> ba2 = directed(engine, b, qb, zb, zwb, tb, world, threads, r.extractMs, r.distanceMs);
+    Result<Direction> ba2 = directed(engine, b, qb, zb, zwb, ba, world, threads, r.extractMs, r.distanceMs);
     if (!ba2) return ba2.error();
     Direction& da = *ab;
     Direction& db = *ba2;

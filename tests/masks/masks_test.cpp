@@ -145,11 +145,12 @@ TEST(MasksBoundary, MatchesBruteForce) {
     std::mt19937 rng(13);
     Volume v = makeVolume(dims, glm::dvec3(1.0));
     for (auto& l : v.labels) l = (rng() % 100) < 60 ? 3 : 0;
-    const detail::Selection s = detail::selectMask(v, LabelSelect{3, false}, 2);
-    const std::vector<uint8_t>& mask = s.mask;
-    EXPECT_EQ(s.count, uint64_t(std::count(mask.begin(), mask.end(), 1)));
+    std::vector<uint8_t> mask(v.labels.size());
+    for (size_t i = 0; i < mask.size(); ++i) mask[i] = v.labels[i] == 3;
     for (int conn : {6, 18, 26}) {
-        const std::vector<uint64_t> got = detail::boundaryVoxels(s, dims, conn, 2);
+        const detail::Extraction e = detail::extractBoundary(v, LabelSelect{3, false}, conn, 2);
+        EXPECT_EQ(e.count, uint64_t(std::count(mask.begin(), mask.end(), 1)));
+        const std::vector<uint64_t>& got = e.boundary;
         std::vector<uint64_t> want;
         for (int64_t k = 0; k < 7; ++k)
             for (int64_t j = 0; j < 8; ++j)
