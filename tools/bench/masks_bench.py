@@ -2,8 +2,9 @@
 """HD95 on segmentation masks: rthdist-masks against the SciPy-EDT
 implementation of the MONAI convention, same machine, same run.
 
-  masks_bench.py --cli build/rthdist-masks [--out docs/bench/masks/results.json]
-                 [--data ../shared/data/nifti] [--runs 3] [--size 512,512,300]
+  masks_bench.py --cli build/rthdist-masks [--itk build-masks-itk/itk-hausdorff]
+                 [--out docs/bench/masks/results.json] [--data ../shared/data/nifti]
+                 [--runs 3] [--size 512,512,300]
 
 Cases (written once as uncompressed .nii into --work):
   organ   512 x 512 x 300, spacing 0.8 x 0.8 x 2.5 mm: a smooth organ-like
@@ -25,7 +26,12 @@ Timings, each the median of --runs:
               edges = m XOR binary_erosion(m), distance_transform_edt of each
               edge complement with the spacing, read at the other's edges,
               numpy.percentile 95 per direction, max. MONAI itself is not
-              installed here (no PyTorch); this is its algorithm.
+              installed here (no PyTorch); this is its algorithm. One run
+              when the first takes over 10 s.
+  itk         ITK 5.2's HausdorffDistanceImageFilter (tools/bench/masks_itk,
+              Debian libinsighttoolkit5-dev): filter->Update() with the images
+              in memory. It computes HD and the average HD, no percentile; its
+              values are checked against rthdist-masks --convention itk.
 Both HD95 values are printed so that agreement can be checked (they must be
 equal to 1e-6 of the diagonal).
 """
@@ -99,7 +105,21 @@ def time_scipy(a, b, spacing, runs):
         t = time.perf_counter()
         value = scipy_monai_hd95(a, b, spacing)
         times.append(time.perf_counter() - t)
+        if times[0] > 10.0:
+            break
     return statistics.median(times), float(value)
+
+
+def run_itk(itk, cli, a_path, b_path, runs, threads):
+    p = subprocess.run([itk, a_path, b_path, "--runs", str(runs), "--threads", threads], capture_output=True,
+                       text=True, check=True)
+    peer = json.loads(p.stdout)
+    q = subprocess.run([cli, a_path, b_path, "--json", "--convention", "itk", "--backend", "cpu"],
+                       capture_output=True, text=True, check=True)
+    row = json.loads(q.stdout)["results"][0]
+    return {"s": peer["ms"] / 1000.0, "hd": peer["hd"], "average_hd": peer["average_hd"],
+            "rthdist_itk_hd": row["hd"], "rthdist_itk_average_hd": row["msd"],
+            "rthdist_itk_s": row["timings_ms"]["total"] / 1000.0}
 
 
 def time_rthdist(cli, a_path, b_path, runs, backend, extra):
@@ -130,6 +150,7 @@ def main():
     ap.add_argument("--size", default="512,512,300")
     ap.add_argument("--backend", default="cpu")
     ap.add_argument("--threads", default="0")
+    ap.add_argument("--itk", default="", help="itk-hausdorff binary (tools/bench/masks_itk)")
     args = ap.parse_args()
     size = tuple(int(v) for v in args.size.split(","))
     t = time.perf_counter()
@@ -162,6 +183,16 @@ def main():
                "voxels_b": int(b.sum()), "rthdist": r, "scipy_monai": {"s": s_time, "hd95": s_value},
                "speedup_lib": s_time / r["lib_s"], "speedup_wall": s_time / r["wall_s"],
                "agree": abs(s_value - r["hd95"]) <= 1e-6 * diag}
+        if args.itk:
+            threads = args.threads if args.threads != "0" else str(os.cpu_count())
+            k = run_itk(args.itk, args.cli, pa, pb, args.runs, threads)
+            row["itk"] = k
+            row["speedup_itk"] = k["s"] / r["lib_s"]
+            row["agree"] = row["agree"] and abs(k["hd"] - k["rthdist_itk_hd"]) <= 1e-6 * diag and \
+                abs(k["average_hd"] - k["rthdist_itk_average_hd"]) <= 1e-6 * diag
+            print(f"{'':22s} itk {k['s'] * 1000:9.1f} ms  x{row['speedup_itk']:.1f}  HD {k['hd']:.6f} vs "
+                  f"{k['rthdist_itk_hd']:.6f}  avg {k['average_hd']:.6f} vs {k['rthdist_itk_average_hd']:.6f}",
+                  file=sys.stderr)
         rows.append(row)
         print(f"{name:22s} rthdist {r['lib_s'] * 1000:9.1f} ms (process {r['wall_s'] * 1000:8.1f} ms)  "
               f"scipy-monai {s_time * 1000:9.1f} ms  x{row['speedup_lib']:.1f}  HD95 {r['hd95']:.6f} vs {s_value:.6f}"
