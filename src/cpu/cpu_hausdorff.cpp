@@ -348,7 +348,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
     const int threads = resolveThreads(options.threads);
     auto start = Clock::now();
 
-    const TargetIndex t = buildTargetIndex(targets, scale, tOrder, threads);
+    const TargetIndex t = buildTargetIndex(scale, tOrder, threads);
     const algo::GridSpec& g = t.grid;
     const glm::dvec3 boxLo = tOrder.bounds.lo, boxHi = tOrder.bounds.hi;
 
@@ -356,19 +356,14 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
     // target grid (clamped outside it); the same pass finds the largest
     // distance from a query to BV(T).
     const size_t nq = queries.size();
-    std::vector<float> qx(nq), qy(nq), qz(nq);
+    const std::vector<float>&qx = qOrder.x, &qy = qOrder.y, &qz = qOrder.z;
     std::vector<uint32_t> qOriginal(nq), qKey(nq);
     std::vector<double> boxBound(size_t(threads), 0.0);
     parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int w) {
         double farthest = 0.0;
         for (size_t i = begin; i < end; ++i) {
-            const uint32_t src = uint32_t(qOrder.keyed[i]);
-            const glm::vec3 p = scaled(queries[src], scale);
-            qx[i] = p.x;
-            qy[i] = p.y;
-            qz[i] = p.z;
-            qOriginal[i] = src;
-            const glm::dvec3 dp(p);
+            qOriginal[i] = uint32_t(qOrder.keyed[i]);
+            const glm::dvec3 dp(qOrder.x[i], qOrder.y[i], qOrder.z[i]);
             qKey[i] = algo::mortonEncode(algo::cellCoord(dp.x, g.origin.x, g.cellSize, g.cellsPerAxis),
                                          algo::cellCoord(dp.y, g.origin.y, g.cellSize, g.cellsPerAxis),
                                          algo::cellCoord(dp.z, g.origin.z, g.cellSize, g.cellsPerAxis));

@@ -98,24 +98,34 @@ SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int
     radixSortKeys(keyed, 3 * order.fineBits, threads);
     // Overfull fine cells ordered by their own boxes.
     refineOrder(keyed, points, scale, threads, &order.identical);
+    // The one gather of the set's coordinates into its order.
+    order.x.resize(n);
+    order.y.resize(n);
+    order.z.resize(n);
+    parallelChunks(n, 1 << 16, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) {
+            const glm::vec3 p = scaled(points[uint32_t(keyed[i])], scale);
+            order.x[i] = p.x;
+            order.y[i] = p.y;
+            order.z[i] = p.z;
+        }
+    });
     return order;
 }
 
-TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, const SetOrder& order,
-                             int threads) {
+TargetIndex buildTargetIndex(double scale, const SetOrder& order, int threads) {
     TargetIndex index;
     index.scale = scale;
     index.grid = order.grid;
     index.fineBits = order.fineBits;
     const int extra = order.fineBits - order.grid.bits;
-    const size_t n = targets.size();
+    const size_t n = order.keyed.size();
 
     // All-identical runs collapsed to their first point (the smallest input
     // index among the copies: the one the tie rule reports anyway).
-    const std::vector<uint64_t>* stored = &order.keyed;
-    std::vector<uint64_t> compact;
+    std::vector<uint32_t> kept;  // positions of the order that are stored (when some are not)
     if (!order.identical.empty()) {
-        compact.reserve(n);
+        kept.reserve(n);
         size_t next = 0;
         for (size_t i = 0; i < n; ++i) {
             const IdenticalRun* run = next < order.identical.size() ? &order.identical[next] : nullptr;
@@ -123,12 +133,11 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, c
                 if (i + 1 == run->end) ++next;
                 continue;
             }
-            compact.push_back(order.keyed[i]);
+            kept.push_back(uint32_t(i));
         }
-        stored = &compact;
     }
-    const std::vector<uint64_t>& keyed = *stored;
-    const size_t m = keyed.size();
+    const size_t m = kept.empty() ? n : kept.size();
+    auto positionOf = [&kept](size_t i) { return kept.empty() ? i : size_t(kept[i]); };
     index.collapsed = n - m;
 
     index.x.resize(m + kPad, kInf);
@@ -138,12 +147,11 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, c
     index.bucketOf.resize(m);
     parallelChunks(m, 1 << 16, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
-            const uint32_t src = uint32_t(keyed[i]);
-            const glm::vec3 p = scaled(targets[src], scale);
-            index.x[i] = p.x;
-            index.y[i] = p.y;
-            index.z[i] = p.z;
-            index.original[i] = src;
+            const size_t at = positionOf(i);
+            index.x[i] = order.x[at];
+            index.y[i] = order.y[at];
+            index.z[i] = order.z[at];
+            index.original[i] = uint32_t(order.keyed[at]);
         }
     });
 
@@ -151,9 +159,9 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, c
     const int coarseShift = 32 + 3 * extra;
     std::vector<uint32_t> bucketFirst;
     for (size_t i = 0; i < m;) {
-        const uint32_t key = uint32_t(keyed[i] >> coarseShift);
+        const uint32_t key = uint32_t(order.keyed[positionOf(i)] >> coarseShift);
         size_t end = i + 1;
-        while (end < m && uint32_t(keyed[end] >> coarseShift) == key) ++end;
+        while (end < m && uint32_t(order.keyed[positionOf(end)] >> coarseShift) == key) ++end;
         index.cellKey.push_back(key);
         index.cellFirst.push_back(uint32_t(i));
         for (size_t b = i; b < end; b += kBucketSize) bucketFirst.push_back(uint32_t(b));
@@ -161,7 +169,7 @@ TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale, c
     }
     index.cellFirst.push_back(uint32_t(m));
     bucketFirst.push_back(uint32_t(m));
-    std::vector<uint64_t>().swap(compact);
+    std::vector<uint32_t>().swap(kept);
 
     // Level 0: tight bucket boxes.
     const uint32_t buckets = uint32_t(bucketFirst.size() - 1);

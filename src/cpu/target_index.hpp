@@ -121,6 +121,7 @@ struct SetOrder {
     algo::GridSpec grid;                  // over them
     int fineBits = 1;                     // bits of the sort key per axis (grid.bits + 2, <= 10)
     std::vector<uint64_t> keyed;          // (fine key << 32 | input index), every point, in order
+    std::vector<float> x, y, z;           // the scaled coordinates in that order
     std::vector<IdenticalRun> identical;  // all-identical runs of that order (refineOrder)
 };
 
@@ -129,10 +130,8 @@ struct SetOrder {
 // algo::chooseBits.
 [[nodiscard]] SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int threads);
 
-// Builds the index over `targets` in their order (from orderSet on the same
-// points and scale).
-[[nodiscard]] TargetIndex buildTargetIndex(std::span<const glm::vec3> targets, double scale,
-                                           const SetOrder& order, int threads);
+// Builds the index over a set in its order (orderSet of the set and scale).
+[[nodiscard]] TargetIndex buildTargetIndex(double scale, const SetOrder& order, int threads);
 
 // Sorts (key << 32 | payload) values by their key bits [32, 32 + keyBits),
 // stably (LSD radix; `threads` workers count and scatter contiguous parts).
