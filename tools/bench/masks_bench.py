@@ -183,6 +183,9 @@ def main():
                "voxels_b": int(b.sum()), "rthdist": r, "scipy_monai": {"s": s_time, "hd95": s_value},
                "speedup_lib": s_time / r["lib_s"], "speedup_wall": s_time / r["wall_s"],
                "agree": abs(s_value - r["hd95"]) <= 1e-6 * diag}
+        print(f"{name:22s} rthdist {r['lib_s'] * 1000:9.1f} ms (process {r['wall_s'] * 1000:8.1f} ms)  "
+              f"scipy-monai {s_time * 1000:9.1f} ms  x{row['speedup_lib']:.1f}  HD95 {r['hd95']:.6f} vs {s_value:.6f}"
+              f"  agree {row['agree']}", file=sys.stderr)
         if args.itk:
             threads = args.threads if args.threads != "0" else str(os.cpu_count())
             k = run_itk(args.itk, args.cli, pa, pb, args.runs, threads)
@@ -194,9 +197,6 @@ def main():
                   f"{k['rthdist_itk_hd']:.6f}  avg {k['average_hd']:.6f} vs {k['rthdist_itk_average_hd']:.6f}",
                   file=sys.stderr)
         rows.append(row)
-        print(f"{name:22s} rthdist {r['lib_s'] * 1000:9.1f} ms (process {r['wall_s'] * 1000:8.1f} ms)  "
-              f"scipy-monai {s_time * 1000:9.1f} ms  x{row['speedup_lib']:.1f}  HD95 {r['hd95']:.6f} vs {s_value:.6f}"
-              f"  agree {row['agree']}", file=sys.stderr)
     result = {"machine": {"cpus": os.cpu_count(), "platform": platform.platform(),
                           "processor": platform.processor(), "loadavg_after": os.getloadavg()},
               "loadavg_before": load_before, "numpy": np.__version__, "scipy": __import__("scipy").__version__, "runs": args.runs,
