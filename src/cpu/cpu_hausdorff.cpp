@@ -23,14 +23,16 @@
 // closer, and the target reported is one at float distance 0 (a copy of the
 // query point), not necessarily the smallest index among several.
 // The seeds before the search (the previous query's bucket, the query's own
-// grid cell when it holds at most kMaxCellScan targets) only lower the best
-// distance with real targets; skipping them (a denser cell) changes the cost,
-// never the result, so no query ever scans more than a bounded number of
-// points before the BVH takes over. Queries are in adaptive Morton order
-// (cpu/adaptive_order.hpp) with copies adjacent, ties in input order: a query
-// equal to the previous one has the same f(q) and a larger index, so it can
-// neither die later nor win, and is skipped (per-point: it takes the previous
-// query's target).
+// grid cell when it holds at most kMaxCellScan targets, a search of the
+// subtree around the previous query's nearest bucket) only lower the best
+// distance with real targets, and a query they kill has a real point strictly
+// below K, exactly as the full search would require; skipping a seed (a
+// denser cell) changes the cost, never the result, so no query scans more
+// than a bounded number of points before the BVH takes over. Queries come in
+// their own adaptive order (cpu/adaptive_order.hpp: ties, such as copies of
+// one point, in ascending input index): a query equal to the previous one has
+// the same f(q) and a larger index, so it can neither die later nor win, and
+// is skipped (per-point: it takes the previous query's target).
 #include "cpu/cpu_hausdorff.hpp"
 
 #include <glm/common.hpp>

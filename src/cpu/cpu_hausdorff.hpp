@@ -1,17 +1,28 @@
 // Exact Hausdorff distance on the CPU (Backend::kCpu).
 //
+// Each set is ordered once per call (adaptive Morton order, cpu/adaptive_order:
+// a uniform grid's Morton order in which every overfull cell is ordered again
+// over its own tight box, so the order follows the points at any density);
+// that order is the layout of its index and the order in which it is queried.
 // Algorithm per direction h(Q, T) (see cpu_hausdorff.cpp for the proofs):
 //   1. Index T: the shared RT-HDIST grid (Kim, Lee, Kim 2025), cells' points
-//      contiguous with tight boxes, cut into buckets under an 8-wide BVH.
+//      contiguous with tight boxes, cut into buckets of 8 under an implicit
+//      8-wide BVH over the adaptive order (an LBVH with bounded leaves: its
+//      depth follows the points, not the bounding box); runs of identical
+//      targets stored once.
 //   2. Lower bound M: exact NN of a strided sample of Q, and the largest
 //      distance from a query to BV(T) (no witness, so it is lowered by 1e-5
 //      relative before use and can never hide the maximizing query).
-//   3. Queries in Morton order, chunks pulled by std::threads: a query dies
-//      when a point of the previous query's nearest bucket or of its own cell
-//      is strictly closer than M (early break, Taha & Hanbury 2015);
-//      survivors run a best-first-ordered BVH search that still breaks as soon
-//      as a point closer than the running M appears, else ends with the exact
-//      nearest neighbour and raises M.
+//   3. Queries in their adaptive order, chunks pulled by std::threads: a query
+//      dies when a point strictly closer than M is found in the previous
+//      query's nearest bucket, its own grid cell (only when that cell holds at
+//      most 64 targets), or the 64 buckets around the previous query's nearest
+//      (early break, Taha & Hanbury 2015); survivors run a best-first-ordered
+//      BVH search that still breaks as soon as a point closer than M appears,
+//      else ends with the exact nearest neighbour and raises M. No query scans
+//      more than a bounded number of points before the BVH takes over; a
+//      nearest distance of 0 ends a query at once; a copy of the previous
+//      query is skipped.
 //   4. The winning pair is recomputed in double.
 // With Options::perPointDistances, steps 2 and 3 become one pass that finds
 // every query's exact nearest neighbour (the same seeds and BVH search, never
@@ -30,8 +41,9 @@
 //   (exact).
 // Threading: options.threads workers (0 = all hardware threads); the result
 //   does not depend on the thread count (ties: smallest query index, then
-//   smallest target index among equal float distances).
-// Timings: index = target index + query ordering, cull = lower bound,
+//   smallest target index among equal nonzero float distances; at distance 0
+//   the target is a copy of the query point, the first one the search meets).
+// Timings: index = both sets' orders + target index + query keys, cull = lower bound,
 //   search = the pass over all queries (neighbourhood kill and BVH search),
 //   refine = witness recomputation.
 #pragma once
