@@ -4,7 +4,8 @@
 //
 //   rthdist-masks A B [--label N | --labels all] [--convention NAME|all]
 //                 [--percentile P]... [--connectivity 6|18|26] [--tolerance MM]
-//                 [--spacing X,Y,Z] [--backend B] [--device N] [--threads N]
+//                 [--spacing X,Y,Z | --affine 12 numbers] [--backend B] [--device N]
+//                 [--threads N]
 //                 [--json | --csv]
 //
 // A separate executable from `rthdist` (tools/cli/main.cpp) so that the point
@@ -21,6 +22,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <glm/matrix.hpp>
 
 #include "cli/args.hpp"
 #include "cli/json_writer.hpp"
@@ -41,6 +44,7 @@ struct MasksArgs {
     int connectivity = 0;
     double tolerance = 1.0;
     glm::dvec3 spacing{1.0};
+    std::optional<glm::dmat4> affine;  // --affine: voxel-to-world of .npy inputs
     Options options;
     bool json = false, csv = false, help = false, version = false;
 };
@@ -56,6 +60,7 @@ const char* kUsage =
     "  --connectivity C     boundary connectivity 6, 18 or 26 (default 6; itk uses all voxels)\n"
     "  --tolerance MM       surface Dice tolerance in mm (default 1)\n"
     "  --spacing X,Y,Z      voxel spacing of .npy inputs along axes 0,1,2 (default 1,1,1)\n"
+    "  --affine R00,R01,R02,T0,R10,...,T2  voxel-to-world of .npy inputs: 3x4, row-major\n"
     "  --backend B          auto, cpu, ray-query, rt-pipeline (default auto)\n"
     "  --device N           Vulkan device index;  --threads N  CPU threads (0 = all)\n"
     "  --json | --csv       output format (default: text)\n"
@@ -109,7 +114,7 @@ Result<MasksArgs> parse(const std::vector<std::string>& argv) {
             a.csv = true;
         } else if (arg == "--label" || arg == "--labels" || arg == "--convention" || arg == "--percentile" ||
                    arg == "--connectivity" || arg == "--tolerance" || arg == "--spacing" ||
-                   arg == "--backend" || arg == "--device" || arg == "--threads") {
+                   arg == "--affine" || arg == "--backend" || arg == "--device" || arg == "--threads") {
             const auto v = need();
             if (!v) return usage("option '" + arg + "' needs a value");
             if (arg == "--label") {
@@ -160,6 +165,19 @@ Result<MasksArgs> parse(const std::vector<std::string>& argv) {
                     at = end + 1;
                 }
                 a.spacing = {s[0], s[1], s[2]};
+            } else if (arg == "--affine") {
+                glm::dmat4 m(1.0);
+                size_t at = 0;
+                for (int k = 0; k < 12; ++k) {
+                    const size_t end = k < 11 ? v->find(',', at) : v->size();
+                    if (end == std::string::npos) return usage("--affine expects 12 comma-separated numbers");
+                    const auto x = number(std::string_view(*v).substr(at, end - at));
+                    if (!x) return usage("--affine expects 12 comma-separated numbers, got '" + *v + "'");
+                    m[k % 4][k / 4] = *x;  // row k / 4, column k % 4 (glm is column-major)
+                    at = end + 1;
+                }
+                if (glm::determinant(glm::dmat3(m)) == 0.0) return usage("--affine is singular");
+                a.affine = m;
             } else if (arg == "--backend") {
                 if (!parseBackend(*v, a.options.backend))
                     return usage("--backend expects auto, cpu, ray-query or rt-pipeline, got '" + *v + "'");
@@ -183,6 +201,7 @@ Result<MasksArgs> parse(const std::vector<std::string>& argv) {
     if (files.size() != 2) return usage("expected two mask files A B, got " + std::to_string(files.size()));
     if (a.label && a.allLabels) return usage("--label and --labels all exclude each other");
     if (a.json && a.csv) return usage("--json and --csv exclude each other");
+    if (a.affine && a.spacing != glm::dvec3(1.0)) return usage("--spacing and --affine exclude each other");
     a.pathA = files[0];
     a.pathB = files[1];
     if (a.percentiles.empty()) a.percentiles.push_back(95.0);
@@ -356,9 +375,9 @@ int run(int argc, char** argv) {
     if (args.help) return std::fputs(kUsage, stdout) >= 0 ? kExitOk : kExitInternal;
     if (args.version) return std::printf("rthdist-masks %s\n", versionString()) > 0 ? kExitOk : kExitInternal;
 
-    Result<masks::Volume> a = masks::loadVolume(args.pathA, args.spacing);
+    Result<masks::Volume> a = masks::loadVolume(args.pathA, args.spacing, args.affine);
     if (!a) return fail(exitCodeFor(a.error().code), a.error().message);
-    Result<masks::Volume> b = masks::loadVolume(args.pathB, args.spacing);
+    Result<masks::Volume> b = masks::loadVolume(args.pathB, args.spacing, args.affine);
     if (!b) return fail(exitCodeFor(b.error().code), b.error().message);
     if (auto e = masks::checkSameGrid(*a, *b)) return fail(exitCodeFor(e->code), e->message);
 
