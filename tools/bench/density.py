@@ -277,7 +277,11 @@ def main():
     if args.merge and os.path.exists(out_json):
         with open(out_json) as f:
             results = json.load(f)
-    results.update({"machine": machine_info(args.bench), "runs": args.runs})
+    if not args.merge:
+        results.update({"machine": machine_info(args.bench), "runs": args.runs})
+    if args.merge:
+        results.setdefault("merged_runs", []).append({"backends": args.backends, "tools": args.tools,
+                                                      "runs": args.runs, "machine": machine_info(args.bench)})
     for name in args.rows.split(","):
         meta = prepare(name, args.data, args.work)
         a, b = read_ply(meta["a_ply"]).astype(np.float64), read_ply(meta["b_ply"]).astype(np.float64)
@@ -314,7 +318,8 @@ def main():
                 growth["tools"][tool] = {"seconds": [p[1] for p in pts], "exponent": slope(pts),
                                          "ratio": pts[-1][1] / pts[0][1]}
         results["growth"] = growth
-    results["machine"]["load_avg_end"] = os.getloadavg()
+    if not args.merge:
+        results["machine"]["load_avg_end"] = os.getloadavg()
     with open(out_json, "w") as f:
         json.dump(results, f, indent=1)
     report(results, args.out)
