@@ -3,6 +3,8 @@
 // Stage 1c, part 2: one Cell per run (flags scanned into cell indices), with
 // the tight box of its points; the first point is the representative. The
 // largest count of a cell that can split (not all one point) goes to maxCount.
+// A cell of more than RTHDIST_SERIAL_BOX points only gets its box's start
+// values here (cell_bounds.comp reduces it in parallel).
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CellsPush pc; };
@@ -15,6 +17,21 @@ void main() {
     if (i != 0 && uintAt(keys, i - 1).v == key) return;
     uint cellIndex = uintAt(pc.flags, i).v;
     uint end = uintAt(pc.dense, key).v;
+    Cell c;
+    c.first = i;
+    c.count = end - i;
+    if (c.count > RTHDIST_SERIAL_BOX) {
+        // Large cell: its box is reduced over all its points in parallel.
+        for (uint k = 0; k < 3u; ++k) {
+            uintAt(pc.boundsU, 6u * cellIndex + k).v = 0xffffffffu;
+            uintAt(pc.boundsU, 6u * cellIndex + 3u + k).v = 0u;
+        }
+        c.lo = vec3(0.0);
+        c.hi = vec3(0.0);
+        cellAt(pc.cells, cellIndex).v = c;
+        if (end == pc.n) uintAt(pc.numCells, 0).v = cellIndex + 1;
+        return;
+    }
     uint64_t pts = pc.sorted;
     vec3 lo = vec4At(pts, i).v.xyz, hi = lo;
     for (uint j = i + 1; j < end; ++j) {
@@ -22,11 +39,8 @@ void main() {
         lo = min(lo, p);
         hi = max(hi, p);
     }
-    Cell c;
     c.lo = lo;
     c.hi = hi;
-    c.first = i;
-    c.count = end - i;
     cellAt(pc.cells, cellIndex).v = c;
     if (any(notEqual(lo, hi))) atomicMax(UintRef(pc.maxCount).v, c.count);
     if (end == pc.n) uintAt(pc.numCells, 0).v = cellIndex + 1;

@@ -83,3 +83,10 @@ float deadThreshold(uint64_t maxPacked, float lowerBound2) {
     uint64_t m = U64Ref(maxPacked).v;
     return max(packedDist2(m), lowerBound2);
 }
+
+// Order-preserving uint of a float (for atomicMin/atomicMax of floats) and back.
+uint orderedBits(float f) {
+    uint b = floatBitsToUint(f);
+    return (b & 0x80000000u) != 0u ? ~b : b | 0x80000000u;
+}
+float fromOrderedBits(uint u) { return uintBitsToFloat((u & 0x80000000u) != 0u ? u & 0x7fffffffu : ~u); }

@@ -93,7 +93,8 @@ struct ScatterPush {
 };
 
 // cell_heads.comp writes flags (1 where a cell starts); after a scan
-// cell_build.comp writes one Cell per head.
+// cell_build.comp writes one Cell per head (the box of a large cell comes from
+// cell_bounds.comp and cell_bounds_fix.comp).
 struct CellsPush {
     uint64_t sorted;
     uint64_t sortedKeys;
@@ -103,8 +104,15 @@ struct CellsPush {
     uint64_t numCells;  // uint[1] out
     uint64_t maxCount;  // uint[1]: atomicMax of the count of every cell that can split
                         // (more than one distinct point)
+    uint64_t boundsU;   // uint[6 * cells]: order-preserving bits of a large cell's box
+                        // (lo xyz, hi xyz), reduced with atomics by cell_bounds.comp
     uint n;
+    uint cellCapacity;  // cells the Cell buffer can hold (cell_bounds_fix dispatch)
 };
+
+// A cell of more than this many points gets its tight box from a parallel
+// reduction (cell_bounds.comp) instead of its head thread's serial loop.
+#define RTHDIST_SERIAL_BOX 64u
 
 // Leaf splitting (density-robust index): a cell holding more than `leafMax`
 // points that are not all identical is cut into 8^k sub-cells of its own tight

@@ -56,9 +56,11 @@ constexpr size_t kHostChunk = size_t(1) << 16;  // points per host work item
 // of more than kCrowdedCell points (not all one point) switches the index to
 // leaves: crowded cells are cut into sub-cells of their own tight box until no
 // leaf that can split holds more than kLeafMax points. The neighbourhood pass
-// scans at most kCrowdedCell points of a cell, so no stage's work per query
-// depends on how many points share a grid cell.
-constexpr uint32_t kCrowdedCell = 128;
+// scans at most kCrowdedCell points of a cell (a larger one is split, or holds
+// copies of one point, whose first copy stands for all), so no stage's
+// work per query depends on how many points share a grid cell. (The Dragon's
+// fullest cell holds 134 points; even data stays on the grid path.)
+constexpr uint32_t kCrowdedCell = 512;
 constexpr uint32_t kLeafMax = 32;
 constexpr int kMaxSplitRounds = 12;  // each round narrows a leaf >= 2x per axis; past it: bigger leaves
 
@@ -261,7 +263,8 @@ struct GpuHausdorff::State {
         ix.dense = &buf(set + ".dense", denseBytes);
         ix.sorted = &buf(set + ".sorted", bytes);
         // Cells: at most one per point or key; the upper bound avoids a read-back.
-        ix.cells = &buf(set + ".cells", VkDeviceSize(std::min<uint64_t>(ix.n, numKeys)) * sizeof(sh::Cell));
+        const uint64_t cellCapacity = std::min<uint64_t>(ix.n, numKeys);
+        ix.cells = &buf(set + ".cells", VkDeviceSize(cellCapacity) * sizeof(sh::Cell));
 
         counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
         cmd = ctx.begin();
@@ -276,18 +279,27 @@ struct GpuHausdorff::State {
                            ix.sorted->address(), sortedKeys.address(), ix.n};
         dispatch(cmd, Kernel::kScatter, sp, ix.n);
         barrier(cmd);
-        sh::CellsPush cp{ix.sorted->address(), sortedKeys.address(), flags.address(), ix.dense->address(),
-                         ix.cells->address(),  cellsCounterAddr(),   maxCountAddr(),  ix.n};
+        sh::CellsPush cp{ix.sorted->address(),
+                         sortedKeys.address(),
+                         flags.address(),
+                         ix.dense->address(),
+                         ix.cells->address(),
+                         cellsCounterAddr(),
+                         maxCountAddr(),
+                         boundsU(cellCapacity).address(),
+                         ix.n,
+                         uint32_t(cellCapacity)};
         dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
         barrier(cmd);
         cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
         barrier(cmd);
-        dispatch(cmd, Kernel::kCellBuild, cp, ix.n);
+        cmdCellBuild(cmd, cp);
+        barrier(cmd);
         cmdCheckIndex(cmd, ix);  // in the same submission: no extra wait
         ctx.submitAndWait(cmd);
         timings->gpuIndex += ctx.lastGpuMs();
         ix.numCells = counter<uint32_t>(RTHDIST_CTR_CELLS);
-        verifyIndex(ix, std::min<uint64_t>(ix.n, numKeys));
+        verifyIndex(ix, cellCapacity);
         if (counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) > kCrowdedCell) splitLeaves(ix);
         timings->index += msSince(t0);
         return ix;
@@ -342,14 +354,21 @@ struct GpuHausdorff::State {
             barrier(cmd);
             dispatch(cmd, Kernel::kLeafScatter, sp, ix.n);
             barrier(cmd);
-            sh::CellsPush cp{
-                sorted[1 - cur]->address(), outSlotKeys.address(), flags.address(), dense.address(),
-                outCells->address(),        cellsCounterAddr(),    maxCountAddr(),  ix.n};
+            sh::CellsPush cp{sorted[1 - cur]->address(),
+                             outSlotKeys.address(),
+                             flags.address(),
+                             dense.address(),
+                             outCells->address(),
+                             cellsCounterAddr(),
+                             maxCountAddr(),
+                             boundsU(n).address(),
+                             ix.n,
+                             ix.n};
             dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
             barrier(cmd);
             cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
             barrier(cmd);
-            dispatch(cmd, Kernel::kCellBuild, cp, ix.n);
+            cmdCellBuild(cmd, cp);
             ctx.submitAndWait(cmd);
             timings->gpuIndex += ctx.lastGpuMs();
             cur = 1 - cur;
@@ -419,6 +438,19 @@ struct GpuHausdorff::State {
             pipelines.cmdTraceRays(cmd, &sp, sizeof(sp),
                                    uint32_t(std::min<uint64_t>(chunk, sp.numActive - first)));
         }
+    }
+
+    // Scratch of the parallel box reduction of large cells (6 uints per cell).
+    Buffer& boundsU(uint64_t cellCapacity) { return buf("boundsU", VkDeviceSize(cellCapacity) * 24); }
+
+    // One Cell per run of equal keys (heads flagged and scanned before):
+    // small cells' boxes by their head thread, large cells' in parallel.
+    void cmdCellBuild(VkCommandBuffer cmd, const sh::CellsPush& cp) {
+        dispatch(cmd, Kernel::kCellBuild, cp, cp.n);
+        barrier(cmd);
+        dispatch(cmd, Kernel::kCellBounds, cp, cp.n);
+        barrier(cmd);
+        dispatch(cmd, Kernel::kCellBoundsFix, cp, cp.cellCapacity);
     }
 
     // Self-check of an index, recorded after its build (check_index.comp);
@@ -528,8 +560,8 @@ struct GpuHausdorff::State {
                           Q.n,
                           lowerBound2,
                           epsilon,
-                          0u,  // search cells are coarser than the block's cells
-                          kCrowdedCell};
+                          0u,             // search cells are coarser than the block's cells
+                          kCrowdedCell};  // past it: split leaves, or copies of one point
         dispatch(cmd, Kernel::kCull, cull, Q.n);
         barrier(cmd);
         sh::CompactPush comp{state.address(), active[0]->address(), countersAddr(), maxPackedAddr(), Q.n,

@@ -8,6 +8,8 @@
 #include "rthdist_shared.h"
 
 // SPIR-V embedded at build time (cmake/Shaders.cmake).
+#include "cell_bounds.comp.h"
+#include "cell_bounds_fix.comp.h"
 #include "cell_build.comp.h"
 #include "cell_heads.comp.h"
 #include "cell_keys.comp.h"
@@ -117,6 +119,8 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
         spirv(k_spv_leaf_slots_comp, "leaf_slots"),
         spirv(k_spv_leaf_keys_comp, "leaf_keys"),
         spirv(k_spv_leaf_scatter_comp, "leaf_scatter"),
+        spirv(k_spv_cell_bounds_comp, "cell_bounds"),
+        spirv(k_spv_cell_bounds_fix_comp, "cell_bounds_fix"),
     };
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !rayQuery) continue;

@@ -33,6 +33,8 @@ enum class Kernel : uint32_t {
     kLeafSlots,     // leaf split of crowded cells (leaf_*.comp)
     kLeafKeys,
     kLeafScatter,
+    kCellBounds,  // parallel tight boxes of large cells (cell_bounds*.comp)
+    kCellBoundsFix,
     kCount
 };
 

@@ -1,0 +1,22 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Stage 1c, part 4: large cells take their reduced box (cell_bounds.comp),
+// and the largest count of a cell that can split goes to maxCount.
+#include "common.glsl"
+layout(local_size_x = RTHDIST_WG) in;
+layout(push_constant) uniform Push { CellsPush pc; };
+
+void main() {
+    uint c = gl_GlobalInvocationID.x;
+    if (c >= pc.cellCapacity || c >= uintAt(pc.numCells, 0).v) return;
+    uint count = cellAt(pc.cells, c).v.count;
+    if (count <= RTHDIST_SERIAL_BOX) return;
+    vec3 lo, hi;
+    for (uint k = 0; k < 3u; ++k) {
+        lo[k] = fromOrderedBits(uintAt(pc.boundsU, 6u * c + k).v);
+        hi[k] = fromOrderedBits(uintAt(pc.boundsU, 6u * c + 3u + k).v);
+    }
+    cellAt(pc.cells, c).v.lo = lo;
+    cellAt(pc.cells, c).v.hi = hi;
+    if (any(notEqual(lo, hi))) atomicMax(UintRef(pc.maxCount).v, count);
+}
