@@ -10,7 +10,7 @@ layout(push_constant) uniform Push { CellsPush pc; };
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i >= pc.n) return;
+    if (i >= pc.n || UintRef(pc.largeCells).v == 0u) return;
     uint64_t keys = pc.sortedKeys;
     bool head = i == 0 || uintAt(keys, i - 1).v != uintAt(keys, i).v;
     // flags holds the exclusive scan of the head flags: the cells before i.

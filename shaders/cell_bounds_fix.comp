@@ -8,7 +8,7 @@ layout(push_constant) uniform Push { CellsPush pc; };
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
-    if (c >= pc.cellCapacity || c >= uintAt(pc.numCells, 0).v) return;
+    if (c >= pc.cellCapacity || UintRef(pc.largeCells).v == 0u || c >= uintAt(pc.numCells, 0).v) return;
     uint count = cellAt(pc.cells, c).v.count;
     if (count <= RTHDIST_SERIAL_BOX) return;
     vec3 lo, hi;

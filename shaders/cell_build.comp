@@ -29,6 +29,7 @@ void main() {
         c.lo = vec3(0.0);
         c.hi = vec3(0.0);
         cellAt(pc.cells, cellIndex).v = c;
+        UintRef(pc.largeCells).v = 1u;
         if (end == pc.n) uintAt(pc.numCells, 0).v = cellIndex + 1;
         return;
     }
@@ -42,6 +43,6 @@ void main() {
     c.lo = lo;
     c.hi = hi;
     cellAt(pc.cells, cellIndex).v = c;
-    if (any(notEqual(lo, hi))) atomicMax(UintRef(pc.maxCount).v, c.count);
+    if (c.count > RTHDIST_LEAF_MAX && any(notEqual(lo, hi))) atomicMax(UintRef(pc.maxCount).v, c.count);
     if (end == pc.n) uintAt(pc.numCells, 0).v = cellIndex + 1;
 }

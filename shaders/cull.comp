@@ -48,7 +48,7 @@ void main() {
             complete = false;
             end = start + 1u;
         }
-        for (uint t = start; t < end && best > 0.0; ++t) {
+        for (uint t = start; t < end; ++t) {
             vec4 tv = vec4At(targets, t).v;
             float d2 = dist2(q, tv.xyz);
             uint t_ = floatBitsToUint(tv.w);

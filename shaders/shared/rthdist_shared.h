@@ -28,16 +28,17 @@ struct vec3f {
 
 // The host-visible counter block (byte offsets; one block per engine, zeroed
 // by the host before the submissions that count into it).
-#define RTHDIST_CTR_ACTIVE 0       // uint: compact.comp, queries entering the search
-#define RTHDIST_CTR_MAX_COUNT 4    // uint: cell_build, points of the largest cell that can split
-#define RTHDIST_CTR_NEXT_ACTIVE 8  // uint: resolve.comp, queries going on
-#define RTHDIST_CTR_CELLS 12       // uint: cell_build/coarsen, cells written
-#define RTHDIST_CTR_MAX_PACKED 16  // uint64: (bits of h^2 << 32) | query slot
-#define RTHDIST_CTR_PAIRS 24       // uint64: candidate pairs appended (64-bit: cannot wrap)
-#define RTHDIST_CTR_CHECK_SUM 32   // uint64: self-check, sum of original indices
-#define RTHDIST_CTR_CHECK_BAD 40   // uint64: self-check, records that broke an invariant
-#define RTHDIST_CTR_MIN_EDGE 48    // float bits: leaf_slots, the narrowest sub-cell edge of a split
-#define RTHDIST_CTR_READBACK 64    // host read-back area after the counters
+#define RTHDIST_CTR_ACTIVE 0        // uint: compact.comp, queries entering the search
+#define RTHDIST_CTR_MAX_COUNT 4     // uint: cell_build, points of the largest cell that can split
+#define RTHDIST_CTR_NEXT_ACTIVE 8   // uint: resolve.comp, queries going on
+#define RTHDIST_CTR_CELLS 12        // uint: cell_build/coarsen, cells written
+#define RTHDIST_CTR_MAX_PACKED 16   // uint64: (bits of h^2 << 32) | query slot
+#define RTHDIST_CTR_PAIRS 24        // uint64: candidate pairs appended (64-bit: cannot wrap)
+#define RTHDIST_CTR_CHECK_SUM 32    // uint64: self-check, sum of original indices
+#define RTHDIST_CTR_CHECK_BAD 40    // uint64: self-check, records that broke an invariant
+#define RTHDIST_CTR_MIN_EDGE 48     // float bits: leaf_slots, the narrowest sub-cell edge of a split
+#define RTHDIST_CTR_LARGE_CELLS 52  // uint: cell_build, 1 when a cell needs the parallel box
+#define RTHDIST_CTR_READBACK 64     // host read-back area after the counters
 #define RTHDIST_CTR_BYTES 256
 
 // Query status values.
@@ -98,14 +99,16 @@ struct ScatterPush {
 struct CellsPush {
     uint64_t sorted;
     uint64_t sortedKeys;
-    uint64_t flags;     // uint[n]: head flags, scanned in place between passes
-    uint64_t dense;     // cell ends by key
-    uint64_t cells;     // Cell[] out
-    uint64_t numCells;  // uint[1] out
-    uint64_t maxCount;  // uint[1]: atomicMax of the count of every cell that can split
-                        // (more than one distinct point)
-    uint64_t boundsU;   // uint[6 * cells]: order-preserving bits of a large cell's box
-                        // (lo xyz, hi xyz), reduced with atomics by cell_bounds.comp
+    uint64_t flags;       // uint[n]: head flags, scanned in place between passes
+    uint64_t dense;       // cell ends by key
+    uint64_t cells;       // Cell[] out
+    uint64_t numCells;    // uint[1] out
+    uint64_t maxCount;    // uint[1]: atomicMax of the count of every cell that can split
+                          // (more than one distinct point)
+    uint64_t boundsU;     // uint[6 * cells]: order-preserving bits of a large cell's box
+                          // (lo xyz, hi xyz), reduced with atomics by cell_bounds.comp
+    uint64_t largeCells;  // uint[1]: set by cell_build when any cell is large (zeroed by
+                          // the host): the parallel box passes return at once otherwise
     uint n;
     uint cellCapacity;  // cells the Cell buffer can hold (cell_bounds_fix dispatch)
 };
@@ -113,6 +116,10 @@ struct CellsPush {
 // A cell of more than this many points gets its tight box from a parallel
 // reduction (cell_bounds.comp) instead of its head thread's serial loop.
 #define RTHDIST_SERIAL_BOX 64u
+// Leaves of a split index hold at most this many points unless all are one
+// point; cell_build reports (maxCount) only cells larger than this, so the
+// common small cells cost no atomic.
+#define RTHDIST_LEAF_MAX 32u
 
 // Leaf splitting (density-robust index): a cell holding more than `leafMax`
 // points that are not all identical is cut into 8^k sub-cells of its own tight

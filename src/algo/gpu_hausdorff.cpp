@@ -61,7 +61,7 @@ constexpr size_t kHostChunk = size_t(1) << 16;  // points per host work item
 // work per query depends on how many points share a grid cell. (The Dragon's
 // fullest cell holds 134 points; even data stays on the grid path.)
 constexpr uint32_t kCrowdedCell = 512;
-constexpr uint32_t kLeafMax = 32;
+constexpr uint32_t kLeafMax = RTHDIST_LEAF_MAX;
 constexpr int kMaxSplitRounds = 12;  // each round narrows a leaf >= 2x per axis; past it: bigger leaves
 
 // A point set sorted into the cells of its own grid.
@@ -267,6 +267,7 @@ struct GpuHausdorff::State {
         ix.cells = &buf(set + ".cells", VkDeviceSize(cellCapacity) * sizeof(sh::Cell));
 
         counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
+        counter<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
         cmd = ctx.begin();
         vkCmdFillBuffer(cmd, ix.dense->handle(), 0, denseBytes, 0);
         barrier(cmd);
@@ -287,6 +288,7 @@ struct GpuHausdorff::State {
                          cellsCounterAddr(),
                          maxCountAddr(),
                          boundsU(cellCapacity).address(),
+                         hostSmall.address() + RTHDIST_CTR_LARGE_CELLS,
                          ix.n,
                          uint32_t(cellCapacity)};
         dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
@@ -329,6 +331,7 @@ struct GpuHausdorff::State {
             Buffer& dense = buf("slotDense", VkDeviceSize(numSlots) * 4);
             Buffer* outCells = leaves[round % 2];
             counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
+            counter<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
             VkCommandBuffer cmd = ctx.begin();
             sh::SplitPush sp{cells->address(),
                              slotBase.address(),
@@ -362,6 +365,7 @@ struct GpuHausdorff::State {
                              cellsCounterAddr(),
                              maxCountAddr(),
                              boundsU(n).address(),
+                             hostSmall.address() + RTHDIST_CTR_LARGE_CELLS,
                              ix.n,
                              ix.n};
             dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
