@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "common/point_shapes.hpp"
 #include "common/rng.hpp"
 #include "rthdist/io.hpp"
 
@@ -24,18 +25,7 @@ namespace {
 
 using Points = std::vector<glm::vec3>;
 
-Points uniformBox(Rng& r, size_t n, glm::dvec3 lo, glm::dvec3 hi) {
-    Points p(n);
-    for (glm::vec3& v : p) {
-        v = glm::vec3(r.uniform(lo.x, hi.x), r.uniform(lo.y, hi.y), r.uniform(lo.z, hi.z));
-    }
-    return p;
-}
 Points cube(Rng& r, size_t n, glm::dvec3 lo, double edge) { return uniformBox(r, n, lo, lo + edge); }
-Points concat(Points a, const Points& b) {
-    a.insert(a.end(), b.begin(), b.end());
-    return a;
-}
 // Radius r(rng) along a uniform direction around the origin.
 template <class Radius>
 Points radial(Rng& r, size_t n, Radius radius) {

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "common/point_shapes.hpp"
 #include "common/rng.hpp"
 #include "cpu/brute_force.hpp"
 
@@ -17,13 +18,6 @@ namespace {
 
 using Points = std::vector<glm::vec3>;
 
-Points uniformBox(Rng& r, size_t n, glm::dvec3 lo, glm::dvec3 hi) {
-    Points p(n);
-    for (glm::vec3& v : p) {
-        v = glm::vec3(r.uniform(lo.x, hi.x), r.uniform(lo.y, hi.y), r.uniform(lo.z, hi.z));
-    }
-    return p;
-}
 Points gaussianBlobs(Rng& r, size_t n, int blobs, double spread, double sigma) {
     std::vector<glm::dvec3> centres(size_t(std::max(blobs, 1)));
     for (glm::dvec3& c : centres) c = glm::dvec3(r.uniform(), r.uniform(), r.uniform()) * spread;
@@ -53,10 +47,6 @@ Points translated(const Points& p, glm::dvec3 d) {
     Points out(p.size());
     for (size_t i = 0; i < p.size(); ++i) out[i] = glm::vec3(glm::dvec3(p[i]) + d);
     return out;
-}
-Points concat(Points a, const Points& b) {
-    a.insert(a.end(), b.begin(), b.end());
-    return a;
 }
 Points shuffled(Rng& r, Points p) {
     for (size_t i = p.size(); i > 1; --i) std::swap(p[i - 1], p[r.index(i)]);
