@@ -18,6 +18,7 @@ enum class ErrorCode {
     kNoDevice,         // no Vulkan device offers what the chosen backend needs
     kOutOfMemory,      // inputs do not fit the device or host memory
     kInternal,         // a Vulkan call failed or an invariant broke
+    kCancelled,        // CallOptions::cancel was set during the call
 };
 
 struct Error {
@@ -33,6 +34,7 @@ struct Error {
         case ErrorCode::kNoDevice: return 4;
         case ErrorCode::kOutOfMemory: return 1;
         case ErrorCode::kInternal: return 1;
+        case ErrorCode::kCancelled: return 130;
     }
     return 1;
 }
