@@ -1,0 +1,176 @@
+"""rthdist: the exact Hausdorff distance between two 3-D point sets.
+
+    >>> import numpy as np, rthdist
+    >>> a = np.random.rand(10000, 3); b = np.random.rand(5000, 3)
+    >>> r = rthdist.hausdorff(a, b)
+    >>> r.distance, r.a_to_b.indices, r.timings["total"]
+
+H(A, B) = max(h(A, B), h(B, A)), h(A, B) = max over a of min over b of |a - b|,
+exact for the coordinates as given (float32 or float64): the value equals a
+brute force in double within 1e-6 of the bounding-box diagonal, and the
+reported index pairs realize it (README, Precision). Backends: "cpu" (exact,
+multithreaded), "ray-query" and "rt-pipeline" (Vulkan ray tracing; Mesa's
+lavapipe runs them on the CPU), "auto" (a hardware ray-tracing GPU when
+there is one, else the CPU).
+
+Inputs (rthdist._points): (N, 3) array-likes of float32/float64 (C order
+and row slices read in place; Fortran order copied), objects with .points
+or .vertices (Open3D, trimesh), PyTorch/CuPy tensors (CPU without a copy,
+CUDA copied to the host). docs/python.md has the guide.
+"""
+
+import os as _os
+
+from . import _rthdist
+from ._points import as_points
+from ._rthdist import (  # noqa: F401 - re-exported
+    CancelledError,
+    DeviceError,
+    Directed,
+    Error,
+    HausdorffResult,
+    InternalError,
+    OutOfMemoryError,
+    list_devices,
+)
+
+__version__ = _rthdist.__version__
+__all__ = [
+    "hausdorff",
+    "Engine",
+    "load",
+    "list_devices",
+    "as_points",
+    "HausdorffResult",
+    "Directed",
+    "Error",
+    "DeviceError",
+    "OutOfMemoryError",
+    "InternalError",
+    "CancelledError",
+    "__version__",
+]
+
+
+def _progress_callable(progress):
+    """progress as callable(stage, fraction): a callable as is, a tqdm bar adapted."""
+    if progress is None or callable(progress):
+        return progress
+    if hasattr(progress, "update") and hasattr(progress, "n"):  # tqdm-like bar
+        bar = progress
+        if getattr(bar, "total", None) is None:
+            bar.total = 100
+        scale = bar.total
+
+        def advance(stage, fraction):
+            target = fraction * scale
+            if target > bar.n:
+                bar.update(target - bar.n)
+            if hasattr(bar, "set_postfix_str"):
+                bar.set_postfix_str(stage, refresh=False)
+
+        return advance
+    raise TypeError("progress must be a callable(stage, fraction) or a tqdm-like bar (with .update and .n)")
+
+
+def hausdorff(a, b, *, directed=False, per_point=False, backend="auto", device=None, bits=0,
+              radius_growth=2.0, threads=0, progress=None, validation=False):
+    """H(A, B) of two point sets, with its witnesses: a HausdorffResult.
+
+    a, b: (N, 3) point sets (see rthdist.as_points for what is accepted).
+    directed: compute only h(A, B) (result.b_to_a is None).
+    per_point: also every point's exact nearest distance and index
+        (result.a_distances, a_nearest, b_distances, b_nearest) and the
+        statistics (percentile, hd95, mean, rms, stats, histogram); slower.
+    backend: "auto", "cpu", "ray-query" or "rt-pipeline".
+    device: Vulkan device index (rthdist.list_devices()); None = first usable.
+    bits: index-space bit count 0..8 (0 = from the data).
+    radius_growth: candidate-search radius factor 1.1..16.
+    threads: CPU backend threads (0 = all).
+    progress: callable(stage, fraction) or a tqdm bar, called between stages.
+
+    A temporary device is created per call; keep an Engine for repeated calls.
+    The GIL is released while computing; Ctrl-C cancels the call.
+    Raises ValueError (bad arrays: shape, dtype, NaN/Inf, empty; bad
+    options), DeviceError (no device for the backend), OutOfMemoryError,
+    InternalError.
+    """
+    pa = as_points(a, "a")
+    pb = as_points(b, "b")
+    return _rthdist._hausdorff(pa, pb, directed=bool(directed), per_point=bool(per_point), backend=str(backend),
+                               device=device, bits=int(bits), radius_growth=float(radius_growth),
+                               threads=int(threads), validation=bool(validation),
+                               progress=_progress_callable(progress))
+
+
+class Engine:
+    """A backend's device and pipelines, kept between calls.
+
+        with rthdist.Engine(backend="ray-query") as engine:
+            for scan in scans:
+                print(engine.hausdorff(reference, scan).distance)
+
+    One Engine serves one call at a time (calls from several threads wait
+    for each other); give each thread its own Engine to run in parallel.
+    close() (or leaving the with block) releases the device.
+    """
+
+    def __init__(self, backend="auto", *, device=None, threads=0, validation=False):
+        self._engine = _rthdist._Engine(str(backend), device, int(threads), bool(validation))
+
+    def hausdorff(self, a, b, *, directed=False, per_point=False, bits=0, radius_growth=2.0, progress=None):
+        """H(A, B) on this Engine's device: as rthdist.hausdorff, without the device setup."""
+        pa = as_points(a, "a")
+        pb = as_points(b, "b")
+        return self._engine.hausdorff(pa, pb, directed=bool(directed), per_point=bool(per_point), bits=int(bits),
+                                      radius_growth=float(radius_growth), progress=_progress_callable(progress))
+
+    @property
+    def backend(self):
+        """The backend this Engine runs: "cpu", "ray-query" or "rt-pipeline"."""
+        return self._engine.backend
+
+    @property
+    def device(self):
+        """Its device's name ("cpu" for the CPU backend)."""
+        return self._engine.device
+
+    @property
+    def closed(self):
+        return self._engine.closed
+
+    def close(self):
+        """Releases the device now (idempotent)."""
+        self._engine.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def __repr__(self):
+        if self.closed:
+            return "Engine(closed)"
+        return f"Engine(backend={self.backend!r}, device={self.device!r})"
+
+
+def load(path, *, las_classes=None):
+    """The points of a file as an (N, 3) NumPy array in the file's precision.
+
+    Formats as the CLI: .ply, .xyz/.txt, .obj, .gltf/.glb, .stl, .off, .pcd,
+    .las (optionally .gz). Decimal text and double/integer binary come back
+    float64, float files float32 (README, Precision). las_classes: keep only
+    these LAS classification values.
+    Raises FileNotFoundError (no such file), ValueError (unreadable or
+    malformed file: the message names the file and the place).
+    """
+    path = _os.fspath(path)
+    if isinstance(path, bytes):
+        path = _os.fsdecode(path)
+    if not _os.path.exists(path):
+        raise FileNotFoundError(2, "No such file or directory", path)
+    if _os.path.isdir(path):
+        raise IsADirectoryError(21, "Is a directory", path)
+    return _rthdist._load(path, list(las_classes or []))

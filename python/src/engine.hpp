@@ -1,0 +1,20 @@
+// rthdist Python module — the entry points that compute: the one-shot
+// hausdorff() and the Engine class (one device and its pipelines kept
+// between calls).
+//
+// Every call releases the GIL while the library works, so other Python
+// threads run (each with its own Engine: an Engine serializes its calls
+// behind a mutex, it is never used by two threads at once). The library's
+// progress callback re-acquires the GIL, checks for signals (Ctrl-C in the
+// main thread) and calls the user's progress callable; a KeyboardInterrupt or
+// an exception from the callable sets the call's cancel flag and is raised
+// when the call returns.
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+namespace rthdist::python {
+
+void bindEngine(pybind11::module_& m);
+
+}  // namespace rthdist::python

@@ -1,0 +1,95 @@
+"""Exactness against cKDTree on random and degenerate sets, float32 and float64, every backend."""
+
+import numpy as np
+import pytest
+
+import rthdist
+from conftest import check_result, directed_reference
+
+
+def random_sets(rng, dtype, n=3000, m=2000):
+    return rng.random((n, 3)).astype(dtype), (rng.random((m, 3)) * 1.3 - 0.1).astype(dtype)
+
+
+def degenerate_cases(rng, dtype):
+    line = np.zeros((500, 3))
+    line[:, 0] = np.linspace(0, 1, 500)
+    plane = np.column_stack([rng.random(800), rng.random(800), np.zeros(800)])
+    cluster = np.vstack([rng.random((400, 3)) * 1e-3, [[5.0, 5.0, 5.0]]])
+    utm = np.column_stack([5.12e5 + rng.random(600) * 200, 5.4e6 + rng.random(600) * 200, rng.random(600) * 30])
+    cases = {
+        "one-point-each": (np.array([[0.0, 0.0, 0.0]]), np.array([[1.0, 2.0, 2.0]])),
+        "one-vs-many": (np.array([[0.5, 0.5, 0.5]]), rng.random((300, 3))),
+        "identical": (plane, plane.copy()),
+        "duplicates": (np.repeat(rng.random((20, 3)), 30, axis=0), rng.random((50, 3))),
+        "all-same-point": (np.ones((100, 3)), np.ones((70, 3))),
+        "collinear": (line, line[::3] + [0.0, 0.01, 0.0]),
+        "coplanar": (plane, plane[:200] + [0.0, 0.0, 0.05]),
+        "cluster-and-outlier": (cluster, rng.random((300, 3)) * 1e-3),
+        "far-apart": (rng.random((200, 3)), rng.random((150, 3)) + 1e4),
+        "negative": (rng.random((400, 3)) - 10.0, rng.random((300, 3)) - 9.5),
+    }
+    if dtype == np.float64:
+        cases["utm"] = (utm, utm[::4] + [0.01, -0.02, 0.005])
+    return {k: (np.asarray(a, dtype=dtype), np.asarray(b, dtype=dtype)) for k, (a, b) in cases.items()}
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_random_sets(backend, rng, dtype):
+    a, b = random_sets(rng, dtype)
+    r = rthdist.hausdorff(a, b, backend=backend)
+    assert r.backend == backend
+    check_result(r, a, b)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_directed(backend, rng, dtype):
+    a, b = random_sets(rng, dtype, 1500, 900)
+    r = rthdist.hausdorff(a, b, directed=True, backend=backend)
+    assert r.directed and r.b_to_a is None
+    check_result(r, a, b, directed=True)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_degenerate_sets(backend, rng, dtype):
+    for name, (a, b) in degenerate_cases(rng, dtype).items():
+        r = rthdist.hausdorff(a, b, backend=backend)
+        try:
+            check_result(r, a, b)
+        except AssertionError as e:
+            raise AssertionError(f"case {name}: {e}") from e
+
+
+@pytest.mark.parametrize("bits", [1, 4, 8])
+def test_fixed_bits(backend, rng, bits):
+    a, b = random_sets(rng, np.float32, 1000, 800)
+    r = rthdist.hausdorff(a, b, backend=backend, bits=bits)
+    assert r.counters["a_to_b"]["bits"] == bits
+    check_result(r, a, b)
+
+
+def test_per_point_matches_ckdtree(backend, rng):
+    a, b = random_sets(rng, np.float64, 1200, 700)
+    r = rthdist.hausdorff(a, b, backend=backend, per_point=True)
+    check_result(r, a, b)
+    _, da = directed_reference(a, b)
+    _, db = directed_reference(b, a)
+    np.testing.assert_allclose(r.a_distances, da, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(r.b_distances, db, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(a - b[r.a_nearest], axis=1), r.a_distances, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(b - a[r.b_nearest], axis=1), r.b_distances, rtol=0, atol=1e-12)
+    assert r.a_distances.dtype == np.float64 and r.a_nearest.dtype == np.uint32
+    assert not r.a_distances.flags.writeable
+
+
+def test_auto_backend_and_device(rng):
+    a, b = random_sets(rng, np.float32, 500, 400)
+    r = rthdist.hausdorff(a, b)
+    assert r.backend in ("cpu", "ray-query", "rt-pipeline")
+    check_result(r, a, b)
+    devices = rthdist.list_devices()
+    usable = [d for d in devices if d["ray_query"]]
+    assert usable, f"no Vulkan device with ray queries: {devices}"
+    r = rthdist.hausdorff(a, b, backend="ray-query", device=usable[0]["index"])
+    assert r.device == usable[0]["name"]
+    check_result(r, a, b)
