@@ -23,7 +23,7 @@
 
 #include <sys/resource.h>
 
-#include "cli/json_writer.hpp"
+#include "cli/json_output.hpp"
 #include "rthdist/io.hpp"
 #include "rthdist/rthdist.hpp"
 
@@ -176,53 +176,52 @@ int main(int argc, char** argv) {
                     1e-6 * std::max(1e-30, ref->hausdorff) + 1e-9;
     }
 
-    cli::JsonWriter j(0);
-    j.beginObject();
-    j.key("case").value(name.empty() ? files[0] + " vs " + files[1] : name);
-    j.key("points")
-        .beginObject()
-        .key("a")
-        .value(uint64_t(a.size()))
-        .key("b")
-        .value(uint64_t(b.size()))
-        .endObject();
-    j.key("backend").value(backendName(last.backend));
-    j.key("per_point").value(options.perPointDistances);
-    j.key("growth").value(double(options.radiusGrowth));
-    j.key("device").value(last.device);
-    j.key("runs").value(int(wall.size())).key("warmup").value(warmDone);
-    j.key("hausdorff").value(last.hausdorff);
-    j.key("h_ab").value(last.aToB.distance).key("h_ba").value(last.bToA.distance);
-    j.key("bits")
-        .beginArray(true)
-        .value(uint64_t(last.aToB.counters.bits))
-        .value(uint64_t(last.bToA.counters.bits))
-        .endArray();
-    j.key("load_ms").value(loadMs).key("setup_ms").value(setupMs);
-    j.key("median_ms").beginObject();
-    j.key("wall").value(median(wall)).key("total").value(median(total)).key("upload").value(median(upload));
-    j.key("index").value(median(index)).key("cull").value(median(cull)).key("search").value(median(search));
-    j.key("refine").value(median(refine)).key("check").value(median(check));
-    j.key("gpu_index").value(median(gIndex)).key("gpu_cull").value(median(gCull));
-    j.key("gpu_search").value(median(gSearch)).key("gpu_refine").value(median(gRefine));
-    j.key("gpu_sum").value(median(gIndex) + median(gCull) + median(gSearch) + median(gRefine));
-    j.endObject();
-    j.key("wall_ms_all").beginArray(true);
-    for (double w : wall) j.value(w);
-    j.endArray();
-    j.key("counters").beginArray();
+    cli::Json counters = cli::Json::array();
     for (const Directed* d : {&last.aToB, &last.bToA}) {
         const Counters& c = d->counters;
-        j.beginObject().key("queries").value(c.queries).key("surviving").value(c.survivingQueries);
-        j.key("iterations").value(uint64_t(c.iterations)).key("rays").value(c.rays);
-        j.key("pairs").value(c.candidatePairs).key("cells").value(c.occupiedCells).endObject();
+        counters.push_back({{"queries", c.queries},
+                            {"surviving", c.survivingQueries},
+                            {"iterations", c.iterations},
+                            {"rays", c.rays},
+                            {"pairs", c.candidatePairs},
+                            {"cells", c.occupiedCells}});
     }
-    j.endArray();
     struct rusage ru {};
     getrusage(RUSAGE_SELF, &ru);
-    j.key("max_rss_kb").value(int64_t(ru.ru_maxrss));
-    j.key("cpu_hausdorff").value(cpuH).key("cpu_ms").value(cpuMs).key("agree").value(agree);
-    j.endObject();
-    std::printf("%s\n", j.str().c_str());
+    const cli::Json j = {{"case", name.empty() ? files[0] + " vs " + files[1] : name},
+                         {"points", {{"a", a.size()}, {"b", b.size()}}},
+                         {"backend", backendName(last.backend)},
+                         {"per_point", options.perPointDistances},
+                         {"growth", double(options.radiusGrowth)},
+                         {"device", last.device},
+                         {"runs", int(wall.size())},
+                         {"warmup", warmDone},
+                         {"hausdorff", last.hausdorff},
+                         {"h_ab", last.aToB.distance},
+                         {"h_ba", last.bToA.distance},
+                         {"bits", {last.aToB.counters.bits, last.bToA.counters.bits}},
+                         {"load_ms", loadMs},
+                         {"setup_ms", setupMs},
+                         {"median_ms",
+                          {{"wall", median(wall)},
+                           {"total", median(total)},
+                           {"upload", median(upload)},
+                           {"index", median(index)},
+                           {"cull", median(cull)},
+                           {"search", median(search)},
+                           {"refine", median(refine)},
+                           {"check", median(check)},
+                           {"gpu_index", median(gIndex)},
+                           {"gpu_cull", median(gCull)},
+                           {"gpu_search", median(gSearch)},
+                           {"gpu_refine", median(gRefine)},
+                           {"gpu_sum", median(gIndex) + median(gCull) + median(gSearch) + median(gRefine)}}},
+                         {"wall_ms_all", wall},
+                         {"counters", std::move(counters)},
+                         {"max_rss_kb", int64_t(ru.ru_maxrss)},
+                         {"cpu_hausdorff", cpuH},
+                         {"cpu_ms", cpuMs},
+                         {"agree", agree}};
+    std::printf("%s\n", cli::jsonText(j, cli::JsonLayout::kCompact).c_str());
     return agree ? 0 : 1;
 }

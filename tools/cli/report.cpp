@@ -4,7 +4,7 @@
 #include <cstdarg>
 #include <cstdio>
 
-#include "cli/json_writer.hpp"
+#include "cli/json_output.hpp"
 #include "cli/stats_report.hpp"
 
 namespace rthdist::cli {
@@ -41,47 +41,33 @@ std::string pointText(const glm::dvec3& p) {
     return "(" + coordinateText(p.x) + ", " + coordinateText(p.y) + ", " + coordinateText(p.z) + ")";
 }
 
-void writePoint(JsonWriter& w, const glm::dvec3& p) {
-    w.beginArray(true).value(p.x).value(p.y).value(p.z).endArray();
-}
+Json pointJson(const glm::dvec3& p) { return Json::array({p.x, p.y, p.z}); }
 
-void writeCounters(JsonWriter& w, const Counters& c) {
-    w.beginObject()
-        .field("bits", c.bits)
-        .field("occupied_cells", c.occupiedCells)
-        .field("queries", c.queries)
-        .field("culled_by_neighbourhood", c.culledByNeighbourhood)
-        .field("surviving_queries", c.survivingQueries)
-        .field("iterations", c.iterations)
-        .field("rays", c.rays)
-        .field("candidate_pairs", c.candidatePairs)
-        .endObject();
+Json countersJson(const Counters& c) {
+    return {{"bits", c.bits},
+            {"occupied_cells", c.occupiedCells},
+            {"queries", c.queries},
+            {"culled_by_neighbourhood", c.culledByNeighbourhood},
+            {"surviving_queries", c.survivingQueries},
+            {"iterations", c.iterations},
+            {"rays", c.rays},
+            {"candidate_pairs", c.candidatePairs}};
 }
 
 // One direction; `q`/`t` name the query and target sets ("a"/"b").
-void writeDirected(JsonWriter& w, const Directed& d, const char* q, const char* t) {
-    const std::string qs(q), ts(t);
-    w.beginObject()
-        .field("distance", d.distance)
-        .field(qs + "_index", d.queryIndex)
-        .field(ts + "_index", d.targetIndex);
-    w.key(qs + "_point");
-    writePoint(w, d.queryPoint);
-    w.key(ts + "_point");
-    writePoint(w, d.targetPoint);
-    w.endObject();
+Json directedJson(const Directed& d, const std::string& q, const std::string& t) {
+    return {{"distance", d.distance},
+            {q + "_index", d.queryIndex},
+            {t + "_index", d.targetIndex},
+            {q + "_point", pointJson(d.queryPoint)},
+            {t + "_point", pointJson(d.targetPoint)}};
 }
 
-void writeDirectedResult(JsonWriter& w, const HausdorffResult& r) {
-    w.field("hausdorff", r.hausdorff);
-    w.key("a_to_b");
-    writeDirected(w, r.aToB, "a", "b");
-    w.key("b_to_a");
-    if (r.directedOnly) {
-        w.null();
-    } else {
-        writeDirected(w, r.bToA, "b", "a");
-    }
+// "hausdorff", "a_to_b", "b_to_a" (null with --directed) into `out`.
+void addDirectedResult(Json& out, const HausdorffResult& r) {
+    out["hausdorff"] = r.hausdorff;
+    out["a_to_b"] = directedJson(r.aToB, "a", "b");
+    out["b_to_a"] = r.directedOnly ? Json() : directedJson(r.bToA, "b", "a");
 }
 
 std::string countersText(const Counters& c) {
@@ -145,72 +131,39 @@ std::string summaryText(const RunReport& report) {
 std::string jsonReport(const RunReport& report) {
     const CliArgs& args = *report.args;
     const HausdorffResult& r = *report.result;
-    JsonWriter w;
-    w.beginObject();
-    w.field("version", versionString());
-    w.key("files").beginObject().field("a", args.pathA).field("b", args.pathB).endObject();
-    w.key("points")
-        .beginObject()
-        .field("a", uint64_t(report.pointsA))
-        .field("b", uint64_t(report.pointsB))
-        .endObject();
     auto precision = [](Scalar s) { return s == Scalar::kFloat64 ? "float64" : "float32"; };
-    w.key("precision")
-        .beginObject()
-        .field("a", precision(report.scalarA))
-        .field("b", precision(report.scalarB))
-        .endObject();
-    w.key("origin");
-    writePoint(w, r.origin);
-    w.field("backend", backendName(r.backend));
-    w.field("device", r.device);
-    w.field("bits", r.aToB.counters.bits);
-    w.field("bits_requested", args.options.bits);
-    w.field("directed", r.directedOnly);
-    writeDirectedResult(w, r);
-
     const Timings& t = r.timings;
-    w.key("timings_ms")
-        .beginObject()
-        .field("load", report.loadMs)
-        .field("setup", t.setup)
-        .field("upload", t.upload)
-        .field("index", t.index)
-        .field("cull", t.cull)
-        .field("search", t.search)
-        .field("refine", t.refine)
-        .field("check", t.check)
-        .field("total", t.total)
-        .field("wall", report.wallMs)
-        .endObject();
-
-    w.key("counters").beginObject();
-    w.key("a_to_b");
-    writeCounters(w, r.aToB.counters);
-    w.key("b_to_a");
-    if (r.directedOnly) {
-        w.null();
-    } else {
-        writeCounters(w, r.bToA.counters);
-    }
-    w.endObject();
-    w.field("validation", args.options.validation);
-    w.field("validation_messages", r.validationMessages);
+    Json j = {{"version", versionString()},
+              {"files", {{"a", args.pathA}, {"b", args.pathB}}},
+              {"points", {{"a", report.pointsA}, {"b", report.pointsB}}},
+              {"precision", {{"a", precision(report.scalarA)}, {"b", precision(report.scalarB)}}},
+              {"origin", pointJson(r.origin)},
+              {"backend", backendName(r.backend)},
+              {"device", r.device},
+              {"bits", r.aToB.counters.bits},
+              {"bits_requested", args.options.bits},
+              {"directed", r.directedOnly}};
+    addDirectedResult(j, r);
+    j["timings_ms"] = {{"load", report.loadMs}, {"setup", t.setup}, {"upload", t.upload},
+                       {"index", t.index},      {"cull", t.cull},   {"search", t.search},
+                       {"refine", t.refine},    {"check", t.check}, {"total", t.total},
+                       {"wall", report.wallMs}};
+    j["counters"] = {{"a_to_b", countersJson(r.aToB.counters)},
+                     {"b_to_a", r.directedOnly ? Json() : countersJson(r.bToA.counters)}};
+    j["validation"] = args.options.validation;
+    j["validation_messages"] = r.validationMessages;
 
     if (const Verification* v = report.verification) {
-        w.key("verify").beginObject();
-        w.field("ok", v->ok).field("tolerance", v->tolerance).field("max_abs_diff", v->maxAbsDiff);
-        w.key("cpu").beginObject();
-        writeDirectedResult(w, v->cpu);
-        w.endObject();
-        w.key("mismatches").beginArray();
-        for (const std::string& m : v->mismatches) w.value(m);
-        w.endArray();
-        w.endObject();
+        Json cpu = Json::object();
+        addDirectedResult(cpu, v->cpu);
+        j["verify"] = {{"ok", v->ok},
+                       {"tolerance", v->tolerance},
+                       {"max_abs_diff", v->maxAbsDiff},
+                       {"cpu", std::move(cpu)},
+                       {"mismatches", v->mismatches}};
     }
-    if (report.stats != nullptr) writeStatsJson(w, *report.stats, r.directedOnly);
-    w.endObject();
-    return w.str() + "\n";
+    if (report.stats != nullptr) j["per_point"] = statsJson(*report.stats, r.directedOnly);
+    return jsonText(j) + "\n";
 }
 
 std::string devicesText(const std::vector<DeviceInfo>& devices) {
@@ -231,25 +184,20 @@ std::string devicesText(const std::vector<DeviceInfo>& devices) {
 }
 
 std::string devicesJson(const std::vector<DeviceInfo>& devices) {
-    JsonWriter w;
-    w.beginObject().key("devices").beginArray();
+    Json list = Json::array();
     for (const DeviceInfo& d : devices) {
-        w.beginObject()
-            .field("index", d.index)
-            .field("name", d.name)
-            .field("type", d.type)
-            .field("driver", d.driver)
-            .field("ray_query", d.rayQuery)
-            .field("rt_pipeline", d.rtPipeline);
-        w.key("missing").beginArray();
-        for (const std::string& why : d.missing) w.value(why);
-        w.endArray();
-        w.key("limits").beginObject();
-        for (const auto& [name, value] : d.limits) w.field(name.c_str(), value);
-        w.endObject().endObject();
+        Json limits = Json::object();
+        for (const auto& [name, value] : d.limits) limits[name] = value;
+        list.push_back({{"index", d.index},
+                        {"name", d.name},
+                        {"type", d.type},
+                        {"driver", d.driver},
+                        {"ray_query", d.rayQuery},
+                        {"rt_pipeline", d.rtPipeline},
+                        {"missing", d.missing},
+                        {"limits", std::move(limits)}});
     }
-    w.endArray().endObject();
-    return w.str() + "\n";
+    return jsonText(Json{{"devices", std::move(list)}}) + "\n";
 }
 
 }  // namespace rthdist::cli

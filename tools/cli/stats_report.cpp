@@ -7,114 +7,88 @@ namespace {
 
 double normalize(double v, double diagonal) { return diagonal > 0.0 ? v / diagonal : 0.0; }
 
-void writePercentiles(JsonWriter& w, const std::vector<Percentile>& list, double diagonal) {
-    w.beginArray();
-    for (const Percentile& p : list) {
-        w.beginObject().field("p", p.p).field("value", normalize(p.value, diagonal)).endObject();
+Json percentilesJson(const std::vector<Percentile>& list, double diagonal) {
+    Json out = Json::array();
+    for (const Percentile& p : list) out.push_back({{"p", p.p}, {"value", normalize(p.value, diagonal)}});
+    return out;
+}
+
+Json blockJson(const DistanceStats& s, double diagonal) {
+    return {{"count", s.count},
+            {"min", s.min},
+            {"max", s.max},
+            {"mean", s.mean},
+            {"rms", s.rms},
+            {"percentiles", percentilesJson(s.percentiles, 1.0)},
+            {"normalized",
+             {{"min", normalize(s.min, diagonal)},
+              {"max", normalize(s.max, diagonal)},
+              {"mean", normalize(s.mean, diagonal)},
+              {"rms", normalize(s.rms, diagonal)},
+              {"percentiles", percentilesJson(s.percentiles, diagonal)}}}};
+}
+
+// The symmetric percentiles: max of the directed ones and pooled (null with --directed).
+Json symmetricJson(const HausdorffStats& s, bool directedOnly) {
+    Json out = Json::array();
+    for (size_t i = 0; i < s.symmetric.size(); ++i) {
+        const double p = s.symmetric[i].p, mx = s.symmetric[i].value;
+        const double pooled = directedOnly ? 0.0 : s.pooled.percentiles[i].value;
+        out.push_back({{"p", p},
+                       {"max", mx},
+                       {"pooled", directedOnly ? Json() : Json(pooled)},
+                       {"max_normalized", normalize(mx, s.diagonal)},
+                       {"pooled_normalized", directedOnly ? Json() : Json(normalize(pooled, s.diagonal))}});
     }
-    w.endArray();
+    return out;
 }
 
-void writeBlock(JsonWriter& w, const DistanceStats& s, double diagonal) {
-    w.beginObject()
-        .field("count", s.count)
-        .field("min", s.min)
-        .field("max", s.max)
-        .field("mean", s.mean)
-        .field("rms", s.rms);
-    w.key("percentiles");
-    writePercentiles(w, s.percentiles, 1.0);
-    w.key("normalized")
-        .beginObject()
-        .field("min", normalize(s.min, diagonal))
-        .field("max", normalize(s.max, diagonal))
-        .field("mean", normalize(s.mean, diagonal))
-        .field("rms", normalize(s.rms, diagonal));
-    w.key("percentiles");
-    writePercentiles(w, s.percentiles, diagonal);
-    w.endObject().endObject();
+Json hd95Json(const HausdorffStats& s, bool directedOnly) {
+    Json out = Json::object();
+    double hdMax = 0.0, hdPooled = 0.0;
+    if (percentileVariant(s, "max", 95.0, hdMax)) {
+        out["max"] = hdMax;
+        out["max_normalized"] = normalize(hdMax, s.diagonal);
+    }
+    if (!directedOnly && percentileVariant(s, "pooled", 95.0, hdPooled)) {
+        out["pooled"] = hdPooled;
+        out["pooled_normalized"] = normalize(hdPooled, s.diagonal);
+    }
+    return out;
 }
 
-void writeCounts(JsonWriter& w, const Histogram& h) {
-    w.beginArray(true);
-    for (uint64_t c : h.counts) w.value(c);
-    w.endArray();
+Json histogramJson(const HausdorffStats& s, bool directedOnly) {
+    const Histogram& h = s.aToB.histogram;
+    Json out = {{"lo", h.lo},
+                {"hi", h.hi},
+                {"bins", h.counts.size()},
+                {"a_to_b", s.aToB.histogram.counts},
+                {"b_to_a", directedOnly ? Json() : Json(s.bToA.histogram.counts)},
+                {"pooled", directedOnly ? Json() : Json(s.pooled.histogram.counts)}};
+    for (const char* side : {"below", "above"}) {
+        const bool below = side[0] == 'b';
+        auto count = [&](const DistanceStats& d) { return below ? d.histogram.below : d.histogram.above; };
+        Json& sideJson = out[side] = {{"a_to_b", count(s.aToB)}};
+        if (!directedOnly) {
+            sideJson["b_to_a"] = count(s.bToA);
+            sideJson["pooled"] = count(s.pooled);
+        }
+    }
+    return out;
 }
 
 }  // namespace
 
-void writeStatsJson(JsonWriter& w, const HausdorffStats& s, bool directedOnly) {
-    const double diag = s.diagonal;
-    w.key("per_point").beginObject();
-    w.field("diagonal", diag).field("diagonal_a", s.diagonalA).field("diagonal_b", s.diagonalB);
-    w.key("a_to_b");
-    writeBlock(w, s.aToB, diag);
-    w.key("b_to_a");
-    if (directedOnly) {
-        w.null();
-    } else {
-        writeBlock(w, s.bToA, diag);
-    }
-    w.key("pooled");
-    if (directedOnly) {
-        w.null();
-    } else {
-        writeBlock(w, s.pooled, diag);
-    }
-    w.key("percentiles").beginArray();
-    for (size_t i = 0; i < s.symmetric.size(); ++i) {
-        const double p = s.symmetric[i].p, mx = s.symmetric[i].value;
-        w.beginObject().field("p", p).field("max", mx);
-        if (directedOnly) {
-            w.key("pooled").null();
-        } else {
-            w.field("pooled", s.pooled.percentiles[i].value);
-        }
-        w.field("max_normalized", normalize(mx, diag));
-        if (directedOnly) {
-            w.key("pooled_normalized").null();
-        } else {
-            w.field("pooled_normalized", normalize(s.pooled.percentiles[i].value, diag));
-        }
-        w.endObject();
-    }
-    w.endArray();
-    double hdMax = 0.0, hdPooled = 0.0;
-    w.key("hd95").beginObject();
-    if (percentileVariant(s, "max", 95.0, hdMax)) {
-        w.field("max", hdMax).field("max_normalized", normalize(hdMax, diag));
-    }
-    if (!directedOnly && percentileVariant(s, "pooled", 95.0, hdPooled)) {
-        w.field("pooled", hdPooled).field("pooled_normalized", normalize(hdPooled, diag));
-    }
-    w.endObject();
-
-    const Histogram& h = s.aToB.histogram;
-    w.key("histogram").beginObject();
-    w.field("lo", h.lo).field("hi", h.hi).field("bins", uint64_t(h.counts.size()));
-    w.key("a_to_b");
-    writeCounts(w, s.aToB.histogram);
-    w.key("b_to_a");
-    if (directedOnly) {
-        w.null();
-    } else {
-        writeCounts(w, s.bToA.histogram);
-    }
-    w.key("pooled");
-    if (directedOnly) {
-        w.null();
-    } else {
-        writeCounts(w, s.pooled.histogram);
-    }
-    for (const char* side : {"below", "above"}) {
-        const bool below = side[0] == 'b';
-        auto count = [&](const DistanceStats& d) { return below ? d.histogram.below : d.histogram.above; };
-        w.key(side).beginObject().field("a_to_b", count(s.aToB));
-        if (!directedOnly) w.field("b_to_a", count(s.bToA)).field("pooled", count(s.pooled));
-        w.endObject();
-    }
-    w.endObject();
-    w.endObject();
+Json statsJson(const HausdorffStats& s, bool directedOnly) {
+    return {{"diagonal", s.diagonal},
+            {"diagonal_a", s.diagonalA},
+            {"diagonal_b", s.diagonalB},
+            {"a_to_b", blockJson(s.aToB, s.diagonal)},
+            {"b_to_a", directedOnly ? Json() : blockJson(s.bToA, s.diagonal)},
+            {"pooled", directedOnly ? Json() : blockJson(s.pooled, s.diagonal)},
+            {"percentiles", symmetricJson(s, directedOnly)},
+            {"hd95", hd95Json(s, directedOnly)},
+            {"histogram", histogramJson(s, directedOnly)}};
 }
 
 std::string statsText(const HausdorffStats& s, bool directedOnly) {

@@ -14,13 +14,13 @@
 
 #include <string>
 
-#include "cli/json_writer.hpp"
+#include "cli/json_output.hpp"
 #include "rthdist/stats.hpp"
 
 namespace rthdist::cli {
 
-// Writes key "per_point" and its object into an open JSON object.
-void writeStatsJson(JsonWriter& w, const HausdorffStats& stats, bool directedOnly);
+// The "per_point" object.
+[[nodiscard]] Json statsJson(const HausdorffStats& stats, bool directedOnly);
 
 // Summary lines (each ends with '\n').
 [[nodiscard]] std::string statsText(const HausdorffStats& stats, bool directedOnly);

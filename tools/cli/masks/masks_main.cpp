@@ -26,7 +26,7 @@
 #include <glm/matrix.hpp>
 
 #include "cli/args.hpp"
-#include "cli/json_writer.hpp"
+#include "cli/json_output.hpp"
 #include "masks/masks.hpp"
 
 namespace rthdist::cli {
@@ -220,91 +220,73 @@ std::string num(double v) {
     return t;
 }
 
-void voxelJson(JsonWriter& w, const char* key, const std::array<int64_t, 3>& v) {
-    w.key(key).beginArray(true);
-    for (int64_t x : v) w.value(x);
-    w.endArray();
-}
-
-void pointJson(JsonWriter& w, const char* key, const glm::dvec3& p) {
-    w.key(key).beginArray(true).value(p.x).value(p.y).value(p.z).endArray();
-}
-
-void volumeJson(JsonWriter& w, const char* key, const masks::Volume& v) {
-    w.key(key).beginObject().field("path", v.path);
-    voxelJson(w, "dims", v.dims);
-    w.field("transform", v.transform);
-    w.key("affine").beginArray();
+Json volumeJson(const masks::Volume& v) {
+    Json affine = Json::array();
     for (int r = 0; r < 3; ++r) {
-        w.beginArray(true);
-        for (int c = 0; c < 4; ++c) w.value(v.voxelToWorld[c][r]);
-        w.endArray();
+        affine.push_back(Json::array());
+        for (int c = 0; c < 4; ++c) affine.back().push_back(v.voxelToWorld[c][r]);
     }
-    w.endArray();
     const glm::dvec3 s = v.spacing();
-    pointJson(w, "spacing", s);
-    w.endObject();
+    return {{"path", v.path},
+            {"dims", v.dims},
+            {"transform", v.transform},
+            {"affine", std::move(affine)},
+            {"spacing", Json::array({s.x, s.y, s.z})}};
 }
 
-void directedJson(JsonWriter& w, const char* key, const masks::DirectedMask& d, const MaskResult& r,
-                  bool ok) {
-    w.key(key).beginObject().field("points", d.points);
-    if (!ok) {
-        w.endObject();
-        return;
-    }
-    w.field("hd", d.hd).field("mean", d.mean);
-    w.key("percentiles").beginArray();
+Json directedJson(const masks::DirectedMask& d, const MaskResult& r, bool ok) {
+    Json out = {{"points", d.points}};
+    if (!ok) return out;
+    Json percentiles = Json::array();
     for (size_t i = 0; i < d.percentiles.size(); ++i)
-        w.beginObject().field("p", r.percentiles[i]).field("value", d.percentiles[i]).endObject();
-    w.endArray();
-    voxelJson(w, "voxel", d.voxel);
-    pointJson(w, "point", d.point);
-    voxelJson(w, "nearest_voxel", d.nearestVoxel);
-    pointJson(w, "nearest_point", d.nearestPoint);
-    w.endObject();
+        percentiles.push_back({{"p", r.percentiles[i]}, {"value", d.percentiles[i]}});
+    out["hd"] = d.hd;
+    out["mean"] = d.mean;
+    out["percentiles"] = std::move(percentiles);
+    out["voxel"] = d.voxel;
+    out["point"] = Json::array({d.point.x, d.point.y, d.point.z});
+    out["nearest_voxel"] = d.nearestVoxel;
+    out["nearest_point"] = Json::array({d.nearestPoint.x, d.nearestPoint.y, d.nearestPoint.z});
+    return out;
+}
+
+Json rowJson(const Row& row) {
+    const MaskResult& r = row.r;
+    const bool ok = r.empty == masks::EmptyStatus::kNone;
+    Json out = {{"label", row.label},
+                {"convention", masks::conventionName(r.convention)},
+                {"rule", masks::conventionRule(r.convention)},
+                {"connectivity", r.connectivity},
+                {"geometry", r.convention == Convention::kRthdist ? "world" : "spacing"},
+                {"status", masks::emptyStatusName(r.empty)}};
+    if (!ok) out["convention_value"] = {{"hd", r.emptyHd}, {"hd_percentile", r.emptyHdPercentile}};
+    Json hdPercentile = Json::array();
+    for (size_t i = 0; i < r.hdPercentile.size(); ++i)
+        hdPercentile.push_back({{"p", r.percentiles[i]}, {"value", r.hdPercentile[i]}});
+    out["hd"] = r.hd;
+    out["hd_percentile"] = std::move(hdPercentile);
+    out["assd"] = r.assd;
+    out["msd"] = r.msd;
+    out["surface_dice"] = r.surfaceDice;
+    out["a_to_b"] = directedJson(r.aToB, r, ok);
+    out["b_to_a"] = directedJson(r.bToA, r, ok);
+    out["timings_ms"] = {{"extract", r.extractMs}, {"distance", r.distanceMs}, {"total", r.totalMs}};
+    return out;
 }
 
 std::string jsonReport(const MasksArgs& args, const masks::Volume& a, const masks::Volume& b,
                        const Engine& engine, const std::vector<Row>& rows) {
-    JsonWriter w;
-    w.beginObject().field("tool", "rthdist-masks").field("version", versionString());
-    volumeJson(w, "a", a);
-    volumeJson(w, "b", b);
-    w.field("backend", backendName(engine.backend())).field("device", engine.deviceName());
-    w.field("tolerance_mm", args.tolerance);
-    w.key("results").beginArray();
-    for (const Row& row : rows) {
-        const MaskResult& r = row.r;
-        const bool ok = r.empty == masks::EmptyStatus::kNone;
-        w.beginObject().field("label", row.label).field("convention", masks::conventionName(r.convention));
-        w.field("rule", masks::conventionRule(r.convention)).field("connectivity", r.connectivity);
-        w.field("geometry", r.convention == Convention::kRthdist ? "world" : "spacing");
-        w.field("status", masks::emptyStatusName(r.empty));
-        if (!ok)
-            w.key("convention_value")
-                .beginObject()
-                .field("hd", r.emptyHd)
-                .field("hd_percentile", r.emptyHdPercentile)
-                .endObject();
-        w.field("hd", r.hd);
-        w.key("hd_percentile").beginArray();
-        for (size_t i = 0; i < r.hdPercentile.size(); ++i)
-            w.beginObject().field("p", r.percentiles[i]).field("value", r.hdPercentile[i]).endObject();
-        w.endArray();
-        w.field("assd", r.assd).field("msd", r.msd).field("surface_dice", r.surfaceDice);
-        directedJson(w, "a_to_b", r.aToB, r, ok);
-        directedJson(w, "b_to_a", r.bToA, r, ok);
-        w.key("timings_ms")
-            .beginObject()
-            .field("extract", r.extractMs)
-            .field("distance", r.distanceMs)
-            .field("total", r.totalMs)
-            .endObject();
-        w.endObject();
-    }
-    w.endArray().endObject();
-    return w.str() + "\n";
+    Json results = Json::array();
+    for (const Row& row : rows) results.push_back(rowJson(row));
+    const Json j = {{"tool", "rthdist-masks"},
+                    {"version", versionString()},
+                    {"a", volumeJson(a)},
+                    {"b", volumeJson(b)},
+                    {"backend", backendName(engine.backend())},
+                    {"device", engine.deviceName()},
+                    {"tolerance_mm", args.tolerance},
+                    {"results", std::move(results)}};
+    return jsonText(j) + "\n";
 }
 
 std::string csvReport(const MasksArgs& args, const std::vector<Row>& rows) {
