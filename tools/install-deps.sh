@@ -8,6 +8,9 @@
 #   RTHDIST_FUZZ_DEPS=1   also clang-14 and its libFuzzer runtime (tools/fuzz/run.sh)
 #   RTHDIST_MASKS_DEPS=0  skip the Python oracle of tests/masks (numpy, scipy, scikit-image,
 #                         nibabel; on by default: ctest runs it)
+#   RTHDIST_PYTHON_DEPS=0 skip the Python package's build and tests (pybind11, pytest, venv,
+#                         pip; scikit-build-core from bookworm-backports; on by default:
+#                         tools/test.sh builds the package and runs tests/python)
 set -euo pipefail
 
 SUDO=""
@@ -19,6 +22,12 @@ BASE_PKGS=(cmake g++ make pkg-config libvulkan-dev glslang-tools libglm-dev
 EXTRA_PKGS=()
 if [ "${RTHDIST_MASKS_DEPS:-1}" = 1 ]; then
   EXTRA_PKGS+=(python3 python3-numpy python3-scipy python3-skimage python3-nibabel)
+fi
+BACKPORTS_PKGS=(mesa-vulkan-drivers)
+if [ "${RTHDIST_PYTHON_DEPS:-1}" = 1 ]; then
+  EXTRA_PKGS+=(python3 python3-dev python3-numpy python3-scipy python3-pybind11 pybind11-dev
+    python3-pytest python3-venv python3-pip)
+  BACKPORTS_PKGS+=(python3-scikit-build-core)
 fi
 if [ "${RTHDIST_BENCH_DEPS:-0}" = 1 ]; then
   EXTRA_PKGS+=(python3 python3-scipy python3-numpy)
@@ -43,7 +52,7 @@ mesa_ok() {
   [ -n "$v" ] && dpkg --compare-versions "$v" ge 24.1
 }
 
-if have_all "${BASE_PKGS[@]}" "${EXTRA_PKGS[@]}" && mesa_ok; then
+if have_all "${BASE_PKGS[@]}" "${EXTRA_PKGS[@]}" "${BACKPORTS_PKGS[@]}" && mesa_ok; then
   exit 0
 fi
 
@@ -68,5 +77,5 @@ fi
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${BASE_PKGS[@]}" "${EXTRA_PKGS[@]}" >/dev/null
 $SUDO apt-get install -y -qq --no-install-recommends -t bookworm-backports \
-  mesa-vulkan-drivers >/dev/null
+  "${BACKPORTS_PKGS[@]}" >/dev/null
 mesa_ok || { echo "install-deps: mesa-vulkan-drivers >= 24.1 is required (lavapipe ray queries)" >&2; exit 1; }
