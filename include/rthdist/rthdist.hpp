@@ -39,9 +39,10 @@
 //   A failure returns kInternal with the reason instead of a value.
 //
 // Threading: an Engine owns one Vulkan device and is not thread-safe; use one
-//   Engine per thread. The free function hausdorff() creates a temporary
-//   Engine (device + pipelines) per call: embedders that call repeatedly
-//   should keep an Engine.
+//   Engine per thread (with its own prepared sets). The free function
+//   hausdorff() creates a temporary Engine (device + pipelines) per call:
+//   embedders that call repeatedly should keep an Engine, and prepare the
+//   sets they reuse (Engine::prepare).
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -55,49 +56,11 @@
 #include <vector>
 
 #include "rthdist/export.hpp"
+#include "rthdist/options.hpp"
 #include "rthdist/point_view.hpp"
 #include "rthdist/result.hpp"
 
 namespace rthdist {
-
-enum class Backend {
-    kAuto,        // a hardware RT device: ray-query if it has it, else rt-pipeline;
-                  // no such device (none, or only a software one such as
-                  // lavapipe): the CPU backend, which is faster there
-    kRayQuery,    // VK_KHR_ray_query in compute shaders
-    kRtPipeline,  // VK_KHR_ray_tracing_pipeline (raygen + intersection)
-    kCpu,         // exact multithreaded CPU implementation (no Vulkan)
-};
-
-[[nodiscard]] RTHDIST_API const char* backendName(Backend backend);
-// Parses "auto", "ray-query", "rt-pipeline", "cpu"; false when unknown.
-[[nodiscard]] RTHDIST_API bool parseBackend(const std::string& text, Backend& out);
-
-struct Options {
-    Backend backend = Backend::kAuto;
-    // Index-space bit count k (cells of edge L / 2^k). 0 = choose from the
-    // data (about kTargetPointsPerCell target points per occupied cell).
-    int bits = 0;
-    // true: compute only h(A,B); b_to_a is left empty.
-    bool directedOnly = false;
-    // Vulkan physical device index as listed by listDevices(); -1 = first usable.
-    int deviceIndex = -1;
-    // Enable VK_LAYER_KHRONOS_validation and count every message it emits
-    // (Result::validationMessages). For tests; slow.
-    bool validation = false;
-    // Radius growth factor between candidate-search iterations (> 1).
-    float radiusGrowth = 2.0f;
-    // CPU backend threads; 0 = all hardware threads.
-    int threads = 0;
-    // Also return every point's exact nearest-neighbour distance and index
-    // (HausdorffResult::aNearest / bNearest). Every query then needs its own
-    // NN, so the early break against the running maximum is off: slower.
-    bool perPointDistances = false;
-    // Called from the calling thread between stages and iterations with a
-    // stage name ("index", "cull", "search", "refine") and the fraction of
-    // the whole call done so far (0..1). Must not throw.
-    std::function<void(const char* stage, double fraction)> progress;
-};
 
 // Every point's nearest neighbour in the other set (perPointDistances).
 struct PerPoint {
@@ -182,15 +145,85 @@ struct DeviceInfo {
 // Lists every Vulkan device; an error only when no Vulkan loader/ICD works.
 [[nodiscard]] RTHDIST_API Result<std::vector<DeviceInfo>> listDevices();
 
-// Owns a Vulkan device, its pipelines and scratch memory between calls.
+class Engine;
+
+// A point set prepared once on an Engine's device (or, on the CPU backend,
+// in host memory): its frame (origin), exact power-of-two scale, bounds, bit
+// count and index, with a copy of its points (the self-check and the
+// witnesses read them). Usable as query set and as target set of any number
+// of later Engine::compute calls on the Engine that prepared it. Copies share
+// one prepared set; the memory is released with the last copy (it keeps the
+// Engine's device alive, so it may outlive the Engine). Not thread-safe: a
+// prepared set is used by its Engine's calls, one at a time.
+class RTHDIST_API PreparedSet {
+public:
+    PreparedSet(const PreparedSet&);
+    PreparedSet& operator=(const PreparedSet&);
+    PreparedSet(PreparedSet&&) noexcept;
+    PreparedSet& operator=(PreparedSet&&) noexcept;
+    ~PreparedSet();
+
+    [[nodiscard]] size_t size() const;
+    // Bit count of its index grid.
+    [[nodiscard]] int bits() const;
+    // The frame: subtracted before the float search (0 for float data).
+    [[nodiscard]] glm::dvec3 origin() const;
+    // Memory it holds now (device-local buffers; host copies and, on the CPU
+    // backend, the index). Coarse search levels are added on first use.
+    [[nodiscard]] uint64_t deviceBytes() const;
+    [[nodiscard]] uint64_t hostBytes() const;
+
+    struct Impl;
+
+private:
+    friend class Engine;
+    explicit PreparedSet(std::shared_ptr<Impl> impl);
+    std::shared_ptr<Impl> m_impl;
+};
+
+// One pair of a batch: indexes into the prepared sets given with it.
+struct PairRef {
+    size_t a = 0;
+    size_t b = 0;
+};
+
+// Owns a Vulkan device, its pipelines and scratch memory between calls (or,
+// on the CPU backend, nothing but its settings).
+//
+// Build once, query many: prepare() a set (a reference model, a scan of a
+// time series) once and compute() it against any number of other prepared
+// sets; each call then indexes nothing and uploads nothing. Two prepared sets
+// meet in one frame (PrepareOptions::origin) and one exact scale; when they
+// do not (double sets prepared with different origins, or magnitudes past
+// 2^40 or below 2^-40 that need different scales) the call indexes both
+// afresh in their union's frame, exactly as the one-shot call does.
 class RTHDIST_API Engine {
 public:
+    [[nodiscard]] static Result<Engine> create(const EngineOptions& options);
+    // As above; compute(a, b) without call options then uses the call part of `options`.
     [[nodiscard]] static Result<Engine> create(const Options& options);
     Engine(Engine&&) noexcept;
     Engine& operator=(Engine&&) noexcept;
     ~Engine();
 
+    // One-shot: indexes both sets for this call only.
     [[nodiscard]] Result<HausdorffResult> compute(PointView a, PointView b);
+    [[nodiscard]] Result<HausdorffResult> compute(PointView a, PointView b, const CallOptions& call);
+
+    // Checks and prepares one set (points as in compute: finite, non-empty,
+    // < 2^31). The view is read during this call only.
+    [[nodiscard]] Result<PreparedSet> prepare(PointView points, const PrepareOptions& options = {});
+    // H(A, B) of two sets prepared by this Engine (either may be both).
+    // Witness indices refer to each set's input order.
+    [[nodiscard]] Result<HausdorffResult> compute(const PreparedSet& a, const PreparedSet& b,
+                                                  const CallOptions& call = {});
+    // Many pairs in one call: result i is H(sets[pairs[i].a], sets[pairs[i].b])
+    // (or its error; one failing pair does not stop the others, a cancelled
+    // call fills the rest with kCancelled).
+    [[nodiscard]] std::vector<Result<HausdorffResult>> computeBatch(std::span<const PreparedSet> sets,
+                                                                    std::span<const PairRef> pairs,
+                                                                    const CallOptions& call = {});
+
     [[nodiscard]] const std::string& deviceName() const;
     [[nodiscard]] Backend backend() const;
 

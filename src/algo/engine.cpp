@@ -41,15 +41,24 @@ bool parseBackend(const std::string& text, Backend& out) {
 
 namespace {
 
-std::optional<Error> validateOptions(const Options& o) {
-    if (o.bits < 0 || o.bits > algo::kMaxBits) {
+std::optional<Error> validateEngineOptions(const EngineOptions& o) {
+    if (o.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
+    return std::nullopt;
+}
+
+std::optional<Error> validateBits(int bits) {
+    if (bits < 0 || bits > algo::kMaxBits) {
         return Error{ErrorCode::kInvalidArgument,
                      "bits must be 0 (auto) or 1.." + std::to_string(algo::kMaxBits)};
     }
+    return std::nullopt;
+}
+
+std::optional<Error> validateCallOptions(const CallOptions& o) {
+    if (auto e = validateBits(o.bits)) return e;
     if (!(o.radiusGrowth > 1.0f) || !std::isfinite(o.radiusGrowth)) {
         return Error{ErrorCode::kInvalidArgument, "radiusGrowth must be a finite number > 1"};
     }
-    if (o.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
     return std::nullopt;
 }
 
@@ -61,7 +70,7 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 // not a software rasterizer: on lavapipe (VK_PHYSICAL_DEVICE_TYPE_CPU) the
 // native CPU backend is 10-100x faster (docs/bench). An explicit --device
 // keeps the Vulkan path on whatever device it names.
-bool hardwareRtDevice(const Options& o) {
+bool hardwareRtDevice(const EngineOptions& o) {
     auto devices = listDevices();
     if (!devices) return false;
     for (const DeviceInfo& d : devices.value()) {
@@ -75,42 +84,98 @@ bool hardwareRtDevice(const Options& o) {
     return false;
 }
 
+// The device of an Engine, shared with the sets it prepared (their buffers
+// must be destroyed before it). Empty on the CPU backend.
+struct Device {
+    std::unique_ptr<gpu::Context> context;
+    std::unique_ptr<algo::GpuHausdorff> gpu;  // destroyed before the context
+};
+
 }  // namespace
 
 struct Engine::Impl {
-    Options options;
-    std::unique_ptr<gpu::Context> context;    // null for the CPU backend
-    std::unique_ptr<algo::GpuHausdorff> gpu;  // null for the CPU backend
+    EngineOptions options;
+    CallOptions callDefaults;        // compute(a, b) without call options
+    std::shared_ptr<Device> device;  // never null; identifies the Engine's prepared sets
     Backend backend = Backend::kCpu;
     std::string deviceName = "cpu";
     double setupMs = 0.0;
+    uint64_t preparedCount = 0;
 };
+
+struct PreparedSet::Impl {
+    std::shared_ptr<Device> device;  // keeps the device alive; first member, destroyed last
+    algo::SetSummary summary;
+    glm::dvec3 origin{0.0};
+    std::vector<glm::vec3> floats;      // p - origin rounded: what the backend searches
+    std::vector<glm::dvec3> originals;  // the input when it is not float-exact
+    double ownScale = 1.0;              // algo::exactScale of `floats` alone
+    std::shared_ptr<algo::DeviceSet> gpuSet;
+    std::shared_ptr<cpu::CpuSet> cpuSet;
+
+    // The input as given (for witnesses in double and for the union frame).
+    [[nodiscard]] PointView input() const {
+        return originals.empty() ? PointView(std::span<const glm::vec3>(floats))
+                                 : PointView(std::span<const glm::dvec3>(originals));
+    }
+};
+
+PreparedSet::PreparedSet(std::shared_ptr<Impl> impl) : m_impl(std::move(impl)) {}
+PreparedSet::PreparedSet(const PreparedSet&) = default;
+PreparedSet& PreparedSet::operator=(const PreparedSet&) = default;
+PreparedSet::PreparedSet(PreparedSet&&) noexcept = default;
+PreparedSet& PreparedSet::operator=(PreparedSet&&) noexcept = default;
+PreparedSet::~PreparedSet() = default;
+
+size_t PreparedSet::size() const { return m_impl->floats.size(); }
+glm::dvec3 PreparedSet::origin() const { return m_impl->origin; }
+int PreparedSet::bits() const {
+    return m_impl->gpuSet ? algo::GpuHausdorff::bits(*m_impl->gpuSet) : m_impl->cpuSet->order.grid.bits;
+}
+uint64_t PreparedSet::deviceBytes() const {
+    return m_impl->gpuSet ? algo::GpuHausdorff::deviceBytes(*m_impl->gpuSet) : 0;
+}
+uint64_t PreparedSet::hostBytes() const {
+    uint64_t bytes =
+        m_impl->floats.capacity() * sizeof(glm::vec3) + m_impl->originals.capacity() * sizeof(glm::dvec3);
+    if (m_impl->cpuSet) bytes += m_impl->cpuSet->hostBytes();
+    return bytes;
+}
 
 Engine::Engine(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
 Engine::Engine(Engine&&) noexcept = default;
 Engine& Engine::operator=(Engine&&) noexcept = default;
 Engine::~Engine() = default;
 
-Result<Engine> Engine::create(const Options& options) {
-    if (auto err = validateOptions(options)) return *err;
+Result<Engine> Engine::create(const EngineOptions& options) {
+    if (auto err = validateEngineOptions(options)) return *err;
     auto t0 = std::chrono::steady_clock::now();
     auto impl = std::make_unique<Impl>();
     impl->options = options;
+    impl->device = std::make_shared<Device>();
     if (options.backend == Backend::kCpu ||
         (options.backend == Backend::kAuto && !hardwareRtDevice(options))) {
         impl->backend = Backend::kCpu;
         return Engine(std::move(impl));
     }
+    Device& device = *impl->device;
     auto ctx = gpu::Context::create(options.backend, options.deviceIndex, options.validation);
     if (!ctx) return ctx.error();
-    impl->context = std::move(ctx.value());
-    auto g = algo::GpuHausdorff::create(*impl->context);
+    device.context = std::move(ctx.value());
+    auto g = algo::GpuHausdorff::create(*device.context);
     if (!g) return g.error();
-    impl->gpu = std::move(g.value());
-    impl->backend = impl->context->backend();
-    impl->deviceName = impl->context->deviceName();
+    device.gpu = std::move(g.value());
+    impl->backend = device.context->backend();
+    impl->deviceName = device.context->deviceName();
     impl->setupMs = msSince(t0);
     return Engine(std::move(impl));
+}
+
+Result<Engine> Engine::create(const Options& options) {
+    if (auto err = validateCallOptions(options)) return *err;
+    Result<Engine> engine = create(static_cast<const EngineOptions&>(options));
+    if (engine) engine->m_impl->callDefaults = static_cast<const CallOptions&>(options);
+    return engine;
 }
 
 const std::string& Engine::deviceName() const { return m_impl->deviceName; }
@@ -133,30 +198,119 @@ Result<CheckedInputs> checkInputs(const PointView& a, const PointView& b) {
     return CheckedInputs{*sa, *sb};
 }
 
+// What every call's result carries besides the backend's figures.
+void finishResult(Engine::Impl& impl, HausdorffResult& r, std::chrono::steady_clock::time_point t0) {
+    r.timings.setup = impl.setupMs;
+    impl.setupMs = 0.0;  // only the first call pays for creation
+    r.timings.total = msSince(t0);
+    if (impl.device->context) r.validationMessages = impl.device->context->validationMessageCount();
+}
+
 Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, const PointView& b,
-                                     const CheckedInputs& checked, std::chrono::steady_clock::time_point t0) {
+                                     const CheckedInputs& checked, const CallOptions& call,
+                                     std::chrono::steady_clock::time_point t0) {
+    if (auto err = validateCallOptions(call)) return *err;
     const glm::dvec3 origin = algo::searchOrigin(checked.a, checked.b);
     const algo::FloatSet fa(a, origin), fb(b, origin);
-    Result<HausdorffResult> r = impl.gpu ? impl.gpu->compute(fa.span(), fb.span(), impl.options)
-                                         : cpu::cpuHausdorff(fa.span(), fb.span(), impl.options);
+    Options options;
+    static_cast<CallOptions&>(options) = call;
+    static_cast<EngineOptions&>(options) = impl.options;
+    Result<HausdorffResult> r = impl.device->gpu ? impl.device->gpu->compute(fa.span(), fb.span(), call)
+                                                 : cpu::cpuHausdorff(fa.span(), fb.span(), options);
     if (!r) return r;
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
     if (copied) algo::restoreOriginal(*r, a, b);
     r->origin = origin;
-    r->timings.setup = impl.setupMs;
-    impl.setupMs = 0.0;  // only the first call pays for creation
-    r->timings.total = msSince(t0);
-    if (impl.context) r->validationMessages = impl.context->validationMessageCount();
+    finishResult(impl, *r, t0);
     return r;
+}
+
+// Whether two prepared sets can be searched as they are: one frame, within
+// the contract's bound, and one exact scale.
+bool shareFrame(const PreparedSet::Impl& a, const PreparedSet::Impl& b) {
+    if (a.origin != b.origin || !algo::frameKeepsBound(a.summary, b.summary, a.origin)) return false;
+    const double pairScale = std::min(a.ownScale, b.ownScale);  // of the larger magnitude
+    return a.ownScale == pairScale && b.ownScale == pairScale;
 }
 
 }  // namespace
 
 Result<HausdorffResult> Engine::compute(PointView a, PointView b) {
+    return compute(a, b, m_impl->callDefaults);
+}
+
+Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOptions& call) {
     const auto t0 = std::chrono::steady_clock::now();
     Result<CheckedInputs> checked = checkInputs(a, b);
     if (!checked) return checked.error();
-    return computeViews(*m_impl, a, b, *checked, t0);
+    return computeViews(*m_impl, a, b, *checked, call, t0);
+}
+
+Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& options) {
+    if (auto err = validateBits(options.bits)) return *err;
+    Result<algo::SetSummary> summary = algo::summarizeSet(points, "to prepare");
+    if (!summary) return summary.error();
+    auto set = std::make_shared<PreparedSet::Impl>();
+    set->device = m_impl->device;
+    set->summary = *summary;
+    set->origin = algo::preparedOrigin(*summary, options.origin);
+    set->floats = algo::roundedCopy(points, set->origin);
+    if (!summary->floatExact) {
+        set->originals.resize(points.count);
+        for (size_t i = 0; i < points.count; ++i) set->originals[i] = points.at(i);
+    }
+    set->ownScale = algo::exactScale(algo::largestMagnitude(set->floats));
+    if (m_impl->device->gpu) {
+        Timings timings;
+        const std::string name = "set#" + std::to_string(++m_impl->preparedCount);
+        auto g = m_impl->device->gpu->prepare(set->floats, set->ownScale, options.bits, name, timings);
+        if (!g) return g.error();
+        set->gpuSet = std::move(g.value());
+    } else {
+        set->cpuSet = cpu::prepareCpuSet(set->floats, set->ownScale, options.bits, m_impl->options.threads);
+    }
+    return PreparedSet(std::move(set));
+}
+
+Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet& b, const CallOptions& call) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (auto err = validateCallOptions(call)) return *err;
+    const PreparedSet::Impl& ia = *a.m_impl;
+    const PreparedSet::Impl& ib = *b.m_impl;
+    if (ia.device != m_impl->device || ib.device != m_impl->device)
+        return Error{ErrorCode::kInvalidArgument, "a prepared set belongs to another Engine"};
+    if (!shareFrame(ia, ib)) {
+        // Different frames or scales: both indexed afresh in the union's frame.
+        return computeViews(*m_impl, ia.input(), ib.input(), CheckedInputs{ia.summary, ib.summary}, call, t0);
+    }
+    Result<HausdorffResult> r =
+        m_impl->device->gpu ? m_impl->device->gpu->compute(*ia.gpuSet, *ib.gpuSet, call)
+                            : cpu::cpuHausdorff(*ia.cpuSet, *ib.cpuSet, call, m_impl->options.threads);
+    if (!r) return r;
+    if (!ia.originals.empty() || !ib.originals.empty()) algo::restoreOriginal(*r, ia.input(), ib.input());
+    r->origin = ia.origin;
+    finishResult(*m_impl, *r, t0);
+    return r;
+}
+
+std::vector<Result<HausdorffResult>> Engine::computeBatch(std::span<const PreparedSet> sets,
+                                                          std::span<const PairRef> pairs,
+                                                          const CallOptions& call) {
+    std::vector<Result<HausdorffResult>> out;
+    out.reserve(pairs.size());
+    for (const PairRef& p : pairs) {
+        if (p.a >= sets.size() || p.b >= sets.size()) {
+            out.emplace_back(Error{ErrorCode::kInvalidArgument,
+                                   "pair (" + std::to_string(p.a) + ", " + std::to_string(p.b) +
+                                       ") names a set past the " + std::to_string(sets.size()) + " given"});
+            continue;
+        }
+        const bool cancelled = call.cancel != nullptr && call.cancel->load();
+        out.push_back(cancelled ? Result<HausdorffResult>(Error{
+                                      ErrorCode::kCancelled, "the call was cancelled (CallOptions::cancel)"})
+                                : compute(sets[p.a], sets[p.b], call));
+    }
+    return out;
 }
 
 Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& options) {
@@ -164,9 +318,10 @@ Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& optio
     // where no device could be created; the points are read once.
     Result<CheckedInputs> checked = checkInputs(a, b);
     if (!checked) return checked.error();
-    auto engine = Engine::create(options);
+    if (auto err = validateCallOptions(options)) return *err;
+    auto engine = Engine::create(static_cast<const EngineOptions&>(options));
     if (!engine) return engine.error();
-    return computeViews(*engine->m_impl, a, b, *checked, std::chrono::steady_clock::now());
+    return computeViews(*engine->m_impl, a, b, *checked, options, std::chrono::steady_clock::now());
 }
 
 }  // namespace rthdist

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <map>
 #include <new>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -74,7 +75,11 @@ struct PointIndex {
     Buffer* cells = nullptr;   // Cell per occupied cell
     uint32_t numCells = 0;
     Buffer* sortedKeys = nullptr;  // fine key per sorted point (builds coarser levels)
-    std::string name;              // "A" or "B": names its pooled buffers
+    std::string name;              // "A", "B" or "set#N": names its buffers and its messages
+    // Where its buffers live: the engine's pool (one-shot sets, reused by
+    // name by the next call) or a prepared set's own map (exact sizes).
+    std::map<std::string, Buffer>* store = nullptr;
+    bool owned = false;
     // Leaves: `cells` are sub-cells of crowded grid cells (still contiguous
     // runs inside their grid cells), searched directly while the radius is
     // small; minEdge is the narrowest split sub-cell's edge (first radius).
@@ -103,19 +108,7 @@ sh::GridParams gridParams(const GridSpec& g) {
 
 // The shared scaling rule (index_space.hpp) over both sets' largest magnitude.
 double exactScaleFor(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
-    float maxAbs = 0.0f;
-    for (auto set : {a, b}) {
-        const int threads = cpu::resolveThreads(0, set.size() / kHostChunk + 1);
-        std::vector<float> m(size_t(threads), 0.0f);
-        cpu::parallelChunks(set.size(), kHostChunk, threads, [&](size_t begin, size_t end, int t) {
-            float v = m[size_t(t)];
-            for (size_t i = begin; i < end; ++i)
-                v = std::max({v, std::abs(set[i].x), std::abs(set[i].y), std::abs(set[i].z)});
-            m[size_t(t)] = v;
-        });
-        maxAbs = std::max(maxAbs, *std::max_element(m.begin(), m.end()));
-    }
-    return exactScale(double(maxAbs));
+    return exactScale(std::max(largestMagnitude(a), largestMagnitude(b)));
 }
 
 // Float copies of the points multiplied by a power of two in double (exact:
@@ -129,7 +122,29 @@ std::vector<glm::vec3> scaledCopy(std::span<const glm::vec3> pts, double scale) 
     return out;
 }
 
+// A call whose cancel flag was set: unwinds to the guard of the entry point.
+struct CallCancelled {};
+
+void throwIfCancelled(const CallOptions& options) {
+    if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
+}
+
 }  // namespace
+
+// A set indexed on the device (DeviceSet in gpu_hausdorff.hpp): its index,
+// the buffers it owns (prepared) and the float points the device holds.
+struct DeviceSet {
+    DeviceSet() = default;
+    DeviceSet(const DeviceSet&) = delete;  // ix.store may point into `own`
+    DeviceSet& operator=(const DeviceSet&) = delete;
+
+    std::map<std::string, Buffer> own;  // a prepared set's buffers (empty for one-shot sets)
+    PointIndex ix;
+    std::span<const glm::vec3> input;   // the backend's input (float, before the scale)
+    std::vector<glm::vec3> scaledCopy;  // input * scale when scale != 1
+    std::span<const glm::vec3> points;  // what the device holds: input or scaledCopy
+    double scale = 1.0;
+};
 
 struct GpuHausdorff::State {
     gpu::Context& ctx;
@@ -147,12 +162,22 @@ struct GpuHausdorff::State {
     // A buffer may be replaced only between submissions: every name is used by
     // at most one purpose inside one command buffer.
     Buffer& buf(const std::string& name, VkDeviceSize bytes, MemoryKind kind = MemoryKind::kDevice) {
-        Buffer& b = pool[name];
+        return bufIn(pool, name, bytes, kind, true);
+    }
+    // A buffer of set `ix` (its index and search levels), in the set's store.
+    Buffer& setBuf(PointIndex& ix, const std::string& suffix, VkDeviceSize bytes) {
+        return bufIn(*ix.store, ix.name + suffix, bytes, MemoryKind::kDevice, !ix.owned);
+    }
+    // Pooled buffers get room to grow; a prepared set's get their size.
+    Buffer& bufIn(std::map<std::string, Buffer>& store, const std::string& name, VkDeviceSize bytes,
+                  MemoryKind kind, bool slack) {
+        Buffer& b = store[name];
         if (!b || b.size() < bytes) {
             b.reset();
             const VkDeviceSize room =
-                std::min<VkDeviceSize>(bytes + std::min(bytes / 4, kMaxSlack),
-                                       std::max<VkDeviceSize>(bytes, ctx.limits().maxBufferBytes));
+                !slack ? bytes
+                       : std::min<VkDeviceSize>(bytes + std::min(bytes / 4, kMaxSlack),
+                                                std::max<VkDeviceSize>(bytes, ctx.limits().maxBufferBytes));
             b = Buffer(
                 ctx, std::max<VkDeviceSize>(room, 256),
                 gpu::kStorageUsage | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
@@ -206,8 +231,8 @@ struct GpuHausdorff::State {
         }
     }
 
-    PointIndex buildIndex(std::span<const glm::vec3> pts, int bits, const std::string& set) {
-        PointIndex ix;
+    // Indexes `pts` into the buffers of `ix` (name and store set by the caller).
+    void buildIndex(PointIndex& ix, std::span<const glm::vec3> pts, int bits) {
         ix.n = uint32_t(pts.size());
         const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
 
@@ -255,16 +280,15 @@ struct GpuHausdorff::State {
         t0 = Clock::now();
         const uint32_t numKeys = 1u << (3 * ix.grid.bits);
         Buffer& keys = buf("keys", VkDeviceSize(ix.n) * 4);
-        ix.name = set;
-        ix.sortedKeys = &buf(set + ".sortedKeys", VkDeviceSize(ix.n) * 4);
+        ix.sortedKeys = &setBuf(ix, ".sortedKeys", VkDeviceSize(ix.n) * 4);
         Buffer& sortedKeys = *ix.sortedKeys;
         Buffer& flags = buf("flags", VkDeviceSize(ix.n) * 4);
         const VkDeviceSize denseBytes = VkDeviceSize(numKeys) * 4;
-        ix.dense = &buf(set + ".dense", denseBytes);
-        ix.sorted = &buf(set + ".sorted", bytes);
+        ix.dense = &setBuf(ix, ".dense", denseBytes);
+        ix.sorted = &setBuf(ix, ".sorted", bytes);
         // Cells: at most one per point or key; the upper bound avoids a read-back.
         const uint64_t cellCapacity = std::min<uint64_t>(ix.n, numKeys);
-        ix.cells = &buf(set + ".cells", VkDeviceSize(cellCapacity) * sizeof(sh::Cell));
+        ix.cells = &setBuf(ix, ".cells", VkDeviceSize(cellCapacity) * sizeof(sh::Cell));
 
         counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
         counter<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
@@ -304,7 +328,6 @@ struct GpuHausdorff::State {
         verifyIndex(ix, cellCapacity);
         if (counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) > kCrowdedCell) splitLeaves(ix);
         timings->index += msSince(t0);
-        return ix;
     }
 
     // Cuts the crowded cells of `ix` into leaves (leaf_*.comp), round by
@@ -312,11 +335,10 @@ struct GpuHausdorff::State {
     // counting sort by slot inside every cell, and the cells of the new order.
     void splitLeaves(PointIndex& ix) {
         const VkDeviceSize n = ix.n;
-        const std::string& s = ix.name;
-        Buffer* sorted[2] = {ix.sorted, &buf(s + ".sorted2", n * 16)};
-        Buffer* gridKeys[2] = {ix.sortedKeys, &buf(s + ".sortedKeys2", n * 4)};
-        Buffer* leaves[2] = {&buf(s + ".leaves0", n * sizeof(sh::Cell)),
-                             &buf(s + ".leaves1", n * sizeof(sh::Cell))};
+        Buffer* sorted[2] = {ix.sorted, &setBuf(ix, ".sorted2", n * 16)};
+        Buffer* gridKeys[2] = {ix.sortedKeys, &setBuf(ix, ".sortedKeys2", n * 4)};
+        Buffer* leaves[2] = {&setBuf(ix, ".leaves0", n * sizeof(sh::Cell)),
+                             &setBuf(ix, ".leaves1", n * sizeof(sh::Cell))};
         Buffer& slotKeys = buf("slotKeys", n * 4);
         Buffer& outSlotKeys = buf("outSlotKeys", n * 4);
         Buffer& flags = buf("flags", n * 4);
@@ -401,10 +423,10 @@ struct GpuHausdorff::State {
             Buffer* finer = j == 1 ? T.cells : T.levels.back().cells;
             Buffer* finerFineFirst = j == 1 ? T.cells : T.levels.back().fineFirst;  // unused at j = 1
             const uint32_t numFiner = j == 1 ? T.numCells : T.levels.back().count;
-            const std::string tag = T.name + ".level" + std::to_string(j);
+            const std::string tag = ".level" + std::to_string(j);
             PointIndex::Level lv;
-            lv.cells = &buf(tag, VkDeviceSize(numFiner) * sizeof(sh::Cell));
-            lv.fineFirst = &buf(tag + ".fineFirst", VkDeviceSize(numFiner) * 4);
+            lv.cells = &setBuf(T, tag, VkDeviceSize(numFiner) * sizeof(sh::Cell));
+            lv.fineFirst = &setBuf(T, tag + ".fineFirst", VkDeviceSize(numFiner) * 4);
             Buffer& flags = buf("coarseFlags", VkDeviceSize(numFiner) * 4);
             auto t0 = Clock::now();
             VkCommandBuffer cmd = ctx.begin();
@@ -513,13 +535,15 @@ struct GpuHausdorff::State {
         return sampled.back();
     }
 
-    // Reports progress; [from, to) is this direction's share of the call.
-    void report(const Options& options, const char* stage, double fraction) {
+    // Reports progress (the fraction of the whole call), then honours the
+    // cancel flag: a cancelled call unwinds to the guard (kCancelled).
+    void report(const CallOptions& options, const char* stage, double fraction) {
         if (options.progress) options.progress(stage, std::clamp(fraction, 0.0, 1.0));
+        throwIfCancelled(options);
     }
 
     Directed direction(const PointIndex& Q, PointIndex& T, std::span<const glm::vec3> qPts,
-                       std::span<const glm::vec3> tPts, const Options& options, PerPoint* perPoint,
+                       std::span<const glm::vec3> tPts, const CallOptions& options, PerPoint* perPoint,
                        double progressFrom, double progressTo) {
         Directed out;
         Counters& cnt = out.counters;
@@ -756,6 +780,84 @@ struct GpuHausdorff::State {
             out.distance[qi] = glm::length(glm::dvec3(qPts[qi]) - glm::dvec3(tPts[ti]));
         }
     }
+
+    // Indexes `input` (float, before the scale) as set `name`: in the pool
+    // (one-shot) or in buffers of its own (owned: a prepared set, whose
+    // buffers the index does not use after a leaf split are released).
+    void indexSet(DeviceSet& set, std::span<const glm::vec3> input, double scale, int bits,
+                  const std::string& name, bool owned) {
+        set.input = input;
+        set.scale = scale;
+        if (scale != 1.0) set.scaledCopy = scaledCopy(input, scale);
+        set.points = scale != 1.0 ? std::span<const glm::vec3>(set.scaledCopy) : input;
+        set.ix.name = name;
+        set.ix.owned = owned;
+        set.ix.store = owned ? &set.own : &pool;
+        buildIndex(set.ix, set.points, bits);
+        if (!owned) return;
+        for (auto it = set.own.begin(); it != set.own.end();) {
+            const Buffer* b = &it->second;
+            const bool used =
+                b == set.ix.sorted || b == set.ix.dense || b == set.ix.cells || b == set.ix.sortedKeys;
+            it = used ? std::next(it) : set.own.erase(it);
+        }
+    }
+
+    // H (or h) of two indexed sets of one scale into `res`; progress covers
+    // [from, 1] of the call.
+    void runPair(DeviceSet& a, DeviceSet& b, const CallOptions& options, HausdorffResult& res, double from) {
+        const bool pp = options.perPointDistances;
+        const double mid = options.directedOnly ? 1.0 : from + 0.5 * (1.0 - from);
+        res.aToB =
+            direction(a.ix, b.ix, a.points, b.points, options, pp ? &res.aNearest : nullptr, from, mid);
+        res.hausdorff = res.aToB.distance;
+        if (!options.directedOnly) {
+            res.bToA =
+                direction(b.ix, a.ix, b.points, a.points, options, pp ? &res.bNearest : nullptr, mid, 1.0);
+            res.hausdorff = std::max(res.hausdorff, res.bToA.distance);
+        }
+        // Witnesses and per-point distances from the unscaled inputs, in double.
+        if (a.scale != 1.0) restoreOriginal(res, PointView(a.input), PointView(b.input));
+    }
+
+    HausdorffResult emptyResult(const CallOptions& options) const {
+        HausdorffResult res;
+        res.backend = ctx.backend();
+        res.device = ctx.deviceName();
+        res.directedOnly = options.directedOnly;
+        return res;
+    }
+
+    // Runs `work` with its timings in `timings`, and turns what it throws
+    // into the error codes of the API (the accel structures are dropped, so
+    // the next call starts clean).
+    template <class Work>
+    std::optional<Error> guarded(Timings& into, Work&& work) {
+        timings = &into;
+        std::optional<Error> err;
+        try {
+            work();
+        } catch (const CallCancelled&) {
+            err = Error{ErrorCode::kCancelled, "the call was cancelled (CallOptions::cancel)"};
+        } catch (const gpu::VulkanError& e) {
+            const bool oom =
+                e.result() == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result() == VK_ERROR_OUT_OF_HOST_MEMORY;
+            err = oom ? Error{ErrorCode::kOutOfMemory,
+                              std::string("the inputs do not fit the device: ") + e.what()}
+                      : Error{ErrorCode::kInternal, e.what()};
+        } catch (const gpu::LimitError& e) {
+            err =
+                Error{ErrorCode::kOutOfMemory, std::string("the inputs do not fit the device: ") + e.what()};
+        } catch (const std::exception& e) {
+            err = Error{ErrorCode::kInternal, e.what()};
+        }
+        timings = nullptr;
+        if (err) {
+            accel.release();
+            tlasBound = false;
+        }
+        return err;
+    }
 };
 
 GpuHausdorff::GpuHausdorff(std::unique_ptr<State> state) : m_state(std::move(state)) {}
@@ -774,55 +876,52 @@ Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx) {
 }
 
 Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                              const Options& options) {
-    HausdorffResult res;
-    res.backend = m_state->ctx.backend();
-    res.device = m_state->ctx.deviceName();
-    res.directedOnly = options.directedOnly;
-    m_state->timings = &res.timings;
+                                              const CallOptions& options) {
+    State& st = *m_state;
+    HausdorffResult res = st.emptyResult(options);
     // Squared distances are float on the device: coordinates so large (or so
     // small) that they overflow (or underflow) are scaled by a power of two,
     // which is exact; values and witnesses are recomputed from the inputs.
-    const double scale = exactScaleFor(a, b);
-    const std::vector<glm::vec3> scaledA = scale != 1.0 ? scaledCopy(a, scale) : std::vector<glm::vec3>();
-    const std::vector<glm::vec3> scaledB = scale != 1.0 ? scaledCopy(b, scale) : std::vector<glm::vec3>();
-    const std::span<const glm::vec3> ga = scale != 1.0 ? std::span<const glm::vec3>(scaledA) : a;
-    const std::span<const glm::vec3> gb = scale != 1.0 ? std::span<const glm::vec3>(scaledB) : b;
-    try {
-        // Each set is indexed once with its own grid: as targets for the other
-        // direction, and as cell-ordered (Morton) queries for its own.
-        PointIndex ia = m_state->buildIndex(ga, options.bits, "A");
-        m_state->report(options, "index", 0.05);
-        PointIndex ib = m_state->buildIndex(gb, options.bits, "B");
-        m_state->report(options, "index", 0.1);
-        const bool pp = options.perPointDistances;
-        const double mid = options.directedOnly ? 1.0 : 0.55;
-        res.aToB = m_state->direction(ia, ib, ga, gb, options, pp ? &res.aNearest : nullptr, 0.1, mid);
-        res.hausdorff = res.aToB.distance;
-        if (!options.directedOnly) {
-            res.bToA = m_state->direction(ib, ia, gb, ga, options, pp ? &res.bNearest : nullptr, mid, 1.0);
-            res.hausdorff = std::max(res.hausdorff, res.bToA.distance);
-        }
-    } catch (const gpu::VulkanError& e) {
-        m_state->accel.release();
-        m_state->tlasBound = false;
-        if (e.result() == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result() == VK_ERROR_OUT_OF_HOST_MEMORY)
-            return Error{ErrorCode::kOutOfMemory,
-                         std::string("the inputs do not fit the device: ") + e.what()};
-        return Error{ErrorCode::kInternal, e.what()};
-    } catch (const gpu::LimitError& e) {
-        m_state->accel.release();
-        m_state->tlasBound = false;
-        return Error{ErrorCode::kOutOfMemory, std::string("the inputs do not fit the device: ") + e.what()};
-    } catch (const std::exception& e) {
-        m_state->accel.release();
-        m_state->tlasBound = false;
-        return Error{ErrorCode::kInternal, e.what()};
-    }
-    // Witnesses and per-point distances from the unscaled inputs, in double.
-    if (scale != 1.0) restoreOriginal(res, a, b);
-    m_state->timings = nullptr;
+    // Each set is indexed once with its own grid: as targets for the other
+    // direction, and as cell-ordered (Morton) queries for its own.
+    auto err = st.guarded(res.timings, [&] {
+        const double scale = exactScaleFor(a, b);
+        DeviceSet da, db;
+        st.indexSet(da, a, scale, options.bits, "A", false);
+        st.report(options, "index", 0.05);
+        st.indexSet(db, b, scale, options.bits, "B", false);
+        st.report(options, "index", 0.1);
+        st.runPair(da, db, options, res, 0.1);
+    });
+    if (err) return *err;
     return res;
 }
+
+Result<std::shared_ptr<DeviceSet>> GpuHausdorff::prepare(std::span<const glm::vec3> points, double scale,
+                                                         int bits, const std::string& name,
+                                                         Timings& timings) {
+    auto set = std::make_shared<DeviceSet>();
+    auto err = m_state->guarded(timings, [&] { m_state->indexSet(*set, points, scale, bits, name, true); });
+    if (err) return *err;
+    return set;
+}
+
+Result<HausdorffResult> GpuHausdorff::compute(DeviceSet& a, DeviceSet& b, const CallOptions& options) {
+    HausdorffResult res = m_state->emptyResult(options);
+    auto err = m_state->guarded(res.timings, [&] {
+        throwIfCancelled(options);
+        m_state->runPair(a, b, options, res, 0.0);
+    });
+    if (err) return *err;
+    return res;
+}
+
+uint64_t GpuHausdorff::deviceBytes(const DeviceSet& set) {
+    uint64_t bytes = 0;
+    for (const auto& [name, buffer] : set.own) bytes += buffer.size();
+    return bytes;
+}
+
+int GpuHausdorff::bits(const DeviceSet& set) { return set.ix.grid.bits; }
 
 }  // namespace rthdist::algo

@@ -9,10 +9,16 @@
 //      becomes a (query, cell) pair unless its representative kills the query;
 //   4. refinement (compute): exact scan of the pairs' cells, early break;
 //      resolve: best <= R -> exact NN; best < threshold -> dead; else R grows.
+// A set's index (step 1) depends on that set alone, so a prepared set
+// (prepare) is indexed once and searched by any number of calls.
+//
+// Threading: one caller at a time per GpuHausdorff (it owns the scratch
+// buffers and the acceleration structures of its device).
 #pragma once
 
 #include <memory>
 #include <span>
+#include <string>
 
 #include "rthdist/rthdist.hpp"
 
@@ -22,12 +28,31 @@ class Context;
 
 namespace rthdist::algo {
 
+// A set indexed on the device, with the buffers it owns.
+struct DeviceSet;
+
 class GpuHausdorff {
 public:
     [[nodiscard]] static Result<std::unique_ptr<GpuHausdorff>> create(gpu::Context& ctx);
     ~GpuHausdorff();
+
+    // One-shot: both sets indexed for this call, in buffers pooled between calls.
     [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                                  const Options& options);
+                                                  const CallOptions& options);
+
+    // Indexes one set into buffers of its own. `points` (float, before the
+    // exact power-of-two `scale` of index_space.hpp) must outlive the set;
+    // `name` labels its buffers and the self-check's messages. Index and
+    // upload times are added to `timings`.
+    [[nodiscard]] Result<std::shared_ptr<DeviceSet>> prepare(std::span<const glm::vec3> points, double scale,
+                                                             int bits, const std::string& name,
+                                                             Timings& timings);
+    // H (or h) of two prepared sets of the same scale. Their coarse search
+    // levels are built on first use and kept.
+    [[nodiscard]] Result<HausdorffResult> compute(DeviceSet& a, DeviceSet& b, const CallOptions& options);
+    [[nodiscard]] static uint64_t deviceBytes(const DeviceSet& set);
+    [[nodiscard]] static int bits(const DeviceSet& set);
+
     // Caps the candidate-pair buffer (default 2^26 pairs); tests shrink it
     // so that queries must retry until their pairs fit.
     void setMaxPairCapacity(uint64_t pairs);

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <vector>
 
+#include "cpu/parallel.hpp"
+
 namespace rthdist::algo {
 
 Bounds boundsOf(std::span<const glm::vec3> points) {
@@ -105,6 +107,20 @@ int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds, double 
             break;
     }
     return chosen;
+}
+
+constexpr size_t kMagnitudeChunk = size_t(1) << 16;  // points per work item
+
+double largestMagnitude(std::span<const glm::vec3> points) {
+    const int threads = cpu::resolveThreads(0, points.size() / kMagnitudeChunk + 1);
+    std::vector<float> part(size_t(threads), 0.0f);
+    cpu::parallelChunks(points.size(), kMagnitudeChunk, threads, [&](size_t begin, size_t end, int t) {
+        float v = part[size_t(t)];
+        for (size_t i = begin; i < end; ++i)
+            v = std::max({v, std::abs(points[i].x), std::abs(points[i].y), std::abs(points[i].z)});
+        part[size_t(t)] = v;
+    });
+    return double(*std::max_element(part.begin(), part.end()));
 }
 
 }  // namespace rthdist::algo

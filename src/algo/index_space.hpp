@@ -52,6 +52,9 @@ struct GridSpec {
 // every finite maxAbs, subnormals included; 1 for maxAbs = 0.
 [[nodiscard]] double exactScale(double maxAbs);
 
+// The largest coordinate magnitude of a float set (the maxAbs of exactScale).
+[[nodiscard]] double largestMagnitude(std::span<const glm::vec3> points);
+
 // Interleaves the low 10 bits of x, y, z (x in bit 0).
 [[nodiscard]] uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z);
 

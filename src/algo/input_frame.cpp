@@ -101,16 +101,38 @@ glm::dvec3 searchOrigin(const SetSummary& a, const SetSummary& b) {
     return 0.5 * (glm::min(a.box.lo, b.box.lo) + glm::max(a.box.hi, b.box.hi));
 }
 
+glm::dvec3 preparedOrigin(const SetSummary& set, const std::optional<glm::dvec3>& wanted) {
+    if (set.floatExact) return glm::dvec3(0.0);
+    return wanted ? *wanted : 0.5 * (set.box.lo + set.box.hi);
+}
+
+bool frameKeepsBound(const SetSummary& a, const SetSummary& b, const glm::dvec3& origin) {
+    const glm::dvec3 lo = glm::min(a.box.lo, b.box.lo), hi = glm::max(a.box.hi, b.box.hi);
+    const double diagonal = glm::length(hi - lo);
+    double m = 0.0;
+    for (const SetSummary* s : {&a, &b}) {
+        if (s->floatExact && origin == glm::dvec3(0.0)) continue;  // searched as it is
+        const glm::dvec3 far = glm::max(glm::abs(s->box.lo - origin), glm::abs(s->box.hi - origin));
+        m = std::max({m, far.x, far.y, far.z});
+    }
+    return m <= 4.0 * diagonal;
+}
+
+std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin) {
+    std::vector<glm::vec3> out(points.count);
+    const int threads = cpu::resolveThreads(0, points.count / kChunk + 1);
+    cpu::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) out[i] = glm::vec3(points.at(i) - origin);
+    });
+    return out;
+}
+
 FloatSet::FloatSet(const PointView& points, const glm::dvec3& origin) {
     if (points.packedFloat() && origin == glm::dvec3(0.0)) {
         m_span = std::span<const glm::vec3>(static_cast<const glm::vec3*>(points.data), points.count);
         return;
     }
-    m_copy.resize(points.count);
-    const int threads = cpu::resolveThreads(0, points.count / kChunk + 1);
-    cpu::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) m_copy[i] = glm::vec3(points.at(i) - origin);
-    });
+    m_copy = roundedCopy(points, origin);
     m_span = m_copy;
 }
 

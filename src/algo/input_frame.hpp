@@ -35,6 +35,20 @@ struct SetSummary {
 // union of both boxes.
 [[nodiscard]] glm::dvec3 searchOrigin(const SetSummary& a, const SetSummary& b);
 
+// The origin of a set prepared alone (Engine::prepare): zero when every
+// coordinate is a float32 value, else `wanted` or the centre of its box.
+[[nodiscard]] glm::dvec3 preparedOrigin(const SetSummary& set, const std::optional<glm::dvec3>& wanted);
+
+// Whether two sets shifted by one origin and rounded to float keep the
+// contract's bound (rthdist.hpp): float-exact sets are not rounded (origin
+// 0); the others' coordinates move by at most 2^-24 m, m the largest
+// |p - origin| over their boxes, so a reported h moves by at most
+// 2 sqrt(3) 2^-24 m, within 1e-6 D when m <= 4 D (D: the union's diagonal).
+[[nodiscard]] bool frameKeepsBound(const SetSummary& a, const SetSummary& b, const glm::dvec3& origin);
+
+// Points shifted by `origin` and rounded to float, in a vector of their own.
+[[nodiscard]] std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin);
+
 // The float32 points a backend searches: the caller's memory when it is
 // packed float and the origin is zero, else a shifted, rounded copy.
 class FloatSet {

@@ -46,6 +46,8 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <mutex>
+#include <optional>
 #include <vector>
 
 #include "cpu/parallel.hpp"
@@ -259,16 +261,24 @@ struct DirectedOutput {
     // A query whose search found no target (impossible for finite, scaled
     // input; kept as an internal error rather than a read past the arrays).
     bool lostQuery = false;
+    bool cancelled = false;  // CallOptions::cancel was set: the output is incomplete
     double indexMs = 0.0, cullMs = 0.0, searchMs = 0.0, refineMs = 0.0;
 };
 
-// Options::progress for one direction, which covers [base, base + span) of
-// the call. Only the calling thread (worker 0 of parallelChunks) reports, and
-// at most once per percent of the direction, so a callback that prints stays cheap.
+// CallOptions::progress for one direction, which covers [base, base + span)
+// of the call. Only the calling thread (worker 0 of parallelChunks) reports,
+// and at most once per percent of the direction, so a callback that prints
+// stays cheap. Every worker polls the cancel flag once per chunk of queries.
 class Progress {
 public:
-    Progress(const Options& options, double base, double span)
-        : m_fn(options.progress ? &options.progress : nullptr), m_base(base), m_span(span) {}
+    Progress(const CallOptions& options, double base, double span)
+        : m_fn(options.progress ? &options.progress : nullptr),
+          m_cancel(options.cancel),
+          m_base(base),
+          m_span(span) {}
+    [[nodiscard]] bool cancelled() const {
+        return m_cancel != nullptr && m_cancel->load(std::memory_order_relaxed);
+    }
     // fraction: of this direction, 0..1.
     void report(const char* stage, double fraction) {
         if (m_fn == nullptr) return;
@@ -281,6 +291,7 @@ public:
 
 private:
     const std::function<void(const char*, double)>* m_fn;
+    const std::atomic<bool>* m_cancel;
     double m_base, m_span;
     double m_last = -1.0;
     const char* m_stage = nullptr;
@@ -306,6 +317,7 @@ void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
     const uint32_t cells = t.cellCount();
     std::atomic<size_t> done{0};
     parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int w) {
+        if (progress.cancelled()) return;
         SearchStats stat;
         uint32_t hint = kNone;
         uint32_t target = kNone;  // the previous query's nearest target (input index)
@@ -342,17 +354,18 @@ void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
     });
 }
 
-DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<const glm::vec3> targets,
-                                 const SetOrder& qOrder, const SetOrder& tOrder, double scale,
-                                 const Options& options, PerPoint* perPoint, Progress& progress) {
+DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet, int threads,
+                                 PerPoint* perPoint, Progress& progress) {
     DirectedOutput out;
     progress.report("index", 0.0);
-    const int threads = resolveThreads(options.threads);
     auto start = Clock::now();
 
-    const TargetIndex t = buildTargetIndex(scale, tOrder, threads);
+    const std::span<const glm::vec3> queries = querySet.points, targets = targetSet.points;
+    const SetOrder& qOrder = querySet.order;
+    const double scale = querySet.scale;
+    const TargetIndex& t = targetSet.targetIndex(threads);
     const algo::GridSpec& g = t.grid;
-    const glm::dvec3 boxLo = tOrder.bounds.lo, boxHi = tOrder.bounds.hi;
+    const glm::dvec3 boxLo = targetSet.order.bounds.lo, boxHi = targetSet.order.bounds.hi;
 
     // Queries in their own adaptive order, each with its cell key in the
     // target grid (clamped outside it); the same pass finds the largest
@@ -387,6 +400,8 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
         perPointPass(t, queries, targets, qx, qy, qz, qOriginal, qKey, threads, *perPoint, stats, progress,
                      lost);
         out.lostQuery = lost.load();
+        out.cancelled = progress.cancelled();
+        if (out.cancelled) return out;
         out.searchMs = msSince(start);
         progress.report("refine", kSearchDone);
         start = Clock::now();
@@ -445,6 +460,7 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
     std::vector<uint64_t> culled(size_t(threads), 0), surviving(size_t(threads), 0);
     const uint32_t cells = t.cellCount();
     parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int w) {
+        if (progress.cancelled()) return;
         // Chunk-local tallies, published once: per-thread slots share cache lines.
         Winner winner = winners[size_t(w)];
         SearchStats stat;
@@ -513,6 +529,8 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
     });
     out.searchMs = msSince(start);
     out.lostQuery = lost.load();
+    out.cancelled = progress.cancelled();
+    if (out.cancelled) return out;
     progress.report("refine", kSearchDone);
 
     start = Clock::now();
@@ -544,16 +562,73 @@ DirectedOutput directedHausdorff(std::span<const glm::vec3> queries, std::span<c
 
 // The shared scaling rule (algo::exactScale) over both sets.
 double chooseScale(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
-    float largest = 0.0f;
-    for (auto set : {a, b}) {
-        for (const glm::vec3& p : set) {
-            largest = std::max({largest, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-        }
-    }
-    return algo::exactScale(double(largest));
+    return algo::exactScale(std::max(algo::largestMagnitude(a), algo::largestMagnitude(b)));
+}
+
+// One direction into `r` (its witness, per-point array and stage times), or
+// why it has no result.
+std::optional<Error> runDirection(const CpuSet& q, const CpuSet& t, int threads, Progress& progress,
+                                  PerPoint* perPoint, Directed& into, Timings& timings) {
+    const DirectedOutput o = directedHausdorff(q, t, threads, perPoint, progress);
+    timings.index += o.indexMs;
+    timings.cull += o.cullMs;
+    timings.search += o.searchMs;
+    timings.refine += o.refineMs;
+    if (o.cancelled) return Error{ErrorCode::kCancelled, "the call was cancelled (CallOptions::cancel)"};
+    if (o.lostQuery) return Error{ErrorCode::kInternal, "CPU backend: a query found no target"};
+    into = o.directed;
+    return std::nullopt;
 }
 
 }  // namespace
+
+const TargetIndex& CpuSet::targetIndex(int threads) const {
+    std::call_once(m_indexOnce, [&] { m_index = buildTargetIndex(scale, order, threads); });
+    return m_index;
+}
+
+uint64_t CpuSet::hostBytes() const {
+    auto bytes = [](const auto& v) { return uint64_t(v.capacity()) * sizeof(v[0]); };
+    uint64_t sum =
+        bytes(order.keyed) + bytes(order.x) + bytes(order.y) + bytes(order.z) + bytes(order.identical);
+    const TargetIndex& t = m_index;
+    sum += bytes(t.x) + bytes(t.y) + bytes(t.z) + bytes(t.original) + bytes(t.bucketOf) + bytes(t.cellKey) +
+           bytes(t.cellFirst) + bytes(t.cellLo) + bytes(t.cellHi) + bytes(t.bucketFirst);
+    for (const BoxLevel& level : t.levels) sum += bytes(level.boxes);
+    return sum;
+}
+
+std::shared_ptr<CpuSet> prepareCpuSet(std::span<const glm::vec3> points, double scale, int bits,
+                                      int threads) {
+    auto set = std::make_shared<CpuSet>();
+    set->points = points;
+    set->scale = scale;
+    set->order = orderSet(points, scale, bits, resolveThreads(threads));
+    return set;
+}
+
+Result<HausdorffResult> cpuHausdorff(const CpuSet& a, const CpuSet& b, const CallOptions& options,
+                                     int threadCount) {
+    const auto start = Clock::now();
+    HausdorffResult r;
+    r.backend = Backend::kCpu;
+    r.device = "cpu";
+    r.directedOnly = options.directedOnly;
+    const int threads = resolveThreads(threadCount);
+    const bool perPoint = options.perPointDistances;
+    Progress first(options, 0.0, options.directedOnly ? 1.0 : 0.5);
+    if (auto e = runDirection(a, b, threads, first, perPoint ? &r.aNearest : nullptr, r.aToB, r.timings))
+        return *e;
+    r.hausdorff = r.aToB.distance;
+    if (!options.directedOnly) {
+        Progress second(options, 0.5, 0.5);
+        if (auto e = runDirection(b, a, threads, second, perPoint ? &r.bNearest : nullptr, r.bToA, r.timings))
+            return *e;
+        r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
+    }
+    r.timings.total = msSince(start);
+    return r;
+}
 
 Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                      const Options& options) {
@@ -561,44 +636,15 @@ Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<con
         return Error{ErrorCode::kInvalidArgument, "cpuHausdorff: empty point set (H is undefined)"};
     }
     const auto start = Clock::now();
-    HausdorffResult r;
-    r.backend = Backend::kCpu;
-    r.device = "cpu";
-    r.directedOnly = options.directedOnly;
-    const double scale = chooseScale(a, b);
-
-    auto add = [&](const DirectedOutput& o) {
-        r.timings.index += o.indexMs;
-        r.timings.cull += o.cullMs;
-        r.timings.search += o.searchMs;
-        r.timings.refine += o.refineMs;
-    };
-    const bool perPoint = options.perPointDistances;
-    const double span = options.directedOnly ? 1.0 : 0.5;
-    Progress first(options, 0.0, span);
-    first.report("index", 0.0);
     // Each set ordered once: the layout of its index and its query order.
-    auto orderStart = Clock::now();
-    const int threads = resolveThreads(options.threads);
-    const SetOrder orderA = orderSet(a, scale, options.bits, threads);
-    const SetOrder orderB = orderSet(b, scale, options.bits, threads);
-    r.timings.index += msSince(orderStart);
-    DirectedOutput ab =
-        directedHausdorff(a, b, orderA, orderB, scale, options, perPoint ? &r.aNearest : nullptr, first);
-    add(ab);
-    if (ab.lostQuery) return Error{ErrorCode::kInternal, "CPU backend: a query of A found no target"};
-    r.aToB = ab.directed;
-    r.hausdorff = r.aToB.distance;
-    if (!options.directedOnly) {
-        Progress second(options, 0.5, 0.5);
-        DirectedOutput ba =
-            directedHausdorff(b, a, orderB, orderA, scale, options, perPoint ? &r.bNearest : nullptr, second);
-        add(ba);
-        if (ba.lostQuery) return Error{ErrorCode::kInternal, "CPU backend: a query of B found no target"};
-        r.bToA = ba.directed;
-        r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
-    }
-    r.timings.total = msSince(start);
+    const double scale = chooseScale(a, b);
+    const std::shared_ptr<CpuSet> setA = prepareCpuSet(a, scale, options.bits, options.threads);
+    const std::shared_ptr<CpuSet> setB = prepareCpuSet(b, scale, options.bits, options.threads);
+    const double orderMs = msSince(start);
+    Result<HausdorffResult> r = cpuHausdorff(*setA, *setB, options, options.threads);
+    if (!r) return r;
+    r->timings.index += orderMs;
+    r->timings.total = msSince(start);
     return r;
 }
 

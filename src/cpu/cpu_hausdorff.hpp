@@ -50,13 +50,45 @@
 
 #include <glm/vec3.hpp>
 
+#include <memory>
+#include <mutex>
 #include <span>
 
+#include "cpu/adaptive_order.hpp"
+#include "cpu/target_index.hpp"
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
 
 namespace rthdist::cpu {
 
+// A set ordered once (its query order and the layout of its index) and, on
+// first use as a target, indexed; `points` (float, before `scale`) must
+// outlive it. targetIndex() builds the index once, thread-safely.
+class CpuSet {
+public:
+    std::span<const glm::vec3> points;
+    double scale = 1.0;
+    SetOrder order;
+
+    [[nodiscard]] const TargetIndex& targetIndex(int threads) const;
+    // Host memory of its order and (once built) index.
+    [[nodiscard]] uint64_t hostBytes() const;
+
+private:
+    mutable std::once_flag m_indexOnce;
+    mutable TargetIndex m_index;
+};
+
+// Orders `points` (exact power-of-two `scale`, algo::exactScale; bits 0 =
+// from the data) with `threads` workers (0 = all).
+[[nodiscard]] std::shared_ptr<CpuSet> prepareCpuSet(std::span<const glm::vec3> points, double scale, int bits,
+                                                    int threads);
+
+// H (or h) of two prepared sets of one scale.
+[[nodiscard]] Result<HausdorffResult> cpuHausdorff(const CpuSet& a, const CpuSet& b,
+                                                   const CallOptions& options, int threads);
+
+// One-shot: both sets prepared for this call.
 [[nodiscard]] Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                    const Options& options);
 

@@ -27,8 +27,9 @@ inline Options gpuOptions() {
     return o;
 }
 
-// Creates an engine or records why none could be created.
-inline std::optional<Engine> makeEngine(const Options& o, std::string& whyNot) {
+// Creates an engine (from Options or EngineOptions) or records why none could be created.
+template <class EngineOrCallOptions>
+std::optional<Engine> makeEngine(const EngineOrCallOptions& o, std::string& whyNot) {
     auto e = Engine::create(o);
     if (!e) {
         whyNot = e.error().message;

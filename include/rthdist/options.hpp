@@ -1,0 +1,88 @@
+// rthdist — settings: what an Engine owns (EngineOptions: device, backend,
+// validation, host threads) and what each call may change without a new
+// Engine (CallOptions: bit count, direction, per-point output, radius
+// growth, progress, cancellation). Options holds both, for the one-shot
+// hausdorff() and for callers of the first releases.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <atomic>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "rthdist/export.hpp"
+
+namespace rthdist {
+
+enum class Backend {
+    kAuto,        // a hardware RT device: ray-query if it has it, else rt-pipeline;
+                  // no such device (none, or only a software one such as
+                  // lavapipe): the CPU backend, which is faster there
+    kRayQuery,    // VK_KHR_ray_query in compute shaders
+    kRtPipeline,  // VK_KHR_ray_tracing_pipeline (raygen + intersection)
+    kCpu,         // exact multithreaded CPU implementation (no Vulkan)
+};
+
+[[nodiscard]] RTHDIST_API const char* backendName(Backend backend);
+// Parses "auto", "ray-query", "rt-pipeline", "cpu"; false when unknown.
+[[nodiscard]] RTHDIST_API bool parseBackend(const std::string& text, Backend& out);
+
+// Fixed for the life of an Engine (its device and pipelines).
+struct EngineOptions {
+    Backend backend = Backend::kAuto;
+    // Vulkan physical device index as listed by listDevices(); -1 = first usable.
+    int deviceIndex = -1;
+    // Enable VK_LAYER_KHRONOS_validation and count every message it emits
+    // (Result::validationMessages). For tests; slow.
+    bool validation = false;
+    // CPU backend threads; 0 = all hardware threads.
+    int threads = 0;
+};
+
+// Settings of one compute call: changing one never rebuilds a device,
+// pipelines or a prepared set.
+struct CallOptions {
+    // Index-space bit count k (cells of edge L / 2^k) of the sets indexed by
+    // this call. 0 = choose from the data (about kTargetPointsPerCell target
+    // points per occupied cell). A prepared set keeps the bit count it was
+    // prepared with (PrepareOptions::bits); this field does not re-index it.
+    int bits = 0;
+    // true: compute only h(A,B); b_to_a is left empty.
+    bool directedOnly = false;
+    // Radius growth factor between candidate-search iterations (> 1).
+    float radiusGrowth = 2.0f;
+    // Also return every point's exact nearest-neighbour distance and index
+    // (HausdorffResult::aNearest / bNearest). Every query then needs its own
+    // NN, so the early break against the running maximum is off: slower.
+    bool perPointDistances = false;
+    // Called from the calling thread between stages and iterations with a
+    // stage name ("index", "cull", "search", "refine") and the fraction of
+    // the whole call done so far (0..1). Must not throw.
+    std::function<void(const char* stage, double fraction)> progress;
+    // Cancellation: when the flag (owned by the caller, settable from any
+    // thread or from `progress`) reads true at a stage boundary, a search
+    // iteration or a percent of the CPU search, the call returns
+    // ErrorCode::kCancelled and leaves the Engine and prepared sets usable.
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+// How a set is prepared (Engine::prepare).
+struct PrepareOptions {
+    // Bit count of the set's index (0 = from the data).
+    int bits = 0;
+    // Frame of a double set whose coordinates are not all float32 values
+    // (DESIGN §8): it is searched as p - origin rounded to float. Unset: the
+    // centre of its own box. Two prepared sets reuse their indexes together
+    // only when they share a frame: give the sets that will meet one origin
+    // (say reference.origin()). Float sets (and double sets of float values)
+    // are searched as they are: origin 0, this field ignored.
+    std::optional<glm::dvec3> origin;
+};
+
+// Both kinds, for hausdorff() and Engine::create(const Options&) (whose
+// compute(a, b) uses the call settings given here).
+struct Options : EngineOptions, CallOptions {};
+
+}  // namespace rthdist

@@ -1,0 +1,216 @@
+// Prepared sets and batches (Engine::prepare, compute on prepared sets,
+// computeBatch) on the backend under test: exact against the brute force and
+// the same computation as the one-shot call, reused across calls, in both
+// roles, in one or two frames, and released after their Engine.
+#include <gtest/gtest.h>
+
+#include <array>
+
+#include "common/geo_cases.hpp"
+#include "common/oracle_cases.hpp"
+#include "engine/engine_test_support.hpp"
+
+namespace rthdist::test {
+namespace {
+
+Result<PreparedSet> prepare(Engine& engine, const std::vector<glm::vec3>& points) {
+    return engine.prepare(points);
+}
+
+// Every oracle case through prepared sets: exact, and identical to one-shot.
+TEST(PreparedSet, OracleCasesMatchOneShot) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    const std::vector<OracleCase> cases = makeOracleCases();
+    for (size_t i = 0; i < cases.size(); i += 3) {  // a third of them: the one-shot suites run all
+        const OracleCase& c = cases[i];
+        SCOPED_TRACE(c.name);
+        auto a = prepare(*engine, c.a);
+        auto b = prepare(*engine, c.b);
+        ASSERT_TRUE(a && b) << (a ? b.error().message : a.error().message);
+        auto r = engine->compute(*a, *b);
+        ASSERT_TRUE(r) << r.error().message;
+        expectMatchesOracle(c, *r);
+        auto once = engine->compute(c.a, c.b, CallOptions{});
+        ASSERT_TRUE(once) << once.error().message;
+        expectSameResult(*r, *once, oracleTolerance(c.a, c.b, once->hausdorff));
+    }
+}
+
+// One reference against many: 100 calls reuse the same prepared sets.
+TEST(PreparedSet, HundredCallsReuseTheSameSets) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    const std::vector<glm::vec3> reference = randomCloud(20000, 1);
+    std::vector<std::vector<glm::vec3>> scans;
+    std::vector<HausdorffResult> oneShot;
+    for (uint64_t k = 0; k < 5; ++k) {
+        scans.push_back(
+            randomCloud(3000 + 1000 * k, 10 + k, glm::vec3(0.01f * float(k)), 1.0f + 0.1f * float(k)));
+        auto once = engine->compute(reference, scans.back(), CallOptions{});
+        ASSERT_TRUE(once) << once.error().message;
+        oneShot.push_back(*once);
+    }
+    auto ref = prepare(*engine, reference);
+    ASSERT_TRUE(ref) << ref.error().message;
+    std::vector<PreparedSet> prepared;
+    for (const auto& scan : scans) {
+        auto p = prepare(*engine, scan);
+        ASSERT_TRUE(p) << p.error().message;
+        prepared.push_back(*p);
+    }
+    // The first round builds what is built on first use (coarse search
+    // levels, the CPU target index); later calls add nothing.
+    auto held = [&] {
+        uint64_t bytes = ref->deviceBytes() + ref->hostBytes();
+        for (const PreparedSet& p : prepared) bytes += p.deviceBytes() + p.hostBytes();
+        return bytes;
+    };
+    uint64_t afterFirstRound = 0;
+    for (int call = 0; call < 100; ++call) {
+        const size_t k = size_t(call) % scans.size();
+        auto r = engine->compute(*ref, prepared[k]);
+        ASSERT_TRUE(r) << "call " << call << ": " << r.error().message;
+        SCOPED_TRACE("call " + std::to_string(call));
+        expectSameResult(*r, oneShot[k], oracleTolerance(reference, scans[k], oneShot[k].hausdorff));
+        EXPECT_EQ(r->timings.upload, 0.0);  // nothing uploaded again
+        if (call + 1 == int(scans.size())) afterFirstRound = held();
+        if (call >= int(scans.size())) EXPECT_EQ(held(), afterFirstRound);
+    }
+}
+
+// A prepared set is a query set and a target set: (P, Q) mirrors (Q, P),
+// and (P, P) is zero.
+TEST(PreparedSet, QueryAndTargetRoles) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    auto p = prepare(*engine, randomCloud(5000, 3));
+    auto q = prepare(*engine, randomCloud(4000, 4, glm::vec3(0.3f, 0.0f, 0.0f)));
+    ASSERT_TRUE(p && q);
+    auto pq = engine->compute(*p, *q);
+    auto qp = engine->compute(*q, *p);
+    auto pp = engine->compute(*p, *p);
+    ASSERT_TRUE(pq && qp && pp);
+    EXPECT_EQ(pq->hausdorff, qp->hausdorff);
+    EXPECT_EQ(pq->aToB.distance, qp->bToA.distance);
+    EXPECT_EQ(pq->aToB.queryIndex, qp->bToA.queryIndex);
+    EXPECT_EQ(pq->aToB.targetIndex, qp->bToA.targetIndex);
+    EXPECT_EQ(pq->bToA.distance, qp->aToB.distance);
+    EXPECT_EQ(pp->hausdorff, 0.0);
+}
+
+// Batches: per-pair results equal the single calls; a bad pair is an error
+// of its own and does not stop the others.
+TEST(PreparedSet, BatchEqualsSingleCalls) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    std::vector<std::vector<glm::vec3>> clouds;
+    std::vector<PreparedSet> sets;
+    for (uint64_t k = 0; k < 6; ++k) {
+        clouds.push_back(randomCloud(2000 + 500 * k, 40 + k, glm::vec3(0.05f * float(k))));
+        auto s = prepare(*engine, clouds.back());
+        ASSERT_TRUE(s) << s.error().message;
+        sets.push_back(*s);
+    }
+    const std::vector<PairRef> pairs{{0, 1}, {0, 2}, {3, 4}, {5, 0}, {2, 2}, {1, 9}, {4, 3}};
+    CallOptions call;
+    call.perPointDistances = true;
+    const auto results = engine->computeBatch(sets, pairs, call);
+    ASSERT_EQ(results.size(), pairs.size());
+    for (size_t i = 0; i < pairs.size(); ++i) {
+        SCOPED_TRACE("pair " + std::to_string(i));
+        if (pairs[i].b >= sets.size()) {
+            ASSERT_FALSE(results[i]);
+            EXPECT_EQ(results[i].error().code, ErrorCode::kInvalidArgument);
+            continue;
+        }
+        ASSERT_TRUE(results[i]) << results[i].error().message;
+        auto once = engine->compute(clouds[pairs[i].a], clouds[pairs[i].b], call);
+        ASSERT_TRUE(once) << once.error().message;
+        expectSameResult(*results[i], *once,
+                         oracleTolerance(clouds[pairs[i].a], clouds[pairs[i].b], once->hausdorff));
+        OracleCase c{"batch", i, clouds[pairs[i].a], clouds[pairs[i].b]};
+        expectMatchesOracle(c, *results[i]);
+    }
+}
+
+// Georeferenced doubles: sets prepared in their own frames meet in the
+// union's frame (indexed afresh); sets given one origin reuse their indexes;
+// an origin that would break the bound is not used. All exact in double.
+TEST(PreparedSet, DoubleSetsInOneOrTwoFrames) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    for (const GeoCase& c : makeGeoCases()) {
+        SCOPED_TRACE(c.name);
+        auto a = engine->prepare(c.a);
+        ASSERT_TRUE(a) << a.error().message;
+        PrepareOptions sameFrame;
+        sameFrame.origin = a->origin();
+        PrepareOptions farOrigin;
+        farOrigin.origin = glm::dvec3(0.0);
+        auto bOwn = engine->prepare(c.b);
+        auto bShared = engine->prepare(c.b, sameFrame);
+        auto aFar = engine->prepare(c.a, farOrigin);
+        auto bFar = engine->prepare(c.b, farOrigin);
+        ASSERT_TRUE(bOwn && bShared && aFar && bFar);
+        EXPECT_EQ(bShared->origin(), a->origin());
+        for (auto [x, y] : {std::pair{&*a, &*bOwn}, std::pair{&*a, &*bShared}, std::pair{&*aFar, &*bFar}}) {
+            auto r = engine->compute(*x, *y);
+            ASSERT_TRUE(r) << r.error().message;
+            expectMatchesGeoOracle(c, *r);
+        }
+    }
+}
+
+TEST(PreparedSet, SetOfAnotherEngineIsAnError) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    std::string whyNot;
+    auto other = makeEngine(engineUnderTest(), whyNot);
+    ASSERT_TRUE(other) << whyNot;
+    auto mine = prepare(*engine, randomCloud(100, 5));
+    auto theirs = prepare(*other, randomCloud(100, 6));
+    ASSERT_TRUE(mine && theirs);
+    auto r = engine->compute(*mine, *theirs);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(r.error().message.find("another Engine"), std::string::npos);
+}
+
+TEST(PreparedSet, BadInputIsAnErrorValue) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    std::vector<glm::vec3> empty;
+    auto e = engine->prepare(empty);
+    ASSERT_FALSE(e);
+    EXPECT_EQ(e.error().code, ErrorCode::kInvalidArgument);
+    std::vector<glm::vec3> nan{{0, 0, 0}, {0, std::numeric_limits<float>::quiet_NaN(), 0}};
+    auto n = engine->prepare(nan);
+    ASSERT_FALSE(n);
+    EXPECT_NE(n.error().message.find("point 1"), std::string::npos) << n.error().message;
+    PrepareOptions bits;
+    bits.bits = 99;
+    auto b = engine->prepare(randomCloud(10, 1), bits);
+    ASSERT_FALSE(b);
+    EXPECT_EQ(b.error().code, ErrorCode::kInvalidArgument);
+}
+
+// What a set holds is reported, its bit count is the one asked for, and it
+// may outlive the Engine that prepared it.
+TEST(PreparedSet, MemoryBitsAndLifetime) {
+    std::optional<PreparedSet> kept;
+    {
+        RTHDIST_REQUIRE_TEST_ENGINE(engine);
+        PrepareOptions o;
+        o.bits = 4;
+        auto s = engine->prepare(randomCloud(50000, 7), o);
+        ASSERT_TRUE(s) << s.error().message;
+        EXPECT_EQ(s->size(), 50000u);
+        EXPECT_EQ(s->bits(), 4);
+        EXPECT_GE(s->hostBytes(), 50000u * 12);
+        if (engine->backend() == Backend::kCpu) {
+            EXPECT_EQ(s->deviceBytes(), 0u);
+        } else {
+            EXPECT_GE(s->deviceBytes(), 50000u * 16);  // the sorted points at least
+        }
+        kept = *s;
+    }
+    EXPECT_EQ(kept->size(), 50000u);
+    kept.reset();  // destroys the index after its Engine: the device is kept alive until here
+}
+
+}  // namespace
+}  // namespace rthdist::test
