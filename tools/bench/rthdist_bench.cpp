@@ -23,6 +23,7 @@
 
 #include <sys/resource.h>
 
+#include "cli/exit_codes.hpp"
 #include "cli/json_output.hpp"
 #include "rthdist/io.hpp"
 #include "rthdist/rthdist.hpp"
@@ -118,7 +119,7 @@ int main(int argc, char** argv) {
     auto engine = Engine::create(options);
     if (!engine)
         return std::fprintf(stderr, "rthdist-bench: %s\n", engine.error().message.c_str()),
-               exitCodeFor(engine.error().code);
+               cli::exitCodeFor(engine.error().code);
     const double setupMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
@@ -137,7 +138,7 @@ int main(int argc, char** argv) {
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count();
         if (!res)
             return std::fprintf(stderr, "rthdist-bench: %s\n", res.error().message.c_str()),
-                   exitCodeFor(res.error().code);
+                   cli::exitCodeFor(res.error().code);
         if (r < warmup) {
             warmMs += w;
             ++warmDone;

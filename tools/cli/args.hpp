@@ -6,18 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "cli/exit_codes.hpp"
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
 
 namespace rthdist::cli {
-
-// Exit codes of the CLI. Errors from the library map through exitCodeFor()
-// (3 bad input, 4 no usable device, 1 internal); an output file that cannot
-// be written (cli/output_file.hpp) is kExitOutput.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitInternal = 1;
-inline constexpr int kExitUsage = 2;
-inline constexpr int kExitOutput = 5;
 
 struct CliArgs {
     std::string pathA;

@@ -1,7 +1,7 @@
 // rthdist — command-line front end of the library: loads two point files,
 // computes the exact Hausdorff distance and prints a summary or JSON.
 // Every failure ends in "rthdist: <message>" on stderr and an exit code
-// (cli/args.hpp, rthdist/result.hpp exitCodeFor); nothing escapes main().
+// (cli/exit_codes.hpp); nothing escapes main().
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli/args.hpp"
+#include "cli/exit_codes.hpp"
 #include "cli/per_point_outputs.hpp"
 #include "cli/progress_meter.hpp"
 #include "cli/report.hpp"

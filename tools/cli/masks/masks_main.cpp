@@ -9,7 +9,7 @@
 //                 [--json | --csv]
 //
 // A separate executable from `rthdist` (tools/cli/main.cpp) so that the point
-// CLI's parser stays as it is. Exit codes are the point CLI's (cli/args.hpp):
+// CLI's parser stays as it is. Exit codes are the point CLI's (cli/exit_codes.hpp):
 // 0 ok, 1 internal, 2 usage, 3 bad input (unreadable file, grids that
 // differ), 4 no device. Every error names the file it concerns.
 #include <charconv>
@@ -25,7 +25,7 @@
 
 #include <glm/matrix.hpp>
 
-#include "cli/args.hpp"
+#include "cli/exit_codes.hpp"
 #include "cli/json_output.hpp"
 #include "masks/masks.hpp"
 
