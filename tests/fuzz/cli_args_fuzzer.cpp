@@ -1,6 +1,7 @@
-// libFuzzer target for the CLI's argument parser (tools/cli/args.cpp,
-// compiled in): the input is split at NUL bytes into argv[1..]. Any input
-// must give a CliArgs or a kInvalidArgument error, never a crash.
+// libFuzzer target for the CLI's argument parser (tools/cli/args.cpp and
+// command_line.cpp on CLI11, compiled in): the input is split at NUL bytes
+// into argv[1..] (so, like argv, no argument holds a NUL). Any input must
+// give a CliArgs or a kInvalidArgument error, never a crash or an exception.
 #include <cstddef>
 #include <cstdint>
 #include <string>

@@ -18,11 +18,15 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include <sys/resource.h>
 
+#include "cli/command_line.hpp"
 #include "cli/exit_codes.hpp"
 #include "cli/json_output.hpp"
 #include "rthdist/io.hpp"
@@ -45,65 +49,83 @@ int usage() {
         "usage: rthdist-bench A B [--backend auto|ray-query|rt-pipeline|cpu] [--runs N] [--warmup W]\n"
         "                     [--translate F] [--bits K] [--name NAME] [--no-verify] [--per-point] [--growth "
         "G]\n");
-    return 2;
+    return cli::kExitUsage;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+struct BenchArgs {
     std::vector<std::string> files;
     Options options;
     int runs = 5, warmup = 2;
     double translate = 0.0, budgetS = 0.0;
     bool verify = true;
     std::string name;
-    for (int i = 1; i < argc; ++i) {
-        std::string a = argv[i];
-        auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
-        if (a == "--backend") {
-            const char* v = next();
-            if (!v || !parseBackend(v, options.backend)) return usage();
-        } else if (a == "--runs") {
-            const char* v = next();
-            if (!v || (runs = std::atoi(v)) < 1) return usage();
-        } else if (a == "--warmup") {
-            const char* v = next();
-            if (!v || (warmup = std::atoi(v)) < 0) return usage();
-        } else if (a == "--translate") {
-            const char* v = next();
-            if (!v) return usage();
-            translate = std::atof(v);
-        } else if (a == "--bits") {
-            const char* v = next();
-            if (!v) return usage();
-            options.bits = std::atoi(v);
-        } else if (a == "--name") {
-            const char* v = next();
-            if (!v) return usage();
-            name = v;
-        } else if (a == "--budget") {
-            const char* v = next();
-            if (!v || (budgetS = std::atof(v)) <= 0.0) return usage();
-        } else if (a == "--growth") {
-            const char* v = next();
-            if (!v) return usage();
-            options.radiusGrowth = float(std::atof(v));
-        } else if (a == "--per-point") {
-            options.perPointDistances = true;
-        } else if (a == "--no-verify") {
-            verify = false;
-        } else if (!a.empty() && a[0] == '-') {
-            return usage();
-        } else {
-            files.push_back(a);
-        }
-    }
-    if (files.size() != 2) return usage();
+};
+
+// Numbers are read with atoi/atof as they always were; any error is the usage
+// text (exit 2), whatever it is.
+std::optional<BenchArgs> parseArgs(std::span<const std::string> argv) {
+    BenchArgs out;
+    cli::CommandLine line([&out](const std::string& token, bool) {
+        if (!token.empty() && token[0] == '-') throw cli::UsageError{};  // "-", "--" and unknown options
+        out.files.push_back(token);
+    });
+    auto value = [&line](const char* name, std::function<bool(const char*)> apply) {
+        line.option(name, 1, [apply = std::move(apply)](const std::vector<std::string>& v, bool inlineValue) {
+            if (inlineValue || v.empty() || !apply(v[0].c_str())) throw cli::UsageError{};
+        });
+    };
+    value("--backend", [&out](const char* v) { return parseBackend(v, out.options.backend); });
+    value("--runs", [&out](const char* v) { return (out.runs = std::atoi(v)) >= 1; });
+    value("--warmup", [&out](const char* v) { return (out.warmup = std::atoi(v)) >= 0; });
+    value("--translate", [&out](const char* v) {
+        out.translate = std::atof(v);
+        return true;
+    });
+    value("--bits", [&out](const char* v) {
+        out.options.bits = std::atoi(v);
+        return true;
+    });
+    value("--name", [&out](const char* v) {
+        out.name = v;
+        return true;
+    });
+    value("--budget", [&out](const char* v) { return (out.budgetS = std::atof(v)) > 0.0; });
+    value("--growth", [&out](const char* v) {
+        out.options.radiusGrowth = float(std::atof(v));
+        return true;
+    });
+    line.flag("--per-point", [&out](bool withValue) {
+        if (withValue) throw cli::UsageError{};
+        out.options.perPointDistances = true;
+    });
+    line.flag("--no-verify", [&out](bool withValue) {
+        if (withValue) throw cli::UsageError{};
+        out.verify = false;
+    });
+    if (line.parse(argv) || out.files.size() != 2) return std::nullopt;
+    return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::vector<std::string> list(argv + (argc > 0 ? 1 : 0), argv + argc);
+    const std::optional<BenchArgs> parsed = parseArgs(list);
+    if (!parsed) return usage();
+    const BenchArgs& args = *parsed;
+    const std::vector<std::string>& files = args.files;
+    Options options = args.options;
+    const int runs = args.runs, warmup = args.warmup;
+    const double translate = args.translate, budgetS = args.budgetS;
+    const bool verify = args.verify;
+    const std::string& name = args.name;
     auto t0 = std::chrono::steady_clock::now();
     auto pa = io::loadPoints(files[0]);
-    if (!pa) return std::fprintf(stderr, "rthdist-bench: %s\n", pa.error().message.c_str()), 3;
+    if (!pa)
+        return std::fprintf(stderr, "rthdist-bench: %s\n", pa.error().message.c_str()), cli::kExitBadInput;
     auto pb = io::loadPoints(files[1]);
-    if (!pb) return std::fprintf(stderr, "rthdist-bench: %s\n", pb.error().message.c_str()), 3;
+    if (!pb)
+        return std::fprintf(stderr, "rthdist-bench: %s\n", pb.error().message.c_str()), cli::kExitBadInput;
     const double loadMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::vector<glm::vec3>& a = pa.value();
@@ -169,7 +191,9 @@ int main(int argc, char** argv) {
         auto c0 = std::chrono::steady_clock::now();
         auto ref = hausdorff(a, b, co);
         cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count();
-        if (!ref) return std::fprintf(stderr, "rthdist-bench: cpu: %s\n", ref.error().message.c_str()), 1;
+        if (!ref)
+            return std::fprintf(stderr, "rthdist-bench: cpu: %s\n", ref.error().message.c_str()),
+                   cli::kExitInternal;
         cpuH = ref->hausdorff;
         agree = std::abs(ref->aToB.distance - last.aToB.distance) <=
                     1e-6 * std::max(1e-30, ref->hausdorff) + 1e-9 &&
@@ -224,5 +248,5 @@ int main(int argc, char** argv) {
                          {"cpu_ms", cpuMs},
                          {"agree", agree}};
     std::printf("%s\n", cli::jsonText(j, cli::JsonLayout::kCompact).c_str());
-    return agree ? 0 : 1;
+    return agree ? cli::kExitOk : cli::kExitInternal;
 }

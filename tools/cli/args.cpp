@@ -4,9 +4,13 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <optional>
 #include <string_view>
+#include <utility>
 #include <vector>
+
+#include "cli/command_line.hpp"
 
 namespace rthdist::cli {
 
@@ -39,10 +43,6 @@ std::string rangeText(double lo, double hi) {
     char text[64];
     std::snprintf(text, sizeof text, "[%g, %g]", lo, hi);
     return text;
-}
-
-Error outOfRange(const std::string& name, const std::string& value, const std::string& expected) {
-    return usageError("option '" + name + "' expects " + expected + ", got '" + value + "'");
 }
 
 // Whole-string integer in [lo, hi]; no sign other than a leading '-'.
@@ -140,150 +140,143 @@ Exit codes: 0 ok, 1 internal error or --verify mismatch, 2 usage error
 )";
 }
 
+namespace {
+
+[[noreturn]] void reject(std::string message) { throw UsageError{std::move(message)}; }
+
+[[noreturn]] void outOfRange(const std::string& name, const std::string& value, const std::string& expected) {
+    reject("option '" + name + "' expects " + expected + ", got '" + value + "'");
+}
+
+// The flags: --name alone, "--name=value" is an error.
+void addFlags(CommandLine& line, CliArgs& out) {
+    const std::pair<const char*, bool*> flags[] = {
+        {"--json", &out.json},
+        {"--directed", &out.options.directedOnly},
+        {"--verify", &out.verify},
+        {"--validation", &out.options.validation},
+        {"--list-devices", &out.listDevices},
+        {"--help", &out.help},  // and -h (parseArgs)
+        {"--version", &out.version},
+        {"--quiet", &out.quiet},
+        {"--per-point", &out.perPoint},
+    };
+    for (const auto& [name, target] : flags) {
+        line.flag(name, [name = std::string(name), target = target](bool withValue) {
+            if (withValue) reject("option '" + name + "' takes no value");
+            *target = true;
+        });
+    }
+}
+
+// An option with one value; `apply` checks and stores it.
+void addValue(CommandLine& line, const std::string& name, std::function<void(const std::string&)> apply) {
+    line.option(name, 1, [name, apply = std::move(apply)](const std::vector<std::string>& values, bool) {
+        if (values.empty()) reject("option '" + name + "' needs a value");
+        apply(values[0]);
+    });
+}
+
+// An integer option in [lo, hi]; `expected` describes the range in messages.
+void addInt(CommandLine& line, const std::string& name, int lo, int hi, const std::string& expected,
+            int& target) {
+    addValue(line, name, [=, &target](const std::string& v) {
+        const auto n = parseInt(v, lo, hi);
+        if (!n) outOfRange(name, v, expected);
+        target = *n;
+    });
+}
+
+void addComputeOptions(CommandLine& line, CliArgs& out) {
+    addValue(line, "--backend", [&out](const std::string& v) {
+        if (!parseBackend(v, out.options.backend))
+            reject("unknown backend '" + v + "' (expected auto, ray-query, rt-pipeline or cpu)");
+    });
+    addInt(line, "--bits", 0, kMaxBitsOption, "an integer in " + rangeText(0, kMaxBitsOption) + " (0 = auto)",
+           out.options.bits);
+    addInt(line, "--device", 0, kMaxDeviceIndex, "a device index in " + rangeText(0, kMaxDeviceIndex),
+           out.options.deviceIndex);
+    addInt(line, "--threads", 0, kMaxThreads, "an integer in " + rangeText(0, kMaxThreads) + " (0 = all)",
+           out.options.threads);
+    addValue(line, "--radius-growth", [&out](const std::string& v) {
+        const auto f = parseNumber(v);
+        if (!f || !(*f >= kMinRadiusGrowth && *f <= kMaxRadiusGrowth))
+            outOfRange("--radius-growth", v, "a number in " + rangeText(kMinRadiusGrowth, kMaxRadiusGrowth));
+        out.options.radiusGrowth = float(*f);
+    });
+    addValue(line, "--las-classes", [&out](const std::string& v) {
+        const auto classes = parseClassList(v);
+        if (!classes)
+            outOfRange("--las-classes", v,
+                       "comma-separated integers in " + rangeText(0, kMaxLasClass) + " (e.g. 2,6)");
+        out.lasClasses = *classes;
+    });
+}
+
+// The per-point options; each turns --per-point on.
+void addPerPointOptions(CommandLine& line, CliArgs& out) {
+    addValue(line, "--percentile", [&out](const std::string& v) {
+        const auto p = parseNumber(v);
+        if (!p || !(*p >= 0.0 && *p <= 100.0)) outOfRange("--percentile", v, "a number in [0, 100]");
+        out.percentiles.push_back(*p);
+        out.perPoint = true;
+    });
+    addValue(line, "--histogram-bins", [&out](const std::string& v) {
+        const auto n = parseInt(v, 1, kMaxHistogramBins);
+        if (!n) outOfRange("--histogram-bins", v, "an integer in " + rangeText(1, kMaxHistogramBins));
+        out.histogramBins = *n;
+        out.perPoint = true;
+    });
+    line.option("--range", 2, [&out](const std::vector<std::string>& v, bool inlineValue) {
+        if (inlineValue) reject("option '--range' takes two values: --range MIN MAX");
+        if (v.size() < 2) reject("option '--range' needs two values MIN MAX");
+        // Distances are >= 0; finite bounds keep MAX - MIN and every bin finite.
+        const auto lo = parseNumber(v[0]), hi = parseNumber(v[1]);
+        if (!lo || !hi || !(*lo >= 0.0 && *hi > *lo))
+            reject("option '--range' expects finite numbers 0 <= MIN < MAX, got '" + v[0] + "' '" + v[1] +
+                   "'");
+        out.hasRange = true;
+        out.rangeLo = *lo;
+        out.rangeHi = *hi;
+        out.perPoint = true;
+    });
+    addValue(line, "--render", [&out](const std::string& v) {
+        if (v != "vulkan" && v != "software")
+            reject("unknown renderer '" + v + "' (expected vulkan or software)");
+        out.softwareRender = v == "software";
+    });
+    for (auto [name, target] :
+         {std::pair{"--out-ply", &out.outPly}, std::pair{"--out-csv", &out.outCsv},
+          std::pair{"--png", &out.png}, std::pair{"--histogram-png", &out.histogramPng}}) {
+        addValue(line, name, [name = std::string(name), target = target, &out](const std::string& v) {
+            if (v.empty()) reject("option '" + name + "' needs a value");
+            *target = v;
+            out.perPoint = true;
+        });
+    }
+}
+
+}  // namespace
+
 Result<CliArgs> parseArgs(std::span<const std::string> args) {
     CliArgs out;
     std::vector<std::string> positional;
-    bool optionsEnded = false;
-
-    for (size_t i = 0; i < args.size(); ++i) {
-        const std::string& arg = args[i];
-        if (optionsEnded || arg.size() < 2 || arg[0] != '-') {
-            positional.push_back(arg);
-            continue;
+    // Operands are any argument that is not an option: "-" included, and
+    // everything after "--".
+    CommandLine line([&](const std::string& token, bool afterEnd) {
+        if (afterEnd || token.size() < 2 || token[0] != '-') {
+            positional.push_back(token);
+        } else if (token == "-h") {
+            out.help = true;
+        } else if (token != "--") {
+            const size_t eq = token.find('=');
+            reject("unknown option '" + (token.rfind("--", 0) == 0 ? token.substr(0, eq) : token) + "'");
         }
-        if (arg == "--") {
-            optionsEnded = true;
-            continue;
-        }
-        std::string name = arg;
-        std::optional<std::string> inlineValue;
-        if (const size_t eq = arg.find('='); arg.rfind("--", 0) == 0 && eq != std::string::npos) {
-            name = arg.substr(0, eq);
-            inlineValue = arg.substr(eq + 1);
-        }
-        // Fetches the option's value from "--name=value" or the next argument.
-        auto takeValue = [&]() -> std::optional<std::string> {
-            if (inlineValue) return inlineValue;
-            if (i + 1 >= args.size()) return std::nullopt;
-            return args[++i];
-        };
-        auto flag = [&](bool& target) -> std::optional<Error> {
-            if (inlineValue) return usageError("option '" + name + "' takes no value");
-            target = true;
-            return std::nullopt;
-        };
-
-        std::optional<Error> error;
-        if (name == "--json") {
-            error = flag(out.json);
-        } else if (name == "--directed") {
-            error = flag(out.options.directedOnly);
-        } else if (name == "--verify") {
-            error = flag(out.verify);
-        } else if (name == "--validation") {
-            error = flag(out.options.validation);
-        } else if (name == "--list-devices") {
-            error = flag(out.listDevices);
-        } else if (name == "--help" || name == "-h") {
-            error = flag(out.help);
-        } else if (name == "--version") {
-            error = flag(out.version);
-        } else if (name == "--backend") {
-            const auto v = takeValue();
-            if (!v) return usageError("option '--backend' needs a value");
-            if (!parseBackend(*v, out.options.backend)) {
-                return usageError("unknown backend '" + *v +
-                                  "' (expected auto, ray-query, rt-pipeline or cpu)");
-            }
-        } else if (name == "--bits") {
-            const auto v = takeValue();
-            if (!v) return usageError("option '--bits' needs a value");
-            const auto n = parseInt(*v, 0, kMaxBitsOption);
-            if (!n)
-                return outOfRange(name, *v, "an integer in " + rangeText(0, kMaxBitsOption) + " (0 = auto)");
-            out.options.bits = *n;
-        } else if (name == "--device") {
-            const auto v = takeValue();
-            if (!v) return usageError("option '--device' needs a value");
-            const auto n = parseInt(*v, 0, kMaxDeviceIndex);
-            if (!n) return outOfRange(name, *v, "a device index in " + rangeText(0, kMaxDeviceIndex));
-            out.options.deviceIndex = *n;
-        } else if (name == "--threads") {
-            const auto v = takeValue();
-            if (!v) return usageError("option '--threads' needs a value");
-            const auto n = parseInt(*v, 0, kMaxThreads);
-            if (!n) return outOfRange(name, *v, "an integer in " + rangeText(0, kMaxThreads) + " (0 = all)");
-            out.options.threads = *n;
-        } else if (name == "--radius-growth") {
-            const auto v = takeValue();
-            if (!v) return usageError("option '--radius-growth' needs a value");
-            const auto f = parseNumber(*v);
-            if (!f || !(*f >= kMinRadiusGrowth && *f <= kMaxRadiusGrowth)) {
-                return outOfRange(name, *v, "a number in " + rangeText(kMinRadiusGrowth, kMaxRadiusGrowth));
-            }
-            out.options.radiusGrowth = float(*f);
-        } else if (name == "--las-classes") {
-            const auto v = takeValue();
-            if (!v) return usageError("option '--las-classes' needs a value");
-            const auto classes = parseClassList(*v);
-            if (!classes) {
-                return outOfRange(
-                    name, *v, "comma-separated integers in " + rangeText(0, kMaxLasClass) + " (e.g. 2,6)");
-            }
-            out.lasClasses = *classes;
-        } else if (name == "--quiet") {
-            error = flag(out.quiet);
-        } else if (name == "--per-point") {
-            error = flag(out.perPoint);
-        } else if (name == "--percentile") {
-            const auto v = takeValue();
-            if (!v) return usageError("option '--percentile' needs a value");
-            const auto p = parseNumber(*v);
-            if (!p || !(*p >= 0.0 && *p <= 100.0)) return outOfRange(name, *v, "a number in [0, 100]");
-            out.percentiles.push_back(*p);
-            out.perPoint = true;
-        } else if (name == "--histogram-bins") {
-            const auto v = takeValue();
-            if (!v) return usageError("option '--histogram-bins' needs a value");
-            const auto n = parseInt(*v, 1, kMaxHistogramBins);
-            if (!n) return outOfRange(name, *v, "an integer in " + rangeText(1, kMaxHistogramBins));
-            out.histogramBins = *n;
-            out.perPoint = true;
-        } else if (name == "--range") {
-            if (inlineValue) return usageError("option '--range' takes two values: --range MIN MAX");
-            if (i + 2 >= args.size()) return usageError("option '--range' needs two values MIN MAX");
-            // Distances are >= 0; finite bounds keep MAX - MIN and every bin finite.
-            const auto lo = parseNumber(args[i + 1]), hi = parseNumber(args[i + 2]);
-            if (!lo || !hi || !(*lo >= 0.0 && *hi > *lo)) {
-                return usageError("option '--range' expects finite numbers 0 <= MIN < MAX, got '" +
-                                  args[i + 1] + "' '" + args[i + 2] + "'");
-            }
-            i += 2;
-            out.hasRange = true;
-            out.rangeLo = *lo;
-            out.rangeHi = *hi;
-            out.perPoint = true;
-        } else if (name == "--render") {
-            const auto v = takeValue();
-            if (!v) return usageError("option '--render' needs a value");
-            if (*v != "vulkan" && *v != "software")
-                return usageError("unknown renderer '" + *v + "' (expected vulkan or software)");
-            out.softwareRender = *v == "software";
-        } else if (name == "--out-ply" || name == "--out-csv" || name == "--png" ||
-                   name == "--histogram-png") {
-            const auto v = takeValue();
-            if (!v || v->empty()) return usageError("option '" + name + "' needs a value");
-            std::string& target = name == "--out-ply"   ? out.outPly
-                                  : name == "--out-csv" ? out.outCsv
-                                  : name == "--png"     ? out.png
-                                                        : out.histogramPng;
-            target = *v;
-            out.perPoint = true;
-        } else {
-            return usageError("unknown option '" + name + "'");
-        }
-        if (error) return *error;
-    }
+    });
+    addFlags(line, out);
+    addComputeOptions(line, out);
+    addPerPointOptions(line, out);
+    if (auto error = line.parse(args)) return usageError(std::move(*error));
 
     if (out.help || out.version) return out;
     if (out.listDevices) {

@@ -1,5 +1,6 @@
-// Command-line parsing for the rthdist CLI. Pure: no I/O, no exit(); the
-// caller prints the usage error and picks the exit code (kExitUsage).
+// Command-line parsing for the rthdist CLI, on CLI11 (cli/command_line.hpp).
+// Pure: no I/O, no exit(); the caller prints the usage error and picks the
+// exit code (kExitUsage).
 #pragma once
 
 #include <span>
@@ -38,9 +39,10 @@ struct CliArgs {
     std::vector<int> lasClasses;  // --las-classes 2,6: LAS classification filter (empty = all)
 };
 
-// Parses argv[1..]. Accepts "--flag value" and "--flag=value"; "--" ends the
-// options. Errors (unknown flag, missing or malformed value, wrong number of
-// input files) come back as ErrorCode::kInvalidArgument with a message.
+// Parses argv[1..]. Accepts "--option value" and "--option=value"; "--" ends
+// the options. Errors (unknown option, missing or malformed value, wrong
+// number of input files) come back as ErrorCode::kInvalidArgument with a
+// message; with several, the first in command-line order.
 [[nodiscard]] Result<CliArgs> parseArgs(std::span<const std::string> args);
 
 // The --help text.

@@ -31,6 +31,7 @@ gpu=${RTHDIST_COMPARE_GPU:-1}
 
 rm -rf "$record" "$fx"
 mkdir -p "$record" "$fx"
+record=$(cd "$record" && pwd)  # the cases run in $run
 
 # ---- fixtures ---------------------------------------------------------------
 printf '0 0 0\n1 0 0\n3 0 0\n' >"$fx/a.xyz"
@@ -221,6 +222,22 @@ r --bits 3 --bits x "$A" "$B"
 r --bits x --bits 3 "$A" "$B"
 r "$A" -x "$B" --frobnicate
 r "$A" "$B" -- --frobnicate
+r --range 1 -- "$A" "$B"
+r --range 0 --json "$A" "$B"
+r --range -1 -2 "$A" "$B"
+r -- -- "$A"
+r --json -- --json "$B"
+r --help -- -x
+r "- x" "$A" "$B"
+r -!x "$A" "$B"
+r --bits:3 "$A" "$B"
+r --json --json --backend cpu --backend=cpu "$A" "$B"
+r --out-ply p --out-ply "" "$A" "$B"
+r --percentile 5 --percentile x "$A" "$B"
+r --backend cpu "$A" "$B" --
+r --backend cpu "$A" "$B" -- -
+r -- --help
+r --version -- a b c
 
 # ---- rthdist: bad input -------------------------------------------------------
 r --backend cpu "$fx/missing.xyz" "$B"
@@ -321,6 +338,14 @@ for v in -1 1024 x; do m --device "$v" "$MA" "$MB"; done
 for v in -1 1025 x; do m --threads "$v" "$MA" "$MB"; done
 m --label x --frobnicate "$MA" "$MB"
 m --frobnicate --label x "$MA" "$MB"
+m --label 1 -- "$MA" "$MB"
+m "$MA" "$MB" --
+m -h=1 "$MA" "$MB"
+m --version=1 --frobnicate
+m --labels=all --label=1 "$MA" "$MB"
+m --convention all --convention monai --backend cpu "$MA" "$MB"
+m --json=1 --csv=0 "$MA" "$MB"
+m - "$MA"
 m "$fx/missing.npy" "$MB"
 m "$MA" "$fx/other.npy"
 m "$fx/a.xyz" "$MB"
@@ -361,6 +386,9 @@ bench --backend gpu "$A" "$B"
 bench "$A" "$B" --runs
 bench "$A" "$B" --name
 bench --no-verify=1 "$A" "$B"
+bench --runs 2 --name "$A" "$B"
+bench --budget -1 "$A" "$B"
+bench -x "$A" "$B"
 bench --backend cpu --runs 1 --warmup 0 "$fx/missing.xyz" "$B"
 bench --backend cpu --runs 1 --warmup 0 "$A" "$B"
 bench --backend cpu --runs 2 --warmup 1 --name tiny --no-verify --per-point --growth 3 --bits 4 "$A" "$B"

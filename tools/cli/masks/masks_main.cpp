@@ -8,23 +8,27 @@
 //                 [--threads N]
 //                 [--json | --csv]
 //
-// A separate executable from `rthdist` (tools/cli/main.cpp) so that the point
-// CLI's parser stays as it is. Exit codes are the point CLI's (cli/exit_codes.hpp):
-// 0 ok, 1 internal, 2 usage, 3 bad input (unreadable file, grids that
-// differ), 4 no device. Every error names the file it concerns.
+// A separate executable from `rthdist` (tools/cli/main.cpp), with its own
+// options on the same CLI11 front end (cli/command_line.hpp). Exit codes are
+// the point CLI's (cli/exit_codes.hpp): 0 ok, 1 internal, 2 usage, 3 bad
+// input (unreadable file, grids that differ), 4 no device. Every error names
+// the file it concerns.
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <functional>
 #include <new>
 #include <optional>
 #include <set>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <glm/matrix.hpp>
 
+#include "cli/command_line.hpp"
 #include "cli/exit_codes.hpp"
 #include "cli/json_output.hpp"
 #include "masks/masks.hpp"
@@ -83,120 +87,126 @@ std::optional<int64_t> integer(std::string_view t) {
     return v;
 }
 
-Result<MasksArgs> parse(const std::vector<std::string>& argv) {
+[[noreturn]] void reject(std::string message) { throw UsageError{std::move(message)}; }
+
+// "X,Y,Z": three positive numbers.
+glm::dvec3 parseSpacing(const std::string& v) {
+    double s[3];
+    size_t at = 0;
+    for (int k = 0; k < 3; ++k) {
+        const size_t end = k < 2 ? v.find(',', at) : v.size();
+        if (end == std::string::npos) reject("--spacing expects X,Y,Z, got '" + v + "'");
+        const auto x = number(std::string_view(v).substr(at, end - at));
+        if (!x || *x <= 0) reject("--spacing expects three positive numbers, got '" + v + "'");
+        s[k] = *x;
+        at = end + 1;
+    }
+    return {s[0], s[1], s[2]};
+}
+
+// 12 comma-separated numbers: the 3x4 voxel-to-world matrix, row-major.
+glm::dmat4 parseAffine(const std::string& v) {
+    glm::dmat4 m(1.0);
+    size_t at = 0;
+    for (int k = 0; k < 12; ++k) {
+        const size_t end = k < 11 ? v.find(',', at) : v.size();
+        if (end == std::string::npos) reject("--affine expects 12 comma-separated numbers");
+        const auto x = number(std::string_view(v).substr(at, end - at));
+        if (!x) reject("--affine expects 12 comma-separated numbers, got '" + v + "'");
+        m[k % 4][k / 4] = *x;  // row k / 4, column k % 4 (glm is column-major)
+        at = end + 1;
+    }
+    if (glm::determinant(glm::dmat3(m)) == 0.0) reject("--affine is singular");
+    return m;
+}
+
+// An integer option in [lo, hi]; `message` + " got '<value>'" when it is not.
+int64_t integerIn(const std::string& v, int64_t lo, int64_t hi, const std::string& message) {
+    const auto n = integer(v);
+    if (!n || *n < lo || *n > hi) reject(message + ", got '" + v + "'");
+    return *n;
+}
+
+// The options that say what to compare and how.
+void addMeasureOptions(CommandLine& line, MasksArgs& a, bool& conventionSet) {
+    auto value = [&line](const std::string& name, std::function<void(const std::string&)> apply) {
+        line.option(name, 1, [name, apply = std::move(apply)](const std::vector<std::string>& v, bool) {
+            if (v.empty()) reject("option '" + name + "' needs a value");
+            apply(v[0]);
+        });
+    };
+    value("--label", [&a](const std::string& v) {
+        a.label = int32_t(integerIn(v, INT32_MIN, INT32_MAX, "--label expects an int32"));
+    });
+    value("--labels", [&a](const std::string& v) {
+        if (v != "all") reject("--labels expects 'all', got '" + v + "'");
+        a.allLabels = true;
+    });
+    value("--convention", [&a, &conventionSet](const std::string& v) {
+        if (!conventionSet) a.conventions.clear();
+        conventionSet = true;
+        Convention c;
+        if (v == "all") {
+            a.conventions.assign(masks::kAllConventions.begin(), masks::kAllConventions.end());
+        } else if (masks::parseConvention(v, c)) {
+            a.conventions.push_back(c);
+        } else {
+            reject("--convention expects rthdist, monai, medpy, plastimatch, itk or all, got '" + v + "'");
+        }
+    });
+    value("--percentile", [&a](const std::string& v) {
+        const auto p = number(v);
+        if (!p || *p < 0 || *p > 100) reject("--percentile expects a number in [0, 100], got '" + v + "'");
+        a.percentiles.push_back(*p);
+    });
+    value("--connectivity", [&a](const std::string& v) {
+        const auto n = integer(v);
+        if (!n || (*n != 6 && *n != 18 && *n != 26))
+            reject("--connectivity expects 6, 18 or 26, got '" + v + "'");
+        a.connectivity = int(*n);
+    });
+    value("--tolerance", [&a](const std::string& v) {
+        const auto t = number(v);
+        if (!t || *t < 0) reject("--tolerance expects a number >= 0, got '" + v + "'");
+        a.tolerance = *t;
+    });
+    value("--spacing", [&a](const std::string& v) { a.spacing = parseSpacing(v); });
+    value("--affine", [&a](const std::string& v) { a.affine = parseAffine(v); });
+    value("--backend", [&a](const std::string& v) {
+        if (!parseBackend(v, a.options.backend))
+            reject("--backend expects auto, cpu, ray-query or rt-pipeline, got '" + v + "'");
+    });
+    value("--device", [&a](const std::string& v) {
+        a.options.deviceIndex = int(integerIn(v, 0, 1023, "--device expects an index in [0, 1023]"));
+    });
+    value("--threads", [&a](const std::string& v) {
+        a.options.threads = int(integerIn(v, 0, 1024, "--threads expects [0, 1024]"));
+    });
+}
+
+Result<MasksArgs> parse(std::span<const std::string> argv) {
     MasksArgs a;
     std::vector<std::string> files;
     bool conventionSet = false;
-    for (size_t i = 0; i < argv.size(); ++i) {
-        std::string arg = argv[i];
-        std::string value;
-        bool hasValue = false;
-        if (arg.rfind("--", 0) == 0) {
-            const size_t eq = arg.find('=');
-            if (eq != std::string::npos) {
-                value = arg.substr(eq + 1);
-                arg = arg.substr(0, eq);
-                hasValue = true;
-            }
-        }
-        auto need = [&]() -> std::optional<std::string> {
-            if (hasValue) return value;
-            if (i + 1 >= argv.size()) return std::nullopt;
-            return argv[++i];
-        };
-        if (arg == "--help" || arg == "-h") {
+    // Any argument that starts with '-' and is not an option is an error, "--" too.
+    CommandLine line([&](const std::string& token, bool) {
+        if (token == "-h") {
             a.help = true;
-        } else if (arg == "--version") {
-            a.version = true;
-        } else if (arg == "--json") {
-            a.json = true;
-        } else if (arg == "--csv") {
-            a.csv = true;
-        } else if (arg == "--label" || arg == "--labels" || arg == "--convention" || arg == "--percentile" ||
-                   arg == "--connectivity" || arg == "--tolerance" || arg == "--spacing" ||
-                   arg == "--affine" || arg == "--backend" || arg == "--device" || arg == "--threads") {
-            const auto v = need();
-            if (!v) return usage("option '" + arg + "' needs a value");
-            if (arg == "--label") {
-                const auto n = integer(*v);
-                if (!n || *n < INT32_MIN || *n > INT32_MAX)
-                    return usage("--label expects an int32, got '" + *v + "'");
-                a.label = int32_t(*n);
-            } else if (arg == "--labels") {
-                if (*v != "all") return usage("--labels expects 'all', got '" + *v + "'");
-                a.allLabels = true;
-            } else if (arg == "--convention") {
-                if (!conventionSet) a.conventions.clear();
-                conventionSet = true;
-                if (*v == "all") {
-                    a.conventions.assign(masks::kAllConventions.begin(), masks::kAllConventions.end());
-                } else {
-                    Convention c;
-                    if (!masks::parseConvention(*v, c))
-                        return usage(
-                            "--convention expects rthdist, monai, medpy, plastimatch, itk or all, got '" +
-                            *v + "'");
-                    a.conventions.push_back(c);
-                }
-            } else if (arg == "--percentile") {
-                const auto p = number(*v);
-                if (!p || *p < 0 || *p > 100)
-                    return usage("--percentile expects a number in [0, 100], got '" + *v + "'");
-                a.percentiles.push_back(*p);
-            } else if (arg == "--connectivity") {
-                const auto n = integer(*v);
-                if (!n || (*n != 6 && *n != 18 && *n != 26))
-                    return usage("--connectivity expects 6, 18 or 26, got '" + *v + "'");
-                a.connectivity = int(*n);
-            } else if (arg == "--tolerance") {
-                const auto t = number(*v);
-                if (!t || *t < 0) return usage("--tolerance expects a number >= 0, got '" + *v + "'");
-                a.tolerance = *t;
-            } else if (arg == "--spacing") {
-                double s[3];
-                size_t at = 0;
-                for (int k = 0; k < 3; ++k) {
-                    const size_t end = k < 2 ? v->find(',', at) : v->size();
-                    if (end == std::string::npos) return usage("--spacing expects X,Y,Z, got '" + *v + "'");
-                    const auto x = number(std::string_view(*v).substr(at, end - at));
-                    if (!x || *x <= 0)
-                        return usage("--spacing expects three positive numbers, got '" + *v + "'");
-                    s[k] = *x;
-                    at = end + 1;
-                }
-                a.spacing = {s[0], s[1], s[2]};
-            } else if (arg == "--affine") {
-                glm::dmat4 m(1.0);
-                size_t at = 0;
-                for (int k = 0; k < 12; ++k) {
-                    const size_t end = k < 11 ? v->find(',', at) : v->size();
-                    if (end == std::string::npos) return usage("--affine expects 12 comma-separated numbers");
-                    const auto x = number(std::string_view(*v).substr(at, end - at));
-                    if (!x) return usage("--affine expects 12 comma-separated numbers, got '" + *v + "'");
-                    m[k % 4][k / 4] = *x;  // row k / 4, column k % 4 (glm is column-major)
-                    at = end + 1;
-                }
-                if (glm::determinant(glm::dmat3(m)) == 0.0) return usage("--affine is singular");
-                a.affine = m;
-            } else if (arg == "--backend") {
-                if (!parseBackend(*v, a.options.backend))
-                    return usage("--backend expects auto, cpu, ray-query or rt-pipeline, got '" + *v + "'");
-            } else if (arg == "--device") {
-                const auto n = integer(*v);
-                if (!n || *n < 0 || *n > 1023)
-                    return usage("--device expects an index in [0, 1023], got '" + *v + "'");
-                a.options.deviceIndex = int(*n);
-            } else {
-                const auto n = integer(*v);
-                if (!n || *n < 0 || *n > 1024) return usage("--threads expects [0, 1024], got '" + *v + "'");
-                a.options.threads = int(*n);
-            }
-        } else if (arg.size() > 1 && arg[0] == '-') {
-            return usage("unknown option '" + arg + "'");
+        } else if (token.size() > 1 && token[0] == '-') {
+            const size_t eq = token.find('=');
+            reject("unknown option '" + (token.rfind("--", 0) == 0 ? token.substr(0, eq) : token) + "'");
         } else {
-            files.push_back(arg);
+            files.push_back(token);
         }
+    });
+    // Flags ignore a value ("--json=x" is --json).
+    for (auto [name, target] : {std::pair{"--help", &a.help}, std::pair{"--version", &a.version},
+                                std::pair{"--json", &a.json}, std::pair{"--csv", &a.csv}}) {
+        line.flag(name, [target = target](bool) { *target = true; });
     }
+    addMeasureOptions(line, a, conventionSet);
+    if (auto error = line.parse(argv)) return usage(*error);
+
     if (a.help || a.version) return a;
     if (files.size() != 2) return usage("expected two mask files A B, got " + std::to_string(files.size()));
     if (a.label && a.allLabels) return usage("--label and --labels all exclude each other");
