@@ -31,6 +31,7 @@ from ._rthdist import (  # noqa: F401 - re-exported
     HausdorffResult,
     InternalError,
     OutOfMemoryError,
+    PreparedSet,
     list_devices,
 )
 
@@ -43,6 +44,7 @@ __all__ = [
     "as_points",
     "HausdorffResult",
     "Directed",
+    "PreparedSet",
     "Error",
     "DeviceError",
     "OutOfMemoryError",
@@ -103,27 +105,60 @@ def hausdorff(a, b, *, directed=False, per_point=False, backend="auto", device=N
                                progress=_progress_callable(progress))
 
 
+def _points_or_prepared(x, name):
+    return x if isinstance(x, PreparedSet) else as_points(x, name)
+
+
 class Engine:
     """A backend's device and pipelines, kept between calls.
 
         with rthdist.Engine(backend="ray-query") as engine:
+            ref = engine.prepare(reference)          # indexed once
             for scan in scans:
-                print(engine.hausdorff(reference, scan).distance)
+                print(engine.hausdorff(ref, scan).distance)
 
-    One Engine serves one call at a time (calls from several threads wait
-    for each other); give each thread its own Engine to run in parallel.
-    close() (or leaving the with block) releases the device.
+    Per-call settings (directed, per_point, bits, radius_growth, progress)
+    never rebuild the device or a prepared set. One Engine serves one call at
+    a time (calls from several threads wait for each other); give each thread
+    its own Engine to run in parallel. close() (or leaving the with block)
+    releases the device; prepared sets keep it alive until they go too.
     """
 
     def __init__(self, backend="auto", *, device=None, threads=0, validation=False):
         self._engine = _rthdist._Engine(str(backend), device, int(threads), bool(validation))
 
+    def prepare(self, points, *, bits=0, origin=None):
+        """points indexed once on this Engine's device: a PreparedSet for any number of calls.
+
+        bits: its index grid's bit count (0 = from the data). origin: the frame
+        of a float64 set (subtracted before the float32 search); sets that
+        will meet should share one (e.g. origin=reference.origin), else a call
+        re-indexes both in their union's frame. Keeps a reference to the array
+        (per-point statistics read its bounding box).
+        """
+        o = None if origin is None else tuple(float(v) for v in origin)
+        return self._engine.prepare(as_points(points, "points"), bits=int(bits), origin=o)
+
     def hausdorff(self, a, b, *, directed=False, per_point=False, bits=0, radius_growth=2.0, progress=None):
-        """H(A, B) on this Engine's device: as rthdist.hausdorff, without the device setup."""
-        pa = as_points(a, "a")
-        pb = as_points(b, "b")
+        """H(A, B) on this Engine's device: as rthdist.hausdorff, without the device setup.
+
+        a, b: point sets or PreparedSets of this Engine; an array against a
+        PreparedSet is prepared for this call in the prepared set's frame.
+        """
+        pa = _points_or_prepared(a, "a")
+        pb = _points_or_prepared(b, "b")
         return self._engine.hausdorff(pa, pb, directed=bool(directed), per_point=bool(per_point), bits=int(bits),
                                       radius_growth=float(radius_growth), progress=_progress_callable(progress))
+
+    def hausdorff_many(self, sets, pairs, *, directed=False, per_point=False, bits=0, radius_growth=2.0,
+                       progress=None):
+        """[H(sets[i], sets[j]) for (i, j) in pairs] in one call (PreparedSets of this Engine).
+
+        Raises the first failing pair's error.
+        """
+        return self._engine.hausdorff_many(list(sets), [(int(i), int(j)) for i, j in pairs],
+                                           directed=bool(directed), per_point=bool(per_point), bits=int(bits),
+                                           radius_growth=float(radius_growth), progress=_progress_callable(progress))
 
     @property
     def backend(self):

@@ -100,14 +100,32 @@ def hausdorff(
     validation: bool = False,
 ) -> HausdorffResult: ...
 
+class PreparedSet:
+    @property
+    def size(self) -> int: ...
+    def __len__(self) -> int: ...
+    @property
+    def bits(self) -> int: ...
+    @property
+    def origin(self) -> tuple[float, float, float]: ...
+    @property
+    def device_bytes(self) -> int: ...
+    @property
+    def host_bytes(self) -> int: ...
+    @property
+    def points(self) -> npt.NDArray[np.floating[Any]]: ...
+
 class Engine:
     def __init__(
         self, backend: BackendName = "auto", *, device: Optional[int] = None, threads: int = 0, validation: bool = False
     ) -> None: ...
+    def prepare(
+        self, points: PointsLike, *, bits: int = 0, origin: Optional[Sequence[float]] = None
+    ) -> PreparedSet: ...
     def hausdorff(
         self,
-        a: PointsLike,
-        b: PointsLike,
+        a: Union[PointsLike, PreparedSet],
+        b: Union[PointsLike, PreparedSet],
         *,
         directed: bool = False,
         per_point: bool = False,
@@ -115,6 +133,17 @@ class Engine:
         radius_growth: float = 2.0,
         progress: Optional[Progress] = None,
     ) -> HausdorffResult: ...
+    def hausdorff_many(
+        self,
+        sets: Sequence[PreparedSet],
+        pairs: Sequence[tuple[int, int]],
+        *,
+        directed: bool = False,
+        per_point: bool = False,
+        bits: int = 0,
+        radius_growth: float = 2.0,
+        progress: Optional[Progress] = None,
+    ) -> list[HausdorffResult]: ...
     @property
     def backend(self) -> str: ...
     @property

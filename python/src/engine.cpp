@@ -3,6 +3,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <atomic>
 #include <memory>
 #include <mutex>
@@ -130,6 +131,7 @@ std::unique_ptr<PyResult> hausdorffOnce(const py::array& a, const py::array& b, 
     const PointView vb = viewOf(b, "b");
     CallMonitor monitor(std::move(progress));
     options.progress = [&monitor](const char* stage, double fraction) { monitor.report(stage, fraction); };
+    options.cancel = monitor.cancelFlag();
     std::optional<Result<HausdorffResult>> r;
     {
         py::gil_scoped_release release;
@@ -139,38 +141,117 @@ std::unique_ptr<PyResult> hausdorffOnce(const py::array& a, const py::array& b, 
     return wrap(valueOrRaise(std::move(*r)), a, b, perPoint);
 }
 
+// A set prepared by a PyEngine (Engine::prepare), with the array it came
+// from (statistics of per-point results read its bounding box).
+struct PyPrepared {
+    PreparedSet set;
+    const void* engine;  // the PyEngine that prepared it (identity only)
+    py::array source;
+};
+
 // An Engine for Python: the device and pipelines live until close() (or the
 // end of a `with` block); calls are serialized by m_mutex.
 class PyEngine {
 public:
-    PyEngine(const std::string& backend, std::optional<int> device, int threads, bool validation)
-        : m_options(engineOptions(backend, device, threads, validation)) {
-        Result<Engine> engine = [&] {
+    PyEngine(const std::string& backend, std::optional<int> device, int threads, bool validation) {
+        const Options options = engineOptions(backend, device, threads, validation);
+        std::optional<Result<Engine>> engine;
+        {
             py::gil_scoped_release release;
-            return create(CallSettings{});
-        }();
-        m_engine.emplace(valueOrRaise(std::move(engine)));
+            engine.emplace(Engine::create(static_cast<const EngineOptions&>(options)));
+        }
+        m_engine.emplace(valueOrRaise(std::move(*engine)));
     }
 
-    std::unique_ptr<PyResult> hausdorff(const py::array& a, const py::array& b, bool directed, bool perPoint,
-                                        int bits, double radiusGrowth, py::object progress) {
-        const CallSettings call{bits, directed, perPoint, radiusGrowth};
-        call.check();
-        const PointView va = viewOf(a, "a");
-        const PointView vb = viewOf(b, "b");
+    // a and b: checked arrays or PyPrepared sets of this Engine. A mix
+    // prepares the array for this call in the prepared set's frame.
+    std::unique_ptr<PyResult> hausdorff(const py::object& a, const py::object& b, bool directed,
+                                        bool perPoint, int bits, double radiusGrowth, py::object progress) {
+        const CallSettings settings{bits, directed, perPoint, radiusGrowth};
+        settings.check();
+        const PyPrepared* pa = preparedOf(a, "a");
+        const PyPrepared* pb = preparedOf(b, "b");
+        const py::array arrayA = pa ? pa->source : a.cast<py::array>();
+        const py::array arrayB = pb ? pb->source : b.cast<py::array>();
+        const PointView va = pa ? PointView{} : viewOf(arrayA, "a");
+        const PointView vb = pb ? PointView{} : viewOf(arrayB, "b");
         CallMonitor monitor(std::move(progress));
+        CallOptions call = callOptions(settings, monitor);
         std::optional<Result<HausdorffResult>> r;
         {
             py::gil_scoped_release release;
             std::lock_guard<std::mutex> lock(m_mutex);
             if (!m_engine) {
                 r.emplace(Error{ErrorCode::kInvalidArgument, "this Engine is closed"});
+            } else if (pa == nullptr && pb == nullptr) {
+                r.emplace(m_engine->compute(va, vb, call));
             } else {
-                r.emplace(computeLocked(va, vb, call, monitor));
+                r.emplace(computePrepared(pa, va, pb, vb, call));
             }
         }
         monitor.raisePending();
-        return wrap(valueOrRaise(std::move(*r)), a, b, perPoint);
+        return wrap(valueOrRaise(std::move(*r)), arrayA, arrayB, perPoint);
+    }
+
+    std::unique_ptr<PyPrepared> prepare(const py::array& points, int bits,
+                                        std::optional<std::array<double, 3>> origin) {
+        if (bits < 0 || bits > 8) throw py::value_error("bits must be in 0..8 (0 = from the data)");
+        const PointView view = viewOf(points, "points");
+        PrepareOptions options;
+        options.bits = bits;
+        if (origin) options.origin = glm::dvec3((*origin)[0], (*origin)[1], (*origin)[2]);
+        std::optional<Result<PreparedSet>> r;
+        {
+            py::gil_scoped_release release;
+            std::lock_guard<std::mutex> lock(m_mutex);
+            if (!m_engine) {
+                r.emplace(Error{ErrorCode::kInvalidArgument, "this Engine is closed"});
+            } else {
+                r.emplace(m_engine->prepare(view, options));
+            }
+        }
+        return std::make_unique<PyPrepared>(PyPrepared{valueOrRaise(std::move(*r)), this, points});
+    }
+
+    // H of every pair (i, j) of `sets` (PyPrepared of this Engine) in one
+    // call; the first failing pair's error is raised.
+    py::list hausdorffMany(const std::vector<py::object>& sets,
+                           const std::vector<std::pair<size_t, size_t>>& pairs, bool directed, bool perPoint,
+                           int bits, double radiusGrowth, py::object progress) {
+        const CallSettings settings{bits, directed, perPoint, radiusGrowth};
+        settings.check();
+        std::vector<PreparedSet> prepared;
+        std::vector<const PyPrepared*> owners;
+        for (size_t i = 0; i < sets.size(); ++i) {
+            const PyPrepared* p = preparedOf(sets[i], "sets");
+            if (p == nullptr) throw py::value_error("sets[" + std::to_string(i) + "] is not a PreparedSet");
+            prepared.push_back(p->set);
+            owners.push_back(p);
+        }
+        std::vector<PairRef> refs;
+        for (const auto& [i, j] : pairs) {
+            if (i >= sets.size() || j >= sets.size()) throw py::value_error("pairs: index past the sets");
+            refs.push_back({i, j});
+        }
+        CallMonitor monitor(std::move(progress));
+        CallOptions call = callOptions(settings, monitor);
+        std::vector<Result<HausdorffResult>> results;
+        bool closed = false;
+        {
+            py::gil_scoped_release release;
+            std::lock_guard<std::mutex> lock(m_mutex);
+            closed = !m_engine;
+            if (!closed) results = m_engine->computeBatch(prepared, refs, call);
+        }
+        monitor.raisePending();
+        if (closed) throw py::value_error("this Engine is closed");
+        py::list out;
+        for (size_t k = 0; k < results.size(); ++k) {
+            auto r = wrap(valueOrRaise(std::move(results[k])), owners[refs[k].a]->source,
+                          owners[refs[k].b]->source, perPoint);
+            out.append(py::cast(std::move(r)));
+        }
+        return out;
     }
 
     void close() {
@@ -197,38 +278,43 @@ public:
     }
 
 private:
-    // The settings of a call are fixed when an Engine is created (this
-    // release's Engine::create(Options)): a call with other settings creates
-    // the engine again. The progress of every call goes through m_monitor.
-    Result<Engine> create(const CallSettings& call) {
-        Options options = optionsFrom(m_options, call);
-        options.progress = [this](const char* stage, double fraction) {
-            if (m_monitor != nullptr) m_monitor->report(stage, fraction);
-        };
-        Result<Engine> engine = Engine::create(options);
-        if (engine) m_call = call;
-        return engine;
+    const PyPrepared* preparedOf(const py::object& o, const char* name) const {
+        if (!py::isinstance<PyPrepared>(o)) return nullptr;
+        const PyPrepared* p = o.cast<const PyPrepared*>();
+        if (p->engine != this) throw py::value_error(std::string(name) + ": prepared by another Engine");
+        return p;
     }
 
-    Result<HausdorffResult> computeLocked(PointView a, PointView b, const CallSettings& call,
-                                          CallMonitor& monitor) {
-        if (!(call == m_call)) {
-            m_engine.reset();
-            Result<Engine> engine = create(call);
-            if (!engine) return engine.error();
-            m_engine.emplace(std::move(engine).value());
+    static CallOptions callOptions(const CallSettings& settings, CallMonitor& monitor) {
+        CallOptions call;
+        call.bits = settings.bits;
+        call.directedOnly = settings.directed;
+        call.perPointDistances = settings.perPoint;
+        call.radiusGrowth = float(settings.radiusGrowth);
+        call.progress = [&monitor](const char* stage, double fraction) { monitor.report(stage, fraction); };
+        call.cancel = monitor.cancelFlag();
+        return call;
+    }
+
+    // A prepared set against an array: the array is prepared for this call
+    // in the prepared set's frame (so both indexes are reused as they are).
+    Result<HausdorffResult> computePrepared(const PyPrepared* pa, PointView va, const PyPrepared* pb,
+                                            PointView vb, const CallOptions& call) {
+        std::optional<PreparedSet> tmpA, tmpB;
+        if (pa == nullptr || pb == nullptr) {
+            const PyPrepared* known = pa ? pa : pb;
+            PrepareOptions options;
+            options.bits = call.bits;
+            options.origin = known->set.origin();
+            Result<PreparedSet> t = m_engine->prepare(pa ? vb : va, options);
+            if (!t) return t.error();
+            (pa ? tmpB : tmpA).emplace(std::move(t).value());
         }
-        m_monitor = &monitor;
-        Result<HausdorffResult> r = m_engine->compute(a, b);
-        m_monitor = nullptr;
-        return r;
+        return m_engine->compute(pa ? pa->set : *tmpA, pb ? pb->set : *tmpB, call);
     }
 
-    Options m_options;  // the device part
-    CallSettings m_call;
     std::mutex m_mutex;
     std::optional<Engine> m_engine;
-    CallMonitor* m_monitor = nullptr;
 };
 
 }  // namespace
@@ -239,11 +325,38 @@ void bindEngine(py::module_& m) {
           py::arg("threads"), py::arg("validation"), py::arg("progress"),
           "One-shot H(A, B) of two checked arrays (rthdist.hausdorff converts its inputs first).");
 
+    py::class_<PyPrepared>(m, "PreparedSet",
+                           "A point set prepared once by an Engine (Engine.prepare): its frame, scale and "
+                           "index, reused by every call that gets it.")
+        .def_property_readonly("size", [](const PyPrepared& p) { return p.set.size(); })
+        .def("__len__", [](const PyPrepared& p) { return p.set.size(); })
+        .def_property_readonly(
+            "bits", [](const PyPrepared& p) { return p.set.bits(); }, "bit count of its index grid")
+        .def_property_readonly(
+            "origin",
+            [](const PyPrepared& p) {
+                const glm::dvec3 o = p.set.origin();
+                return py::make_tuple(o.x, o.y, o.z);
+            },
+            "its frame: subtracted before the float search (0 for float32 data)")
+        .def_property_readonly("device_bytes", [](const PyPrepared& p) { return p.set.deviceBytes(); })
+        .def_property_readonly("host_bytes", [](const PyPrepared& p) { return p.set.hostBytes(); })
+        .def_property_readonly(
+            "points", [](const PyPrepared& p) { return p.source; }, "the array it was prepared from")
+        .def("__repr__", [](const PyPrepared& p) {
+            return "PreparedSet(size=" + std::to_string(p.set.size()) +
+                   ", bits=" + std::to_string(p.set.bits()) + ")";
+        });
+
     py::class_<PyEngine>(m, "_Engine", "A device and its pipelines kept between calls (rthdist.Engine).")
         .def(py::init<const std::string&, std::optional<int>, int, bool>(), py::arg("backend"),
              py::arg("device"), py::arg("threads"), py::arg("validation"))
         .def("hausdorff", &PyEngine::hausdorff, py::arg("a"), py::arg("b"), py::arg("directed"),
              py::arg("per_point"), py::arg("bits"), py::arg("radius_growth"), py::arg("progress"))
+        .def("prepare", &PyEngine::prepare, py::arg("points"), py::arg("bits"), py::arg("origin"))
+        .def("hausdorff_many", &PyEngine::hausdorffMany, py::arg("sets"), py::arg("pairs"),
+             py::arg("directed"), py::arg("per_point"), py::arg("bits"), py::arg("radius_growth"),
+             py::arg("progress"))
         .def("close", &PyEngine::close)
         .def_property_readonly("closed", &PyEngine::closed)
         .def_property_readonly("device", &PyEngine::deviceName)

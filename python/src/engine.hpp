@@ -1,13 +1,15 @@
 // rthdist Python module — the entry points that compute: the one-shot
-// hausdorff() and the Engine class (one device and its pipelines kept
-// between calls).
+// hausdorff(), the Engine class (one device and its pipelines kept between
+// calls; per-call settings, CallOptions) and its PreparedSets (a set indexed
+// once, Engine::prepare, reused by any number of calls and batches).
 //
 // Every call releases the GIL while the library works, so other Python
 // threads run (each with its own Engine: an Engine serializes its calls
 // behind a mutex, it is never used by two threads at once). The library's
 // progress callback re-acquires the GIL, checks for signals (Ctrl-C in the
 // main thread) and calls the user's progress callable; a KeyboardInterrupt or
-// an exception from the callable sets the call's cancel flag and is raised
+// an exception from the callable sets the call's cancel flag
+// (CallOptions::cancel: the library stops at its next check) and is raised
 // when the call returns.
 #pragma once
 
