@@ -60,6 +60,16 @@ py::object sharedArray(const std::vector<T>& values, py::handle owner) {
     return out;
 }
 
+// The getter of one per-point array of the result (None without per_point).
+template <class T>
+auto perPointArray(PerPoint HausdorffResult::*side, std::vector<T> PerPoint::*field) {
+    return [side, field](py::object self) -> py::object {
+        const std::vector<T>& values = (self.cast<const PyResult&>().result.*side).*field;
+        if (values.empty()) return py::none();
+        return sharedArray(values, self);
+    };
+}
+
 void requirePerPoint(const PyResult& r) {
     if (r.result.aNearest.distance.empty()) {
         throw py::value_error("this result has no per-point distances: call with per_point=True");
@@ -283,36 +293,15 @@ void bindResult(py::module_& m) {
             "validation_messages", [](const PyResult& r) { return r.result.validationMessages; },
             "validation-layer messages (validation=True only)")
         .def_property_readonly(
-            "a_distances",
-            [](py::object self) -> py::object {
-                const PyResult& r = self.cast<const PyResult&>();
-                if (r.result.aNearest.distance.empty()) return py::none();
-                return sharedArray(r.result.aNearest.distance, self);
-            },
+            "a_distances", perPointArray(&HausdorffResult::aNearest, &PerPoint::distance),
             "every a's exact nearest distance to B (float64, read-only); None without per_point")
+        .def_property_readonly("a_nearest", perPointArray(&HausdorffResult::aNearest, &PerPoint::nearest),
+                               "index in B of every a's nearest point (uint32); None without per_point")
         .def_property_readonly(
-            "a_nearest",
-            [](py::object self) -> py::object {
-                const PyResult& r = self.cast<const PyResult&>();
-                if (r.result.aNearest.nearest.empty()) return py::none();
-                return sharedArray(r.result.aNearest.nearest, self);
-            },
-            "index in B of every a's nearest point (uint32); None without per_point")
-        .def_property_readonly(
-            "b_distances",
-            [](py::object self) -> py::object {
-                const PyResult& r = self.cast<const PyResult&>();
-                if (r.result.bNearest.distance.empty()) return py::none();
-                return sharedArray(r.result.bNearest.distance, self);
-            },
+            "b_distances", perPointArray(&HausdorffResult::bNearest, &PerPoint::distance),
             "every b's exact nearest distance to A; None without per_point or when directed")
         .def_property_readonly(
-            "b_nearest",
-            [](py::object self) -> py::object {
-                const PyResult& r = self.cast<const PyResult&>();
-                if (r.result.bNearest.nearest.empty()) return py::none();
-                return sharedArray(r.result.bNearest.nearest, self);
-            },
+            "b_nearest", perPointArray(&HausdorffResult::bNearest, &PerPoint::nearest),
             "index in A of every b's nearest point; None without per_point or when directed")
         .def("percentile", &percentile, py::arg("q"), py::arg("variant") = "max",
              "Nearest-rank percentile q in [0, 100] of the per-point distances (stats.hpp): 'max' "
