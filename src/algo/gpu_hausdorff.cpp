@@ -845,6 +845,7 @@ struct GpuHausdorff::State {
             err = oom ? Error{ErrorCode::kOutOfMemory,
                               std::string("the inputs do not fit the device: ") + e.what()}
                       : Error{ErrorCode::kInternal, e.what()};
+            err->vkResult = int(e.result());
         } catch (const gpu::LimitError& e) {
             err =
                 Error{ErrorCode::kOutOfMemory, std::string("the inputs do not fit the device: ") + e.what()};
