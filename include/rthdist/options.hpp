@@ -39,6 +39,12 @@ struct EngineOptions {
     bool validation = false;
     // CPU backend threads; 0 = all hardware threads.
     int threads = 0;
+    // GPU backends: the directory of the pipeline cache file, which spares a
+    // new process the pipeline compilation on the same device and driver.
+    // Empty: $RTHDIST_CACHE_DIR, else $XDG_CACHE_HOME/rthdist, else
+    // $HOME/.cache/rthdist; "off": no file. A missing, foreign or damaged
+    // file only means compiling again (Engine::pipelineCacheStatus).
+    std::string pipelineCacheDir;
 };
 
 // Settings of one compute call: changing one never rebuilds a device,

@@ -226,6 +226,10 @@ public:
 
     [[nodiscard]] const std::string& deviceName() const;
     [[nodiscard]] Backend backend() const;
+    // The pipeline cache file (empty: none, e.g. the CPU backend) and
+    // whether creation read it: "loaded", "none", or why it was ignored.
+    [[nodiscard]] std::string pipelineCachePath() const;
+    [[nodiscard]] std::string pipelineCacheStatus() const;
 
     struct Impl;
 

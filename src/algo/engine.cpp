@@ -14,6 +14,7 @@
 #include "algo/input_frame.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 #include "gpu/context.hpp"
+#include "gpu/pipeline_cache.hpp"
 
 namespace rthdist {
 
@@ -162,7 +163,10 @@ Result<Engine> Engine::create(const EngineOptions& options) {
     auto ctx = gpu::Context::create(options.backend, options.deviceIndex, options.validation);
     if (!ctx) return ctx.error();
     device.context = std::move(ctx.value());
-    auto g = algo::GpuHausdorff::create(*device.context);
+    const std::string cacheDir = options.pipelineCacheDir == "off"  ? std::string()
+                                 : options.pipelineCacheDir.empty() ? gpu::defaultPipelineCacheDir()
+                                                                    : options.pipelineCacheDir;
+    auto g = algo::GpuHausdorff::create(*device.context, cacheDir);
     if (!g) return g.error();
     device.gpu = std::move(g.value());
     impl->backend = device.context->backend();
@@ -180,6 +184,12 @@ Result<Engine> Engine::create(const Options& options) {
 
 const std::string& Engine::deviceName() const { return m_impl->deviceName; }
 Backend Engine::backend() const { return m_impl->backend; }
+std::string Engine::pipelineCachePath() const {
+    return m_impl->device->gpu ? m_impl->device->gpu->pipelineCachePath() : std::string();
+}
+std::string Engine::pipelineCacheStatus() const {
+    return m_impl->device->gpu ? m_impl->device->gpu->pipelineCacheStatus() : std::string("none");
+}
 
 namespace {
 

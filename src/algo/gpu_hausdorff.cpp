@@ -22,6 +22,7 @@
 #include "gpu/buffer.hpp"
 #include "gpu/context.hpp"
 #include "gpu/device_limits.hpp"
+#include "gpu/pipeline_cache.hpp"
 #include "gpu/pipelines.hpp"
 #include "rthdist_shared.h"
 
@@ -111,6 +112,14 @@ double exactScaleFor(std::span<const glm::vec3> a, std::span<const glm::vec3> b)
     return exactScale(std::max(largestMagnitude(a), largestMagnitude(b)));
 }
 
+// The square of the largest excess of q's box over t's box along one axis
+// (0 when q's box lies inside t's): a lower bound of h(Q, T)^2.
+double boxLowerBound2(const Bounds& q, const Bounds& t) {
+    const glm::dvec3 excess = glm::max(glm::max(q.hi - t.hi, t.lo - q.lo), glm::dvec3(0.0));
+    const double e = std::max({excess.x, excess.y, excess.z});
+    return e * e;
+}
+
 // Float copies of the points multiplied by a power of two in double (exact:
 // the rule keeps every product a normal float or zero).
 std::vector<glm::vec3> scaledCopy(std::span<const glm::vec3> pts, double scale) {
@@ -148,6 +157,7 @@ struct DeviceSet {
 
 struct GpuHausdorff::State {
     gpu::Context& ctx;
+    gpu::PipelineCache pipelineCache;  // before the pipelines it seeds
     gpu::Pipelines pipelines;
     gpu::AccelStructures accel;
     bool rayQuery;
@@ -187,11 +197,13 @@ struct GpuHausdorff::State {
         return b;
     }
 
-    State(gpu::Context& c)
+    State(gpu::Context& c, const std::string& cacheDir)
         : ctx(c),
-          pipelines(c, c.backend() == Backend::kRayQuery),
+          pipelineCache(c.device(), c.physicalDevice(), cacheDir),
+          pipelines(c, c.backend() == Backend::kRayQuery, pipelineCache.handle()),
           accel(c),
           rayQuery(c.backend() == Backend::kRayQuery) {
+        pipelineCache.save();
         hostSmall = Buffer(ctx, RTHDIST_CTR_READBACK + (kCheckSamples + 1) * 32, gpu::kStorageUsage,
                            MemoryKind::kHost);
     }
@@ -551,20 +563,12 @@ struct GpuHausdorff::State {
         cnt.occupiedCells = T.numCells;
         cnt.queries = Q.n;
 
-        // Witness-less lower bound: the farthest query from BV(T), shrunk a
-        // little so float rounding never kills the query that realizes h.
-        const int threads = cpu::resolveThreads(0, qPts.size() / kHostChunk + 1);
-        std::vector<double> lbs(size_t(threads), 0.0);
-        cpu::parallelChunks(qPts.size(), kHostChunk, threads, [&](size_t begin, size_t end, int t) {
-            double m = lbs[size_t(t)];
-            for (size_t i = begin; i < end; ++i) {
-                const glm::dvec3 q(qPts[i]);
-                const glm::dvec3 d = glm::max(glm::max(T.bounds.lo - q, q - T.bounds.hi), glm::dvec3(0.0));
-                m = std::max(m, d.x * d.x + d.y * d.y + d.z * d.z);
-            }
-            lbs[size_t(t)] = m;
-        });
-        const double lb = *std::max_element(lbs.begin(), lbs.end());
+        // Witness-less lower bound from the two boxes alone (no pass over the
+        // points): each face of Q's tight box holds a query, whose distance
+        // to BV(T), hence to T, is at least that face's excess over T's box
+        // on its axis. Shrunk a little so float rounding never kills the
+        // query that realizes h.
+        const double lb = boxLowerBound2(Q.bounds, T.bounds);
         // Per-point distances need every query's NN: a negative bound turns
         // the early break off in every shader (deadThreshold returns 0).
         const float lowerBound2 = perPoint ? -1.0f : float(lb * (1.0 - 1e-5));
@@ -868,9 +872,9 @@ void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
     m_state->maxPairCapacity = std::max<uint64_t>(1, pairs);
 }
 
-Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx) {
+Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, const std::string& cacheDir) {
     try {
-        return std::unique_ptr<GpuHausdorff>(new GpuHausdorff(std::make_unique<State>(ctx)));
+        return std::unique_ptr<GpuHausdorff>(new GpuHausdorff(std::make_unique<State>(ctx, cacheDir)));
     } catch (const gpu::VulkanError& e) {
         return Error{ErrorCode::kInternal, std::string("pipeline creation failed: ") + e.what()};
     }
@@ -924,5 +928,8 @@ uint64_t GpuHausdorff::deviceBytes(const DeviceSet& set) {
 }
 
 int GpuHausdorff::bits(const DeviceSet& set) { return set.ix.grid.bits; }
+
+const std::string& GpuHausdorff::pipelineCachePath() const { return m_state->pipelineCache.path(); }
+const std::string& GpuHausdorff::pipelineCacheStatus() const { return m_state->pipelineCache.loadStatus(); }
 
 }  // namespace rthdist::algo

@@ -33,7 +33,10 @@ struct DeviceSet;
 
 class GpuHausdorff {
 public:
-    [[nodiscard]] static Result<std::unique_ptr<GpuHausdorff>> create(gpu::Context& ctx);
+    // cacheDir: where the pipeline cache file lives (gpu/pipeline_cache.hpp);
+    // empty: none.
+    [[nodiscard]] static Result<std::unique_ptr<GpuHausdorff>> create(gpu::Context& ctx,
+                                                                      const std::string& cacheDir);
     ~GpuHausdorff();
 
     // One-shot: both sets indexed for this call, in buffers pooled between calls.
@@ -52,6 +55,10 @@ public:
     [[nodiscard]] Result<HausdorffResult> compute(DeviceSet& a, DeviceSet& b, const CallOptions& options);
     [[nodiscard]] static uint64_t deviceBytes(const DeviceSet& set);
     [[nodiscard]] static int bits(const DeviceSet& set);
+
+    [[nodiscard]] const std::string& pipelineCachePath() const;
+    // "loaded", "none", or why the file was ignored.
+    [[nodiscard]] const std::string& pipelineCacheStatus() const;
 
     // Caps the candidate-pair buffer (default 2^26 pairs); tests shrink it
     // so that queries must retry until their pairs fit.

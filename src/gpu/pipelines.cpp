@@ -64,7 +64,7 @@ VkShaderModule Pipelines::createModule(const uint32_t* code, size_t bytes) {
     return m;
 }
 
-Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQuery) {
+Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache) : m_ctx(ctx), m_rayQuery(rayQuery) {
     VkDevice d = ctx.device();
     VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT;
     if (!rayQuery) {
@@ -132,7 +132,7 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
         ci.stage.pName = "main";
         ci.layout = m_layout;
         ci.flags = VK_PIPELINE_CREATE_DISPATCH_BASE_BIT;
-        VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &ci, nullptr, &m_compute[k]);
+        VkResult r = vkCreateComputePipelines(d, cache, 1, &ci, nullptr, &m_compute[k]);
         vkDestroyShaderModule(d, m, nullptr);
         RTHDIST_VK_CHECK(r);
         ctx.setDebugName(VK_OBJECT_TYPE_PIPELINE, uint64_t(m_compute[k]), compute[k].name);
@@ -171,8 +171,7 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery) : m_ctx(ctx), m_rayQuery(rayQu
     rci.pGroups = g;
     rci.maxPipelineRayRecursionDepth = 1;
     rci.layout = m_layout;
-    VkResult r =
-        ctx.rt().createRtPipelines(d, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &rci, nullptr, &m_rtPipeline);
+    VkResult r = ctx.rt().createRtPipelines(d, VK_NULL_HANDLE, cache, 1, &rci, nullptr, &m_rtPipeline);
     for (VkShaderModule m : mods) vkDestroyShaderModule(d, m, nullptr);
     RTHDIST_VK_CHECK(r);
     ctx.setDebugName(VK_OBJECT_TYPE_PIPELINE, uint64_t(m_rtPipeline), "search_rt_pipeline");

@@ -40,7 +40,8 @@ enum class Kernel : uint32_t {
 
 class Pipelines {
 public:
-    Pipelines(Context& ctx, bool rayQuery);
+    // cache: a VkPipelineCache (gpu/pipeline_cache.hpp) or VK_NULL_HANDLE.
+    Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache);
     ~Pipelines();
     Pipelines(const Pipelines&) = delete;
     Pipelines& operator=(const Pipelines&) = delete;

@@ -3,7 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <filesystem>
+#include <fstream>
 #include <string>
+
+#include <unistd.h>
 
 #include "common/oracle_cases.hpp"
 #include "cpu/brute_force.hpp"
@@ -107,6 +111,46 @@ TEST(CallOptions, CancellationStopsTheCallAndKeepsTheEngine) {
         expectMatchesOracle(c, *after);
         EXPECT_EQ(after->validationMessages, 0u);
     }
+}
+
+// The pipeline cache file: written by the first Engine, read by the next;
+// a damaged file is ignored (and replaced), "off" writes nothing.
+TEST(PipelineCache, WrittenReadAndRepaired) {
+    if (engineUnderTest().backend == Backend::kCpu) {
+        RTHDIST_REQUIRE_TEST_ENGINE(engine);
+        EXPECT_EQ(engine->pipelineCachePath(), "");
+        return;
+    }
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("rthdist-cache-test-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    EngineOptions o = engineUnderTest();
+    o.pipelineCacheDir = dir.string();
+    const auto a = randomCloud(500, 1), b = randomCloud(400, 2);
+    auto exactWith = [&](const EngineOptions& opts, const std::string& wantStatus) {
+        std::string whyNot;
+        auto engine = makeEngine(opts, whyNot);
+        ASSERT_TRUE(engine) << whyNot;
+        EXPECT_EQ(engine->pipelineCacheStatus().rfind(wantStatus, 0), 0u) << engine->pipelineCacheStatus();
+        auto r = engine->compute(a, b, CallOptions{});
+        ASSERT_TRUE(r) << r.error().message;
+        expectMatchesOracle(OracleCase{"cache", 1, a, b}, *r);
+        if (opts.pipelineCacheDir != "off") EXPECT_TRUE(fs::exists(engine->pipelineCachePath()));
+    };
+    exactWith(o, "none");    // no file yet: compiles, then writes it
+    exactWith(o, "loaded");  // a new Engine reads it
+    const fs::path file = fs::directory_iterator(dir)->path();
+    {
+        std::ofstream damage(file, std::ios::binary | std::ios::trunc);
+        damage << std::string(100, 'x');
+    }
+    exactWith(o, "ignored");  // damaged: compiles again and replaces it
+    exactWith(o, "loaded");
+    EngineOptions off = o;
+    off.pipelineCacheDir = "off";
+    fs::remove_all(dir);
+    exactWith(off, "none");
+    EXPECT_FALSE(fs::exists(dir));
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // H(A,B) of two tiny point sets with rthdist: one call on the CPU backend,
 // then an Engine on the default backend (a ray-tracing GPU when there is one,
-// else the CPU). The consumer that tools/package_test.sh builds against the
+// else the CPU), one-shot and with prepared sets. The consumer that tools/package_test.sh builds against the
 // installed package, and the README's C++ example.
 #include <rthdist/rthdist.hpp>
 #include <rthdist/version.hpp>
@@ -38,6 +38,15 @@ int main() {
         return 1;
     }
     if (!report(engine->compute(a, bView))) return 1;
+
+    // Build once, query many: a prepared set is indexed once on the Engine's
+    // device and reused by every later call; call options change per call.
+    rthdist::Result<rthdist::PreparedSet> pa = engine->prepare(a), pb = engine->prepare(bView);
+    if (!pa || !pb) return 1;
+    rthdist::CallOptions directed;
+    directed.directedOnly = true;  // h(A,B) only
+    rthdist::Result<rthdist::HausdorffResult> h = engine->compute(*pa, *pb, directed);
+    if (!h || h->hausdorff != 1.0 || !report(engine->compute(*pa, *pb))) return 1;
 
     // The headers and the library come from the same release.
     return std::strcmp(rthdist::versionString(), RTHDIST_VERSION_STRING) == 0 ? 0 : 1;
