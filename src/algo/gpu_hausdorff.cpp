@@ -426,7 +426,6 @@ struct GpuHausdorff::State {
         verifyIndex(ix, ix.n);
     }
 
-    // h(Q, T): Q's points in Q's cell order are the queries.
     // Search cells of level `level` (>= 1) of T, coarsened from the level
     // below on first use (coarsen.comp: head flags, scan, build).
     const PointIndex::Level& searchLevel(PointIndex& T, int level) {
@@ -554,6 +553,19 @@ struct GpuHausdorff::State {
         throwIfCancelled(options);
     }
 
+    // What the stages of one direction h(Q, T) share.
+    struct DirectionRun {
+        const PointIndex& Q;
+        PointIndex& T;
+        Counters& cnt;
+        float lowerBound2 = 0.0f;  // < 0: per-point (no early break)
+        float epsilon = 0.0f;
+        Buffer* state = nullptr;                 // QueryState per query slot
+        Buffer* active[2] = {nullptr, nullptr};  // active slots, ping-pong
+        int cur = 0;                             // active[cur] holds this iteration's slots
+    };
+
+    // h(Q, T): Q's points in Q's cell order are the queries.
     Directed direction(const PointIndex& Q, PointIndex& T, std::span<const glm::vec3> qPts,
                        std::span<const glm::vec3> tPts, const CallOptions& options, PerPoint* perPoint,
                        double progressFrom, double progressTo) {
@@ -569,44 +581,76 @@ struct GpuHausdorff::State {
         // on its axis. Shrunk a little so float rounding never kills the
         // query that realizes h.
         const double lb = boxLowerBound2(Q.bounds, T.bounds);
+        DirectionRun d{Q, T, cnt};
         // Per-point distances need every query's NN: a negative bound turns
         // the early break off in every shader (deadThreshold returns 0).
-        const float lowerBound2 = perPoint ? -1.0f : float(lb * (1.0 - 1e-5));
+        d.lowerBound2 = perPoint ? -1.0f : float(lb * (1.0 - 1e-5));
         double maxAbs = 0.0;
         for (const Bounds* b : {&Q.bounds, static_cast<const Bounds*>(&T.bounds)})
             maxAbs = std::max({maxAbs, std::abs(b->lo.x), std::abs(b->lo.y), std::abs(b->lo.z),
                                std::abs(b->hi.x), std::abs(b->hi.y), std::abs(b->hi.z)});
-        const float epsilon = float(maxAbs * 4e-7 + T.grid.cellSize * 1e-5);
+        d.epsilon = float(maxAbs * 4e-7 + T.grid.cellSize * 1e-5);
+        d.state = &buf("state", VkDeviceSize(Q.n) * sizeof(sh::QueryState));
+        d.active[0] = &buf("active0", VkDeviceSize(Q.n) * 4);
+        d.active[1] = &buf("active1", VkDeviceSize(Q.n) * 4);
 
-        auto t0 = Clock::now();
-        Buffer& state = buf("state", VkDeviceSize(Q.n) * sizeof(sh::QueryState));
-        Buffer* active[2] = {&buf("active0", VkDeviceSize(Q.n) * 4), &buf("active1", VkDeviceSize(Q.n) * 4)};
+        const uint32_t survivors = runCull(d);
+        report(options, "cull", progressFrom + 0.2 * (progressTo - progressFrom));
+        runSearch(d, survivors, options, progressFrom, progressTo);
+
+        // Witness: the query slot in the low half of maxPacked, its target in
+        // the query's state; both read back (and checked) by the self-check.
+        const auto checkStart = Clock::now();
+        const SampledQuery witness =
+            checkDirection(Q, *d.state, qPts, tPts, perPoint != nullptr, Q.name + "->" + T.name);
+        out.queryIndex = std::bit_cast<uint32_t>(witness.sorted[3]);
+        out.targetIndex = uint32_t(witness.state.best & 0xffffffffu);
+        out.queryPoint = qPts[out.queryIndex];
+        out.targetPoint = tPts[out.targetIndex];
+        out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
+        std::string why = witnessFailure(out.distance, *maxPacked(), std::sqrt(lb));
+        if (!why.empty()) throw SelfCheckError(Q.name + "->" + T.name + ": " + why);
+        timings->check += msSince(checkStart);
+        if (perPoint) readPerPoint(Q, *d.state, qPts, tPts, *perPoint);
+        return out;
+    }
+
+    // Neighbourhood pass and compaction (one submission): returns how many
+    // queries survive into the candidate search (their slots in active[0]).
+    uint32_t runCull(DirectionRun& d) {
+        const auto t0 = Clock::now();
         std::memset(hostSmall.mapped(), 0, 32);
         VkCommandBuffer cmd = ctx.begin();
-        sh::CullPush cull{Q.sorted->address(),
-                          T.sorted->address(),
-                          T.dense->address(),
-                          state.address(),
+        sh::CullPush cull{d.Q.sorted->address(),
+                          d.T.sorted->address(),
+                          d.T.dense->address(),
+                          d.state->address(),
                           maxPackedAddr(),
-                          gridParams(T.grid),
-                          Q.n,
-                          lowerBound2,
-                          epsilon,
+                          gridParams(d.T.grid),
+                          d.Q.n,
+                          d.lowerBound2,
+                          d.epsilon,
                           0u,             // search cells are coarser than the block's cells
                           kCrowdedCell};  // past it: split leaves, or copies of one point
-        dispatch(cmd, Kernel::kCull, cull, Q.n);
+        dispatch(cmd, Kernel::kCull, cull, d.Q.n);
         barrier(cmd);
-        sh::CompactPush comp{state.address(), active[0]->address(), countersAddr(), maxPackedAddr(), Q.n,
-                             lowerBound2};
-        dispatch(cmd, Kernel::kCompact, comp, Q.n);
+        sh::CompactPush comp{
+            d.state->address(), d.active[0]->address(), countersAddr(), maxPackedAddr(), d.Q.n,
+            d.lowerBound2};
+        dispatch(cmd, Kernel::kCompact, comp, d.Q.n);
         ctx.submitAndWait(cmd);
         timings->gpuCull += ctx.lastGpuMs();
-        uint32_t numActive = counter<uint32_t>(RTHDIST_CTR_ACTIVE);
-        cnt.survivingQueries = numActive;
-        cnt.culledByNeighbourhood = Q.n - numActive;
+        const uint32_t numActive = counter<uint32_t>(RTHDIST_CTR_ACTIVE);
+        d.cnt.survivingQueries = numActive;
+        d.cnt.culledByNeighbourhood = d.Q.n - numActive;
         timings->cull += msSince(t0);
-        report(options, "cull", progressFrom + 0.2 * (progressTo - progressFrom));
+        return numActive;
+    }
 
+    // Candidate search with a growing radius until no query is active.
+    void runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options, double progressFrom,
+                   double progressTo) {
+        const PointIndex& T = d.T;
         // Small first radius, grown geometrically: measured against starting
         // at the threshold's root, which makes every ray visit far more boxes
         // (docs/bench/gpu.md, growth sweep).
@@ -624,112 +668,24 @@ struct GpuHausdorff::State {
         uint64_t pairCapacity =
             std::min(std::clamp<uint64_t>(pairBase * 4, 1u << 16, 1u << 22), maxPairCapacity);
         Buffer* pairs = nullptr;
-        int cur = 0;
         int builtLevel = -1;  // level of the BLAS now built (-1: none yet)
         while (numActive > 0) {
-            if (++cnt.iterations > kMaxIterations)
+            if (++d.cnt.iterations > kMaxIterations)
                 throw std::runtime_error("candidate search did not converge");
             if (!pairs) {
                 pairs = &buf("pairs", pairCapacity * 8);
                 pairCapacity = std::min<uint64_t>(pairs->size() / 8, maxPairCapacity);
             }
-            const float r = float(radius);
-            // The ray only has to start inside the grown boxes: a short one
-            // crosses few other boxes (leaves are far smaller than grid cells).
-            const float rayTMax = float(std::min(T.grid.cellSize, T.split ? radius : T.grid.cellSize) * 1e-3);
-            // Search cells about an eighth of the radius wide: level j with
-            // s * 2^j <= R / 8, at least 1, at most bits - 1. Wider cells mean
-            // fewer boxes per ray but longer scans in the refinement; R/2 and
-            // R/4 were slower overall on the lavapipe scenarios (README).
-            // A split index searches its leaves (level 0) until level 1 is due.
-            const int wanted = int(std::floor(std::log2(radius / (8.0 * T.grid.cellSize))));
-            const int level = T.split && wanted < 1 ? 0 : std::clamp(wanted, 1, std::max(1, T.grid.bits - 1));
-            PointIndex::Level lv{T.cells, nullptr, T.numCells};
-            if (level > 0) lv = searchLevel(T, level);
-            Buffer* searchCells = lv.cells;
-            const uint32_t numSearchCells = lv.count;
-            const bool sameLevel = level == builtLevel;
-            Buffer& aabbs = buf("aabbs", VkDeviceSize(numSearchCells) * 24);
-
-            t0 = Clock::now();
-            counter<uint64_t>(RTHDIST_CTR_PAIRS) = 0;
-            counter<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE) = 0;
-            cmd = ctx.begin();
-            // Per-box slack: float rounding at the box's magnitude (the old
-            // global epsilon used the largest coordinate of both sets) plus,
-            // for a grid index, the grid's absolute term.
-            sh::BoxesPush bp{
-                searchCells->address(), aabbs.address(), numSearchCells,
-                r + r * 1e-6f,          4e-7f,           T.split ? 0.0f : float(T.grid.cellSize * 1e-5)};
-            dispatch(cmd, Kernel::kGrowBoxes, bp, numSearchCells);
-            gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                            VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
-                            VK_ACCESS_SHADER_READ_BIT);
-            // Same cells: the boxes only grew, so refit; new level: rebuild.
-            if (accel.cmdBuild(cmd, aabbs.address(), numSearchCells, sameLevel, pipelines.shaderStages()) ||
-                !tlasBound) {
-                pipelines.bindTlas(accel.tlas());
-                tlasBound = true;
-            }
+            const int level = searchLevelFor(T, radius);
+            const uint64_t pairCount =
+                searchPass(d, level, level == builtLevel, radius, *pairs, pairCapacity, numActive);
             builtLevel = level;
-            sh::SearchPush sp{Q.sorted->address(),
-                              T.sorted->address(),
-                              searchCells->address(),
-                              state.address(),
-                              active[cur]->address(),
-                              pairs->address(),
-                              countersAddr(),
-                              maxPackedAddr(),
-                              numActive,
-                              uint32_t(pairCapacity),
-                              r,
-                              lowerBound2,
-                              rayTMax,
-                              sameLevel ? 1u : 0u,
-                              0u};
-            if (rayQuery)
-                dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
-            else
-                cmdTraceRaysSplit(cmd, sp);
-            ctx.submitAndWait(cmd);
-            timings->gpuSearch += ctx.lastGpuMs();
-            const uint64_t pairCount = counter<uint64_t>(RTHDIST_CTR_PAIRS);
-            cnt.rays += numActive;
-            timings->search += msSince(t0);
-
-            t0 = Clock::now();
-            const uint64_t used = std::min<uint64_t>(pairCount, pairCapacity);
-            cnt.candidatePairs += used;
-            cmd = ctx.begin();
-            sh::RefinePush rp{Q.sorted->address(),    T.sorted->address(),
-                              searchCells->address(), state.address(),
-                              active[cur]->address(), pairs->address(),
-                              countersAddr(),         maxPackedAddr(),
-                              T.cells->address(),     level > 0 ? lv.fineFirst->address() : 0,
-                              uint32_t(pairCapacity), lowerBound2,
-                              numSearchCells,         T.numCells};
-            dispatch(cmd, Kernel::kRefine, rp, used);
-            barrier(cmd);
-            sh::ResolvePush rs{state.address(),
-                               active[cur]->address(),
-                               active[1 - cur]->address(),
-                               countersAddr(),
-                               maxPackedAddr(),
-                               numActive,
-                               r,
-                               lowerBound2};
-            dispatch(cmd, Kernel::kResolve, rs, numActive);
-            ctx.submitAndWait(cmd);
-            timings->gpuRefine += ctx.lastGpuMs();
-            numActive = counter<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE);
-            cur = 1 - cur;
-            timings->refine += msSince(t0);
+            numActive = refinePass(d, level, float(radius), *pairs, pairCapacity, pairCount, numActive);
             report(options, "search",
                    progressFrom +
                        (progressTo - progressFrom) *
                            (0.2 + 0.8 * (1.0 - double(numActive) /
-                                                   double(std::max<uint64_t>(1, cnt.survivingQueries)))));
-
+                                                   double(std::max<uint64_t>(1, d.cnt.survivingQueries)))));
             if (pairCount > pairCapacity && pairCapacity < maxPairCapacity) {
                 // Some queries lost pairs: redo them at the same radius with room.
                 pairCapacity =
@@ -739,22 +695,121 @@ struct GpuHausdorff::State {
                 radius *= double(options.radiusGrowth);
             }
         }
+    }
 
-        // Witness: the query slot in the low half of maxPacked, its target in
-        // the query's state; both read back (and checked) by the self-check.
-        const auto checkStart = Clock::now();
-        const SampledQuery witness =
-            checkDirection(Q, state, qPts, tPts, perPoint != nullptr, Q.name + "->" + T.name);
-        out.queryIndex = std::bit_cast<uint32_t>(witness.sorted[3]);
-        out.targetIndex = uint32_t(witness.state.best & 0xffffffffu);
-        out.queryPoint = qPts[out.queryIndex];
-        out.targetPoint = tPts[out.targetIndex];
-        out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
-        std::string why = witnessFailure(out.distance, *maxPacked(), std::sqrt(lb));
-        if (!why.empty()) throw SelfCheckError(Q.name + "->" + T.name + ": " + why);
-        timings->check += msSince(checkStart);
-        if (perPoint) readPerPoint(Q, state, qPts, tPts, *perPoint);
-        return out;
+    // Search cells about an eighth of the radius wide: level j with
+    // s * 2^j <= R / 8, at least 1, at most bits - 1. Wider cells mean fewer
+    // boxes per ray but longer scans in the refinement; R/2 and R/4 were
+    // slower overall on the lavapipe scenarios (README). A split index
+    // searches its leaves (level 0) until level 1 is due.
+    static int searchLevelFor(const PointIndex& T, double radius) {
+        const int wanted = int(std::floor(std::log2(radius / (8.0 * T.grid.cellSize))));
+        return T.split && wanted < 1 ? 0 : std::clamp(wanted, 1, std::max(1, T.grid.bits - 1));
+    }
+
+    // The search cells of `level` (0: the index's own cells or leaves).
+    PointIndex::Level levelCells(PointIndex& T, int level) {
+        return level > 0 ? searchLevel(T, level) : PointIndex::Level{T.cells, nullptr, T.numCells};
+    }
+
+    // One search submission: the level's boxes grown by the radius, the
+    // BLAS refitted (same level) or rebuilt, one ray per active query.
+    // Returns how many (query, cell) pairs the rays reported.
+    uint64_t searchPass(DirectionRun& d, int level, bool sameLevel, double radius, Buffer& pairs,
+                        uint64_t pairCapacity, uint32_t numActive) {
+        PointIndex& T = d.T;
+        const PointIndex::Level lv = levelCells(T, level);
+        const float r = float(radius);
+        // The ray only has to start inside the grown boxes: a short one
+        // crosses few other boxes (leaves are far smaller than grid cells).
+        const float rayTMax = float(std::min(T.grid.cellSize, T.split ? radius : T.grid.cellSize) * 1e-3);
+        Buffer& aabbs = buf("aabbs", VkDeviceSize(lv.count) * 24);
+        const auto t0 = Clock::now();
+        counter<uint64_t>(RTHDIST_CTR_PAIRS) = 0;
+        counter<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE) = 0;
+        VkCommandBuffer cmd = ctx.begin();
+        // Per-box slack: float rounding at the box's magnitude (the old
+        // global epsilon used the largest coordinate of both sets) plus,
+        // for a grid index, the grid's absolute term.
+        sh::BoxesPush bp{
+            lv.cells->address(), aabbs.address(), lv.count,
+            r + r * 1e-6f,       4e-7f,           T.split ? 0.0f : float(T.grid.cellSize * 1e-5)};
+        dispatch(cmd, Kernel::kGrowBoxes, bp, lv.count);
+        gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_SHADER_READ_BIT);
+        // Same cells: the boxes only grew, so refit; new level: rebuild.
+        if (accel.cmdBuild(cmd, aabbs.address(), lv.count, sameLevel, pipelines.shaderStages()) ||
+            !tlasBound) {
+            pipelines.bindTlas(accel.tlas());
+            tlasBound = true;
+        }
+        sh::SearchPush sp{d.Q.sorted->address(),
+                          T.sorted->address(),
+                          lv.cells->address(),
+                          d.state->address(),
+                          d.active[d.cur]->address(),
+                          pairs.address(),
+                          countersAddr(),
+                          maxPackedAddr(),
+                          numActive,
+                          uint32_t(pairCapacity),
+                          r,
+                          d.lowerBound2,
+                          rayTMax,
+                          sameLevel ? 1u : 0u,
+                          0u};
+        if (rayQuery)
+            dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
+        else
+            cmdTraceRaysSplit(cmd, sp);
+        ctx.submitAndWait(cmd);
+        timings->gpuSearch += ctx.lastGpuMs();
+        d.cnt.rays += numActive;
+        timings->search += msSince(t0);
+        return counter<uint64_t>(RTHDIST_CTR_PAIRS);
+    }
+
+    // One refinement submission: the pairs that fit are scanned exactly,
+    // then every active query is resolved (exact, dead, or on to the next
+    // radius). Returns how many stay active (their slots in the other
+    // active buffer, which becomes the current one).
+    uint32_t refinePass(DirectionRun& d, int level, float r, Buffer& pairs, uint64_t pairCapacity,
+                        uint64_t pairCount, uint32_t numActive) {
+        const PointIndex::Level lv = levelCells(d.T, level);
+        const auto t0 = Clock::now();
+        const uint64_t used = std::min<uint64_t>(pairCount, pairCapacity);
+        d.cnt.candidatePairs += used;
+        VkCommandBuffer cmd = ctx.begin();
+        sh::RefinePush rp{d.Q.sorted->address(),
+                          d.T.sorted->address(),
+                          lv.cells->address(),
+                          d.state->address(),
+                          d.active[d.cur]->address(),
+                          pairs.address(),
+                          countersAddr(),
+                          maxPackedAddr(),
+                          d.T.cells->address(),
+                          level > 0 ? lv.fineFirst->address() : 0,
+                          uint32_t(pairCapacity),
+                          d.lowerBound2,
+                          lv.count,
+                          d.T.numCells};
+        dispatch(cmd, Kernel::kRefine, rp, used);
+        barrier(cmd);
+        sh::ResolvePush rs{d.state->address(),
+                           d.active[d.cur]->address(),
+                           d.active[1 - d.cur]->address(),
+                           countersAddr(),
+                           maxPackedAddr(),
+                           numActive,
+                           r,
+                           d.lowerBound2};
+        dispatch(cmd, Kernel::kResolve, rs, numActive);
+        ctx.submitAndWait(cmd);
+        timings->gpuRefine += ctx.lastGpuMs();
+        d.cur = 1 - d.cur;
+        timings->refine += msSince(t0);
+        return counter<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE);
     }
 
     // Every query is EXACT after a per-point run: its state holds its NN.
