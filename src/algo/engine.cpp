@@ -3,6 +3,7 @@
 #include "rthdist/rthdist.hpp"
 #include "rthdist/version.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -225,8 +226,11 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     Options options;
     static_cast<CallOptions&>(options) = call;
     static_cast<EngineOptions&>(options) = impl.options;
-    Result<HausdorffResult> r = impl.device->gpu ? impl.device->gpu->compute(fa.span(), fb.span(), call)
-                                                 : cpu::cpuHausdorff(fa.span(), fb.span(), options);
+    const double scale = algo::exactScale(
+        std::max(algo::searchMagnitude(checked.a, origin), algo::searchMagnitude(checked.b, origin)));
+    Result<HausdorffResult> r = impl.device->gpu
+                                    ? impl.device->gpu->compute(fa.span(), fb.span(), scale, call)
+                                    : cpu::cpuHausdorff(fa.span(), fb.span(), options);
     if (!r) return r;
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
     if (copied) algo::restoreOriginal(*r, a, b);
@@ -269,7 +273,7 @@ Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& opti
         set->originals.resize(points.count);
         for (size_t i = 0; i < points.count; ++i) set->originals[i] = points.at(i);
     }
-    set->ownScale = algo::exactScale(algo::largestMagnitude(set->floats));
+    set->ownScale = algo::exactScale(algo::searchMagnitude(*summary, set->origin));
     if (m_impl->device->gpu) {
         Timings timings;
         const std::string name = "set#" + std::to_string(++m_impl->preparedCount);

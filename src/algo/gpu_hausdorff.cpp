@@ -1,6 +1,7 @@
 #include "algo/gpu_hausdorff.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -64,7 +65,11 @@ constexpr size_t kHostChunk = size_t(1) << 16;  // points per host work item
 // fullest cell holds 134 points; even data stays on the grid path.)
 constexpr uint32_t kCrowdedCell = 512;
 constexpr uint32_t kLeafMax = RTHDIST_LEAF_MAX;
-constexpr int kMaxSplitRounds = 12;  // each round narrows a leaf >= 2x per axis; past it: bigger leaves
+constexpr int kMaxSplitRounds = 12;
+// One-shot sets of at most this many points together are uploaded and
+// indexed in one submission, each with scratch buffers of its own.
+constexpr size_t kFusedBuildPoints =
+    size_t(1) << 25;  // each round narrows a leaf >= 2x per axis; past it: bigger leaves
 
 // A point set sorted into the cells of its own grid.
 struct PointIndex {
@@ -75,8 +80,10 @@ struct PointIndex {
     Buffer* dense = nullptr;   // uint per key: end of the key's cell
     Buffer* cells = nullptr;   // Cell per occupied cell
     uint32_t numCells = 0;
+    uint64_t cellCapacity = 0;     // room of `cells` at the build: min(n, keys)
     Buffer* sortedKeys = nullptr;  // fine key per sorted point (builds coarser levels)
     std::string name;              // "A", "B" or "set#N": names its buffers and its messages
+    std::string scratch;           // prefix of its build's pooled scratch buffers ("A", "B", "build")
     // Where its buffers live: the engine's pool (one-shot sets, reused by
     // name by the next call) or a prepared set's own map (exact sizes).
     std::map<std::string, Buffer>* store = nullptr;
@@ -107,11 +114,6 @@ sh::GridParams gridParams(const GridSpec& g) {
     return p;
 }
 
-// The shared scaling rule (index_space.hpp) over both sets' largest magnitude.
-double exactScaleFor(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
-    return exactScale(std::max(largestMagnitude(a), largestMagnitude(b)));
-}
-
 // The square of the largest excess of q's box over t's box along one axis
 // (0 when q's box lies inside t's): a lower bound of h(Q, T)^2.
 double boxLowerBound2(const Bounds& q, const Bounds& t) {
@@ -140,6 +142,22 @@ void throwIfCancelled(const CallOptions& options) {
 
 }  // namespace
 
+// One block of the host-visible counters (offsets RTHDIST_CTR_* of
+// rthdist_shared.h, the read-back area after them). The shaders find a
+// counter at the block's address plus its offset, so two index builds in one
+// submission each count into a block of their own.
+struct CounterBlock {
+    char* host = nullptr;
+    VkDeviceAddress device = 0;
+    template <class T>
+    T& at(size_t offset) const {
+        return *reinterpret_cast<T*>(host + offset);
+    }
+    [[nodiscard]] VkDeviceAddress addr(size_t offset) const { return device + offset; }
+};
+constexpr VkDeviceSize kCounterBlockBytes = 2048;
+static_assert(RTHDIST_CTR_READBACK + (kCheckSamples + 1) * 32 <= kCounterBlockBytes);
+
 // A set indexed on the device (DeviceSet in gpu_hausdorff.hpp): its index,
 // the buffers it owns (prepared) and the float points the device holds.
 struct DeviceSet {
@@ -162,7 +180,8 @@ struct GpuHausdorff::State {
     gpu::AccelStructures accel;
     bool rayQuery;
     bool tlasBound = false;
-    Buffer hostSmall;  // the counter block (RTHDIST_CTR_*), read-backs after it
+    Buffer hostSmall;                    // the counter blocks (RTHDIST_CTR_*), read-backs after each
+    std::array<CounterBlock, 2> blocks;  // blocks[0]: every stage; [1]: a second index build
     uint64_t maxPairCapacity = kMaxPairCapacity;
     Timings* timings = nullptr;
     // Buffers live across calls and only grow: allocation is a large share of
@@ -204,8 +223,10 @@ struct GpuHausdorff::State {
           accel(c),
           rayQuery(c.backend() == Backend::kRayQuery) {
         pipelineCache.save();
-        hostSmall = Buffer(ctx, RTHDIST_CTR_READBACK + (kCheckSamples + 1) * 32, gpu::kStorageUsage,
-                           MemoryKind::kHost);
+        hostSmall = Buffer(ctx, kCounterBlockBytes * blocks.size(), gpu::kStorageUsage, MemoryKind::kHost);
+        for (size_t k = 0; k < blocks.size(); ++k)
+            blocks[k] = CounterBlock{static_cast<char*>(hostSmall.mapped()) + k * kCounterBlockBytes,
+                                     hostSmall.address() + k * kCounterBlockBytes};
     }
 
     // A counter of the block (offsets from rthdist_shared.h).
@@ -243,14 +264,13 @@ struct GpuHausdorff::State {
         }
     }
 
-    // Indexes `pts` into the buffers of `ix` (name and store set by the caller).
-    void buildIndex(PointIndex& ix, std::span<const glm::vec3> pts, int bits) {
+    // Host half of an index build: the points into the set's staging buffer
+    // (vec4) in one parallel pass that also takes their bounds, then the bit
+    // count and the grid. Nothing is submitted.
+    void stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int bits) {
         ix.n = uint32_t(pts.size());
         const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
-
-        // One parallel host pass: vec3 -> vec4 staging and the bounds.
-        auto t0 = Clock::now();
-        Buffer& staging = buf("staging", bytes, MemoryKind::kHost);
+        Buffer& staging = buf(ix.scratch + ".staging", bytes, MemoryKind::kHost);
         auto* dst = static_cast<float*>(staging.mapped());
         const int threads = cpu::resolveThreads(0, ix.n / kHostChunk + 1);
         std::vector<glm::vec3> lo(size_t(threads), pts[0]), hi(size_t(threads), pts[0]);
@@ -281,65 +301,97 @@ struct GpuHausdorff::State {
             while (bits > kMinBits && (uint64_t(1) << (3 * bits)) > 8 * uint64_t(ix.n) + 4096) --bits;
         }
         ix.grid = makeGrid(ix.bounds, bits);
+    }
 
-        Buffer& points = buf("points", bytes);
-        VkCommandBuffer cmd = ctx.begin();
-        VkBufferCopy region{0, 0, bytes};
-        vkCmdCopyBuffer(cmd, staging.handle(), points.handle(), 1, &region);
-        ctx.submitAndWait(cmd);
-        timings->upload += msSince(t0);
+    // The staged points' copy to the device (before cmdBuildIndex, with a
+    // barrier between: several sets' copies run back to back).
+    void cmdUpload(VkCommandBuffer cmd, PointIndex& ix) {
+        const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
+        Buffer& points = buf(ix.scratch + ".points", bytes);
+        const VkBufferCopy region{0, 0, bytes};
+        vkCmdCopyBuffer(cmd, buf(ix.scratch + ".staging", bytes, MemoryKind::kHost).handle(), points.handle(),
+                        1, &region);
+    }
 
-        t0 = Clock::now();
+    // Device half of an index build, recorded into `cmd` after the upload:
+    // cell keys, counting sort over the dense key table, run-length encoding
+    // into cells with tight boxes, the self-check. Counters go to `blk`;
+    // scratch buffers are the set's own (ix.scratch), so two sets can be
+    // built in one submission.
+    void cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const CounterBlock& blk) {
+        const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
+        Buffer& points = buf(ix.scratch + ".points", bytes);
         const uint32_t numKeys = 1u << (3 * ix.grid.bits);
-        Buffer& keys = buf("keys", VkDeviceSize(ix.n) * 4);
+        Buffer& keys = buf(ix.scratch + ".keys", VkDeviceSize(ix.n) * 4);
         ix.sortedKeys = &setBuf(ix, ".sortedKeys", VkDeviceSize(ix.n) * 4);
-        Buffer& sortedKeys = *ix.sortedKeys;
-        Buffer& flags = buf("flags", VkDeviceSize(ix.n) * 4);
+        Buffer& flags = buf(ix.scratch + ".flags", VkDeviceSize(ix.n) * 4);
         const VkDeviceSize denseBytes = VkDeviceSize(numKeys) * 4;
         ix.dense = &setBuf(ix, ".dense", denseBytes);
         ix.sorted = &setBuf(ix, ".sorted", bytes);
         // Cells: at most one per point or key; the upper bound avoids a read-back.
-        const uint64_t cellCapacity = std::min<uint64_t>(ix.n, numKeys);
-        ix.cells = &setBuf(ix, ".cells", VkDeviceSize(cellCapacity) * sizeof(sh::Cell));
+        ix.cellCapacity = std::min<uint64_t>(ix.n, numKeys);
+        ix.cells = &setBuf(ix, ".cells", VkDeviceSize(ix.cellCapacity) * sizeof(sh::Cell));
 
-        counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
-        counter<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
-        cmd = ctx.begin();
+        blk.at<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
+        blk.at<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
         vkCmdFillBuffer(cmd, ix.dense->handle(), 0, denseBytes, 0);
         barrier(cmd);
         sh::KeysPush kp{points.address(), keys.address(), ix.dense->address(), gridParams(ix.grid), ix.n};
         dispatch(cmd, Kernel::kCellKeys, kp, ix.n);
         barrier(cmd);
-        cmdScan(cmd, ix.dense->address(), numKeys, "scanKeys", 0);
+        cmdScan(cmd, ix.dense->address(), numKeys, ix.scratch + ".scanKeys", 0);
         barrier(cmd);
-        sh::ScatterPush sp{points.address(),     keys.address(),       ix.dense->address(),
-                           ix.sorted->address(), sortedKeys.address(), ix.n};
+        sh::ScatterPush sp{points.address(),     keys.address(),           ix.dense->address(),
+                           ix.sorted->address(), ix.sortedKeys->address(), ix.n};
         dispatch(cmd, Kernel::kScatter, sp, ix.n);
         barrier(cmd);
         sh::CellsPush cp{ix.sorted->address(),
-                         sortedKeys.address(),
+                         ix.sortedKeys->address(),
                          flags.address(),
                          ix.dense->address(),
                          ix.cells->address(),
-                         cellsCounterAddr(),
-                         maxCountAddr(),
-                         boundsU(cellCapacity).address(),
-                         hostSmall.address() + RTHDIST_CTR_LARGE_CELLS,
+                         blk.addr(RTHDIST_CTR_CELLS),
+                         blk.addr(RTHDIST_CTR_MAX_COUNT),
+                         buf(ix.scratch + ".boundsU", VkDeviceSize(ix.cellCapacity) * 24).address(),
+                         blk.addr(RTHDIST_CTR_LARGE_CELLS),
                          ix.n,
-                         uint32_t(cellCapacity)};
+                         uint32_t(ix.cellCapacity)};
         dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
         barrier(cmd);
-        cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
+        cmdScan(cmd, flags.address(), ix.n, ix.scratch + ".scanFlags", 0);
         barrier(cmd);
         cmdCellBuild(cmd, cp);
         barrier(cmd);
-        cmdCheckIndex(cmd, ix);  // in the same submission: no extra wait
+        cmdCheckIndex(cmd, ix, blk);  // in the same submission: no extra wait
+    }
+
+    // After the build's submission: the self-check's verdict and the cell
+    // count from `blk`; crowded cells are split into leaves (own submissions).
+    void finishIndex(PointIndex& ix, const CounterBlock& blk) {
+        ix.numCells = blk.at<uint32_t>(RTHDIST_CTR_CELLS);
+        verifyIndex(ix, ix.cellCapacity, blk);
+        if (blk.at<uint32_t>(RTHDIST_CTR_MAX_COUNT) > kCrowdedCell) splitLeaves(ix);
+    }
+
+    // Indexes the staged sets (one or two) in one submission: both uploads
+    // back to back, then each build; then each set's checks and leaves.
+    template <size_t N>
+    void buildIndexes(const std::array<PointIndex*, N>& sets) {
+        static_assert(N <= std::tuple_size_v<decltype(blocks)>, "a counter block per set");
+        if (sets.size() > blocks.size())
+            throw std::logic_error("buildIndexes: more sets than counter blocks");
+        auto t0 = Clock::now();
+        VkCommandBuffer cmd = ctx.begin();
+        for (PointIndex* ix : sets) cmdUpload(cmd, *ix);
+        const uint32_t uploaded = ctx.cmdMark(cmd);
+        barrier(cmd);
+        for (size_t k = 0; k < sets.size(); ++k) cmdBuildIndex(cmd, *sets[k], blocks[k]);
         ctx.submitAndWait(cmd);
-        timings->gpuIndex += ctx.lastGpuMs();
-        ix.numCells = counter<uint32_t>(RTHDIST_CTR_CELLS);
-        verifyIndex(ix, cellCapacity);
-        if (counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) > kCrowdedCell) splitLeaves(ix);
-        timings->index += msSince(t0);
+        const double uploadMs = ctx.gpuMsBetween(0, uploaded);
+        timings->upload += uploadMs;
+        timings->gpuIndex += ctx.lastGpuMs() - uploadMs;
+        for (size_t k = 0; k < sets.size(); ++k) finishIndex(*sets[k], blocks[k]);
+        timings->index += msSince(t0) - uploadMs;
     }
 
     // Cuts the crowded cells of `ix` into leaves (leaf_*.comp), round by
@@ -421,9 +473,9 @@ struct GpuHausdorff::State {
         const float edge = std::bit_cast<float>(counter<uint32_t>(RTHDIST_CTR_MIN_EDGE));
         ix.minEdge = std::isfinite(edge) ? double(edge) : 0.0;
         VkCommandBuffer cmd = ctx.begin();
-        cmdCheckIndex(cmd, ix);
+        cmdCheckIndex(cmd, ix, blocks[0]);
         ctx.submitAndWait(cmd);
-        verifyIndex(ix, ix.n);
+        verifyIndex(ix, ix.n, blocks[0]);
     }
 
     // Search cells of level `level` (>= 1) of T, coarsened from the level
@@ -492,19 +544,19 @@ struct GpuHausdorff::State {
 
     // Self-check of an index, recorded after its build (check_index.comp);
     // verifyIndex reads the verdict once the submission has completed.
-    void cmdCheckIndex(VkCommandBuffer cmd, const PointIndex& ix) {
-        counter<uint64_t>(RTHDIST_CTR_CHECK_SUM) = 0;
-        counter<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
+    void cmdCheckIndex(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {
+        blk.at<uint64_t>(RTHDIST_CTR_CHECK_SUM) = 0;
+        blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
         sh::CheckPush cp{
-            ix.sorted->address(), ix.sortedKeys->address(), 0, countersAddr(), gridParams(ix.grid), ix.n, 0u};
+            ix.sorted->address(), ix.sortedKeys->address(), 0, blk.device, gridParams(ix.grid), ix.n, 0u};
         dispatch(cmd, Kernel::kCheckIndex, cp, ix.n);
     }
-    void verifyIndex(const PointIndex& ix, uint64_t cellCapacity) {
+    void verifyIndex(const PointIndex& ix, uint64_t cellCapacity, const CounterBlock& blk) {
         const uint64_t n = ix.n;
         const uint64_t expectedSum = n % 2 == 0 ? (n / 2) * (n - 1) : n * ((n - 1) / 2);
-        std::string why = indexCheckFailure(n, counter<uint64_t>(RTHDIST_CTR_CHECK_BAD),
-                                            counter<uint64_t>(RTHDIST_CTR_CHECK_SUM), expectedSum,
-                                            ix.numCells, cellCapacity);
+        std::string why = indexCheckFailure(n, blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD),
+                                            blk.at<uint64_t>(RTHDIST_CTR_CHECK_SUM), expectedSum, ix.numCells,
+                                            cellCapacity);
         if (!why.empty()) throw SelfCheckError("index of " + ix.name + ": " + why);
     }
 
@@ -840,20 +892,26 @@ struct GpuHausdorff::State {
         }
     }
 
-    // Indexes `input` (float, before the scale) as set `name`: in the pool
-    // (one-shot) or in buffers of its own (owned: a prepared set, whose
-    // buffers the index does not use after a leaf split are released).
-    void indexSet(DeviceSet& set, std::span<const glm::vec3> input, double scale, int bits,
-                  const std::string& name, bool owned) {
+    // Stages `input` (float, before the scale) as set `name` for an index
+    // build: in the pool (one-shot) or in buffers of its own (owned: a
+    // prepared set). The host pass counts as upload time.
+    void stageSet(DeviceSet& set, std::span<const glm::vec3> input, double scale, int bits,
+                  const std::string& name, const std::string& scratch, bool owned = false) {
+        const auto t0 = Clock::now();
         set.input = input;
         set.scale = scale;
         if (scale != 1.0) set.scaledCopy = scaledCopy(input, scale);
         set.points = scale != 1.0 ? std::span<const glm::vec3>(set.scaledCopy) : input;
         set.ix.name = name;
+        set.ix.scratch = scratch;
         set.ix.owned = owned;
         set.ix.store = owned ? &set.own : &pool;
-        buildIndex(set.ix, set.points, bits);
-        if (!owned) return;
+        stageIndex(set.ix, set.points, bits);
+        timings->upload += msSince(t0);
+    }
+
+    // A prepared set keeps only the buffers its index uses after a leaf split.
+    static void releaseUnused(DeviceSet& set) {
         for (auto it = set.own.begin(); it != set.own.end();) {
             const Buffer* b = &it->second;
             const bool used =
@@ -936,7 +994,7 @@ Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, co
 }
 
 Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                              const CallOptions& options) {
+                                              double scale, const CallOptions& options) {
     State& st = *m_state;
     HausdorffResult res = st.emptyResult(options);
     // Squared distances are float on the device: coordinates so large (or so
@@ -945,11 +1003,20 @@ Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std:
     // Each set is indexed once with its own grid: as targets for the other
     // direction, and as cell-ordered (Morton) queries for its own.
     auto err = st.guarded(res.timings, [&] {
-        const double scale = exactScaleFor(a, b);
+        // Small sets: both staged, then uploaded and indexed in one
+        // submission (scratch of their own). Large ones: one after the other
+        // in the same scratch (a submission is then cheap beside the work,
+        // and the device holds one set's scratch, not two).
         DeviceSet da, db;
-        st.indexSet(da, a, scale, options.bits, "A", false);
+        const bool together = a.size() + b.size() <= kFusedBuildPoints;
+        st.stageSet(da, a, scale, options.bits, "A", together ? "A" : "build");
+        if (!together) st.buildIndexes(std::array{&da.ix});
+        st.stageSet(db, b, scale, options.bits, "B", together ? "B" : "build");
         st.report(options, "index", 0.05);
-        st.indexSet(db, b, scale, options.bits, "B", false);
+        if (together)
+            st.buildIndexes(std::array{&da.ix, &db.ix});
+        else
+            st.buildIndexes(std::array{&db.ix});
         st.report(options, "index", 0.1);
         st.runPair(da, db, options, res, 0.1);
     });
@@ -957,11 +1024,20 @@ Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std:
     return res;
 }
 
+Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                              const CallOptions& options) {
+    return compute(a, b, exactScale(std::max(largestMagnitude(a), largestMagnitude(b))), options);
+}
+
 Result<std::shared_ptr<DeviceSet>> GpuHausdorff::prepare(std::span<const glm::vec3> points, double scale,
                                                          int bits, const std::string& name,
                                                          Timings& timings) {
     auto set = std::make_shared<DeviceSet>();
-    auto err = m_state->guarded(timings, [&] { m_state->indexSet(*set, points, scale, bits, name, true); });
+    auto err = m_state->guarded(timings, [&] {
+        m_state->stageSet(*set, points, scale, bits, name, "build", true);
+        m_state->buildIndexes(std::array{&set->ix});
+        State::releaseUnused(*set);
+    });
     if (err) return *err;
     return set;
 }

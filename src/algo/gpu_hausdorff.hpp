@@ -39,7 +39,12 @@ public:
                                                                       const std::string& cacheDir);
     ~GpuHausdorff();
 
-    // One-shot: both sets indexed for this call, in buffers pooled between calls.
+    // One-shot: both sets indexed for this call, in buffers pooled between
+    // calls. `scale`: the exact power of two of index_space.hpp for both sets
+    // (exactScale of their largest magnitude).
+    [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                                  double scale, const CallOptions& options);
+    // As above, the scale taken from the points (one pass over each).
     [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                   const CallOptions& options);
 

@@ -118,6 +118,12 @@ bool frameKeepsBound(const SetSummary& a, const SetSummary& b, const glm::dvec3&
     return m <= 4.0 * diagonal;
 }
 
+double searchMagnitude(const SetSummary& set, const glm::dvec3& origin) {
+    const glm::vec3 lo(set.box.lo - origin), hi(set.box.hi - origin);
+    const glm::vec3 m = glm::max(glm::abs(lo), glm::abs(hi));
+    return double(std::max({m.x, m.y, m.z}));
+}
+
 std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin) {
     std::vector<glm::vec3> out(points.count);
     const int threads = cpu::resolveThreads(0, points.count / kChunk + 1);

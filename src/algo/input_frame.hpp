@@ -46,6 +46,13 @@ struct SetSummary {
 // 2 sqrt(3) 2^-24 m, within 1e-6 D when m <= 4 D (D: the union's diagonal).
 [[nodiscard]] bool frameKeepsBound(const SetSummary& a, const SetSummary& b, const glm::dvec3& origin);
 
+// The largest coordinate magnitude of the set as searched (shifted by
+// `origin`, rounded to float): the maxAbs of exactScale (index_space.hpp),
+// from the box alone. Rounding p - origin is monotone in p, so the extremes
+// of the rounded points are the rounded corners of the box: no pass over the
+// points.
+[[nodiscard]] double searchMagnitude(const SetSummary& set, const glm::dvec3& origin);
+
 // Points shifted by `origin` and rounded to float, in a vector of their own.
 [[nodiscard]] std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin);
 

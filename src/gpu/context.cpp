@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstring>
 #include <sstream>
+#include <stdexcept>
 
 namespace rthdist::gpu {
 
@@ -349,7 +350,7 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
         RTHDIST_VK_CHECK(vkCreateFence(d, &fci, nullptr, &ctx->m_fence));
         VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
         qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-        qpi.queryCount = 2;
+        qpi.queryCount = kTimestampSlots;
         RTHDIST_VK_CHECK(vkCreateQueryPool(d, &qpi, nullptr, &ctx->m_timestamps));
         uint32_t qn = 0;
         vkGetPhysicalDeviceQueueFamilyProperties(chosenPd, &qn, nullptr);
@@ -398,13 +399,27 @@ VkCommandBuffer Context::begin() {
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     RTHDIST_VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
-    vkCmdResetQueryPool(m_cmd, m_timestamps, 0, 2);
+    vkCmdResetQueryPool(m_cmd, m_timestamps, 0, kTimestampSlots);
     vkCmdWriteTimestamp(m_cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, m_timestamps, 0);
+    m_marks = 1;
     return m_cmd;
 }
 
+uint32_t Context::cmdMark(VkCommandBuffer cmd) {
+    if (m_marks + 1 >= kTimestampSlots)
+        throw std::logic_error("Context::cmdMark: too many marks in one submission");
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps, m_marks);
+    return m_marks++;
+}
+
+double Context::gpuMsBetween(uint32_t from, uint32_t to) const {
+    const uint64_t mask = m_timestampBits >= 64 ? ~uint64_t(0) : ((uint64_t(1) << m_timestampBits) - 1);
+    return double((m_stamps[to] - m_stamps[from]) & mask) * double(m_timestampPeriod) * 1e-6;
+}
+
 void Context::submitAndWait(VkCommandBuffer cmd) {
-    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps, 1);
+    const uint32_t last = m_marks;
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps, last);
     RTHDIST_VK_CHECK(vkEndCommandBuffer(cmd));
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     si.commandBufferCount = 1;
@@ -416,12 +431,10 @@ void Context::submitAndWait(VkCommandBuffer cmd) {
     } while (r == VK_TIMEOUT);
     RTHDIST_VK_CHECK(r);
     RTHDIST_VK_CHECK(vkResetFences(m_device, 1, &m_fence));
-    uint64_t ts[2] = {0, 0};
-    r = vkGetQueryPoolResults(m_device, m_timestamps, 0, 2, sizeof(ts), ts, sizeof(uint64_t),
-                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+    r = vkGetQueryPoolResults(m_device, m_timestamps, 0, last + 1, sizeof(m_stamps), m_stamps.data(),
+                              sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
     RTHDIST_VK_CHECK(r);
-    const uint64_t mask = m_timestampBits >= 64 ? ~uint64_t(0) : ((uint64_t(1) << m_timestampBits) - 1);
-    m_lastGpuMs = double((ts[1] - ts[0]) & mask) * double(m_timestampPeriod) * 1e-6;
+    m_lastGpuMs = gpuMsBetween(0, last);
 }
 
 }  // namespace rthdist::gpu

@@ -5,6 +5,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -65,6 +66,13 @@ public:
     // Device milliseconds between begin() and the end of the last submitted
     // command buffer (timestamp queries).
     [[nodiscard]] double lastGpuMs() const { return m_lastGpuMs; }
+    // A timestamp after the commands recorded so far (at most
+    // kTimestampSlots - 2 per command buffer); returns its mark, 0 being
+    // begin(). After submitAndWait, gpuMsBetween(mark, later mark) times the
+    // commands between them (e.g. the uploads of a submission).
+    uint32_t cmdMark(VkCommandBuffer cmd);
+    [[nodiscard]] double gpuMsBetween(uint32_t from, uint32_t to) const;
+    static constexpr uint32_t kTimestampSlots = 8;
 
     void countValidationMessage() { ++m_validationMessages; }
 
@@ -87,6 +95,8 @@ private:
     VkFence m_fence = VK_NULL_HANDLE;
     VkQueryPool m_timestamps = VK_NULL_HANDLE;
     double m_lastGpuMs = 0.0;
+    uint32_t m_marks = 1;                              // timestamps written since begin()
+    std::array<uint64_t, kTimestampSlots> m_stamps{};  // of the last submission
     uint32_t m_timestampBits = 64;
     Backend m_backend = Backend::kRayQuery;
     std::string m_name;
