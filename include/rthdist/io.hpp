@@ -65,14 +65,25 @@
 // the float range is then an error): kept for callers that want float32;
 // for decimal text it can differ from a direct float conversion by one unit
 // in the last place when the decimal lies almost halfway between two floats.
-// Limits: a LAS file is read whole into memory like every other format (its
-// point records plus the cloud, 24 bytes per point); extended VLRs and
-// waveform data after the points are not read. A glTF mesh instanced by
+// Reading: a regular file is memory-mapped read-only and parsed in place;
+// binary PLY vertices without list properties, binary PCD rows and LAS
+// points are converted in parallel chunks straight into the cloud, and text
+// bodies (XYZ/TXT, ascii PLY, OBJ, OFF, ascii PCD) are cut at line ends into
+// chunks parsed in parallel (LoadOptions::threads). Points, precision and
+// errors are those of a serial parse: an error names the first bad place in
+// the file. A .gz file is inflated into memory first; a file that is not
+// regular (a FIFO, a device) is refused. A file truncated by another
+// process while it is being loaded ends the process with SIGBUS, as with
+// any reader of a mapped file. Memory: the cloud (24 bytes per point in
+// double, 12 in float) beside the page cache's copy of the file.
+// Limits: extended VLRs and LAS waveform data after the points are not
+// read. A glTF mesh instanced by
 // several nodes gives its points once per instance; NaN points (e.g. in
 // organized PCD clouds) are rejected, not dropped; a binary PLY whose vertex
 // count is one too high can go unnoticed when the bytes it takes happen to
 // leave a valid rest (e.g. 12-byte vertices before uchar/int triangles).
-// Reentrant: no shared state, safe to call from several threads.
+// Reentrant: no shared state, safe to call from several threads (each call
+// starts and joins its own parsing threads).
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -105,6 +116,9 @@ struct LoadOptions {
     // have no classification and ignore it. A filter that keeps no point is
     // kBadInput naming the classes.
     std::vector<int> lasClasses;
+    // Threads that parse one file: 0 (default) every hardware thread, 1 the
+    // calling thread only. The points and the errors do not depend on it.
+    unsigned threads = 0;
 };
 
 [[nodiscard]] RTHDIST_IO_API Result<PointCloud> loadPointCloud(const std::string& path,

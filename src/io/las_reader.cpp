@@ -4,6 +4,7 @@
 // 64-bit point counts (375).
 #include "io/las_reader.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -150,6 +151,75 @@ std::string classList(const std::vector<int>& classes) {
     return s;
 }
 
+// The point records cut into chunks of perChunk records.
+struct PointChunks {
+    const char* file = nullptr;
+    const LasHeader& h;
+    uint64_t perChunk = 1;
+
+    [[nodiscard]] size_t count() const { return chunkCount(h.count, perChunk); }
+    [[nodiscard]] uint64_t begin(size_t c) const { return c * perChunk; }
+    [[nodiscard]] uint64_t end(size_t c) const { return std::min(h.count, (c + 1) * perChunk); }
+    [[nodiscard]] const char* record(uint64_t k) const { return file + h.pointOffset + k * h.recordLength; }
+};
+
+// For each chunk, how many points the filter keeps before it; the last entry
+// is the total.
+std::vector<uint64_t> keptBefore(const PointChunks& chunks, const std::array<bool, 256>& keep,
+                                 const ChunkPlan& plan) {
+    std::vector<uint64_t> kept(chunks.count() + 1, 0);
+    (void)forEachChunk(chunks.count(), plan, [&](size_t c) -> std::optional<Error> {
+        uint64_t n = 0;
+        for (uint64_t k = chunks.begin(c); k < chunks.end(c); ++k) {
+            n += keep[classification(chunks.record(k), chunks.h.format)] ? 1 : 0;
+        }
+        kept[c + 1] = n;
+        return std::nullopt;
+    });
+    for (size_t c = 0; c < chunks.count(); ++c) kept[c + 1] += kept[c];
+    return kept;
+}
+
+// The classification values the file holds, ascending.
+std::vector<int> classesPresent(const PointChunks& chunks, const ChunkPlan& plan) {
+    std::vector<std::array<bool, 256>> present(chunks.count());
+    (void)forEachChunk(chunks.count(), plan, [&](size_t c) -> std::optional<Error> {
+        for (uint64_t k = chunks.begin(c); k < chunks.end(c); ++k)
+            present[c][classification(chunks.record(k), chunks.h.format)] = true;
+        return std::nullopt;
+    });
+    std::vector<int> found;
+    for (int v = 0; v < 256; ++v) {
+        const auto has = [v](const std::array<bool, 256>& p) { return p[static_cast<size_t>(v)]; };
+        if (std::any_of(present.begin(), present.end(), has)) found.push_back(v);
+    }
+    return found;
+}
+
+// Chunk c's kept points, X * scale + offset in double, into out; the first
+// point whose coordinate is not finite is the chunk's error.
+template <bool kFilter>
+std::optional<Error> convertPoints(const PointChunks& chunks, size_t c, const std::array<bool, 256>& keep,
+                                   glm::dvec3* out, const std::string& path) {
+    const LasHeader& h = chunks.h;
+    for (uint64_t k = chunks.begin(c); k < chunks.end(c); ++k) {
+        const char* p = chunks.record(k);
+        if (kFilter && !keep[classification(p, h.format)]) continue;
+        glm::dvec3 v;
+        for (size_t axis = 0; axis < 3; ++axis) {
+            const int32_t raw = detail::loadRaw<int32_t>(p + 4 * axis, false);
+            v[static_cast<int>(axis)] = static_cast<double>(raw) * h.scale[axis] + h.offset[axis];
+        }
+        if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
+            const int axis = !std::isfinite(v.x) ? 0 : !std::isfinite(v.y) ? 1 : 2;
+            return badInput(path, "point " + std::to_string(k) + " (" + offsetWhere(p - chunks.file) + ")",
+                            std::string(1, "XYZ"[axis]) + " * scale + offset is not finite");
+        }
+        *out++ = v;
+    }
+    return std::nullopt;
+}
+
 }  // namespace
 
 Error lazError(const std::string& path, const std::string& where) {
@@ -159,7 +229,8 @@ Error lazError(const std::string& path, const std::string& where) {
                     "and pass the .las file");
 }
 
-Result<PointCloud> readLas(std::string_view bytes, const std::string& path, const std::vector<int>& classes) {
+Result<PointCloud> readLas(std::string_view bytes, const std::string& path, const std::vector<int>& classes,
+                           const ChunkPlan& plan) {
     auto header = parseHeader(bytes, path);
     if (!header) return header.error();
     const LasHeader& h = *header;
@@ -172,46 +243,28 @@ Result<PointCloud> readLas(std::string_view bytes, const std::string& path, cons
         }
         keep[static_cast<size_t>(c)] = true;
     }
-    const char* records = bytes.data() + h.pointOffset;
-    uint64_t kept = h.count;
-    std::array<bool, 256> present{};
+    const PointChunks chunks{bytes.data(), h, plan.items(h.recordLength)};
+    std::vector<uint64_t> firstKept(chunks.count() + 1);
+    for (size_t c = 0; c <= chunks.count(); ++c) firstKept[c] = std::min(h.count, c * chunks.perChunk);
     if (!classes.empty()) {
-        kept = 0;
-        for (uint64_t k = 0; k < h.count; ++k) {
-            const uint8_t c = classification(records + k * h.recordLength, h.format);
-            present[c] = true;
-            if (keep[c]) ++kept;
-        }
-        if (kept == 0 && h.count != 0) {
-            std::vector<int> found;
-            for (int c = 0; c < 256; ++c) {
-                if (present[static_cast<size_t>(c)]) found.push_back(c);
-            }
+        firstKept = keptBefore(chunks, keep, plan);
+        if (firstKept.back() == 0 && h.count != 0) {
             return badInput(path, "classification",
                             "none of the " + std::to_string(h.count) + " points has class " +
-                                classList(classes) + " (the file holds class " + classList(found) + ")");
+                                classList(classes) + " (the file holds class " +
+                                classList(classesPresent(chunks, plan)) + ")");
         }
     }
 
     PointCloud cloud;
     cloud.scalar = Scalar::kFloat64;
-    cloud.doubles.resize(static_cast<size_t>(kept));
-    size_t out = 0;
-    for (uint64_t k = 0; k < h.count; ++k) {
-        const char* p = records + k * h.recordLength;
-        if (!keep[classification(p, h.format)]) continue;
-        glm::dvec3 v;
-        for (size_t axis = 0; axis < 3; ++axis) {
-            const int32_t raw = detail::loadRaw<int32_t>(p + 4 * axis, false);
-            v[static_cast<int>(axis)] = static_cast<double>(raw) * h.scale[axis] + h.offset[axis];
-            if (!std::isfinite(v[static_cast<int>(axis)])) {
-                return badInput(path,
-                                "point " + std::to_string(k) + " (" + offsetWhere(p - bytes.data()) + ")",
-                                std::string(1, "XYZ"[axis]) + " * scale + offset is not finite");
-            }
-        }
-        cloud.doubles[out++] = v;
-    }
+    cloud.doubles.resize(static_cast<size_t>(firstKept.back()));
+    auto err = forEachChunk(chunks.count(), plan, [&](size_t c) -> std::optional<Error> {
+        glm::dvec3* out = cloud.doubles.data() + firstKept[c];
+        return classes.empty() ? convertPoints<false>(chunks, c, keep, out, path)
+                               : convertPoints<true>(chunks, c, keep, out, path);
+    });
+    if (err) return *err;
     return cloud;
 }
 

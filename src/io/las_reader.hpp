@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "io/parallel_chunks.hpp"
 #include "rthdist/io.hpp"
 #include "rthdist/result.hpp"
 
@@ -30,8 +31,10 @@ inline constexpr uint16_t kLasMinRecordLength[11] = {20, 28, 26, 34, 57, 63, 30,
 // classes: keep only points with one of these classification values (empty:
 // all); classification is the low 5 bits of byte 15 in formats 0-5, byte 16
 // in formats 6-10. Keeping no point is an error naming the classes.
+// plan: threads and chunk size of the parallel conversion (the result does
+// not depend on it).
 [[nodiscard]] Result<PointCloud> readLas(std::string_view bytes, const std::string& path,
-                                         const std::vector<int>& classes);
+                                         const std::vector<int>& classes, const ChunkPlan& plan = {});
 
 // The error for compressed LAS (a .laz file, or a LAS header whose point
 // format carries LASzip's compression bits).

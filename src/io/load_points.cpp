@@ -1,18 +1,24 @@
-// loadPointCloud: read (and gunzip), dispatch on the extension, then enforce
+// loadPointCloud: map (or read and gunzip), dispatch on the extension, then enforce
 // the contract shared by every format: at least one point, every coordinate
 // finite. loadPoints: the same, rounded to float.
 #include <algorithm>
+#include <bit>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <optional>
+#include <type_traits>
 
 #include "io/file_bytes.hpp"
 #include "io/gltf_reader.hpp"
 #include "io/io_error.hpp"
 #include "io/las_reader.hpp"
+#include "io/load_tuning.hpp"
 #include "io/number_parse.hpp"
 #include "io/obj_reader.hpp"
 #include "io/off_reader.hpp"
+#include "io/parallel_chunks.hpp"
 #include "io/pcd_reader.hpp"
 #include "io/ply_reader.hpp"
 #include "io/stl_reader.hpp"
@@ -34,57 +40,91 @@ std::string formatExtension(const std::string& path) {
 // A reader and, for formats whose header bounds the file size, the check
 // that caps a .gz before it is inflated.
 struct Format {
-    Result<PointCloud> (*read)(std::string_view, const std::string&, const LoadOptions&) = nullptr;
+    Result<PointCloud> (*read)(std::string_view, const std::string&, const LoadOptions&,
+                               const ChunkPlan&) = nullptr;
     InflatedBound gzipBound = nullptr;
 };
 
-template <Result<PointCloud> (*kRead)(std::string_view, const std::string&)>
-Result<PointCloud> ignoreOptions(std::string_view bytes, const std::string& path, const LoadOptions&) {
-    return kRead(bytes, path);
+template <Result<PointCloud> (*kRead)(std::string_view, const std::string&, const ChunkPlan&)>
+Result<PointCloud> withPlan(std::string_view bytes, const std::string& path, const LoadOptions&,
+                            const ChunkPlan& plan) {
+    return kRead(bytes, path, plan);
 }
 
-Result<PointCloud> readGltfCloud(std::string_view bytes, const std::string& path, const LoadOptions&) {
+Result<PointCloud> readStlCloud(std::string_view bytes, const std::string& path, const LoadOptions&,
+                                const ChunkPlan&) {
+    return readStl(bytes, path);
+}
+
+Result<PointCloud> readGltfCloud(std::string_view bytes, const std::string& path, const LoadOptions&,
+                                 const ChunkPlan&) {
     auto points = readGltf(bytes, path);
     if (!points) return points.error();
     return PointCloud{Scalar::kFloat32, std::move(points).value(), {}};
 }
 
-Result<PointCloud> readLasCloud(std::string_view bytes, const std::string& path, const LoadOptions& options) {
-    return readLas(bytes, path, options.lasClasses);
+Result<PointCloud> readLasCloud(std::string_view bytes, const std::string& path, const LoadOptions& options,
+                                const ChunkPlan& plan) {
+    return readLas(bytes, path, options.lasClasses, plan);
 }
 
 Format formatFor(const std::string& ext) {
-    if (ext == ".ply") return {&ignoreOptions<&readPly>, &plyInflatedBound};
-    if (ext == ".xyz" || ext == ".txt") return {&ignoreOptions<&readXyz>};
-    if (ext == ".obj") return {&ignoreOptions<&readObj>};
+    if (ext == ".ply") return {&withPlan<&readPly>, &plyInflatedBound};
+    if (ext == ".xyz" || ext == ".txt") return {&withPlan<&readXyz>};
+    if (ext == ".obj") return {&withPlan<&readObj>};
     if (ext == ".gltf" || ext == ".glb") return {&readGltfCloud, &glbInflatedBound};
-    if (ext == ".stl") return {&ignoreOptions<&readStl>, &stlInflatedBound};
-    if (ext == ".off") return {&ignoreOptions<&readOff>};
-    if (ext == ".pcd") return {&ignoreOptions<&readPcd>};
+    if (ext == ".stl") return {&readStlCloud, &stlInflatedBound};
+    if (ext == ".off") return {&withPlan<&readOff>};
+    if (ext == ".pcd") return {&withPlan<&readPcd>};
     if (ext == ".las") return {&readLasCloud};
     return {};
 }
 
-// The first coordinate that is NaN or infinite, as the error naming it.
+// Whether a coordinate of p[0, n) is NaN or infinite (all exponent bits
+// set): an OR over the bits without an early exit, so that it vectorizes.
 template <class Vec>
-std::optional<Error> firstNonFinite(const std::vector<Vec>& points, const std::string& path,
-                                    const char* note) {
-    for (size_t i = 0; i < points.size(); ++i) {
-        const Vec& p = points[i];
-        for (int axis = 0; axis < 3; ++axis) {
-            if (!std::isfinite(p[axis])) {
-                return badInput(path, "vertex " + std::to_string(i),
-                                std::string("coordinate ") + "xyz"[axis] + " is " +
-                                    (std::isnan(p[axis]) ? "NaN" : "infinite") + note);
+bool anyNonFinite(const Vec* p, size_t n) {
+    using Real = typename Vec::value_type;
+    using Bits = std::conditional_t<sizeof(Real) == 8, uint64_t, uint32_t>;
+    constexpr Bits kExponent = std::bit_cast<Bits>(std::numeric_limits<Real>::infinity());
+    Bits bad = 0;
+    for (size_t i = 0; i < n; ++i) {
+        bad |= static_cast<Bits>((std::bit_cast<Bits>(p[i].x) & kExponent) == kExponent) |
+               static_cast<Bits>((std::bit_cast<Bits>(p[i].y) & kExponent) == kExponent) |
+               static_cast<Bits>((std::bit_cast<Bits>(p[i].z) & kExponent) == kExponent);
+    }
+    return bad != 0;
+}
+
+// The first coordinate that is NaN or infinite, as the error naming it;
+// checked in parallel chunks (the lowest chunk's first is the first).
+template <class Vec>
+std::optional<Error> firstNonFinite(const std::vector<Vec>& points, const std::string& path, const char* note,
+                                    const ChunkPlan& plan) {
+    const uint64_t perChunk = plan.items(sizeof(Vec));
+    const size_t chunks = chunkCount(points.size(), perChunk);
+    return forEachChunk(chunks, plan, [&](size_t c) -> std::optional<Error> {
+        const size_t begin = static_cast<size_t>(c * perChunk);
+        const size_t end = static_cast<size_t>(std::min<uint64_t>(points.size(), (c + 1) * perChunk));
+        if (!anyNonFinite(points.data() + begin, end - begin)) return std::nullopt;
+        for (size_t i = begin; i < end; ++i) {
+            const Vec& p = points[i];
+            for (int axis = 0; axis < 3; ++axis) {
+                if (!std::isfinite(p[axis])) {
+                    return badInput(path, "vertex " + std::to_string(i),
+                                    std::string("coordinate ") + "xyz"[axis] + " is " +
+                                        (std::isnan(p[axis]) ? "NaN" : "infinite") + note);
+                }
             }
         }
-    }
-    return std::nullopt;
+        return std::nullopt;
+    });
 }
 
 }  // namespace
 
-Result<PointCloud> loadPointCloud(const std::string& path, const LoadOptions& options) {
+Result<PointCloud> loadPointCloudTuned(const std::string& path, const LoadOptions& options,
+                                       const LoadTuning& tuning) {
     const std::string ext = formatExtension(path);
     if (ext == ".laz") return lazError(path, "file");
     const Format format = formatFor(ext);
@@ -94,30 +134,43 @@ Result<PointCloud> loadPointCloud(const std::string& path, const LoadOptions& op
                             "' (ply, xyz, txt, obj, gltf, glb, stl, off, pcd, las, optionally .gz)");
     }
 
-    auto bytes = readFileBytes(path, format.gzipBound);
+    auto bytes = openFileBytes(path, format.gzipBound, tuning.access);
     if (!bytes) return bytes.error();
-    if (bytes->empty()) return badInput(path, "file", "empty file");
+    if (bytes->view().empty()) return badInput(path, "file", "empty file");
 
-    auto cloud = format.read(*bytes, path, options);
+    const ChunkPlan plan{options.threads, tuning.chunkBytes};
+    auto cloud = format.read(bytes->view(), path, options, plan);
     if (!cloud) return cloud;
     if (cloud->size() == 0) return badInput(path, "file", "contains no points");
-    const std::optional<Error> bad = cloud->scalar == Scalar::kFloat64
-                                         ? firstNonFinite(cloud->doubles, path, "")
-                                         : firstNonFinite(cloud->floats, path, " (or beyond float range)");
+    const std::optional<Error> bad =
+        cloud->scalar == Scalar::kFloat64
+            ? firstNonFinite(cloud->doubles, path, "", plan)
+            : firstNonFinite(cloud->floats, path, " (or beyond float range)", plan);
     if (bad) return *bad;
     return cloud;
+}
+
+Result<PointCloud> loadPointCloud(const std::string& path, const LoadOptions& options) {
+    return loadPointCloudTuned(path, options, LoadTuning{});
 }
 
 Result<std::vector<glm::vec3>> loadPoints(const std::string& path) {
     auto cloud = loadPointCloud(path);
     if (!cloud) return cloud.error();
     if (cloud->scalar == Scalar::kFloat32) return std::move(cloud->floats);
+    const ChunkPlan plan;
     std::vector<glm::vec3> points(cloud->doubles.size());
-    for (size_t i = 0; i < points.size(); ++i) {
-        const glm::dvec3& p = cloud->doubles[i];
-        points[i] = glm::vec3(narrowToFloat(p.x), narrowToFloat(p.y), narrowToFloat(p.z));
-    }
-    if (auto bad = firstNonFinite(points, path, " (or beyond float range)")) return *bad;
+    const uint64_t perChunk = plan.items(sizeof(glm::dvec3));
+    const size_t chunks = chunkCount(points.size(), perChunk);
+    (void)forEachChunk(chunks, plan, [&](size_t c) -> std::optional<Error> {
+        const size_t end = static_cast<size_t>(std::min<uint64_t>(points.size(), (c + 1) * perChunk));
+        for (size_t i = static_cast<size_t>(c * perChunk); i < end; ++i) {
+            const glm::dvec3& p = cloud->doubles[i];
+            points[i] = glm::vec3(narrowToFloat(p.x), narrowToFloat(p.y), narrowToFloat(p.z));
+        }
+        return std::nullopt;
+    });
+    if (auto bad = firstNonFinite(points, path, " (or beyond float range)", plan)) return *bad;
     return points;
 }
 

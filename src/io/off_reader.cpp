@@ -5,18 +5,24 @@
 
 #include "io/io_error.hpp"
 #include "io/number_parse.hpp"
+#include "io/text_chunks.hpp"
 #include "io/text_cursor.hpp"
 
 namespace rthdist::io {
 namespace {
 
+// A line without its '#' comment and surrounding blanks.
+std::string_view contentOf(std::string_view line) {
+    const size_t hash = line.find('#');
+    if (hash != std::string_view::npos) line = line.substr(0, hash);
+    return trimBlank(line);
+}
+
 // Next line that is not blank once its '#' comment is cut off.
 bool nextContentLine(TextCursor& cursor, std::string_view& out) {
     std::string_view line;
     while (cursor.nextLine(line)) {
-        const size_t hash = line.find('#');
-        if (hash != std::string_view::npos) line = line.substr(0, hash);
-        line = trimBlank(line);
+        line = contentOf(line);
         if (!line.empty()) {
             out = line;
             return true;
@@ -25,9 +31,48 @@ bool nextContentLine(TextCursor& cursor, std::string_view& out) {
     return false;
 }
 
+bool isContentLine(std::string_view line) { return !contentOf(line).empty(); }
+
+// The vertexCount content lines of text (which starts after the line
+// countLine), parsed in parallel chunks.
+Result<PointCloud> readVertices(std::string_view text, size_t countLine, uint64_t vertexCount,
+                                const std::string& path, const ChunkPlan& plan) {
+    TextChunks chunks = splitLines(text, countLine + 1, &isContentLine, plan);
+    keepItems(chunks, text, &isContentLine, vertexCount);
+    std::vector<glm::dvec3> points(static_cast<size_t>(vertexCount));
+    auto err = parseChunks(chunks, text, plan,
+                           [&](const TextChunk& chunk, TextCursor& cursor) -> std::optional<Error> {
+                               uint64_t k = chunk.firstItem;
+                               std::string_view line;
+                               while (k < vertexCount && cursor.nextLine(line)) {
+                                   line = contentOf(line);
+                                   if (line.empty()) continue;
+                                   std::array<std::string_view, 3> xyz{};
+                                   const size_t m = splitTokens(line, xyz.data(), xyz.size());
+                                   if (m < 3) {
+                                       return badInput(path, lineWhere(cursor.line()),
+                                                       "vertex line with " + std::to_string(m) + " value(s)");
+                                   }
+                                   if (const auto bad = parsePoint(xyz.data(), points[k])) {
+                                       return badInput(path, lineWhere(cursor.line()), notANumber(*bad));
+                                   }
+                                   ++k;
+                               }
+                               return std::nullopt;
+                           });
+    if (err) return *err;
+    if (chunks.items < vertexCount) {
+        // The file's last line (countLine when none follows), as a serial walk names it.
+        return badInput(
+            path, lineWhere(chunks.lastLine()),
+            "file ends at vertex " + std::to_string(chunks.items) + " of " + std::to_string(vertexCount));
+    }
+    return PointCloud{Scalar::kFloat64, {}, std::move(points)};
+}
+
 }  // namespace
 
-Result<PointCloud> readOff(std::string_view bytes, const std::string& path) {
+Result<PointCloud> readOff(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
     TextCursor cursor(bytes);
     std::string_view line;
     if (!nextContentLine(cursor, line)) return badInput(path, lineWhere(1), "no OFF header");
@@ -68,26 +113,7 @@ Result<PointCloud> readOff(std::string_view bytes, const std::string& path) {
                             std::to_string(cursor.remaining()) +
                             " bytes follow (truncated file or wrong count)");
     }
-
-    std::vector<glm::dvec3> points(static_cast<size_t>(vertexCount));
-    for (uint64_t k = 0; k < vertexCount; ++k) {
-        if (!nextContentLine(cursor, line)) {
-            return badInput(
-                path, lineWhere(cursor.line()),
-                "file ends at vertex " + std::to_string(k) + " of " + std::to_string(vertexCount));
-        }
-        std::array<std::string_view, 3> xyz{};
-        const size_t m = splitTokens(line, xyz.data(), xyz.size());
-        if (m < 3)
-            return badInput(path, lineWhere(cursor.line()),
-                            "vertex line with " + std::to_string(m) + " value(s)");
-        glm::dvec3 p;
-        if (const auto bad = parsePoint(xyz.data(), p)) {
-            return badInput(path, lineWhere(cursor.line()), notANumber(*bad));
-        }
-        points[k] = p;
-    }
-    return PointCloud{Scalar::kFloat64, {}, std::move(points)};
+    return readVertices(bytes.substr(cursor.offset()), countLine, vertexCount, path, plan);
 }
 
 }  // namespace rthdist::io

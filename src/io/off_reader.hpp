@@ -7,12 +7,16 @@
 #include <string_view>
 #include <vector>
 
+#include "io/parallel_chunks.hpp"
 #include "rthdist/io.hpp"
 #include "rthdist/result.hpp"
 
 namespace rthdist::io {
 
 // bytes: the whole (already gunzipped) file; path names it in error messages.
-[[nodiscard]] Result<PointCloud> readOff(std::string_view bytes, const std::string& path);
+// plan: threads and chunk size of the parallel parse (the result does not
+// depend on it).
+[[nodiscard]] Result<PointCloud> readOff(std::string_view bytes, const std::string& path,
+                                         const ChunkPlan& plan = {});
 
 }  // namespace rthdist::io

@@ -9,8 +9,9 @@
 
 #include "io/io_error.hpp"
 #include "io/number_parse.hpp"
+#include "io/record_convert.hpp"
 #include "io/scalar_type.hpp"
-#include "io/text_cursor.hpp"
+#include "io/text_chunks.hpp"
 
 namespace rthdist::io {
 namespace {
@@ -37,96 +38,120 @@ std::optional<ScalarType> pcdScalarType(char type, size_t size) {
     return std::nullopt;
 }
 
-}  // namespace
+struct PcdHeader {
+    std::vector<PcdField> fields;
+    uint64_t points = 0;
+    bool binary = false;
+    size_t dataLine = 0;
+    size_t bodyOffset = 0;  // first byte after the DATA line
+};
 
-Result<PointCloud> readPcd(std::string_view bytes, const std::string& path) {
-    TextCursor cursor(bytes);
+// Header state while its lines are read.
+struct HeaderState {
     std::vector<PcdField> fields;
     std::optional<uint64_t> points;
     uint64_t width = 0;
     uint64_t height = 1;
     std::string data;
     size_t dataLine = 0;
+};
+
+// Applies one header line (key tok[0], n tokens) to the state.
+std::optional<Error> applyHeaderLine(HeaderState& h, const std::string_view* tok, size_t n, size_t lineNo,
+                                     const std::string& path) {
+    const std::string_view key = tok[0];
+    auto where = lineWhere(lineNo);
+    auto perField = [&](const char* what) -> std::optional<Error> {
+        if (n - 1 != h.fields.size()) {
+            return badInput(path, where,
+                            std::string(what) + " has " + std::to_string(n - 1) + " values for " +
+                                std::to_string(h.fields.size()) + " fields");
+        }
+        return std::nullopt;
+    };
+    if (key == "VERSION" || key == "VIEWPOINT") return std::nullopt;
+    if (key == "FIELDS" || key == "COLUMNS") {
+        h.fields.clear();
+        for (size_t i = 1; i < n; ++i) h.fields.push_back(PcdField{std::string(tok[i])});
+    } else if (key == "SIZE") {
+        if (auto err = perField("SIZE")) return err;
+        for (size_t i = 1; i < n; ++i) {
+            uint64_t s = 0;
+            if (!parseUInt(tok[i], s) || s == 0 || s > 8)
+                return badInput(path, where, "bad SIZE '" + std::string(tok[i]) + "'");
+            h.fields[i - 1].size = static_cast<size_t>(s);
+        }
+    } else if (key == "TYPE") {
+        if (auto err = perField("TYPE")) return err;
+        for (size_t i = 1; i < n; ++i) {
+            if (tok[i].size() != 1) return badInput(path, where, "bad TYPE '" + std::string(tok[i]) + "'");
+            h.fields[i - 1].type = tok[i][0];
+        }
+    } else if (key == "COUNT") {
+        if (auto err = perField("COUNT")) return err;
+        for (size_t i = 1; i < n; ++i) {
+            uint64_t c = 0;
+            if (!parseUInt(tok[i], c) || c == 0 || c > 1'000'000) {
+                return badInput(path, where, "bad COUNT '" + std::string(tok[i]) + "'");
+            }
+            h.fields[i - 1].count = c;
+        }
+    } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
+        uint64_t v = 0;
+        if (n != 2 || !parseUInt(tok[1], v))
+            return badInput(path, where, "bad " + std::string(key) + " line");
+        if (key == "WIDTH") h.width = v;
+        if (key == "HEIGHT") h.height = v;
+        if (key == "POINTS") h.points = v;
+    } else if (key == "DATA") {
+        if (n != 2) return badInput(path, where, "bad DATA line");
+        h.data = std::string(tok[1]);
+        h.dataLine = lineNo;
+    } else {
+        return badInput(path, where, "unknown header keyword '" + std::string(key) + "'");
+    }
+    return std::nullopt;
+}
+
+Result<PcdHeader> parseHeader(std::string_view bytes, const std::string& path) {
+    TextCursor cursor(bytes);
+    HeaderState h;
     std::string_view line;
     // Headers have a handful of fields in practice; 4096 bounds the work
     // (refilled per line, only the first n are read).
-    std::array<std::string_view, 4096> headerTok{};
-    while (data.empty()) {
+    std::array<std::string_view, 4096> tok{};
+    while (h.data.empty()) {
         if (!cursor.nextLine(line)) return badInput(path, "header", "no DATA line");
-        const size_t lineNo = cursor.line();
         const std::string_view body = trimBlank(line);
         if (body.empty() || body.front() == '#') continue;
-        auto& tok = headerTok;
         const size_t n = splitTokens(body, tok.data(), tok.size());
-        if (n > tok.size()) return badInput(path, lineWhere(lineNo), "too many header values");
-        const std::string_view key = tok[0];
-        auto where = lineWhere(lineNo);
-        auto perField = [&](const char* what) -> std::optional<Error> {
-            if (n - 1 != fields.size()) {
-                return badInput(path, where,
-                                std::string(what) + " has " + std::to_string(n - 1) + " values for " +
-                                    std::to_string(fields.size()) + " fields");
-            }
-            return std::nullopt;
-        };
-        if (key == "VERSION" || key == "VIEWPOINT") continue;
-        if (key == "FIELDS" || key == "COLUMNS") {
-            fields.clear();
-            for (size_t i = 1; i < n; ++i) fields.push_back(PcdField{std::string(tok[i])});
-        } else if (key == "SIZE") {
-            if (auto err = perField("SIZE")) return *err;
-            for (size_t i = 1; i < n; ++i) {
-                uint64_t s = 0;
-                if (!parseUInt(tok[i], s) || s == 0 || s > 8)
-                    return badInput(path, where, "bad SIZE '" + std::string(tok[i]) + "'");
-                fields[i - 1].size = static_cast<size_t>(s);
-            }
-        } else if (key == "TYPE") {
-            if (auto err = perField("TYPE")) return *err;
-            for (size_t i = 1; i < n; ++i) {
-                if (tok[i].size() != 1)
-                    return badInput(path, where, "bad TYPE '" + std::string(tok[i]) + "'");
-                fields[i - 1].type = tok[i][0];
-            }
-        } else if (key == "COUNT") {
-            if (auto err = perField("COUNT")) return *err;
-            for (size_t i = 1; i < n; ++i) {
-                uint64_t c = 0;
-                if (!parseUInt(tok[i], c) || c == 0 || c > 1'000'000) {
-                    return badInput(path, where, "bad COUNT '" + std::string(tok[i]) + "'");
-                }
-                fields[i - 1].count = c;
-            }
-        } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
-            uint64_t v = 0;
-            if (n != 2 || !parseUInt(tok[1], v))
-                return badInput(path, where, "bad " + std::string(key) + " line");
-            if (key == "WIDTH") width = v;
-            if (key == "HEIGHT") height = v;
-            if (key == "POINTS") points = v;
-        } else if (key == "DATA") {
-            if (n != 2) return badInput(path, where, "bad DATA line");
-            data = std::string(tok[1]);
-            dataLine = lineNo;
-        } else {
-            return badInput(path, where, "unknown header keyword '" + std::string(key) + "'");
-        }
+        if (n > tok.size()) return badInput(path, lineWhere(cursor.line()), "too many header values");
+        if (auto err = applyHeaderLine(h, tok.data(), n, cursor.line(), path)) return *err;
     }
-    if (data != "ascii" && data != "binary") {
-        return badInput(path, lineWhere(dataLine), "unsupported DATA '" + data + "' (ascii or binary only)");
+    if (h.data != "ascii" && h.data != "binary") {
+        return badInput(path, lineWhere(h.dataLine),
+                        "unsupported DATA '" + h.data + "' (ascii or binary only)");
     }
-    if (!points) {
-        if (height != 0 && width > UINT64_MAX / height)
+    if (!h.points) {
+        if (h.height != 0 && h.width > UINT64_MAX / h.height)
             return badInput(path, "header", "WIDTH * HEIGHT overflows");
-        points = width * height;
+        h.points = h.width * h.height;
     }
+    return PcdHeader{std::move(h.fields), *h.points, h.data == "binary", h.dataLine, cursor.offset()};
+}
 
-    // Column of x, y, z (first element of each) and bytes/values per row.
-    std::array<std::optional<uint64_t>, 3> column{};  // ascii value index
-    std::array<uint64_t, 3> byteOffset{};             // binary byte offset
+// Where x, y, z are in a row (the first element of each), and its size.
+struct PcdLayout {
+    std::array<uint64_t, 3> column{};      // ascii value index
+    std::array<uint64_t, 3> byteOffset{};  // binary byte offset
     std::array<ScalarType, 3> scalar{};
     uint64_t valuesPerRow = 0;
     uint64_t bytesPerRow = 0;
+};
+
+Result<PcdLayout> layoutOf(const std::vector<PcdField>& fields, const std::string& path) {
+    PcdLayout l;
+    std::array<bool, 3> found{};
     constexpr std::array<std::string_view, 3> kNames = {"x", "y", "z"};
     for (const PcdField& f : fields) {
         const auto type = pcdScalarType(f.type, f.size);
@@ -136,82 +161,126 @@ Result<PointCloud> readPcd(std::string_view bytes, const std::string& path) {
                 "unsupported TYPE " + std::string(1, f.type) + " with SIZE " + std::to_string(f.size));
         }
         for (size_t axis = 0; axis < 3; ++axis) {
-            if (f.name == kNames[axis] && !column[axis]) {
-                column[axis] = valuesPerRow;
-                byteOffset[axis] = bytesPerRow;
-                scalar[axis] = *type;
+            if (f.name == kNames[axis] && !found[axis]) {
+                found[axis] = true;
+                l.column[axis] = l.valuesPerRow;
+                l.byteOffset[axis] = l.bytesPerRow;
+                l.scalar[axis] = *type;
             }
         }
-        valuesPerRow += f.count;
-        bytesPerRow += f.count * f.size;
+        l.valuesPerRow += f.count;
+        l.bytesPerRow += f.count * f.size;
     }
     for (size_t axis = 0; axis < 3; ++axis) {
-        if (!column[axis]) return badInput(path, "header", "no field '" + std::string(kNames[axis]) + "'");
+        if (!found[axis]) return badInput(path, "header", "no field '" + std::string(kNames[axis]) + "'");
     }
+    return l;
+}
 
-    if (*points == 0) return PointCloud{};
-    const uint64_t left = cursor.remaining();
-    if (data == "binary") {
-        if (*points > left / bytesPerRow) {
-            return badInput(path, offsetWhere(cursor.offset()),
-                            "declares " + std::to_string(*points) + " points of " +
-                                std::to_string(bytesPerRow) + " bytes, but only " + std::to_string(left) +
-                                " bytes remain (truncated body or wrong count)");
-        }
-        PointCloud out;
-        out.scalar =
-            std::any_of(scalar.begin(), scalar.end(), needsDouble) ? Scalar::kFloat64 : Scalar::kFloat32;
-        if (out.scalar == Scalar::kFloat64) {
-            out.doubles.resize(static_cast<size_t>(*points));
-        } else {
-            out.floats.resize(static_cast<size_t>(*points));
-        }
-        const char* row = bytes.data() + cursor.offset();
-        for (uint64_t k = 0; k < *points; ++k, row += bytesPerRow) {
-            double v[3];
-            for (size_t axis = 0; axis < 3; ++axis)
-                v[axis] = loadScalar(row + byteOffset[axis], scalar[axis], false);
-            if (out.scalar == Scalar::kFloat64) {
-                out.doubles[k] = glm::dvec3(v[0], v[1], v[2]);
-            } else {
-                out.floats[k] = glm::vec3(narrowToFloat(v[0]), narrowToFloat(v[1]), narrowToFloat(v[2]));
-            }
-        }
-        return out;
+Result<PointCloud> readBinaryRows(std::string_view bytes, const PcdHeader& h, const PcdLayout& l,
+                                  const std::string& path, const ChunkPlan& plan) {
+    const uint64_t left = bytes.size() - h.bodyOffset;
+    if (h.points > left / l.bytesPerRow) {
+        return badInput(path, offsetWhere(h.bodyOffset),
+                        "declares " + std::to_string(h.points) + " points of " +
+                            std::to_string(l.bytesPerRow) + " bytes, but only " + std::to_string(left) +
+                            " bytes remain (truncated body or wrong count)");
     }
+    const RecordLayout rows{bytes.data() + h.bodyOffset,
+                            static_cast<size_t>(l.bytesPerRow),
+                            h.points,
+                            {l.byteOffset[0], l.byteOffset[1], l.byteOffset[2]},
+                            l.scalar,
+                            false};
+    PointCloud out;
+    out.scalar =
+        std::any_of(l.scalar.begin(), l.scalar.end(), needsDouble) ? Scalar::kFloat64 : Scalar::kFloat32;
+    if (out.scalar == Scalar::kFloat64) {
+        out.doubles.resize(static_cast<size_t>(h.points));
+        convertRecords(rows, out.doubles.data(), plan);
+    } else {
+        out.floats.resize(static_cast<size_t>(h.points));
+        convertRecords(rows, out.floats.data(), plan);
+    }
+    return out;
+}
 
-    // ascii: one row per line; every value is at least one char and a separator.
-    if (*points > (left + 1) / (2 * valuesPerRow)) {
-        return badInput(path, lineWhere(dataLine),
-                        "declares " + std::to_string(*points) + " points but only " + std::to_string(left) +
-                            " bytes follow (truncated body or wrong count)");
-    }
-    std::vector<glm::dvec3> out(static_cast<size_t>(*points));
-    const uint64_t lastColumn = std::max({*column[0], *column[1], *column[2]});
-    std::vector<std::string_view> tok(static_cast<size_t>(lastColumn + 1));
-    for (uint64_t k = 0; k < *points;) {
-        if (!cursor.nextLine(line)) {
-            return badInput(path, lineWhere(cursor.line() + 1),
-                            "file ends at point " + std::to_string(k) + " of " + std::to_string(*points));
-        }
-        if (trimBlank(line).empty()) continue;
-        const size_t n = splitTokens(line, tok.data(), tok.size());
-        if (n < valuesPerRow) {
-            return badInput(
-                path, lineWhere(cursor.line()),
-                "row has " + std::to_string(n) + " values, fields need " + std::to_string(valuesPerRow));
-        }
-        double v[3];
+bool isRowLine(std::string_view line) { return !trimBlank(line).empty(); }
+
+// Counts the blank-separated values of line and picks those in columns.
+size_t pickColumns(std::string_view line, const std::array<uint64_t, 3>& columns,
+                   std::array<std::string_view, 3>& picked) {
+    size_t n = 0;
+    size_t i = 0;
+    while (i < line.size()) {
+        while (i < line.size() && isBlank(line[i])) ++i;
+        if (i == line.size()) break;
+        const size_t start = i;
+        while (i < line.size() && !isBlank(line[i])) ++i;
         for (size_t axis = 0; axis < 3; ++axis) {
-            const std::string_view t = tok[static_cast<size_t>(*column[axis])];
-            if (!parseDouble(t, v[axis])) {
-                return badInput(path, lineWhere(cursor.line()), notANumber(t));
-            }
+            if (columns[axis] == n) picked[axis] = line.substr(start, i - start);
         }
-        out[k] = glm::dvec3(v[0], v[1], v[2]);
-        ++k;
+        ++n;
+    }
+    return n;
+}
+
+// One row per non-blank line, parsed in parallel chunks.
+Result<PointCloud> readAsciiRows(std::string_view bytes, const PcdHeader& h, const PcdLayout& l,
+                                 const std::string& path, const ChunkPlan& plan) {
+    const std::string_view text = bytes.substr(h.bodyOffset);
+    // Every value is at least one char and a separator.
+    if (h.points > (text.size() + 1) / (2 * l.valuesPerRow)) {
+        return badInput(path, lineWhere(h.dataLine),
+                        "declares " + std::to_string(h.points) + " points but only " +
+                            std::to_string(text.size()) + " bytes follow (truncated body or wrong count)");
+    }
+    TextChunks chunks = splitLines(text, h.dataLine + 1, &isRowLine, plan);
+    keepItems(chunks, text, &isRowLine, h.points);
+    std::vector<glm::dvec3> out(static_cast<size_t>(h.points));
+    auto err = parseChunks(
+        chunks, text, plan, [&](const TextChunk& chunk, TextCursor& cursor) -> std::optional<Error> {
+            std::array<std::string_view, 3> tok{};
+            uint64_t k = chunk.firstItem;
+            std::string_view line;
+            while (k < h.points && cursor.nextLine(line)) {
+                if (!isRowLine(line)) continue;
+                const size_t n = pickColumns(line, l.column, tok);
+                if (n < l.valuesPerRow) {
+                    return badInput(path, lineWhere(cursor.line()),
+                                    "row has " + std::to_string(n) + " values, fields need " +
+                                        std::to_string(l.valuesPerRow));
+                }
+                for (size_t axis = 0; axis < 3; ++axis) {
+                    const std::string_view t = tok[axis];
+                    if (!parseDouble(t, out[k][static_cast<int>(axis)])) {
+                        return badInput(path, lineWhere(cursor.line()), notANumber(t));
+                    }
+                }
+                ++k;
+            }
+            return std::nullopt;
+        });
+    if (err) return *err;
+    if (chunks.items < h.points) {
+        // The line after the file's last one, as a serial walk names it.
+        return badInput(
+            path, lineWhere(chunks.lastLine() + 1),
+            "file ends at point " + std::to_string(chunks.items) + " of " + std::to_string(h.points));
     }
     return PointCloud{Scalar::kFloat64, {}, std::move(out)};
+}
+
+}  // namespace
+
+Result<PointCloud> readPcd(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
+    auto header = parseHeader(bytes, path);
+    if (!header) return header.error();
+    auto layout = layoutOf(header->fields, path);
+    if (!layout) return layout.error();
+    if (header->points == 0) return PointCloud{};
+    if (header->binary) return readBinaryRows(bytes, *header, *layout, path, plan);
+    return readAsciiRows(bytes, *header, *layout, path, plan);
 }
 
 }  // namespace rthdist::io

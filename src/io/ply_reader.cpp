@@ -11,7 +11,9 @@
 #include "io/gzip_inflate.hpp"
 #include "io/io_error.hpp"
 #include "io/number_parse.hpp"
+#include "io/record_convert.hpp"
 #include "io/scalar_type.hpp"
+#include "io/text_chunks.hpp"
 #include "io/text_cursor.hpp"
 
 namespace rthdist::io {
@@ -56,6 +58,17 @@ struct PlyElement {
         return size;
     }
 };
+
+// Bytes per item of an element without list properties; 0 when it has one
+// (or no property at all).
+uint64_t fixedItemSize(const PlyElement& e) {
+    uint64_t size = 0;
+    for (const PlyProperty& p : e.properties) {
+        if (p.isList) return 0;
+        size += scalarSize(p.type);
+    }
+    return size;
+}
 
 struct PlyHeader {
     PlyFormat format = PlyFormat::kAscii;
@@ -246,11 +259,20 @@ public:
 
     std::optional<Error> skipElement(const PlyElement& e) {
         if (e.properties.empty()) return std::nullopt;
+        const uint64_t size = fixedItemSize(e);
+        if (size != 0 && e.count <= (m_bytes.size() - m_pos) / size) {
+            m_pos += static_cast<size_t>(e.count * size);  // every item fits: nothing to check inside
+            return std::nullopt;
+        }
         for (uint64_t k = 0; k < e.count; ++k) {
             if (auto err = item(e, k, nullptr, nullptr)) return err;
         }
         return std::nullopt;
     }
+
+    // Steps over bytes the caller has read (and checked to be there).
+    void advance(uint64_t bytes) { m_pos += static_cast<size_t>(bytes); }
+    [[nodiscard]] const char* here() const { return m_bytes.data() + m_pos; }
 
     // After the last element only padding (blanks, NUL bytes) may follow;
     // anything else means a count or a list length did not match the data.
@@ -288,9 +310,52 @@ Scalar binaryPrecision(const PlyElement& vertex, const XyzIndex& xyz) {
     return Scalar::kFloat32;
 }
 
+// The vertex element as fixed-size records, when it has no list property.
+std::optional<RecordLayout> fixedLayout(const PlyElement& vertex, const XyzIndex& xyz, const char* first,
+                                        bool bigEndian) {
+    const uint64_t stride = fixedItemSize(vertex);
+    if (stride == 0) return std::nullopt;
+    RecordLayout layout{first, static_cast<size_t>(stride), vertex.count, {}, {}, bigEndian};
+    for (size_t axis = 0; axis < 3; ++axis) {
+        size_t offset = 0;
+        for (size_t i = 0; i < xyz.prop[axis]; ++i) offset += scalarSize(vertex.properties[i].type);
+        layout.offset[axis] = offset;
+        layout.type[axis] = vertex.properties[xyz.prop[axis]].type;
+    }
+    return layout;
+}
+
+// Reads the vertex element into points (sized already): fixed-size records
+// in parallel chunks, vertices with list properties item by item.
+std::optional<Error> readVertices(BinaryBody& body, const PlyElement& vertex, const XyzIndex& xyz,
+                                  bool bigEndian, const ChunkPlan& plan, PointCloud& points) {
+    const bool doubles = points.scalar == Scalar::kFloat64;
+    if (auto layout = fixedLayout(vertex, xyz, body.here(), bigEndian)) {
+        // checkFit has made sure that every record is in the file.
+        if (doubles) {
+            convertRecords(*layout, points.doubles.data(), plan);
+        } else {
+            convertRecords(*layout, points.floats.data(), plan);
+        }
+        body.advance(vertex.count * layout->stride);
+        return std::nullopt;
+    }
+    double v[3] = {0, 0, 0};
+    for (uint64_t k = 0; k < vertex.count; ++k) {
+        if (auto err = body.item(vertex, k, &xyz, v)) return err;
+        if (doubles) {
+            points.doubles[k] = glm::dvec3(v[0], v[1], v[2]);
+        } else {
+            points.floats[k] = glm::vec3(narrowToFloat(v[0]), narrowToFloat(v[1]), narrowToFloat(v[2]));
+        }
+    }
+    return std::nullopt;
+}
+
 Result<PointCloud> readBinaryBody(std::string_view bytes, const PlyHeader& header, size_t vertexElement,
-                                  const XyzIndex& xyz, const std::string& path) {
-    BinaryBody body(bytes, header.bodyOffset, header.format == PlyFormat::kBinaryBigEndian, path);
+                                  const XyzIndex& xyz, const std::string& path, const ChunkPlan& plan) {
+    const bool bigEndian = header.format == PlyFormat::kBinaryBigEndian;
+    BinaryBody body(bytes, header.bodyOffset, bigEndian, path);
     for (size_t ei = 0; ei < vertexElement; ++ei) {
         if (auto err = body.checkFit(header.elements, ei, ei + 1)) return *err;
         if (auto err = body.skipElement(header.elements[ei])) return *err;
@@ -299,21 +364,12 @@ Result<PointCloud> readBinaryBody(std::string_view bytes, const PlyHeader& heade
     const PlyElement& vertex = header.elements[vertexElement];
     PointCloud points;
     points.scalar = binaryPrecision(vertex, xyz);
-    const bool doubles = points.scalar == Scalar::kFloat64;
-    if (doubles) {
+    if (points.scalar == Scalar::kFloat64) {
         points.doubles.resize(static_cast<size_t>(vertex.count));
     } else {
         points.floats.resize(static_cast<size_t>(vertex.count));
     }
-    double v[3] = {0, 0, 0};
-    for (uint64_t k = 0; k < vertex.count; ++k) {
-        if (auto err = body.item(vertex, k, &xyz, v)) return *err;
-        if (doubles) {
-            points.doubles[k] = glm::dvec3(v[0], v[1], v[2]);
-        } else {
-            points.floats[k] = glm::vec3(narrowToFloat(v[0]), narrowToFloat(v[1]), narrowToFloat(v[2]));
-        }
-    }
+    if (auto err = readVertices(body, vertex, xyz, bigEndian, plan, points)) return *err;
     for (size_t ei = vertexElement + 1; ei < header.elements.size(); ++ei) {
         if (auto err = body.skipElement(header.elements[ei])) return *err;
     }
@@ -324,141 +380,136 @@ Result<PointCloud> readBinaryBody(std::string_view bytes, const PlyHeader& heade
 // ---- ascii bodies ----------------------------------------------------------
 
 // An ascii body holds one item per line (Turk: "each element on its own
-// line"), so a wrong count or a stray value cannot shift later items.
-class AsciiBody {
-public:
-    AsciiBody(std::string_view bytes, const PlyHeader& header, const std::string& path)
-        : m_cursor(bytes.substr(header.bodyOffset), header.bodyLine), m_path(path) {}
+// line"), so a wrong count or a stray value cannot shift later items: the
+// n-th non-blank body line is item n over the elements in header order,
+// which lets chunks of lines be parsed in parallel.
+bool isItemLine(std::string_view line) { return !trimBlank(line).empty(); }
 
-    // Every declared item with properties needs its own non-blank line:
-    // checked for all elements (also those after the vertex element) before
-    // anything is allocated.
-    std::optional<Error> checkFit(const std::vector<PlyElement>& elements) const {
-        TextCursor counter = m_cursor;
-        uint64_t lines = 0;
-        std::string_view line;
-        while (counter.nextLine(line)) {
-            if (!trimBlank(line).empty()) ++lines;
+// Every declared item with properties needs its own non-blank line: checked
+// for all elements (also those after the vertex element) before anything
+// is allocated.
+std::optional<Error> checkAsciiFit(const std::vector<PlyElement>& elements, uint64_t lines,
+                                   const std::string& path) {
+    uint64_t need = 0;
+    for (const PlyElement& e : elements) {
+        if (e.properties.empty()) continue;
+        if (e.count > lines - need) {
+            return badInput(path, "element " + e.name,
+                            "declares " + std::to_string(e.count) + " items (one per line), but only " +
+                                std::to_string(lines - need) + " of the " + std::to_string(lines) +
+                                " non-blank body lines are left for it (truncated body or wrong count)");
         }
-        uint64_t need = 0;
-        for (const PlyElement& e : elements) {
-            if (e.properties.empty()) continue;
-            if (e.count > lines - need) {
-                return badInput(m_path, "element " + e.name,
-                                "declares " + std::to_string(e.count) + " items (one per line), but only " +
-                                    std::to_string(lines - need) + " of the " + std::to_string(lines) +
-                                    " non-blank body lines are left for it (truncated body or wrong count)");
-            }
-            need += e.count;
-        }
-        return std::nullopt;
+        need += e.count;
     }
+    return std::nullopt;
+}
 
-    // Reads item `index` of e from its line; for the vertex element,
-    // values[axis] receives x/y/z.
-    std::optional<Error> item(const PlyElement& e, uint64_t index, const XyzIndex* xyz, double* values) {
-        std::string_view line;
-        do {
-            if (!m_cursor.nextLine(line)) {
-                return badInput(m_path, lineWhere(m_cursor.line()),
-                                "file ends before element " + e.name + " item " + std::to_string(index));
-            }
-        } while (trimBlank(line).empty());
-        TextCursor tokens(line, m_cursor.line());
-        auto itemWhere = [&] { return "element " + e.name + " item " + std::to_string(index); };
-        size_t found = 0;
-        auto next = [&](std::string_view& tok) -> std::optional<Error> {
-            tok = tokens.nextToken();
-            if (tok.empty()) {
-                return badInput(m_path, lineWhere(m_cursor.line()),
-                                itemWhere() + ": the line ends after " + std::to_string(found) +
-                                    " values, the properties need more (one item per line)");
-            }
-            ++found;
-            return std::nullopt;
-        };
-        for (size_t i = 0; i < e.properties.size(); ++i) {
-            const PlyProperty& p = e.properties[i];
-            std::string_view tok;
-            if (auto err = next(tok)) return err;
-            if (p.isList) {
-                uint64_t length = 0;
-                if (!parseUInt(tok, length)) {
-                    return badInput(m_path, lineWhere(m_cursor.line()),
-                                    itemWhere() + ": bad list length '" + std::string(tok) + "'");
-                }
-                for (uint64_t t = 0; t < length; ++t) {
-                    if (auto err = next(tok)) return err;
-                }
-                continue;
-            }
-            if (xyz == nullptr) continue;
-            for (size_t axis = 0; axis < 3; ++axis) {
-                if (xyz->prop[axis] != i) continue;
-                if (!parseDouble(tok, values[axis])) {
-                    return badInput(
-                        m_path, lineWhere(m_cursor.line()),
-                        "vertex " + std::to_string(index) + " property " + p.name + ": " + notANumber(tok));
-                }
-            }
+// Checks item `index` of e on its line (number lineNo); for the vertex
+// element, values[axis] receives x/y/z.
+std::optional<Error> parseAsciiItem(std::string_view line, size_t lineNo, const PlyElement& e, uint64_t index,
+                                    const XyzIndex* xyz, double* values, const std::string& path) {
+    TextCursor tokens(line, lineNo);
+    auto itemWhere = [&] { return "element " + e.name + " item " + std::to_string(index); };
+    size_t found = 0;
+    auto next = [&](std::string_view& tok) -> std::optional<Error> {
+        tok = tokens.nextToken();
+        if (tok.empty()) {
+            return badInput(path, lineWhere(lineNo),
+                            itemWhere() + ": the line ends after " + std::to_string(found) +
+                                " values, the properties need more (one item per line)");
         }
-        if (!tokens.nextToken().empty()) {
-            return badInput(m_path, lineWhere(m_cursor.line()),
-                            itemWhere() + ": more values than its " + std::to_string(found) +
-                                " declared ones (one item per line)");
-        }
+        ++found;
         return std::nullopt;
-    }
-
-    std::optional<Error> skipElement(const PlyElement& e) {
-        if (e.properties.empty()) return std::nullopt;
-        for (uint64_t k = 0; k < e.count; ++k) {
-            if (auto err = item(e, k, nullptr, nullptr)) return err;
+    };
+    for (size_t i = 0; i < e.properties.size(); ++i) {
+        const PlyProperty& p = e.properties[i];
+        std::string_view tok;
+        if (auto err = next(tok)) return err;
+        if (p.isList) {
+            uint64_t length = 0;
+            if (!parseUInt(tok, length)) {
+                return badInput(path, lineWhere(lineNo),
+                                itemWhere() + ": bad list length '" + std::string(tok) + "'");
+            }
+            for (uint64_t t = 0; t < length; ++t) {
+                if (auto err = next(tok)) return err;
+            }
+            continue;
         }
-        return std::nullopt;
-    }
-
-    // After the last element only blank lines may follow.
-    std::optional<Error> checkEnd() {
-        std::string_view line;
-        while (m_cursor.nextLine(line)) {
-            if (!trimBlank(line).empty()) {
-                return badInput(m_path, lineWhere(m_cursor.line()),
-                                "text after the last declared element (wrong count)");
+        if (xyz == nullptr) continue;
+        for (size_t axis = 0; axis < 3; ++axis) {
+            if (xyz->prop[axis] != i) continue;
+            if (!parseDouble(tok, values[axis])) {
+                return badInput(
+                    path, lineWhere(lineNo),
+                    "vertex " + std::to_string(index) + " property " + p.name + ": " + notANumber(tok));
             }
         }
-        return std::nullopt;
     }
+    if (!tokens.nextToken().empty()) {
+        return badInput(path, lineWhere(lineNo),
+                        itemWhere() + ": more values than its " + std::to_string(found) +
+                            " declared ones (one item per line)");
+    }
+    return std::nullopt;
+}
 
-private:
-    TextCursor m_cursor;
-    const std::string& m_path;
+// The first item of each element that has properties, in body order.
+struct ItemRange {
+    uint64_t first = 0;
+    size_t element = 0;
 };
 
+std::vector<ItemRange> itemRanges(const std::vector<PlyElement>& elements, uint64_t& need) {
+    std::vector<ItemRange> ranges;
+    need = 0;
+    for (size_t ei = 0; ei < elements.size(); ++ei) {
+        if (elements[ei].properties.empty() || elements[ei].count == 0) continue;
+        ranges.push_back(ItemRange{need, ei});
+        need += elements[ei].count;
+    }
+    return ranges;
+}
+
 Result<PointCloud> readAsciiBody(std::string_view bytes, const PlyHeader& header, size_t vertexElement,
-                                 const XyzIndex& xyz, const std::string& path) {
-    AsciiBody body(bytes, header, path);
-    if (auto err = body.checkFit(header.elements)) return *err;
-    for (size_t ei = 0; ei < vertexElement; ++ei) {
-        if (auto err = body.skipElement(header.elements[ei])) return *err;
-    }
-    const PlyElement& vertex = header.elements[vertexElement];
-    std::vector<glm::dvec3> points(static_cast<size_t>(vertex.count));
-    for (uint64_t k = 0; k < vertex.count; ++k) {
-        double v[3] = {0, 0, 0};
-        if (auto err = body.item(vertex, k, &xyz, v)) return *err;
-        points[k] = glm::dvec3(v[0], v[1], v[2]);
-    }
-    for (size_t ei = vertexElement + 1; ei < header.elements.size(); ++ei) {
-        if (auto err = body.skipElement(header.elements[ei])) return *err;
-    }
-    if (auto err = body.checkEnd()) return *err;
+                                 const XyzIndex& xyz, const std::string& path, const ChunkPlan& plan) {
+    const std::string_view text = bytes.substr(header.bodyOffset);
+    const TextChunks chunks = splitLines(text, header.bodyLine, &isItemLine, plan);
+    if (auto err = checkAsciiFit(header.elements, chunks.items, path)) return *err;
+    uint64_t need = 0;
+    const std::vector<ItemRange> ranges = itemRanges(header.elements, need);
+    std::vector<glm::dvec3> points(static_cast<size_t>(header.elements[vertexElement].count));
+    auto err = parseChunks(
+        chunks, text, plan, [&](const TextChunk& chunk, TextCursor& cursor) -> std::optional<Error> {
+            uint64_t g = chunk.firstItem;
+            size_t r = 0;
+            std::string_view line;
+            while (cursor.nextLine(line)) {
+                if (!isItemLine(line)) continue;
+                if (g >= need) {
+                    return badInput(path, lineWhere(cursor.line()),
+                                    "text after the last declared element (wrong count)");
+                }
+                while (r + 1 < ranges.size() && ranges[r + 1].first <= g) ++r;
+                const bool isVertex = ranges[r].element == vertexElement;
+                const uint64_t k = g - ranges[r].first;
+                double v[3] = {0, 0, 0};
+                if (auto e = parseAsciiItem(line, cursor.line(), header.elements[ranges[r].element], k,
+                                            isVertex ? &xyz : nullptr, v, path)) {
+                    return e;
+                }
+                if (isVertex) points[k] = glm::dvec3(v[0], v[1], v[2]);
+                ++g;
+            }
+            return std::nullopt;
+        });
+    if (err) return *err;
     return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }
 
 }  // namespace
 
-Result<PointCloud> readPly(std::string_view bytes, const std::string& path) {
+Result<PointCloud> readPly(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
     auto header = parseHeader(bytes, path);
     if (!header) return header.error();
     size_t vertexElement = header->elements.size();
@@ -471,8 +522,10 @@ Result<PointCloud> readPly(std::string_view bytes, const std::string& path) {
     if (vertexElement == header->elements.size()) return badInput(path, "header", "no 'vertex' element");
     auto xyz = findXyz(header->elements[vertexElement], path);
     if (!xyz) return xyz.error();
-    if (header->format == PlyFormat::kAscii) return readAsciiBody(bytes, *header, vertexElement, *xyz, path);
-    return readBinaryBody(bytes, *header, vertexElement, *xyz, path);
+    if (header->format == PlyFormat::kAscii) {
+        return readAsciiBody(bytes, *header, vertexElement, *xyz, path, plan);
+    }
+    return readBinaryBody(bytes, *header, vertexElement, *xyz, path, plan);
 }
 
 Result<uint64_t> plyInflatedBound(std::string_view head, bool whole, const std::string& path) {

@@ -11,13 +11,17 @@
 #include <string_view>
 #include <vector>
 
+#include "io/parallel_chunks.hpp"
 #include "rthdist/io.hpp"
 #include "rthdist/result.hpp"
 
 namespace rthdist::io {
 
 // bytes: the whole (already gunzipped) file; path names it in error messages.
-[[nodiscard]] Result<PointCloud> readPly(std::string_view bytes, const std::string& path);
+// plan: threads and chunk size of the parallel parts (the result does not
+// depend on it).
+[[nodiscard]] Result<PointCloud> readPly(std::string_view bytes, const std::string& path,
+                                         const ChunkPlan& plan = {});
 
 // The gunzip header check (gzip_inflate.hpp): a binary PLY inflates to at
 // most its header plus every declared item at its largest; ascii: no bound.

@@ -1,0 +1,72 @@
+// Text bodies parsed in parallel: the text is cut after line ends into
+// chunks, a first parallel pass counts each chunk's lines and item lines
+// (the lines a format reads: points, vertices, rows), prefix sums give every
+// chunk the file line number of its first line and the index of its first
+// item, and a second parallel pass parses each chunk straight into the
+// output at that index. Errors name the same line and item as a serial
+// parse, and the first chunk's error wins, so the message is the one a
+// serial parse gives for the first bad place in the file.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "io/parallel_chunks.hpp"
+#include "io/text_cursor.hpp"
+#include "rthdist/result.hpp"
+
+namespace rthdist::io {
+
+// Which lines of a format are items (the same test in both passes).
+using ItemLine = bool (*)(std::string_view line);
+
+struct TextChunk {
+    size_t begin = 0;        // byte offsets into the text
+    size_t end = 0;          // after the chunk's last line end
+    size_t firstLine = 0;    // file line number of its first line
+    size_t lines = 0;        // lines in it
+    uint64_t firstItem = 0;  // items in the text before it
+    uint64_t items = 0;      // item lines in it
+};
+
+struct TextChunks {
+    std::vector<TextChunk> chunks;
+    size_t firstLine = 0;  // of the text
+    size_t lines = 0;      // in the whole text (keepItems leaves it)
+    uint64_t items = 0;    // in the whole text (keepItems leaves it)
+
+    // Line number of the text's last line; firstLine - 1 when it has none
+    // (what a serial TextCursor's line() says after its last line).
+    [[nodiscard]] size_t lastLine() const { return firstLine + lines - 1; }
+};
+
+// Cuts text, whose first line has number firstLine, after line ends
+// ("\n", "\r\n", "\r": never between the two bytes of "\r\n") into chunks
+// of about plan.bytes() bytes, and counts each chunk's lines and items in
+// parallel.
+[[nodiscard]] TextChunks splitLines(std::string_view text, size_t firstLine, ItemLine isItem,
+                                    const ChunkPlan& plan);
+
+// Keeps the chunks up to the line of item maxItems - 1 (that chunk then ends
+// after this line); nothing changes when the text has no more than maxItems
+// items. maxItems 0 keeps no chunk.
+void keepItems(TextChunks& chunks, std::string_view text, ItemLine isItem, uint64_t maxItems);
+
+// Calls parse(chunk, cursor) for every chunk, in parallel; cursor walks the
+// chunk's lines with their file line numbers. parse returns the chunk's
+// first error or std::nullopt; the error of the first chunk that has one is
+// returned.
+template <class Parse>
+std::optional<Error> parseChunks(const TextChunks& chunks, std::string_view text, const ChunkPlan& plan,
+                                 Parse&& parse) {
+    return forEachChunk(chunks.chunks.size(), plan, [&](size_t c) -> std::optional<Error> {
+        const TextChunk& chunk = chunks.chunks[c];
+        TextCursor cursor(text.substr(chunk.begin, chunk.end - chunk.begin), chunk.firstLine);
+        return parse(chunk, cursor);
+    });
+}
+
+}  // namespace rthdist::io
