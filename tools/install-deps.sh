@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what rthdist needs to build and test on Debian 12 (bookworm).
 # Mesa's lavapipe gained VK_KHR_ray_query in 24.1; bookworm ships 22.3, so the
-# Vulkan driver comes from bookworm-backports (25.0.x). Idempotent: packages
+# Vulkan driver comes from bookworm-backports (25.0.x). Open MPI (openmpi-bin,
+# libopenmpi-dev) builds rthdist-mpi and its tests (mpirun). Idempotent: packages
 # already present are left alone. Needs root or sudo.
 #   RTHDIST_BENCH_DEPS=1  also python3-scipy/numpy for tools/bench
 #   RTHDIST_LINT_DEPS=1   also clang-format for .ci/run
@@ -18,7 +19,8 @@ if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 
 BASE_PKGS=(cmake g++ make pkg-config libvulkan-dev glslang-tools libglm-dev
   libtinygltf-dev libgtest-dev libnanoflann-dev zlib1g-dev vulkan-validationlayers
-  vulkan-tools nlohmann-json3-dev libcli11-dev libstb-dev strace libnifti2-dev)
+  vulkan-tools nlohmann-json3-dev libcli11-dev libstb-dev strace libnifti2-dev
+  openmpi-bin libopenmpi-dev)
 EXTRA_PKGS=()
 if [ "${RTHDIST_MASKS_DEPS:-1}" = 1 ]; then
   EXTRA_PKGS+=(python3 python3-numpy python3-scipy python3-skimage python3-nibabel)

@@ -1,0 +1,168 @@
+// hausdorffMpi: the frame, one directed pass per direction (replicated or
+// spatial targets), the winner of each direction chosen identically on every
+// rank, and its distance recomputed in double from the caller's points.
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <vector>
+
+#include "mpi/collectives.hpp"
+#include "mpi/directed_pass.hpp"
+#include "mpi/global_sets.hpp"
+#include "rthdist/mpi.hpp"
+
+namespace rthdist {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Largest distance first, then the smallest query index: one engine's rule.
+mpi::Candidate winnerOf(MPI_Comm comm, const mpi::Candidate& mine) {
+    Result<std::vector<mpi::Candidate>> all = mpi::allgatherRecords(comm, std::vector<mpi::Candidate>{mine});
+    mpi::Candidate best;
+    if (!all) return best;  // a few bytes per rank; agreed on every rank
+    for (const mpi::Candidate& c : *all) {
+        if (!c.any) continue;
+        if (!best.any || c.squaredFloat > best.squaredFloat ||
+            (c.squaredFloat == best.squaredFloat && c.query < best.query))
+            best = c;
+    }
+    return best;
+}
+
+// Sums the counters over ranks; bits and iterations are the maximum.
+Counters reduceCounters(MPI_Comm comm, const Counters& c) {
+    uint64_t sums[6] = {c.occupiedCells,    c.queries, c.culledByNeighbourhood,
+                        c.survivingQueries, c.rays,    c.candidatePairs};
+    uint32_t maxima[2] = {c.bits, c.iterations};
+    MPI_Allreduce(MPI_IN_PLACE, sums, 6, MPI_UINT64_T, MPI_SUM, comm);
+    MPI_Allreduce(MPI_IN_PLACE, maxima, 2, MPI_UINT32_T, MPI_MAX, comm);
+    Counters out;
+    out.occupiedCells = sums[0];
+    out.queries = sums[1];
+    out.culledByNeighbourhood = sums[2];
+    out.survivingQueries = sums[3];
+    out.rays = sums[4];
+    out.candidatePairs = sums[5];
+    out.bits = maxima[0];
+    out.iterations = maxima[1];
+    return out;
+}
+
+// Each stage's maximum over ranks.
+Timings reduceTimings(MPI_Comm comm, const Timings& t) {
+    double v[12] = {t.setup, t.upload, t.index,    t.cull,    t.search,    t.refine,
+                    t.check, t.total,  t.gpuIndex, t.gpuCull, t.gpuSearch, t.gpuRefine};
+    MPI_Allreduce(MPI_IN_PLACE, v, 12, MPI_DOUBLE, MPI_MAX, comm);
+    Timings out;
+    double* fields[12] = {&out.setup,    &out.upload,  &out.index,     &out.cull,
+                          &out.search,   &out.refine,  &out.check,     &out.total,
+                          &out.gpuIndex, &out.gpuCull, &out.gpuSearch, &out.gpuRefine};
+    for (int i = 0; i < 12; ++i) *fields[i] = v[i];
+    return out;
+}
+
+// One direction: the pass, then the winner with its points in the caller's coordinates.
+Result<Directed> direction(MPI_Comm comm, Engine& engine, const mpi::GlobalSets& sets, bool aToB,
+                           bool spatial, const CallOptions& call, Timings& timings, uint64_t& validation) {
+    const mpi::GlobalSet& q = aToB ? sets.a : sets.b;
+    const mpi::GlobalSet& t = aToB ? sets.b : sets.a;
+    Result<mpi::PassOutcome> pass = spatial ? mpi::spatialPass(comm, engine, q, t, sets.diagonal, call)
+                                            : mpi::replicatedPass(comm, engine, q, t, call);
+    if (!pass) return pass.error();
+    const mpi::Candidate best = winnerOf(comm, pass->best);
+    if (!best.any) return Error{ErrorCode::kInternal, "no rank reported a witness"};
+    Directed d;
+    d.queryIndex = best.query;
+    d.targetIndex = best.target;
+    d.queryPoint = mpi::broadcastPoint(comm, q, best.query);
+    d.targetPoint = mpi::broadcastPoint(comm, t, best.target);
+    d.distance = glm::length(d.queryPoint - d.targetPoint);
+    d.counters = reduceCounters(comm, pass->counters);
+    mpi::addTimings(timings, pass->timings);
+    validation += pass->validationMessages;
+    return d;
+}
+
+bool replicate(const mpi::GlobalSets& sets, const MpiOptions& mpi) {
+    if (mpi.mode != TargetMode::kAuto) return mpi.mode == TargetMode::kReplicated;
+    return (sets.a.total() + sets.b.total()) * sizeof(glm::vec3) <= mpi.replicateLimitBytes;
+}
+
+}  // namespace
+
+const char* targetModeName(TargetMode mode) {
+    switch (mode) {
+        case TargetMode::kAuto: return "auto";
+        case TargetMode::kReplicated: return "replicated";
+        case TargetMode::kSpatial: return "spatial";
+    }
+    return "auto";
+}
+
+bool parseTargetMode(const char* text, TargetMode& out) {
+    for (TargetMode m : {TargetMode::kAuto, TargetMode::kReplicated, TargetMode::kSpatial}) {
+        if (std::strcmp(text, targetModeName(m)) == 0) {
+            out = m;
+            return true;
+        }
+    }
+    return false;
+}
+
+Result<HausdorffResult> hausdorffMpi(MPI_Comm comm, Engine& engine, PointView localA, PointView localB,
+                                     const CallOptions& call, const MpiOptions& mpi) {
+    const Clock::time_point start = Clock::now();
+    std::optional<Error> local;
+    if (call.perPointDistances)
+        local = Error{ErrorCode::kInvalidArgument, "hausdorffMpi does not compute per-point distances"};
+    if (auto error = agreeOnError(comm, local)) return *error;
+    Result<mpi::GlobalSets> sets = mpi::makeGlobalSets(comm, localA, localB);
+    if (!sets) return sets.error();
+    const bool spatial = !replicate(*sets, mpi);
+
+    HausdorffResult r;
+    Timings timings;
+    uint64_t validation = 0;
+    Result<Directed> ab = direction(comm, engine, *sets, true, spatial, call, timings, validation);
+    if (!ab) return ab.error();
+    r.aToB = *ab;
+    r.hausdorff = r.aToB.distance;
+    r.directedOnly = call.directedOnly;
+    if (!call.directedOnly) {
+        Result<Directed> ba = direction(comm, engine, *sets, false, spatial, call, timings, validation);
+        if (!ba) return ba.error();
+        r.bToA = *ba;
+        r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
+    }
+    r.backend = engine.backend();
+    r.device = engine.deviceName();
+    mpi::broadcastString(comm, 0, r.device);
+    int backend = int(r.backend);
+    MPI_Bcast(&backend, 1, MPI_INT, 0, comm);
+    r.backend = Backend(backend);
+    r.origin = sets->origin;
+    r.timings = reduceTimings(comm, timings);
+    r.timings.total = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    MPI_Allreduce(MPI_IN_PLACE, &r.timings.total, 1, MPI_DOUBLE, MPI_MAX, comm);
+    MPI_Allreduce(&validation, &r.validationMessages, 1, MPI_UINT64_T, MPI_SUM, comm);
+    return r;
+}
+
+Result<HausdorffResult> hausdorffMpi(MPI_Comm comm, PointView localA, PointView localB,
+                                     const Options& options, const MpiOptions& mpi) {
+    std::optional<Engine> engine;
+    std::optional<Error> local = mpi::guarded([&]() -> std::optional<Error> {
+        Result<Engine> e = Engine::create(static_cast<const EngineOptions&>(options));
+        if (!e) return e.error();
+        engine.emplace(std::move(e).value());
+        return std::nullopt;
+    });
+    if (auto error = agreeOnError(comm, local)) return *error;
+    return hausdorffMpi(comm, *engine, localA, localB, static_cast<const CallOptions&>(options), mpi);
+}
+
+}  // namespace rthdist
