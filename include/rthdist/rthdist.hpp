@@ -109,6 +109,9 @@ struct Timings {
     double gpuCull = 0.0;
     double gpuSearch = 0.0;
     double gpuRefine = 0.0;
+    // Device time of the host -> device transfers (the copy commands alone;
+    // their bytes over this time is the link speed the call reached).
+    double gpuUpload = 0.0;
 };
 
 struct HausdorffResult {

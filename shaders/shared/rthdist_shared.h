@@ -39,6 +39,7 @@ struct vec3f {
 #define RTHDIST_CTR_MIN_EDGE 48     // float bits: leaf_slots, the narrowest sub-cell edge of a split
 #define RTHDIST_CTR_LARGE_CELLS 52  // uint: cell_build, 1 when a cell needs the parallel box
 #define RTHDIST_CTR_READBACK 64     // host read-back area after the counters
+#define RTHDIST_CTR_INGEST 1152     // IngestSummary: ingest.comp, one set's bounds and first bad point
 #define RTHDIST_CTR_BYTES 256
 
 // Query status values.
@@ -74,6 +75,30 @@ struct KeysPush {
     uint64_t dense;   // uint[2^(3 bits)] histogram (zeroed)
     GridParams grid;
     uint n;
+};
+
+// ingest.comp: the caller's points (x, y, z floats at source + i * stride, in
+// host-visible or device memory) into vec4 records, with their bounds, the
+// first point that is not finite, and every sampleStride-th point for the
+// host's bit count (sample 0: none).
+struct IngestPush {
+    uint64_t source;
+    uint64_t points;   // vec4[n] out: xyz, w = 0
+    uint64_t summary;  // IngestSummary, initialised by the host
+    uint64_t samples;  // vec4[n / sampleStride + 1] out
+    uint n;
+    uint stride;  // bytes, a multiple of 4, >= 12
+    uint sampleStride;
+};
+
+// What ingest.comp reports of a set: the bounds of its finite points as
+// order-preserving bits (orderedBits in common.glsl; lo starts at 0xffffffff,
+// hi at 0) and the smallest index of a non-finite point (0xffffffff: none).
+struct IngestSummary {
+    uint lo[3];
+    uint hi[3];
+    uint firstBad;
+    uint pad;
 };
 
 // scan_block.comp / scan_add.comp: exclusive scan of uint[n] in place.

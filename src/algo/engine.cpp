@@ -253,8 +253,32 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b) {
     return compute(a, b, m_impl->callDefaults);
 }
 
+namespace {
+
+// A one-shot GPU call on packed float arrays: the device checks, bounds and
+// samples the points (GpuHausdorff::computePacked); the host only copies them.
+Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
+                                        const CallOptions& call, std::chrono::steady_clock::time_point t0) {
+    if (auto err = algo::checkShape(a, "A")) return *err;
+    if (auto err = algo::checkShape(b, "B")) return *err;
+    if (auto err = validateCallOptions(call)) return *err;
+    auto asVec3 = [](const PointView& v) {
+        return std::span<const glm::vec3>(static_cast<const glm::vec3*>(v.data), v.count);
+    };
+    Result<HausdorffResult> r = impl.device->gpu->computePacked(asVec3(a), asVec3(b), call);
+    if (!r) return r;
+    r->origin = glm::dvec3(0.0);
+    finishResult(impl, *r, t0);
+    return r;
+}
+
+}  // namespace
+
 Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOptions& call) {
     const auto t0 = std::chrono::steady_clock::now();
+    if (m_impl->device->gpu && a.packedFloat() && b.packedFloat() &&
+        algo::GpuHausdorff::ingests(a.count, b.count))
+        return computeIngested(*m_impl, a, b, call, t0);
     Result<CheckedInputs> checked = checkInputs(a, b);
     if (!checked) return checked.error();
     return computeViews(*m_impl, a, b, *checked, call, t0);

@@ -133,8 +133,26 @@ std::vector<glm::vec3> scaledCopy(std::span<const glm::vec3> pts, double scale) 
     return out;
 }
 
+// The float of orderedBits (common.glsl): the host's read of a reduced bound.
+float fromOrderedBits(uint32_t u) {
+    return std::bit_cast<float>((u & 0x80000000u) != 0u ? u & 0x7fffffffu : ~u);
+}
+
+// The dense key table costs O(2^(3k)) to clear and scan: an automatic bit
+// count keeps it within a few entries per point.
+int clampedBits(int bits, uint32_t n) {
+    while (bits > kMinBits && (uint64_t(1) << (3 * bits)) > 8 * uint64_t(n) + 4096) --bits;
+    return bits;
+}
+
 // A call whose cancel flag was set: unwinds to the guard of the entry point.
 struct CallCancelled {};
+
+// Bad input found on the device (ingest.comp): unwinds to the guard, which
+// returns it as it is.
+struct InputRejected {
+    Error error;
+};
 
 void throwIfCancelled(const CallOptions& options) {
     if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
@@ -295,10 +313,7 @@ struct GpuHausdorff::State {
         ix.bounds.lo = glm::dvec3(lo[0]);
         ix.bounds.hi = glm::dvec3(hi[0]);
         if (bits <= 0) {
-            // The dense key table costs O(2^(3k)) to clear and scan: keep it
-            // within a few entries per point when the bit count is automatic.
-            bits = chooseBits(pts, ix.bounds);
-            while (bits > kMinBits && (uint64_t(1) << (3 * bits)) > 8 * uint64_t(ix.n) + 4096) --bits;
+            bits = clampedBits(chooseBits(pts, ix.bounds), ix.n);
         }
         ix.grid = makeGrid(ix.bounds, bits);
     }
@@ -311,6 +326,82 @@ struct GpuHausdorff::State {
         const VkBufferCopy region{0, 0, bytes};
         vkCmdCopyBuffer(cmd, buf(ix.scratch + ".staging", bytes, MemoryKind::kHost).handle(), points.handle(),
                         1, &region);
+    }
+
+    // The device ingest path (ingest.comp) for packed float host arrays: the
+    // host copies each array into a host-visible buffer (its only pass over
+    // the points); the device uploads it, checks it, takes its bounds and a
+    // sample for the bit count. Sets `ix.n`; nothing is submitted.
+    void stageSource(PointIndex& ix, std::span<const glm::vec3> pts) {
+        ix.n = uint32_t(pts.size());
+        Buffer& source = buf(ix.scratch + ".source", VkDeviceSize(ix.n) * 12, MemoryKind::kHost);
+        auto* dst = static_cast<char*>(source.mapped());
+        const char* src = reinterpret_cast<const char*>(pts.data());
+        const int threads = cpu::resolveThreads(0, ix.n / kHostChunk + 1);
+        cpu::parallelChunks(ix.n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
+            std::memcpy(dst + begin * 12, src + begin * 12, (end - begin) * 12);
+        });
+    }
+
+    // Records the upload of a staged source (stageSource) into device memory.
+    void cmdUploadSource(VkCommandBuffer cmd, const PointIndex& ix) {
+        const VkDeviceSize bytes = VkDeviceSize(ix.n) * 12;
+        const VkBufferCopy region{0, 0, bytes};
+        vkCmdCopyBuffer(cmd, buf(ix.scratch + ".source", bytes, MemoryKind::kHost).handle(),
+                        buf(ix.scratch + ".raw", bytes).handle(), 1, &region);
+    }
+
+    // Records the ingest of an uploaded source into the set's vec4 points,
+    // its summary in `blk` and its bit-count sample.
+    void cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {
+        auto& summary = blk.at<sh::IngestSummary>(RTHDIST_CTR_INGEST);
+        for (int k = 0; k < 3; ++k) {
+            summary.lo[k] = 0xffffffffu;
+            summary.hi[k] = 0u;
+        }
+        summary.firstBad = 0xffffffffu;
+        const uint32_t stride = uint32_t(bitsSampleStride(ix.n));
+        sh::IngestPush ip{buf(ix.scratch + ".raw", VkDeviceSize(ix.n) * 12).address(),
+                          buf(ix.scratch + ".points", VkDeviceSize(ix.n) * 16).address(),
+                          blk.addr(RTHDIST_CTR_INGEST),
+                          sampleBuffer(ix).address(),
+                          ix.n,
+                          12u,
+                          stride};
+        dispatch(cmd, Kernel::kIngest, ip, ix.n);
+    }
+    Buffer& sampleBuffer(const PointIndex& ix) {
+        const VkDeviceSize count = (ix.n - 1) / bitsSampleStride(ix.n) + 1;
+        return buf(ix.scratch + ".sample", count * 16, MemoryKind::kReadback);
+    }
+
+    // After the ingest's submission: the set's bounds from `blk`, or the
+    // error naming its first point that is not finite (as summarizeSet
+    // words it for host input).
+    void finishIngest(PointIndex& ix, const CounterBlock& blk) {
+        const auto& summary = blk.at<sh::IngestSummary>(RTHDIST_CTR_INGEST);
+        if (summary.firstBad != 0xffffffffu)
+            throw InputRejected{Error{ErrorCode::kInvalidArgument, "point set " + ix.name + ": point " +
+                                                                       std::to_string(summary.firstBad) +
+                                                                       " has a NaN or infinite coordinate"}};
+        for (int k = 0; k < 3; ++k) {
+            ix.bounds.lo[k] = double(fromOrderedBits(summary.lo[k]));
+            ix.bounds.hi[k] = double(fromOrderedBits(summary.hi[k]));
+        }
+    }
+
+    // The bit count and grid of an ingested set, from its device sample.
+    void chooseIngestedGrid(PointIndex& ix, int bits) {
+        if (bits <= 0) {
+            const Buffer& sampleBuf = sampleBuffer(ix);
+            const size_t count = (ix.n - 1) / bitsSampleStride(ix.n) + 1;
+            const auto* records = static_cast<const float*>(sampleBuf.mapped());
+            std::vector<glm::vec3> sample(count);
+            for (size_t j = 0; j < count; ++j)
+                sample[j] = glm::vec3(records[4 * j], records[4 * j + 1], records[4 * j + 2]);
+            bits = clampedBits(chooseBitsFromSample(sample, ix.n, ix.bounds), ix.n);
+        }
+        ix.grid = makeGrid(ix.bounds, bits);
     }
 
     // Device half of an index build, recorded into `cmd` after the upload:
@@ -376,19 +467,21 @@ struct GpuHausdorff::State {
     // Indexes the staged sets (one or two) in one submission: both uploads
     // back to back, then each build; then each set's checks and leaves.
     template <size_t N>
-    void buildIndexes(const std::array<PointIndex*, N>& sets) {
+    void buildIndexes(const std::array<PointIndex*, N>& sets, bool ingested = false) {
         static_assert(N <= std::tuple_size_v<decltype(blocks)>, "a counter block per set");
         if (sets.size() > blocks.size())
             throw std::logic_error("buildIndexes: more sets than counter blocks");
         auto t0 = Clock::now();
         VkCommandBuffer cmd = ctx.begin();
-        for (PointIndex* ix : sets) cmdUpload(cmd, *ix);
+        for (PointIndex* ix : sets)
+            if (!ingested) cmdUpload(cmd, *ix);
         const uint32_t uploaded = ctx.cmdMark(cmd);
         barrier(cmd);
         for (size_t k = 0; k < sets.size(); ++k) cmdBuildIndex(cmd, *sets[k], blocks[k]);
         ctx.submitAndWait(cmd);
         const double uploadMs = ctx.gpuMsBetween(0, uploaded);
         timings->upload += uploadMs;
+        timings->gpuUpload += uploadMs;
         timings->gpuIndex += ctx.lastGpuMs() - uploadMs;
         for (size_t k = 0; k < sets.size(); ++k) finishIndex(*sets[k], blocks[k]);
         timings->index += msSince(t0) - uploadMs;
@@ -920,6 +1013,64 @@ struct GpuHausdorff::State {
         }
     }
 
+    // One-shot H of two packed float host arrays through the ingest path:
+    // one submission uploads and ingests both, the host reads their bounds
+    // and samples (the bit count needs them), a second builds both indexes.
+    // Returns false, having done nothing else, when the sets need the exact
+    // power-of-two scale (index_space.hpp), which the host path applies.
+    bool ingestPair(DeviceSet& da, DeviceSet& db, std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                    const CallOptions& options) {
+        const auto t0 = Clock::now();
+        std::array<DeviceSet*, 2> sets = {&da, &db};
+        std::array<std::span<const glm::vec3>, 2> inputs = {a, b};
+        for (size_t k = 0; k < 2; ++k) {
+            DeviceSet& set = *sets[k];
+            set.input = set.points = inputs[k];
+            set.ix.name = set.ix.scratch = k == 0 ? "A" : "B";
+            set.ix.store = &pool;
+            stageSource(set.ix, inputs[k]);
+        }
+        VkCommandBuffer cmd = ctx.begin();
+        for (DeviceSet* set : sets) cmdUploadSource(cmd, set->ix);
+        const uint32_t uploaded = ctx.cmdMark(cmd);
+        barrier(cmd);
+        for (size_t k = 0; k < 2; ++k) cmdIngest(cmd, sets[k]->ix, blocks[k]);
+        ctx.submitAndWait(cmd);
+        const double uploadMs = ctx.gpuMsBetween(0, uploaded);
+        timings->upload += msSince(t0) - (ctx.lastGpuMs() - uploadMs);
+        timings->gpuUpload += uploadMs;
+        timings->gpuIndex += ctx.lastGpuMs() - uploadMs;
+        for (size_t k = 0; k < 2; ++k) finishIngest(sets[k]->ix, blocks[k]);
+        const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
+        if (exactScale(magnitude) != 1.0) return false;
+        const auto t1 = Clock::now();
+        for (DeviceSet* set : sets) chooseIngestedGrid(set->ix, options.bits);
+        timings->index += msSince(t1);
+        buildIndexes(std::array{&da.ix, &db.ix}, /*uploaded=*/true);
+        return true;
+    }
+
+    // One-shot H of two float sets through the host path: each staged by
+    // the host (vec4 copy, bounds, bit count), uploaded and indexed. Small
+    // sets: both in one submission (scratch of their own). Large ones: one
+    // after the other in the same scratch (a submission is then cheap beside
+    // the work, and the device holds one set's scratch, not two).
+    void hostPair(std::span<const glm::vec3> a, std::span<const glm::vec3> b, double scale,
+                  const CallOptions& options, HausdorffResult& res) {
+        DeviceSet da, db;
+        const bool together = a.size() + b.size() <= kFusedBuildPoints;
+        stageSet(da, a, scale, options.bits, "A", together ? "A" : "build");
+        if (!together) buildIndexes(std::array{&da.ix});
+        stageSet(db, b, scale, options.bits, "B", together ? "B" : "build");
+        report(options, "index", 0.05);
+        if (together)
+            buildIndexes(std::array{&da.ix, &db.ix});
+        else
+            buildIndexes(std::array{&db.ix});
+        report(options, "index", 0.1);
+        runPair(da, db, options, res, 0.1);
+    }
+
     // H (or h) of two indexed sets of one scale into `res`; progress covers
     // [from, 1] of the call.
     void runPair(DeviceSet& a, DeviceSet& b, const CallOptions& options, HausdorffResult& res, double from) {
@@ -954,6 +1105,8 @@ struct GpuHausdorff::State {
         std::optional<Error> err;
         try {
             work();
+        } catch (const InputRejected& e) {
+            err = e.error;
         } catch (const CallCancelled&) {
             err = Error{ErrorCode::kCancelled, "the call was cancelled (CallOptions::cancel)"};
         } catch (const gpu::VulkanError& e) {
@@ -1002,27 +1155,32 @@ Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std:
     // which is exact; values and witnesses are recomputed from the inputs.
     // Each set is indexed once with its own grid: as targets for the other
     // direction, and as cell-ordered (Morton) queries for its own.
+    auto err = st.guarded(res.timings, [&] { st.hostPair(a, b, scale, options, res); });
+    if (err) return *err;
+    return res;
+}
+
+Result<HausdorffResult> GpuHausdorff::computePacked(std::span<const glm::vec3> a,
+                                                    std::span<const glm::vec3> b,
+                                                    const CallOptions& options) {
+    State& st = *m_state;
+    HausdorffResult res = st.emptyResult(options);
     auto err = st.guarded(res.timings, [&] {
-        // Small sets: both staged, then uploaded and indexed in one
-        // submission (scratch of their own). Large ones: one after the other
-        // in the same scratch (a submission is then cheap beside the work,
-        // and the device holds one set's scratch, not two).
         DeviceSet da, db;
-        const bool together = a.size() + b.size() <= kFusedBuildPoints;
-        st.stageSet(da, a, scale, options.bits, "A", together ? "A" : "build");
-        if (!together) st.buildIndexes(std::array{&da.ix});
-        st.stageSet(db, b, scale, options.bits, "B", together ? "B" : "build");
-        st.report(options, "index", 0.05);
-        if (together)
-            st.buildIndexes(std::array{&da.ix, &db.ix});
-        else
-            st.buildIndexes(std::array{&db.ix});
+        if (!st.ingestPair(da, db, a, b, options)) {
+            // Coordinates past 2^40 or below 2^-40: the host path scales them.
+            const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
+            st.hostPair(a, b, exactScale(magnitude), options, res);
+            return;
+        }
         st.report(options, "index", 0.1);
         st.runPair(da, db, options, res, 0.1);
     });
     if (err) return *err;
     return res;
 }
+
+bool GpuHausdorff::ingests(size_t aPoints, size_t bPoints) { return aPoints + bPoints <= kFusedBuildPoints; }
 
 Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                               const CallOptions& options) {

@@ -44,6 +44,18 @@ public:
     // (exactScale of their largest magnitude).
     [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                   double scale, const CallOptions& options);
+    // One-shot from packed float host arrays through the device ingest path
+    // (ingest.comp): the host copies each array once into memory the device
+    // reads; validation (NaN/Inf: kInvalidArgument naming the set and the
+    // point), bounds and the bit count's sample come from the device. The
+    // caller has checked only the views' shape (count, pointer). For sets
+    // that ingests() accepts.
+    [[nodiscard]] Result<HausdorffResult> computePacked(std::span<const glm::vec3> a,
+                                                        std::span<const glm::vec3> b,
+                                                        const CallOptions& options);
+    // Whether computePacked takes sets of these sizes (both indexed in one
+    // submission, each with scratch of its own: up to 2^25 points together).
+    [[nodiscard]] static bool ingests(size_t aPoints, size_t bPoints);
     // As above, the scale taken from the points (one pass over each).
     [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                   const CallOptions& options);

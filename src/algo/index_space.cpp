@@ -61,19 +61,16 @@ namespace {
 constexpr int kProbeBits = 10;  // the sample's keys: 10 bits per axis, 30 in all
 constexpr size_t kSampleSize = 32768;
 
-// The probe keys of a strided sample of `targets`, in ascending order (LSD
-// radix sort, three passes of 10 bits: linear in the sample, where a
-// comparison sort of 32k keys cost ~1.5 ms per set on the host path).
-std::vector<uint32_t> sortedSampleKeys(std::span<const glm::vec3> targets, const GridSpec& probe,
-                                       size_t stride) {
+// The probe keys of the sample, in ascending order (LSD radix sort, three
+// passes of 10 bits: linear in the sample, where a comparison sort of 32k
+// keys cost ~1.5 ms per set on the host path).
+std::vector<uint32_t> sortedSampleKeys(std::span<const glm::vec3> sample, const GridSpec& probe) {
     std::vector<uint32_t> keys, tmp;
-    keys.reserve(targets.size() / stride + 1);
-    for (size_t i = 0; i < targets.size(); i += stride) {
-        const glm::vec3& p = targets[i];
+    keys.reserve(sample.size());
+    for (const glm::vec3& p : sample)
         keys.push_back(mortonEncode(cellCoord(p.x, probe.origin.x, probe.cellSize, probe.cellsPerAxis),
                                     cellCoord(p.y, probe.origin.y, probe.cellSize, probe.cellsPerAxis),
                                     cellCoord(p.z, probe.origin.z, probe.cellSize, probe.cellsPerAxis)));
-    }
     tmp.resize(keys.size());
     constexpr uint32_t kDigits = 1u << kProbeBits;
     for (int shift = 0; shift < 3 * kProbeBits; shift += kProbeBits) {
@@ -110,8 +107,18 @@ std::array<size_t, kMaxBits + 1> distinctCellsPerLevel(const std::vector<uint32_
 
 }  // namespace
 
+size_t bitsSampleStride(size_t n) { return std::max<size_t>(1, n / kSampleSize); }
+
 int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds, double targetPointsPerCell) {
-    const size_t n = targets.size();
+    const size_t stride = bitsSampleStride(targets.size());
+    std::vector<glm::vec3> sample;
+    sample.reserve(targets.size() / stride + 1);
+    for (size_t i = 0; i < targets.size(); i += stride) sample.push_back(targets[i]);
+    return chooseBitsFromSample(sample, targets.size(), bounds, targetPointsPerCell);
+}
+
+int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Bounds& bounds,
+                         double targetPointsPerCell) {
     if (n <= 1) return kMinBits;
     GridSpec probe = makeGrid(bounds, kMaxBits);
     probe.bits = kProbeBits;
@@ -121,18 +128,18 @@ int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds, double 
     if (!(longest > 0.0)) return kMinBits;
     probe.cellSize = longest / double(probe.cellsPerAxis);
 
-    // Strided sample; its distinct-cell counts per level are trustworthy while
-    // the sample still puts several points in each cell.
-    const size_t stride = std::max<size_t>(1, n / kSampleSize);
-    const std::vector<uint32_t> keys = sortedSampleKeys(targets, probe, stride);
+    // Its distinct-cell counts per level are trustworthy while the sample
+    // still puts several points in each cell.
+    const bool whole = bitsSampleStride(n) == 1;
+    const std::vector<uint32_t> keys = sortedSampleKeys(sample, probe);
     const std::array<size_t, kMaxBits + 1> distinct = distinctCellsPerLevel(keys);
-    const double sample = double(keys.size());
+    const double sampled = double(keys.size());
     double estimate = 1.0;  // occupied cells at the previous level
     double growth = 8.0;
     int chosen = kMinBits;
     for (int k = 1; k <= kMaxBits; ++k) {
         double occupied;
-        if (sample / double(distinct[size_t(k)]) >= 8.0 || stride == 1) {
+        if (sampled / double(distinct[size_t(k)]) >= 8.0 || whole) {
             occupied = double(distinct[size_t(k)]);
             if (k > 1) growth = std::clamp(occupied / estimate, 1.0, 8.0);
         } else {
@@ -148,6 +155,11 @@ int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds, double 
 }
 
 constexpr size_t kMagnitudeChunk = size_t(1) << 16;  // points per work item
+
+double largestMagnitude(const Bounds& box) {
+    const glm::dvec3 m = glm::max(glm::abs(box.lo), glm::abs(box.hi));
+    return std::max({m.x, m.y, m.z});
+}
 
 double largestMagnitude(std::span<const glm::vec3> points) {
     const int threads = cpu::resolveThreads(0, points.size() / kMagnitudeChunk + 1);

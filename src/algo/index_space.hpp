@@ -42,6 +42,15 @@ struct GridSpec {
 [[nodiscard]] int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds,
                              double targetPointsPerCell = kTargetPointsPerCell);
 
+// The sample chooseBits reads: targets[0], targets[s], targets[2s], ... with
+// s = bitsSampleStride(n) (about 32k points).
+[[nodiscard]] size_t bitsSampleStride(size_t n);
+
+// chooseBits from that sample gathered elsewhere (the GPU's ingest pass):
+// sample[j] = targets[j * bitsSampleStride(n)]; the same k as chooseBits.
+[[nodiscard]] int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Bounds& bounds,
+                                       double targetPointsPerCell = kTargetPointsPerCell);
+
 // The one scaling rule of both backends (squared distances are float there):
 // 1 when the largest coordinate magnitude maxAbs lies in [2^-40, 2^40] (then
 // every squared difference of distinct coordinates near maxAbs is a normal
@@ -54,6 +63,8 @@ struct GridSpec {
 
 // The largest coordinate magnitude of a float set (the maxAbs of exactScale).
 [[nodiscard]] double largestMagnitude(std::span<const glm::vec3> points);
+// The same from a set's box (the extremes of |p| lie on its corners).
+[[nodiscard]] double largestMagnitude(const Bounds& box);
 
 // Interleaves the low 10 bits of x, y, z (x in bit 0).
 [[nodiscard]] uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z);

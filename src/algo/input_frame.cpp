@@ -72,7 +72,7 @@ void merge(ChunkSummary& into, const ChunkSummary& part) {
 
 }  // namespace
 
-Result<SetSummary> summarizeSet(const PointView& points, const char* name) {
+std::optional<Error> checkShape(const PointView& points, const char* name) {
     if (points.empty()) return setError(name, " is empty: the Hausdorff distance is undefined");
     if (points.count > kMaxPoints) return setError(name, " has more than 2^31-1 points");
     const size_t scalar = scalarBytes(points.scalar);
@@ -80,6 +80,11 @@ Result<SetSummary> summarizeSet(const PointView& points, const char* name) {
         return setError(name, ": a stride of " + std::to_string(points.strideBytes) +
                                   " bytes cannot hold three " + (scalar == 8 ? "doubles" : "floats") +
                                   " per point (or the data pointer is null)");
+    return std::nullopt;
+}
+
+Result<SetSummary> summarizeSet(const PointView& points, const char* name) {
+    if (auto err = checkShape(points, name)) return *err;
     const char* base = static_cast<const char*>(points.data);
     const int threads = cpu::resolveThreads(0, points.count / kChunk + 1);
     std::vector<ChunkSummary> parts(static_cast<size_t>(threads));

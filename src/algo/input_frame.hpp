@@ -25,6 +25,10 @@ struct SetSummary {
     bool floatExact = true;
 };
 
+// The view's shape alone (no pass over the points): the error for an empty
+// set, too many points, a stride that cannot hold a point or a null pointer.
+[[nodiscard]] std::optional<Error> checkShape(const PointView& points, const char* name);
+
 // Box and precision of one set, or the error naming the first bad point
 // (NaN/Inf, an empty set, a stride that cannot hold a point, too many points).
 [[nodiscard]] Result<SetSummary> summarizeSet(const PointView& points, const char* name);

@@ -17,11 +17,15 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
     RTHDIST_VK_CHECK(vkCreateBuffer(m_device, &bi, nullptr, &m_buffer));
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(m_device, m_buffer, &req);
-    VkMemoryPropertyFlags wanted =
-        kind == MemoryKind::kDevice
-            ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
-            : (VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-    uint32_t type = ctx.memoryTypeIndex(req.memoryTypeBits, wanted);
+    const VkMemoryPropertyFlags hostFlags =
+        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    const VkMemoryPropertyFlags wanted =
+        kind == MemoryKind::kDevice ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT : hostFlags;
+    uint32_t type =
+        kind == MemoryKind::kReadback
+            ? ctx.memoryTypeIndex(req.memoryTypeBits, hostFlags | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+            : ~0u;
+    if (type == ~0u) type = ctx.memoryTypeIndex(req.memoryTypeBits, wanted);
     if (type == ~0u) {
         reset();
         throwVulkanError(VK_ERROR_FEATURE_NOT_PRESENT, "memoryTypeIndex (no suitable memory type)", __FILE__,
@@ -43,7 +47,7 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
         throwVulkanError(r, what.c_str(), __FILE__, __LINE__);
     }
     RTHDIST_VK_CHECK(vkBindBufferMemory(m_device, m_buffer, m_memory, 0));
-    if (kind == MemoryKind::kHost)
+    if (kind != MemoryKind::kDevice)
         RTHDIST_VK_CHECK(vkMapMemory(m_device, m_memory, 0, VK_WHOLE_SIZE, 0, &m_mapped));
     VkBufferDeviceAddressInfo dai{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
     dai.buffer = m_buffer;

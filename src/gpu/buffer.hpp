@@ -11,7 +11,11 @@ namespace rthdist::gpu {
 
 class Context;
 
-enum class MemoryKind { kDevice, kHost };
+// kDevice: device-local. kHost: host-visible and coherent, for data the host
+// writes and the device reads (staging, counters). kReadback: host-visible,
+// coherent and, where the device has it, cached: for data the device writes
+// and the host reads in bulk (uncached reads run at a fraction of memory speed).
+enum class MemoryKind { kDevice, kHost, kReadback };
 
 class Buffer {
 public:

@@ -16,6 +16,7 @@
 #include "check_index.comp.h"
 #include "check_queries.comp.h"
 #include "coarsen.comp.h"
+#include "ingest.comp.h"
 #include "compact.comp.h"
 #include "cull.comp.h"
 #include "grow_boxes.comp.h"
@@ -121,6 +122,7 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache) : m_ctx
         spirv(k_spv_leaf_scatter_comp, "leaf_scatter"),
         spirv(k_spv_cell_bounds_comp, "cell_bounds"),
         spirv(k_spv_cell_bounds_fix_comp, "cell_bounds_fix"),
+        spirv(k_spv_ingest_comp, "ingest"),
     };
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !rayQuery) continue;

@@ -35,6 +35,7 @@ enum class Kernel : uint32_t {
     kLeafScatter,
     kCellBounds,  // parallel tight boxes of large cells (cell_bounds*.comp)
     kCellBoundsFix,
+    kIngest,  // the caller's points into vec4 records, bounds, validation (ingest.comp)
     kCount
 };
 

@@ -66,9 +66,11 @@ nlohmann::ordered_json stageMedians(const std::vector<double>& wall, const std::
         for (const HausdorffResult& r : rs) v.push_back(r.timings.*field);
         return median(v);
     };
-    std::vector<double> gpu;
-    for (const HausdorffResult& r : rs)
+    std::vector<double> gpu, gpuAll;
+    for (const HausdorffResult& r : rs) {
         gpu.push_back(r.timings.gpuIndex + r.timings.gpuCull + r.timings.gpuSearch + r.timings.gpuRefine);
+        gpuAll.push_back(gpu.back() + r.timings.gpuUpload);
+    }
     return {{"wall", median(wall)},
             {"upload", of(&rthdist::Timings::upload)},
             {"index", of(&rthdist::Timings::index)},
@@ -76,7 +78,10 @@ nlohmann::ordered_json stageMedians(const std::vector<double>& wall, const std::
             {"search", of(&rthdist::Timings::search)},
             {"refine", of(&rthdist::Timings::refine)},
             {"check", of(&rthdist::Timings::check)},
-            {"gpu_sum", median(gpu)}};
+            {"gpu_sum", median(gpu)},
+            {"gpu_upload", of(&rthdist::Timings::gpuUpload)},  // device time of the transfers
+            {"gpu_with_upload", median(gpuAll)},               // every device stage, transfers included
+            {"wall_over_gpu", median(wall) / median(gpuAll)}};
 }
 
 template <class Call>

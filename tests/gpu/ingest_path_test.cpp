@@ -1,0 +1,103 @@
+// The device ingest path (ingest.comp, GpuHausdorff::computePacked): packed
+// float arrays are checked, bounded and sampled on the device, other views
+// on the host. Both paths must give the same index and the same answer, and
+// the device must reject what the host rejects, with the same words.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "common/oracle_cases.hpp"
+#include "gpu_test_support.hpp"
+
+namespace rthdist::test {
+namespace {
+
+// The same points as a float view with a 16-byte stride: not packed, so the
+// engine takes the host path (summary pass, host bit count, staging copy).
+struct Strided {
+    std::vector<float> data;
+    PointView view;
+    explicit Strided(const std::vector<glm::vec3>& p) : data(p.size() * 4, -1.0f) {
+        for (size_t i = 0; i < p.size(); ++i) {
+            data[4 * i] = p[i].x;
+            data[4 * i + 1] = p[i].y;
+            data[4 * i + 2] = p[i].z;
+        }
+        view = PointView::floats(data.data(), p.size(), 16);
+    }
+};
+
+void expectSameDirection(const Directed& device, const Directed& host) {
+    EXPECT_EQ(device.distance, host.distance);
+    EXPECT_EQ(device.queryIndex, host.queryIndex);
+    EXPECT_EQ(device.targetIndex, host.targetIndex);
+    EXPECT_EQ(device.counters.bits, host.counters.bits);
+    EXPECT_EQ(device.counters.occupiedCells, host.counters.occupiedCells);
+    EXPECT_EQ(device.counters.survivingQueries, host.counters.survivingQueries);
+    EXPECT_EQ(device.counters.rays, host.counters.rays);
+}
+
+TEST(IngestPath, SameIndexAndAnswerAsTheHostPath) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    const std::vector<OracleCase> cases = makeOracleCases();
+    int compared = 0;
+    for (size_t k = 0; k < cases.size(); k += 7) {  // every family, a seventh of the cases
+        const OracleCase& c = cases[k];
+        SCOPED_TRACE(c.name);
+        auto device = engine->compute(c.a, c.b);
+        const Strided sa(c.a), sb(c.b);
+        auto host = engine->compute(sa.view, sb.view);
+        ASSERT_TRUE(device.ok()) << device.error().message;
+        ASSERT_TRUE(host.ok()) << host.error().message;
+        expectMatchesOracle(c, *device);
+        EXPECT_EQ(device->hausdorff, host->hausdorff);
+        expectSameDirection(device->aToB, host->aToB);
+        expectSameDirection(device->bToA, host->bToA);
+        EXPECT_EQ(device->validationMessages, 0u);
+        ++compared;
+    }
+    EXPECT_GT(compared, 40);
+}
+
+TEST(IngestPath, FirstNonFinitePointOfEachSetIsNamedAsOnTheHost) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    std::vector<glm::vec3> a(10000), b(5000);
+    for (size_t i = 0; i < a.size(); ++i) a[i] = glm::vec3(float(i % 97), float(i % 13), float(i) * 1e-3f);
+    for (size_t i = 0; i < b.size(); ++i) b[i] = glm::vec3(float(i % 31), 0.5f, float(i) * 2e-3f);
+    b[4321].y = std::numeric_limits<float>::infinity();
+    b[3000].z = -std::numeric_limits<float>::infinity();
+    b[4999].x = std::numeric_limits<float>::quiet_NaN();
+    auto device = engine->compute(a, b);
+    const Strided sa(a), sb(b);
+    auto host = engine->compute(sa.view, sb.view);
+    ASSERT_FALSE(device.ok());
+    ASSERT_FALSE(host.ok());
+    EXPECT_EQ(device.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_EQ(device.error().message, host.error().message);
+    EXPECT_NE(device.error().message.find("point set B: point 3000 "), std::string::npos)
+        << device.error().message;
+    a[129].x = std::numeric_limits<float>::quiet_NaN();  // A is checked first
+    auto both = engine->compute(a, b);
+    ASSERT_FALSE(both.ok());
+    EXPECT_NE(both.error().message.find("point set A: point 129 "), std::string::npos)
+        << both.error().message;
+}
+
+TEST(IngestPath, CoordinatesPastTheFloatSquareRangeAreScaledExactly) {
+    // |p| ~ 1e25: squared distances overflow float, so the pair needs the
+    // exact power-of-two scale of index_space.hpp (the host path applies it).
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    const std::vector<OracleCase> cases = makeOracleCases();
+    const OracleCase& base = cases[3];
+    OracleCase c{base.name + "-times-1e25", base.seed, base.a, base.b};
+    for (auto* set : {&c.a, &c.b})
+        for (glm::vec3& p : *set) p *= 1e25f;
+    auto r = engine->compute(c.a, c.b);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    expectMatchesOracle(c, *r);
+}
+
+}  // namespace
+}  // namespace rthdist::test
