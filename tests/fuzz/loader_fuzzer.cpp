@@ -5,17 +5,20 @@
 // PLY reader, as loadPoints does for a .ply.gz.
 //
 // Any input must give points or a kBadInput error; a crash, a sanitizer
-// report, a leak, a timeout or an allocation beyond -rss_limit_mb is a bug.
+// report, a leak, a timeout or an allocation beyond -rss_limit_mb is a bug,
+// and so is a result that changes with the parse's chunk size.
 #include <unistd.h>
 
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "io/gltf_reader.hpp"
 #include "io/gzip_inflate.hpp"
@@ -50,17 +53,47 @@ const std::string& scratchDir() {
     return dir;
 }
 
+bool sameCloud(const rthdist::io::PointCloud& a, const rthdist::io::PointCloud& b) {
+    return a.scalar == b.scalar && a.floats.size() == b.floats.size() &&
+           a.doubles.size() == b.doubles.size() &&
+           // memcmp only on non-empty arrays: an empty vector's data() may be null.
+           (a.floats.empty() ||
+            std::memcmp(a.floats.data(), b.floats.data(), a.floats.size() * sizeof(glm::vec3)) == 0) &&
+           (a.doubles.empty() ||
+            std::memcmp(a.doubles.data(), b.doubles.data(), a.doubles.size() * sizeof(glm::dvec3)) == 0);
+}
+
+// The parallel parse must not depend on its chunks: read(plan) once with the
+// whole input as one chunk and once with chunks of 1 to 16 bytes (record
+// and line boundaries everywhere); the points or the error message must be
+// the same, else abort (a finding).
+template <class Read>
+void differential(std::string_view bytes, Read&& read) {
+    using rthdist::io::ChunkPlan;
+    const auto whole = read(ChunkPlan{1, ~size_t(0)});
+    const auto tiny = read(ChunkPlan{1, 1 + bytes.size() % 16});
+    if (whole.ok() != tiny.ok()) std::abort();
+    if (!whole.ok() && whole.error().message != tiny.error().message) std::abort();
+    if (whole.ok() && !sameCloud(*whole, *tiny)) std::abort();
+}
+
 void loadBytes(std::string_view bytes) {
     using namespace rthdist::io;
-    if (kFormat == "ply") (void)readPly(bytes, "fuzz.ply");
-    if (kFormat == "xyz") (void)readXyz(bytes, "fuzz.xyz");
-    if (kFormat == "obj") (void)readObj(bytes, "fuzz.obj");
+    auto with = [&](auto reader, const char* path) {
+        differential(bytes, [&](const ChunkPlan& plan) { return reader(bytes, path, plan); });
+    };
+    if (kFormat == "ply") with(&readPly, "fuzz.ply");
+    if (kFormat == "xyz") with(&readXyz, "fuzz.xyz");
+    if (kFormat == "obj") with(&readObj, "fuzz.obj");
     if (kFormat == "stl") (void)readStl(bytes, "fuzz.stl");
-    if (kFormat == "off") (void)readOff(bytes, "fuzz.off");
-    if (kFormat == "pcd") (void)readPcd(bytes, "fuzz.pcd");
+    if (kFormat == "off") with(&readOff, "fuzz.off");
+    if (kFormat == "pcd") with(&readPcd, "fuzz.pcd");
     if (kFormat == "las") {
-        (void)readLas(bytes, "fuzz.las", {});
-        (void)readLas(bytes, "fuzz.las", {2, 6});  // the classification filter's two passes
+        for (const std::vector<int>& classes : {std::vector<int>{}, std::vector<int>{2, 6}}) {
+            // The classification filter's two passes.
+            differential(bytes,
+                         [&](const ChunkPlan& plan) { return readLas(bytes, "fuzz.las", classes, plan); });
+        }
     }
     if (kFormat == "gltf" || kFormat == "glb") {
         (void)readGltf(bytes, scratchDir() + "/fuzz." + std::string(kFormat));
@@ -70,7 +103,10 @@ void loadBytes(std::string_view bytes) {
 void loadGzippedPly(std::string_view bytes) {
     using namespace rthdist::io;
     auto inflated = gunzip(bytes, "fuzz.ply.gz", &plyInflatedBound);
-    if (inflated) (void)readPly(*inflated, "fuzz.ply.gz");
+    if (inflated) {
+        const std::string_view ply = *inflated;
+        differential(ply, [&](const ChunkPlan& plan) { return readPly(ply, "fuzz.ply.gz", plan); });
+    }
 }
 
 }  // namespace

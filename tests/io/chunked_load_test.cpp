@@ -31,8 +31,11 @@ Result<PointCloud> serialLoad(const std::string& path, LoadOptions options = {})
 bool sameBits(const PointCloud& a, const PointCloud& b) {
     if (a.scalar != b.scalar || a.floats.size() != b.floats.size() || a.doubles.size() != b.doubles.size())
         return false;
-    return std::memcmp(a.floats.data(), b.floats.data(), a.floats.size() * sizeof(glm::vec3)) == 0 &&
-           std::memcmp(a.doubles.data(), b.doubles.data(), a.doubles.size() * sizeof(glm::dvec3)) == 0;
+    // memcmp only on non-empty arrays: an empty vector's data() may be null.
+    return (a.floats.empty() ||
+            std::memcmp(a.floats.data(), b.floats.data(), a.floats.size() * sizeof(glm::vec3)) == 0) &&
+           (a.doubles.empty() ||
+            std::memcmp(a.doubles.data(), b.doubles.data(), a.doubles.size() * sizeof(glm::dvec3)) == 0);
 }
 
 // Every access, chunk size and thread count gives what the serial reference
