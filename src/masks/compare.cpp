@@ -7,7 +7,8 @@
 // X inside Y has distance 0 while the nearest voxel of Y to any voxel outside
 // Y is one of Y's 6-connected boundary voxels (a step from an interior voxel
 // towards the query along its largest axis gets closer and stays in Y). The
-// zeros still count in every mean, percentile and surface Dice.
+// zeros still count in every mean, percentile and surface Dice. The deepmind
+// convention (surfels with areas) lives in deepmind.cpp.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,6 +17,7 @@
 
 #include "cpu/parallel.hpp"
 #include "masks/boundary.hpp"
+#include "masks/deepmind.hpp"
 #include "masks/masks.hpp"
 #include "rthdist/stats.hpp"
 
@@ -130,6 +132,7 @@ void emptyValues(Convention c, EmptyStatus s, MaskResult& r) {
         case Convention::kMedpy: r.emptyHd = r.emptyHdPercentile = "error"; break;
         case Convention::kPlastimatch: r.emptyHd = r.emptyHdPercentile = both ? "0" : "undefined"; break;
         case Convention::kItk: r.emptyHd = r.emptyHdPercentile = "undefined"; break;
+        case Convention::kDeepmind: break;  // deepmind.cpp
     }
 }
 
@@ -142,6 +145,7 @@ const char* conventionName(Convention c) {
         case Convention::kMedpy: return "medpy";
         case Convention::kPlastimatch: return "plastimatch";
         case Convention::kItk: return "itk";
+        case Convention::kDeepmind: return "deepmind";
     }
     return "?";
 }
@@ -175,6 +179,9 @@ const char* conventionRule(Convention c) {
         case Convention::kItk:
             return "all foreground voxels (inside the other = 0), spacing; HD only; average = mean of the "
                    "directed means";
+        case Convention::kDeepmind:
+            return "surfels on the half-voxel-shifted grid with marching-cubes areas, spacing; HD-p = max of "
+                   "the two directed area-weighted percentiles (first cumulative area fraction >= p/100)";
     }
     return "?";
 }
@@ -211,6 +218,7 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
         return Error{ErrorCode::kInvalidArgument, "masks: tolerance must be >= 0"};
 
     const Convention c = options.convention;
+    if (c == Convention::kDeepmind) return detail::compareDeepmind(engine, a, selectA, b, selectB, options);
     const int conn = connectivityOf(c, options.connectivity);
     const bool itk = c == Convention::kItk;
     MaskResult r;
@@ -233,6 +241,7 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
         r.hd = r.assd = r.msd = r.surfaceDice = nan;
         r.hdPercentile.assign(itk ? 0 : options.percentiles.size(), nan);
         r.aToB.hd = r.bToA.hd = r.aToB.mean = r.bToA.mean = nan;
+        r.aToB.surfaceOverlap = r.bToA.surfaceOverlap = nan;
         r.extractMs = msSince(t0);
         r.totalMs = msSince(start);
         return r;
@@ -275,9 +284,12 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
     r.assd = (da.sum + db.sum) / nAll;
     r.msd = 0.5 * (da.out.mean + db.out.mean);
     uint64_t within = 0;
-    for (const Direction* d : {&da, &db})
-        within += uint64_t(std::upper_bound(d->sorted.begin(), d->sorted.end(), options.tolerance) -
-                           d->sorted.begin());
+    for (Direction* d : {&da, &db}) {
+        const uint64_t w = uint64_t(std::upper_bound(d->sorted.begin(), d->sorted.end(), options.tolerance) -
+                                    d->sorted.begin());
+        d->out.surfaceOverlap = double(w) / double(d->out.points);
+        within += w;
+    }
     r.surfaceDice = double(within) / nAll;
 
     std::vector<double> pooled;
@@ -308,7 +320,8 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
                 pb = percentilePlastimatch(db.sorted, p);
                 combined = 0.5 * (pa + pb);
                 break;
-            case Convention::kItk: break;
+            case Convention::kItk:
+            case Convention::kDeepmind: break;
         }
         if (!itk) {
             da.out.percentiles.push_back(pa);
@@ -316,7 +329,9 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
             r.hdPercentile.push_back(combined);
         }
     }
-    if (itk) r.assd = r.surfaceDice = std::numeric_limits<double>::quiet_NaN();
+    if (itk)
+        r.assd = r.surfaceDice = da.out.surfaceOverlap = db.out.surfaceOverlap =
+            std::numeric_limits<double>::quiet_NaN();
     r.aToB = std::move(da.out);
     r.bToA = std::move(db.out);
     r.totalMs = msSince(start);

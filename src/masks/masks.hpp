@@ -28,13 +28,33 @@
 //   itk         ALL foreground voxels (HausdorffDistanceImageFilter): a voxel
 //               inside the other mask counts 0; no percentile; "average" =
 //               mean of the directed means (AverageHausdorffDistance).
+//   deepmind    surface-distance (1f805ce): surfels = corners of the voxel grid
+//               (voxel coordinates (i - 1/2, j - 1/2, k - 1/2)) whose 2x2x2
+//               neighbour code is neither 0 nor 255, each with the area of its
+//               marching-cubes piece (surfel_area.hpp); distance from each
+//               surfel of X to the nearest surfel of Y; every statistic weighted
+//               by area: HD-p per direction = d_i of the first i (sorted by
+//               distance, then area) whose cumulative area / total >= p/100,
+//               no interpolation; HD-p = max of the two ("robust HD");
+//               directed mean = sum(a d) / sum(a); ASSD = both surfaces' sum(a d)
+//               / both areas; MSD = mean of the directed means; surface overlap
+//               = area within the tolerance / area, per direction; surface
+//               Dice = (both areas within the tolerance) / (both areas).
+//               Empty: HD and HD-p inf; surface Dice 0 (one empty) or NaN
+//               (both); the empty side's mean NaN, the other's inf.
 // Every convention but rthdist measures with the voxel spacing only (the
 // column norms of the affine's 3x3 part), as those tools do; for an
-// orthonormal direction matrix the distances equal the world ones.
+// orthonormal direction matrix the distances equal the world ones. DeepMind
+// takes only spacing_mm: an oblique affine's direction matrix is ignored
+// (witness points are still reported in world coordinates).
 //
 // Precision: coordinates in double; distances are the engine's exact values
 // (within 1e-6 of the union's bounding-box diagonal of the brute force in
-// double, rthdist.hpp), so every order statistic is as well.
+// double, rthdist.hpp), so every order statistic is as well. deepmind
+// recomputes each distance from the engine's nearest surfel with SciPy's EDT
+// arithmetic, sqrt(((di sx)^2 + (dj sy)^2) + (dk sz)^2), and sums areas in
+// NumPy's order (area_weighted.hpp), so its area-weighted percentiles pick
+// the index DeepMind's own run picks, rounding included.
 // Threading: extraction uses options.threads (0 = all); the Engine passed in is
 // not thread-safe (one per thread). Functions are otherwise reentrant.
 // Limits: volumes up to 2^31 - 1 selected points per mask (engine limit);
@@ -103,9 +123,10 @@ struct Volume {
 // Sorted distinct non-zero labels present in the volume.
 [[nodiscard]] std::vector<int32_t> labelsPresent(const Volume& v);
 
-enum class Convention { kRthdist, kMonai, kMedpy, kPlastimatch, kItk };
-inline constexpr std::array<Convention, 5> kAllConventions{
-    Convention::kRthdist, Convention::kMonai, Convention::kMedpy, Convention::kPlastimatch, Convention::kItk};
+enum class Convention { kRthdist, kMonai, kMedpy, kPlastimatch, kItk, kDeepmind };
+inline constexpr std::array<Convention, 6> kAllConventions{Convention::kRthdist, Convention::kMonai,
+                                                           Convention::kMedpy,   Convention::kPlastimatch,
+                                                           Convention::kItk,     Convention::kDeepmind};
 [[nodiscard]] const char* conventionName(Convention c);
 [[nodiscard]] bool parseConvention(const std::string& text, Convention& out);
 // One line naming the point set, the metric, the percentile rule and the combination.
@@ -120,7 +141,7 @@ struct LabelSelect {
 struct MaskOptions {
     Convention convention = Convention::kRthdist;
     // 6, 18 or 26; 0 = 6. Used by rthdist and medpy; monai and plastimatch
-    // always use 6 (their tools take none), itk all voxels.
+    // always use 6 (their tools take none), itk all voxels, deepmind surfels.
     int connectivity = 0;
     std::vector<double> percentiles{95.0};  // each in [0, 100]
     double tolerance = 1.0;                 // surface Dice tolerance, in mm (>= 0)
@@ -132,29 +153,40 @@ enum class EmptyStatus { kNone, kBothEmpty, kAEmpty, kBEmpty };
 
 // One direction X -> Y.
 struct DirectedMask {
-    uint64_t points = 0;  // X's points under the convention (boundary voxels or all voxels)
+    uint64_t points = 0;  // X's points under the convention (boundary voxels, all voxels or surfels)
     double hd = 0.0;      // max over X of the nearest distance to Y
-    double mean = 0.0;
-    std::vector<double> percentiles;               // this direction's percentile per MaskOptions::percentiles
-                                                   // (the convention's rule; medpy: the pooled values)
-    std::array<int64_t, 3> voxel{0, 0, 0};         // X's voxel realizing hd
-    std::array<int64_t, 3> nearestVoxel{0, 0, 0};  // its nearest voxel of Y
-    glm::dvec3 point{0.0}, nearestPoint{0.0};      // their centres in world coordinates
+    double mean = 0.0;    // deepmind: area-weighted
+    std::vector<double> percentiles;  // this direction's percentile per MaskOptions::percentiles
+                                      // (the convention's rule; medpy: the pooled values)
+    // The fraction of X's points within the tolerance of Y (deepmind: of X's
+    // surfel area, its "surface overlap"); itk: not defined (NaN).
+    double surfaceOverlap = 0.0;
+    double area = 0.0;  // deepmind: X's total surfel area (mm²); 0 for the others
+    // X's point realizing hd and its nearest point of Y, as grid indices: voxels,
+    // or for deepmind surfel corners (corner (i, j, k) at voxel coordinates
+    // (i - 1/2, j - 1/2, k - 1/2)).
+    std::array<int64_t, 3> voxel{0, 0, 0};
+    std::array<int64_t, 3> nearestVoxel{0, 0, 0};
+    glm::dvec3 point{0.0}, nearestPoint{0.0};  // those two in world coordinates
 };
 
 struct MaskResult {
     Convention convention = Convention::kRthdist;
-    int connectivity = 6;  // 0 for itk (all voxels)
+    int connectivity = 6;  // 0 for itk (all voxels) and deepmind (surfels)
     EmptyStatus empty = EmptyStatus::kNone;
     // With empty != kNone: no number below is valid; what the convention
     // itself would report, as text ("nan", "inf", "0", "undefined").
     std::string emptyHd, emptyHdPercentile;
+    // deepmind only (else ""): its surface Dice and directed means.
+    std::string emptySurfaceDice, emptyMeanAToB, emptyMeanBToA;
     double hd = 0.0;
     std::vector<double> percentiles;   // the requested p values
     std::vector<double> hdPercentile;  // combined per the convention (empty for itk)
-    double assd = 0.0;                 // (sum of both directions' distances) / (n_a + n_b)
-    double msd = 0.0;                  // mean of the two directed means (itk/plastimatch "average HD")
-    double surfaceDice = 0.0;  // (#{d_ab <= tol} + #{d_ba <= tol}) / (n_a + n_b); itk: not defined (NaN)
+    double assd = 0.0;  // (sum of both directions' distances) / (n_a + n_b); deepmind: area-weighted
+    double msd = 0.0;   // mean of the two directed means (itk/plastimatch "average HD")
+    // (#{d_ab <= tol} + #{d_ba <= tol}) / (n_a + n_b); deepmind: areas instead
+    // of counts; itk: not defined (NaN).
+    double surfaceDice = 0.0;
     DirectedMask aToB, bToA;
     double extractMs = 0.0, distanceMs = 0.0, totalMs = 0.0;
 };

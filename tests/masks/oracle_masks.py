@@ -14,6 +14,8 @@ The oracles:
   world metric    cKDTree over voxel centres mapped by the affine (rthdist)
   percentiles     numpy.percentile (linear); nearest rank x[ceil(p n/100)-1];
                   plastimatch x[clamp(floor(p/100 n - 1))]
+  deepmind        oracle_deepmind.py: surfels with marching-cubes areas, EDT
+                  on the corner grid, DeepMind's area-weighted statistics
 Exit status 0 when every value matches; otherwise every mismatch is printed.
 """
 import argparse
@@ -29,7 +31,9 @@ import numpy as np
 from scipy import ndimage as ndi
 from scipy.spatial import cKDTree
 
-CONVENTIONS = ["rthdist", "monai", "medpy", "plastimatch", "itk"]
+import oracle_deepmind
+
+CONVENTIONS = ["rthdist", "monai", "medpy", "plastimatch", "itk", "deepmind"]
 FAILURES = []
 
 
@@ -139,6 +143,50 @@ def check_witness(name, d, x_set, y_set, affine, conv, expect_hd, tol):
     close(name + " witness point", float(np.linalg.norm(np.array(d["point"]) - w)), 0.0, tol)
 
 
+def within(name, got, options, eps):
+    """options = (value just below the threshold, at it, just above): rthdist
+    recomputes DeepMind's distances with SciPy's arithmetic and sums areas in
+    NumPy's order, so it must give the value at the threshold itself."""
+    if got is None or not abs(got - options[1]) <= eps:
+        FAILURES.append(f"{name}: got {got}, expected {options[1]} (+- {eps:.3g}; just below / above the "
+                        f"threshold: {options[0]} / {options[2]})")
+
+
+def check_deepmind(tag, row, xa, xb, affine, percentiles, tol, eps, offset=(0, 0, 0)):
+    """One deepmind row against oracle_deepmind (xa, xb: the masks, cropped by `offset` voxels)."""
+    sp = spacing_of(affine)
+    want = oracle_deepmind.expected(xa, xb, sp, percentiles, tol)
+    if row["status"] != want["status"]:
+        FAILURES.append(f"{tag}: status {row['status']}, expected {want['status']}")
+        return
+    if want["status"] != "ok":
+        if row["convention_value"] != want["text"] or row["hd"] is not None:
+            FAILURES.append(f"{tag}: empty values {row['convention_value']} / hd {row['hd']}, expected {want['text']}")
+        return
+    for key in ("hd", "msd", "assd"):
+        close(f"{tag} {key}", row[key], want[key], eps)
+    within(tag + " surface_dice", row["surface_dice"], want["surface_dice"], 1e-12)
+    for got, exp in zip(row["hd_percentile"], want["hd_percentile"]):
+        within(tag + f" hd{got['p']:g}", got["value"], exp, eps)
+    for side, x, y in (("a", xa, xb), ("b", xb, xa)):
+        d = row[side + "_to_b" if side == "a" else "b_to_a"]
+        if d["points"] != want[side + "_points"]:
+            FAILURES.append(f"{tag}: {side} surfels {d['points']}, expected {want[side + '_points']}")
+        close(f"{tag} {side} hd", d["hd"], want[side + "_hd"], eps)
+        close(f"{tag} {side} mean", d["mean"], want[side + "_mean"], eps)
+        close(f"{tag} {side} area", d["area_mm2"], want[side + "_area"], 1e-9 * want[side + "_area"])
+        within(f"{tag} {side} surface_overlap", d["surface_overlap"], want[side + "_overlap"], 1e-12)
+        # The witness: a surfel of X, a surfel of Y, at the directed HD; its world point.
+        c, nc = np.array(d["corner"]) - offset, np.array(d["nearest_corner"]) - offset
+        bx, by = oracle_deepmind.border_corners(x), oracle_deepmind.border_corners(y)
+        if not bx[tuple(c)] or not by[tuple(nc)]:
+            FAILURES.append(f"{tag} {side}: witness corners {d['corner']} -> {d['nearest_corner']} are not surfels")
+            continue
+        close(f"{tag} {side} witness distance", float(np.linalg.norm((c - nc) * sp)), want[side + "_hd"], eps)
+        w = nib.affines.apply_affine(affine, c - 0.5)
+        close(f"{tag} {side} witness point", float(np.linalg.norm(np.array(d["point"]) - w)), 0.0, eps)
+
+
 def run_cli(cli, backend, a_path, b_path, extra):
     cmd = [cli, a_path, b_path, "--json", "--convention", "all", "--backend", backend, "--percentile", "95",
            "--percentile", "50", "--percentile", "100"] + extra
@@ -185,6 +233,10 @@ def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_vol
             xa, xb = label_volumes[0] == lab, label_volumes[1] == lab
         else:
             xa, xb = a, b
+        if conv == "deepmind":
+            check_deepmind(f"[{backend}] {name} label {row['label']} deepmind", row, xa, xb, affine, percentiles,
+                           tol, eps)
+            continue
         want = oracle(conv, xa, xb, affine, percentiles, conn, tol)
         tag = f"[{backend}] {name} label {row['label']} {conv}"
         if row["status"] != want["status"]:
@@ -316,8 +368,11 @@ def atlas_cases(cli, backend, tmp, data):
         eps = 1e-6 * diagonal(lab.shape, aff)
         for row in out["results"]:
             conv = row["convention"]
-            want = oracle(conv, ca, cb, shifted, [95.0, 50.0, 100.0], 6, 1.0)
             tag = f"[{backend}] {name} {conv}"
+            if conv == "deepmind":
+                check_deepmind(tag, row, ca, cb, shifted, [95.0, 50.0, 100.0], 1.0, eps, offset=lo)
+                continue
+            want = oracle(conv, ca, cb, shifted, [95.0, 50.0, 100.0], 6, 1.0)
             close(tag + " hd", row["hd"], want["hd"], eps)
             close(tag + " msd", row["msd"], want["msd"], eps)
             if conv != "itk":

@@ -59,9 +59,11 @@ const char* kUsage =
     "(.nii, .nii.gz: NIfTI-1/2 with sform, else qform, else pixdim; .npy with --spacing).\n"
     "  --label N            compare label N in both volumes (default: every non-zero voxel)\n"
     "  --labels all         one row per label present in either volume\n"
-    "  --convention NAME    rthdist (default), monai, medpy, plastimatch, itk, or all (one row each)\n"
+    "  --convention NAME    rthdist (default), monai, medpy, plastimatch, itk, deepmind,\n"
+    "                       or all (one row each)\n"
     "  --percentile P       HD-p to report, repeatable (default 95)\n"
-    "  --connectivity C     boundary connectivity 6, 18 or 26 (default 6; itk uses all voxels)\n"
+    "  --connectivity C     boundary connectivity 6, 18 or 26 (default 6; itk uses all voxels,\n"
+    "                       deepmind surfels)\n"
     "  --tolerance MM       surface Dice tolerance in mm (default 1)\n"
     "  --spacing X,Y,Z      voxel spacing of .npy inputs along axes 0,1,2 (default 1,1,1)\n"
     "  --affine R00,R01,R02,T0,R10,...,T2  voxel-to-world of .npy inputs: 3x4, row-major\n"
@@ -151,7 +153,8 @@ void addMeasureOptions(CommandLine& line, MasksArgs& a, bool& conventionSet) {
         } else if (masks::parseConvention(v, c)) {
             a.conventions.push_back(c);
         } else {
-            reject("--convention expects rthdist, monai, medpy, plastimatch, itk or all, got '" + v + "'");
+            reject("--convention expects rthdist, monai, medpy, plastimatch, itk, deepmind or all, got '" +
+                   v + "'");
         }
     });
     value("--percentile", [&a](const std::string& v) {
@@ -252,10 +255,14 @@ Json directedJson(const masks::DirectedMask& d, const MaskResult& r, bool ok) {
         percentiles.push_back({{"p", r.percentiles[i]}, {"value", d.percentiles[i]}});
     out["hd"] = d.hd;
     out["mean"] = d.mean;
+    out["surface_overlap"] = d.surfaceOverlap;
+    if (r.convention == Convention::kDeepmind) out["area_mm2"] = d.area;
     out["percentiles"] = std::move(percentiles);
-    out["voxel"] = d.voxel;
+    // deepmind's points are surfel corners: corner (i, j, k) at voxel coordinates (i - 1/2, ...).
+    const bool corners = r.convention == Convention::kDeepmind;
+    out[corners ? "corner" : "voxel"] = d.voxel;
     out["point"] = Json::array({d.point.x, d.point.y, d.point.z});
-    out["nearest_voxel"] = d.nearestVoxel;
+    out[corners ? "nearest_corner" : "nearest_voxel"] = d.nearestVoxel;
     out["nearest_point"] = Json::array({d.nearestPoint.x, d.nearestPoint.y, d.nearestPoint.z});
     return out;
 }
@@ -268,8 +275,18 @@ Json rowJson(const Row& row) {
                 {"rule", masks::conventionRule(r.convention)},
                 {"connectivity", r.connectivity},
                 {"geometry", r.convention == Convention::kRthdist ? "world" : "spacing"},
+                {"points_are", r.convention == Convention::kDeepmind ? "surfels"
+                               : r.convention == Convention::kItk    ? "voxels"
+                                                                     : "boundary_voxels"},
                 {"status", masks::emptyStatusName(r.empty)}};
-    if (!ok) out["convention_value"] = {{"hd", r.emptyHd}, {"hd_percentile", r.emptyHdPercentile}};
+    if (!ok) {
+        out["convention_value"] = {{"hd", r.emptyHd}, {"hd_percentile", r.emptyHdPercentile}};
+        if (!r.emptySurfaceDice.empty()) {
+            out["convention_value"]["surface_dice"] = r.emptySurfaceDice;
+            out["convention_value"]["a_to_b_mean"] = r.emptyMeanAToB;
+            out["convention_value"]["b_to_a_mean"] = r.emptyMeanBToA;
+        }
+    }
     Json hdPercentile = Json::array();
     for (size_t i = 0; i < r.hdPercentile.size(); ++i)
         hdPercentile.push_back({{"p", r.percentiles[i]}, {"value", r.hdPercentile[i]}});
