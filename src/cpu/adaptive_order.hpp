@@ -23,11 +23,10 @@
 // is deterministic and independent of the thread count.
 #pragma once
 
-#include <glm/vec3.hpp>
-
 #include <cstdint>
-#include <span>
 #include <vector>
+
+#include "cpu/key_sort.hpp"
 
 namespace rthdist::cpu {
 
@@ -41,14 +40,12 @@ struct IdenticalRun {
     uint32_t end = 0;
 };
 
-// `keyed` holds (key << 32 | index) values sorted by key, ties by ascending
-// index (what radixSortKeys gives for keys built in input order); index
-// refers to `points`, whose coordinates are multiplied by `scale` (as
-// cpu::scaled) before boxes and keys are taken. Reorders every run of equal
-// keys in place as described above; the keys themselves are left as they
-// were (each run is only permuted). When `identical` is given, it receives
-// the identical runs, ascending.
-void refineOrder(std::vector<uint64_t>& keyed, std::span<const glm::vec3> points, double scale, int threads,
-                 std::vector<IdenticalRun>* identical = nullptr);
+// `order` holds points sorted by key, ties by ascending input index (what
+// sortPointsByKey gives); its coordinates are the scaled ones, from which
+// boxes and keys are taken. Reorders every run of equal keys in place as
+// described above (keyed values and coordinates together); the keys
+// themselves are left as they were (each run is only permuted). When
+// `identical` is given, it receives the identical runs, ascending.
+void refineOrder(OrderedPoints& order, int threads, std::vector<IdenticalRun>* identical = nullptr);
 
 }  // namespace rthdist::cpu

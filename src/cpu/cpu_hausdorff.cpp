@@ -176,8 +176,8 @@ inline void scanOwnCell(const TargetIndex& t, uint32_t key, uint32_t& cursor, co
     scanRange(t, first, end, q, best);
 }
 
-inline bool sameQuery(const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z,
-                      size_t i) {
+inline bool sameQuery(const UninitVector<float>& x, const UninitVector<float>& y,
+                      const UninitVector<float>& z, size_t i) {
     return x[i] == x[i - 1] && y[i] == y[i - 1] && z[i] == z[i - 1];
 }
 
@@ -306,9 +306,9 @@ constexpr double kIndexDone = 0.1, kCullDone = 0.15, kSearchDone = 0.95;
 // to the previous one takes its nearest target. Fills `nearest` (input order)
 // with the target index and the double distance recomputed from the pair.
 void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
-                  std::span<const glm::vec3> targets, const std::vector<float>& qx,
-                  const std::vector<float>& qy, const std::vector<float>& qz,
-                  const std::vector<uint32_t>& qOriginal, const std::vector<uint32_t>& qKey, int threads,
+                  std::span<const glm::vec3> targets, const UninitVector<float>& qx,
+                  const UninitVector<float>& qy, const UninitVector<float>& qz,
+                  const UninitVector<uint32_t>& qOriginal, const UninitVector<uint32_t>& qKey, int threads,
                   PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress,
                   std::atomic<bool>& lost) {
     const size_t nq = queries.size();
@@ -371,8 +371,8 @@ DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet
     // target grid (clamped outside it); the same pass finds the largest
     // distance from a query to BV(T).
     const size_t nq = queries.size();
-    const std::vector<float>&qx = qOrder.x, &qy = qOrder.y, &qz = qOrder.z;
-    std::vector<uint32_t> qOriginal(nq), qKey(nq);
+    const UninitVector<float>&qx = qOrder.x, &qy = qOrder.y, &qz = qOrder.z;
+    UninitVector<uint32_t> qOriginal(nq), qKey(nq);
     std::vector<double> boxBound(size_t(threads), 0.0);
     parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int w) {
         double farthest = 0.0;
@@ -592,8 +592,8 @@ uint64_t CpuSet::hostBytes() const {
     uint64_t sum =
         bytes(order.keyed) + bytes(order.x) + bytes(order.y) + bytes(order.z) + bytes(order.identical);
     const TargetIndex& t = m_index;
-    sum += bytes(t.x) + bytes(t.y) + bytes(t.z) + bytes(t.original) + bytes(t.bucketOf) + bytes(t.cellKey) +
-           bytes(t.cellFirst) + bytes(t.cellLo) + bytes(t.cellHi) + bytes(t.bucketFirst);
+    sum += bytes(t.keptX) + bytes(t.keptY) + bytes(t.keptZ) + bytes(t.original) + bytes(t.bucketOf) +
+           bytes(t.cellKey) + bytes(t.cellFirst) + bytes(t.cellLo) + bytes(t.cellHi) + bytes(t.bucketFirst);
     for (const BoxLevel& level : t.levels) sum += bytes(level.boxes);
     return sum;
 }

@@ -12,6 +12,25 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// algo::boundsOf with `threads` workers (min and max are exact in any order).
+algo::Bounds boundsOf(std::span<const glm::vec3> points, int threads) {
+    std::vector<glm::vec3> lo(size_t(resolveThreads(threads)), points[0]), hi = lo;
+    parallelChunks(points.size(), 1 << 16, threads, [&](size_t begin, size_t end, int w) {
+        glm::vec3 l = lo[size_t(w)], h = hi[size_t(w)];
+        for (size_t i = begin; i < end; ++i) {
+            l = glm::min(l, points[i]);
+            h = glm::max(h, points[i]);
+        }
+        lo[size_t(w)] = l, hi[size_t(w)] = h;
+    });
+    algo::Bounds b{glm::dvec3(lo[0]), glm::dvec3(hi[0])};
+    for (size_t w = 1; w < lo.size(); ++w) {
+        b.lo = glm::min(b.lo, glm::dvec3(lo[w]));
+        b.hi = glm::max(b.hi, glm::dvec3(hi[w]));
+    }
+    return b;
+}
+
 }  // namespace
 
 void BoxLevel::resize(uint32_t n) {
@@ -23,52 +42,12 @@ void BoxLevel::resize(uint32_t n) {
     }
 }
 
-void radixSortKeys(std::vector<uint64_t>& values, int keyBits, int threads) {
-    constexpr int kDigit = 12;  // 16 KiB of counts (8-bit digits measured slower)
-    constexpr uint32_t kDigits = 1u << kDigit;
-    constexpr size_t kMinPerPart = 1 << 16;
-    const size_t n = values.size();
-    // Parts: contiguous ranges counted and scattered independently; a digit's
-    // slots are handed out in part order, so every pass stays stable.
-    const size_t parts = std::clamp<size_t>(n / kMinPerPart, 1, size_t(resolveThreads(threads)) * 2);
-    const size_t partSize = (n + parts - 1) / parts;
-    std::vector<uint64_t> scratch(n);
-    std::vector<uint32_t> histogram(parts * kDigits);
-    for (int shift = 32; shift < 32 + keyBits; shift += kDigit) {
-        std::fill(histogram.begin(), histogram.end(), 0u);
-        auto digit = [shift](uint64_t v) { return uint32_t(v >> shift) & (kDigits - 1); };
-        parallelChunks(parts, 1, threads, [&](size_t p, size_t, int) {
-            uint32_t* h = &histogram[p * kDigits];
-            for (size_t i = p * partSize; i < std::min(n, (p + 1) * partSize); ++i) ++h[digit(values[i])];
-        });
-        uint32_t sum = 0;
-        bool oneDigit = false;  // every value has the same digit: the pass is the identity
-        for (uint32_t d = 0; d < kDigits; ++d) {
-            const uint32_t before = sum;
-            for (size_t p = 0; p < parts; ++p) {
-                const uint32_t c = histogram[p * kDigits + d];
-                histogram[p * kDigits + d] = sum;
-                sum += c;
-            }
-            oneDigit = oneDigit || sum - before == n;
-        }
-        if (oneDigit) continue;
-        parallelChunks(parts, 1, threads, [&](size_t p, size_t, int) {
-            uint32_t* h = &histogram[p * kDigits];
-            for (size_t i = p * partSize; i < std::min(n, (p + 1) * partSize); ++i) {
-                scratch[h[digit(values[i])]++] = values[i];
-            }
-        });
-        values.swap(scratch);
-    }
-}
-
 SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int threads) {
     SetOrder order;
     const size_t n = points.size();
 
     // Grid over the scaled points; the bit count is scale invariant.
-    const algo::Bounds raw = algo::boundsOf(points);
+    const algo::Bounds raw = boundsOf(points, threads);
     if (bits <= 0) bits = algo::chooseBits(points, raw);
     order.bounds = algo::Bounds{raw.lo * scale, raw.hi * scale};
     order.grid = algo::makeGrid(order.bounds, bits);
@@ -83,33 +62,25 @@ SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int
     fine.cellsPerAxis = 1u << fine.bits;
     fine.cellSize = order.grid.cellSize / double(1u << extra);
 
-    std::vector<uint64_t>& keyed = order.keyed;
-    keyed.resize(n);
+    // Fine keys in input order, then the points sorted by them (moved with
+    // their keys: no gather afterwards), then overfull fine cells ordered by
+    // their own boxes.
+    UninitVector<uint32_t> keys(n);  // every entry written below
     parallelChunks(n, 1 << 16, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
             const glm::vec3 p = scaled(points[i], scale);
-            const uint32_t key =
+            keys[i] =
                 algo::mortonEncode(algo::cellCoord(p.x, fine.origin.x, fine.cellSize, fine.cellsPerAxis),
                                    algo::cellCoord(p.y, fine.origin.y, fine.cellSize, fine.cellsPerAxis),
                                    algo::cellCoord(p.z, fine.origin.z, fine.cellSize, fine.cellsPerAxis));
-            keyed[i] = (uint64_t(key) << 32) | uint64_t(i);
         }
     });
-    radixSortKeys(keyed, 3 * order.fineBits, threads);
-    // Overfull fine cells ordered by their own boxes.
-    refineOrder(keyed, points, scale, threads, &order.identical);
-    // The one gather of the set's coordinates into its order.
-    order.x.resize(n);
-    order.y.resize(n);
-    order.z.resize(n);
-    parallelChunks(n, 1 << 16, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) {
-            const glm::vec3 p = scaled(points[uint32_t(keyed[i])], scale);
-            order.x[i] = p.x;
-            order.y[i] = p.y;
-            order.z[i] = p.z;
-        }
-    });
+    OrderedPoints sorted = sortPointsByKey(keys, 3 * order.fineBits, points, scale, threads, kPad);
+    refineOrder(sorted, threads, &order.identical);
+    order.keyed = std::move(sorted.keyed);
+    order.x = std::move(sorted.x);
+    order.y = std::move(sorted.y);
+    order.z = std::move(sorted.z);
     return order;
 }
 
@@ -140,20 +111,28 @@ TargetIndex buildTargetIndex(double scale, const SetOrder& order, int threads) {
     auto positionOf = [&kept](size_t i) { return kept.empty() ? i : size_t(kept[i]); };
     index.collapsed = n - m;
 
-    index.x.resize(m + kPad, kInf);
-    index.y.resize(m + kPad, kInf);
-    index.z.resize(m + kPad, kInf);
-    index.original.resize(m + kPad, std::numeric_limits<uint32_t>::max());
+    // Sized without a fill: the copies below are the first touch, in parallel.
+    index.original.resize(m + kPad);
+    std::fill(index.original.begin() + ptrdiff_t(m), index.original.end(),
+              std::numeric_limits<uint32_t>::max());
     index.bucketOf.resize(m);
     parallelChunks(m, 1 << 16, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) {
-            const size_t at = positionOf(i);
-            index.x[i] = order.x[at];
-            index.y[i] = order.y[at];
-            index.z[i] = order.z[at];
-            index.original[i] = uint32_t(order.keyed[at]);
-        }
+        for (size_t i = begin; i < end; ++i) index.original[i] = uint32_t(order.keyed[positionOf(i)]);
     });
+    if (kept.empty()) {  // the order's arrays as they are (padded by orderSet)
+        index.x = order.x, index.y = order.y, index.z = order.z;
+    } else {
+        UninitVector<float>* stored[3] = {&index.keptX, &index.keptY, &index.keptZ};
+        const UninitVector<float>* from[3] = {&order.x, &order.y, &order.z};
+        for (int a = 0; a < 3; ++a) {
+            stored[a]->resize(m + kPad);
+            std::fill(stored[a]->begin() + ptrdiff_t(m), stored[a]->end(), kInf);
+            parallelChunks(m, 1 << 16, threads, [&](size_t begin, size_t end, int) {
+                for (size_t i = begin; i < end; ++i) (*stored[a])[i] = (*from[a])[positionOf(i)];
+            });
+        }
+        index.x = index.keptX, index.y = index.keptY, index.z = index.keptZ;
+    }
 
     // Cells (runs of the coarse key) and buckets (pieces of a cell).
     const int coarseShift = 32 + 3 * extra;

@@ -48,6 +48,7 @@
 
 #include "algo/index_space.hpp"
 #include "cpu/adaptive_order.hpp"
+#include "cpu/uninit_vector.hpp"
 
 namespace rthdist::cpu {
 
@@ -88,10 +89,14 @@ struct TargetIndex {
     double scale = 1.0;    // algo::exactScale
     size_t collapsed = 0;  // copies of identical points not stored (targets - stored)
 
-    // Sorted targets (scaled), padded with kPad entries of +inf.
-    std::vector<float> x, y, z;
-    std::vector<uint32_t> original;  // sorted position -> input index (of the first copy)
-    std::vector<uint32_t> bucketOf;  // sorted position -> bucket
+    // Sorted targets (scaled), each padded with kPad entries of +inf: views of
+    // the set order's own arrays (SetOrder::x, y, z carry the same padding)
+    // when no copy was collapsed, else of kept*. So an index must not outlive
+    // the SetOrder it was built from; it is move-only (the views follow a move).
+    std::span<const float> x, y, z;
+    UninitVector<float> keptX, keptY, keptZ;  // the stored targets, only when some were collapsed
+    UninitVector<uint32_t> original;          // sorted position -> input index (of the first copy)
+    UninitVector<uint32_t> bucketOf;          // sorted position -> bucket
 
     // Occupied cells, ascending Morton key (grid.bits per axis).
     std::vector<uint32_t> cellKey;
@@ -101,6 +106,12 @@ struct TargetIndex {
     // Buckets and the BVH: levels[0] holds the buckets, levels.back() one root.
     std::vector<uint32_t> bucketFirst;  // bucketCount + 1 offsets
     std::vector<BoxLevel> levels;
+
+    TargetIndex() = default;
+    TargetIndex(TargetIndex&&) = default;
+    TargetIndex& operator=(TargetIndex&&) = default;
+    TargetIndex(const TargetIndex&) = delete;
+    TargetIndex& operator=(const TargetIndex&) = delete;
 
     [[nodiscard]] uint32_t cellCount() const { return uint32_t(cellKey.size()); }
     [[nodiscard]] uint32_t bucketCount() const { return levels.empty() ? 0 : levels[0].count; }
@@ -120,8 +131,8 @@ struct SetOrder {
     algo::Bounds bounds;                  // of the scaled points
     algo::GridSpec grid;                  // over them
     int fineBits = 1;                     // bits of the sort key per axis (grid.bits + 2, <= 10)
-    std::vector<uint64_t> keyed;          // (fine key << 32 | input index), every point, in order
-    std::vector<float> x, y, z;           // the scaled coordinates in that order
+    UninitVector<uint64_t> keyed;         // (fine key << 32 | input index), every point, in order
+    UninitVector<float> x, y, z;          // the scaled coordinates in that order, then kPad of +inf
     std::vector<IdenticalRun> identical;  // all-identical runs of that order (refineOrder)
 };
 
@@ -132,9 +143,5 @@ struct SetOrder {
 
 // Builds the index over a set in its order (orderSet of the set and scale).
 [[nodiscard]] TargetIndex buildTargetIndex(double scale, const SetOrder& order, int threads);
-
-// Sorts (key << 32 | payload) values by their key bits [32, 32 + keyBits),
-// stably (LSD radix; `threads` workers count and scatter contiguous parts).
-void radixSortKeys(std::vector<uint64_t>& values, int keyBits, int threads = 1);
 
 }  // namespace rthdist::cpu
