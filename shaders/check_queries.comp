@@ -5,7 +5,9 @@
 // point strictly closer than a value h reaches), and in both cases its best
 // squared distance is at most the final maximum. With per-point distances
 // every query must be EXACT. A query never visited, or one whose distance was
-// lost, breaks this.
+// lost, breaks this. Thread 0 also copies the witness's records (the query
+// slot in the low half of the maximum) for the host, so the check needs no
+// round trip to learn that slot first.
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CheckPush pc; };
@@ -14,7 +16,13 @@ void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.n) return;
     QueryState st = stateAt(pc.state, i).v;
-    float maxD2 = packedDist2(U64Ref(pc.counters + RTHDIST_CTR_MAX_PACKED).v);
+    uint64_t packed = U64Ref(pc.counters + RTHDIST_CTR_MAX_PACKED).v;
+    if (i == 0u) {
+        uint slot = min(uint(packed & 0xffffffffu), pc.n - 1u);
+        vec4At(pc.witnessOut, 0u).v = vec4At(pc.sorted, slot).v;
+        StateRef(pc.witnessOut + 16ul).v = stateAt(pc.state, slot).v;
+    }
+    float maxD2 = packedDist2(packed);
     bool settled = st.status == RTHDIST_EXACT || (st.status == RTHDIST_DEAD && pc.perPoint == 0u);
     if (!settled || !(packedDist2(st.best) <= maxD2))
         atomicAdd(U64Ref(pc.counters + RTHDIST_CTR_CHECK_BAD).v, 1ul);

@@ -255,13 +255,14 @@ struct SearchPush {
 // check_index.comp / check_queries.comp: the self-check (every record visited
 // once, violations counted at RTHDIST_CTR_CHECK_BAD).
 struct CheckPush {
-    uint64_t sorted;      // check_index: vec4[n] cell-sorted points (w = original index)
+    uint64_t sorted;      // vec4[n] cell-sorted points (w = original index)
     uint64_t sortedKeys;  // check_index: uint[n]
     uint64_t state;       // check_queries: QueryState[n]
     uint64_t counters;    // the counter block
     GridParams grid;      // check_index: the index's grid
     uint n;
-    uint perPoint;  // check_queries: 1 = every query must be EXACT
+    uint perPoint;        // check_queries: 1 = every query must be EXACT
+    uint64_t witnessOut;  // check_queries: the witness query's sorted record and state (32 bytes)
 };
 
 // refine.comp: exact scan of the candidate pairs' cells.

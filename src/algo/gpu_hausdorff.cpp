@@ -6,11 +6,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <deque>
 #include <map>
 #include <new>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -23,6 +25,7 @@
 #include "gpu/buffer.hpp"
 #include "gpu/context.hpp"
 #include "gpu/device_limits.hpp"
+#include "gpu/host_import.hpp"
 #include "gpu/pipeline_cache.hpp"
 #include "gpu/pipelines.hpp"
 #include "rthdist_shared.h"
@@ -84,6 +87,7 @@ struct PointIndex {
     Buffer* sortedKeys = nullptr;  // fine key per sorted point (builds coarser levels)
     std::string name;              // "A", "B" or "set#N": names its buffers and its messages
     std::string scratch;           // prefix of its build's pooled scratch buffers ("A", "B", "build")
+    const gpu::HostImport* source = nullptr;  // ingest: the caller's array imported in place, if it could be
     // Where its buffers live: the engine's pool (one-shot sets, reused by
     // name by the next call) or a prepared set's own map (exact sizes).
     std::map<std::string, Buffer>* store = nullptr;
@@ -167,6 +171,7 @@ void throwIfCancelled(const CallOptions& options) {
 struct CounterBlock {
     char* host = nullptr;
     VkDeviceAddress device = 0;
+    VkDeviceSize offset = 0;  // in the buffer that holds the blocks
     template <class T>
     T& at(size_t offset) const {
         return *reinterpret_cast<T*>(host + offset);
@@ -205,6 +210,9 @@ struct GpuHausdorff::State {
     // Buffers live across calls and only grow: allocation is a large share of
     // a call's cost on discrete GPUs.
     std::map<std::string, Buffer> pool;
+    // The caller's arrays imported for the submission in flight (deque:
+    // stable addresses for PointIndex::source).
+    std::deque<gpu::HostImport> imports;
 
     // A buffer may be replaced only between submissions: every name is used by
     // at most one purpose inside one command buffer.
@@ -244,7 +252,7 @@ struct GpuHausdorff::State {
         hostSmall = Buffer(ctx, kCounterBlockBytes * blocks.size(), gpu::kStorageUsage, MemoryKind::kHost);
         for (size_t k = 0; k < blocks.size(); ++k)
             blocks[k] = CounterBlock{static_cast<char*>(hostSmall.mapped()) + k * kCounterBlockBytes,
-                                     hostSmall.address() + k * kCounterBlockBytes};
+                                     hostSmall.address() + k * kCounterBlockBytes, k * kCounterBlockBytes};
     }
 
     // A counter of the block (offsets from rthdist_shared.h).
@@ -252,12 +260,8 @@ struct GpuHausdorff::State {
     T& counter(size_t offset) {
         return *reinterpret_cast<T*>(static_cast<char*>(hostSmall.mapped()) + offset);
     }
-    uint64_t* maxPacked() { return &counter<uint64_t>(RTHDIST_CTR_MAX_PACKED); }
-    VkDeviceAddress countersAddr() const { return hostSmall.address(); }
-    VkDeviceAddress maxPackedAddr() const { return hostSmall.address() + RTHDIST_CTR_MAX_PACKED; }
     VkDeviceAddress cellsCounterAddr() const { return hostSmall.address() + RTHDIST_CTR_CELLS; }
     VkDeviceAddress maxCountAddr() const { return hostSmall.address() + RTHDIST_CTR_MAX_COUNT; }
-    char* readback() { return static_cast<char*>(hostSmall.mapped()) + RTHDIST_CTR_READBACK; }
 
     void barrier(VkCommandBuffer cmd) { gpu::cmdShaderBarrier(cmd, pipelines.shaderStages()); }
 
@@ -328,13 +332,22 @@ struct GpuHausdorff::State {
                         1, &region);
     }
 
-    // The device ingest path (ingest.comp) for packed float host arrays: the
-    // host copies each array into a host-visible buffer (its only pass over
-    // the points); the device uploads it, checks it, takes its bounds and a
-    // sample for the bit count. Sets `ix.n`; nothing is submitted.
+    // The device ingest path (ingest.comp) for packed float host arrays:
+    // the device reads each array where it lies (an import of the caller's
+    // pages, gpu/host_import.hpp) or, where the driver refuses that, from a
+    // host-visible copy (the host's only pass over the points). The device
+    // uploads it, checks it, takes its bounds and a sample for the bit
+    // count. Sets `ix.n`; nothing is submitted.
     void stageSource(PointIndex& ix, std::span<const glm::vec3> pts) {
         ix.n = uint32_t(pts.size());
-        Buffer& source = buf(ix.scratch + ".source", VkDeviceSize(ix.n) * 12, MemoryKind::kHost);
+        const size_t bytes = size_t(ix.n) * 12;
+        if (std::optional<gpu::HostImport> im = gpu::HostImport::create(ctx, pts.data(), bytes)) {
+            imports.push_back(std::move(*im));
+            ix.source = &imports.back();
+            return;
+        }
+        ix.source = nullptr;
+        Buffer& source = buf(ix.scratch + ".source", bytes, MemoryKind::kHost);
         auto* dst = static_cast<char*>(source.mapped());
         const char* src = reinterpret_cast<const char*>(pts.data());
         const int threads = cpu::resolveThreads(0, ix.n / kHostChunk + 1);
@@ -346,9 +359,10 @@ struct GpuHausdorff::State {
     // Records the upload of a staged source (stageSource) into device memory.
     void cmdUploadSource(VkCommandBuffer cmd, const PointIndex& ix) {
         const VkDeviceSize bytes = VkDeviceSize(ix.n) * 12;
-        const VkBufferCopy region{0, 0, bytes};
-        vkCmdCopyBuffer(cmd, buf(ix.scratch + ".source", bytes, MemoryKind::kHost).handle(),
-                        buf(ix.scratch + ".raw", bytes).handle(), 1, &region);
+        const VkBuffer from =
+            ix.source ? ix.source->handle() : buf(ix.scratch + ".source", bytes, MemoryKind::kHost).handle();
+        const VkBufferCopy region{ix.source ? ix.source->offset() : 0, 0, bytes};
+        vkCmdCopyBuffer(cmd, from, buf(ix.scratch + ".raw", bytes).handle(), 1, &region);
     }
 
     // Records the ingest of an uploaded source into the set's vec4 points,
@@ -391,11 +405,11 @@ struct GpuHausdorff::State {
     }
 
     // The bit count and grid of an ingested set, from its device sample.
-    void chooseIngestedGrid(PointIndex& ix, int bits) {
+    // `records`: the set's sample buffer (vec4 per sampled point). Touches
+    // nothing shared: the sets' grids are chosen on two threads.
+    static void chooseIngestedGrid(PointIndex& ix, int bits, const float* records) {
         if (bits <= 0) {
-            const Buffer& sampleBuf = sampleBuffer(ix);
             const size_t count = (ix.n - 1) / bitsSampleStride(ix.n) + 1;
-            const auto* records = static_cast<const float*>(sampleBuf.mapped());
             std::vector<glm::vec3> sample(count);
             for (size_t j = 0; j < count; ++j)
                 sample[j] = glm::vec3(records[4 * j], records[4 * j + 1], records[4 * j + 2]);
@@ -653,44 +667,6 @@ struct GpuHausdorff::State {
         if (!why.empty()) throw SelfCheckError("index of " + ix.name + ": " + why);
     }
 
-    // Self-check of a finished direction: every query settled below the
-    // final maximum (check_queries.comp), and a sample of query records,
-    // the witness's among them, agrees with the host's copy of the points.
-    // Returns the witness's records (the query slot of the maximum).
-    SampledQuery checkDirection(const PointIndex& Q, const Buffer& state, std::span<const glm::vec3> qPts,
-                                std::span<const glm::vec3> tPts, bool perPoint, const std::string& name) {
-        const uint64_t packed = *maxPacked();
-        std::vector<uint32_t> slots = sampleSlots(Q.n, kCheckSamples);
-        slots.push_back(uint32_t(packed & 0xffffffffu));
-        counter<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
-        VkCommandBuffer cmd = ctx.begin();
-        sh::CheckPush cp{0, 0, state.address(), countersAddr(), {}, Q.n, perPoint ? 1u : 0u};
-        dispatch(cmd, Kernel::kCheckQueries, cp, Q.n);
-        std::vector<VkBufferCopy> sortedCopies, stateCopies;
-        for (size_t k = 0; k < slots.size(); ++k) {
-            const VkDeviceSize at = RTHDIST_CTR_READBACK + VkDeviceSize(k) * 32;
-            sortedCopies.push_back({VkDeviceSize(slots[k]) * 16, at, 16});
-            stateCopies.push_back({VkDeviceSize(slots[k]) * sizeof(sh::QueryState), at + 16, 16});
-        }
-        vkCmdCopyBuffer(cmd, Q.sorted->handle(), hostSmall.handle(), uint32_t(sortedCopies.size()),
-                        sortedCopies.data());
-        vkCmdCopyBuffer(cmd, state.handle(), hostSmall.handle(), uint32_t(stateCopies.size()),
-                        stateCopies.data());
-        ctx.submitAndWait(cmd);
-        std::vector<SampledQuery> sampled(slots.size());
-        for (size_t k = 0; k < slots.size(); ++k) {
-            sampled[k].slot = slots[k];
-            std::memcpy(sampled[k].sorted, readback() + k * 32, 16);
-            std::memcpy(&sampled[k].state, readback() + k * 32 + 16, 16);
-        }
-        const uint64_t bad = counter<uint64_t>(RTHDIST_CTR_CHECK_BAD);
-        std::string why = bad != 0 ? std::to_string(bad) + " of " + std::to_string(Q.n) +
-                                         " queries ended unsettled or above the maximum"
-                                   : sampledQueryFailure(sampled, qPts, tPts, packed, perPoint);
-        if (!why.empty()) throw SelfCheckError(name + ": " + why);
-        return sampled.back();
-    }
-
     // Reports progress (the fraction of the whole call), then honours the
     // cancel flag: a cancelled call unwinds to the guard (kCancelled).
     void report(const CallOptions& options, const char* stage, double fraction) {
@@ -698,79 +674,62 @@ struct GpuHausdorff::State {
         throwIfCancelled(options);
     }
 
-    // What the stages of one direction h(Q, T) share.
+    // What the stages of one direction h(Q, T) share. Each direction of a
+    // pair counts into a counter block of its own and keeps its query states
+    // in buffers of its own (tag), so both can be culled in one submission.
     struct DirectionRun {
         const PointIndex& Q;
         PointIndex& T;
-        Counters& cnt;
-        float lowerBound2 = 0.0f;  // < 0: per-point (no early break)
+        std::span<const glm::vec3> qPts, tPts;  // the host's copies of what the device holds
+        const CounterBlock& blk;
+        PerPoint* perPoint = nullptr;
+        Directed out;
+        double lowerBound2Exact = 0.0;  // the boxes' bound (double), for the witness check
+        float lowerBound2 = 0.0f;       // < 0: per-point (no early break)
         float epsilon = 0.0f;
         Buffer* state = nullptr;                 // QueryState per query slot
         Buffer* active[2] = {nullptr, nullptr};  // active slots, ping-pong
         int cur = 0;                             // active[cur] holds this iteration's slots
+        std::vector<uint32_t> checkSlots;        // the self-check's sampled query slots
+        [[nodiscard]] std::string name() const { return Q.name + "->" + T.name; }
     };
 
-    // h(Q, T): Q's points in Q's cell order are the queries.
-    Directed direction(const PointIndex& Q, PointIndex& T, std::span<const glm::vec3> qPts,
-                       std::span<const glm::vec3> tPts, const CallOptions& options, PerPoint* perPoint,
-                       double progressFrom, double progressTo) {
-        Directed out;
-        Counters& cnt = out.counters;
-        cnt.bits = uint32_t(T.grid.bits);
-        cnt.occupiedCells = T.numCells;
-        cnt.queries = Q.n;
-
+    // Sets up h(Q, T) (Q's points in Q's cell order are the queries): its
+    // bounds, epsilon and buffers; nothing is recorded.
+    void startDirection(DirectionRun& d, const std::string& tag) {
+        Counters& cnt = d.out.counters;
+        cnt.bits = uint32_t(d.T.grid.bits);
+        cnt.occupiedCells = d.T.numCells;
+        cnt.queries = d.Q.n;
         // Witness-less lower bound from the two boxes alone (no pass over the
         // points): each face of Q's tight box holds a query, whose distance
         // to BV(T), hence to T, is at least that face's excess over T's box
         // on its axis. Shrunk a little so float rounding never kills the
         // query that realizes h.
-        const double lb = boxLowerBound2(Q.bounds, T.bounds);
-        DirectionRun d{Q, T, cnt};
+        d.lowerBound2Exact = boxLowerBound2(d.Q.bounds, d.T.bounds);
         // Per-point distances need every query's NN: a negative bound turns
         // the early break off in every shader (deadThreshold returns 0).
-        d.lowerBound2 = perPoint ? -1.0f : float(lb * (1.0 - 1e-5));
+        d.lowerBound2 = d.perPoint ? -1.0f : float(d.lowerBound2Exact * (1.0 - 1e-5));
         double maxAbs = 0.0;
-        for (const Bounds* b : {&Q.bounds, static_cast<const Bounds*>(&T.bounds)})
+        for (const Bounds* b : {&d.Q.bounds, static_cast<const Bounds*>(&d.T.bounds)})
             maxAbs = std::max({maxAbs, std::abs(b->lo.x), std::abs(b->lo.y), std::abs(b->lo.z),
                                std::abs(b->hi.x), std::abs(b->hi.y), std::abs(b->hi.z)});
-        d.epsilon = float(maxAbs * 4e-7 + T.grid.cellSize * 1e-5);
-        d.state = &buf("state", VkDeviceSize(Q.n) * sizeof(sh::QueryState));
-        d.active[0] = &buf("active0", VkDeviceSize(Q.n) * 4);
-        d.active[1] = &buf("active1", VkDeviceSize(Q.n) * 4);
-
-        const uint32_t survivors = runCull(d);
-        report(options, "cull", progressFrom + 0.2 * (progressTo - progressFrom));
-        runSearch(d, survivors, options, progressFrom, progressTo);
-
-        // Witness: the query slot in the low half of maxPacked, its target in
-        // the query's state; both read back (and checked) by the self-check.
-        const auto checkStart = Clock::now();
-        const SampledQuery witness =
-            checkDirection(Q, *d.state, qPts, tPts, perPoint != nullptr, Q.name + "->" + T.name);
-        out.queryIndex = std::bit_cast<uint32_t>(witness.sorted[3]);
-        out.targetIndex = uint32_t(witness.state.best & 0xffffffffu);
-        out.queryPoint = qPts[out.queryIndex];
-        out.targetPoint = tPts[out.targetIndex];
-        out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
-        std::string why = witnessFailure(out.distance, *maxPacked(), std::sqrt(lb));
-        if (!why.empty()) throw SelfCheckError(Q.name + "->" + T.name + ": " + why);
-        timings->check += msSince(checkStart);
-        if (perPoint) readPerPoint(Q, *d.state, qPts, tPts, *perPoint);
-        return out;
+        d.epsilon = float(maxAbs * 4e-7 + d.T.grid.cellSize * 1e-5);
+        d.state = &buf(tag + ".state", VkDeviceSize(d.Q.n) * sizeof(sh::QueryState));
+        d.active[0] = &buf(tag + ".active0", VkDeviceSize(d.Q.n) * 4);
+        d.active[1] = &buf(tag + ".active1", VkDeviceSize(d.Q.n) * 4);
+        d.checkSlots = sampleSlots(d.Q.n, kCheckSamples);
     }
 
-    // Neighbourhood pass and compaction (one submission): returns how many
-    // queries survive into the candidate search (their slots in active[0]).
-    uint32_t runCull(DirectionRun& d) {
-        const auto t0 = Clock::now();
-        std::memset(hostSmall.mapped(), 0, 32);
-        VkCommandBuffer cmd = ctx.begin();
+    // Records the neighbourhood pass and the compaction of the survivors
+    // (their slots in active[0], their count at RTHDIST_CTR_ACTIVE).
+    void cmdCull(VkCommandBuffer cmd, DirectionRun& d) {
+        std::memset(d.blk.host, 0, 32);  // ACTIVE .. PAIRS
         sh::CullPush cull{d.Q.sorted->address(),
                           d.T.sorted->address(),
                           d.T.dense->address(),
                           d.state->address(),
-                          maxPackedAddr(),
+                          d.blk.addr(RTHDIST_CTR_MAX_PACKED),
                           gridParams(d.T.grid),
                           d.Q.n,
                           d.lowerBound2,
@@ -779,17 +738,118 @@ struct GpuHausdorff::State {
                           kCrowdedCell};  // past it: split leaves, or copies of one point
         dispatch(cmd, Kernel::kCull, cull, d.Q.n);
         barrier(cmd);
-        sh::CompactPush comp{
-            d.state->address(), d.active[0]->address(), countersAddr(), maxPackedAddr(), d.Q.n,
-            d.lowerBound2};
+        sh::CompactPush comp{d.state->address(),
+                             d.active[0]->address(),
+                             d.blk.device,
+                             d.blk.addr(RTHDIST_CTR_MAX_PACKED),
+                             d.Q.n,
+                             d.lowerBound2};
         dispatch(cmd, Kernel::kCompact, comp, d.Q.n);
+    }
+
+    // Records the self-check of a direction (check_queries.comp: every query
+    // settled below the final maximum, the witness's records copied by the
+    // shader) and the copies of the sampled queries' records into the
+    // block's read-back area. Recorded right after the cull, it is the
+    // direction's check when no query survives the cull (no extra
+    // submission); otherwise it is recorded again after the search.
+    void cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d) {
+        d.blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
+        const VkDeviceSize readback = d.blk.offset + RTHDIST_CTR_READBACK;
+        const VkDeviceSize witnessAt = readback + VkDeviceSize(d.checkSlots.size()) * 32;
+        sh::CheckPush cp{d.Q.sorted->address(),
+                         0,
+                         d.state->address(),
+                         d.blk.device,
+                         {},
+                         d.Q.n,
+                         d.perPoint ? 1u : 0u,
+                         hostSmall.address() + witnessAt};
+        dispatch(cmd, Kernel::kCheckQueries, cp, d.Q.n);
+        std::vector<VkBufferCopy> sortedCopies, stateCopies;
+        for (size_t k = 0; k < d.checkSlots.size(); ++k) {
+            const VkDeviceSize at = readback + VkDeviceSize(k) * 32;
+            sortedCopies.push_back({VkDeviceSize(d.checkSlots[k]) * 16, at, 16});
+            stateCopies.push_back({VkDeviceSize(d.checkSlots[k]) * sizeof(sh::QueryState), at + 16, 16});
+        }
+        vkCmdCopyBuffer(cmd, d.Q.sorted->handle(), hostSmall.handle(), uint32_t(sortedCopies.size()),
+                        sortedCopies.data());
+        vkCmdCopyBuffer(cmd, d.state->handle(), hostSmall.handle(), uint32_t(stateCopies.size()),
+                        stateCopies.data());
+    }
+
+    // The self-check's verdict once its submission completed: every query
+    // settled, the sampled records and the witness's agree with the host's
+    // copy of the points. Returns the witness's records (the query slot of
+    // the maximum).
+    SampledQuery finishCheck(const DirectionRun& d) {
+        const uint64_t packed = d.blk.at<uint64_t>(RTHDIST_CTR_MAX_PACKED);
+        const char* readback = d.blk.host + RTHDIST_CTR_READBACK;
+        std::vector<SampledQuery> sampled(d.checkSlots.size() + 1);
+        for (size_t k = 0; k < sampled.size(); ++k) {
+            sampled[k].slot = k < d.checkSlots.size() ? d.checkSlots[k] : uint32_t(packed & 0xffffffffu);
+            std::memcpy(sampled[k].sorted, readback + k * 32, 16);
+            std::memcpy(&sampled[k].state, readback + k * 32 + 16, 16);
+        }
+        const uint64_t bad = d.blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD);
+        std::string why = bad != 0
+                              ? std::to_string(bad) + " of " + std::to_string(d.Q.n) +
+                                    " queries ended unsettled or above the maximum"
+                              : sampledQueryFailure(sampled, d.qPts, d.tPts, packed, d.perPoint != nullptr);
+        if (!why.empty()) throw SelfCheckError(d.name() + ": " + why);
+        return sampled.back();
+    }
+
+    // The direction's result from its checked witness (and its per-point
+    // distances).
+    Directed finishDirection(DirectionRun& d, const SampledQuery& witness) {
+        Directed& out = d.out;
+        out.queryIndex = std::bit_cast<uint32_t>(witness.sorted[3]);
+        out.targetIndex = uint32_t(witness.state.best & 0xffffffffu);
+        out.queryPoint = d.qPts[out.queryIndex];
+        out.targetPoint = d.tPts[out.targetIndex];
+        out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
+        std::string why = witnessFailure(out.distance, d.blk.at<uint64_t>(RTHDIST_CTR_MAX_PACKED),
+                                         std::sqrt(d.lowerBound2Exact));
+        if (!why.empty()) throw SelfCheckError(d.name() + ": " + why);
+        if (d.perPoint) readPerPoint(d.Q, *d.state, d.qPts, d.tPts, *d.perPoint);
+        return out;
+    }
+
+    // The culls of the directions (one or two) in one submission, each
+    // followed by its self-check; returns each direction's survivors.
+    template <size_t N>
+    std::array<uint32_t, N> runCulls(const std::array<DirectionRun*, N>& dirs) {
+        const auto t0 = Clock::now();
+        VkCommandBuffer cmd = ctx.begin();
+        for (DirectionRun* d : dirs) cmdCull(cmd, *d);
+        barrier(cmd);
+        const uint32_t culled = ctx.cmdMark(cmd);
+        for (DirectionRun* d : dirs) cmdCheckQueries(cmd, *d);
         ctx.submitAndWait(cmd);
-        timings->gpuCull += ctx.lastGpuMs();
-        const uint32_t numActive = counter<uint32_t>(RTHDIST_CTR_ACTIVE);
-        d.cnt.survivingQueries = numActive;
-        d.cnt.culledByNeighbourhood = d.Q.n - numActive;
+        timings->gpuCull += ctx.gpuMsBetween(0, culled);
+        std::array<uint32_t, N> survivors{};
+        for (size_t k = 0; k < N; ++k) {
+            survivors[k] = dirs[k]->blk.template at<uint32_t>(RTHDIST_CTR_ACTIVE);
+            dirs[k]->out.counters.survivingQueries = survivors[k];
+            dirs[k]->out.counters.culledByNeighbourhood = dirs[k]->Q.n - survivors[k];
+        }
         timings->cull += msSince(t0);
-        return numActive;
+        return survivors;
+    }
+
+    // The search of a direction that has survivors, then its self-check
+    // (one more submission); returns the checked witness.
+    SampledQuery searchAndCheck(DirectionRun& d, uint32_t survivors, const CallOptions& options,
+                                double progressFrom, double progressTo) {
+        runSearch(d, survivors, options, progressFrom, progressTo);
+        const auto t0 = Clock::now();
+        VkCommandBuffer cmd = ctx.begin();
+        cmdCheckQueries(cmd, d);
+        ctx.submitAndWait(cmd);
+        SampledQuery witness = finishCheck(d);
+        timings->check += msSince(t0);
+        return witness;
     }
 
     // Candidate search with a growing radius until no query is active.
@@ -815,7 +875,7 @@ struct GpuHausdorff::State {
         Buffer* pairs = nullptr;
         int builtLevel = -1;  // level of the BLAS now built (-1: none yet)
         while (numActive > 0) {
-            if (++d.cnt.iterations > kMaxIterations)
+            if (++d.out.counters.iterations > kMaxIterations)
                 throw std::runtime_error("candidate search did not converge");
             if (!pairs) {
                 pairs = &buf("pairs", pairCapacity * 8);
@@ -827,10 +887,10 @@ struct GpuHausdorff::State {
             builtLevel = level;
             numActive = refinePass(d, level, float(radius), *pairs, pairCapacity, pairCount, numActive);
             report(options, "search",
-                   progressFrom +
-                       (progressTo - progressFrom) *
-                           (0.2 + 0.8 * (1.0 - double(numActive) /
-                                                   double(std::max<uint64_t>(1, d.cnt.survivingQueries)))));
+                   progressFrom + (progressTo - progressFrom) *
+                                      (0.2 + 0.8 * (1.0 - double(numActive) /
+                                                              double(std::max<uint64_t>(
+                                                                  1, d.out.counters.survivingQueries)))));
             if (pairCount > pairCapacity && pairCapacity < maxPairCapacity) {
                 // Some queries lost pairs: redo them at the same radius with room.
                 pairCapacity =
@@ -870,8 +930,8 @@ struct GpuHausdorff::State {
         const float rayTMax = float(std::min(T.grid.cellSize, T.split ? radius : T.grid.cellSize) * 1e-3);
         Buffer& aabbs = buf("aabbs", VkDeviceSize(lv.count) * 24);
         const auto t0 = Clock::now();
-        counter<uint64_t>(RTHDIST_CTR_PAIRS) = 0;
-        counter<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE) = 0;
+        d.blk.at<uint64_t>(RTHDIST_CTR_PAIRS) = 0;
+        d.blk.at<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE) = 0;
         VkCommandBuffer cmd = ctx.begin();
         // Per-box slack: float rounding at the box's magnitude (the old
         // global epsilon used the largest coordinate of both sets) plus,
@@ -894,8 +954,8 @@ struct GpuHausdorff::State {
                           d.state->address(),
                           d.active[d.cur]->address(),
                           pairs.address(),
-                          countersAddr(),
-                          maxPackedAddr(),
+                          d.blk.device,
+                          d.blk.addr(RTHDIST_CTR_MAX_PACKED),
                           numActive,
                           uint32_t(pairCapacity),
                           r,
@@ -909,9 +969,9 @@ struct GpuHausdorff::State {
             cmdTraceRaysSplit(cmd, sp);
         ctx.submitAndWait(cmd);
         timings->gpuSearch += ctx.lastGpuMs();
-        d.cnt.rays += numActive;
+        d.out.counters.rays += numActive;
         timings->search += msSince(t0);
-        return counter<uint64_t>(RTHDIST_CTR_PAIRS);
+        return d.blk.at<uint64_t>(RTHDIST_CTR_PAIRS);
     }
 
     // One refinement submission: the pairs that fit are scanned exactly,
@@ -923,7 +983,7 @@ struct GpuHausdorff::State {
         const PointIndex::Level lv = levelCells(d.T, level);
         const auto t0 = Clock::now();
         const uint64_t used = std::min<uint64_t>(pairCount, pairCapacity);
-        d.cnt.candidatePairs += used;
+        d.out.counters.candidatePairs += used;
         VkCommandBuffer cmd = ctx.begin();
         sh::RefinePush rp{d.Q.sorted->address(),
                           d.T.sorted->address(),
@@ -931,8 +991,8 @@ struct GpuHausdorff::State {
                           d.state->address(),
                           d.active[d.cur]->address(),
                           pairs.address(),
-                          countersAddr(),
-                          maxPackedAddr(),
+                          d.blk.device,
+                          d.blk.addr(RTHDIST_CTR_MAX_PACKED),
                           d.T.cells->address(),
                           level > 0 ? lv.fineFirst->address() : 0,
                           uint32_t(pairCapacity),
@@ -944,8 +1004,8 @@ struct GpuHausdorff::State {
         sh::ResolvePush rs{d.state->address(),
                            d.active[d.cur]->address(),
                            d.active[1 - d.cur]->address(),
-                           countersAddr(),
-                           maxPackedAddr(),
+                           d.blk.device,
+                           d.blk.addr(RTHDIST_CTR_MAX_PACKED),
                            numActive,
                            r,
                            d.lowerBound2};
@@ -954,7 +1014,7 @@ struct GpuHausdorff::State {
         timings->gpuRefine += ctx.lastGpuMs();
         d.cur = 1 - d.cur;
         timings->refine += msSince(t0);
-        return counter<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE);
+        return d.blk.at<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE);
     }
 
     // Every query is EXACT after a per-point run: its state holds its NN.
@@ -1036,6 +1096,7 @@ struct GpuHausdorff::State {
         barrier(cmd);
         for (size_t k = 0; k < 2; ++k) cmdIngest(cmd, sets[k]->ix, blocks[k]);
         ctx.submitAndWait(cmd);
+        imports.clear();  // the device has read the caller's arrays
         const double uploadMs = ctx.gpuMsBetween(0, uploaded);
         timings->upload += msSince(t0) - (ctx.lastGpuMs() - uploadMs);
         timings->gpuUpload += uploadMs;
@@ -1044,7 +1105,12 @@ struct GpuHausdorff::State {
         const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
         if (exactScale(magnitude) != 1.0) return false;
         const auto t1 = Clock::now();
-        for (DeviceSet* set : sets) chooseIngestedGrid(set->ix, options.bits);
+        // The two bit counts side by side (each ~0.2-0.4 ms of host work).
+        const auto* samplesA = static_cast<const float*>(sampleBuffer(da.ix).mapped());
+        const auto* samplesB = static_cast<const float*>(sampleBuffer(db.ix).mapped());
+        std::thread second([&] { chooseIngestedGrid(db.ix, options.bits, samplesB); });
+        chooseIngestedGrid(da.ix, options.bits, samplesA);
+        second.join();
         timings->index += msSince(t1);
         buildIndexes(std::array{&da.ix, &db.ix}, /*uploaded=*/true);
         return true;
@@ -1076,12 +1142,29 @@ struct GpuHausdorff::State {
     void runPair(DeviceSet& a, DeviceSet& b, const CallOptions& options, HausdorffResult& res, double from) {
         const bool pp = options.perPointDistances;
         const double mid = options.directedOnly ? 1.0 : from + 0.5 * (1.0 - from);
-        res.aToB =
-            direction(a.ix, b.ix, a.points, b.points, options, pp ? &res.aNearest : nullptr, from, mid);
+        DirectionRun ab{a.ix, b.ix, a.points, b.points, blocks[0], pp ? &res.aNearest : nullptr};
+        DirectionRun ba{b.ix, a.ix, b.points, a.points, blocks[1], pp ? &res.bNearest : nullptr};
+        startDirection(ab, "ab");
+        if (!options.directedOnly) startDirection(ba, "ba");
+        // Both culls (and their checks) in one submission; a direction with
+        // survivors searches, then checks again.
+        std::array<uint32_t, 2> survivors{};
+        if (options.directedOnly)
+            survivors[0] = runCulls(std::array{&ab})[0];
+        else
+            survivors = runCulls(std::array{&ab, &ba});
+        report(options, "cull", from + 0.2 * (1.0 - from));
+        const auto directed = [&](DirectionRun& d, uint32_t n, double lo, double hi) {
+            const SampledQuery witness = n > 0 ? searchAndCheck(d, n, options, lo, hi) : finishCheck(d);
+            const auto t0 = Clock::now();
+            Directed out = finishDirection(d, witness);
+            timings->check += msSince(t0);
+            return out;
+        };
+        res.aToB = directed(ab, survivors[0], from, mid);
         res.hausdorff = res.aToB.distance;
         if (!options.directedOnly) {
-            res.bToA =
-                direction(b.ix, a.ix, b.points, a.points, options, pp ? &res.bNearest : nullptr, mid, 1.0);
+            res.bToA = directed(ba, survivors[1], mid, 1.0);
             res.hausdorff = std::max(res.hausdorff, res.bToA.distance);
         }
         // Witnesses and per-point distances from the unscaled inputs, in double.
@@ -1123,6 +1206,7 @@ struct GpuHausdorff::State {
             err = Error{ErrorCode::kInternal, e.what()};
         }
         timings = nullptr;
+        imports.clear();  // never past the call: the caller may free its arrays
         if (err) {
             accel.release();
             tlasBound = false;

@@ -44,16 +44,22 @@ double exactScale(double maxAbs) {
     return std::ldexp(1.0, -e);
 }
 
+namespace {
+
+// The low 10 bits of v, two zero bits after each (Morton interleave).
+inline uint32_t spreadBits(uint32_t v) {
+    v &= 0x3ffu;
+    v = (v | (v << 16)) & 0x030000ffu;
+    v = (v | (v << 8)) & 0x0300f00fu;
+    v = (v | (v << 4)) & 0x030c30c3u;
+    v = (v | (v << 2)) & 0x09249249u;
+    return v;
+}
+
+}  // namespace
+
 uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z) {
-    auto spread = [](uint32_t v) {
-        v &= 0x3ffu;
-        v = (v | (v << 16)) & 0x030000ffu;
-        v = (v | (v << 8)) & 0x0300f00fu;
-        v = (v | (v << 4)) & 0x030c30c3u;
-        v = (v | (v << 2)) & 0x09249249u;
-        return v;
-    };
-    return spread(x) | (spread(y) << 1) | (spread(z) << 2);
+    return spreadBits(x) | (spreadBits(y) << 1) | (spreadBits(z) << 2);
 }
 
 namespace {
@@ -65,13 +71,13 @@ constexpr size_t kSampleSize = 32768;
 // passes of 10 bits: linear in the sample, where a comparison sort of 32k
 // keys cost ~1.5 ms per set on the host path).
 std::vector<uint32_t> sortedSampleKeys(std::span<const glm::vec3> sample, const GridSpec& probe) {
-    std::vector<uint32_t> keys, tmp;
-    keys.reserve(sample.size());
-    for (const glm::vec3& p : sample)
-        keys.push_back(mortonEncode(cellCoord(p.x, probe.origin.x, probe.cellSize, probe.cellsPerAxis),
-                                    cellCoord(p.y, probe.origin.y, probe.cellSize, probe.cellsPerAxis),
-                                    cellCoord(p.z, probe.origin.z, probe.cellSize, probe.cellsPerAxis)));
-    tmp.resize(keys.size());
+    std::vector<uint32_t> keys(sample.size()), tmp(sample.size());
+    for (size_t i = 0; i < sample.size(); ++i) {
+        const glm::vec3& p = sample[i];
+        keys[i] = spreadBits(cellCoord(p.x, probe.origin.x, probe.cellSize, probe.cellsPerAxis)) |
+                  spreadBits(cellCoord(p.y, probe.origin.y, probe.cellSize, probe.cellsPerAxis)) << 1 |
+                  spreadBits(cellCoord(p.z, probe.origin.z, probe.cellSize, probe.cellsPerAxis)) << 2;
+    }
     constexpr uint32_t kDigits = 1u << kProbeBits;
     for (int shift = 0; shift < 3 * kProbeBits; shift += kProbeBits) {
         std::vector<uint32_t> start(kDigits + 1, 0);

@@ -1,6 +1,7 @@
 #include "gpu/context.hpp"
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <sstream>
 #include <stdexcept>
@@ -52,6 +53,21 @@ bool hasExtension(const std::vector<VkExtensionProperties>& exts, const char* na
     for (const auto& e : exts)
         if (std::strcmp(e.extensionName, name) == 0) return true;
     return false;
+}
+
+std::vector<VkExtensionProperties> deviceExtensions(VkPhysicalDevice pd) {
+    uint32_t n = 0;
+    vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, nullptr);
+    std::vector<VkExtensionProperties> exts(n);
+    vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, exts.data());
+    return exts;
+}
+
+// RTHDIST_HOST_IMPORT=0 turns the in-place reads of host arrays off (the
+// copy into a staging buffer then serves), e.g. to compare the two.
+bool wantsHostImport() {
+    const char* env = std::getenv("RTHDIST_HOST_IMPORT");
+    return env == nullptr || std::string(env) != "0";
 }
 
 const char* typeName(VkPhysicalDeviceType t) {
@@ -280,6 +296,10 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
 
         std::vector<const char*> exts(std::begin(kCommonExtensions), std::end(kCommonExtensions));
         exts.push_back(useRq ? VK_KHR_RAY_QUERY_EXTENSION_NAME : VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
+        // Optional: the device reads the caller's arrays in place (gpu/host_import.hpp).
+        ctx->m_hostImport = wantsHostImport() && hasExtension(deviceExtensions(chosenPd),
+                                                              VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
+        if (ctx->m_hostImport) exts.push_back(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
 
         VkPhysicalDeviceRayQueryFeaturesKHR rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
         rq.rayQuery = VK_TRUE;
@@ -334,6 +354,16 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
         VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &ctx->m_asProps};
         vkGetPhysicalDeviceProperties2(chosenPd, &p2);
         ctx->m_timestampPeriod = p2.properties.limits.timestampPeriod;
+        if (ctx->m_hostImport) {
+            VkPhysicalDeviceExternalMemoryHostPropertiesEXT hp{
+                VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_MEMORY_HOST_PROPERTIES_EXT};
+            VkPhysicalDeviceProperties2 hp2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &hp};
+            vkGetPhysicalDeviceProperties2(chosenPd, &hp2);
+            ctx->m_importAlignment = hp.minImportedHostPointerAlignment;
+            ctx->m_getHostPointerProperties = reinterpret_cast<PFN_vkGetMemoryHostPointerPropertiesEXT>(
+                vkGetDeviceProcAddr(d, "vkGetMemoryHostPointerPropertiesEXT"));
+            ctx->m_hostImport = ctx->m_getHostPointerProperties != nullptr && ctx->m_importAlignment > 0;
+        }
         vkGetPhysicalDeviceMemoryProperties(chosenPd, &ctx->m_memProps);
         ctx->m_limits = readDeviceLimits(chosenPd);
 

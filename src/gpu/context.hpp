@@ -58,6 +58,13 @@ public:
     [[nodiscard]] uint64_t validationMessageCount() const { return m_validationMessages.load(); }
     [[nodiscard]] uint32_t memoryTypeIndex(uint32_t typeBits, VkMemoryPropertyFlags wanted) const;
     [[nodiscard]] float timestampPeriodNs() const { return m_timestampPeriod; }
+    // VK_EXT_external_memory_host is on (host arrays can be imported in
+    // place, gpu/host_import.hpp), with its pointer alignment.
+    [[nodiscard]] bool hostImport() const { return m_hostImport; }
+    [[nodiscard]] VkDeviceSize importAlignment() const { return m_importAlignment; }
+    [[nodiscard]] PFN_vkGetMemoryHostPointerPropertiesEXT getHostPointerProperties() const {
+        return m_getHostPointerProperties;
+    }
 
     // One-shot command buffers: begin() returns a recording buffer;
     // submitAndWait() submits it and blocks until the queue has executed it.
@@ -106,6 +113,9 @@ private:
     VkPhysicalDeviceMemoryProperties m_memProps{};
     DeviceLimits m_limits;
     float m_timestampPeriod = 1.0f;
+    bool m_hostImport = false;
+    VkDeviceSize m_importAlignment = 0;
+    PFN_vkGetMemoryHostPointerPropertiesEXT m_getHostPointerProperties = nullptr;
     std::atomic<uint64_t> m_validationMessages{0};
 };
 

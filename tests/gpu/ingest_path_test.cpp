@@ -4,8 +4,11 @@
 // the device must reject what the host rejects, with the same words.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "common/oracle_cases.hpp"
@@ -29,14 +32,15 @@ struct Strided {
     }
 };
 
+// The index (bit count, cells) and the value are the same. Which of several
+// tied pairs is the witness, and how many queries the running maximum kills
+// early, depend on the order of atomics on a parallel device (NVIDIA), so
+// they are not compared; both witnesses are checked against the oracle.
 void expectSameDirection(const Directed& device, const Directed& host) {
     EXPECT_EQ(device.distance, host.distance);
-    EXPECT_EQ(device.queryIndex, host.queryIndex);
-    EXPECT_EQ(device.targetIndex, host.targetIndex);
     EXPECT_EQ(device.counters.bits, host.counters.bits);
     EXPECT_EQ(device.counters.occupiedCells, host.counters.occupiedCells);
-    EXPECT_EQ(device.counters.survivingQueries, host.counters.survivingQueries);
-    EXPECT_EQ(device.counters.rays, host.counters.rays);
+    EXPECT_EQ(device.counters.queries, host.counters.queries);
 }
 
 TEST(IngestPath, SameIndexAndAnswerAsTheHostPath) {
@@ -52,6 +56,7 @@ TEST(IngestPath, SameIndexAndAnswerAsTheHostPath) {
         ASSERT_TRUE(device.ok()) << device.error().message;
         ASSERT_TRUE(host.ok()) << host.error().message;
         expectMatchesOracle(c, *device);
+        expectMatchesOracle(c, *host);
         EXPECT_EQ(device->hausdorff, host->hausdorff);
         expectSameDirection(device->aToB, host->aToB);
         expectSameDirection(device->bToA, host->bToA);
@@ -59,6 +64,30 @@ TEST(IngestPath, SameIndexAndAnswerAsTheHostPath) {
         ++compared;
     }
     EXPECT_GT(compared, 40);
+}
+
+// The device reads the caller's arrays in place (an import of their pages)
+// where the driver allows it; arrays that start mid-page and the copy that
+// serves when imports are off give the same answers.
+TEST(IngestPath, ImportedOrCopiedArraysStartingAnywhere) {
+    const std::vector<OracleCase> cases = makeOracleCases();
+    for (const char* import : {"1", "0"}) {
+        setenv("RTHDIST_HOST_IMPORT", import, 1);
+        RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+        unsetenv("RTHDIST_HOST_IMPORT");
+        for (size_t k = 5; k < cases.size(); k += 41) {
+            const OracleCase& c = cases[k];
+            SCOPED_TRACE(c.name + (import[0] == '1' ? " imported" : " copied"));
+            // B placed 1..3 points into a larger array: its data starts at
+            // an offset of 12-36 bytes from the array's start.
+            const size_t shift = 1 + k % 3;
+            std::vector<glm::vec3> padded(c.b.size() + shift + 5, glm::vec3(1e9f));
+            std::copy(c.b.begin(), c.b.end(), padded.begin() + long(shift));
+            auto r = engine->compute(c.a, std::span<const glm::vec3>(padded.data() + shift, c.b.size()));
+            ASSERT_TRUE(r.ok()) << r.error().message;
+            expectMatchesOracle(c, *r);
+        }
+    }
 }
 
 TEST(IngestPath, FirstNonFinitePointOfEachSetIsNamedAsOnTheHost) {
