@@ -40,8 +40,9 @@
 //     from an allreduced histogram) and sent to their slab's rank; queries go
 //     to the slab of their coordinate on that axis (clamped at both ends).
 //     Rank r bounds every NN of its queries Q_r from above by
-//     w_r = h(Q_r, T_r ∪ S) (T_r its slab's targets, S a global sample of at
-//     most 4096 targets; both subsets of T, so NN_T(q) <= w_r for q in Q_r),
+//     w_r = h(Q_r, T'_r ∪ S) (T'_r every 16th target of its slab, S a global
+//     sample of about 4096 targets; both subsets of T, so NN_T(q) <= w_r for
+//     q in Q_r),
 //     widened by a relative 1e-4 and 1e-5 D against rounding. Every target t
 //     with |t - q| <= w_r has |t_axis - q_axis| <= w_r, so the halo "targets
 //     whose axis coordinate lies within w_r of [min, max] of Q_r's axis
@@ -60,9 +61,19 @@
 // Result fields beyond the witnesses: origin as above; counters summed over
 //   ranks (queries = |Q|), except bits and iterations (their maximum over
 //   ranks) — the work of the final pass; spatial mode's bound pass is not
-//   counted. timings: each stage's maximum over ranks; total = the wall time
-//   of the whole collective call (exchanges included). device and backend:
-//   rank 0's engine.
+//   counted. timings: each stage summed over the rank's engine calls
+//   (spatial: bound and final pass), then the maximum over ranks; total = the
+//   wall time of the whole collective call (frame, exchanges, both passes).
+//   device and backend: rank 0's engine.
+// Identical to one process: on the CPU backend, H, both directed distances
+//   (bit for bit), witness indices and points equal those of
+//   rthdist::hausdorff over the concatenated sets (tests/mpi, np 1..3, every
+//   oracle and georeferenced case). On the GPU backends the values keep the
+//   contract above, but among queries whose squared float distances tie the
+//   GPU keeps the one of the largest slot of its own query order, which
+//   depends on the slice a rank holds: the witness (and, for double input,
+//   the last bits of the recomputed distance) may then differ from one
+//   process's.
 // Limits: up to 2^31 - 1 points per global set (indices are 32-bit, as in
 //   rthdist.hpp). Replicated mode holds the whole target set as float32 on
 //   every rank; spatial mode holds the rank's slab, its halo and its queries.

@@ -1,5 +1,7 @@
 #include "mpi/local_pass.hpp"
 
+#include <chrono>
+
 namespace rthdist::mpi {
 
 void addTimings(Timings& into, const Timings& t) {
@@ -17,28 +19,67 @@ void addTimings(Timings& into, const Timings& t) {
     into.gpuRefine += t.gpuRefine;
 }
 
-Result<PassOutcome> searchLocal(Engine& engine, std::span<const glm::vec3> queries,
-                                std::span<const uint32_t> queryIds, std::span<const glm::vec3> targets,
-                                std::span<const uint32_t> targetIds, const CallOptions& call) {
-    PassOutcome out;
-    if (queries.empty()) return out;
-    if (targets.empty()) return Error{ErrorCode::kInternal, "a rank's target set is empty"};
+namespace {
+
+CallOptions directedCall(const CallOptions& call) {
     CallOptions directed = call;
     directed.directedOnly = true;
     directed.perPointDistances = false;
     directed.progress = nullptr;
-    Result<HausdorffResult> r = engine.compute(queries, targets, directed);
-    if (!r) return r.error();
-    const glm::vec3 q = queries[r->aToB.queryIndex], t = targets[r->aToB.targetIndex];
+    return directed;
+}
+
+// The outcome of a directed engine result, its witness in global indices.
+PassOutcome outcomeOf(const HausdorffResult& r, std::span<const glm::vec3> queries,
+                      std::span<const uint32_t> queryIds, std::span<const glm::vec3> targets,
+                      std::span<const uint32_t> targetIds) {
+    PassOutcome out;
+    const glm::vec3 q = queries[r.aToB.queryIndex], t = targets[r.aToB.targetIndex];
     const float dx = q.x - t.x, dy = q.y - t.y, dz = q.z - t.z;
     out.best.squaredFloat = dx * dx + dy * dy + dz * dz;
-    out.best.distance = r->aToB.distance;
-    out.best.query = queryIds[r->aToB.queryIndex];
-    out.best.target = targetIds[r->aToB.targetIndex];
+    out.best.distance = r.aToB.distance;
+    out.best.query = queryIds[r.aToB.queryIndex];
+    out.best.target = targetIds[r.aToB.targetIndex];
     out.best.any = 1;
-    out.counters = r->aToB.counters;
-    out.timings = r->timings;
-    out.validationMessages = r->validationMessages;
+    out.counters = r.aToB.counters;
+    out.timings = r.timings;
+    out.validationMessages = r.validationMessages;
+    return out;
+}
+
+double msSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+Result<PassOutcome> searchLocal(Engine& engine, std::span<const glm::vec3> queries,
+                                std::span<const uint32_t> queryIds, std::span<const glm::vec3> targets,
+                                std::span<const uint32_t> targetIds, const CallOptions& call) {
+    if (queries.empty()) return PassOutcome{};
+    if (targets.empty()) return Error{ErrorCode::kInternal, "a rank's target set is empty"};
+    Result<HausdorffResult> r = engine.compute(queries, targets, directedCall(call));
+    if (!r) return r.error();
+    return outcomeOf(*r, queries, queryIds, targets, targetIds);
+}
+
+Result<PassOutcome> searchPrepared(Engine& engine, const PreparedSet* prepared,
+                                   std::span<const glm::vec3> queries, std::span<const uint32_t> queryIds,
+                                   std::span<const glm::vec3> targets, std::span<const uint32_t> targetIds,
+                                   const CallOptions& call) {
+    if (queries.empty()) return PassOutcome{};
+    if (targets.empty()) return Error{ErrorCode::kInternal, "a rank's target set is empty"};
+    const auto start = std::chrono::steady_clock::now();
+    PrepareOptions options;
+    options.bits = call.bits;
+    Result<PreparedSet> t = engine.prepare(targets, options);
+    if (!t) return t.error();
+    const double prepareMs = msSince(start);
+    Result<HausdorffResult> r = engine.compute(*prepared, *t, directedCall(call));
+    if (!r) return r.error();
+    PassOutcome out = outcomeOf(*r, queries, queryIds, targets, targetIds);
+    out.timings.index += prepareMs;  // the target's index is built by prepare()
+    out.timings.total += prepareMs;
     return out;
 }
 

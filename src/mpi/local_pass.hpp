@@ -44,4 +44,16 @@ void addTimings(Timings& into, const Timings& t);
                                               std::span<const glm::vec3> targets,
                                               std::span<const uint32_t> targetIds, const CallOptions& call);
 
+// As searchLocal, with the queries prepared once by the caller
+// (Engine::prepare of `queries`, kept for several passes: the spatial mode's
+// bound and final pass order them once). The targets are prepared here; the
+// time of that is added to timings.index and total. `prepared` may be null
+// only when `queries` is empty.
+[[nodiscard]] Result<PassOutcome> searchPrepared(Engine& engine, const PreparedSet* prepared,
+                                                 std::span<const glm::vec3> queries,
+                                                 std::span<const uint32_t> queryIds,
+                                                 std::span<const glm::vec3> targets,
+                                                 std::span<const uint32_t> targetIds,
+                                                 const CallOptions& call);
+
 }  // namespace rthdist::mpi
