@@ -308,7 +308,7 @@ constexpr double kIndexDone = 0.1, kCullDone = 0.15, kSearchDone = 0.95;
 void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
                   std::span<const glm::vec3> targets, const UninitVector<float>& qx,
                   const UninitVector<float>& qy, const UninitVector<float>& qz,
-                  const UninitVector<uint32_t>& qOriginal, const UninitVector<uint32_t>& qKey, int threads,
+                  const UninitVector<uint64_t>& qKeyed, const UninitVector<uint32_t>& qKey, int threads,
                   PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress,
                   std::atomic<bool>& lost) {
     const size_t nq = queries.size();
@@ -324,7 +324,7 @@ void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
         const uint32_t* keys = t.cellKey.data();
         uint32_t cursor = uint32_t(std::lower_bound(keys, keys + cells, qKey[begin]) - keys);
         for (size_t i = begin; i < end; ++i) {
-            const uint32_t src = qOriginal[i];
+            const uint32_t src = uint32_t(qKeyed[i]);  // input index
             if (!(i > begin && hint != kNone && sameQuery(qx, qy, qz, i))) {
                 const Query q{splat(qx[i]), splat(qy[i]), splat(qz[i])};
                 Best best;
@@ -372,12 +372,11 @@ DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet
     // distance from a query to BV(T).
     const size_t nq = queries.size();
     const UninitVector<float>&qx = qOrder.x, &qy = qOrder.y, &qz = qOrder.z;
-    UninitVector<uint32_t> qOriginal(nq), qKey(nq);
+    UninitVector<uint32_t> qKey(nq);
     std::vector<double> boxBound(size_t(threads), 0.0);
     parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int w) {
         double farthest = 0.0;
         for (size_t i = begin; i < end; ++i) {
-            qOriginal[i] = uint32_t(qOrder.keyed[i]);
             const glm::dvec3 dp(qOrder.x[i], qOrder.y[i], qOrder.z[i]);
             qKey[i] = algo::mortonEncode(algo::cellCoord(dp.x, g.origin.x, g.cellSize, g.cellsPerAxis),
                                          algo::cellCoord(dp.y, g.origin.y, g.cellSize, g.cellsPerAxis),
@@ -397,7 +396,7 @@ DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet
         start = Clock::now();
         std::vector<SearchStats> stats(static_cast<size_t>(threads));
         std::atomic<bool> lost{false};
-        perPointPass(t, queries, targets, qx, qy, qz, qOriginal, qKey, threads, *perPoint, stats, progress,
+        perPointPass(t, queries, targets, qx, qy, qz, qOrder.keyed, qKey, threads, *perPoint, stats, progress,
                      lost);
         out.lostQuery = lost.load();
         out.cancelled = progress.cancelled();
@@ -515,7 +514,7 @@ DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet
             hintPos = best.pos;
             hint = t.bucketOf[best.pos];
             if (dead) continue;
-            winner.offer(best.d2, qOriginal[i], best.target);
+            winner.offer(best.d2, uint32_t(qOrder.keyed[i]), best.target);
             atomicMax(kill, best.d2);
         }
         winners[size_t(w)] = winner;

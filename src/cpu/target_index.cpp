@@ -31,6 +31,44 @@ algo::Bounds boundsOf(std::span<const glm::vec3> points, int threads) {
     return b;
 }
 
+// Cells of the sorted targets (runs of equal coarseKey(i), i < m: their
+// first positions and keys into `index`, cell starts found in parallel
+// chunks) and buckets (each cell cut into pieces of at most kBucketSize):
+// bucketFirst gets every bucket's first position then m, cellBucket every
+// cell's first bucket then the bucket count.
+template <class CoarseKey>
+void buildCells(size_t m, CoarseKey coarseKey, int threads, TargetIndex& index,
+                std::vector<uint32_t>& bucketFirst, std::vector<uint32_t>& cellBucket) {
+    constexpr size_t kChunk = size_t(1) << 16;
+    std::vector<std::vector<uint32_t>> starts((m + kChunk - 1) / kChunk);
+    parallelChunks(m, kChunk, threads, [&](size_t begin, size_t end, int) {
+        std::vector<uint32_t>& s = starts[begin / kChunk];
+        for (size_t i = begin; i < end; ++i) {
+            if (i == 0 || coarseKey(i) != coarseKey(i - 1)) s.push_back(uint32_t(i));
+        }
+    });
+    for (const std::vector<uint32_t>& s : starts)
+        index.cellFirst.insert(index.cellFirst.end(), s.begin(), s.end());
+    index.cellFirst.push_back(uint32_t(m));
+    const size_t cells = index.cellFirst.size() - 1;
+    index.cellKey.resize(cells);
+    cellBucket.assign(cells + 1, 0);
+    for (size_t c = 0; c < cells; ++c) {
+        index.cellKey[c] = coarseKey(index.cellFirst[c]);
+        const uint32_t size = index.cellFirst[c + 1] - index.cellFirst[c];
+        cellBucket[c + 1] = cellBucket[c] + (size + kBucketSize - 1) / kBucketSize;
+    }
+    bucketFirst.resize(size_t(cellBucket[cells]) + 1);
+    parallelChunks(cells, 4096, threads, [&](size_t begin, size_t end, int) {
+        for (size_t c = begin; c < end; ++c) {
+            uint32_t b = cellBucket[c];
+            for (uint32_t i = index.cellFirst[c]; i < index.cellFirst[c + 1]; i += kBucketSize)
+                bucketFirst[b++] = i;
+        }
+    });
+    bucketFirst.back() = uint32_t(m);
+}
+
 }  // namespace
 
 void BoxLevel::resize(uint32_t n) {
@@ -136,18 +174,10 @@ TargetIndex buildTargetIndex(double scale, const SetOrder& order, int threads) {
 
     // Cells (runs of the coarse key) and buckets (pieces of a cell).
     const int coarseShift = 32 + 3 * extra;
-    std::vector<uint32_t> bucketFirst;
-    for (size_t i = 0; i < m;) {
-        const uint32_t key = uint32_t(order.keyed[positionOf(i)] >> coarseShift);
-        size_t end = i + 1;
-        while (end < m && uint32_t(order.keyed[positionOf(end)] >> coarseShift) == key) ++end;
-        index.cellKey.push_back(key);
-        index.cellFirst.push_back(uint32_t(i));
-        for (size_t b = i; b < end; b += kBucketSize) bucketFirst.push_back(uint32_t(b));
-        i = end;
-    }
-    index.cellFirst.push_back(uint32_t(m));
-    bucketFirst.push_back(uint32_t(m));
+    std::vector<uint32_t> bucketFirst, cellBucket;
+    buildCells(
+        m, [&](size_t i) { return uint32_t(order.keyed[positionOf(i)] >> coarseShift); }, threads, index,
+        bucketFirst, cellBucket);
     std::vector<uint32_t>().swap(kept);
 
     // Level 0: tight bucket boxes.
@@ -173,15 +203,17 @@ TargetIndex buildTargetIndex(double scale, const SetOrder& order, int threads) {
     const uint32_t cells = index.cellCount();
     index.cellLo.resize(cells);
     index.cellHi.resize(cells);
-    for (uint32_t c = 0, b = 0; c < cells; ++c) {
-        glm::vec3 lo(kInf), hi(-kInf);
-        for (; b < buckets && index.bucketFirst[b] < index.cellFirst[c + 1]; ++b) {
-            lo = glm::min(lo, leaves.lo(b));
-            hi = glm::max(hi, leaves.hi(b));
+    parallelChunks(cells, 4096, threads, [&](size_t begin, size_t end, int) {
+        for (size_t c = begin; c < end; ++c) {
+            glm::vec3 lo(kInf), hi(-kInf);
+            for (uint32_t b = cellBucket[c]; b < cellBucket[c + 1]; ++b) {
+                lo = glm::min(lo, leaves.lo(b));
+                hi = glm::max(hi, leaves.hi(b));
+            }
+            index.cellLo[c] = lo;
+            index.cellHi[c] = hi;
         }
-        index.cellLo[c] = lo;
-        index.cellHi[c] = hi;
-    }
+    });
 
     // Upper levels: node j covers children kFanout*j .. kFanout*j + 7. At least
     // one level above the leaves so the search always starts at an inner node.
