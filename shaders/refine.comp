@@ -2,15 +2,12 @@
 #extension GL_GOOGLE_include_directive : require
 // Stage 3: exact minimum over the points of each candidate (query, search
 // cell) pair, breaking off once a point is strictly closer than the running
-// maximum.
+// maximum. One thread per pair (grid-stride).
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { RefinePush pc; };
 
-void main() {
-    uint p = gl_GlobalInvocationID.x;
-    uint numPairs = uint(min(U64Ref(pc.counters + RTHDIST_CTR_PAIRS).v, uint64_t(pc.pairCapacity)));
-    if (p >= numPairs) return;
+void refinePair(uint p) {
     uvec2 pair = uvec2At(pc.pairs, p).v;
     uint qi = uintAt(pc.activeList, pair.x).v;
     uint64_t state = pc.state;
@@ -56,4 +53,13 @@ void main() {
     }
     if (best == uintBitsToFloat(0x7f800000u)) return;
     atomicMin(stateAt(state, qi).v.best, packDistIndex(best, bestT));
+}
+
+// Dispatched indirectly (refine_args.comp sizes it from the pairs the rays
+// appended, at most the device's group limit): a grid-stride loop covers
+// every pair.
+void main() {
+    uint numPairs = uint(min(U64Ref(pc.counters + RTHDIST_CTR_PAIRS).v, uint64_t(pc.pairCapacity)));
+    uint step = gl_NumWorkGroups.x * RTHDIST_WG;
+    for (uint p = gl_GlobalInvocationID.x; p < numPairs; p += step) refinePair(p);
 }

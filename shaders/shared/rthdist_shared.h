@@ -284,6 +284,15 @@ struct RefinePush {
     uint numFineCells;
 };
 
+// refine_args.comp: VkDispatchIndirectCommand for refine.comp from the pair
+// counter (groups of RTHDIST_WG pairs, at most maxGroups).
+struct RefineArgsPush {
+    uint64_t counters;  // the counter block (RTHDIST_CTR_PAIRS)
+    uint64_t args;      // uint[3] out
+    uint pairCapacity;
+    uint maxGroups;
+};
+
 // resolve.comp: classifies active queries after an iteration, compacts the rest.
 struct ResolvePush {
     uint64_t state;

@@ -333,9 +333,9 @@ struct GpuHausdorff::State {
     }
 
     // The device ingest path (ingest.comp) for packed float host arrays:
-    // the device reads each array where it lies (an import of the caller's
-    // pages, gpu/host_import.hpp) or, where the driver refuses that, from a
-    // host-visible copy (the host's only pass over the points). The device
+    // the device reads each array from a host-visible copy (the host's only
+    // pass over the points) or, with imports on (gpu/host_import.hpp), where
+    // it lies. The device
     // uploads it, checks it, takes its bounds and a sample for the bit
     // count. Sets `ix.n`; nothing is submitted.
     void stageSource(PointIndex& ix, std::span<const glm::vec3> pts) {
@@ -882,10 +882,11 @@ struct GpuHausdorff::State {
                 pairCapacity = std::min<uint64_t>(pairs->size() / 8, maxPairCapacity);
             }
             const int level = searchLevelFor(T, radius);
-            const uint64_t pairCount =
-                searchPass(d, level, level == builtLevel, radius, *pairs, pairCapacity, numActive);
+            const IterationCounts counts =
+                iterate(d, level, level == builtLevel, radius, *pairs, pairCapacity, numActive);
+            const uint64_t pairCount = counts.pairs;
             builtLevel = level;
-            numActive = refinePass(d, level, float(radius), *pairs, pairCapacity, pairCount, numActive);
+            numActive = counts.stillOpen;
             report(options, "search",
                    progressFrom + (progressTo - progressFrom) *
                                       (0.2 + 0.8 * (1.0 - double(numActive) /
@@ -917,22 +918,54 @@ struct GpuHausdorff::State {
         return level > 0 ? searchLevel(T, level) : PointIndex::Level{T.cells, nullptr, T.numCells};
     }
 
-    // One search submission: the level's boxes grown by the radius, the
-    // BLAS refitted (same level) or rebuilt, one ray per active query.
-    // Returns how many (query, cell) pairs the rays reported.
-    uint64_t searchPass(DirectionRun& d, int level, bool sameLevel, double radius, Buffer& pairs,
-                        uint64_t pairCapacity, uint32_t numActive) {
+    // What one radius of the search reported.
+    struct IterationCounts {
+        uint64_t pairs = 0;      // (query, cell) pairs the rays appended (some may not fit)
+        uint32_t stillOpen = 0;  // queries going on to the next radius (or retrying)
+    };
+
+    // One radius in one submission: the search (cmdSearch), then the
+    // refinement sized by the device from the pairs the rays appended
+    // (cmdRefine, indirect dispatch), then the resolution of every active
+    // query. The host reads the counts once, at the end.
+    IterationCounts iterate(DirectionRun& d, int level, bool sameLevel, double radius, Buffer& pairs,
+                            uint64_t pairCapacity, uint32_t numActive) {
+        const PointIndex::Level lv = levelCells(d.T, level);
+        const auto t0 = Clock::now();
+        d.blk.at<uint64_t>(RTHDIST_CTR_PAIRS) = 0;
+        d.blk.at<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE) = 0;
+        VkCommandBuffer cmd = ctx.begin();
+        cmdSearch(cmd, d, lv, sameLevel, radius, pairs, pairCapacity, numActive);
+        const uint32_t searched = ctx.cmdMark(cmd);
+        barrier(cmd);
+        cmdRefine(cmd, d, lv, level > 0, float(radius), pairs, pairCapacity, numActive);
+        ctx.submitAndWait(cmd);
+        const double searchGpu = ctx.gpuMsBetween(0, searched), allGpu = ctx.lastGpuMs();
+        timings->gpuSearch += searchGpu;
+        timings->gpuRefine += allGpu - searchGpu;
+        // The wall time split between the two stages as their device time is.
+        const double wall = msSince(t0), searchShare = allGpu > 0.0 ? searchGpu / allGpu : 1.0;
+        timings->search += wall * searchShare;
+        timings->refine += wall * (1.0 - searchShare);
+        d.out.counters.rays += numActive;
+        IterationCounts counts{d.blk.at<uint64_t>(RTHDIST_CTR_PAIRS),
+                               d.blk.at<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE)};
+        d.out.counters.candidatePairs += std::min<uint64_t>(counts.pairs, pairCapacity);
+        d.cur = 1 - d.cur;
+        return counts;
+    }
+
+    // Records the search of one radius: the level's boxes grown by the
+    // radius, the BLAS refitted (same level) or rebuilt, one ray per active
+    // query; the rays append (query, cell) pairs.
+    void cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool sameLevel,
+                   double radius, Buffer& pairs, uint64_t pairCapacity, uint32_t numActive) {
         PointIndex& T = d.T;
-        const PointIndex::Level lv = levelCells(T, level);
         const float r = float(radius);
         // The ray only has to start inside the grown boxes: a short one
         // crosses few other boxes (leaves are far smaller than grid cells).
         const float rayTMax = float(std::min(T.grid.cellSize, T.split ? radius : T.grid.cellSize) * 1e-3);
         Buffer& aabbs = buf("aabbs", VkDeviceSize(lv.count) * 24);
-        const auto t0 = Clock::now();
-        d.blk.at<uint64_t>(RTHDIST_CTR_PAIRS) = 0;
-        d.blk.at<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE) = 0;
-        VkCommandBuffer cmd = ctx.begin();
         // Per-box slack: float rounding at the box's magnitude (the old
         // global epsilon used the largest coordinate of both sets) plus,
         // for a grid index, the grid's absolute term.
@@ -967,24 +1000,21 @@ struct GpuHausdorff::State {
             dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
         else
             cmdTraceRaysSplit(cmd, sp);
-        ctx.submitAndWait(cmd);
-        timings->gpuSearch += ctx.lastGpuMs();
-        d.out.counters.rays += numActive;
-        timings->search += msSince(t0);
-        return d.blk.at<uint64_t>(RTHDIST_CTR_PAIRS);
     }
 
-    // One refinement submission: the pairs that fit are scanned exactly,
-    // then every active query is resolved (exact, dead, or on to the next
-    // radius). Returns how many stay active (their slots in the other
-    // active buffer, which becomes the current one).
-    uint32_t refinePass(DirectionRun& d, int level, float r, Buffer& pairs, uint64_t pairCapacity,
-                        uint64_t pairCount, uint32_t numActive) {
-        const PointIndex::Level lv = levelCells(d.T, level);
-        const auto t0 = Clock::now();
-        const uint64_t used = std::min<uint64_t>(pairCount, pairCapacity);
-        d.out.counters.candidatePairs += used;
-        VkCommandBuffer cmd = ctx.begin();
+    // Records the refinement of one radius: the pairs that fit are scanned
+    // exactly (as many groups as the device counted pairs for), then every
+    // active query is resolved (exact, dead, or on to the next radius) into
+    // the other active buffer.
+    void cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse, float r,
+                   Buffer& pairs, uint64_t pairCapacity, uint32_t numActive) {
+        Buffer& args = buf("refineArgs", 16);
+        sh::RefineArgsPush ap{d.blk.device, args.address(), uint32_t(pairCapacity),
+                              std::max<uint32_t>(1, ctx.limits().maxGroupsX)};
+        pipelines.cmdDispatch(cmd, Kernel::kRefineArgs, &ap, sizeof(ap), 1);
+        gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
         sh::RefinePush rp{d.Q.sorted->address(),
                           d.T.sorted->address(),
                           lv.cells->address(),
@@ -994,12 +1024,12 @@ struct GpuHausdorff::State {
                           d.blk.device,
                           d.blk.addr(RTHDIST_CTR_MAX_PACKED),
                           d.T.cells->address(),
-                          level > 0 ? lv.fineFirst->address() : 0,
+                          coarse ? lv.fineFirst->address() : 0,
                           uint32_t(pairCapacity),
                           d.lowerBound2,
                           lv.count,
                           d.T.numCells};
-        dispatch(cmd, Kernel::kRefine, rp, used);
+        pipelines.cmdDispatchIndirect(cmd, Kernel::kRefine, &rp, sizeof(rp), args.handle(), 0);
         barrier(cmd);
         sh::ResolvePush rs{d.state->address(),
                            d.active[d.cur]->address(),
@@ -1010,11 +1040,6 @@ struct GpuHausdorff::State {
                            r,
                            d.lowerBound2};
         dispatch(cmd, Kernel::kResolve, rs, numActive);
-        ctx.submitAndWait(cmd);
-        timings->gpuRefine += ctx.lastGpuMs();
-        d.cur = 1 - d.cur;
-        timings->refine += msSince(t0);
-        return d.blk.at<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE);
     }
 
     // Every query is EXACT after a per-point run: its state holds its NN.

@@ -9,7 +9,8 @@
 // import lives; rthdist imports for the duration of one call and releases
 // the import before the call returns. An import the driver refuses (memory
 // it cannot pin, an alignment past the page size) is not an error: create()
-// returns nothing and the caller copies instead.
+// returns nothing and the caller copies instead. Used only when
+// RTHDIST_HOST_IMPORT=1 (gpu/context.cpp says why).
 #pragma once
 
 #include <vulkan/vulkan.h>

@@ -16,14 +16,15 @@
 #include "check_index.comp.h"
 #include "check_queries.comp.h"
 #include "coarsen.comp.h"
-#include "ingest.comp.h"
 #include "compact.comp.h"
 #include "cull.comp.h"
 #include "grow_boxes.comp.h"
+#include "ingest.comp.h"
 #include "leaf_keys.comp.h"
 #include "leaf_scatter.comp.h"
 #include "leaf_slots.comp.h"
 #include "refine.comp.h"
+#include "refine_args.comp.h"
 #include "resolve.comp.h"
 #include "scan_add.comp.h"
 #include "scan_block.comp.h"
@@ -123,6 +124,7 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache) : m_ctx
         spirv(k_spv_cell_bounds_comp, "cell_bounds"),
         spirv(k_spv_cell_bounds_fix_comp, "cell_bounds_fix"),
         spirv(k_spv_ingest_comp, "ingest"),
+        spirv(k_spv_refine_args_comp, "refine_args"),
     };
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !rayQuery) continue;
@@ -221,9 +223,8 @@ void Pipelines::bindTlas(VkAccelerationStructureKHR tlas) {
     vkUpdateDescriptorSets(m_ctx.device(), 1, &w, 0, nullptr);
 }
 
-void Pipelines::cmdDispatch(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize,
-                            uint32_t groups) const {
-    if (groups == 0) return;
+void Pipelines::cmdBindCompute(VkCommandBuffer cmd, Kernel kernel, const void* push,
+                               uint32_t pushSize) const {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_compute[size_t(kernel)]);
     if (kernel == Kernel::kSearchRayQuery)
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_layout, 0, 1, &m_set, 0, nullptr);
@@ -232,6 +233,12 @@ void Pipelines::cmdDispatch(VkCommandBuffer cmd, Kernel kernel, const void* push
                                   : (VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_RAYGEN_BIT_KHR |
                                      VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR),
                        0, pushSize, push);
+}
+
+void Pipelines::cmdDispatch(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize,
+                            uint32_t groups) const {
+    if (groups == 0) return;
+    cmdBindCompute(cmd, kernel, push, pushSize);
     // Large 1-D dispatches are split to respect maxComputeWorkGroupCount[0]
     // (the device's, or a smaller one a test set); shaders see
     // gl_WorkGroupID offsets through vkCmdDispatchBase.
@@ -239,6 +246,12 @@ void Pipelines::cmdDispatch(VkCommandBuffer cmd, Kernel kernel, const void* push
     for (uint64_t first = 0; first < groups; first += maxGroups)
         vkCmdDispatchBase(cmd, uint32_t(first), 0, 0, uint32_t(std::min<uint64_t>(maxGroups, groups - first)),
                           1, 1);
+}
+
+void Pipelines::cmdDispatchIndirect(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize,
+                                    VkBuffer args, VkDeviceSize offset) const {
+    cmdBindCompute(cmd, kernel, push, pushSize);
+    vkCmdDispatchIndirect(cmd, args, offset);
 }
 
 void Pipelines::cmdTraceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize, uint32_t width) const {

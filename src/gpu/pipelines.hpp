@@ -35,7 +35,8 @@ enum class Kernel : uint32_t {
     kLeafScatter,
     kCellBounds,  // parallel tight boxes of large cells (cell_bounds*.comp)
     kCellBoundsFix,
-    kIngest,  // the caller's points into vec4 records, bounds, validation (ingest.comp)
+    kIngest,      // the caller's points into vec4 records, bounds, validation (ingest.comp)
+    kRefineArgs,  // refine.comp's indirect dispatch size (refine_args.comp)
     kCount
 };
 
@@ -52,6 +53,10 @@ public:
 
     void cmdDispatch(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize,
                      uint32_t groups) const;
+    // A dispatch whose group counts the device wrote at `args` (a
+    // VkDispatchIndirectCommand; at most the device's group limits).
+    void cmdDispatchIndirect(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize,
+                             VkBuffer args, VkDeviceSize offset) const;
     // Ray-tracing pipeline: one ray-generation invocation per index in [0, width).
     void cmdTraceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize, uint32_t width) const;
 
@@ -59,6 +64,8 @@ public:
 
 private:
     VkShaderModule createModule(const uint32_t* code, size_t bytes);
+    // Binds a compute kernel (and the TLAS for ray queries) and its push constants.
+    void cmdBindCompute(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize) const;
 
     Context& m_ctx;
     bool m_rayQuery;
