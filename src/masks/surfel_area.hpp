@@ -18,9 +18,15 @@
 //     through the midpoints of its outgoing edges, in the order the cube's
 //     faces join them (3 to 6 vertices);
 //   - a polygon is split into triangles the way of largest total area on the
-//     unit cube (the 5-gon of three corners of a face folds along the chord
-//     joining the midpoints above its two end corners; the 6-gon of a 4-corner
-//     path likewise; all other polygons are planar).
+//     unit cube. Only two kinds are not planar: the 5-gon around three
+//     corners of a face, which then folds along the chord joining the
+//     midpoints of the edges leaving the face at its two end corners, and
+//     the 6-gon around a path of four corners in three directions; the
+//     triangulations of equal largest area differ only inside planar parts,
+//     so they agree at every spacing.
+// This reproduces the table DeepMind ships (lookup_tables.py, built from a
+// marching-cubes table) for all 256 codes at several spacings — checked when
+// this was written, not in the tests, which hold no copy of that table.
 // A triangle's area at spacing s is |(n.x s.y s.z, n.y s.x s.z, n.z s.x s.y)|
 // for its area vector n on the unit cube; a code's area is the sum over its
 // triangles (DeepMind's create_table_neighbour_code_to_surface_area, which

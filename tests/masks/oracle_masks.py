@@ -96,6 +96,8 @@ def oracle(conv, a, b, affine, percentiles, conn, tol):
         out["surface_dice_range"] = (
             (np.count_nonzero(sa <= tol - e) + np.count_nonzero(sb <= tol - e)) / (len(sa) + len(sb)),
             (np.count_nonzero(sa <= tol + e) + np.count_nonzero(sb <= tol + e)) / (len(sa) + len(sb)))
+        for side, s in (("a", sa), ("b", sb)):
+            out[side + "_overlap_range"] = (np.count_nonzero(s <= tol - e) / len(s), np.count_nonzero(s <= tol + e) / len(s))
         hp = []
         for p in percentiles:
             if conv == "rthdist":
@@ -263,6 +265,10 @@ def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_vol
                                 f"(range {lo}..{hi} for distances within rounding of the tolerance)")
             for got, exp in zip(row["hd_percentile"], want["hd_percentile"]):
                 close(tag + f" hd{got['p']:g}", got["value"], exp, eps)
+            for side, key in (("a", "a_to_b"), ("b", "b_to_a")):
+                lo, hi = want[side + "_overlap_range"]
+                if not (lo - 1e-12 <= row[key]["surface_overlap"] <= hi + 1e-12):
+                    FAILURES.append(f"{tag} {key} surface_overlap: got {row[key]['surface_overlap']}, expected {lo}..{hi}")
             c = conn if conv in ("rthdist", "medpy") else 6
             sa, sb = boundary(xa, c), boundary(xb, c)
         else:
