@@ -3,9 +3,9 @@
 // The data path's first stage: the caller's points (three floats every
 // `stride` bytes) into the vec4 records the index build reads, in one pass
 // that also reduces their bounds (per workgroup in shared memory, then one
-// atomic per axis and workgroup), finds the first point that is not finite,
-// and copies a strided sample for the host's bit count. The host makes no
-// pass over the points besides the copy into a buffer the device can read.
+// atomic per axis and workgroup) and finds the first point that is not
+// finite. The host makes no pass over the points besides the copy into a
+// buffer the device can read.
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { IngestPush pc; };
@@ -36,7 +36,6 @@ void main() {
         } else {
             atomicMin(UintRef(pc.summary + 24ul).v, i);
         }
-        if (pc.samples != 0ul && i % pc.sampleStride == 0u) vec4At(pc.samples, i / pc.sampleStride).v = vec4(p, 0.0);
     }
     barrier();
     if (gl_LocalInvocationID.x < 3u && s_lo[gl_LocalInvocationID.x] != 0xffffffffu) {

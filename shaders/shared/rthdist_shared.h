@@ -78,17 +78,14 @@ struct KeysPush {
 };
 
 // ingest.comp: the caller's points (x, y, z floats at source + i * stride, in
-// host-visible or device memory) into vec4 records, with their bounds, the
-// first point that is not finite, and every sampleStride-th point for the
-// host's bit count (sample 0: none).
+// host-visible or device memory) into vec4 records, with their bounds and
+// the first point that is not finite.
 struct IngestPush {
     uint64_t source;
     uint64_t points;   // vec4[n] out: xyz, w = 0
     uint64_t summary;  // IngestSummary, initialised by the host
-    uint64_t samples;  // vec4[n / sampleStride + 1] out
     uint n;
     uint stride;  // bytes, a multiple of 4, >= 12
-    uint sampleStride;
 };
 
 // What ingest.comp reports of a set: the bounds of its finite points as

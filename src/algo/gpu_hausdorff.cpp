@@ -335,9 +335,8 @@ struct GpuHausdorff::State {
     // The device ingest path (ingest.comp) for packed float host arrays:
     // the device reads each array from a host-visible copy (the host's only
     // pass over the points) or, with imports on (gpu/host_import.hpp), where
-    // it lies. The device
-    // uploads it, checks it, takes its bounds and a sample for the bit
-    // count. Sets `ix.n`; nothing is submitted.
+    // it lies. The device uploads it, checks it and takes its bounds. Sets
+    // `ix.n`; nothing is submitted.
     void stageSource(PointIndex& ix, std::span<const glm::vec3> pts) {
         ix.n = uint32_t(pts.size());
         const size_t bytes = size_t(ix.n) * 12;
@@ -365,8 +364,8 @@ struct GpuHausdorff::State {
         vkCmdCopyBuffer(cmd, from, buf(ix.scratch + ".raw", bytes).handle(), 1, &region);
     }
 
-    // Records the ingest of an uploaded source into the set's vec4 points,
-    // its summary in `blk` and its bit-count sample.
+    // Records the ingest of an uploaded source into the set's vec4 points
+    // and its summary in `blk`.
     void cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {
         auto& summary = blk.at<sh::IngestSummary>(RTHDIST_CTR_INGEST);
         for (int k = 0; k < 3; ++k) {
@@ -374,19 +373,10 @@ struct GpuHausdorff::State {
             summary.hi[k] = 0u;
         }
         summary.firstBad = 0xffffffffu;
-        const uint32_t stride = uint32_t(bitsSampleStride(ix.n));
         sh::IngestPush ip{buf(ix.scratch + ".raw", VkDeviceSize(ix.n) * 12).address(),
                           buf(ix.scratch + ".points", VkDeviceSize(ix.n) * 16).address(),
-                          blk.addr(RTHDIST_CTR_INGEST),
-                          sampleBuffer(ix).address(),
-                          ix.n,
-                          12u,
-                          stride};
+                          blk.addr(RTHDIST_CTR_INGEST), ix.n, 12u};
         dispatch(cmd, Kernel::kIngest, ip, ix.n);
-    }
-    Buffer& sampleBuffer(const PointIndex& ix) {
-        const VkDeviceSize count = (ix.n - 1) / bitsSampleStride(ix.n) + 1;
-        return buf(ix.scratch + ".sample", count * 16, MemoryKind::kReadback);
     }
 
     // After the ingest's submission: the set's bounds from `blk`, or the
@@ -404,17 +394,12 @@ struct GpuHausdorff::State {
         }
     }
 
-    // The bit count and grid of an ingested set, from its device sample.
-    // `records`: the set's sample buffer (vec4 per sampled point). Touches
-    // nothing shared: the sets' grids are chosen on two threads.
-    static void chooseIngestedGrid(PointIndex& ix, int bits, const float* records) {
-        if (bits <= 0) {
-            const size_t count = (ix.n - 1) / bitsSampleStride(ix.n) + 1;
-            std::vector<glm::vec3> sample(count);
-            for (size_t j = 0; j < count; ++j)
-                sample[j] = glm::vec3(records[4 * j], records[4 * j + 1], records[4 * j + 2]);
-            bits = clampedBits(chooseBitsFromSample(sample, ix.n, ix.bounds), ix.n);
-        }
+    // The bit count and grid of an ingested set: its bounds come from the
+    // device, its bit count from a strided sample of the caller's array
+    // (chooseBits reads ~32k points in place). Touches nothing shared: the
+    // two sets' grids are chosen on two threads.
+    static void chooseIngestedGrid(PointIndex& ix, std::span<const glm::vec3> pts, int bits) {
+        if (bits <= 0) bits = clampedBits(chooseBits(pts, ix.bounds), ix.n);
         ix.grid = makeGrid(ix.bounds, bits);
     }
 
@@ -1100,7 +1085,7 @@ struct GpuHausdorff::State {
 
     // One-shot H of two packed float host arrays through the ingest path:
     // one submission uploads and ingests both, the host reads their bounds
-    // and samples (the bit count needs them), a second builds both indexes.
+    // (the grid and the bit count need them), a second builds both indexes.
     // Returns false, having done nothing else, when the sets need the exact
     // power-of-two scale (index_space.hpp), which the host path applies.
     bool ingestPair(DeviceSet& da, DeviceSet& db, std::span<const glm::vec3> a, std::span<const glm::vec3> b,
@@ -1131,10 +1116,8 @@ struct GpuHausdorff::State {
         if (exactScale(magnitude) != 1.0) return false;
         const auto t1 = Clock::now();
         // The two bit counts side by side (each ~0.2-0.4 ms of host work).
-        const auto* samplesA = static_cast<const float*>(sampleBuffer(da.ix).mapped());
-        const auto* samplesB = static_cast<const float*>(sampleBuffer(db.ix).mapped());
-        std::thread second([&] { chooseIngestedGrid(db.ix, options.bits, samplesB); });
-        chooseIngestedGrid(da.ix, options.bits, samplesA);
+        std::thread second([&] { chooseIngestedGrid(db.ix, b, options.bits); });
+        chooseIngestedGrid(da.ix, a, options.bits);
         second.join();
         timings->index += msSince(t1);
         buildIndexes(std::array{&da.ix, &db.ix}, /*uploaded=*/true);
