@@ -25,8 +25,10 @@
 //     triangulations of equal largest area differ only inside planar parts,
 //     so they agree at every spacing.
 // This reproduces the table DeepMind ships (lookup_tables.py, built from a
-// marching-cubes table) for all 256 codes at several spacings — checked when
-// this was written, not in the tests, which hold no copy of that table.
+// marching-cubes table) for all 256 codes at several spacings, bit for bit at
+// unit spacing and within 1e-15 otherwise (a planar part split into other
+// triangles) — checked when this was written, not in the tests, which hold no
+// copy of that table.
 // A triangle's area at spacing s is |(n.x s.y s.z, n.y s.x s.z, n.z s.x s.y)|
 // for its area vector n on the unit cube; a code's area is the sum over its
 // triangles (DeepMind's create_table_neighbour_code_to_surface_area, which
