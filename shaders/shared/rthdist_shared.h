@@ -260,6 +260,9 @@ struct CheckPush {
     uint n;
     uint perPoint;        // check_queries: 1 = every query must be EXACT
     uint64_t witnessOut;  // check_queries: the witness query's sorted record and state (32 bytes)
+    uint afterCull;       // check_queries recorded behind the cull: nothing to do when queries
+                          // survived (RTHDIST_CTR_ACTIVE > 0): they are checked after the search
+    uint pad0;
 };
 
 // refine.comp: exact scan of the candidate pairs' cells.

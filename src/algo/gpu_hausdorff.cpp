@@ -737,8 +737,9 @@ struct GpuHausdorff::State {
     // shader) and the copies of the sampled queries' records into the
     // block's read-back area. Recorded right after the cull, it is the
     // direction's check when no query survives the cull (no extra
-    // submission); otherwise it is recorded again after the search.
-    void cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d) {
+    // submission); otherwise (afterCull: the shader then returns at once) it
+    // is recorded again after the search.
+    void cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, bool afterCull) {
         d.blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
         const VkDeviceSize readback = d.blk.offset + RTHDIST_CTR_READBACK;
         const VkDeviceSize witnessAt = readback + VkDeviceSize(d.checkSlots.size()) * 32;
@@ -749,7 +750,9 @@ struct GpuHausdorff::State {
                          {},
                          d.Q.n,
                          d.perPoint ? 1u : 0u,
-                         hostSmall.address() + witnessAt};
+                         hostSmall.address() + witnessAt,
+                         afterCull ? 1u : 0u,
+                         0u};
         dispatch(cmd, Kernel::kCheckQueries, cp, d.Q.n);
         std::vector<VkBufferCopy> sortedCopies, stateCopies;
         for (size_t k = 0; k < d.checkSlots.size(); ++k) {
@@ -810,7 +813,7 @@ struct GpuHausdorff::State {
         for (DirectionRun* d : dirs) cmdCull(cmd, *d);
         barrier(cmd);
         const uint32_t culled = ctx.cmdMark(cmd);
-        for (DirectionRun* d : dirs) cmdCheckQueries(cmd, *d);
+        for (DirectionRun* d : dirs) cmdCheckQueries(cmd, *d, true);
         ctx.submitAndWait(cmd);
         timings->gpuCull += ctx.gpuMsBetween(0, culled);
         std::array<uint32_t, N> survivors{};
@@ -830,7 +833,7 @@ struct GpuHausdorff::State {
         runSearch(d, survivors, options, progressFrom, progressTo);
         const auto t0 = Clock::now();
         VkCommandBuffer cmd = ctx.begin();
-        cmdCheckQueries(cmd, d);
+        cmdCheckQueries(cmd, d, false);
         ctx.submitAndWait(cmd);
         SampledQuery witness = finishCheck(d);
         timings->check += msSince(t0);
