@@ -32,7 +32,8 @@ enum class Backend {
 // Fixed for the life of an Engine (its device and pipelines).
 struct EngineOptions {
     Backend backend = Backend::kAuto;
-    // Vulkan physical device index as listed by listDevices(); -1 = first usable.
+    // Vulkan physical device index as listed by listDevices(); -1 = the first
+    // usable discrete GPU, else integrated, virtual, other, software last.
     int deviceIndex = -1;
     // Enable VK_LAYER_KHRONOS_validation and count every message it emits
     // (Result::validationMessages). For tests; slow.

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -240,6 +241,56 @@ Result<std::vector<DeviceInfo>> listDevices() {
 
 namespace rthdist::gpu {
 
+namespace {
+
+// Preference among usable devices when none is named: discrete GPUs first,
+// then integrated, virtual, other, and software (CPU) devices last.
+int typeRank(VkPhysicalDeviceType t) {
+    switch (t) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+        case VK_PHYSICAL_DEVICE_TYPE_CPU: return 4;
+        default: return 3;
+    }
+}
+
+struct Choice {
+    int index = -1;
+    Probe probe;
+};
+
+// The device that runs `backend`: the one named (deviceIndex >= 0), else the
+// usable one of the best type (lowest index among equals). Appends why each
+// examined device that cannot run it was rejected to `reasons`.
+std::optional<Choice> chooseDevice(const std::vector<VkPhysicalDevice>& pds, Backend backend, int deviceIndex,
+                                   std::string& reasons) {
+    std::optional<Choice> best;
+    int bestRank = 0;
+    for (int i = 0; i < int(pds.size()); ++i) {
+        if (deviceIndex >= 0 && i != deviceIndex) continue;
+        Probe p = probeDevice(pds[size_t(i)], i);
+        const bool usable = backend == Backend::kRayQuery     ? p.info.rayQuery
+                            : backend == Backend::kRtPipeline ? p.info.rtPipeline
+                                                              : (p.info.rayQuery || p.info.rtPipeline);
+        if (!usable) {
+            reasons += "\n  device " + std::to_string(i) + " (" + p.info.name + "): lacks ";
+            for (size_t m = 0; m < p.info.missing.size(); ++m) reasons += (m ? "; " : "") + p.info.missing[m];
+            continue;
+        }
+        VkPhysicalDeviceProperties props;
+        vkGetPhysicalDeviceProperties(pds[size_t(i)], &props);
+        const int rank = typeRank(props.deviceType);
+        if (!best || rank < bestRank) {
+            best = Choice{i, p};
+            bestRank = rank;
+        }
+    }
+    return best;
+}
+
+}  // namespace
+
 Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceIndex, bool validation) {
     auto inst = createInstance(validation);
     if (!inst) return inst.error();
@@ -264,22 +315,9 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
         std::vector<VkPhysicalDevice> pds = physicalDevices(ctx->m_instance);
         if (pds.empty()) return Error{ErrorCode::kNoDevice, "no Vulkan physical device found"};
         std::string reasons;
-        Probe chosen;
-        VkPhysicalDevice chosenPd = VK_NULL_HANDLE;
-        for (int i = 0; i < int(pds.size()); ++i) {
-            if (deviceIndex >= 0 && i != deviceIndex) continue;
-            Probe p = probeDevice(pds[i], i);
-            bool usable = backend == Backend::kRayQuery     ? p.info.rayQuery
-                          : backend == Backend::kRtPipeline ? p.info.rtPipeline
-                                                            : (p.info.rayQuery || p.info.rtPipeline);
-            if (usable) {
-                chosen = p;
-                chosenPd = pds[i];
-                break;
-            }
-            reasons += "\n  device " + std::to_string(i) + " (" + p.info.name + "): lacks ";
-            for (size_t m = 0; m < p.info.missing.size(); ++m) reasons += (m ? "; " : "") + p.info.missing[m];
-        }
+        const std::optional<Choice> choice = chooseDevice(pds, backend, deviceIndex, reasons);
+        const Probe chosen = choice ? choice->probe : Probe{};
+        const VkPhysicalDevice chosenPd = choice ? pds[size_t(choice->index)] : VK_NULL_HANDLE;
         if (!chosenPd) {
             if (deviceIndex >= int(pds.size()))
                 return Error{ErrorCode::kNoDevice, "device " + std::to_string(deviceIndex) +
@@ -450,6 +488,13 @@ double Context::gpuMsBetween(uint32_t from, uint32_t to) const {
 }
 
 void Context::submitAndWait(VkCommandBuffer cmd) {
+    // Every write of the submission made available to the host before the
+    // fence signals: the caller reads counters and read-backs right after.
+    VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    toHost.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
+    toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost,
+                         0, nullptr, 0, nullptr);
     const uint32_t last = m_marks;
     vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps, last);
     RTHDIST_VK_CHECK(vkEndCommandBuffer(cmd));
