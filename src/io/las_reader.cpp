@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "io/io_error.hpp"
+#include "io/non_finite.hpp"
 #include "io/scalar_type.hpp"
 
 namespace rthdist::io {
@@ -196,12 +197,33 @@ std::vector<int> classesPresent(const PointChunks& chunks, const ChunkPlan& plan
     return found;
 }
 
+// The first kept point of chunk c whose coordinate is not finite, as the
+// error naming it (the slow path, for a chunk known to have one).
+std::optional<Error> firstNonFinitePoint(const PointChunks& chunks, size_t c,
+                                         const std::array<bool, 256>& keep, const std::string& path) {
+    const LasHeader& h = chunks.h;
+    for (uint64_t k = chunks.begin(c); k < chunks.end(c); ++k) {
+        const char* p = chunks.record(k);
+        if (!keep[classification(p, h.format)]) continue;
+        for (size_t axis = 0; axis < 3; ++axis) {
+            const int32_t raw = detail::loadRaw<int32_t>(p + 4 * axis, false);
+            if (!std::isfinite(static_cast<double>(raw) * h.scale[axis] + h.offset[axis])) {
+                return badInput(path,
+                                "point " + std::to_string(k) + " (" + offsetWhere(p - chunks.file) + ")",
+                                std::string(1, "XYZ"[axis]) + " * scale + offset is not finite");
+            }
+        }
+    }
+    return std::nullopt;
+}
+
 // Chunk c's kept points, X * scale + offset in double, into out; the first
 // point whose coordinate is not finite is the chunk's error.
 template <bool kFilter>
 std::optional<Error> convertPoints(const PointChunks& chunks, size_t c, const std::array<bool, 256>& keep,
                                    glm::dvec3* out, const std::string& path) {
     const LasHeader& h = chunks.h;
+    glm::dvec3* next = out;
     for (uint64_t k = chunks.begin(c); k < chunks.end(c); ++k) {
         const char* p = chunks.record(k);
         if (kFilter && !keep[classification(p, h.format)]) continue;
@@ -210,13 +232,9 @@ std::optional<Error> convertPoints(const PointChunks& chunks, size_t c, const st
             const int32_t raw = detail::loadRaw<int32_t>(p + 4 * axis, false);
             v[static_cast<int>(axis)] = static_cast<double>(raw) * h.scale[axis] + h.offset[axis];
         }
-        if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
-            const int axis = !std::isfinite(v.x) ? 0 : !std::isfinite(v.y) ? 1 : 2;
-            return badInput(path, "point " + std::to_string(k) + " (" + offsetWhere(p - chunks.file) + ")",
-                            std::string(1, "XYZ"[axis]) + " * scale + offset is not finite");
-        }
-        *out++ = v;
+        *next++ = v;
     }
+    if (anyNonFinite(out, static_cast<size_t>(next - out))) return firstNonFinitePoint(chunks, c, keep, path);
     return std::nullopt;
 }
 

@@ -2,19 +2,17 @@
 // the contract shared by every format: at least one point, every coordinate
 // finite. loadPoints: the same, rounded to float.
 #include <algorithm>
-#include <bit>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <optional>
-#include <type_traits>
 
 #include "io/file_bytes.hpp"
 #include "io/gltf_reader.hpp"
 #include "io/io_error.hpp"
 #include "io/las_reader.hpp"
 #include "io/load_tuning.hpp"
+#include "io/non_finite.hpp"
 #include "io/number_parse.hpp"
 #include "io/obj_reader.hpp"
 #include "io/off_reader.hpp"
@@ -78,22 +76,6 @@ Format formatFor(const std::string& ext) {
     if (ext == ".pcd") return {&withPlan<&readPcd>};
     if (ext == ".las") return {&readLasCloud};
     return {};
-}
-
-// Whether a coordinate of p[0, n) is NaN or infinite (all exponent bits
-// set): an OR over the bits without an early exit, so that it vectorizes.
-template <class Vec>
-bool anyNonFinite(const Vec* p, size_t n) {
-    using Real = typename Vec::value_type;
-    using Bits = std::conditional_t<sizeof(Real) == 8, uint64_t, uint32_t>;
-    constexpr Bits kExponent = std::bit_cast<Bits>(std::numeric_limits<Real>::infinity());
-    Bits bad = 0;
-    for (size_t i = 0; i < n; ++i) {
-        bad |= static_cast<Bits>((std::bit_cast<Bits>(p[i].x) & kExponent) == kExponent) |
-               static_cast<Bits>((std::bit_cast<Bits>(p[i].y) & kExponent) == kExponent) |
-               static_cast<Bits>((std::bit_cast<Bits>(p[i].z) & kExponent) == kExponent);
-    }
-    return bad != 0;
 }
 
 // The first coordinate that is NaN or infinite, as the error naming it;

@@ -9,8 +9,10 @@ For every file, --rounds rounds; each round runs the before binary, then the
 after binary (order swapped every other round), each with --runs timed loads
 after --warmup, so that both see the same page cache and the same load from
 other users of the machine. The figure per binary is the median over all its
-timed loads' medians. Writes every raw record and the summary as JSON and
-prints a Markdown table.
+timed loads' medians; the CPU seconds (all threads) of a load are kept
+beside the wall time. Writes every raw record and the summary as JSON and
+prints a Markdown table (file, MB, before / after / best after MB/s,
+speedup, before / after CPU s, 1-minute load average).
 """
 import argparse
 import json
@@ -64,11 +66,14 @@ def main():
             row[which + "_median_s"] = s
             row[which + "_mb_per_s"] = row["bytes"] / 1e6 / s
             row[which + "_best_mb_per_s"] = row["bytes"] / 1e6 / min(x["min_s"] for x in seen[which])
+            row[which + "_cpu_s"] = statistics.median(x["cpu_median_s"] for x in seen[which])
         row["speedup"] = row["before_median_s"] / row["after_median_s"]
         row["read_mb_per_s"] = statistics.median(x["read_mb_per_s"] for x in records if x["file"] == path)
         summary.append(row)
+        row["loadavg_1min"] = statistics.median(x["loadavg_1min"] for x in seen["after"])
         print(f"| {name} | {row['bytes'] / 1e6:.0f} | {row['before_mb_per_s']:.0f} | "
-              f"{row['after_mb_per_s']:.0f} | {row['after_best_mb_per_s']:.0f} | {row['speedup']:.2f}x |",
+              f"{row['after_mb_per_s']:.0f} | {row['after_best_mb_per_s']:.0f} | {row['speedup']:.2f}x | "
+              f"{row['before_cpu_s']:.2f} | {row['after_cpu_s']:.2f} | {row['loadavg_1min']:.1f} |",
               flush=True)
     with open(a.out, "w") as f:
         json.dump({"rounds": a.rounds, "runs": a.runs, "warmup": a.warmup, "cpus": os.cpu_count(),

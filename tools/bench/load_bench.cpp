@@ -8,8 +8,11 @@
 // calls; --floats: loadPoints, rounded to float32). Alongside, the same
 // number of plain read()s of the whole file into one buffer: what the page
 // cache itself delivers on this machine. Prints one JSON object per file
-// (times in seconds, MB = 1e6 bytes of the file as stored on disk).
+// (times in seconds, MB = 1e6 bytes of the file as stored on disk;
+// cpu_median_s: user + system CPU seconds of a load, all threads: what a
+// load costs whatever else runs on the machine).
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -30,6 +33,14 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// CPU seconds (user + system, every thread) this process has used so far.
+double cpuSeconds() {
+    rusage u{};
+    ::getrusage(RUSAGE_SELF, &u);
+    auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * t.tv_usec; };
+    return seconds(u.ru_utime) + seconds(u.ru_stime);
+}
 
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
@@ -82,12 +93,15 @@ nlohmann::ordered_json benchFile(const std::string& path, const Settings& s) {
     Loaded loaded;
     for (int i = 0; i < s.warmup; ++i) loaded = loadOnce(path, s);
     std::vector<double> load;
+    std::vector<double> cpu;
     std::vector<double> read;
     std::vector<char> buffer(static_cast<size_t>(bytes));
     for (int i = 0; i < s.runs; ++i) {
+        const double cpu0 = cpuSeconds();
         const Clock::time_point t0 = Clock::now();
         loaded = loadOnce(path, s);
         load.push_back(secondsSince(t0));
+        cpu.push_back(cpuSeconds() - cpu0);
         read.push_back(readSeconds(path, buffer));
         if (!loaded.error.empty()) break;
     }
@@ -105,6 +119,7 @@ nlohmann::ordered_json benchFile(const std::string& path, const Settings& s) {
                                 {"max_s", *std::max_element(load.begin(), load.end())},
                                 {"mb_per_s", bytes / 1e6 / t},
                                 {"points_per_s", static_cast<double>(loaded.points) / t},
+                                {"cpu_median_s", median(cpu)},
                                 {"read_median_s", median(read)},
                                 {"read_mb_per_s", bytes / 1e6 / median(read)}};
     if (!loaded.error.empty()) j["error"] = loaded.error;
