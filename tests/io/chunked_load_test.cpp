@@ -376,6 +376,37 @@ TEST_F(ChunkedLoad, GzippedFilesAreReadAndChunkedAlike) {
     EXPECT_TRUE(loadsAlike(write("b.ply.gz", gzip(binaryPly<double>(true, "double", kPoints)))));
 }
 
+// Formats without chunks still go through the mapping.
+TEST_F(ChunkedLoad, StlAndGlbMappedAsRead) {
+    ByteBuilder stl;
+    stl.text(std::string(80, ' ')).put<uint32_t>(2);
+    for (int facet = 0; facet < 2; ++facet) {
+        stl.put(0.0f).put(0.0f).put(1.0f);
+        for (const glm::vec3& p : threePoints()) stl.put(p.x + facet).put(p.y).put(p.z);
+        stl.put<uint16_t>(0);
+    }
+    const std::string binary = write("b.stl", stl.str());
+    auto r = serialLoad(binary);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->floats.size(), 6u);
+    EXPECT_TRUE(loadsAlike(binary));
+    EXPECT_TRUE(loadsAlike(write("a.stl",
+                                 "solid t\r\nfacet normal 0 0 1\r\nouter loop\r\nvertex 1 2 3\r\nvertex 4 5 "
+                                 "6\r\nvertex 7 8 9\r\nendloop\r\nendfacet\r\nendsolid t\r\n")));
+    ByteBuilder bin;
+    for (const glm::vec3& p : threePoints()) bin.put(p.x).put(p.y).put(p.z);
+    const std::string json =
+        R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36}],"bufferViews":[{"buffer":0,)"
+        R"("byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],)"
+        R"("scenes":[{"nodes":[0]}],"scene":0})";
+    const std::string glbPath = write("a.glb", glb(json, bin.str()));
+    auto g = serialLoad(glbPath);
+    ASSERT_TRUE(g.ok()) << g.error().message;
+    EXPECT_EQ(g->floats, threePoints());
+    EXPECT_TRUE(loadsAlike(glbPath));
+}
+
 TEST_F(ChunkedLoad, AFifoIsRefusedWithoutBlocking) {
     const std::string path = file("pipe.xyz");
     ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
