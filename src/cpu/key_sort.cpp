@@ -24,11 +24,14 @@ int digitBits(int keyBits) {
     return passes == 0 ? 0 : (keyBits + passes - 1) / passes;
 }
 
-// Contiguous parts of n values for a parallel pass.
+// Contiguous parts of n values for a parallel pass: kPartsPerThread per
+// worker, pulled dynamically, so a worker that the OS preempts (cores shared
+// with other work) holds up the pass by one small part, not by half of it.
 struct Parts {
+    static constexpr size_t kPartsPerThread = 8;
     size_t count = 1, size = 0;
     Parts(size_t n, int threads)
-        : count(std::clamp<size_t>(n / kMinPerPart, 1, size_t(resolveThreads(threads)) * 2)),
+        : count(std::clamp<size_t>(n / kMinPerPart, 1, size_t(resolveThreads(threads)) * kPartsPerThread)),
           size((n + count - 1) / count) {}
     [[nodiscard]] size_t begin(size_t p, size_t n) const { return std::min(n, p * size); }
     [[nodiscard]] size_t end(size_t p, size_t n) const { return std::min(n, (p + 1) * size); }
