@@ -46,24 +46,6 @@ double exactScale(double maxAbs) {
 
 namespace {
 
-// The low 10 bits of v, two zero bits after each (Morton interleave).
-inline uint32_t spreadBits(uint32_t v) {
-    v &= 0x3ffu;
-    v = (v | (v << 16)) & 0x030000ffu;
-    v = (v | (v << 8)) & 0x0300f00fu;
-    v = (v | (v << 4)) & 0x030c30c3u;
-    v = (v | (v << 2)) & 0x09249249u;
-    return v;
-}
-
-}  // namespace
-
-uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z) {
-    return spreadBits(x) | (spreadBits(y) << 1) | (spreadBits(z) << 2);
-}
-
-namespace {
-
 constexpr int kProbeBits = 10;  // the sample's keys: 10 bits per axis, 30 in all
 constexpr size_t kSampleSize = 32768;
 
