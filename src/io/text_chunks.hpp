@@ -14,6 +14,8 @@
 #include <string_view>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "io/parallel_chunks.hpp"
 #include "io/text_cursor.hpp"
 #include "rthdist/result.hpp"
@@ -67,6 +69,37 @@ std::optional<Error> parseChunks(const TextChunks& chunks, std::string_view text
         TextCursor cursor(text.substr(chunk.begin, chunk.end - chunk.begin), chunk.firstLine);
         return parse(chunk, cursor);
     });
+}
+
+// The points of a text format with one point per item line (XYZ, OBJ), in
+// parallel chunks: pointOf(line, cursor, point) parses an item line into
+// `point` or returns its error, naming cursor.line(). shortestLine: the
+// fewest bytes an item line takes with its line end; when the text holds
+// more item lines than that allows, one of them is bad, and it is found
+// before anything is allocated for all of them.
+template <class PointOf>
+Result<std::vector<glm::dvec3>> readPointLines(std::string_view text, const ChunkPlan& plan, ItemLine isItem,
+                                               size_t shortestLine, PointOf&& pointOf) {
+    const TextChunks chunks = splitLines(text, 1, isItem, plan);
+    std::vector<glm::dvec3> points;
+    auto parse = [&](const TextChunk& chunk, TextCursor& cursor) -> std::optional<Error> {
+        uint64_t k = chunk.firstItem;
+        std::string_view line;
+        while (cursor.nextLine(line)) {
+            if (!isItem(line)) continue;
+            glm::dvec3 p;
+            if (std::optional<Error> err = pointOf(line, cursor, p)) return err;
+            if (!points.empty()) points[k] = p;
+            ++k;
+        }
+        return std::nullopt;
+    };
+    if (chunks.items > (text.size() + 1) / shortestLine) {
+        if (auto err = parseChunks(chunks, text, plan, parse)) return *err;
+    }
+    points.resize(static_cast<size_t>(chunks.items));
+    if (auto err = parseChunks(chunks, text, plan, parse)) return *err;
+    return points;
 }
 
 }  // namespace rthdist::io

@@ -22,36 +22,21 @@ constexpr size_t kShortestPointLine = 6;
 
 Result<PointCloud> readXyz(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
     const std::string_view text = bytes.substr(bomLength(bytes));
-    const TextChunks chunks = splitLines(text, 1, &isPointLine, plan);
-    std::vector<glm::dvec3> points;
-    auto parse = [&](const TextChunk& chunk, TextCursor& cursor) -> std::optional<Error> {
-        uint64_t k = chunk.firstItem;
-        std::string_view line;
-        while (cursor.nextLine(line)) {
-            if (!isPointLine(line)) continue;
-            std::array<std::string_view, 3> tok{};
-            const size_t n = splitTokens(trimBlank(line), tok.data(), tok.size(), ",;");
-            if (n < 3) {
-                return badInput(path, lineWhere(cursor.line()),
-                                "expected 'x y z', found " + std::to_string(n) + " column(s)");
-            }
-            glm::dvec3 p;
-            if (const auto bad = parsePoint(tok.data(), p)) {
-                return badInput(path, lineWhere(cursor.line()), notANumber(*bad));
-            }
-            if (!points.empty()) points[k] = p;
-            ++k;
-        }
+    auto pointOf = [&](std::string_view line, const TextCursor& cursor,
+                       glm::dvec3& p) -> std::optional<Error> {
+        std::array<std::string_view, 3> tok{};
+        const size_t n = splitTokens(trimBlank(line), tok.data(), tok.size(), ",;");
+        if (n < 3)
+            return badInput(path, lineWhere(cursor.line()),
+                            "expected 'x y z', found " + std::to_string(n) + " column(s)");
+        if (const auto bad = parsePoint(tok.data(), p))
+            return badInput(path, lineWhere(cursor.line()), notANumber(*bad));
         return std::nullopt;
     };
-    // Too many point lines for the file's size: find the bad one before
-    // allocating for all of them.
-    if (chunks.items > (text.size() + 1) / kShortestPointLine) {
-        if (auto err = parseChunks(chunks, text, plan, parse)) return *err;
-    }
-    points.resize(static_cast<size_t>(chunks.items));
-    if (auto err = parseChunks(chunks, text, plan, parse)) return *err;
-    return PointCloud{Scalar::kFloat64, {}, std::move(points)};
+    Result<std::vector<glm::dvec3>> points =
+        readPointLines(text, plan, &isPointLine, kShortestPointLine, pointOf);
+    if (!points) return points.error();
+    return PointCloud{Scalar::kFloat64, {}, std::move(points.value())};
 }
 
 }  // namespace rthdist::io
