@@ -12,7 +12,6 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -147,6 +146,22 @@ float fromOrderedBits(uint32_t u) {
 int clampedBits(int bits, uint32_t n) {
     while (bits > kMinBits && (uint64_t(1) << (3 * bits)) > 8 * uint64_t(n) + 4096) --bits;
     return bits;
+}
+
+// The bit counts and grids of two ingested sets, side by side: their bounds
+// come from the device, their bit counts from a strided sample of the
+// caller's arrays (chooseBits reads ~32k points in place, ~0.2-0.4 ms each).
+// A free function of this file, so no instantiation of its thread is
+// exported from the shared library.
+void chooseIngestedGrids(const std::array<PointIndex*, 2>& sets,
+                         const std::array<std::span<const glm::vec3>, 2>& pts, int bits) {
+    cpu::parallelChunks(2, 1, 2, [&](size_t begin, size_t end, int) {
+        for (size_t k = begin; k < end; ++k) {
+            PointIndex& ix = *sets[k];
+            const int chosen = bits > 0 ? bits : clampedBits(chooseBits(pts[k], ix.bounds), ix.n);
+            ix.grid = makeGrid(ix.bounds, chosen);
+        }
+    });
 }
 
 // A call whose cancel flag was set: unwinds to the guard of the entry point.
@@ -392,15 +407,6 @@ struct GpuHausdorff::State {
             ix.bounds.lo[k] = double(fromOrderedBits(summary.lo[k]));
             ix.bounds.hi[k] = double(fromOrderedBits(summary.hi[k]));
         }
-    }
-
-    // The bit count and grid of an ingested set: its bounds come from the
-    // device, its bit count from a strided sample of the caller's array
-    // (chooseBits reads ~32k points in place). Touches nothing shared: the
-    // two sets' grids are chosen on two threads.
-    static void chooseIngestedGrid(PointIndex& ix, std::span<const glm::vec3> pts, int bits) {
-        if (bits <= 0) bits = clampedBits(chooseBits(pts, ix.bounds), ix.n);
-        ix.grid = makeGrid(ix.bounds, bits);
     }
 
     // Device half of an index build, recorded into `cmd` after the upload:
@@ -1118,10 +1124,7 @@ struct GpuHausdorff::State {
         const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
         if (exactScale(magnitude) != 1.0) return false;
         const auto t1 = Clock::now();
-        // The two bit counts side by side (each ~0.2-0.4 ms of host work).
-        std::thread second([&] { chooseIngestedGrid(db.ix, b, options.bits); });
-        chooseIngestedGrid(da.ix, a, options.bits);
-        second.join();
+        chooseIngestedGrids({&da.ix, &db.ix}, inputs, options.bits);
         timings->index += msSince(t1);
         buildIndexes(std::array{&da.ix, &db.ix}, /*uploaded=*/true);
         return true;
