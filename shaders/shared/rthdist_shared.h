@@ -26,8 +26,9 @@ struct vec3f {
 #define RTHDIST_SCAN_PER_THREAD 16
 #define RTHDIST_SCAN_BLOCK 4096
 
-// The host-visible counter block (byte offsets; one block per engine, zeroed
-// by the host before the submissions that count into it).
+// A host-visible counter block (byte offsets; one per index build or
+// direction in flight, zeroed by the host before the submissions that count
+// into it; RTHDIST_CTR_BYTES apart).
 #define RTHDIST_CTR_ACTIVE 0        // uint: compact.comp, queries entering the search
 #define RTHDIST_CTR_MAX_COUNT 4     // uint: cell_build, points of the largest cell that can split
 #define RTHDIST_CTR_NEXT_ACTIVE 8   // uint: resolve.comp, queries going on
@@ -40,7 +41,7 @@ struct vec3f {
 #define RTHDIST_CTR_LARGE_CELLS 52  // uint: cell_build, 1 when a cell needs the parallel box
 #define RTHDIST_CTR_READBACK 64     // host read-back area after the counters
 #define RTHDIST_CTR_INGEST 1152     // IngestSummary: ingest.comp, one set's bounds and first bad point
-#define RTHDIST_CTR_BYTES 256
+#define RTHDIST_CTR_BYTES 2048
 
 // Query status values.
 #define RTHDIST_OPEN 0u

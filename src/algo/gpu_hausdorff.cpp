@@ -193,8 +193,9 @@ struct CounterBlock {
     }
     [[nodiscard]] VkDeviceAddress addr(size_t offset) const { return device + offset; }
 };
-constexpr VkDeviceSize kCounterBlockBytes = 2048;
-static_assert(RTHDIST_CTR_READBACK + (kCheckSamples + 1) * 32 <= kCounterBlockBytes);
+constexpr VkDeviceSize kCounterBlockBytes = RTHDIST_CTR_BYTES;
+static_assert(RTHDIST_CTR_READBACK + (kCheckSamples + 1) * 32 <= RTHDIST_CTR_INGEST &&
+              RTHDIST_CTR_INGEST + sizeof(sh::IngestSummary) <= kCounterBlockBytes);
 
 // A set indexed on the device (DeviceSet in gpu_hausdorff.hpp): its index,
 // the buffers it owns (prepared) and the float points the device holds.
@@ -270,13 +271,13 @@ struct GpuHausdorff::State {
                                      hostSmall.address() + k * kCounterBlockBytes, k * kCounterBlockBytes};
     }
 
-    // A counter of the block (offsets from rthdist_shared.h).
+    // A counter of block 0 (offsets from rthdist_shared.h): the stages run one at a time.
     template <class T>
     T& counter(size_t offset) {
-        return *reinterpret_cast<T*>(static_cast<char*>(hostSmall.mapped()) + offset);
+        return blocks[0].at<T>(offset);
     }
-    VkDeviceAddress cellsCounterAddr() const { return hostSmall.address() + RTHDIST_CTR_CELLS; }
-    VkDeviceAddress maxCountAddr() const { return hostSmall.address() + RTHDIST_CTR_MAX_COUNT; }
+    VkDeviceAddress cellsCounterAddr() const { return blocks[0].addr(RTHDIST_CTR_CELLS); }
+    VkDeviceAddress maxCountAddr() const { return blocks[0].addr(RTHDIST_CTR_MAX_COUNT); }
 
     void barrier(VkCommandBuffer cmd) { gpu::cmdShaderBarrier(cmd, pipelines.shaderStages()); }
 
@@ -526,7 +527,7 @@ struct GpuHausdorff::State {
                              sorted[1 - cur]->address(),
                              gridKeys[1 - cur]->address(),
                              outSlotKeys.address(),
-                             hostSmall.address() + RTHDIST_CTR_MIN_EDGE,
+                             blocks[0].addr(RTHDIST_CTR_MIN_EDGE),
                              ix.numCells,
                              ix.n,
                              kLeafMax};
@@ -549,7 +550,7 @@ struct GpuHausdorff::State {
                              cellsCounterAddr(),
                              maxCountAddr(),
                              boundsU(n).address(),
-                             hostSmall.address() + RTHDIST_CTR_LARGE_CELLS,
+                             blocks[0].addr(RTHDIST_CTR_LARGE_CELLS),
                              ix.n,
                              ix.n};
             dispatch(cmd, Kernel::kCellHeads, cp, ix.n);

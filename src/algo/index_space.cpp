@@ -56,9 +56,9 @@ std::vector<uint32_t> sortedSampleKeys(std::span<const glm::vec3> sample, const 
     std::vector<uint32_t> keys(sample.size()), tmp(sample.size());
     for (size_t i = 0; i < sample.size(); ++i) {
         const glm::vec3& p = sample[i];
-        keys[i] = spreadBits(cellCoord(p.x, probe.origin.x, probe.cellSize, probe.cellsPerAxis)) |
-                  spreadBits(cellCoord(p.y, probe.origin.y, probe.cellSize, probe.cellsPerAxis)) << 1 |
-                  spreadBits(cellCoord(p.z, probe.origin.z, probe.cellSize, probe.cellsPerAxis)) << 2;
+        keys[i] = mortonEncode(cellCoord(p.x, probe.origin.x, probe.cellSize, probe.cellsPerAxis),
+                               cellCoord(p.y, probe.origin.y, probe.cellSize, probe.cellsPerAxis),
+                               cellCoord(p.z, probe.origin.z, probe.cellSize, probe.cellsPerAxis));
     }
     constexpr uint32_t kDigits = 1u << kProbeBits;
     for (int shift = 0; shift < 3 * kProbeBits; shift += kProbeBits) {
@@ -93,18 +93,10 @@ std::array<size_t, kMaxBits + 1> distinctCellsPerLevel(const std::vector<uint32_
     return distinct;
 }
 
-}  // namespace
+// Every stride-th target is sampled: about kSampleSize points.
+size_t sampleStride(size_t n) { return std::max<size_t>(1, n / kSampleSize); }
 
-size_t bitsSampleStride(size_t n) { return std::max<size_t>(1, n / kSampleSize); }
-
-int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds, double targetPointsPerCell) {
-    const size_t stride = bitsSampleStride(targets.size());
-    std::vector<glm::vec3> sample;
-    sample.reserve(targets.size() / stride + 1);
-    for (size_t i = 0; i < targets.size(); i += stride) sample.push_back(targets[i]);
-    return chooseBitsFromSample(sample, targets.size(), bounds, targetPointsPerCell);
-}
-
+// The rule of chooseBits over the sample (sample[j] = targets[j * sampleStride(n)]).
 int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Bounds& bounds,
                          double targetPointsPerCell) {
     if (n <= 1) return kMinBits;
@@ -118,7 +110,7 @@ int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Boun
 
     // Its distinct-cell counts per level are trustworthy while the sample
     // still puts several points in each cell.
-    const bool whole = bitsSampleStride(n) == 1;
+    const bool whole = sampleStride(n) == 1;
     const std::vector<uint32_t> keys = sortedSampleKeys(sample, probe);
     const std::array<size_t, kMaxBits + 1> distinct = distinctCellsPerLevel(keys);
     const double sampled = double(keys.size());
@@ -140,6 +132,16 @@ int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Boun
             break;
     }
     return chosen;
+}
+
+}  // namespace
+
+int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds, double targetPointsPerCell) {
+    const size_t stride = sampleStride(targets.size());
+    std::vector<glm::vec3> sample;
+    sample.reserve(targets.size() / stride + 1);
+    for (size_t i = 0; i < targets.size(); i += stride) sample.push_back(targets[i]);
+    return chooseBitsFromSample(sample, targets.size(), bounds, targetPointsPerCell);
 }
 
 constexpr size_t kMagnitudeChunk = size_t(1) << 16;  // points per work item

@@ -42,15 +42,6 @@ struct GridSpec {
 [[nodiscard]] int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds,
                              double targetPointsPerCell = kTargetPointsPerCell);
 
-// The sample chooseBits reads: targets[0], targets[s], targets[2s], ... with
-// s = bitsSampleStride(n) (about 32k points).
-[[nodiscard]] size_t bitsSampleStride(size_t n);
-
-// chooseBits from that sample gathered elsewhere (the GPU's ingest pass):
-// sample[j] = targets[j * bitsSampleStride(n)]; the same k as chooseBits.
-[[nodiscard]] int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Bounds& bounds,
-                                       double targetPointsPerCell = kTargetPointsPerCell);
-
 // The one scaling rule of both backends (squared distances are float there):
 // 1 when the largest coordinate magnitude maxAbs lies in [2^-40, 2^40] (then
 // every squared difference of distinct coordinates near maxAbs is a normal

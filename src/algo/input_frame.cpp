@@ -124,9 +124,10 @@ bool frameKeepsBound(const SetSummary& a, const SetSummary& b, const glm::dvec3&
 }
 
 double searchMagnitude(const SetSummary& set, const glm::dvec3& origin) {
-    const glm::vec3 lo(set.box.lo - origin), hi(set.box.hi - origin);
-    const glm::vec3 m = glm::max(glm::abs(lo), glm::abs(hi));
-    return double(std::max({m.x, m.y, m.z}));
+    // The box rounded to float as the points are (glm::vec3 of p - origin).
+    const Bounds rounded{glm::dvec3(glm::vec3(set.box.lo - origin)),
+                         glm::dvec3(glm::vec3(set.box.hi - origin))};
+    return largestMagnitude(rounded);
 }
 
 std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin) {
