@@ -11,11 +11,12 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <random>
 
 namespace rthdist::cli {
 namespace {
 
-// ".XXXXXX.tmp": what mkstemps appends to the final file's name.
+// ".XXXXXX.tmp": what createTempFile appends to the final file's name.
 constexpr char kTempSuffix[] = ".tmp";
 constexpr size_t kTempExtra = 7 + sizeof kTempSuffix - 1;
 constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP};
@@ -32,14 +33,11 @@ extern "C" void removePendingTempAndDie(int sig) {
     raise(sig);
 }
 
-// While alive, SIGINT/SIGTERM/SIGHUP remove `path` before the process dies.
-// A signal the caller ignores (nohup) stays ignored.
+// While alive, SIGINT/SIGTERM/SIGHUP remove the armed path before the process
+// dies. A signal the caller ignores (nohup) stays ignored.
 class PendingTemp {
 public:
-    explicit PendingTemp(const std::string& path) {
-        std::memcpy(g_pendingTemp, path.c_str(),
-                    path.size() + 1);  // path.size() < PATH_MAX: mkstemps took it
-        g_hasPendingTemp = 1;
+    PendingTemp() {
         struct sigaction ours {};
         ours.sa_handler = removePendingTempAndDie;
         ours.sa_flags = SA_RESETHAND;
@@ -49,6 +47,13 @@ public:
             if (m_previous[i].sa_handler != SIG_IGN) sigaction(kCleanupSignals[i], &ours, nullptr);
         }
     }
+    // From now on a signal removes `path` (which may not exist yet).
+    void arm(const std::string& path) {
+        g_hasPendingTemp = 0;
+        std::memcpy(g_pendingTemp, path.c_str(), path.size() + 1);  // path.size() < PATH_MAX: checked
+        g_hasPendingTemp = 1;
+    }
+    void disarm() { g_hasPendingTemp = 0; }
     ~PendingTemp() {
         g_hasPendingTemp = 0;
         for (size_t i = 0; i < std::size(kCleanupSignals); ++i) {
@@ -102,6 +107,33 @@ Result<bool> writeInPlace(const std::string& path, const std::string& target, st
     return true;
 }
 
+
+// Replaces the "XXXXXX" before ".tmp" in `temp` with random characters and
+// creates that file exclusively, arming `pending` with each name before it is
+// created (mkstemps would leave a window between creating and arming). Returns
+// the descriptor, or -1 with errno set.
+int createTempFile(std::string& temp, PendingTemp& pending) {
+    static constexpr char kLetters[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
+    const size_t at = temp.size() - (sizeof kTempSuffix - 1) - 6;
+    std::random_device seed;
+    std::mt19937 random(seed());
+    std::uniform_int_distribution<int> letter(0, int(sizeof kLetters) - 2);
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        for (size_t i = 0; i < 6; ++i) temp[at + i] = kLetters[letter(random)];
+        pending.arm(temp);
+        const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+        if (fd >= 0) return fd;
+        const int e = errno;
+        pending.disarm();
+        if (e != EEXIST) {
+            errno = e;
+            return -1;
+        }
+    }
+    errno = EEXIST;
+    return -1;
+}
+
 }  // namespace
 
 Result<bool> writeOutputFile(const std::string& path, std::string_view bytes) {
@@ -125,9 +157,11 @@ Result<bool> writeOutputFile(const std::string& path, std::string_view bytes) {
         (slash == std::string::npos ? "" : target.substr(0, slash + 1)) + base + ".XXXXXX" + kTempSuffix;
     if (temp.size() >= PATH_MAX) return outputError(path, ENAMETOOLONG, "naming the temporary file");
 
-    const int fd = ::mkstemps(temp.data(), int(sizeof kTempSuffix - 1));
+    // The handlers go in and the name is armed before the file exists, so a
+    // signal at any moment finds the temporary file it must remove.
+    PendingTemp pending;
+    const int fd = createTempFile(temp, pending);
     if (fd < 0) return outputError(path, errno, "creating a temporary file in '" + dir + "'");
-    PendingTemp pending(temp);
     auto fail = [&](int e, const char* step) {
         ::unlink(temp.c_str());
         return outputError(path, e, step);
@@ -139,6 +173,7 @@ Result<bool> writeOutputFile(const std::string& path, std::string_view bytes) {
     }
     if (::close(fd) != 0) return fail(errno, "closing the temporary file");
     if (::rename(temp.c_str(), target.c_str()) != 0) return fail(errno, "renaming the temporary file");
+    pending.disarm();
 
     // Make the rename itself durable. The new file is already in place, so a
     // failure here is not reported: the output exists and is complete.

@@ -3,7 +3,7 @@
 // under the final name and an earlier good file survives a failed write:
 //
 //   1. the bytes go to a new temporary file "<name>.XXXXXX.tmp" in the same
-//      directory (mkstemps; the name shortened to fit NAME_MAX), made
+//      directory (created exclusively; the name shortened to fit NAME_MAX), made
 //      readable as a fresh file would be (0666 & ~umask);
 //   2. it is written completely, fsync'd and closed, each step checked;
 //   3. it is renamed over the final name (atomic within one file system),
