@@ -1,8 +1,9 @@
 # Install rules and the two ways to consume the installed library:
 #   CMake:      find_package(rthdist [COMPONENTS io]) -> rthdist::rthdist, rthdist::io
 #   pkg-config: rthdist.pc, rthdist-io.pc
-# Static builds also install librthdist_cpu.a (the CPU layer that
-# librthdist.a needs; exported as rthdist::cpu, not meant to be linked directly).
+# Static builds also install the internal layers librthdist.a needs
+# (librthdist_core.a, _cpu.a, _gpu.a, _gpu_algo.a; exported as rthdist::core,
+# ... for the link line only, not meant to be linked directly).
 include(CMakePackageConfigHelpers)
 set(RTHDIST_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/rthdist)
 
@@ -10,11 +11,14 @@ set(RTHDIST_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/rthdist)
 set_target_properties(rthdist rthdist_io PROPERTIES
   VERSION ${PROJECT_VERSION} SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
 set_target_properties(rthdist_io PROPERTIES EXPORT_NAME io)
-set_target_properties(rthdist_cpu PROPERTIES EXPORT_NAME cpu)
+foreach(layer IN LISTS RTHDIST_INTERNAL_LAYERS)
+  string(REGEX REPLACE "^rthdist_" "" name ${layer})
+  set_target_properties(${layer} PROPERTIES EXPORT_NAME ${name})
+endforeach()
 
 set(core_targets rthdist)
 if(NOT BUILD_SHARED_LIBS)
-  list(APPEND core_targets rthdist_cpu)
+  list(APPEND core_targets ${RTHDIST_INTERNAL_LAYERS})
 endif()
 install(TARGETS ${core_targets} EXPORT rthdistTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
@@ -56,7 +60,7 @@ if(BUILD_SHARED_LIBS)
 else()
   set(RTHDIST_PC_REQUIRES "glm vulkan")
   set(RTHDIST_PC_REQUIRES_PRIVATE "")
-  set(RTHDIST_PC_LIBS "-lrthdist -lrthdist_cpu -lpthread")
+  set(RTHDIST_PC_LIBS "-lrthdist -lrthdist_gpu_algo -lrthdist_gpu -lrthdist_cpu -lrthdist_core -lpthread")
   set(RTHDIST_PC_LIBS_PRIVATE "")
   set(RTHDIST_IO_PC_REQUIRES "glm zlib")
   set(RTHDIST_IO_PC_REQUIRES_PRIVATE "")

@@ -5,11 +5,14 @@
 #include <algorithm>
 #include <limits>
 
-#include "algo/index_space.hpp"
+#include "core/index_space.hpp"
 #include "cpu/key_sort.hpp"
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace rthdist::cpu {
+
+using core::parallelChunks;
+using core::resolveThreads;
 namespace {
 
 constexpr uint32_t kRefineCells = 1024;      // cells per axis of a refinement key (10 bits)
@@ -108,9 +111,9 @@ public:
                 const size_t i = run.first + j;
                 const glm::dvec3 p(m_order.x[i], m_order.y[i], m_order.z[i]);
                 const uint32_t key =
-                    algo::mortonEncode(algo::cellCoord(p.x, origin.x, cellSize, kRefineCells),
-                                       algo::cellCoord(p.y, origin.y, cellSize, kRefineCells),
-                                       algo::cellCoord(p.z, origin.z, cellSize, kRefineCells));
+                    core::mortonEncode(core::cellCoord(p.x, origin.x, cellSize, kRefineCells),
+                                       core::cellCoord(p.y, origin.y, cellSize, kRefineCells),
+                                       core::cellCoord(p.z, origin.z, cellSize, kRefineCells));
                 sorted[j] = (uint64_t(key) << 32) | j;
             }
         });

@@ -11,7 +11,7 @@
 // Rules: a run of equal keys longer than kRefineRun whose points are not all
 // identical is sorted by the 30-bit Morton key (10 bits per axis) of its
 // points over its tight box (cubic, longest side / 1024; cell coordinates
-// as algo::cellCoord, clamped); the runs of equal keys that this gives are
+// as core::cellCoord, clamped); the runs of equal keys that this gives are
 // refined the same way. The box of a refined run has at least two distinct
 // keys along its longest axis (its min point is in cell 0, its max point in
 // cell 1023), so every round splits the run, and a sub-run's extent is at

@@ -50,10 +50,13 @@
 #include <optional>
 #include <vector>
 
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 #include "cpu/target_index.hpp"
 
 namespace rthdist::cpu {
+
+using core::parallelChunks;
+using core::resolveThreads;
 namespace {
 
 // Internal 8-wide float vectors (GCC/Clang extension; SSE pairs, AVX when enabled).
@@ -364,7 +367,7 @@ DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet
     const SetOrder& qOrder = querySet.order;
     const double scale = querySet.scale;
     const TargetIndex& t = targetSet.targetIndex(threads);
-    const algo::GridSpec& g = t.grid;
+    const core::GridSpec& g = t.grid;
     const glm::dvec3 boxLo = targetSet.order.bounds.lo, boxHi = targetSet.order.bounds.hi;
 
     // Queries in their own adaptive order, each with its cell key in the
@@ -378,9 +381,9 @@ DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet
         double farthest = 0.0;
         for (size_t i = begin; i < end; ++i) {
             const glm::dvec3 dp(qOrder.x[i], qOrder.y[i], qOrder.z[i]);
-            qKey[i] = algo::mortonEncode(algo::cellCoord(dp.x, g.origin.x, g.cellSize, g.cellsPerAxis),
-                                         algo::cellCoord(dp.y, g.origin.y, g.cellSize, g.cellsPerAxis),
-                                         algo::cellCoord(dp.z, g.origin.z, g.cellSize, g.cellsPerAxis));
+            qKey[i] = core::mortonEncode(core::cellCoord(dp.x, g.origin.x, g.cellSize, g.cellsPerAxis),
+                                         core::cellCoord(dp.y, g.origin.y, g.cellSize, g.cellsPerAxis),
+                                         core::cellCoord(dp.z, g.origin.z, g.cellSize, g.cellsPerAxis));
             const glm::dvec3 d = glm::max(glm::max(boxLo - dp, dp - boxHi), glm::dvec3(0.0));
             farthest = std::max(farthest, d.x * d.x + d.y * d.y + d.z * d.z);
         }
@@ -559,9 +562,9 @@ DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet
     return out;
 }
 
-// The shared scaling rule (algo::exactScale) over both sets.
+// The shared scaling rule (core::exactScale) over both sets.
 double chooseScale(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
-    return algo::exactScale(std::max(algo::largestMagnitude(a), algo::largestMagnitude(b)));
+    return core::exactScale(std::max(core::largestMagnitude(a), core::largestMagnitude(b)));
 }
 
 // One direction into `r` (its witness, per-point array and stage times), or

@@ -79,7 +79,7 @@ private:
     mutable TargetIndex m_index;
 };
 
-// Orders `points` (exact power-of-two `scale`, algo::exactScale; bits 0 =
+// Orders `points` (exact power-of-two `scale`, core::exactScale; bits 0 =
 // from the data) with `threads` workers (0 = all).
 [[nodiscard]] std::shared_ptr<CpuSet> prepareCpuSet(std::span<const glm::vec3> points, double scale, int bits,
                                                     int threads);

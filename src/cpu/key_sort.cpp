@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <limits>
 
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 #include "cpu/target_index.hpp"
 
 namespace rthdist::cpu {
+
+using core::parallelChunks;
+using core::resolveThreads;
 namespace {
 
 constexpr int kMaxDigit = 12;                    // 16 KiB of counts per part (8-bit digits measured slower)

@@ -5,15 +5,18 @@
 #include <limits>
 
 #include "cpu/adaptive_order.hpp"
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace rthdist::cpu {
+
+using core::parallelChunks;
+using core::resolveThreads;
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// algo::boundsOf with `threads` workers (min and max are exact in any order).
-algo::Bounds boundsOf(std::span<const glm::vec3> points, int threads) {
+// core::boundsOf with `threads` workers (min and max are exact in any order).
+core::Bounds boundsOf(std::span<const glm::vec3> points, int threads) {
     std::vector<glm::vec3> lo(size_t(resolveThreads(threads)), points[0]), hi = lo;
     parallelChunks(points.size(), 1 << 16, threads, [&](size_t begin, size_t end, int w) {
         glm::vec3 l = lo[size_t(w)], h = hi[size_t(w)];
@@ -23,7 +26,7 @@ algo::Bounds boundsOf(std::span<const glm::vec3> points, int threads) {
         }
         lo[size_t(w)] = l, hi[size_t(w)] = h;
     });
-    algo::Bounds b{glm::dvec3(lo[0]), glm::dvec3(hi[0])};
+    core::Bounds b{glm::dvec3(lo[0]), glm::dvec3(hi[0])};
     for (size_t w = 1; w < lo.size(); ++w) {
         b.lo = glm::min(b.lo, glm::dvec3(lo[w]));
         b.hi = glm::max(b.hi, glm::dvec3(hi[w]));
@@ -85,17 +88,17 @@ SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int
     const size_t n = points.size();
 
     // Grid over the scaled points; the bit count is scale invariant.
-    const algo::Bounds raw = boundsOf(points, threads);
-    if (bits <= 0) bits = algo::chooseBits(points, raw);
-    order.bounds = algo::Bounds{raw.lo * scale, raw.hi * scale};
-    order.grid = algo::makeGrid(order.bounds, bits);
+    const core::Bounds raw = boundsOf(points, threads);
+    if (bits <= 0) bits = core::chooseBits(points, raw);
+    order.bounds = core::Bounds{raw.lo * scale, raw.hi * scale};
+    order.grid = core::makeGrid(order.bounds, bits);
     order.fineBits = std::min(order.grid.bits + 2, 10);
     const int extra = order.fineBits - order.grid.bits;
     // A fine cell is the grid cell split 2^extra times per axis. The fine cell
     // size differs from the grid's by a power of two, so (p - o) / s scales
-    // exactly and fine >> extra equals algo::cellCoord of the grid (clamping
+    // exactly and fine >> extra equals core::cellCoord of the grid (clamping
     // included): the grid's cells are contiguous runs of the fine order.
-    algo::GridSpec fine = order.grid;
+    core::GridSpec fine = order.grid;
     fine.bits = order.fineBits;
     fine.cellsPerAxis = 1u << fine.bits;
     fine.cellSize = order.grid.cellSize / double(1u << extra);
@@ -108,9 +111,9 @@ SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int
         for (size_t i = begin; i < end; ++i) {
             const glm::vec3 p = scaled(points[i], scale);
             keys[i] =
-                algo::mortonEncode(algo::cellCoord(p.x, fine.origin.x, fine.cellSize, fine.cellsPerAxis),
-                                   algo::cellCoord(p.y, fine.origin.y, fine.cellSize, fine.cellsPerAxis),
-                                   algo::cellCoord(p.z, fine.origin.z, fine.cellSize, fine.cellsPerAxis));
+                core::mortonEncode(core::cellCoord(p.x, fine.origin.x, fine.cellSize, fine.cellsPerAxis),
+                                   core::cellCoord(p.y, fine.origin.y, fine.cellSize, fine.cellsPerAxis),
+                                   core::cellCoord(p.z, fine.origin.z, fine.cellSize, fine.cellsPerAxis));
         }
     });
     OrderedPoints sorted = sortPointsByKey(keys, 3 * order.fineBits, points, scale, threads, kPad);

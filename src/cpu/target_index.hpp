@@ -46,7 +46,7 @@
 #include <span>
 #include <vector>
 
-#include "algo/index_space.hpp"
+#include "core/index_space.hpp"
 #include "cpu/adaptive_order.hpp"
 #include "cpu/uninit_vector.hpp"
 
@@ -84,9 +84,9 @@ struct BoxLevel {
 };
 
 struct TargetIndex {
-    algo::GridSpec grid;   // over the scaled targets
+    core::GridSpec grid;   // over the scaled targets
     int fineBits = 1;      // bits of the sort key per axis (grid.bits + 2, <= 10)
-    double scale = 1.0;    // algo::exactScale
+    double scale = 1.0;    // core::exactScale
     size_t collapsed = 0;  // copies of identical points not stored (targets - stored)
 
     // Sorted targets (scaled), each padded with kPad entries of +inf: views of
@@ -119,7 +119,7 @@ struct TargetIndex {
 };
 
 // p * scale computed in double and rounded: exact for a power of two that
-// keeps the product a normal float (algo::exactScale), never inf or NaN.
+// keeps the product a normal float (core::exactScale), never inf or NaN.
 [[nodiscard]] inline glm::vec3 scaled(const glm::vec3& p, double scale) {
     return glm::vec3(glm::dvec3(p) * scale);
 }
@@ -128,8 +128,8 @@ struct TargetIndex {
 // same order, the order in which it is queried (neighbours consecutive, copies
 // adjacent, ties in input order). Computed once per set and call.
 struct SetOrder {
-    algo::Bounds bounds;                  // of the scaled points
-    algo::GridSpec grid;                  // over them
+    core::Bounds bounds;                  // of the scaled points
+    core::GridSpec grid;                  // over them
     int fineBits = 1;                     // bits of the sort key per axis (grid.bits + 2, <= 10)
     UninitVector<uint64_t> keyed;         // (fine key << 32 | input index), every point, in order
     UninitVector<float> x, y, z;          // the scaled coordinates in that order, then kPad of +inf
@@ -138,7 +138,7 @@ struct SetOrder {
 
 // Orders `points` (non-empty, finite) scaled by `scale`: the fine Morton key
 // over the grid, then refineOrder. bits <= 0 picks the grid's bit count with
-// algo::chooseBits.
+// core::chooseBits.
 [[nodiscard]] SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int threads);
 
 // Builds the index over a set in its order (orderSet of the set and scale).

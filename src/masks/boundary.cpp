@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 #include "masks/selected.hpp"
 
 namespace rthdist::masks::detail {
@@ -42,7 +42,7 @@ Extraction extractFrom(const T* labels, Dims dims, LabelSelect select, int conne
             }
     std::vector<std::vector<uint64_t>> slabs(size_t(std::max<int64_t>(nz, 0)));
     std::vector<uint64_t> counts(slabs.size(), 0);
-    cpu::parallelChunks(size_t(nz), 1, threads, [&](size_t zb, size_t ze, int) {
+    core::parallelChunks(size_t(nz), 1, threads, [&](size_t zb, size_t ze, int) {
         for (int64_t z = int64_t(zb); z < int64_t(ze); ++z) {
             std::vector<uint64_t>& out = slabs[size_t(z)];
             uint64_t count = 0;
@@ -83,7 +83,7 @@ std::vector<uint64_t> differenceFrom(const A* a, LabelSelect sa, const B* b, Lab
     const Selected<B> inB(b, sb);
     const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
     std::vector<std::vector<uint64_t>> slabs(size_t(std::max<int64_t>(nz, 0)));
-    cpu::parallelChunks(size_t(nz), 1, threads, [&](size_t zb, size_t ze, int) {
+    core::parallelChunks(size_t(nz), 1, threads, [&](size_t zb, size_t ze, int) {
         for (int64_t z = int64_t(zb); z < int64_t(ze); ++z) {
             std::vector<uint64_t>& out = slabs[size_t(z)];
             for (int64_t y = 0; y < ny; ++y) {

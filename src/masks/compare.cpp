@@ -15,7 +15,7 @@
 #include <iterator>
 #include <limits>
 
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 #include "masks/boundary.hpp"
 #include "masks/deepmind.hpp"
 #include "masks/masks.hpp"
@@ -74,7 +74,7 @@ std::vector<glm::dvec3> coordinates(const std::vector<uint64_t>& voxels, const V
                                     int threads) {
     std::vector<glm::dvec3> out(voxels.size());
     const glm::dvec3 s = v.spacing();
-    cpu::parallelChunks(voxels.size(), size_t(1) << 16, threads, [&](size_t b, size_t e, int) {
+    core::parallelChunks(voxels.size(), size_t(1) << 16, threads, [&](size_t b, size_t e, int) {
         for (size_t i = b; i < e; ++i) {
             const auto ijk = detail::voxelOf(voxels[i], v.dims);
             out[i] = world ? worldOf(v, ijk)

@@ -13,7 +13,7 @@
 #include <limits>
 #include <utility>
 
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 #include "masks/area_weighted.hpp"
 #include "masks/surfel_area.hpp"
 #include "masks/surfels.hpp"
@@ -41,7 +41,7 @@ std::vector<glm::dvec3> cornerCoordinates(const std::vector<uint64_t>& corners, 
                                           int threads) {
     std::vector<glm::dvec3> out(corners.size());
     const glm::dvec3 s = v.spacing();
-    cpu::parallelChunks(corners.size(), size_t(1) << 16, threads, [&](size_t b, size_t e, int) {
+    core::parallelChunks(corners.size(), size_t(1) << 16, threads, [&](size_t b, size_t e, int) {
         for (size_t i = b; i < e; ++i) {
             const auto c = cornerOf(corners[i], v.dims);
             const glm::dvec3 at(static_cast<double>(c[0]), static_cast<double>(c[1]),

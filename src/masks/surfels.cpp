@@ -7,7 +7,7 @@
 
 #include <algorithm>
 
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 #include "masks/selected.hpp"
 #include "masks/surfel_area.hpp"
 
@@ -66,7 +66,7 @@ Surfels extractSurfels(const Volume& v, LabelSelect select, int threads) {
     std::vector<SliceSurfels> slices(static_cast<size_t>(cz));
     withLabels(v, [&](const auto* labels) {
         const Selected sel(labels, select);
-        cpu::parallelChunks(size_t(cz), 1, threads, [&](size_t kb, size_t ke, int) {
+        core::parallelChunks(size_t(cz), 1, threads, [&](size_t kb, size_t ke, int) {
             for (size_t k = kb; k < ke; ++k) scanCornerSlice(sel, v.dims, int64_t(k), slices[k]);
         });
     });

@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "algo/index_space.hpp"
+#include "core/index_space.hpp"
 #include "mpi/collectives.hpp"
 #include "rthdist/mpi.hpp"
 
@@ -77,7 +77,7 @@ void roundInto(GlobalSet& set, const glm::dvec3& origin, double scale) {
         set.floats[i] = glm::vec3(glm::dvec3(glm::vec3(set.local.at(i) - origin)) * scale);
 }
 
-// Largest |coordinate| of the slice after the shift, in float (algo::largestMagnitude's measure).
+// Largest |coordinate| of the slice after the shift, in float (core::largestMagnitude's measure).
 double sliceMagnitude(const GlobalSet& set, const glm::dvec3& origin) {
     float m = 0.0f;
     for (size_t i = 0; i < set.local.count; ++i) {
@@ -121,7 +121,7 @@ Result<GlobalSets> makeGlobalSets(MPI_Comm comm, PointView localA, PointView loc
     sets.origin = floatExact ? glm::dvec3(0.0) : 0.5 * (boxLo + boxHi);
     double magnitude = std::max(sliceMagnitude(sets.a, sets.origin), sliceMagnitude(sets.b, sets.origin));
     MPI_Allreduce(MPI_IN_PLACE, &magnitude, 1, MPI_DOUBLE, MPI_MAX, comm);
-    sets.scale = algo::exactScale(magnitude);
+    sets.scale = core::exactScale(magnitude);
     sets.diagonal = glm::length(boxHi - boxLo) * sets.scale;
 
     local = guarded([&]() -> std::optional<Error> {

@@ -3,7 +3,7 @@
 // the frame a one-process call would search (rthdist.hpp, Precision): every
 // rank agrees on the union's box and on whether every coordinate is a
 // float32 value, and rounds p - origin to float32 with origin 0 for float
-// data, else the centre of the union's box (algo::searchOrigin's rule); the
+// data, else the centre of the union's box (core::searchOrigin's rule); the
 // floats are then scaled by the one-process call's exact power of two.
 #pragma once
 
@@ -32,7 +32,7 @@ struct GlobalSet {
 struct GlobalSets {
     GlobalSet a, b;
     glm::dvec3 origin{0.0};
-    // The exact power-of-two scale a one-process call applies (algo::exactScale
+    // The exact power-of-two scale a one-process call applies (core::exactScale
     // of the largest float magnitude of both sets), applied here already, so
     // that every rank's engine compares the squared floats one engine would.
     double scale = 1.0;

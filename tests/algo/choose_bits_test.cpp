@@ -13,11 +13,11 @@
 #include <set>
 #include <vector>
 
-#include "algo/index_space.hpp"
+#include "core/index_space.hpp"
 #include "common/point_shapes.hpp"
 #include "common/rng.hpp"
 
-namespace rthdist::algo {
+namespace rthdist::core {
 namespace {
 
 // The rule of DESIGN §5 written out directly (a set per level, no tricks).
@@ -89,4 +89,4 @@ TEST(ChooseBits, DegenerateSetsTakeTheSmallestCount) {
 }
 
 }  // namespace
-}  // namespace rthdist::algo
+}  // namespace rthdist::core

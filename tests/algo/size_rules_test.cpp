@@ -9,11 +9,11 @@
 #include <limits>
 #include <vector>
 
-#include "algo/index_space.hpp"
-#include "algo/self_check.hpp"
+#include "core/index_space.hpp"
+#include "gpu_algo/self_check.hpp"
 #include "gpu/device_limits.hpp"
 
-namespace rthdist::algo {
+namespace rthdist::core {
 namespace {
 
 // Every float magnitude class: subnormal, tiny, ordinary, huge, near max.
@@ -166,4 +166,4 @@ TEST(DeviceLimits, RefuseWithTheLimitNamed) {
 }
 
 }  // namespace
-}  // namespace rthdist::algo
+}  // namespace rthdist::core

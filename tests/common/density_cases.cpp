@@ -100,19 +100,19 @@ Distinct distinctOf(const Points& p) {
 }
 
 // Per-point brute force over the distinct queries and targets, expanded.
-std::vector<cpu::NearestExact> nearestAll(const Points& q, const Points& t) {
+std::vector<oracle::NearestExact> nearestAll(const Points& q, const Points& t) {
     const Distinct dq = distinctOf(q), dt = distinctOf(t);
-    const std::vector<cpu::NearestExact> nn = cpu::bruteForceNearestIndexed(dq.points, dt.points);
-    std::vector<cpu::NearestExact> out(q.size());
+    const std::vector<oracle::NearestExact> nn = oracle::bruteForceNearestIndexed(dq.points, dt.points);
+    std::vector<oracle::NearestExact> out(q.size());
     for (size_t i = 0; i < q.size(); ++i) {
-        const cpu::NearestExact& n = nn[dq.of[i]];
+        const oracle::NearestExact& n = nn[dq.of[i]];
         out[i] = {n.distance, dt.first[n.targetIndex]};
     }
     return out;
 }
 
-cpu::DirectedExact maxOf(const std::vector<cpu::NearestExact>& nn) {
-    cpu::DirectedExact d;
+oracle::DirectedExact maxOf(const std::vector<oracle::NearestExact>& nn) {
+    oracle::DirectedExact d;
     d.distance = -1.0;
     for (size_t i = 0; i < nn.size(); ++i) {
         if (nn[i].distance > d.distance) d = {nn[i].distance, uint32_t(i), nn[i].targetIndex};
@@ -121,7 +121,7 @@ cpu::DirectedExact maxOf(const std::vector<cpu::NearestExact>& nn) {
 }
 
 void expectDirected(const char* what, const Points& q, const Points& t, const Directed& d,
-                    const std::vector<cpu::NearestExact>& nn, double oracle, double tolerance) {
+                    const std::vector<oracle::NearestExact>& nn, double oracle, double tolerance) {
     SCOPED_TRACE(what);
     EXPECT_NEAR(d.distance, oracle, tolerance);
     ASSERT_LT(d.queryIndex, q.size());
@@ -280,7 +280,7 @@ void expectPerPointMatchesDensity(const OracleCase& c, const DensityReference& r
     const double tolerance = oracleTolerance(
         c.a, c.b, std::max(ref.aToB.distance, r.bNearest.distance.empty() ? 0.0 : ref.bToA.distance));
     auto check = [&](const char* what, const Points& q, const Points& t, const PerPoint& got,
-                     const std::vector<cpu::NearestExact>& want) {
+                     const std::vector<oracle::NearestExact>& want) {
         SCOPED_TRACE(what);
         ASSERT_EQ(got.distance.size(), q.size());
         ASSERT_EQ(got.nearest.size(), q.size());

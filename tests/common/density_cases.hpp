@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "common/oracle_cases.hpp"
-#include "cpu/brute_force.hpp"
+#include "common/brute_force.hpp"
 
 namespace rthdist::test {
 
@@ -27,10 +27,10 @@ namespace rthdist::test {
 
 // Exact per-point nearest neighbours both ways (brute force, double; ties to
 // the smallest target index) and the directed maxima (ties to the smallest
-// query index), as cpu::bruteForceDirected would give them.
+// query index), as oracle::bruteForceDirected would give them.
 struct DensityReference {
-    std::vector<cpu::NearestExact> aNearest, bNearest;  // per point of A (into B), of B (into A)
-    cpu::DirectedExact aToB, bToA;
+    std::vector<oracle::NearestExact> aNearest, bNearest;  // per point of A (into B), of B (into A)
+    oracle::DirectedExact aToB, bToA;
 };
 [[nodiscard]] DensityReference densityReference(const OracleCase& c);
 

@@ -11,7 +11,7 @@
 
 #include "common/point_shapes.hpp"
 #include "common/rng.hpp"
-#include "cpu/brute_force.hpp"
+#include "common/brute_force.hpp"
 
 namespace rthdist::test {
 namespace {
@@ -291,7 +291,7 @@ void expectDirected(const char* what, std::span<const glm::vec3> q, std::span<co
     EXPECT_EQ(d.targetPoint, glm::dvec3(t[d.targetIndex]));
     const double pair = glm::length(glm::dvec3(q[d.queryIndex]) - glm::dvec3(t[d.targetIndex]));
     EXPECT_NEAR(pair, d.distance, 1e-12 * std::max(1.0, pair)) << "the witness pair does not realize it";
-    const std::vector<double> nn = cpu::bruteForceNearest(q.subspan(d.queryIndex, 1), t, 1);
+    const std::vector<double> nn = oracle::bruteForceNearest(q.subspan(d.queryIndex, 1), t, 1);
     EXPECT_NEAR(pair, nn[0], tolerance) << "the witness target is not a nearest neighbour";
 }
 
@@ -301,8 +301,8 @@ void expectMatchesOracle(const OracleCase& c, const HausdorffResult& r, bool dir
     std::ostringstream trace;
     trace << "case " << c.name << " seed " << c.seed << " |A|=" << c.a.size() << " |B|=" << c.b.size();
     SCOPED_TRACE(trace.str());
-    const double hab = cpu::bruteForceDirected(c.a, c.b).distance;
-    const double hba = directedOnly ? 0.0 : cpu::bruteForceDirected(c.b, c.a).distance;
+    const double hab = oracle::bruteForceDirected(c.a, c.b).distance;
+    const double hba = directedOnly ? 0.0 : oracle::bruteForceDirected(c.b, c.a).distance;
     const double h = std::max(hab, hba);
     const double tolerance = oracleTolerance(c.a, c.b, h);
     expectDirected("h(A,B)", c.a, c.b, r.aToB, hab, tolerance);

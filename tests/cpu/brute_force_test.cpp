@@ -3,9 +3,9 @@
 
 #include <cmath>
 
-#include "cpu/brute_force.hpp"
+#include "common/brute_force.hpp"
 
-namespace rthdist::cpu {
+namespace rthdist::oracle {
 namespace {
 
 TEST(BruteForce, HandComputed) {
@@ -50,4 +50,4 @@ TEST(BruteForce, ComputesInDouble) {
 }
 
 }  // namespace
-}  // namespace rthdist::cpu
+}  // namespace rthdist::oracle

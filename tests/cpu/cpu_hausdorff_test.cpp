@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "common/oracle_cases.hpp"
-#include "cpu/brute_force.hpp"
+#include "common/brute_force.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 
 namespace rthdist::test {

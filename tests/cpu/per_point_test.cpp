@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/oracle_cases.hpp"
-#include "cpu/brute_force.hpp"
+#include "common/brute_force.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 
 namespace rthdist::test {
@@ -43,7 +43,7 @@ double pairDistance(const glm::vec3& p, const glm::vec3& q) {
 size_t expectNearestMatches(const std::vector<glm::vec3>& queries, const std::vector<glm::vec3>& targets,
                             const PerPoint& got, double tolerance, const char* direction) {
     SCOPED_TRACE(direction);
-    const std::vector<cpu::NearestExact> want = cpu::bruteForceNearestIndexed(queries, targets);
+    const std::vector<oracle::NearestExact> want = oracle::bruteForceNearestIndexed(queries, targets);
     EXPECT_EQ(got.distance.size(), queries.size());
     EXPECT_EQ(got.nearest.size(), queries.size());
     if (got.distance.size() != queries.size() || got.nearest.size() != queries.size()) return 0;

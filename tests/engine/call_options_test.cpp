@@ -10,7 +10,7 @@
 #include <unistd.h>
 
 #include "common/oracle_cases.hpp"
-#include "cpu/brute_force.hpp"
+#include "common/brute_force.hpp"
 #include "engine/engine_test_support.hpp"
 
 namespace rthdist::test {
@@ -26,7 +26,7 @@ TEST(CallOptions, ChangeBetweenCallsOfOneEngine) {
     auto pa = engine->prepare(c.a);
     auto pb = engine->prepare(c.b);
     ASSERT_TRUE(pa && pb);
-    const std::vector<double> nnA = cpu::bruteForceNearest(c.a, c.b);
+    const std::vector<double> nnA = oracle::bruteForceNearest(c.a, c.b);
     for (bool directed : {false, true}) {
         for (bool perPoint : {false, true}) {
             for (float growth : {1.5f, 2.0f, 4.0f}) {

@@ -7,7 +7,7 @@
 #include <random>
 
 #include "common/oracle_cases.hpp"
-#include "cpu/brute_force.hpp"
+#include "common/brute_force.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {

@@ -7,7 +7,7 @@
 
 #include "common/geo_cases.hpp"
 #include "common/oracle_cases.hpp"
-#include "cpu/brute_force.hpp"
+#include "common/brute_force.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {
@@ -82,7 +82,7 @@ TEST(GpuOracle, PerPointDistancesMatchBruteForce) {
             const PerPoint& pp = dir == 0 ? r->aNearest : r->bNearest;
             ASSERT_EQ(pp.distance.size(), q.size());
             ASSERT_EQ(pp.nearest.size(), q.size());
-            const std::vector<double> ref = cpu::bruteForceNearest(q, t);
+            const std::vector<double> ref = oracle::bruteForceNearest(q, t);
             size_t bad = 0;
             for (size_t k = 0; k < q.size(); ++k) {
                 const double d = glm::length(glm::dvec3(q[k]) - glm::dvec3(t[pp.nearest[k]]));

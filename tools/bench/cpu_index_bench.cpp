@@ -6,7 +6,7 @@
 //
 //   cpu-index-bench A B [--threads T] [--runs N] [--bits K]
 //
-// The scale is the one rule of the backend (algo::exactScale over both sets);
+// The scale is the one rule of the backend (core::exactScale over both sets);
 // the hash covers the order (keys and input indices), the gathered
 // coordinates, the identical runs, and the index's arrays and BVH boxes.
 #include <algorithm>
@@ -21,7 +21,7 @@
 
 #include <sys/resource.h>
 
-#include "algo/index_space.hpp"
+#include "core/index_space.hpp"
 #include "cpu/target_index.hpp"
 #include "rthdist/io.hpp"
 
@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
         sets.push_back(std::move(loaded.value()));
     }
     const double scale =
-        algo::exactScale(std::max(algo::largestMagnitude(sets[0]), algo::largestMagnitude(sets[1])));
+        core::exactScale(std::max(core::largestMagnitude(sets[0]), core::largestMagnitude(sets[1])));
     SetTimes times[2];
     for (int r = 0; r < runs; ++r) {
         for (int s = 0; s < 2; ++s) {

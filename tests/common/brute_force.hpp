@@ -14,7 +14,7 @@
 #include <span>
 #include <vector>
 
-namespace rthdist::cpu {
+namespace rthdist::oracle {
 
 struct DirectedExact {
     double distance = 0.0;     // h(queries, targets)
@@ -39,4 +39,4 @@ struct NearestExact {
                                                                  std::span<const glm::vec3> targets,
                                                                  int threads = 0);
 
-}  // namespace rthdist::cpu
+}  // namespace rthdist::oracle

@@ -1,9 +1,9 @@
-#include "algo/self_check.hpp"
+#include "gpu_algo/self_check.hpp"
 
 #include <bit>
 #include <cmath>
 
-namespace rthdist::algo {
+namespace rthdist::gpu_algo {
 
 namespace {
 
@@ -104,4 +104,4 @@ std::string witnessFailure(double distance, uint64_t maxPacked, double lowerBoun
     return "";
 }
 
-}  // namespace rthdist::algo
+}  // namespace rthdist::gpu_algo

@@ -1,4 +1,4 @@
-#include "algo/index_space.hpp"
+#include "core/index_space.hpp"
 
 #include <glm/common.hpp>
 
@@ -8,9 +8,9 @@
 #include <cmath>
 #include <vector>
 
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 
-namespace rthdist::algo {
+namespace rthdist::core {
 
 Bounds boundsOf(std::span<const glm::vec3> points) {
     Bounds b;
@@ -152,9 +152,9 @@ double largestMagnitude(const Bounds& box) {
 }
 
 double largestMagnitude(std::span<const glm::vec3> points) {
-    const int threads = cpu::resolveThreads(0, points.size() / kMagnitudeChunk + 1);
+    const int threads = core::resolveThreads(0, points.size() / kMagnitudeChunk + 1);
     std::vector<float> part(size_t(threads), 0.0f);
-    cpu::parallelChunks(points.size(), kMagnitudeChunk, threads, [&](size_t begin, size_t end, int t) {
+    core::parallelChunks(points.size(), kMagnitudeChunk, threads, [&](size_t begin, size_t end, int t) {
         float v = part[size_t(t)];
         for (size_t i = begin; i < end; ++i)
             v = std::max({v, std::abs(points[i].x), std::abs(points[i].y), std::abs(points[i].z)});
@@ -163,4 +163,4 @@ double largestMagnitude(std::span<const glm::vec3> points) {
     return double(*std::max_element(part.begin(), part.end()));
 }
 
-}  // namespace rthdist::algo
+}  // namespace rthdist::core

@@ -8,7 +8,7 @@
 #include <thread>
 #include <vector>
 
-namespace rthdist::cpu {
+namespace rthdist::core {
 
 // 0 -> all hardware threads; never more threads than chunks of work.
 [[nodiscard]] inline int resolveThreads(int requested, size_t work = ~size_t(0)) {
@@ -47,4 +47,4 @@ void parallelChunks(size_t count, size_t chunk, int threads, Fn&& fn) {
     for (std::thread& th : pool) th.join();
 }
 
-}  // namespace rthdist::cpu
+}  // namespace rthdist::core

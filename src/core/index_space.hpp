@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <span>
 
-namespace rthdist::algo {
+namespace rthdist::core {
 
 // Largest bit count with a dense cell table (2^(3k) entries) that we allow.
 inline constexpr int kMaxBits = 8;
@@ -81,4 +81,4 @@ struct GridSpec {
     return uint32_t(c);
 }
 
-}  // namespace rthdist::algo
+}  // namespace rthdist::core

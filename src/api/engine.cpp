@@ -9,10 +9,10 @@
 #include <optional>
 
 #include <string>
-#include "algo/index_space.hpp"
+#include "core/index_space.hpp"
 
-#include "algo/gpu_hausdorff.hpp"
-#include "algo/input_frame.hpp"
+#include "gpu_algo/gpu_hausdorff.hpp"
+#include "core/input_frame.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 #include "gpu/context.hpp"
 #include "gpu/pipeline_cache.hpp"
@@ -49,9 +49,9 @@ std::optional<Error> validateEngineOptions(const EngineOptions& o) {
 }
 
 std::optional<Error> validateBits(int bits) {
-    if (bits < 0 || bits > algo::kMaxBits) {
+    if (bits < 0 || bits > core::kMaxBits) {
         return Error{ErrorCode::kInvalidArgument,
-                     "bits must be 0 (auto) or 1.." + std::to_string(algo::kMaxBits)};
+                     "bits must be 0 (auto) or 1.." + std::to_string(core::kMaxBits)};
     }
     return std::nullopt;
 }
@@ -90,7 +90,7 @@ bool hardwareRtDevice(const EngineOptions& o) {
 // must be destroyed before it). Empty on the CPU backend.
 struct Device {
     std::unique_ptr<gpu::Context> context;
-    std::unique_ptr<algo::GpuHausdorff> gpu;  // destroyed before the context
+    std::unique_ptr<gpu_algo::GpuHausdorff> gpu;  // destroyed before the context
 };
 
 }  // namespace
@@ -107,12 +107,12 @@ struct Engine::Impl {
 
 struct PreparedSet::Impl {
     std::shared_ptr<Device> device;  // keeps the device alive; first member, destroyed last
-    algo::SetSummary summary;
+    core::SetSummary summary;
     glm::dvec3 origin{0.0};
     std::vector<glm::vec3> floats;      // p - origin rounded: what the backend searches
     std::vector<glm::dvec3> originals;  // the input when it is not float-exact
-    double ownScale = 1.0;              // algo::exactScale of `floats` alone
-    std::shared_ptr<algo::DeviceSet> gpuSet;
+    double ownScale = 1.0;              // core::exactScale of `floats` alone
+    std::shared_ptr<gpu_algo::DeviceSet> gpuSet;
     std::shared_ptr<cpu::CpuSet> cpuSet;
 
     // The input as given (for witnesses in double and for the union frame).
@@ -132,10 +132,10 @@ PreparedSet::~PreparedSet() = default;
 size_t PreparedSet::size() const { return m_impl->floats.size(); }
 glm::dvec3 PreparedSet::origin() const { return m_impl->origin; }
 int PreparedSet::bits() const {
-    return m_impl->gpuSet ? algo::GpuHausdorff::bits(*m_impl->gpuSet) : m_impl->cpuSet->order.grid.bits;
+    return m_impl->gpuSet ? gpu_algo::GpuHausdorff::bits(*m_impl->gpuSet) : m_impl->cpuSet->order.grid.bits;
 }
 uint64_t PreparedSet::deviceBytes() const {
-    return m_impl->gpuSet ? algo::GpuHausdorff::deviceBytes(*m_impl->gpuSet) : 0;
+    return m_impl->gpuSet ? gpu_algo::GpuHausdorff::deviceBytes(*m_impl->gpuSet) : 0;
 }
 uint64_t PreparedSet::hostBytes() const {
     uint64_t bytes =
@@ -167,7 +167,7 @@ Result<Engine> Engine::create(const EngineOptions& options) {
     const std::string cacheDir = options.pipelineCacheDir == "off"  ? std::string()
                                  : options.pipelineCacheDir.empty() ? gpu::defaultPipelineCacheDir()
                                                                     : options.pipelineCacheDir;
-    auto g = algo::GpuHausdorff::create(*device.context, cacheDir);
+    auto g = gpu_algo::GpuHausdorff::create(*device.context, cacheDir);
     if (!g) return g.error();
     device.gpu = std::move(g.value());
     impl->backend = device.context->backend();
@@ -198,13 +198,13 @@ namespace {
 // (input_frame.hpp); the backends search float32 sets (shifted when an input
 // is double); witnesses and distances come back in the original coordinates.
 struct CheckedInputs {
-    algo::SetSummary a, b;
+    core::SetSummary a, b;
 };
 
 Result<CheckedInputs> checkInputs(const PointView& a, const PointView& b) {
-    Result<algo::SetSummary> sa = algo::summarizeSet(a, "A");
+    Result<core::SetSummary> sa = core::summarizeSet(a, "A");
     if (!sa) return sa.error();
-    Result<algo::SetSummary> sb = algo::summarizeSet(b, "B");
+    Result<core::SetSummary> sb = core::summarizeSet(b, "B");
     if (!sb) return sb.error();
     return CheckedInputs{*sa, *sb};
 }
@@ -221,19 +221,19 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
                                      const CheckedInputs& checked, const CallOptions& call,
                                      std::chrono::steady_clock::time_point t0) {
     if (auto err = validateCallOptions(call)) return *err;
-    const glm::dvec3 origin = algo::searchOrigin(checked.a, checked.b);
-    const algo::FloatSet fa(a, origin), fb(b, origin);
+    const glm::dvec3 origin = core::searchOrigin(checked.a, checked.b);
+    const core::FloatSet fa(a, origin), fb(b, origin);
     Options options;
     static_cast<CallOptions&>(options) = call;
     static_cast<EngineOptions&>(options) = impl.options;
-    const double scale = algo::exactScale(
-        std::max(algo::searchMagnitude(checked.a, origin), algo::searchMagnitude(checked.b, origin)));
+    const double scale = core::exactScale(
+        std::max(core::searchMagnitude(checked.a, origin), core::searchMagnitude(checked.b, origin)));
     Result<HausdorffResult> r = impl.device->gpu
                                     ? impl.device->gpu->compute(fa.span(), fb.span(), scale, call)
                                     : cpu::cpuHausdorff(fa.span(), fb.span(), options);
     if (!r) return r;
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
-    if (copied) algo::restoreOriginal(*r, a, b);
+    if (copied) core::restoreOriginal(*r, a, b);
     r->origin = origin;
     finishResult(impl, *r, t0);
     return r;
@@ -242,7 +242,7 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
 // Whether two prepared sets can be searched as they are: one frame, within
 // the contract's bound, and one exact scale.
 bool shareFrame(const PreparedSet::Impl& a, const PreparedSet::Impl& b) {
-    if (a.origin != b.origin || !algo::frameKeepsBound(a.summary, b.summary, a.origin)) return false;
+    if (a.origin != b.origin || !core::frameKeepsBound(a.summary, b.summary, a.origin)) return false;
     const double pairScale = std::min(a.ownScale, b.ownScale);  // of the larger magnitude
     return a.ownScale == pairScale && b.ownScale == pairScale;
 }
@@ -259,8 +259,8 @@ namespace {
 // samples the points (GpuHausdorff::computePacked); the host only copies them.
 Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
                                         const CallOptions& call, std::chrono::steady_clock::time_point t0) {
-    if (auto err = algo::checkShape(a, "A")) return *err;
-    if (auto err = algo::checkShape(b, "B")) return *err;
+    if (auto err = core::checkShape(a, "A")) return *err;
+    if (auto err = core::checkShape(b, "B")) return *err;
     if (auto err = validateCallOptions(call)) return *err;
     auto asVec3 = [](const PointView& v) {
         return std::span<const glm::vec3>(static_cast<const glm::vec3*>(v.data), v.count);
@@ -277,7 +277,7 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
 Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOptions& call) {
     const auto t0 = std::chrono::steady_clock::now();
     if (m_impl->device->gpu && a.packedFloat() && b.packedFloat() &&
-        algo::GpuHausdorff::ingests(a.count, b.count))
+        gpu_algo::GpuHausdorff::ingests(a.count, b.count))
         return computeIngested(*m_impl, a, b, call, t0);
     Result<CheckedInputs> checked = checkInputs(a, b);
     if (!checked) return checked.error();
@@ -286,18 +286,18 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOpti
 
 Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& options) {
     if (auto err = validateBits(options.bits)) return *err;
-    Result<algo::SetSummary> summary = algo::summarizeSet(points, "to prepare");
+    Result<core::SetSummary> summary = core::summarizeSet(points, "to prepare");
     if (!summary) return summary.error();
     auto set = std::make_shared<PreparedSet::Impl>();
     set->device = m_impl->device;
     set->summary = *summary;
-    set->origin = algo::preparedOrigin(*summary, options.origin);
-    set->floats = algo::roundedCopy(points, set->origin);
+    set->origin = core::preparedOrigin(*summary, options.origin);
+    set->floats = core::roundedCopy(points, set->origin);
     if (!summary->floatExact) {
         set->originals.resize(points.count);
         for (size_t i = 0; i < points.count; ++i) set->originals[i] = points.at(i);
     }
-    set->ownScale = algo::exactScale(algo::searchMagnitude(*summary, set->origin));
+    set->ownScale = core::exactScale(core::searchMagnitude(*summary, set->origin));
     if (m_impl->device->gpu) {
         Timings timings;
         const std::string name = "set#" + std::to_string(++m_impl->preparedCount);
@@ -325,7 +325,7 @@ Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet&
         m_impl->device->gpu ? m_impl->device->gpu->compute(*ia.gpuSet, *ib.gpuSet, call)
                             : cpu::cpuHausdorff(*ia.cpuSet, *ib.cpuSet, call, m_impl->options.threads);
     if (!r) return r;
-    if (!ia.originals.empty() || !ib.originals.empty()) algo::restoreOriginal(*r, ia.input(), ib.input());
+    if (!ia.originals.empty() || !ib.originals.empty()) core::restoreOriginal(*r, ia.input(), ib.input());
     r->origin = ia.origin;
     finishResult(*m_impl, *r, t0);
     return r;

@@ -13,10 +13,10 @@
 #include <span>
 #include <vector>
 
-#include "algo/index_space.hpp"
+#include "core/index_space.hpp"
 #include "rthdist/rthdist.hpp"
 
-namespace rthdist::algo {
+namespace rthdist::core {
 
 struct SetSummary {
     Bounds box;
@@ -76,4 +76,4 @@ private:
 // after the shift) by those of the original coordinates, in double.
 void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b);
 
-}  // namespace rthdist::algo
+}  // namespace rthdist::core

@@ -26,7 +26,7 @@ namespace rthdist::gpu {
 class Context;
 }
 
-namespace rthdist::algo {
+namespace rthdist::gpu_algo {
 
 // A set indexed on the device, with the buffers it owns.
 struct DeviceSet;
@@ -41,7 +41,7 @@ public:
 
     // One-shot: both sets indexed for this call, in buffers pooled between
     // calls. `scale`: the exact power of two of index_space.hpp for both sets
-    // (exactScale of their largest magnitude).
+    // (core::exactScale of their largest magnitude).
     [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                   double scale, const CallOptions& options);
     // One-shot from packed float host arrays through the device ingest path
@@ -88,4 +88,4 @@ private:
     std::unique_ptr<State> m_state;
 };
 
-}  // namespace rthdist::algo
+}  // namespace rthdist::gpu_algo

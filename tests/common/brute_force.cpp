@@ -1,11 +1,14 @@
-#include "cpu/brute_force.hpp"
+#include "common/brute_force.hpp"
 
 #include <cmath>
 #include <limits>
 
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 
-namespace rthdist::cpu {
+namespace rthdist::oracle {
+
+using core::parallelChunks;
+using core::resolveThreads;
 namespace {
 
 struct Nearest {
@@ -101,4 +104,4 @@ std::vector<NearestExact> bruteForceNearestIndexed(std::span<const glm::vec3> qu
     return out;
 }
 
-}  // namespace rthdist::cpu
+}  // namespace rthdist::oracle

@@ -1,4 +1,4 @@
-#include "algo/input_frame.hpp"
+#include "core/input_frame.hpp"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -8,9 +8,9 @@
 #include <cstring>
 #include <string>
 
-#include "cpu/parallel.hpp"
+#include "core/parallel.hpp"
 
-namespace rthdist::algo {
+namespace rthdist::core {
 
 namespace {
 
@@ -86,9 +86,9 @@ std::optional<Error> checkShape(const PointView& points, const char* name) {
 Result<SetSummary> summarizeSet(const PointView& points, const char* name) {
     if (auto err = checkShape(points, name)) return *err;
     const char* base = static_cast<const char*>(points.data);
-    const int threads = cpu::resolveThreads(0, points.count / kChunk + 1);
+    const int threads = core::resolveThreads(0, points.count / kChunk + 1);
     std::vector<ChunkSummary> parts(static_cast<size_t>(threads));
-    cpu::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int t) {
+    core::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int t) {
         merge(parts[size_t(t)], points.scalar == Scalar::kFloat64
                                     ? summarizeChunk<double>(base, points.strideBytes, begin, end)
                                     : summarizeChunk<float>(base, points.strideBytes, begin, end));
@@ -132,8 +132,8 @@ double searchMagnitude(const SetSummary& set, const glm::dvec3& origin) {
 
 std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin) {
     std::vector<glm::vec3> out(points.count);
-    const int threads = cpu::resolveThreads(0, points.count / kChunk + 1);
-    cpu::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int) {
+    const int threads = core::resolveThreads(0, points.count / kChunk + 1);
+    core::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) out[i] = glm::vec3(points.at(i) - origin);
     });
     return out;
@@ -161,8 +161,8 @@ void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b)
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
     }
     auto perPoint = [](PerPoint& pp, const PointView& q, const PointView& t) {
-        const int threads = cpu::resolveThreads(0, pp.nearest.size() / kChunk + 1);
-        cpu::parallelChunks(pp.nearest.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
+        const int threads = core::resolveThreads(0, pp.nearest.size() / kChunk + 1);
+        core::parallelChunks(pp.nearest.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
             for (size_t i = begin; i < end; ++i) pp.distance[i] = glm::length(q.at(i) - t.at(pp.nearest[i]));
         });
     };
@@ -170,4 +170,4 @@ void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b)
     perPoint(r.bNearest, b, a);
 }
 
-}  // namespace rthdist::algo
+}  // namespace rthdist::core

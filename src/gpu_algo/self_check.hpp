@@ -16,7 +16,7 @@
 
 #include "rthdist_shared.h"
 
-namespace rthdist::algo {
+namespace rthdist::gpu_algo {
 
 class SelfCheckError : public std::runtime_error {
 public:
@@ -60,4 +60,4 @@ struct SampledQuery {
 // lower bound (the farthest query from the targets' box). "" when it holds.
 [[nodiscard]] std::string witnessFailure(double distance, uint64_t maxPacked, double lowerBound);
 
-}  // namespace rthdist::algo
+}  // namespace rthdist::gpu_algo

@@ -1,4 +1,4 @@
-#include "gpu/pipelines.hpp"
+#include "gpu_algo/pipelines.hpp"
 
 #include <algorithm>
 #include <cstring>

@@ -1,0 +1,140 @@
+#include "gpu_algo/candidate_search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace rthdist::gpu_algo {
+
+void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options,
+                                double progressFrom, double progressTo) {
+    const PointIndex& T = d.T;
+    // Small first radius, grown geometrically: measured against starting
+    // at the threshold's root, which makes every ray visit far more boxes
+    // (docs/bench/gpu.md, growth sweep).
+    double radius = 2.0 * T.grid.cellSize;
+    // Leaves: start at half the narrowest split sub-cell's edge, about the
+    // nearest-neighbour spacing of ~8 points per sub-cell (measured on
+    // lavapipe, cluster + outlier: 2x the edge made rays visit ~4x more
+    // leaves, 1/4 cost an iteration); the growth reaches the grid's scale
+    // in a few iterations.
+    if (T.split && T.minEdge > 0.0) radius = std::min(radius, 0.5 * T.minEdge);
+    // Room for ~4 pairs per cell, or per query when a split index sends
+    // the crowded regions' queries to the search (a full buffer costs a
+    // repeated iteration).
+    const uint64_t pairBase = std::max<uint64_t>(T.numCells, T.split ? numActive : 0u);
+    uint64_t pairCapacity =
+        std::min(std::clamp<uint64_t>(pairBase * 4, 1u << 16, 1u << 22), m_ws.maxPairCapacity);
+    Buffer* pairs = nullptr;
+    int builtLevel = -1;  // level of the BLAS now built (-1: none yet)
+    while (numActive > 0) {
+        if (++d.out.counters.iterations > kMaxIterations)
+            throw std::runtime_error("candidate search did not converge");
+        if (!pairs) {
+            pairs = &m_ws.buf("pairs", pairCapacity * 8);
+            pairCapacity = std::min<uint64_t>(pairs->size() / 8, m_ws.maxPairCapacity);
+        }
+        const int level = IndexBuild::searchLevelFor(T, radius);
+        const IterationCounts counts =
+            iterate(d, level, level == builtLevel, radius, *pairs, pairCapacity, numActive);
+        const uint64_t pairCount = counts.pairs;
+        builtLevel = level;
+        numActive = counts.stillOpen;
+        reportProgress(
+            options, "search",
+            progressFrom +
+                (progressTo - progressFrom) *
+                    (0.2 + 0.8 * (1.0 - double(numActive) /
+                                            double(std::max<uint64_t>(1, d.out.counters.survivingQueries)))));
+        if (pairCount > pairCapacity && pairCapacity < m_ws.maxPairCapacity) {
+            // Some queries lost pairs: redo them at the same radius with room.
+            pairCapacity =
+                std::min<uint64_t>(m_ws.maxPairCapacity, std::max<uint64_t>(pairCount, pairCapacity * 2));
+            pairs = nullptr;
+        } else if (pairCount <= pairCapacity) {
+            radius *= double(options.radiusGrowth);
+        }
+    }
+}
+
+IterationCounts CandidateSearch::iterate(DirectionRun& d, int level, bool sameLevel, double radius,
+                                         Buffer& pairs, uint64_t pairCapacity, uint32_t numActive) {
+    const PointIndex::Level lv = m_index.levelCells(d.T, level);
+    const auto t0 = Clock::now();
+    d.blk.at<uint64_t>(RTHDIST_CTR_PAIRS) = 0;
+    d.blk.at<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE) = 0;
+    VkCommandBuffer cmd = m_ws.ctx.begin();
+    cmdSearch(cmd, d, lv, sameLevel, radius, pairs, pairCapacity, numActive);
+    const uint32_t searched = m_ws.ctx.cmdMark(cmd);
+    m_ws.barrier(cmd);
+    m_refine.cmdRefine(cmd, d, lv, level > 0, float(radius), pairs, pairCapacity, numActive);
+    m_ws.ctx.submitAndWait(cmd);
+    const double searchGpu = m_ws.ctx.gpuMsBetween(0, searched), allGpu = m_ws.ctx.lastGpuMs();
+    m_ws.timings->gpuSearch += searchGpu;
+    m_ws.timings->gpuRefine += allGpu - searchGpu;
+    // The wall time split between the two stages as their device time is.
+    const double wall = msSince(t0), searchShare = allGpu > 0.0 ? searchGpu / allGpu : 1.0;
+    m_ws.timings->search += wall * searchShare;
+    m_ws.timings->refine += wall * (1.0 - searchShare);
+    d.out.counters.rays += numActive;
+    IterationCounts counts{d.blk.at<uint64_t>(RTHDIST_CTR_PAIRS),
+                           d.blk.at<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE)};
+    d.out.counters.candidatePairs += std::min<uint64_t>(counts.pairs, pairCapacity);
+    d.cur = 1 - d.cur;
+    return counts;
+}
+
+void CandidateSearch::cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv,
+                                bool sameLevel, double radius, Buffer& pairs, uint64_t pairCapacity,
+                                uint32_t numActive) {
+    PointIndex& T = d.T;
+    const float r = float(radius);
+    // The ray only has to start inside the grown boxes: a short one
+    // crosses few other boxes (leaves are far smaller than grid cells).
+    const float rayTMax = float(std::min(T.grid.cellSize, T.split ? radius : T.grid.cellSize) * 1e-3);
+    Buffer& aabbs = m_ws.buf("aabbs", VkDeviceSize(lv.count) * 24);
+    // Per-box slack: float rounding at the box's magnitude (the old
+    // global epsilon used the largest coordinate of both sets) plus,
+    // for a grid index, the grid's absolute term.
+    sh::BoxesPush bp{lv.cells->address(), aabbs.address(), lv.count,
+                     r + r * 1e-6f,       4e-7f,           T.split ? 0.0f : float(T.grid.cellSize * 1e-5)};
+    m_ws.dispatch(cmd, Kernel::kGrowBoxes, bp, lv.count);
+    gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                    VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_SHADER_READ_BIT);
+    // Same cells: the boxes only grew, so refit; new level: rebuild.
+    if (m_ws.accel.cmdBuild(cmd, aabbs.address(), lv.count, sameLevel, m_ws.pipelines.shaderStages()) ||
+        !m_ws.tlasBound) {
+        m_ws.pipelines.bindTlas(m_ws.accel.tlas());
+        m_ws.tlasBound = true;
+    }
+    sh::SearchPush sp{d.Q.sorted->address(),
+                      T.sorted->address(),
+                      lv.cells->address(),
+                      d.state->address(),
+                      d.active[d.cur]->address(),
+                      pairs.address(),
+                      d.blk.device,
+                      d.blk.addr(RTHDIST_CTR_MAX_PACKED),
+                      numActive,
+                      uint32_t(pairCapacity),
+                      r,
+                      d.lowerBound2,
+                      rayTMax,
+                      sameLevel ? 1u : 0u,
+                      0u};
+    if (m_ws.rayQuery)
+        m_ws.dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
+    else
+        cmdTraceRaysSplit(cmd, sp);
+}
+
+void CandidateSearch::cmdTraceRaysSplit(VkCommandBuffer cmd, sh::SearchPush sp) {
+    const uint64_t chunk = std::max<uint64_t>(1, m_ws.ctx.limits().maxRayDispatch);
+    for (uint64_t first = 0; first < sp.numActive; first += chunk) {
+        sp.slotBase = uint32_t(first);
+        m_ws.pipelines.cmdTraceRays(cmd, &sp, sizeof(sp),
+                                    uint32_t(std::min<uint64_t>(chunk, sp.numActive - first)));
+    }
+}
+
+}  // namespace rthdist::gpu_algo

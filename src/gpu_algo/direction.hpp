@@ -1,0 +1,39 @@
+// One direction h(Q, T) of a pair as its stages see it: the neighbourhood
+// pass (neighbourhood_pass.hpp), the candidate search and refinement
+// (candidate_search.hpp, refinement.hpp), the self-check (query_check.hpp).
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "gpu_algo/point_index.hpp"
+#include "gpu_algo/workspace.hpp"
+#include "rthdist/rthdist.hpp"
+
+namespace rthdist::gpu_algo {
+
+// What the stages of one direction h(Q, T) share. Each direction of a
+// pair counts into a counter block of its own and keeps its query states
+// in buffers of its own (tag), so both can be culled in one submission.
+struct DirectionRun {
+    const PointIndex& Q;
+    PointIndex& T;
+    std::span<const glm::vec3> qPts, tPts;  // the host's copies of what the device holds
+    const CounterBlock& blk;
+    PerPoint* perPoint = nullptr;
+    Directed out;
+    double lowerBound2Exact = 0.0;  // the boxes' bound (double), for the witness check
+    float lowerBound2 = 0.0f;       // < 0: per-point (no early break)
+    float epsilon = 0.0f;
+    Buffer* state = nullptr;                 // QueryState per query slot
+    Buffer* active[2] = {nullptr, nullptr};  // active slots, ping-pong
+    int cur = 0;                             // active[cur] holds this iteration's slots
+    std::vector<uint32_t> checkSlots;        // the self-check's sampled query slots
+    [[nodiscard]] std::string name() const { return Q.name + "->" + T.name; }
+};
+
+}  // namespace rthdist::gpu_algo

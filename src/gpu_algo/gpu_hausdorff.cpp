@@ -1,0 +1,338 @@
+#include "gpu_algo/gpu_hausdorff.hpp"
+
+#include <algorithm>
+#include <array>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/index_space.hpp"
+#include "core/input_frame.hpp"
+#include "core/parallel.hpp"
+#include "gpu/device_limits.hpp"
+#include "gpu_algo/candidate_search.hpp"
+#include "gpu_algo/direction.hpp"
+#include "gpu_algo/index_build.hpp"
+#include "gpu_algo/neighbourhood_pass.hpp"
+#include "gpu_algo/point_index.hpp"
+#include "gpu_algo/query_check.hpp"
+#include "gpu_algo/refinement.hpp"
+#include "gpu_algo/self_check.hpp"
+#include "gpu_algo/workspace.hpp"
+
+namespace rthdist::gpu_algo {
+
+using core::exactScale;
+using core::largestMagnitude;
+
+static_assert(sizeof(sh::QueryState) == 16 && offsetof(sh::QueryState, rLo) == 8);
+static_assert(sizeof(sh::SearchPush) <= 128 && sizeof(sh::CullPush) <= 128 && sizeof(sh::RefinePush) <= 128);
+
+namespace {
+
+// One-shot sets of at most this many points together are uploaded and
+// indexed in one submission, each with scratch buffers of its own.
+constexpr size_t kFusedBuildPoints = size_t(1) << 25;
+
+// Float copies of the points multiplied by a power of two in double (exact:
+// the rule keeps every product a normal float or zero).
+std::vector<glm::vec3> scaledCopy(std::span<const glm::vec3> pts, double scale) {
+    std::vector<glm::vec3> out(pts.size());
+    const int threads = core::resolveThreads(0, pts.size() / kHostChunk + 1);
+    core::parallelChunks(pts.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) out[i] = glm::vec3(glm::dvec3(pts[i]) * scale);
+    });
+    return out;
+}
+
+}  // namespace
+
+// The stages on one workspace, and the calls that run them in order: a pair
+// indexed (host staging or device ingest), both directions culled together,
+// each direction's search and self-check, the result.
+struct GpuHausdorff::State {
+    State(gpu::Context& ctx, const std::string& cacheDir)
+        : ws(ctx, cacheDir), index(ws), check(ws), cull(ws, check), refine(ws), search(ws, index, refine) {}
+
+    Workspace ws;
+    IndexBuild index;
+    QueryCheck check;
+    NeighbourhoodPass cull;
+    Refinement refine;
+    CandidateSearch search;
+
+    // The search of a direction that has survivors, then its self-check
+    // (one more submission); returns the checked witness.
+    SampledQuery searchAndCheck(DirectionRun& d, uint32_t survivors, const CallOptions& options,
+                                double progressFrom, double progressTo) {
+        search.runSearch(d, survivors, options, progressFrom, progressTo);
+        const auto t0 = Clock::now();
+        VkCommandBuffer cmd = ws.ctx.begin();
+        check.cmdCheckQueries(cmd, d, false);
+        ws.ctx.submitAndWait(cmd);
+        SampledQuery witness = check.finishCheck(d);
+        ws.timings->check += msSince(t0);
+        return witness;
+    }
+
+    // Stages `input` (float, before the scale) as set `name` for an index
+    // build: in the pool (one-shot) or in buffers of its own (owned: a
+    // prepared set). The host pass counts as upload time.
+    void stageSet(DeviceSet& set, std::span<const glm::vec3> input, double scale, int bits,
+                  const std::string& name, const std::string& scratch, bool owned = false) {
+        const auto t0 = Clock::now();
+        set.input = input;
+        set.scale = scale;
+        if (scale != 1.0) set.scaledCopy = scaledCopy(input, scale);
+        set.points = scale != 1.0 ? std::span<const glm::vec3>(set.scaledCopy) : input;
+        set.ix.name = name;
+        set.ix.scratch = scratch;
+        set.ix.owned = owned;
+        set.ix.store = owned ? &set.own : &ws.pool;
+        index.stageIndex(set.ix, set.points, bits);
+        ws.timings->upload += msSince(t0);
+    }
+
+    // A prepared set keeps only the buffers its index uses after a leaf split.
+    static void releaseUnused(DeviceSet& set) {
+        for (auto it = set.own.begin(); it != set.own.end();) {
+            const Buffer* b = &it->second;
+            const bool used =
+                b == set.ix.sorted || b == set.ix.dense || b == set.ix.cells || b == set.ix.sortedKeys;
+            it = used ? std::next(it) : set.own.erase(it);
+        }
+    }
+
+    // One-shot H of two packed float host arrays through the ingest path:
+    // one submission uploads and ingests both, the host reads their bounds
+    // (the grid and the bit count need them), a second builds both indexes.
+    // Returns false, having done nothing else, when the sets need the exact
+    // power-of-two scale (index_space.hpp), which the host path applies.
+    bool ingestPair(DeviceSet& da, DeviceSet& db, std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                    const CallOptions& options) {
+        const auto t0 = Clock::now();
+        std::array<DeviceSet*, 2> sets = {&da, &db};
+        std::array<std::span<const glm::vec3>, 2> inputs = {a, b};
+        for (size_t k = 0; k < 2; ++k) {
+            DeviceSet& set = *sets[k];
+            set.input = set.points = inputs[k];
+            set.ix.name = set.ix.scratch = k == 0 ? "A" : "B";
+            set.ix.store = &ws.pool;
+            index.stageSource(set.ix, inputs[k]);
+        }
+        VkCommandBuffer cmd = ws.ctx.begin();
+        for (DeviceSet* set : sets) index.cmdUploadSource(cmd, set->ix);
+        const uint32_t uploaded = ws.ctx.cmdMark(cmd);
+        ws.barrier(cmd);
+        for (size_t k = 0; k < 2; ++k) index.cmdIngest(cmd, sets[k]->ix, ws.blocks[k]);
+        ws.ctx.submitAndWait(cmd);
+        ws.imports.clear();  // the device has read the caller's arrays
+        const double uploadMs = ws.ctx.gpuMsBetween(0, uploaded);
+        ws.timings->upload += msSince(t0) - (ws.ctx.lastGpuMs() - uploadMs);
+        ws.timings->gpuUpload += uploadMs;
+        ws.timings->gpuIndex += ws.ctx.lastGpuMs() - uploadMs;
+        for (size_t k = 0; k < 2; ++k) index.finishIngest(sets[k]->ix, ws.blocks[k]);
+        const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
+        if (exactScale(magnitude) != 1.0) return false;
+        const auto t1 = Clock::now();
+        chooseIngestedGrids({&da.ix, &db.ix}, inputs, options.bits);
+        ws.timings->index += msSince(t1);
+        index.buildIndexes(std::array{&da.ix, &db.ix}, /*uploaded=*/true);
+        return true;
+    }
+
+    // One-shot H of two float sets through the host path: each staged by
+    // the host (vec4 copy, bounds, bit count), uploaded and indexed. Small
+    // sets: both in one submission (scratch of their own). Large ones: one
+    // after the other in the same scratch (a submission is then cheap beside
+    // the work, and the device holds one set's scratch, not two).
+    void hostPair(std::span<const glm::vec3> a, std::span<const glm::vec3> b, double scale,
+                  const CallOptions& options, HausdorffResult& res) {
+        DeviceSet da, db;
+        const bool together = a.size() + b.size() <= kFusedBuildPoints;
+        stageSet(da, a, scale, options.bits, "A", together ? "A" : "build");
+        if (!together) index.buildIndexes(std::array{&da.ix});
+        stageSet(db, b, scale, options.bits, "B", together ? "B" : "build");
+        reportProgress(options, "index", 0.05);
+        if (together)
+            index.buildIndexes(std::array{&da.ix, &db.ix});
+        else
+            index.buildIndexes(std::array{&db.ix});
+        reportProgress(options, "index", 0.1);
+        runPair(da, db, options, res, 0.1);
+    }
+
+    // H (or h) of two indexed sets of one scale into `res`; progress covers
+    // [from, 1] of the call.
+    void runPair(DeviceSet& a, DeviceSet& b, const CallOptions& options, HausdorffResult& res, double from) {
+        const bool pp = options.perPointDistances;
+        const double mid = options.directedOnly ? 1.0 : from + 0.5 * (1.0 - from);
+        DirectionRun ab{a.ix, b.ix, a.points, b.points, ws.blocks[0], pp ? &res.aNearest : nullptr};
+        DirectionRun ba{b.ix, a.ix, b.points, a.points, ws.blocks[1], pp ? &res.bNearest : nullptr};
+        cull.startDirection(ab, "ab");
+        if (!options.directedOnly) cull.startDirection(ba, "ba");
+        // Both culls (and their checks) in one submission; a direction with
+        // survivors searches, then checks again.
+        std::array<uint32_t, 2> survivors{};
+        if (options.directedOnly)
+            survivors[0] = cull.runCulls(std::array{&ab})[0];
+        else
+            survivors = cull.runCulls(std::array{&ab, &ba});
+        reportProgress(options, "cull", from + 0.2 * (1.0 - from));
+        const auto directed = [&](DirectionRun& d, uint32_t n, double lo, double hi) {
+            const SampledQuery witness = n > 0 ? searchAndCheck(d, n, options, lo, hi) : check.finishCheck(d);
+            const auto t0 = Clock::now();
+            Directed out = check.finishDirection(d, witness);
+            ws.timings->check += msSince(t0);
+            return out;
+        };
+        res.aToB = directed(ab, survivors[0], from, mid);
+        res.hausdorff = res.aToB.distance;
+        if (!options.directedOnly) {
+            res.bToA = directed(ba, survivors[1], mid, 1.0);
+            res.hausdorff = std::max(res.hausdorff, res.bToA.distance);
+        }
+        // Witnesses and per-point distances from the unscaled inputs, in double.
+        if (a.scale != 1.0) core::restoreOriginal(res, PointView(a.input), PointView(b.input));
+    }
+
+    HausdorffResult emptyResult(const CallOptions& options) const {
+        HausdorffResult res;
+        res.backend = ws.ctx.backend();
+        res.device = ws.ctx.deviceName();
+        res.directedOnly = options.directedOnly;
+        return res;
+    }
+
+    // Runs `work` with its timings in `timings`, and turns what it throws
+    // into the error codes of the API (the accel structures are dropped, so
+    // the next call starts clean).
+    template <class Work>
+    std::optional<Error> guarded(Timings& into, Work&& work) {
+        ws.timings = &into;
+        std::optional<Error> err;
+        try {
+            work();
+        } catch (const InputRejected& e) {
+            err = e.error;
+        } catch (const CallCancelled&) {
+            err = Error{ErrorCode::kCancelled, "the call was cancelled (CallOptions::cancel)"};
+        } catch (const gpu::VulkanError& e) {
+            const bool oom =
+                e.result() == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result() == VK_ERROR_OUT_OF_HOST_MEMORY;
+            err = oom ? Error{ErrorCode::kOutOfMemory,
+                              std::string("the inputs do not fit the device: ") + e.what()}
+                      : Error{ErrorCode::kInternal, e.what()};
+            err->vkResult = int(e.result());
+        } catch (const gpu::LimitError& e) {
+            err =
+                Error{ErrorCode::kOutOfMemory, std::string("the inputs do not fit the device: ") + e.what()};
+        } catch (const std::exception& e) {
+            err = Error{ErrorCode::kInternal, e.what()};
+        }
+        ws.timings = nullptr;
+        ws.imports.clear();  // never past the call: the caller may free its arrays
+        if (err) {
+            ws.accel.release();
+            ws.tlasBound = false;
+        }
+        return err;
+    }
+};
+
+GpuHausdorff::GpuHausdorff(std::unique_ptr<State> state) : m_state(std::move(state)) {}
+GpuHausdorff::~GpuHausdorff() = default;
+
+void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
+    m_state->ws.maxPairCapacity = std::max<uint64_t>(1, pairs);
+}
+
+Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, const std::string& cacheDir) {
+    try {
+        return std::unique_ptr<GpuHausdorff>(new GpuHausdorff(std::make_unique<State>(ctx, cacheDir)));
+    } catch (const gpu::VulkanError& e) {
+        return Error{ErrorCode::kInternal, std::string("pipeline creation failed: ") + e.what()};
+    }
+}
+
+Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                              double scale, const CallOptions& options) {
+    State& st = *m_state;
+    HausdorffResult res = st.emptyResult(options);
+    // Squared distances are float on the device: coordinates so large (or so
+    // small) that they overflow (or underflow) are scaled by a power of two,
+    // which is exact; values and witnesses are recomputed from the inputs.
+    // Each set is indexed once with its own grid: as targets for the other
+    // direction, and as cell-ordered (Morton) queries for its own.
+    auto err = st.guarded(res.timings, [&] { st.hostPair(a, b, scale, options, res); });
+    if (err) return *err;
+    return res;
+}
+
+Result<HausdorffResult> GpuHausdorff::computePacked(std::span<const glm::vec3> a,
+                                                    std::span<const glm::vec3> b,
+                                                    const CallOptions& options) {
+    State& st = *m_state;
+    HausdorffResult res = st.emptyResult(options);
+    auto err = st.guarded(res.timings, [&] {
+        DeviceSet da, db;
+        if (!st.ingestPair(da, db, a, b, options)) {
+            // Coordinates past 2^40 or below 2^-40: the host path scales them.
+            const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
+            st.hostPair(a, b, exactScale(magnitude), options, res);
+            return;
+        }
+        reportProgress(options, "index", 0.1);
+        st.runPair(da, db, options, res, 0.1);
+    });
+    if (err) return *err;
+    return res;
+}
+
+bool GpuHausdorff::ingests(size_t aPoints, size_t bPoints) { return aPoints + bPoints <= kFusedBuildPoints; }
+
+Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                              const CallOptions& options) {
+    return compute(a, b, exactScale(std::max(largestMagnitude(a), largestMagnitude(b))), options);
+}
+
+Result<std::shared_ptr<DeviceSet>> GpuHausdorff::prepare(std::span<const glm::vec3> points, double scale,
+                                                         int bits, const std::string& name,
+                                                         Timings& timings) {
+    auto set = std::make_shared<DeviceSet>();
+    auto err = m_state->guarded(timings, [&] {
+        m_state->stageSet(*set, points, scale, bits, name, "build", true);
+        m_state->index.buildIndexes(std::array{&set->ix});
+        State::releaseUnused(*set);
+    });
+    if (err) return *err;
+    return set;
+}
+
+Result<HausdorffResult> GpuHausdorff::compute(DeviceSet& a, DeviceSet& b, const CallOptions& options) {
+    HausdorffResult res = m_state->emptyResult(options);
+    auto err = m_state->guarded(res.timings, [&] {
+        throwIfCancelled(options);
+        m_state->runPair(a, b, options, res, 0.0);
+    });
+    if (err) return *err;
+    return res;
+}
+
+uint64_t GpuHausdorff::deviceBytes(const DeviceSet& set) {
+    uint64_t bytes = 0;
+    for (const auto& [name, buffer] : set.own) bytes += buffer.size();
+    return bytes;
+}
+
+int GpuHausdorff::bits(const DeviceSet& set) { return set.ix.grid.bits; }
+
+const std::string& GpuHausdorff::pipelineCachePath() const { return m_state->ws.pipelineCache.path(); }
+const std::string& GpuHausdorff::pipelineCacheStatus() const {
+    return m_state->ws.pipelineCache.loadStatus();
+}
+
+}  // namespace rthdist::gpu_algo

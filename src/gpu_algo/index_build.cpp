@@ -1,0 +1,161 @@
+#include "gpu_algo/index_build.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/parallel.hpp"
+#include "gpu/device_limits.hpp"
+#include "gpu_algo/self_check.hpp"
+
+namespace rthdist::gpu_algo {
+
+int clampedBits(int bits, uint32_t n) {
+    while (bits > core::kMinBits && (uint64_t(1) << (3 * bits)) > 8 * uint64_t(n) + 4096) --bits;
+    return bits;
+}
+
+void IndexBuild::stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int bits) {
+    ix.n = uint32_t(pts.size());
+    const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
+    Buffer& staging = m_ws.buf(ix.scratch + ".staging", bytes, MemoryKind::kHost);
+    auto* dst = static_cast<float*>(staging.mapped());
+    const int threads = core::resolveThreads(0, ix.n / kHostChunk + 1);
+    std::vector<glm::vec3> lo(size_t(threads), pts[0]), hi(size_t(threads), pts[0]);
+    core::parallelChunks(ix.n, kHostChunk, threads, [&](size_t begin, size_t end, int t) {
+        glm::vec3 l = lo[size_t(t)], h = hi[size_t(t)];
+        for (size_t i = begin; i < end; ++i) {
+            const glm::vec3 p = pts[i];
+            dst[4 * i + 0] = p.x;
+            dst[4 * i + 1] = p.y;
+            dst[4 * i + 2] = p.z;
+            dst[4 * i + 3] = 0.0f;
+            l = glm::min(l, p);
+            h = glm::max(h, p);
+        }
+        lo[size_t(t)] = l;
+        hi[size_t(t)] = h;
+    });
+    for (int t = 1; t < threads; ++t) {
+        lo[0] = glm::min(lo[0], lo[size_t(t)]);
+        hi[0] = glm::max(hi[0], hi[size_t(t)]);
+    }
+    ix.bounds.lo = glm::dvec3(lo[0]);
+    ix.bounds.hi = glm::dvec3(hi[0]);
+    if (bits <= 0) {
+        bits = clampedBits(core::chooseBits(pts, ix.bounds), ix.n);
+    }
+    ix.grid = core::makeGrid(ix.bounds, bits);
+}
+
+void IndexBuild::cmdUpload(VkCommandBuffer cmd, PointIndex& ix) {
+    const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
+    Buffer& points = m_ws.buf(ix.scratch + ".points", bytes);
+    const VkBufferCopy region{0, 0, bytes};
+    vkCmdCopyBuffer(cmd, m_ws.buf(ix.scratch + ".staging", bytes, MemoryKind::kHost).handle(),
+                    points.handle(), 1, &region);
+}
+
+void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const CounterBlock& blk) {
+    const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
+    Buffer& points = m_ws.buf(ix.scratch + ".points", bytes);
+    const uint32_t numKeys = 1u << (3 * ix.grid.bits);
+    Buffer& keys = m_ws.buf(ix.scratch + ".keys", VkDeviceSize(ix.n) * 4);
+    ix.sortedKeys = &m_ws.setBuf(ix, ".sortedKeys", VkDeviceSize(ix.n) * 4);
+    Buffer& flags = m_ws.buf(ix.scratch + ".flags", VkDeviceSize(ix.n) * 4);
+    const VkDeviceSize denseBytes = VkDeviceSize(numKeys) * 4;
+    ix.dense = &m_ws.setBuf(ix, ".dense", denseBytes);
+    ix.sorted = &m_ws.setBuf(ix, ".sorted", bytes);
+    // Cells: at most one per point or key; the upper bound avoids a read-back.
+    ix.cellCapacity = std::min<uint64_t>(ix.n, numKeys);
+    ix.cells = &m_ws.setBuf(ix, ".cells", VkDeviceSize(ix.cellCapacity) * sizeof(sh::Cell));
+
+    blk.at<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
+    blk.at<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
+    vkCmdFillBuffer(cmd, ix.dense->handle(), 0, denseBytes, 0);
+    m_ws.barrier(cmd);
+    sh::KeysPush kp{points.address(), keys.address(), ix.dense->address(), gridParams(ix.grid), ix.n};
+    m_ws.dispatch(cmd, Kernel::kCellKeys, kp, ix.n);
+    m_ws.barrier(cmd);
+    m_ws.cmdScan(cmd, ix.dense->address(), numKeys, ix.scratch + ".scanKeys", 0);
+    m_ws.barrier(cmd);
+    sh::ScatterPush sp{points.address(),     keys.address(),           ix.dense->address(),
+                       ix.sorted->address(), ix.sortedKeys->address(), ix.n};
+    m_ws.dispatch(cmd, Kernel::kScatter, sp, ix.n);
+    m_ws.barrier(cmd);
+    sh::CellsPush cp{ix.sorted->address(),
+                     ix.sortedKeys->address(),
+                     flags.address(),
+                     ix.dense->address(),
+                     ix.cells->address(),
+                     blk.addr(RTHDIST_CTR_CELLS),
+                     blk.addr(RTHDIST_CTR_MAX_COUNT),
+                     m_ws.buf(ix.scratch + ".boundsU", VkDeviceSize(ix.cellCapacity) * 24).address(),
+                     blk.addr(RTHDIST_CTR_LARGE_CELLS),
+                     ix.n,
+                     uint32_t(ix.cellCapacity)};
+    m_ws.dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
+    m_ws.barrier(cmd);
+    m_ws.cmdScan(cmd, flags.address(), ix.n, ix.scratch + ".scanFlags", 0);
+    m_ws.barrier(cmd);
+    cmdCellBuild(cmd, cp);
+    m_ws.barrier(cmd);
+    cmdCheckIndex(cmd, ix, blk);  // in the same submission: no extra wait
+}
+
+void IndexBuild::finishIndex(PointIndex& ix, const CounterBlock& blk) {
+    ix.numCells = blk.at<uint32_t>(RTHDIST_CTR_CELLS);
+    verifyIndex(ix, ix.cellCapacity, blk);
+    if (blk.at<uint32_t>(RTHDIST_CTR_MAX_COUNT) > kCrowdedCell) splitLeaves(ix);
+}
+
+void IndexBuild::buildIndexes(std::span<PointIndex* const> sets, bool ingested) {
+    if (sets.size() > m_ws.blocks.size())
+        throw std::logic_error("buildIndexes: more sets than counter blocks");
+    auto t0 = Clock::now();
+    VkCommandBuffer cmd = m_ws.ctx.begin();
+    for (PointIndex* ix : sets)
+        if (!ingested) cmdUpload(cmd, *ix);
+    const uint32_t uploaded = m_ws.ctx.cmdMark(cmd);
+    m_ws.barrier(cmd);
+    for (size_t k = 0; k < sets.size(); ++k) cmdBuildIndex(cmd, *sets[k], m_ws.blocks[k]);
+    m_ws.ctx.submitAndWait(cmd);
+    const double uploadMs = m_ws.ctx.gpuMsBetween(0, uploaded);
+    m_ws.timings->upload += uploadMs;
+    m_ws.timings->gpuUpload += uploadMs;
+    m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs() - uploadMs;
+    for (size_t k = 0; k < sets.size(); ++k) finishIndex(*sets[k], m_ws.blocks[k]);
+    m_ws.timings->index += msSince(t0) - uploadMs;
+}
+
+void IndexBuild::cmdCellBuild(VkCommandBuffer cmd, const sh::CellsPush& cp) {
+    m_ws.dispatch(cmd, Kernel::kCellBuild, cp, cp.n);
+    m_ws.barrier(cmd);
+    m_ws.dispatch(cmd, Kernel::kCellBounds, cp, cp.n);
+    m_ws.barrier(cmd);
+    m_ws.dispatch(cmd, Kernel::kCellBoundsFix, cp, cp.cellCapacity);
+}
+
+void IndexBuild::cmdCheckIndex(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {
+    blk.at<uint64_t>(RTHDIST_CTR_CHECK_SUM) = 0;
+    blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
+    sh::CheckPush cp{
+        ix.sorted->address(), ix.sortedKeys->address(), 0, blk.device, gridParams(ix.grid), ix.n, 0u};
+    m_ws.dispatch(cmd, Kernel::kCheckIndex, cp, ix.n);
+}
+
+void IndexBuild::verifyIndex(const PointIndex& ix, uint64_t cellCapacity, const CounterBlock& blk) {
+    const uint64_t n = ix.n;
+    const uint64_t expectedSum = n % 2 == 0 ? (n / 2) * (n - 1) : n * ((n - 1) / 2);
+    std::string why =
+        indexCheckFailure(n, blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD), blk.at<uint64_t>(RTHDIST_CTR_CHECK_SUM),
+                          expectedSum, ix.numCells, cellCapacity);
+    if (!why.empty()) throw SelfCheckError("index of " + ix.name + ": " + why);
+}
+
+}  // namespace rthdist::gpu_algo

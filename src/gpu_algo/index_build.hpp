@@ -1,0 +1,111 @@
+// Step 1 of RT-HDIST on the device: a point set into its index (cell keys,
+// counting sort over the dense key table, run-length encoding into cells
+// with tight boxes, the index's self-check), from host arrays staged by the
+// host (index_build.cpp) or ingested by the device (ingest.cpp); crowded
+// cells cut into leaves (leaf_split.cpp); coarser search levels built on
+// first use (search_levels.cpp).
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "gpu_algo/point_index.hpp"
+#include "gpu_algo/workspace.hpp"
+
+namespace rthdist::gpu_algo {
+
+// The dense key table costs O(2^(3k)) to clear and scan: an automatic bit
+// count keeps it within a few entries per point.
+[[nodiscard]] int clampedBits(int bits, uint32_t n);
+
+// The bit counts and grids of two ingested sets, side by side: their bounds
+// come from the device, their bit counts from a strided sample of the
+// caller's arrays (chooseBits reads ~32k points in place, ~0.2-0.4 ms each).
+void chooseIngestedGrids(const std::array<PointIndex*, 2>& sets,
+                         const std::array<std::span<const glm::vec3>, 2>& pts, int bits);
+
+class IndexBuild {
+public:
+    explicit IndexBuild(Workspace& workspace) : m_ws(workspace) {}
+
+    // Host half of an index build: the points into the set's staging buffer
+    // (vec4) in one parallel pass that also takes their bounds, then the bit
+    // count and the grid. Nothing is submitted.
+    void stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int bits);
+
+    // The staged points' copy to the device (before cmdBuildIndex, with a
+    // barrier between: several sets' copies run back to back).
+    void cmdUpload(VkCommandBuffer cmd, PointIndex& ix);
+
+    // Device half of an index build, recorded into `cmd` after the upload:
+    // cell keys, counting sort over the dense key table, run-length encoding
+    // into cells with tight boxes, the self-check. Counters go to `blk`;
+    // scratch buffers are the set's own (ix.scratch), so two sets can be
+    // built in one submission.
+    void cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const CounterBlock& blk);
+
+    // After the build's submission: the self-check's verdict and the cell
+    // count from `blk`; crowded cells are split into leaves (own submissions).
+    void finishIndex(PointIndex& ix, const CounterBlock& blk);
+
+    // Indexes the staged sets (one or two) in one submission: both uploads
+    // back to back, then each build; then each set's checks and leaves.
+    // (At most one set per counter block: two.)
+    void buildIndexes(std::span<PointIndex* const> sets, bool ingested = false);
+
+    // One Cell per run of equal keys (heads flagged and scanned before):
+    // small cells' boxes by their head thread, large cells' in parallel.
+    void cmdCellBuild(VkCommandBuffer cmd, const sh::CellsPush& cp);
+
+    // Self-check of an index, recorded after its build (check_index.comp);
+    // verifyIndex reads the verdict once the submission has completed.
+    void cmdCheckIndex(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk);
+
+    void verifyIndex(const PointIndex& ix, uint64_t cellCapacity, const CounterBlock& blk);
+
+    // The device ingest path (ingest.comp) for packed float host arrays:
+    // the device reads each array from a host-visible copy (the host's only
+    // pass over the points) or, with imports on (gpu/host_import.hpp), where
+    // it lies. The device uploads it, checks it and takes its bounds. Sets
+    // `ix.n`; nothing is submitted.
+    void stageSource(PointIndex& ix, std::span<const glm::vec3> pts);
+
+    // Records the upload of a staged source (stageSource) into device memory.
+    void cmdUploadSource(VkCommandBuffer cmd, const PointIndex& ix);
+
+    // Records the ingest of an uploaded source into the set's vec4 points
+    // and its summary in `blk`.
+    void cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk);
+
+    // After the ingest's submission: the set's bounds from `blk`, or the
+    // error naming its first point that is not finite (as summarizeSet
+    // words it for host input).
+    void finishIngest(PointIndex& ix, const CounterBlock& blk);
+
+    // Cuts the crowded cells of `ix` into leaves (leaf_*.comp), round by
+    // round, then checks the index again. Each round is one submission: a
+    // counting sort by slot inside every cell, and the cells of the new order.
+    void splitLeaves(PointIndex& ix);
+
+    // Search cells of level `level` (>= 1) of T, coarsened from the level
+    // below on first use (coarsen.comp: head flags, scan, build).
+    const PointIndex::Level& searchLevel(PointIndex& T, int level);
+
+    // Search cells about an eighth of the radius wide: level j with
+    // s * 2^j <= R / 8, at least 1, at most bits - 1. Wider cells mean fewer
+    // boxes per ray but longer scans in the refinement; R/2 and R/4 were
+    // slower overall on the lavapipe scenarios (README). A split index
+    // searches its leaves (level 0) until level 1 is due.
+    [[nodiscard]] static int searchLevelFor(const PointIndex& T, double radius);
+
+    // The search cells of `level` (0: the index's own cells or leaves).
+    PointIndex::Level levelCells(PointIndex& T, int level);
+
+private:
+    Workspace& m_ws;
+};
+
+}  // namespace rthdist::gpu_algo

@@ -1,0 +1,99 @@
+#include "gpu_algo/index_build.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/parallel.hpp"
+#include "gpu/device_limits.hpp"
+#include "gpu_algo/self_check.hpp"
+
+namespace rthdist::gpu_algo {
+
+void IndexBuild::splitLeaves(PointIndex& ix) {
+    const VkDeviceSize n = ix.n;
+    Buffer* sorted[2] = {ix.sorted, &m_ws.setBuf(ix, ".sorted2", n * 16)};
+    Buffer* gridKeys[2] = {ix.sortedKeys, &m_ws.setBuf(ix, ".sortedKeys2", n * 4)};
+    Buffer* leaves[2] = {&m_ws.setBuf(ix, ".leaves0", n * sizeof(sh::Cell)),
+                         &m_ws.setBuf(ix, ".leaves1", n * sizeof(sh::Cell))};
+    Buffer& slotKeys = m_ws.buf("slotKeys", n * 4);
+    Buffer& outSlotKeys = m_ws.buf("outSlotKeys", n * 4);
+    Buffer& flags = m_ws.buf("flags", n * 4);
+    Buffer* cells = ix.cells;
+    int cur = 0;
+    m_ws.counter<uint32_t>(RTHDIST_CTR_MIN_EDGE) = 0x7f800000u;  // +inf
+    for (int round = 0; round < kMaxSplitRounds; ++round) {
+        // All slots together: one per kept cell, 8^k <= count per split one.
+        const uint64_t numSlots = uint64_t(ix.n) + ix.numCells;
+        gpu::requireWithin(numSlots, uint64_t(UINT32_MAX), "slots of a leaf split", "2^32 - 1");
+        Buffer& slotBase = m_ws.buf("slotBase", VkDeviceSize(ix.numCells) * 4);
+        Buffer& dense = m_ws.buf("slotDense", VkDeviceSize(numSlots) * 4);
+        Buffer* outCells = leaves[round % 2];
+        m_ws.counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
+        m_ws.counter<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
+        VkCommandBuffer cmd = m_ws.ctx.begin();
+        sh::SplitPush sp{cells->address(),
+                         slotBase.address(),
+                         sorted[cur]->address(),
+                         gridKeys[cur]->address(),
+                         dense.address(),
+                         slotKeys.address(),
+                         sorted[1 - cur]->address(),
+                         gridKeys[1 - cur]->address(),
+                         outSlotKeys.address(),
+                         m_ws.blocks[0].addr(RTHDIST_CTR_MIN_EDGE),
+                         ix.numCells,
+                         ix.n,
+                         kLeafMax};
+        m_ws.dispatch(cmd, Kernel::kLeafSlots, sp, ix.numCells);
+        vkCmdFillBuffer(cmd, dense.handle(), 0, VkDeviceSize(numSlots) * 4, 0);
+        m_ws.barrier(cmd);
+        m_ws.cmdScan(cmd, slotBase.address(), ix.numCells, "scanSlots", 0);
+        m_ws.barrier(cmd);
+        m_ws.dispatch(cmd, Kernel::kLeafKeys, sp, ix.n);
+        m_ws.barrier(cmd);
+        m_ws.cmdScan(cmd, dense.address(), uint32_t(numSlots), "scanDense", 0);
+        m_ws.barrier(cmd);
+        m_ws.dispatch(cmd, Kernel::kLeafScatter, sp, ix.n);
+        m_ws.barrier(cmd);
+        sh::CellsPush cp{sorted[1 - cur]->address(),
+                         outSlotKeys.address(),
+                         flags.address(),
+                         dense.address(),
+                         outCells->address(),
+                         m_ws.cellsCounterAddr(),
+                         m_ws.maxCountAddr(),
+                         m_ws.boundsU(n).address(),
+                         m_ws.blocks[0].addr(RTHDIST_CTR_LARGE_CELLS),
+                         ix.n,
+                         ix.n};
+        m_ws.dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
+        m_ws.barrier(cmd);
+        m_ws.cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
+        m_ws.barrier(cmd);
+        cmdCellBuild(cmd, cp);
+        m_ws.ctx.submitAndWait(cmd);
+        m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
+        cur = 1 - cur;
+        cells = outCells;
+        ix.numCells = m_ws.counter<uint32_t>(RTHDIST_CTR_CELLS);
+        if (m_ws.counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) <= kLeafMax) break;
+    }
+    ix.sorted = sorted[cur];
+    ix.sortedKeys = gridKeys[cur];
+    ix.cells = cells;
+    ix.split = true;
+    const float edge = std::bit_cast<float>(m_ws.counter<uint32_t>(RTHDIST_CTR_MIN_EDGE));
+    ix.minEdge = std::isfinite(edge) ? double(edge) : 0.0;
+    VkCommandBuffer cmd = m_ws.ctx.begin();
+    cmdCheckIndex(cmd, ix, m_ws.blocks[0]);
+    m_ws.ctx.submitAndWait(cmd);
+    verifyIndex(ix, ix.n, m_ws.blocks[0]);
+}
+
+}  // namespace rthdist::gpu_algo

@@ -1,0 +1,89 @@
+#include "gpu_algo/neighbourhood_pass.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include <glm/glm.hpp>
+
+namespace rthdist::gpu_algo {
+namespace {
+
+// The square of the largest excess of q's box over t's box along one axis
+// (0 when q's box lies inside t's): a lower bound of h(Q, T)^2.
+double boxLowerBound2(const core::Bounds& q, const core::Bounds& t) {
+    const glm::dvec3 excess = glm::max(glm::max(q.hi - t.hi, t.lo - q.lo), glm::dvec3(0.0));
+    const double e = std::max({excess.x, excess.y, excess.z});
+    return e * e;
+}
+
+}  // namespace
+
+void NeighbourhoodPass::startDirection(DirectionRun& d, const std::string& tag) {
+    Counters& cnt = d.out.counters;
+    cnt.bits = uint32_t(d.T.grid.bits);
+    cnt.occupiedCells = d.T.numCells;
+    cnt.queries = d.Q.n;
+    // Witness-less lower bound from the two boxes alone (no pass over the
+    // points): each face of Q's tight box holds a query, whose distance
+    // to BV(T), hence to T, is at least that face's excess over T's box
+    // on its axis. Shrunk a little so float rounding never kills the
+    // query that realizes h.
+    d.lowerBound2Exact = boxLowerBound2(d.Q.bounds, d.T.bounds);
+    // Per-point distances need every query's NN: a negative bound turns
+    // the early break off in every shader (deadThreshold returns 0).
+    d.lowerBound2 = d.perPoint ? -1.0f : float(d.lowerBound2Exact * (1.0 - 1e-5));
+    double maxAbs = 0.0;
+    for (const core::Bounds* b : {&d.Q.bounds, static_cast<const core::Bounds*>(&d.T.bounds)})
+        maxAbs = std::max({maxAbs, std::abs(b->lo.x), std::abs(b->lo.y), std::abs(b->lo.z), std::abs(b->hi.x),
+                           std::abs(b->hi.y), std::abs(b->hi.z)});
+    d.epsilon = float(maxAbs * 4e-7 + d.T.grid.cellSize * 1e-5);
+    d.state = &m_ws.buf(tag + ".state", VkDeviceSize(d.Q.n) * sizeof(sh::QueryState));
+    d.active[0] = &m_ws.buf(tag + ".active0", VkDeviceSize(d.Q.n) * 4);
+    d.active[1] = &m_ws.buf(tag + ".active1", VkDeviceSize(d.Q.n) * 4);
+    d.checkSlots = sampleSlots(d.Q.n, kCheckSamples);
+}
+
+void NeighbourhoodPass::cmdCull(VkCommandBuffer cmd, DirectionRun& d) {
+    std::memset(d.blk.host, 0, 32);  // ACTIVE .. PAIRS
+    sh::CullPush cull{d.Q.sorted->address(),
+                      d.T.sorted->address(),
+                      d.T.dense->address(),
+                      d.state->address(),
+                      d.blk.addr(RTHDIST_CTR_MAX_PACKED),
+                      gridParams(d.T.grid),
+                      d.Q.n,
+                      d.lowerBound2,
+                      d.epsilon,
+                      0u,             // search cells are coarser than the block's cells
+                      kCrowdedCell};  // past it: split leaves, or copies of one point
+    m_ws.dispatch(cmd, Kernel::kCull, cull, d.Q.n);
+    m_ws.barrier(cmd);
+    sh::CompactPush comp{
+        d.state->address(), d.active[0]->address(), d.blk.device, d.blk.addr(RTHDIST_CTR_MAX_PACKED), d.Q.n,
+        d.lowerBound2};
+    m_ws.dispatch(cmd, Kernel::kCompact, comp, d.Q.n);
+}
+
+std::array<uint32_t, 2> NeighbourhoodPass::runCulls(std::span<DirectionRun* const> dirs) {
+    if (dirs.size() > 2) throw std::logic_error("runCulls: more directions than counter blocks");
+    const auto t0 = Clock::now();
+    VkCommandBuffer cmd = m_ws.ctx.begin();
+    for (DirectionRun* d : dirs) cmdCull(cmd, *d);
+    m_ws.barrier(cmd);
+    const uint32_t culled = m_ws.ctx.cmdMark(cmd);
+    for (DirectionRun* d : dirs) m_check.cmdCheckQueries(cmd, *d, true);
+    m_ws.ctx.submitAndWait(cmd);
+    m_ws.timings->gpuCull += m_ws.ctx.gpuMsBetween(0, culled);
+    std::array<uint32_t, 2> survivors{};
+    for (size_t k = 0; k < dirs.size(); ++k) {
+        survivors[k] = dirs[k]->blk.at<uint32_t>(RTHDIST_CTR_ACTIVE);
+        dirs[k]->out.counters.survivingQueries = survivors[k];
+        dirs[k]->out.counters.culledByNeighbourhood = dirs[k]->Q.n - survivors[k];
+    }
+    m_ws.timings->cull += msSince(t0);
+    return survivors;
+}
+
+}  // namespace rthdist::gpu_algo

@@ -1,0 +1,20 @@
+#include "gpu_algo/point_index.hpp"
+
+namespace rthdist::gpu_algo {
+
+static_assert(sizeof(sh::Cell) == 32 && offsetof(sh::Cell, hi) == 16 && offsetof(sh::Cell, count) == 28);
+static_assert(sizeof(sh::GridParams) == 32);
+
+sh::GridParams gridParams(const core::GridSpec& g) {
+    sh::GridParams p{};
+    p.originX = float(g.origin.x);
+    p.originY = float(g.origin.y);
+    p.originZ = float(g.origin.z);
+    p.cellSize = float(g.cellSize);
+    p.invCellSize = float(1.0 / g.cellSize);
+    p.bits = uint32_t(g.bits);
+    p.cellsPerAxis = g.cellsPerAxis;
+    return p;
+}
+
+}  // namespace rthdist::gpu_algo

@@ -1,0 +1,93 @@
+// A point set sorted into the cells of its own grid on the device (the index
+// space of RT-HDIST, DESIGN §2), and the set a prepared call or a one-shot
+// call holds: its index, the buffers it owns, the float points behind it.
+// Data only; IndexBuild (index_build.hpp) fills them.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/index_space.hpp"
+#include "gpu/buffer.hpp"
+#include "rthdist_shared.h"
+
+namespace rthdist::gpu {
+class HostImport;
+}
+
+namespace rthdist::gpu_algo {
+
+using gpu::Buffer;
+namespace sh = rthdist::shared;
+
+// Density-robust index (issue 17): a uniform grid over the bounding box puts a
+// dense cluster into a few cells when a stray point stretches the box. A cell
+// of more than kCrowdedCell points (not all one point) switches the index to
+// leaves: crowded cells are cut into sub-cells of their own tight box until no
+// leaf that can split holds more than kLeafMax points. The neighbourhood pass
+// scans at most kCrowdedCell points of a cell (a larger one is split, or holds
+// copies of one point, whose first copy stands for all), so no stage's
+// work per query depends on how many points share a grid cell. (The Dragon's
+// fullest cell holds 134 points; even data stays on the grid path.)
+inline constexpr uint32_t kCrowdedCell = 512;
+inline constexpr uint32_t kLeafMax = RTHDIST_LEAF_MAX;
+// Each round narrows a leaf >= 2x per axis; past it: bigger leaves.
+inline constexpr int kMaxSplitRounds = 12;
+// Points per host work item (the host's copies and bounds).
+inline constexpr size_t kHostChunk = size_t(1) << 16;
+
+struct PointIndex {
+    uint32_t n = 0;
+    core::GridSpec grid;
+    core::Bounds bounds;
+    Buffer* sorted = nullptr;  // vec4: xyz, w = original index bits (cell order)
+    Buffer* dense = nullptr;   // uint per key: end of the key's cell
+    Buffer* cells = nullptr;   // Cell per occupied cell
+    uint32_t numCells = 0;
+    uint64_t cellCapacity = 0;     // room of `cells` at the build: min(n, keys)
+    Buffer* sortedKeys = nullptr;  // fine key per sorted point (builds coarser levels)
+    std::string name;              // "A", "B" or "set#N": names its buffers and its messages
+    std::string scratch;           // prefix of its build's pooled scratch buffers ("A", "B", "build")
+    const gpu::HostImport* source = nullptr;  // ingest: the caller's array imported in place, if it could be
+    // Where its buffers live: the engine's pool (one-shot sets, reused by
+    // name by the next call) or a prepared set's own map (exact sizes).
+    std::map<std::string, Buffer>* store = nullptr;
+    bool owned = false;
+    // Leaves: `cells` are sub-cells of crowded grid cells (still contiguous
+    // runs inside their grid cells), searched directly while the radius is
+    // small; minEdge is the narrowest split sub-cell's edge (first radius).
+    bool split = false;
+    double minEdge = 0.0;
+    // Search cells by level j >= 1 (edge s * 2^j), built on first use.
+    struct Level {
+        Buffer* cells = nullptr;
+        Buffer* fineFirst = nullptr;  // uint per cell: its first level-0 cell
+        uint32_t count = 0;
+    };
+    std::vector<Level> levels;
+};
+
+// A set indexed on the device (DeviceSet in gpu_hausdorff.hpp): its index,
+// the buffers it owns (prepared) and the float points the device holds.
+struct DeviceSet {
+    DeviceSet() = default;
+    DeviceSet(const DeviceSet&) = delete;  // ix.store may point into `own`
+    DeviceSet& operator=(const DeviceSet&) = delete;
+
+    std::map<std::string, Buffer> own;  // a prepared set's buffers (empty for one-shot sets)
+    PointIndex ix;
+    std::span<const glm::vec3> input;   // the backend's input (float, before the scale)
+    std::vector<glm::vec3> scaledCopy;  // input * scale when scale != 1
+    std::span<const glm::vec3> points;  // what the device holds: input or scaledCopy
+    double scale = 1.0;
+};
+
+// The grid as the shaders read it (rthdist_shared.h).
+[[nodiscard]] sh::GridParams gridParams(const core::GridSpec& g);
+
+}  // namespace rthdist::gpu_algo

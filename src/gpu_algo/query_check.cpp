@@ -1,0 +1,97 @@
+#include "gpu_algo/query_check.hpp"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace rthdist::gpu_algo {
+
+void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, bool afterCull) {
+    d.blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
+    const VkDeviceSize readback = d.blk.offset + RTHDIST_CTR_READBACK;
+    const VkDeviceSize witnessAt = readback + VkDeviceSize(d.checkSlots.size()) * 32;
+    sh::CheckPush cp{d.Q.sorted->address(),
+                     0,
+                     d.state->address(),
+                     d.blk.device,
+                     {},
+                     d.Q.n,
+                     d.perPoint ? 1u : 0u,
+                     m_ws.hostSmall.address() + witnessAt,
+                     afterCull ? 1u : 0u,
+                     0u};
+    m_ws.dispatch(cmd, Kernel::kCheckQueries, cp, d.Q.n);
+    std::vector<VkBufferCopy> sortedCopies, stateCopies;
+    for (size_t k = 0; k < d.checkSlots.size(); ++k) {
+        const VkDeviceSize at = readback + VkDeviceSize(k) * 32;
+        sortedCopies.push_back({VkDeviceSize(d.checkSlots[k]) * 16, at, 16});
+        stateCopies.push_back({VkDeviceSize(d.checkSlots[k]) * sizeof(sh::QueryState), at + 16, 16});
+    }
+    vkCmdCopyBuffer(cmd, d.Q.sorted->handle(), m_ws.hostSmall.handle(), uint32_t(sortedCopies.size()),
+                    sortedCopies.data());
+    vkCmdCopyBuffer(cmd, d.state->handle(), m_ws.hostSmall.handle(), uint32_t(stateCopies.size()),
+                    stateCopies.data());
+}
+
+SampledQuery QueryCheck::finishCheck(const DirectionRun& d) {
+    const uint64_t packed = d.blk.at<uint64_t>(RTHDIST_CTR_MAX_PACKED);
+    const char* readback = d.blk.host + RTHDIST_CTR_READBACK;
+    std::vector<SampledQuery> sampled(d.checkSlots.size() + 1);
+    for (size_t k = 0; k < sampled.size(); ++k) {
+        sampled[k].slot = k < d.checkSlots.size() ? d.checkSlots[k] : uint32_t(packed & 0xffffffffu);
+        std::memcpy(sampled[k].sorted, readback + k * 32, 16);
+        std::memcpy(&sampled[k].state, readback + k * 32 + 16, 16);
+    }
+    const uint64_t bad = d.blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD);
+    std::string why = bad != 0 ? std::to_string(bad) + " of " + std::to_string(d.Q.n) +
+                                     " queries ended unsettled or above the maximum"
+                               : sampledQueryFailure(sampled, d.qPts, d.tPts, packed, d.perPoint != nullptr);
+    if (!why.empty()) throw SelfCheckError(d.name() + ": " + why);
+    return sampled.back();
+}
+
+Directed QueryCheck::finishDirection(DirectionRun& d, const SampledQuery& witness) {
+    Directed& out = d.out;
+    out.queryIndex = std::bit_cast<uint32_t>(witness.sorted[3]);
+    out.targetIndex = uint32_t(witness.state.best & 0xffffffffu);
+    out.queryPoint = d.qPts[out.queryIndex];
+    out.targetPoint = d.tPts[out.targetIndex];
+    out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
+    std::string why = witnessFailure(out.distance, d.blk.at<uint64_t>(RTHDIST_CTR_MAX_PACKED),
+                                     std::sqrt(d.lowerBound2Exact));
+    if (!why.empty()) throw SelfCheckError(d.name() + ": " + why);
+    if (d.perPoint) readPerPoint(d.Q, *d.state, d.qPts, d.tPts, *d.perPoint);
+    return out;
+}
+
+void QueryCheck::readPerPoint(const PointIndex& Q, const Buffer& state, std::span<const glm::vec3> qPts,
+                              std::span<const glm::vec3> tPts, PerPoint& out) {
+    const VkDeviceSize stateBytes = VkDeviceSize(Q.n) * sizeof(sh::QueryState);
+    const VkDeviceSize pointBytes = VkDeviceSize(Q.n) * 16;
+    Buffer& host = m_ws.buf("readback", stateBytes + pointBytes, MemoryKind::kHost);
+    VkCommandBuffer cmd = m_ws.ctx.begin();
+    VkBufferCopy c1{0, 0, stateBytes};
+    vkCmdCopyBuffer(cmd, state.handle(), host.handle(), 1, &c1);
+    VkBufferCopy c2{0, stateBytes, pointBytes};
+    vkCmdCopyBuffer(cmd, Q.sorted->handle(), host.handle(), 1, &c2);
+    m_ws.ctx.submitAndWait(cmd);
+    const auto* states = static_cast<const sh::QueryState*>(host.mapped());
+    const auto* sorted = reinterpret_cast<const float*>(static_cast<const char*>(host.mapped()) + stateBytes);
+    out.distance.assign(Q.n, 0.0);
+    out.nearest.assign(Q.n, 0);
+    for (uint32_t i = 0; i < Q.n; ++i) {
+        const uint32_t qi = std::bit_cast<uint32_t>(sorted[4 * i + 3]);
+        const uint32_t ti = uint32_t(states[i].best & 0xffffffffu);
+        if (qi >= qPts.size() || ti >= tPts.size() || states[i].status != RTHDIST_EXACT)
+            throw std::runtime_error("per-point read-back: query " + std::to_string(i) + " has no exact NN");
+        out.nearest[qi] = ti;
+        out.distance[qi] = glm::length(glm::dvec3(qPts[qi]) - glm::dvec3(tPts[ti]));
+    }
+}
+
+}  // namespace rthdist::gpu_algo

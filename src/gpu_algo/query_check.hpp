@@ -1,0 +1,46 @@
+// The self-check of a direction on the device (check_query.comp, DESIGN §6):
+// every query settled below the final maximum, sampled query records and
+// the witness's compared with the host's copy of the points; the checked
+// witness becomes the direction's result, with its per-point distances.
+#pragma once
+
+#include <span>
+
+#include "gpu_algo/direction.hpp"
+#include "gpu_algo/self_check.hpp"
+#include "gpu_algo/workspace.hpp"
+
+namespace rthdist::gpu_algo {
+
+class QueryCheck {
+public:
+    explicit QueryCheck(Workspace& workspace) : m_ws(workspace) {}
+
+    // Records the self-check of a direction (check_queries.comp: every query
+    // settled below the final maximum, the witness's records copied by the
+    // shader) and the copies of the sampled queries' records into the
+    // block's read-back area. Recorded right after the cull, it is the
+    // direction's check when no query survives the cull (no extra
+    // submission); otherwise (afterCull: the shader then returns at once) it
+    // is recorded again after the search.
+    void cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, bool afterCull);
+
+    // The self-check's verdict once its submission completed: every query
+    // settled, the sampled records and the witness's agree with the host's
+    // copy of the points. Returns the witness's records (the query slot of
+    // the maximum).
+    SampledQuery finishCheck(const DirectionRun& d);
+
+    // The direction's result from its checked witness (and its per-point
+    // distances).
+    Directed finishDirection(DirectionRun& d, const SampledQuery& witness);
+
+    // Every query is EXACT after a per-point run: its state holds its NN.
+    void readPerPoint(const PointIndex& Q, const Buffer& state, std::span<const glm::vec3> qPts,
+                      std::span<const glm::vec3> tPts, PerPoint& out);
+
+private:
+    Workspace& m_ws;
+};
+
+}  // namespace rthdist::gpu_algo

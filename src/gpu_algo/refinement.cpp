@@ -1,0 +1,43 @@
+#include "gpu_algo/refinement.hpp"
+
+#include <algorithm>
+
+namespace rthdist::gpu_algo {
+
+void Refinement::cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse,
+                           float r, Buffer& pairs, uint64_t pairCapacity, uint32_t numActive) {
+    Buffer& args = m_ws.buf("refineArgs", 16);
+    sh::RefineArgsPush ap{d.blk.device, args.address(), uint32_t(pairCapacity),
+                          std::max<uint32_t>(1, m_ws.ctx.limits().maxGroupsX)};
+    m_ws.pipelines.cmdDispatch(cmd, Kernel::kRefineArgs, &ap, sizeof(ap), 1);
+    gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                    VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                    VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
+    sh::RefinePush rp{d.Q.sorted->address(),
+                      d.T.sorted->address(),
+                      lv.cells->address(),
+                      d.state->address(),
+                      d.active[d.cur]->address(),
+                      pairs.address(),
+                      d.blk.device,
+                      d.blk.addr(RTHDIST_CTR_MAX_PACKED),
+                      d.T.cells->address(),
+                      coarse ? lv.fineFirst->address() : 0,
+                      uint32_t(pairCapacity),
+                      d.lowerBound2,
+                      lv.count,
+                      d.T.numCells};
+    m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kRefine, &rp, sizeof(rp), args.handle(), 0);
+    m_ws.barrier(cmd);
+    sh::ResolvePush rs{d.state->address(),
+                       d.active[d.cur]->address(),
+                       d.active[1 - d.cur]->address(),
+                       d.blk.device,
+                       d.blk.addr(RTHDIST_CTR_MAX_PACKED),
+                       numActive,
+                       r,
+                       d.lowerBound2};
+    m_ws.dispatch(cmd, Kernel::kResolve, rs, numActive);
+}
+
+}  // namespace rthdist::gpu_algo

@@ -1,0 +1,27 @@
+// Step 4 of RT-HDIST on the device (refine_args.comp, refine.comp,
+// resolve.comp): the exact scan of the (query, cell) pairs the rays
+// appended, sized by the device (indirect dispatch), with the early break;
+// then every active query resolved: exact, dead, or on to the next radius.
+#pragma once
+
+#include "gpu_algo/direction.hpp"
+#include "gpu_algo/workspace.hpp"
+
+namespace rthdist::gpu_algo {
+
+class Refinement {
+public:
+    explicit Refinement(Workspace& workspace) : m_ws(workspace) {}
+
+    // Records the refinement of one radius: the pairs that fit are scanned
+    // exactly (as many groups as the device counted pairs for), then every
+    // active query is resolved (exact, dead, or on to the next radius) into
+    // the other active buffer.
+    void cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse, float r,
+                   Buffer& pairs, uint64_t pairCapacity, uint32_t numActive);
+
+private:
+    Workspace& m_ws;
+};
+
+}  // namespace rthdist::gpu_algo

@@ -1,0 +1,133 @@
+// What every stage of the GPU algorithm shares on one device: the context,
+// the pipelines and their cache, the acceleration structures, the
+// host-visible counter blocks, the pool of scratch buffers, the timings of
+// the call in flight; and the helpers every stage records with (barrier,
+// dispatch, scan). One Workspace per GpuHausdorff: one caller at a time.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <string>
+
+#include "gpu/accel.hpp"
+#include "gpu/buffer.hpp"
+#include "gpu/context.hpp"
+#include "gpu/host_import.hpp"
+#include "gpu/pipeline_cache.hpp"
+#include "gpu_algo/pipelines.hpp"
+#include "gpu_algo/point_index.hpp"
+#include "rthdist/rthdist.hpp"
+#include "rthdist_shared.h"
+
+namespace rthdist::gpu_algo {
+
+using gpu::Kernel;
+using gpu::MemoryKind;
+
+using Clock = std::chrono::steady_clock;
+[[nodiscard]] inline double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+inline constexpr uint64_t kMaxPairCapacity = uint64_t(1) << 26;  // 512 MiB of pairs at most
+// Pooled buffers get this much room to grow (a quarter, at most 64 MiB, never
+// past the device's largest buffer).
+inline constexpr VkDeviceSize kMaxSlack = VkDeviceSize(64) << 20;
+// Query slots whose device records the self-check compares with the host.
+inline constexpr uint32_t kCheckSamples = 32;
+
+// One block of the host-visible counters (offsets RTHDIST_CTR_* of
+// rthdist_shared.h, the read-back area after them). The shaders find a
+// counter at the block's address plus its offset, so two index builds in one
+// submission each count into a block of their own.
+struct CounterBlock {
+    char* host = nullptr;
+    VkDeviceAddress device = 0;
+    VkDeviceSize offset = 0;  // in the buffer that holds the blocks
+    template <class T>
+    T& at(size_t offset) const {
+        return *reinterpret_cast<T*>(host + offset);
+    }
+    [[nodiscard]] VkDeviceAddress addr(size_t offset) const { return device + offset; }
+};
+inline constexpr VkDeviceSize kCounterBlockBytes = RTHDIST_CTR_BYTES;
+static_assert(RTHDIST_CTR_READBACK + (kCheckSamples + 1) * 32 <= RTHDIST_CTR_INGEST &&
+              RTHDIST_CTR_INGEST + sizeof(sh::IngestSummary) <= kCounterBlockBytes);
+
+// A call whose cancel flag was set: unwinds to the guard of the entry point.
+struct CallCancelled {};
+
+// Bad input found on the device (ingest.comp): unwinds to the guard, which
+// returns it as it is.
+struct InputRejected {
+    Error error;
+};
+
+void throwIfCancelled(const CallOptions& options);
+
+// Reports progress (the fraction of the whole call), then honours the
+// cancel flag: a cancelled call unwinds to the guard (kCancelled).
+void reportProgress(const CallOptions& options, const char* stage, double fraction);
+
+struct Workspace {
+    // Creates the pipelines (seeded from the cache file in cacheDir, which is
+    // then saved) and the counter blocks.
+    Workspace(gpu::Context& c, const std::string& cacheDir);
+
+    gpu::Context& ctx;
+    gpu::PipelineCache pipelineCache;  // before the pipelines it seeds
+    gpu::Pipelines pipelines;
+    gpu::AccelStructures accel;
+    bool rayQuery;
+    bool tlasBound = false;
+    Buffer hostSmall;                    // the counter blocks (RTHDIST_CTR_*), read-backs after each
+    std::array<CounterBlock, 2> blocks;  // blocks[0]: every stage; [1]: a second index build
+    uint64_t maxPairCapacity = kMaxPairCapacity;
+    Timings* timings = nullptr;
+    // Buffers live across calls and only grow: allocation is a large share of
+    // a call's cost on discrete GPUs.
+    std::map<std::string, Buffer> pool;
+    // The caller's arrays imported for the submission in flight (deque:
+    // stable addresses for PointIndex::source).
+    std::deque<gpu::HostImport> imports;
+
+    // A buffer may be replaced only between submissions: every name is used by
+    // at most one purpose inside one command buffer.
+    Buffer& buf(const std::string& name, VkDeviceSize bytes, MemoryKind kind = MemoryKind::kDevice);
+
+    // A buffer of set `ix` (its index and search levels), in the set's store.
+    Buffer& setBuf(PointIndex& ix, const std::string& suffix, VkDeviceSize bytes);
+
+    // Pooled buffers get room to grow; a prepared set's get their size.
+    Buffer& bufIn(std::map<std::string, Buffer>& store, const std::string& name, VkDeviceSize bytes,
+                  MemoryKind kind, bool slack);
+
+    // A counter of block 0 (offsets from rthdist_shared.h): the stages run one at a time.
+    template <class T>
+    T& counter(size_t offset) {
+        return blocks[0].at<T>(offset);
+    }
+    [[nodiscard]] VkDeviceAddress cellsCounterAddr() const { return blocks[0].addr(RTHDIST_CTR_CELLS); }
+    [[nodiscard]] VkDeviceAddress maxCountAddr() const { return blocks[0].addr(RTHDIST_CTR_MAX_COUNT); }
+
+    // Shader and transfer writes before the next shader or transfer reads.
+    void barrier(VkCommandBuffer cmd) { gpu::cmdShaderBarrier(cmd, pipelines.shaderStages()); }
+
+    // One thread per item (groups of groupSize), push constants `push`.
+    template <class Push>
+    void dispatch(VkCommandBuffer cmd, Kernel k, const Push& push, uint64_t items,
+                  uint32_t groupSize = RTHDIST_WG) {
+        pipelines.cmdDispatch(cmd, k, &push, sizeof(Push), gpu::groupsFor(items, groupSize));
+    }
+
+    // Exclusive scan of uint[n] at `data`, recursively over block sums.
+    void cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, const std::string& tag, size_t level);
+
+    // Scratch of the parallel box reduction of large cells (6 uints per cell).
+    Buffer& boundsU(uint64_t cellCapacity) { return buf("boundsU", VkDeviceSize(cellCapacity) * 24); }
+};
+
+}  // namespace rthdist::gpu_algo
