@@ -22,7 +22,7 @@
 //   Inputs whose every coordinate is a float32 value (float views, and double
 //   views holding float values, e.g. text written from floats) are searched
 //   as they are (o = 0). Squared distances that would overflow or vanish in float
-//   are handled by an exact power-of-two scale (algo::exactScale).
+//   are handled by an exact power-of-two scale (core::exactScale).
 //
 // Inputs: PointView (float or double, any stride; spans and vectors of
 //   glm::vec3 or glm::dvec3 convert), finite coordinates (NaN/Inf -> kInvalidArgument),
