@@ -11,11 +11,11 @@
 #include <string>
 #include "core/index_space.hpp"
 
-#include "gpu_algo/gpu_hausdorff.hpp"
 #include "core/input_frame.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 #include "gpu/context.hpp"
 #include "gpu/pipeline_cache.hpp"
+#include "gpu_algo/gpu_hausdorff.hpp"
 
 namespace rthdist {
 
@@ -167,7 +167,7 @@ Result<Engine> Engine::create(const EngineOptions& options) {
     const std::string cacheDir = options.pipelineCacheDir == "off"  ? std::string()
                                  : options.pipelineCacheDir.empty() ? gpu::defaultPipelineCacheDir()
                                                                     : options.pipelineCacheDir;
-    auto g = gpu_algo::GpuHausdorff::create(*device.context, cacheDir);
+    auto g = gpu_algo::GpuHausdorff::create(*device.context, cacheDir, options.threads);
     if (!g) return g.error();
     device.gpu = std::move(g.value());
     impl->backend = device.context->backend();
@@ -201,10 +201,10 @@ struct CheckedInputs {
     core::SetSummary a, b;
 };
 
-Result<CheckedInputs> checkInputs(const PointView& a, const PointView& b) {
-    Result<core::SetSummary> sa = core::summarizeSet(a, "A");
+Result<CheckedInputs> checkInputs(const PointView& a, const PointView& b, int threads) {
+    Result<core::SetSummary> sa = core::summarizeSet(a, "A", threads);
     if (!sa) return sa.error();
-    Result<core::SetSummary> sb = core::summarizeSet(b, "B");
+    Result<core::SetSummary> sb = core::summarizeSet(b, "B", threads);
     if (!sb) return sb.error();
     return CheckedInputs{*sa, *sb};
 }
@@ -222,7 +222,7 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
                                      std::chrono::steady_clock::time_point t0) {
     if (auto err = validateCallOptions(call)) return *err;
     const glm::dvec3 origin = core::searchOrigin(checked.a, checked.b);
-    const core::FloatSet fa(a, origin), fb(b, origin);
+    const core::FloatSet fa(a, origin, impl.options.threads), fb(b, origin, impl.options.threads);
     Options options;
     static_cast<CallOptions&>(options) = call;
     static_cast<EngineOptions&>(options) = impl.options;
@@ -233,7 +233,7 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
                                     : cpu::cpuHausdorff(fa.span(), fb.span(), options);
     if (!r) return r;
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
-    if (copied) core::restoreOriginal(*r, a, b);
+    if (copied) core::restoreOriginal(*r, a, b, impl.options.threads);
     r->origin = origin;
     finishResult(impl, *r, t0);
     return r;
@@ -279,20 +279,20 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOpti
     if (m_impl->device->gpu && a.packedFloat() && b.packedFloat() &&
         gpu_algo::GpuHausdorff::ingests(a.count, b.count))
         return computeIngested(*m_impl, a, b, call, t0);
-    Result<CheckedInputs> checked = checkInputs(a, b);
+    Result<CheckedInputs> checked = checkInputs(a, b, m_impl->options.threads);
     if (!checked) return checked.error();
     return computeViews(*m_impl, a, b, *checked, call, t0);
 }
 
 Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& options) {
     if (auto err = validateBits(options.bits)) return *err;
-    Result<core::SetSummary> summary = core::summarizeSet(points, "to prepare");
+    Result<core::SetSummary> summary = core::summarizeSet(points, "to prepare", m_impl->options.threads);
     if (!summary) return summary.error();
     auto set = std::make_shared<PreparedSet::Impl>();
     set->device = m_impl->device;
     set->summary = *summary;
     set->origin = core::preparedOrigin(*summary, options.origin);
-    set->floats = core::roundedCopy(points, set->origin);
+    set->floats = core::roundedCopy(points, set->origin, m_impl->options.threads);
     if (!summary->floatExact) {
         set->originals.resize(points.count);
         for (size_t i = 0; i < points.count; ++i) set->originals[i] = points.at(i);
@@ -325,7 +325,8 @@ Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet&
         m_impl->device->gpu ? m_impl->device->gpu->compute(*ia.gpuSet, *ib.gpuSet, call)
                             : cpu::cpuHausdorff(*ia.cpuSet, *ib.cpuSet, call, m_impl->options.threads);
     if (!r) return r;
-    if (!ia.originals.empty() || !ib.originals.empty()) core::restoreOriginal(*r, ia.input(), ib.input());
+    if (!ia.originals.empty() || !ib.originals.empty())
+        core::restoreOriginal(*r, ia.input(), ib.input(), m_impl->options.threads);
     r->origin = ia.origin;
     finishResult(*m_impl, *r, t0);
     return r;
@@ -354,7 +355,7 @@ std::vector<Result<HausdorffResult>> Engine::computeBatch(std::span<const Prepar
 Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& options) {
     // Checked before the engine exists: bad input is reported as such even
     // where no device could be created; the points are read once.
-    Result<CheckedInputs> checked = checkInputs(a, b);
+    Result<CheckedInputs> checked = checkInputs(a, b, options.threads);
     if (!checked) return checked.error();
     if (auto err = validateCallOptions(options)) return *err;
     auto engine = Engine::create(static_cast<const EngineOptions&>(options));

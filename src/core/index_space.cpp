@@ -151,8 +151,8 @@ double largestMagnitude(const Bounds& box) {
     return std::max({m.x, m.y, m.z});
 }
 
-double largestMagnitude(std::span<const glm::vec3> points) {
-    const int threads = core::resolveThreads(0, points.size() / kMagnitudeChunk + 1);
+double largestMagnitude(std::span<const glm::vec3> points, int threads) {
+    threads = core::resolveThreads(threads, points.size() / kMagnitudeChunk + 1);
     std::vector<float> part(size_t(threads), 0.0f);
     core::parallelChunks(points.size(), kMagnitudeChunk, threads, [&](size_t begin, size_t end, int t) {
         float v = part[size_t(t)];

@@ -53,7 +53,8 @@ struct GridSpec {
 [[nodiscard]] double exactScale(double maxAbs);
 
 // The largest coordinate magnitude of a float set (the maxAbs of exactScale).
-[[nodiscard]] double largestMagnitude(std::span<const glm::vec3> points);
+// threads: as EngineOptions::threads (0: every hardware thread).
+[[nodiscard]] double largestMagnitude(std::span<const glm::vec3> points, int threads = 0);
 // The same from a set's box (the extremes of |p| lie on its corners).
 [[nodiscard]] double largestMagnitude(const Bounds& box);
 

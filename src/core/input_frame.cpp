@@ -83,10 +83,10 @@ std::optional<Error> checkShape(const PointView& points, const char* name) {
     return std::nullopt;
 }
 
-Result<SetSummary> summarizeSet(const PointView& points, const char* name) {
+Result<SetSummary> summarizeSet(const PointView& points, const char* name, int threads) {
     if (auto err = checkShape(points, name)) return *err;
     const char* base = static_cast<const char*>(points.data);
-    const int threads = core::resolveThreads(0, points.count / kChunk + 1);
+    threads = core::resolveThreads(threads, points.count / kChunk + 1);
     std::vector<ChunkSummary> parts(static_cast<size_t>(threads));
     core::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int t) {
         merge(parts[size_t(t)], points.scalar == Scalar::kFloat64
@@ -130,25 +130,25 @@ double searchMagnitude(const SetSummary& set, const glm::dvec3& origin) {
     return largestMagnitude(rounded);
 }
 
-std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin) {
+std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin, int threads) {
     std::vector<glm::vec3> out(points.count);
-    const int threads = core::resolveThreads(0, points.count / kChunk + 1);
+    threads = core::resolveThreads(threads, points.count / kChunk + 1);
     core::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) out[i] = glm::vec3(points.at(i) - origin);
     });
     return out;
 }
 
-FloatSet::FloatSet(const PointView& points, const glm::dvec3& origin) {
+FloatSet::FloatSet(const PointView& points, const glm::dvec3& origin, int threads) {
     if (points.packedFloat() && origin == glm::dvec3(0.0)) {
         m_span = std::span<const glm::vec3>(static_cast<const glm::vec3*>(points.data), points.count);
         return;
     }
-    m_copy = roundedCopy(points, origin);
+    m_copy = roundedCopy(points, origin, threads);
     m_span = m_copy;
 }
 
-void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b) {
+void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b, int threads) {
     auto restore = [](Directed& d, const PointView& q, const PointView& t) {
         d.queryPoint = q.at(d.queryIndex);
         d.targetPoint = t.at(d.targetIndex);
@@ -160,9 +160,9 @@ void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b)
         restore(r.bToA, b, a);
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
     }
-    auto perPoint = [](PerPoint& pp, const PointView& q, const PointView& t) {
-        const int threads = core::resolveThreads(0, pp.nearest.size() / kChunk + 1);
-        core::parallelChunks(pp.nearest.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
+    auto perPoint = [threads](PerPoint& pp, const PointView& q, const PointView& t) {
+        const int workers = core::resolveThreads(threads, pp.nearest.size() / kChunk + 1);
+        core::parallelChunks(pp.nearest.size(), kChunk, workers, [&](size_t begin, size_t end, int) {
             for (size_t i = begin; i < end; ++i) pp.distance[i] = glm::length(q.at(i) - t.at(pp.nearest[i]));
         });
     };

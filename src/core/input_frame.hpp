@@ -31,7 +31,9 @@ struct SetSummary {
 
 // Box and precision of one set, or the error naming the first bad point
 // (NaN/Inf, an empty set, a stride that cannot hold a point, too many points).
-[[nodiscard]] Result<SetSummary> summarizeSet(const PointView& points, const char* name);
+// The passes over the points of this file run on `threads` threads, as
+// EngineOptions::threads (0: every hardware thread).
+[[nodiscard]] Result<SetSummary> summarizeSet(const PointView& points, const char* name, int threads = 0);
 
 // The origin subtracted before the float search: zero when every coordinate
 // of both sets is a float32 value (their differences are then as exact as
@@ -58,13 +60,14 @@ struct SetSummary {
 [[nodiscard]] double searchMagnitude(const SetSummary& set, const glm::dvec3& origin);
 
 // Points shifted by `origin` and rounded to float, in a vector of their own.
-[[nodiscard]] std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin);
+[[nodiscard]] std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin,
+                                                 int threads = 0);
 
 // The float32 points a backend searches: the caller's memory when it is
 // packed float and the origin is zero, else a shifted, rounded copy.
 class FloatSet {
 public:
-    FloatSet(const PointView& points, const glm::dvec3& origin);
+    FloatSet(const PointView& points, const glm::dvec3& origin, int threads = 0);
     [[nodiscard]] std::span<const glm::vec3> span() const { return m_span; }
 
 private:
@@ -74,6 +77,6 @@ private:
 
 // Replaces a backend's witnesses and per-point distances (float coordinates
 // after the shift) by those of the original coordinates, in double.
-void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b);
+void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b, int threads = 0);
 
 }  // namespace rthdist::core

@@ -6,8 +6,8 @@
 #include <limits>
 
 #include "core/index_space.hpp"
-#include "cpu/key_sort.hpp"
 #include "core/parallel.hpp"
+#include "cpu/key_sort.hpp"
 
 namespace rthdist::cpu {
 

@@ -4,8 +4,8 @@
 #include <cassert>
 #include <limits>
 
-#include "cpu/adaptive_order.hpp"
 #include "core/parallel.hpp"
+#include "cpu/adaptive_order.hpp"
 
 namespace rthdist::cpu {
 

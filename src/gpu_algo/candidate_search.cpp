@@ -31,7 +31,7 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
         if (++d.out.counters.iterations > kMaxIterations)
             throw std::runtime_error("candidate search did not converge");
         if (!pairs) {
-            pairs = &m_ws.buf("pairs", pairCapacity * 8);
+            pairs = &m_ws.grow(m_ws.scratch.search.pairs, pairCapacity * 8, "pairs");
             pairCapacity = std::min<uint64_t>(pairs->size() / 8, m_ws.maxPairCapacity);
         }
         const int level = IndexBuild::searchLevelFor(T, radius);
@@ -92,7 +92,7 @@ void CandidateSearch::cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const Poin
     // The ray only has to start inside the grown boxes: a short one
     // crosses few other boxes (leaves are far smaller than grid cells).
     const float rayTMax = float(std::min(T.grid.cellSize, T.split ? radius : T.grid.cellSize) * 1e-3);
-    Buffer& aabbs = m_ws.buf("aabbs", VkDeviceSize(lv.count) * 24);
+    Buffer& aabbs = m_ws.grow(m_ws.scratch.search.aabbs, VkDeviceSize(lv.count) * 24, "aabbs");
     // Per-box slack: float rounding at the box's magnitude (the old
     // global epsilon used the largest coordinate of both sets) plus,
     // for a grid index, the grid's absolute term.

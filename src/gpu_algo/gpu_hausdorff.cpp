@@ -39,9 +39,9 @@ constexpr size_t kFusedBuildPoints = size_t(1) << 25;
 
 // Float copies of the points multiplied by a power of two in double (exact:
 // the rule keeps every product a normal float or zero).
-std::vector<glm::vec3> scaledCopy(std::span<const glm::vec3> pts, double scale) {
+std::vector<glm::vec3> scaledCopy(std::span<const glm::vec3> pts, double scale, int threads) {
     std::vector<glm::vec3> out(pts.size());
-    const int threads = core::resolveThreads(0, pts.size() / kHostChunk + 1);
+    threads = core::resolveThreads(threads, pts.size() / kHostChunk + 1);
     core::parallelChunks(pts.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) out[i] = glm::vec3(glm::dvec3(pts[i]) * scale);
     });
@@ -54,8 +54,13 @@ std::vector<glm::vec3> scaledCopy(std::span<const glm::vec3> pts, double scale) 
 // indexed (host staging or device ingest), both directions culled together,
 // each direction's search and self-check, the result.
 struct GpuHausdorff::State {
-    State(gpu::Context& ctx, const std::string& cacheDir)
-        : ws(ctx, cacheDir), index(ws), check(ws), cull(ws, check), refine(ws), search(ws, index, refine) {}
+    State(gpu::Context& ctx, const std::string& cacheDir, int threads)
+        : ws(ctx, cacheDir, threads),
+          index(ws),
+          check(ws),
+          cull(ws, check),
+          refine(ws),
+          search(ws, index, refine) {}
 
     Workspace ws;
     IndexBuild index;
@@ -79,31 +84,22 @@ struct GpuHausdorff::State {
     }
 
     // Stages `input` (float, before the scale) as set `name` for an index
-    // build: in the pool (one-shot) or in buffers of its own (owned: a
-    // prepared set). The host pass counts as upload time.
+    // build in `scratch`: its index in the workspace's `shared` buffers
+    // (one-shot) or, shared null, in buffers of its own (owned: a prepared
+    // set). The host pass counts as upload time.
     void stageSet(DeviceSet& set, std::span<const glm::vec3> input, double scale, int bits,
-                  const std::string& name, const std::string& scratch, bool owned = false) {
+                  const std::string& name, BuildScratch& scratch, SetBuffers* shared) {
         const auto t0 = Clock::now();
         set.input = input;
         set.scale = scale;
-        if (scale != 1.0) set.scaledCopy = scaledCopy(input, scale);
+        if (scale != 1.0) set.scaledCopy = scaledCopy(input, scale, ws.threads);
         set.points = scale != 1.0 ? std::span<const glm::vec3>(set.scaledCopy) : input;
         set.ix.name = name;
-        set.ix.scratch = scratch;
-        set.ix.owned = owned;
-        set.ix.store = owned ? &set.own : &ws.pool;
+        set.ix.scratch = &scratch;
+        set.ix.owned = shared == nullptr;
+        set.ix.store = shared != nullptr ? shared : &set.own;
         index.stageIndex(set.ix, set.points, bits);
         ws.timings->upload += msSince(t0);
-    }
-
-    // A prepared set keeps only the buffers its index uses after a leaf split.
-    static void releaseUnused(DeviceSet& set) {
-        for (auto it = set.own.begin(); it != set.own.end();) {
-            const Buffer* b = &it->second;
-            const bool used =
-                b == set.ix.sorted || b == set.ix.dense || b == set.ix.cells || b == set.ix.sortedKeys;
-            it = used ? std::next(it) : set.own.erase(it);
-        }
     }
 
     // One-shot H of two packed float host arrays through the ingest path:
@@ -119,8 +115,9 @@ struct GpuHausdorff::State {
         for (size_t k = 0; k < 2; ++k) {
             DeviceSet& set = *sets[k];
             set.input = set.points = inputs[k];
-            set.ix.name = set.ix.scratch = k == 0 ? "A" : "B";
-            set.ix.store = &ws.pool;
+            set.ix.name = k == 0 ? "A" : "B";
+            set.ix.scratch = &ws.scratch.builds[k];
+            set.ix.store = &ws.oneShot[k];
             index.stageSource(set.ix, inputs[k]);
         }
         VkCommandBuffer cmd = ws.ctx.begin();
@@ -153,9 +150,10 @@ struct GpuHausdorff::State {
                   const CallOptions& options, HausdorffResult& res) {
         DeviceSet da, db;
         const bool together = a.size() + b.size() <= kFusedBuildPoints;
-        stageSet(da, a, scale, options.bits, "A", together ? "A" : "build");
+        std::array<BuildScratch, 2>& builds = ws.scratch.builds;
+        stageSet(da, a, scale, options.bits, "A", builds[0], &ws.oneShot[0]);
         if (!together) index.buildIndexes(std::array{&da.ix});
-        stageSet(db, b, scale, options.bits, "B", together ? "B" : "build");
+        stageSet(db, b, scale, options.bits, "B", builds[together ? 1 : 0], &ws.oneShot[1]);
         reportProgress(options, "index", 0.05);
         if (together)
             index.buildIndexes(std::array{&da.ix, &db.ix});
@@ -172,8 +170,8 @@ struct GpuHausdorff::State {
         const double mid = options.directedOnly ? 1.0 : from + 0.5 * (1.0 - from);
         DirectionRun ab{a.ix, b.ix, a.points, b.points, ws.blocks[0], pp ? &res.aNearest : nullptr};
         DirectionRun ba{b.ix, a.ix, b.points, a.points, ws.blocks[1], pp ? &res.bNearest : nullptr};
-        cull.startDirection(ab, "ab");
-        if (!options.directedOnly) cull.startDirection(ba, "ba");
+        cull.startDirection(ab, 0);
+        if (!options.directedOnly) cull.startDirection(ba, 1);
         // Both culls (and their checks) in one submission; a direction with
         // survivors searches, then checks again.
         std::array<uint32_t, 2> survivors{};
@@ -196,7 +194,7 @@ struct GpuHausdorff::State {
             res.hausdorff = std::max(res.hausdorff, res.bToA.distance);
         }
         // Witnesses and per-point distances from the unscaled inputs, in double.
-        if (a.scale != 1.0) core::restoreOriginal(res, PointView(a.input), PointView(b.input));
+        if (a.scale != 1.0) core::restoreOriginal(res, PointView(a.input), PointView(b.input), ws.threads);
     }
 
     HausdorffResult emptyResult(const CallOptions& options) const {
@@ -250,9 +248,11 @@ void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
     m_state->ws.maxPairCapacity = std::max<uint64_t>(1, pairs);
 }
 
-Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, const std::string& cacheDir) {
+Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, const std::string& cacheDir,
+                                                           int threads) {
     try {
-        return std::unique_ptr<GpuHausdorff>(new GpuHausdorff(std::make_unique<State>(ctx, cacheDir)));
+        return std::unique_ptr<GpuHausdorff>(
+            new GpuHausdorff(std::make_unique<State>(ctx, cacheDir, threads)));
     } catch (const gpu::VulkanError& e) {
         return Error{ErrorCode::kInternal, std::string("pipeline creation failed: ") + e.what()};
     }
@@ -304,9 +304,9 @@ Result<std::shared_ptr<DeviceSet>> GpuHausdorff::prepare(std::span<const glm::ve
                                                          Timings& timings) {
     auto set = std::make_shared<DeviceSet>();
     auto err = m_state->guarded(timings, [&] {
-        m_state->stageSet(*set, points, scale, bits, name, "build", true);
+        m_state->stageSet(*set, points, scale, bits, name, m_state->ws.scratch.builds[0], nullptr);
         m_state->index.buildIndexes(std::array{&set->ix});
-        State::releaseUnused(*set);
+        set->own.releaseUnused(set->ix);  // a prepared set keeps what its index uses
     });
     if (err) return *err;
     return set;
@@ -322,11 +322,7 @@ Result<HausdorffResult> GpuHausdorff::compute(DeviceSet& a, DeviceSet& b, const 
     return res;
 }
 
-uint64_t GpuHausdorff::deviceBytes(const DeviceSet& set) {
-    uint64_t bytes = 0;
-    for (const auto& [name, buffer] : set.own) bytes += buffer.size();
-    return bytes;
-}
+uint64_t GpuHausdorff::deviceBytes(const DeviceSet& set) { return set.own.bytes(); }
 
 int GpuHausdorff::bits(const DeviceSet& set) { return set.ix.grid.bits; }
 

@@ -35,8 +35,11 @@ class GpuHausdorff {
 public:
     // cacheDir: where the pipeline cache file lives (gpu/pipeline_cache.hpp);
     // empty: none.
+    // threads: the host's passes over the points (EngineOptions::threads;
+    // 0: every hardware thread).
     [[nodiscard]] static Result<std::unique_ptr<GpuHausdorff>> create(gpu::Context& ctx,
-                                                                      const std::string& cacheDir);
+                                                                      const std::string& cacheDir,
+                                                                      int threads);
     ~GpuHausdorff();
 
     // One-shot: both sets indexed for this call, in buffers pooled between

@@ -23,9 +23,9 @@ int clampedBits(int bits, uint32_t n) {
 void IndexBuild::stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int bits) {
     ix.n = uint32_t(pts.size());
     const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
-    Buffer& staging = m_ws.buf(ix.scratch + ".staging", bytes, MemoryKind::kHost);
+    Buffer& staging = m_ws.grow(ix.scratch->staging, bytes, ix.name + ".staging", MemoryKind::kHost);
     auto* dst = static_cast<float*>(staging.mapped());
-    const int threads = core::resolveThreads(0, ix.n / kHostChunk + 1);
+    const int threads = core::resolveThreads(m_ws.threads, ix.n / kHostChunk + 1);
     std::vector<glm::vec3> lo(size_t(threads), pts[0]), hi(size_t(threads), pts[0]);
     core::parallelChunks(ix.n, kHostChunk, threads, [&](size_t begin, size_t end, int t) {
         glm::vec3 l = lo[size_t(t)], h = hi[size_t(t)];
@@ -55,25 +55,27 @@ void IndexBuild::stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int 
 
 void IndexBuild::cmdUpload(VkCommandBuffer cmd, PointIndex& ix) {
     const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
-    Buffer& points = m_ws.buf(ix.scratch + ".points", bytes);
+    Buffer& points = m_ws.grow(ix.scratch->points, bytes, ix.name + ".points");
     const VkBufferCopy region{0, 0, bytes};
-    vkCmdCopyBuffer(cmd, m_ws.buf(ix.scratch + ".staging", bytes, MemoryKind::kHost).handle(),
+    vkCmdCopyBuffer(cmd,
+                    m_ws.grow(ix.scratch->staging, bytes, ix.name + ".staging", MemoryKind::kHost).handle(),
                     points.handle(), 1, &region);
 }
 
 void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const CounterBlock& blk) {
     const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
-    Buffer& points = m_ws.buf(ix.scratch + ".points", bytes);
+    Buffer& points = m_ws.grow(ix.scratch->points, bytes, ix.name + ".points");
     const uint32_t numKeys = 1u << (3 * ix.grid.bits);
-    Buffer& keys = m_ws.buf(ix.scratch + ".keys", VkDeviceSize(ix.n) * 4);
-    ix.sortedKeys = &m_ws.setBuf(ix, ".sortedKeys", VkDeviceSize(ix.n) * 4);
-    Buffer& flags = m_ws.buf(ix.scratch + ".flags", VkDeviceSize(ix.n) * 4);
+    Buffer& keys = m_ws.grow(ix.scratch->keys, VkDeviceSize(ix.n) * 4, ix.name + ".keys");
+    ix.sortedKeys = &m_ws.setBuffer(ix, ix.store->sortedKeys, ".sortedKeys", VkDeviceSize(ix.n) * 4);
+    Buffer& flags = m_ws.grow(ix.scratch->flags, VkDeviceSize(ix.n) * 4, ix.name + ".flags");
     const VkDeviceSize denseBytes = VkDeviceSize(numKeys) * 4;
-    ix.dense = &m_ws.setBuf(ix, ".dense", denseBytes);
-    ix.sorted = &m_ws.setBuf(ix, ".sorted", bytes);
+    ix.dense = &m_ws.setBuffer(ix, ix.store->dense, ".dense", denseBytes);
+    ix.sorted = &m_ws.setBuffer(ix, ix.store->sorted, ".sorted", bytes);
     // Cells: at most one per point or key; the upper bound avoids a read-back.
     ix.cellCapacity = std::min<uint64_t>(ix.n, numKeys);
-    ix.cells = &m_ws.setBuf(ix, ".cells", VkDeviceSize(ix.cellCapacity) * sizeof(sh::Cell));
+    ix.cells =
+        &m_ws.setBuffer(ix, ix.store->cells, ".cells", VkDeviceSize(ix.cellCapacity) * sizeof(sh::Cell));
 
     blk.at<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
     blk.at<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
@@ -82,26 +84,27 @@ void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const Counte
     sh::KeysPush kp{points.address(), keys.address(), ix.dense->address(), gridParams(ix.grid), ix.n};
     m_ws.dispatch(cmd, Kernel::kCellKeys, kp, ix.n);
     m_ws.barrier(cmd);
-    m_ws.cmdScan(cmd, ix.dense->address(), numKeys, ix.scratch + ".scanKeys", 0);
+    m_ws.cmdScan(cmd, ix.dense->address(), numKeys, ix.scratch->scanKeys, "scanKeys");
     m_ws.barrier(cmd);
     sh::ScatterPush sp{points.address(),     keys.address(),           ix.dense->address(),
                        ix.sorted->address(), ix.sortedKeys->address(), ix.n};
     m_ws.dispatch(cmd, Kernel::kScatter, sp, ix.n);
     m_ws.barrier(cmd);
-    sh::CellsPush cp{ix.sorted->address(),
-                     ix.sortedKeys->address(),
-                     flags.address(),
-                     ix.dense->address(),
-                     ix.cells->address(),
-                     blk.addr(RTHDIST_CTR_CELLS),
-                     blk.addr(RTHDIST_CTR_MAX_COUNT),
-                     m_ws.buf(ix.scratch + ".boundsU", VkDeviceSize(ix.cellCapacity) * 24).address(),
-                     blk.addr(RTHDIST_CTR_LARGE_CELLS),
-                     ix.n,
-                     uint32_t(ix.cellCapacity)};
+    sh::CellsPush cp{
+        ix.sorted->address(),
+        ix.sortedKeys->address(),
+        flags.address(),
+        ix.dense->address(),
+        ix.cells->address(),
+        blk.addr(RTHDIST_CTR_CELLS),
+        blk.addr(RTHDIST_CTR_MAX_COUNT),
+        m_ws.grow(ix.scratch->boundsU, VkDeviceSize(ix.cellCapacity) * 24, ix.name + ".boundsU").address(),
+        blk.addr(RTHDIST_CTR_LARGE_CELLS),
+        ix.n,
+        uint32_t(ix.cellCapacity)};
     m_ws.dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
     m_ws.barrier(cmd);
-    m_ws.cmdScan(cmd, flags.address(), ix.n, ix.scratch + ".scanFlags", 0);
+    m_ws.cmdScan(cmd, flags.address(), ix.n, ix.scratch->scanFlags, "scanFlags");
     m_ws.barrier(cmd);
     cmdCellBuild(cmd, cp);
     m_ws.barrier(cmd);

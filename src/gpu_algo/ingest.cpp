@@ -43,10 +43,10 @@ void IndexBuild::stageSource(PointIndex& ix, std::span<const glm::vec3> pts) {
         return;
     }
     ix.source = nullptr;
-    Buffer& source = m_ws.buf(ix.scratch + ".source", bytes, MemoryKind::kHost);
+    Buffer& source = m_ws.grow(ix.scratch->source, bytes, ix.name + ".source", MemoryKind::kHost);
     auto* dst = static_cast<char*>(source.mapped());
     const char* src = reinterpret_cast<const char*>(pts.data());
-    const int threads = core::resolveThreads(0, ix.n / kHostChunk + 1);
+    const int threads = core::resolveThreads(m_ws.threads, ix.n / kHostChunk + 1);
     core::parallelChunks(ix.n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
         std::memcpy(dst + begin * 12, src + begin * 12, (end - begin) * 12);
     });
@@ -55,9 +55,10 @@ void IndexBuild::stageSource(PointIndex& ix, std::span<const glm::vec3> pts) {
 void IndexBuild::cmdUploadSource(VkCommandBuffer cmd, const PointIndex& ix) {
     const VkDeviceSize bytes = VkDeviceSize(ix.n) * 12;
     const VkBuffer from =
-        ix.source ? ix.source->handle() : m_ws.buf(ix.scratch + ".source", bytes, MemoryKind::kHost).handle();
+        ix.source ? ix.source->handle()
+                  : m_ws.grow(ix.scratch->source, bytes, ix.name + ".source", MemoryKind::kHost).handle();
     const VkBufferCopy region{ix.source ? ix.source->offset() : 0, 0, bytes};
-    vkCmdCopyBuffer(cmd, from, m_ws.buf(ix.scratch + ".raw", bytes).handle(), 1, &region);
+    vkCmdCopyBuffer(cmd, from, m_ws.grow(ix.scratch->raw, bytes, ix.name + ".raw").handle(), 1, &region);
 }
 
 void IndexBuild::cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {
@@ -67,8 +68,8 @@ void IndexBuild::cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const Coun
         summary.hi[k] = 0u;
     }
     summary.firstBad = 0xffffffffu;
-    sh::IngestPush ip{m_ws.buf(ix.scratch + ".raw", VkDeviceSize(ix.n) * 12).address(),
-                      m_ws.buf(ix.scratch + ".points", VkDeviceSize(ix.n) * 16).address(),
+    sh::IngestPush ip{m_ws.grow(ix.scratch->raw, VkDeviceSize(ix.n) * 12, ix.name + ".raw").address(),
+                      m_ws.grow(ix.scratch->points, VkDeviceSize(ix.n) * 16, ix.name + ".points").address(),
                       blk.addr(RTHDIST_CTR_INGEST), ix.n, 12u};
     m_ws.dispatch(cmd, Kernel::kIngest, ip, ix.n);
 }

@@ -17,13 +17,14 @@ namespace rthdist::gpu_algo {
 
 void IndexBuild::splitLeaves(PointIndex& ix) {
     const VkDeviceSize n = ix.n;
-    Buffer* sorted[2] = {ix.sorted, &m_ws.setBuf(ix, ".sorted2", n * 16)};
-    Buffer* gridKeys[2] = {ix.sortedKeys, &m_ws.setBuf(ix, ".sortedKeys2", n * 4)};
-    Buffer* leaves[2] = {&m_ws.setBuf(ix, ".leaves0", n * sizeof(sh::Cell)),
-                         &m_ws.setBuf(ix, ".leaves1", n * sizeof(sh::Cell))};
-    Buffer& slotKeys = m_ws.buf("slotKeys", n * 4);
-    Buffer& outSlotKeys = m_ws.buf("outSlotKeys", n * 4);
-    Buffer& flags = m_ws.buf("flags", n * 4);
+    LeafScratch& leaf = m_ws.scratch.leaves;
+    Buffer* sorted[2] = {ix.sorted, &m_ws.setBuffer(ix, ix.store->sorted2, ".sorted2", n * 16)};
+    Buffer* gridKeys[2] = {ix.sortedKeys, &m_ws.setBuffer(ix, ix.store->sortedKeys2, ".sortedKeys2", n * 4)};
+    Buffer* leaves[2] = {&m_ws.setBuffer(ix, ix.store->leaves0, ".leaves0", n * sizeof(sh::Cell)),
+                         &m_ws.setBuffer(ix, ix.store->leaves1, ".leaves1", n * sizeof(sh::Cell))};
+    Buffer& slotKeys = m_ws.grow(leaf.slotKeys, n * 4, "leaf.slotKeys");
+    Buffer& outSlotKeys = m_ws.grow(leaf.outSlotKeys, n * 4, "leaf.outSlotKeys");
+    Buffer& flags = m_ws.grow(leaf.flags, n * 4, "leaf.flags");
     Buffer* cells = ix.cells;
     int cur = 0;
     m_ws.counter<uint32_t>(RTHDIST_CTR_MIN_EDGE) = 0x7f800000u;  // +inf
@@ -31,8 +32,8 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
         // All slots together: one per kept cell, 8^k <= count per split one.
         const uint64_t numSlots = uint64_t(ix.n) + ix.numCells;
         gpu::requireWithin(numSlots, uint64_t(UINT32_MAX), "slots of a leaf split", "2^32 - 1");
-        Buffer& slotBase = m_ws.buf("slotBase", VkDeviceSize(ix.numCells) * 4);
-        Buffer& dense = m_ws.buf("slotDense", VkDeviceSize(numSlots) * 4);
+        Buffer& slotBase = m_ws.grow(leaf.slotBase, VkDeviceSize(ix.numCells) * 4, "leaf.slotBase");
+        Buffer& dense = m_ws.grow(leaf.slotDense, VkDeviceSize(numSlots) * 4, "leaf.slotDense");
         Buffer* outCells = leaves[round % 2];
         m_ws.counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
         m_ws.counter<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
@@ -53,11 +54,11 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
         m_ws.dispatch(cmd, Kernel::kLeafSlots, sp, ix.numCells);
         vkCmdFillBuffer(cmd, dense.handle(), 0, VkDeviceSize(numSlots) * 4, 0);
         m_ws.barrier(cmd);
-        m_ws.cmdScan(cmd, slotBase.address(), ix.numCells, "scanSlots", 0);
+        m_ws.cmdScan(cmd, slotBase.address(), ix.numCells, leaf.scanSlots, "leaf.scanSlots");
         m_ws.barrier(cmd);
         m_ws.dispatch(cmd, Kernel::kLeafKeys, sp, ix.n);
         m_ws.barrier(cmd);
-        m_ws.cmdScan(cmd, dense.address(), uint32_t(numSlots), "scanDense", 0);
+        m_ws.cmdScan(cmd, dense.address(), uint32_t(numSlots), leaf.scanDense, "leaf.scanDense");
         m_ws.barrier(cmd);
         m_ws.dispatch(cmd, Kernel::kLeafScatter, sp, ix.n);
         m_ws.barrier(cmd);
@@ -68,13 +69,13 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
                          outCells->address(),
                          m_ws.cellsCounterAddr(),
                          m_ws.maxCountAddr(),
-                         m_ws.boundsU(n).address(),
+                         m_ws.grow(leaf.boundsU, n * 24, "leaf.boundsU").address(),
                          m_ws.blocks[0].addr(RTHDIST_CTR_LARGE_CELLS),
                          ix.n,
                          ix.n};
         m_ws.dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
         m_ws.barrier(cmd);
-        m_ws.cmdScan(cmd, flags.address(), ix.n, "scanFlags", 0);
+        m_ws.cmdScan(cmd, flags.address(), ix.n, leaf.scanFlags, "leaf.scanFlags");
         m_ws.barrier(cmd);
         cmdCellBuild(cmd, cp);
         m_ws.ctx.submitAndWait(cmd);

@@ -20,7 +20,7 @@ double boxLowerBound2(const core::Bounds& q, const core::Bounds& t) {
 
 }  // namespace
 
-void NeighbourhoodPass::startDirection(DirectionRun& d, const std::string& tag) {
+void NeighbourhoodPass::startDirection(DirectionRun& d, size_t direction) {
     Counters& cnt = d.out.counters;
     cnt.bits = uint32_t(d.T.grid.bits);
     cnt.occupiedCells = d.T.numCells;
@@ -39,9 +39,10 @@ void NeighbourhoodPass::startDirection(DirectionRun& d, const std::string& tag) 
         maxAbs = std::max({maxAbs, std::abs(b->lo.x), std::abs(b->lo.y), std::abs(b->lo.z), std::abs(b->hi.x),
                            std::abs(b->hi.y), std::abs(b->hi.z)});
     d.epsilon = float(maxAbs * 4e-7 + d.T.grid.cellSize * 1e-5);
-    d.state = &m_ws.buf(tag + ".state", VkDeviceSize(d.Q.n) * sizeof(sh::QueryState));
-    d.active[0] = &m_ws.buf(tag + ".active0", VkDeviceSize(d.Q.n) * 4);
-    d.active[1] = &m_ws.buf(tag + ".active1", VkDeviceSize(d.Q.n) * 4);
+    DirectionBuffers& memory = m_ws.scratch.directions[direction];
+    d.state = &m_ws.grow(memory.state, VkDeviceSize(d.Q.n) * sizeof(sh::QueryState), d.name() + ".state");
+    d.active[0] = &m_ws.grow(memory.active[0], VkDeviceSize(d.Q.n) * 4, d.name() + ".active0");
+    d.active[1] = &m_ws.grow(memory.active[1], VkDeviceSize(d.Q.n) * 4, d.name() + ".active1");
     d.checkSlots = sampleSlots(d.Q.n, kCheckSamples);
 }
 

@@ -20,8 +20,9 @@ public:
     NeighbourhoodPass(Workspace& workspace, QueryCheck& queryCheck) : m_ws(workspace), m_check(queryCheck) {}
 
     // Sets up h(Q, T) (Q's points in Q's cell order are the queries): its
-    // bounds, epsilon and buffers; nothing is recorded.
-    void startDirection(DirectionRun& d, const std::string& tag);
+    // bounds, epsilon and buffers (the workspace's for `direction`: 0 for
+    // A->B, 1 for B->A); nothing is recorded.
+    void startDirection(DirectionRun& d, size_t direction);
 
     // Records the neighbourhood pass and the compaction of the survivors
     // (their slots in active[0], their count at RTHDIST_CTR_ACTIVE).

@@ -7,13 +7,14 @@
 #include <glm/vec3.hpp>
 
 #include <cstdint>
-#include <map>
+#include <deque>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "core/index_space.hpp"
 #include "gpu/buffer.hpp"
+#include "gpu_algo/scratch.hpp"
 #include "rthdist_shared.h"
 
 namespace rthdist::gpu {
@@ -41,6 +42,25 @@ inline constexpr int kMaxSplitRounds = 12;
 // Points per host work item (the host's copies and bounds).
 inline constexpr size_t kHostChunk = size_t(1) << 16;
 
+struct PointIndex;
+
+// The device memory of a set's index: its own (a prepared set, exact
+// sizes) or the workspace's for set A or B (one-shot sets, reused and grown
+// by the next call).
+struct SetBuffers {
+    Buffer sorted, sortedKeys, dense, cells;
+    Buffer sorted2, sortedKeys2, leaves0, leaves1;  // the leaf split's ping-pong
+    struct Level {
+        Buffer cells, fineFirst;
+    };
+    std::deque<Level> levels;  // search level j at [j - 1] (deque: stable addresses)
+
+    // Device bytes held.
+    [[nodiscard]] uint64_t bytes() const;
+    // Drops the buffers `ix` does not use (after a leaf split).
+    void releaseUnused(const PointIndex& ix);
+};
+
 struct PointIndex {
     uint32_t n = 0;
     core::GridSpec grid;
@@ -49,14 +69,14 @@ struct PointIndex {
     Buffer* dense = nullptr;   // uint per key: end of the key's cell
     Buffer* cells = nullptr;   // Cell per occupied cell
     uint32_t numCells = 0;
-    uint64_t cellCapacity = 0;     // room of `cells` at the build: min(n, keys)
-    Buffer* sortedKeys = nullptr;  // fine key per sorted point (builds coarser levels)
-    std::string name;              // "A", "B" or "set#N": names its buffers and its messages
-    std::string scratch;           // prefix of its build's pooled scratch buffers ("A", "B", "build")
+    uint64_t cellCapacity = 0;                // room of `cells` at the build: min(n, keys)
+    Buffer* sortedKeys = nullptr;             // fine key per sorted point (builds coarser levels)
+    std::string name;                         // "A", "B" or "set#N": names its buffers and its messages
+    BuildScratch* scratch = nullptr;          // its build's scratch (the workspace's for A or B)
     const gpu::HostImport* source = nullptr;  // ingest: the caller's array imported in place, if it could be
-    // Where its buffers live: the engine's pool (one-shot sets, reused by
-    // name by the next call) or a prepared set's own map (exact sizes).
-    std::map<std::string, Buffer>* store = nullptr;
+    // Where its buffers live: the workspace's (one-shot sets, reused by the
+    // next call, with room to grow) or a prepared set's own (owned: exact sizes).
+    SetBuffers* store = nullptr;
     bool owned = false;
     // Leaves: `cells` are sub-cells of crowded grid cells (still contiguous
     // runs inside their grid cells), searched directly while the radius is
@@ -76,10 +96,10 @@ struct PointIndex {
 // the buffers it owns (prepared) and the float points the device holds.
 struct DeviceSet {
     DeviceSet() = default;
-    DeviceSet(const DeviceSet&) = delete;  // ix.store may point into `own`
+    DeviceSet(const DeviceSet&) = delete;  // ix.store may point to `own`
     DeviceSet& operator=(const DeviceSet&) = delete;
 
-    std::map<std::string, Buffer> own;  // a prepared set's buffers (empty for one-shot sets)
+    SetBuffers own;  // a prepared set's buffers (empty for one-shot sets)
     PointIndex ix;
     std::span<const glm::vec3> input;   // the backend's input (float, before the scale)
     std::vector<glm::vec3> scaledCopy;  // input * scale when scale != 1

@@ -73,7 +73,8 @@ void QueryCheck::readPerPoint(const PointIndex& Q, const Buffer& state, std::spa
                               std::span<const glm::vec3> tPts, PerPoint& out) {
     const VkDeviceSize stateBytes = VkDeviceSize(Q.n) * sizeof(sh::QueryState);
     const VkDeviceSize pointBytes = VkDeviceSize(Q.n) * 16;
-    Buffer& host = m_ws.buf("readback", stateBytes + pointBytes, MemoryKind::kHost);
+    Buffer& host =
+        m_ws.grow(m_ws.scratch.search.readback, stateBytes + pointBytes, "readback", MemoryKind::kHost);
     VkCommandBuffer cmd = m_ws.ctx.begin();
     VkBufferCopy c1{0, 0, stateBytes};
     vkCmdCopyBuffer(cmd, state.handle(), host.handle(), 1, &c1);

@@ -23,9 +23,12 @@ const PointIndex::Level& IndexBuild::searchLevel(PointIndex& T, int level) {
         const uint32_t numFiner = j == 1 ? T.numCells : T.levels.back().count;
         const std::string tag = ".level" + std::to_string(j);
         PointIndex::Level lv;
-        lv.cells = &m_ws.setBuf(T, tag, VkDeviceSize(numFiner) * sizeof(sh::Cell));
-        lv.fineFirst = &m_ws.setBuf(T, tag + ".fineFirst", VkDeviceSize(numFiner) * 4);
-        Buffer& flags = m_ws.buf("coarseFlags", VkDeviceSize(numFiner) * 4);
+        if (T.store->levels.size() < size_t(j)) T.store->levels.resize(size_t(j));
+        SetBuffers::Level& memory = T.store->levels[size_t(j - 1)];
+        lv.cells = &m_ws.setBuffer(T, memory.cells, tag.c_str(), VkDeviceSize(numFiner) * sizeof(sh::Cell));
+        lv.fineFirst =
+            &m_ws.setBuffer(T, memory.fineFirst, (tag + ".fineFirst").c_str(), VkDeviceSize(numFiner) * 4);
+        Buffer& flags = m_ws.grow(m_ws.scratch.levels.flags, VkDeviceSize(numFiner) * 4, "level.flags");
         auto t0 = Clock::now();
         VkCommandBuffer cmd = m_ws.ctx.begin();
         sh::CoarsenPush co{finer->address(),
@@ -40,7 +43,7 @@ const PointIndex::Level& IndexBuild::searchLevel(PointIndex& T, int level) {
                            uint32_t(3 * j)};
         m_ws.dispatch(cmd, Kernel::kCoarsen, co, numFiner);
         m_ws.barrier(cmd);
-        m_ws.cmdScan(cmd, flags.address(), numFiner, "scanCoarse", 0);
+        m_ws.cmdScan(cmd, flags.address(), numFiner, m_ws.scratch.levels.scan, "level.scan");
         m_ws.barrier(cmd);
         co.mode = 1;
         m_ws.dispatch(cmd, Kernel::kCoarsen, co, numFiner);

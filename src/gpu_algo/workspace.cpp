@@ -13,12 +13,13 @@ void reportProgress(const CallOptions& options, const char* stage, double fracti
     throwIfCancelled(options);
 }
 
-Workspace::Workspace(gpu::Context& c, const std::string& cacheDir)
+Workspace::Workspace(gpu::Context& c, const std::string& cacheDir, int hostThreads)
     : ctx(c),
       pipelineCache(c.device(), c.physicalDevice(), cacheDir),
       pipelines(c, c.backend() == Backend::kRayQuery, pipelineCache.handle()),
       accel(c),
-      rayQuery(c.backend() == Backend::kRayQuery) {
+      rayQuery(c.backend() == Backend::kRayQuery),
+      threads(hostThreads) {
     pipelineCache.save();
     hostSmall = Buffer(ctx, kCounterBlockBytes * blocks.size(), gpu::kStorageUsage, MemoryKind::kHost);
     for (size_t k = 0; k < blocks.size(); ++k)
@@ -26,17 +27,7 @@ Workspace::Workspace(gpu::Context& c, const std::string& cacheDir)
                                  hostSmall.address() + k * kCounterBlockBytes, k * kCounterBlockBytes};
 }
 
-Buffer& Workspace::buf(const std::string& name, VkDeviceSize bytes, MemoryKind kind) {
-    return bufIn(pool, name, bytes, kind, true);
-}
-
-Buffer& Workspace::setBuf(PointIndex& ix, const std::string& suffix, VkDeviceSize bytes) {
-    return bufIn(*ix.store, ix.name + suffix, bytes, MemoryKind::kDevice, !ix.owned);
-}
-
-Buffer& Workspace::bufIn(std::map<std::string, Buffer>& store, const std::string& name, VkDeviceSize bytes,
-                         MemoryKind kind, bool slack) {
-    Buffer& b = store[name];
+Buffer& Workspace::grow(Buffer& b, VkDeviceSize bytes, const std::string& name, MemoryKind kind, bool slack) {
     if (!b || b.size() < bytes) {
         b.reset();
         const VkDeviceSize room =
@@ -51,15 +42,17 @@ Buffer& Workspace::bufIn(std::map<std::string, Buffer>& store, const std::string
     return b;
 }
 
-void Workspace::cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, const std::string& tag,
-                        size_t level) {
+void Workspace::cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, ScanScratch& sums,
+                        const char* name, size_t level) {
     const uint32_t blocks = gpu::groupsFor(n, RTHDIST_SCAN_BLOCK);
-    const VkDeviceAddress sums = buf(tag + std::to_string(level), VkDeviceSize(blocks) * 4).address();
-    sh::ScanPush p{data, sums, n};
+    if (sums.size() <= level) sums.resize(level + 1);
+    const VkDeviceAddress sumsAt =
+        grow(sums[level], VkDeviceSize(blocks) * 4, std::string(name) + std::to_string(level)).address();
+    sh::ScanPush p{data, sumsAt, n};
     pipelines.cmdDispatch(cmd, Kernel::kScanBlock, &p, sizeof(p), blocks);
     if (blocks > 1) {
         barrier(cmd);
-        cmdScan(cmd, sums, blocks, tag, level + 1);
+        cmdScan(cmd, sumsAt, blocks, sums, name, level + 1);
         barrier(cmd);
         pipelines.cmdDispatch(cmd, Kernel::kScanAdd, &p, sizeof(p), blocks);
     }

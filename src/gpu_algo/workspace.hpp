@@ -9,7 +9,6 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
-#include <map>
 #include <string>
 
 #include "gpu/accel.hpp"
@@ -19,6 +18,7 @@
 #include "gpu/pipeline_cache.hpp"
 #include "gpu_algo/pipelines.hpp"
 #include "gpu_algo/point_index.hpp"
+#include "gpu_algo/scratch.hpp"
 #include "rthdist/rthdist.hpp"
 #include "rthdist_shared.h"
 
@@ -74,36 +74,39 @@ void reportProgress(const CallOptions& options, const char* stage, double fracti
 
 struct Workspace {
     // Creates the pipelines (seeded from the cache file in cacheDir, which is
-    // then saved) and the counter blocks.
-    Workspace(gpu::Context& c, const std::string& cacheDir);
+    // then saved) and the counter blocks. threads: the host's passes over the
+    // points (EngineOptions::threads; 0: every hardware thread).
+    Workspace(gpu::Context& c, const std::string& cacheDir, int threads);
 
     gpu::Context& ctx;
     gpu::PipelineCache pipelineCache;  // before the pipelines it seeds
     gpu::Pipelines pipelines;
     gpu::AccelStructures accel;
     bool rayQuery;
+    int threads;
     bool tlasBound = false;
     Buffer hostSmall;                    // the counter blocks (RTHDIST_CTR_*), read-backs after each
     std::array<CounterBlock, 2> blocks;  // blocks[0]: every stage; [1]: a second index build
     uint64_t maxPairCapacity = kMaxPairCapacity;
     Timings* timings = nullptr;
     // Buffers live across calls and only grow: allocation is a large share of
-    // a call's cost on discrete GPUs.
-    std::map<std::string, Buffer> pool;
+    // a call's cost on discrete GPUs. oneShot: the indexes of one-shot sets A, B.
+    Scratch scratch;
+    std::array<SetBuffers, 2> oneShot;
     // The caller's arrays imported for the submission in flight (deque:
     // stable addresses for PointIndex::source).
     std::deque<gpu::HostImport> imports;
 
-    // A buffer may be replaced only between submissions: every name is used by
-    // at most one purpose inside one command buffer.
-    Buffer& buf(const std::string& name, VkDeviceSize bytes, MemoryKind kind = MemoryKind::kDevice);
-
-    // A buffer of set `ix` (its index and search levels), in the set's store.
-    Buffer& setBuf(PointIndex& ix, const std::string& suffix, VkDeviceSize bytes);
-
-    // Pooled buffers get room to grow; a prepared set's get their size.
-    Buffer& bufIn(std::map<std::string, Buffer>& store, const std::string& name, VkDeviceSize bytes,
-                  MemoryKind kind, bool slack);
+    // `b` with room for `bytes` at least: replaced (contents lost) when too
+    // small, with room to grow (slack: a quarter more, at most kMaxSlack,
+    // never past the device's largest buffer) unless exact sizes are asked.
+    // `name` labels it in GPU captures and validation messages.
+    Buffer& grow(Buffer& b, VkDeviceSize bytes, const std::string& name,
+                 MemoryKind kind = MemoryKind::kDevice, bool slack = true);
+    // A buffer of set `ix`'s index (exact size for a prepared set).
+    Buffer& setBuffer(PointIndex& ix, Buffer& b, const char* what, VkDeviceSize bytes) {
+        return grow(b, bytes, ix.name + what, MemoryKind::kDevice, !ix.owned);
+    }
 
     // A counter of block 0 (offsets from rthdist_shared.h): the stages run one at a time.
     template <class T>
@@ -123,11 +126,10 @@ struct Workspace {
         pipelines.cmdDispatch(cmd, k, &push, sizeof(Push), gpu::groupsFor(items, groupSize));
     }
 
-    // Exclusive scan of uint[n] at `data`, recursively over block sums.
-    void cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, const std::string& tag, size_t level);
-
-    // Scratch of the parallel box reduction of large cells (6 uints per cell).
-    Buffer& boundsU(uint64_t cellCapacity) { return buf("boundsU", VkDeviceSize(cellCapacity) * 24); }
+    // Exclusive scan of uint[n] at `data`, recursively over block sums:
+    // `sums` holds each level's; `name` labels them.
+    void cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, ScanScratch& sums, const char* name,
+                 size_t level = 0);
 };
 
 }  // namespace rthdist::gpu_algo

@@ -13,9 +13,9 @@
 #include <set>
 #include <vector>
 
-#include "core/index_space.hpp"
 #include "common/point_shapes.hpp"
 #include "common/rng.hpp"
+#include "core/index_space.hpp"
 
 namespace rthdist::core {
 namespace {

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "core/index_space.hpp"
-#include "gpu_algo/self_check.hpp"
 #include "gpu/device_limits.hpp"
+#include "gpu_algo/self_check.hpp"
 
 namespace rthdist::core {
 namespace {

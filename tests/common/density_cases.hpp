@@ -16,8 +16,8 @@
 
 #include <vector>
 
-#include "common/oracle_cases.hpp"
 #include "common/brute_force.hpp"
+#include "common/oracle_cases.hpp"
 
 namespace rthdist::test {
 

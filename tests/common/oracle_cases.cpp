@@ -9,9 +9,9 @@
 #include <numbers>
 #include <sstream>
 
+#include "common/brute_force.hpp"
 #include "common/point_shapes.hpp"
 #include "common/rng.hpp"
-#include "common/brute_force.hpp"
 
 namespace rthdist::test {
 namespace {

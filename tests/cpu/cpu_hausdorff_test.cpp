@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "common/oracle_cases.hpp"
 #include "common/brute_force.hpp"
+#include "common/oracle_cases.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 
 namespace rthdist::test {

@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "common/oracle_cases.hpp"
 #include "common/brute_force.hpp"
+#include "common/oracle_cases.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 
 namespace rthdist::test {

@@ -9,8 +9,8 @@
 
 #include <unistd.h>
 
-#include "common/oracle_cases.hpp"
 #include "common/brute_force.hpp"
+#include "common/oracle_cases.hpp"
 #include "engine/engine_test_support.hpp"
 
 namespace rthdist::test {

@@ -6,8 +6,8 @@
 #include <limits>
 #include <random>
 
-#include "common/oracle_cases.hpp"
 #include "common/brute_force.hpp"
+#include "common/oracle_cases.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {

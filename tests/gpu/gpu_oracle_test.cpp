@@ -5,9 +5,9 @@
 
 #include <glm/glm.hpp>
 
+#include "common/brute_force.hpp"
 #include "common/geo_cases.hpp"
 #include "common/oracle_cases.hpp"
-#include "common/brute_force.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {

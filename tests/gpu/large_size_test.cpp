@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "address_probe.comp.h"
-#include "gpu_algo/gpu_hausdorff.hpp"
 #include "common/oracle_cases.hpp"
 #include "gpu/buffer.hpp"
 #include "gpu/context.hpp"
+#include "gpu_algo/gpu_hausdorff.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {
@@ -102,7 +102,7 @@ TEST(LargeSizes, ExactWhenEverySplitIsForcedSmall) {
     limits.maxGroupsX = 3;
     limits.maxRayDispatch = 5;
     ctx->setLimits(limits);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "");
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0);
     ASSERT_TRUE(engine) << engine.error().message;
     (*engine)->setMaxPairCapacity(600);
     const std::vector<OracleCase> cases = makeOracleCases();
@@ -126,7 +126,7 @@ TEST(LargeSizes, BufferPastMaxBufferSizeIsRefusedWithTheLimitNamed) {
     gpu::DeviceLimits limits = ctx->limits();
     limits.maxBufferBytes = 64 << 10;  // 4096 points of 16 bytes
     ctx->setLimits(limits);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "");
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0);
     ASSERT_TRUE(engine) << engine.error().message;
     std::vector<glm::vec3> a(10000), b(3);
     for (size_t i = 0; i < a.size(); ++i) a[i] = glm::vec3(float(i % 100), float(i / 100), 0.0f);
@@ -146,7 +146,7 @@ TEST(LargeSizes, BlasPastMaxPrimitiveCountIsRefusedWithTheLimitNamed) {
     gpu::DeviceLimits limits = ctx->limits();
     limits.maxPrimitives = 2;
     ctx->setLimits(limits);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "");
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0);
     ASSERT_TRUE(engine) << engine.error().message;
     // Far-apart sets: queries survive the neighbourhood pass and need rays.
     std::vector<glm::vec3> a, b;

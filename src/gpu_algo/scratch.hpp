@@ -1,0 +1,67 @@
+// The typed scratch buffers of the GPU stages. Each stage's buffers are
+// named members, not names in a map; they live in the Workspace, are reused
+// by the next call and only grow (Workspace::grow). A buffer is replaced
+// only between submissions: inside one command buffer each member serves
+// one purpose.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "gpu/buffer.hpp"
+
+namespace rthdist::gpu_algo {
+
+using gpu::Buffer;
+
+// The block sums of an exclusive scan, one buffer per recursion level.
+using ScanScratch = std::vector<Buffer>;
+
+// One index build (index_build.cpp, ingest.cpp). Two exist so that two sets
+// are built in one submission.
+struct BuildScratch {
+    Buffer staging;  // host: the points as vec4 (host path)
+    Buffer source;   // host: the caller's packed floats (device ingest)
+    Buffer raw;      // the packed floats on the device (device ingest)
+    Buffer points;   // vec4 points before the sort
+    Buffer keys;     // cell key per point
+    Buffer flags;    // cell-head flags, scanned into cell numbers
+    Buffer boundsU;  // the parallel box reduction of large cells (6 uints per cell)
+    ScanScratch scanKeys, scanFlags;
+};
+
+// The rounds of a leaf split (leaf_split.cpp).
+struct LeafScratch {
+    Buffer slotKeys, outSlotKeys, flags, slotBase, slotDense, boundsU;
+    ScanScratch scanSlots, scanDense, scanFlags;
+};
+
+// The coarsening of a search level (search_levels.cpp).
+struct LevelScratch {
+    Buffer flags;
+    ScanScratch scan;
+};
+
+// One direction's query states and active lists (ping-pong).
+struct DirectionBuffers {
+    Buffer state;
+    std::array<Buffer, 2> active;
+};
+
+// The candidate search, refinement and per-point read-back.
+struct SearchScratch {
+    Buffer pairs;       // (query, cell) pairs the rays append
+    Buffer aabbs;       // the search cells' grown boxes (BLAS input)
+    Buffer refineArgs;  // the refinement's indirect dispatch
+    Buffer readback;    // host: per-point states and points
+};
+
+struct Scratch {
+    std::array<BuildScratch, 2> builds;  // set A (and every single build), set B
+    LeafScratch leaves;
+    LevelScratch levels;
+    std::array<DirectionBuffers, 2> directions;  // A->B, B->A
+    SearchScratch search;
+};
+
+}  // namespace rthdist::gpu_algo
