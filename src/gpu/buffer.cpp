@@ -82,19 +82,4 @@ void Buffer::reset() {
     m_size = 0;
 }
 
-void cmdBarrier(VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags srcAccess,
-                VkPipelineStageFlags dst, VkAccessFlags dstAccess) {
-    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    mb.srcAccessMask = srcAccess;
-    mb.dstAccessMask = dstAccess;
-    vkCmdPipelineBarrier(cmd, src, dst, 0, 1, &mb, 0, nullptr, 0, nullptr);
-}
-
-void cmdShaderBarrier(VkCommandBuffer cmd, VkPipelineStageFlags shaderStages) {
-    VkPipelineStageFlags stages = shaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT;
-    cmdBarrier(cmd, stages, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, stages,
-               VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
-                   VK_ACCESS_TRANSFER_WRITE_BIT);
-}
-
 }  // namespace rthdist::gpu

@@ -7,6 +7,8 @@
 
 #include <cstdint>
 
+#include "gpu/barriers.hpp"  // cmdBarrier and cmdShaderBarrier, declared here before
+
 namespace rthdist::gpu {
 
 class Context;
@@ -48,12 +50,5 @@ private:
 inline constexpr VkBufferUsageFlags kStorageUsage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
     VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
-
-// Global memory barrier between two groups of pipeline stages.
-void cmdBarrier(VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags srcAccess,
-                VkPipelineStageFlags dst, VkAccessFlags dstAccess);
-// Shader and transfer writes -> shader and transfer reads/writes, over the
-// given shader stages (compute, plus ray tracing where the device has it).
-void cmdShaderBarrier(VkCommandBuffer cmd, VkPipelineStageFlags shaderStages);
 
 }  // namespace rthdist::gpu

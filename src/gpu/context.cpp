@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "gpu/barriers.hpp"
+
 namespace rthdist::gpu {
 
 const char* vkResultName(VkResult r) {
@@ -97,8 +99,8 @@ Probe probeDevice(VkPhysicalDevice pd, int index) {
         p.info.driver = std::string(driver.driverName) + " " + driver.driverInfo;
     }
     auto& missing = p.info.missing;
-    if (props.apiVersion < VK_API_VERSION_1_2) {
-        missing.push_back("Vulkan 1.2 (device offers " +
+    if (props.apiVersion < VK_API_VERSION_1_3) {
+        missing.push_back("Vulkan 1.3 (device offers " +
                           std::to_string(VK_API_VERSION_MAJOR(props.apiVersion)) + "." +
                           std::to_string(VK_API_VERSION_MINOR(props.apiVersion)) + ")");
         return p;
@@ -120,7 +122,8 @@ Probe probeDevice(VkPhysicalDevice pd, int index) {
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR, &rq};
     VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rtp};
-    VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as};
+    VkPhysicalDeviceVulkan13Features v13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES, &as};
+    VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &v13};
     VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &v12};
     vkGetPhysicalDeviceFeatures2(pd, &f2);
     auto need = [&](bool have, const char* what) {
@@ -133,6 +136,7 @@ Probe probeDevice(VkPhysicalDevice pd, int index) {
     need(v12.bufferDeviceAddress, "bufferDeviceAddress");
     need(v12.shaderBufferInt64Atomics, "shaderBufferInt64Atomics");
     need(v12.scalarBlockLayout, "scalarBlockLayout");
+    need(v13.synchronization2, "synchronization2");
     need(as.accelerationStructure, "accelerationStructure");
 
     uint32_t qn = 0;
@@ -181,7 +185,7 @@ struct InstanceHolder {
 Result<VkInstance> createInstance(bool validation) {
     VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
     app.pApplicationName = "rthdist";
-    app.apiVersion = VK_API_VERSION_1_2;
+    app.apiVersion = VK_API_VERSION_1_3;
     std::vector<const char*> layers, exts;
     if (validation) {
         uint32_t n = 0;
@@ -350,7 +354,9 @@ Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceInde
             VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
         as.accelerationStructure = VK_TRUE;
         as.pNext = useRq ? static_cast<void*>(&rq) : static_cast<void*>(&rtp);
-        VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as};
+        VkPhysicalDeviceVulkan13Features v13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES, &as};
+        v13.synchronization2 = VK_TRUE;  // gpu/barriers.hpp records vkCmdPipelineBarrier2
+        VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &v13};
         v12.bufferDeviceAddress = VK_TRUE;
         v12.shaderBufferInt64Atomics = VK_TRUE;
         v12.scalarBlockLayout = VK_TRUE;
@@ -490,11 +496,7 @@ double Context::gpuMsBetween(uint32_t from, uint32_t to) const {
 void Context::submitAndWait(VkCommandBuffer cmd) {
     // Every write of the submission made available to the host before the
     // fence signals: the caller reads counters and read-backs right after.
-    VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    toHost.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
-    toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost,
-                         0, nullptr, 0, nullptr);
+    cmdHostReadBarrier(cmd);
     const uint32_t last = m_marks;
     vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps, last);
     RTHDIST_VK_CHECK(vkEndCommandBuffer(cmd));
