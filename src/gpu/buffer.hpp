@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "gpu/barriers.hpp"  // cmdBarrier and cmdShaderBarrier, declared here before
+#include "gpu/unique_handle.hpp"
 
 namespace rthdist::gpu {
 
@@ -28,19 +29,19 @@ public:
     Buffer& operator=(Buffer&& o) noexcept;
     Buffer(const Buffer&) = delete;
     Buffer& operator=(const Buffer&) = delete;
-    ~Buffer() { reset(); }
+    ~Buffer() = default;
 
+    // Releases the buffer and its memory now; the Buffer is empty after.
     void reset();
-    [[nodiscard]] VkBuffer handle() const { return m_buffer; }
+    [[nodiscard]] VkBuffer handle() const { return m_buffer.get(); }
     [[nodiscard]] VkDeviceAddress address() const { return m_address; }
     [[nodiscard]] VkDeviceSize size() const { return m_size; }
     [[nodiscard]] void* mapped() const { return m_mapped; }
-    [[nodiscard]] explicit operator bool() const { return m_buffer != VK_NULL_HANDLE; }
+    [[nodiscard]] explicit operator bool() const { return bool(m_buffer); }
 
 private:
-    VkDevice m_device = VK_NULL_HANDLE;
-    VkBuffer m_buffer = VK_NULL_HANDLE;
-    VkDeviceMemory m_memory = VK_NULL_HANDLE;
+    UniqueMemory m_memory;  // declared first: released after the buffer bound to it
+    UniqueBuffer m_buffer;
     VkDeviceAddress m_address = 0;
     VkDeviceSize m_size = 0;
     void* m_mapped = nullptr;
