@@ -1,5 +1,6 @@
 #include "render/splat_renderer.hpp"
 
+#include <array>
 #include <cstddef>
 #include <cstring>
 #include <limits>
@@ -143,7 +144,10 @@ const std::string& SplatRenderer::deviceName() const { return m_impl->ctx->devic
 uint64_t SplatRenderer::validationMessageCount() const { return m_impl->ctx->validationMessageCount(); }
 
 Result<std::unique_ptr<SplatRenderer>> SplatRenderer::create(int deviceIndex, bool validation) {
-    auto ctx = gpu::Context::create(Backend::kAuto, deviceIndex, validation);
+    // Compute only: no ray tracing, so any Vulkan 1.3 compute device with
+    // 64-bit buffer atomics qualifies.
+    const std::array<gpu::DeviceRequirements, 1> needs{gpu::computeRequirements()};
+    auto ctx = gpu::Context::create(needs, "the splat renderer", deviceIndex, validation);
     if (!ctx) return ctx.error();
     auto impl = std::make_unique<Impl>();
     impl->ctx = std::move(ctx.value());
