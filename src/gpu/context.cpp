@@ -50,6 +50,16 @@ bool wantsHostImport() {
     return env != nullptr && std::string(env) == "1";
 }
 
+bool instanceHasExtension(const char* name) {
+    uint32_t n = 0;
+    vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr);
+    std::vector<VkExtensionProperties> exts(n);
+    vkEnumerateInstanceExtensionProperties(nullptr, &n, exts.data());
+    for (uint32_t i = 0; i < n; ++i)
+        if (std::strcmp(exts[i].extensionName, name) == 0) return true;
+    return false;
+}
+
 bool hasValidationLayer() {
     uint32_t n = 0;
     vkEnumerateInstanceLayerProperties(&n, nullptr);
@@ -128,7 +138,8 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBit
     return VK_FALSE;
 }
 
-// An instance of Vulkan 1.3; with validation, the layer and VK_EXT_debug_utils.
+// An instance of Vulkan 1.3 with VK_EXT_debug_utils where the loader offers
+// it, and the validation layer when asked for.
 Result<UniqueInstance> makeInstance(bool validation) {
     VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
     app.pApplicationName = "rthdist";
@@ -141,7 +152,8 @@ Result<UniqueInstance> makeInstance(bool validation) {
                          "(Debian: vulkan-validationlayers)"};
         layers.push_back("VK_LAYER_KHRONOS_validation");
     }
-    if (validation) exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    if (validation || instanceHasExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME))
+        exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
     ci.pApplicationInfo = &app;
     ci.enabledLayerCount = uint32_t(layers.size());
@@ -265,7 +277,7 @@ std::optional<Error> Context::createInstance(bool validation) {
     if (!instance) return instance.error();
     m_instance = std::move(instance.value());
     const VkInstance inst = m_instance.get();
-    // Null where the instance has no VK_EXT_debug_utils: names are then not set.
+    // Null where the instance has no VK_EXT_debug_utils: the helpers then do nothing.
     m_setObjectName = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
         vkGetInstanceProcAddr(inst, "vkSetDebugUtilsObjectNameEXT"));
     if (!validation) return std::nullopt;
@@ -302,6 +314,16 @@ void Context::createDevice(const DeviceRequirements& req) {
     RTHDIST_VK_CHECK(createDeviceFor(m_physical, req, optional, m_queueFamily, &device));
     m_device = UniqueDevice(device, {});
     vkGetDeviceQueue(device, m_queueFamily, 0, &m_queue);
+    if (m_setObjectName) {  // the instance has VK_EXT_debug_utils
+        m_cmdBeginLabel = reinterpret_cast<PFN_vkCmdBeginDebugUtilsLabelEXT>(
+            vkGetDeviceProcAddr(device, "vkCmdBeginDebugUtilsLabelEXT"));
+        m_cmdEndLabel = reinterpret_cast<PFN_vkCmdEndDebugUtilsLabelEXT>(
+            vkGetDeviceProcAddr(device, "vkCmdEndDebugUtilsLabelEXT"));
+        if (!m_cmdBeginLabel || !m_cmdEndLabel) {  // labels come in pairs or not at all
+            m_cmdBeginLabel = nullptr;
+            m_cmdEndLabel = nullptr;
+        }
+    }
 }
 
 // Device-level entry points of the ray-tracing extensions `req` enables.
@@ -396,6 +418,17 @@ void Context::setDebugName(VkObjectType type, uint64_t handle, const char* name)
     info.objectHandle = handle;
     info.pObjectName = name;
     m_setObjectName(m_device.get(), &info);
+}
+
+void Context::cmdBeginLabel(VkCommandBuffer cmd, const char* name) const {
+    if (!m_cmdBeginLabel) return;
+    VkDebugUtilsLabelEXT label{VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT};
+    label.pLabelName = name;
+    m_cmdBeginLabel(cmd, &label);
+}
+
+void Context::cmdEndLabel(VkCommandBuffer cmd) const {
+    if (m_cmdEndLabel) m_cmdEndLabel(cmd);
 }
 
 uint32_t Context::memoryTypeIndex(uint32_t typeBits, VkMemoryPropertyFlags wanted) const {

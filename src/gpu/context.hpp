@@ -99,9 +99,19 @@ public:
 
     void countValidationMessage() { ++m_validationMessages; }
 
+    // Debug utilities (VK_EXT_debug_utils, enabled whenever the instance
+    // offers it; with validation the layer provides it). Without it they do
+    // nothing, so callers never test for it.
+    //
     // Gives a Vulkan object a debug name (shown in validation messages and
-    // debuggers) when VK_EXT_debug_utils is on, i.e. with validation.
+    // captures).
     void setDebugName(VkObjectType type, uint64_t handle, const char* name) const;
+    // Opens / closes a labelled region of a command buffer: GPU captures
+    // (RenderDoc, Nsight) show the commands between as one named step, and
+    // validation messages name the region. Regions nest; each begin needs an
+    // end in the same command buffer (ScopedLabel below pairs them).
+    void cmdBeginLabel(VkCommandBuffer cmd, const char* name) const;
+    void cmdEndLabel(VkCommandBuffer cmd) const;
 
 private:
     Context() = default;
@@ -116,6 +126,8 @@ private:
     UniqueInstance m_instance;
     UniqueMessenger m_messenger;
     PFN_vkSetDebugUtilsObjectNameEXT m_setObjectName = nullptr;
+    PFN_vkCmdBeginDebugUtilsLabelEXT m_cmdBeginLabel = nullptr;
+    PFN_vkCmdEndDebugUtilsLabelEXT m_cmdEndLabel = nullptr;
     VkPhysicalDevice m_physical = VK_NULL_HANDLE;
     UniqueDevice m_device;
     VkQueue m_queue = VK_NULL_HANDLE;
@@ -140,6 +152,28 @@ private:
     VkDeviceSize m_importAlignment = 0;
     PFN_vkGetMemoryHostPointerPropertiesEXT m_getHostPointerProperties = nullptr;
     std::atomic<uint64_t> m_validationMessages{0};
+};
+
+// A debug-utils label over the commands recorded during its lifetime:
+//
+//     {
+//         gpu::ScopedLabel label(ctx, cmd, "cull");
+//         ... cmd* calls ...
+//     }
+//
+// Nothing is recorded when the instance has no VK_EXT_debug_utils.
+class ScopedLabel {
+public:
+    ScopedLabel(const Context& ctx, VkCommandBuffer cmd, const char* name) : m_ctx(ctx), m_cmd(cmd) {
+        m_ctx.cmdBeginLabel(m_cmd, name);
+    }
+    ~ScopedLabel() { m_ctx.cmdEndLabel(m_cmd); }
+    ScopedLabel(const ScopedLabel&) = delete;
+    ScopedLabel& operator=(const ScopedLabel&) = delete;
+
+private:
+    const Context& m_ctx;
+    VkCommandBuffer m_cmd;
 };
 
 }  // namespace rthdist::gpu

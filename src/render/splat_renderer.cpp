@@ -94,17 +94,22 @@ struct SplatRenderer::Impl {
     // to `readBack` (the host-read barrier is Context::submitAndWait's).
     void cmdSplat(VkCommandBuffer cmd, const sh::SplatPush& pc, const gpu::Buffer& pixels,
                   const gpu::Buffer& readBack) const {
-        vkCmdFillBuffer(cmd, pixels.handle(), 0, VK_WHOLE_SIZE, ~0u);  // every word ~0: empty
-        // All transfer stages: where vkCmdFillBuffer runs (clear or copy)
-        // changed across spec versions and validation layers.
-        gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        {
+            gpu::ScopedLabel label(*ctx, cmd, "splat: clear");
+            vkCmdFillBuffer(cmd, pixels.handle(), 0, VK_WHOLE_SIZE, ~0u);  // every word ~0: empty
+            // All transfer stages: where vkCmdFillBuffer runs (clear or copy)
+            // changed across spec versions and validation layers.
+            gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                             VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                             VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        }
         if (pc.count > 0) {
+            gpu::ScopedLabel label(*ctx, cmd, "splat: points");
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.get());
             vkCmdPushConstants(cmd, layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
             vkCmdDispatch(cmd, (pc.count + RTHDIST_SPLAT_WG - 1) / RTHDIST_SPLAT_WG, 1, 1);
         }
+        gpu::ScopedLabel label(*ctx, cmd, "splat: read back");
         gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
                          VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
                          VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);

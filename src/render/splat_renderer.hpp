@@ -10,7 +10,8 @@
 //
 // Needs any Vulkan 1.3 compute device with buffer device addresses, 64-bit
 // integers and buffer atomics, scalar block layout and synchronization2
-// (gpu::computeRequirements); no ray tracing. lavapipe qualifies. No Vulkan
+// (gpu::computeRequirements); no ray tracing. lavapipe qualifies. Command
+// regions carry debug-utils labels ("splat: ...") for GPU captures. No Vulkan
 // types in this header.
 //
 // Threading: one SplatRenderer per thread. Precision: float projection, so a
