@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "gpu/buffer.hpp"
+#include "gpu/unique_handle.hpp"
 
 namespace rthdist::gpu {
 
@@ -16,7 +17,7 @@ class Context;
 class AccelStructures {
 public:
     explicit AccelStructures(Context& ctx) : m_ctx(ctx) {}
-    ~AccelStructures() { release(); }
+    ~AccelStructures() = default;
     AccelStructures(const AccelStructures&) = delete;
     AccelStructures& operator=(const AccelStructures&) = delete;
 
@@ -25,18 +26,22 @@ public:
     // Returns true when the TLAS handle changed (descriptor must be rebound).
     bool cmdBuild(VkCommandBuffer cmd, VkDeviceAddress aabbs, uint32_t count, bool update,
                   VkPipelineStageFlags shaderStages);
-    [[nodiscard]] VkAccelerationStructureKHR tlas() const { return m_tlas; }
+    [[nodiscard]] VkAccelerationStructureKHR tlas() const { return m_tlas.get(); }
+    // Releases both structures and their memory now.
     void release();
 
 private:
     // Creates an acceleration structure of `size` bytes in `storage`, which
     // is (re)allocated when too small.
-    VkAccelerationStructureKHR createIn(Buffer& storage, VkDeviceSize size,
-                                        VkAccelerationStructureTypeKHR type);
+    UniqueAccel createIn(Buffer& storage, VkDeviceSize size, VkAccelerationStructureTypeKHR type);
+    // The scratch buffer, grown to `bytes` when smaller; its aligned address.
+    VkDeviceAddress scratchFor(VkDeviceSize bytes);
+    // The TLAS's one instance: the BLAS, identity transform.
+    void writeInstance();
 
     Context& m_ctx;
-    VkAccelerationStructureKHR m_blas = VK_NULL_HANDLE, m_tlas = VK_NULL_HANDLE;
     Buffer m_blasBuffer, m_tlasBuffer, m_scratch, m_instances;
+    UniqueAccel m_blas, m_tlas;  // declared after their storage: destroyed before it
     uint32_t m_count = 0;
 };
 

@@ -1,44 +1,42 @@
 #include "gpu/buffer.hpp"
 
 #include <string>
+#include <utility>
 
 #include "gpu/context.hpp"
 
 namespace rthdist::gpu {
 
-Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind) {
-    m_device = ctx.device();
-    m_size = size == 0 ? 16 : size;
-    requireWithin(m_size, ctx.limits().maxBufferBytes, "a buffer", "maxBufferSize");
-    VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-    bi.size = m_size;
-    bi.usage = usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
-    bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    RTHDIST_VK_CHECK(vkCreateBuffer(m_device, &bi, nullptr, &m_buffer));
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(m_device, m_buffer, &req);
+namespace {
+
+// The memory type of a buffer of `kind`: cached host memory for read-backs
+// where the device has it, else the kind's required properties.
+uint32_t memoryTypeFor(const Context& ctx, uint32_t typeBits, MemoryKind kind) {
     const VkMemoryPropertyFlags hostFlags =
         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    if (kind == MemoryKind::kReadback) {
+        const uint32_t cached = ctx.memoryTypeIndex(typeBits, hostFlags | VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+        if (cached != ~0u) return cached;
+    }
     const VkMemoryPropertyFlags wanted =
-        kind == MemoryKind::kDevice ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT : hostFlags;
-    uint32_t type =
-        kind == MemoryKind::kReadback
-            ? ctx.memoryTypeIndex(req.memoryTypeBits, hostFlags | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
-            : ~0u;
-    if (type == ~0u) type = ctx.memoryTypeIndex(req.memoryTypeBits, wanted);
-    if (type == ~0u) {
-        reset();
+        kind == MemoryKind::kDevice ? VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) : hostFlags;
+    const uint32_t type = ctx.memoryTypeIndex(typeBits, wanted);
+    if (type == ~0u)
         throwVulkanError(VK_ERROR_FEATURE_NOT_PRESENT, "memoryTypeIndex (no suitable memory type)", __FILE__,
                          __LINE__);
-    }
+    return type;
+}
+
+// Device-address memory for `req`; a failure names the device's limits.
+UniqueMemory allocateMemory(const Context& ctx, const VkMemoryRequirements& req, uint32_t type) {
     VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
     flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
     VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags};
     ai.allocationSize = req.size;
     ai.memoryTypeIndex = type;
-    VkResult r = vkAllocateMemory(m_device, &ai, nullptr, &m_memory);
+    VkDeviceMemory memory;
+    const VkResult r = vkAllocateMemory(ctx.device(), &ai, nullptr, &memory);
     if (r < 0) {
-        reset();
         const DeviceLimits& l = ctx.limits();
         const std::string what = "vkAllocateMemory of " + std::to_string(req.size) +
                                  " bytes (the device's maxMemoryAllocationSize is " +
@@ -46,55 +44,50 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
                                  std::to_string(l.deviceHeapBytes) + " bytes)";
         throwVulkanError(r, what.c_str(), __FILE__, __LINE__);
     }
-    RTHDIST_VK_CHECK(vkBindBufferMemory(m_device, m_buffer, m_memory, 0));
+    return UniqueMemory(memory, ctx.device());
+}
+
+}  // namespace
+
+Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind) {
+    const VkDevice d = ctx.device();
+    const VkDeviceSize bytes = size == 0 ? 16 : size;
+    requireWithin(bytes, ctx.limits().maxBufferBytes, "a buffer", "maxBufferSize");
+    VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    bi.size = bytes;
+    bi.usage = usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+    bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    m_buffer = RTHDIST_VK_CREATE(UniqueBuffer, vkCreateBuffer, d, bi);
+    const VkBuffer buffer = m_buffer.get();
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(d, buffer, &req);
+    m_memory = allocateMemory(ctx, req, memoryTypeFor(ctx, req.memoryTypeBits, kind));
+    RTHDIST_VK_CHECK(vkBindBufferMemory(d, buffer, m_memory.get(), 0));
     if (kind != MemoryKind::kDevice)
-        RTHDIST_VK_CHECK(vkMapMemory(m_device, m_memory, 0, VK_WHOLE_SIZE, 0, &m_mapped));
+        RTHDIST_VK_CHECK(vkMapMemory(d, m_memory.get(), 0, VK_WHOLE_SIZE, 0, &m_mapped));
     VkBufferDeviceAddressInfo dai{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
-    dai.buffer = m_buffer;
-    m_address = vkGetBufferDeviceAddress(m_device, &dai);
+    dai.buffer = buffer;
+    m_address = vkGetBufferDeviceAddress(d, &dai);
+    m_size = bytes;
 }
 
 Buffer& Buffer::operator=(Buffer&& o) noexcept {
     if (this != &o) {
-        reset();
-        m_device = o.m_device;
-        m_buffer = o.m_buffer;
-        m_memory = o.m_memory;
-        m_address = o.m_address;
-        m_size = o.m_size;
-        m_mapped = o.m_mapped;
-        o.m_buffer = VK_NULL_HANDLE;
-        o.m_memory = VK_NULL_HANDLE;
-        o.m_mapped = nullptr;
-        o.m_address = 0;
-        o.m_size = 0;
+        m_buffer = std::move(o.m_buffer);
+        m_memory = std::move(o.m_memory);
+        m_address = std::exchange(o.m_address, 0);
+        m_size = std::exchange(o.m_size, 0);
+        m_mapped = std::exchange(o.m_mapped, nullptr);
     }
     return *this;
 }
 
 void Buffer::reset() {
-    if (m_buffer) vkDestroyBuffer(m_device, m_buffer, nullptr);
-    if (m_memory) vkFreeMemory(m_device, m_memory, nullptr);
-    m_buffer = VK_NULL_HANDLE;
-    m_memory = VK_NULL_HANDLE;
+    m_buffer.reset();
+    m_memory.reset();
     m_mapped = nullptr;
     m_address = 0;
     m_size = 0;
-}
-
-void cmdBarrier(VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags srcAccess,
-                VkPipelineStageFlags dst, VkAccessFlags dstAccess) {
-    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    mb.srcAccessMask = srcAccess;
-    mb.dstAccessMask = dstAccess;
-    vkCmdPipelineBarrier(cmd, src, dst, 0, 1, &mb, 0, nullptr, 0, nullptr);
-}
-
-void cmdShaderBarrier(VkCommandBuffer cmd, VkPipelineStageFlags shaderStages) {
-    VkPipelineStageFlags stages = shaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT;
-    cmdBarrier(cmd, stages, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, stages,
-               VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
-                   VK_ACCESS_TRANSFER_WRITE_BIT);
 }
 
 }  // namespace rthdist::gpu

@@ -7,6 +7,9 @@
 
 #include <cstdint>
 
+#include "gpu/barriers.hpp"  // cmdBarrier and cmdShaderBarrier, declared here before
+#include "gpu/unique_handle.hpp"
+
 namespace rthdist::gpu {
 
 class Context;
@@ -26,19 +29,19 @@ public:
     Buffer& operator=(Buffer&& o) noexcept;
     Buffer(const Buffer&) = delete;
     Buffer& operator=(const Buffer&) = delete;
-    ~Buffer() { reset(); }
+    ~Buffer() = default;
 
+    // Releases the buffer and its memory now; the Buffer is empty after.
     void reset();
-    [[nodiscard]] VkBuffer handle() const { return m_buffer; }
+    [[nodiscard]] VkBuffer handle() const { return m_buffer.get(); }
     [[nodiscard]] VkDeviceAddress address() const { return m_address; }
     [[nodiscard]] VkDeviceSize size() const { return m_size; }
     [[nodiscard]] void* mapped() const { return m_mapped; }
-    [[nodiscard]] explicit operator bool() const { return m_buffer != VK_NULL_HANDLE; }
+    [[nodiscard]] explicit operator bool() const { return bool(m_buffer); }
 
 private:
-    VkDevice m_device = VK_NULL_HANDLE;
-    VkBuffer m_buffer = VK_NULL_HANDLE;
-    VkDeviceMemory m_memory = VK_NULL_HANDLE;
+    UniqueMemory m_memory;  // declared first: released after the buffer bound to it
+    UniqueBuffer m_buffer;
     VkDeviceAddress m_address = 0;
     VkDeviceSize m_size = 0;
     void* m_mapped = nullptr;
@@ -48,12 +51,5 @@ private:
 inline constexpr VkBufferUsageFlags kStorageUsage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
     VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
-
-// Global memory barrier between two groups of pipeline stages.
-void cmdBarrier(VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags srcAccess,
-                VkPipelineStageFlags dst, VkAccessFlags dstAccess);
-// Shader and transfer writes -> shader and transfer reads/writes, over the
-// given shader stages (compute, plus ray tracing where the device has it).
-void cmdShaderBarrier(VkCommandBuffer cmd, VkPipelineStageFlags shaderStages);
 
 }  // namespace rthdist::gpu

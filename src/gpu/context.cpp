@@ -1,11 +1,14 @@
 #include "gpu/context.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+
+#include "gpu/barriers.hpp"
 
 namespace rthdist::gpu {
 
@@ -38,32 +41,6 @@ void throwVulkanError(VkResult result, const char* expr, const char* file, int l
 
 namespace {
 
-// What a device must offer, as data.
-const char* const kCommonExtensions[] = {
-    VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
-    VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
-};
-
-struct Probe {
-    DeviceInfo info;
-    uint32_t queueFamily = ~0u;
-    bool common = false;  // everything both paths need is there
-};
-
-bool hasExtension(const std::vector<VkExtensionProperties>& exts, const char* name) {
-    for (const auto& e : exts)
-        if (std::strcmp(e.extensionName, name) == 0) return true;
-    return false;
-}
-
-std::vector<VkExtensionProperties> deviceExtensions(VkPhysicalDevice pd) {
-    uint32_t n = 0;
-    vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, nullptr);
-    std::vector<VkExtensionProperties> exts(n);
-    vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, exts.data());
-    return exts;
-}
-
 // RTHDIST_HOST_IMPORT=1 turns the in-place reads of host arrays on. Off by
 // default: on the H200 (driver 580) importing cost more than the copy it
 // saves (docs/bench/prepared: the pages are pinned on every call; 5M x 5M
@@ -71,6 +48,26 @@ std::vector<VkExtensionProperties> deviceExtensions(VkPhysicalDevice pd) {
 bool wantsHostImport() {
     const char* env = std::getenv("RTHDIST_HOST_IMPORT");
     return env != nullptr && std::string(env) == "1";
+}
+
+bool instanceHasExtension(const char* name) {
+    uint32_t n = 0;
+    vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr);
+    std::vector<VkExtensionProperties> exts(n);
+    vkEnumerateInstanceExtensionProperties(nullptr, &n, exts.data());
+    for (uint32_t i = 0; i < n; ++i)
+        if (std::strcmp(exts[i].extensionName, name) == 0) return true;
+    return false;
+}
+
+bool hasValidationLayer() {
+    uint32_t n = 0;
+    vkEnumerateInstanceLayerProperties(&n, nullptr);
+    std::vector<VkLayerProperties> props(n);
+    vkEnumerateInstanceLayerProperties(&n, props.data());
+    for (uint32_t i = 0; i < n; ++i)
+        if (std::strcmp(props[i].layerName, "VK_LAYER_KHRONOS_validation") == 0) return true;
+    return false;
 }
 
 const char* typeName(VkPhysicalDeviceType t) {
@@ -82,166 +79,6 @@ const char* typeName(VkPhysicalDeviceType t) {
         default: return "other";
     }
 }
-
-Probe probeDevice(VkPhysicalDevice pd, int index) {
-    Probe p;
-    p.info.index = index;
-    VkPhysicalDeviceProperties props;
-    vkGetPhysicalDeviceProperties(pd, &props);
-    p.info.name = props.deviceName;
-    p.info.type = typeName(props.deviceType);
-    VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
-    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver};
-    if (props.apiVersion >= VK_API_VERSION_1_2) {
-        vkGetPhysicalDeviceProperties2(pd, &props2);
-        p.info.driver = std::string(driver.driverName) + " " + driver.driverInfo;
-    }
-    auto& missing = p.info.missing;
-    if (props.apiVersion < VK_API_VERSION_1_2) {
-        missing.push_back("Vulkan 1.2 (device offers " +
-                          std::to_string(VK_API_VERSION_MAJOR(props.apiVersion)) + "." +
-                          std::to_string(VK_API_VERSION_MINOR(props.apiVersion)) + ")");
-        return p;
-    }
-    uint32_t n = 0;
-    vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, nullptr);
-    std::vector<VkExtensionProperties> exts(n);
-    vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, exts.data());
-
-    bool common = true;
-    for (const char* e : kCommonExtensions) {
-        if (!hasExtension(exts, e)) {
-            missing.push_back(std::string("extension ") + e);
-            common = false;
-        }
-    }
-    VkPhysicalDeviceRayQueryFeaturesKHR rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
-    VkPhysicalDeviceRayTracingPipelineFeaturesKHR rtp{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR, &rq};
-    VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rtp};
-    VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as};
-    VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &v12};
-    vkGetPhysicalDeviceFeatures2(pd, &f2);
-    auto need = [&](bool have, const char* what) {
-        if (!have) {
-            missing.push_back(std::string("feature ") + what);
-            common = false;
-        }
-    };
-    need(f2.features.shaderInt64, "shaderInt64");
-    need(v12.bufferDeviceAddress, "bufferDeviceAddress");
-    need(v12.shaderBufferInt64Atomics, "shaderBufferInt64Atomics");
-    need(v12.scalarBlockLayout, "scalarBlockLayout");
-    need(as.accelerationStructure, "accelerationStructure");
-
-    uint32_t qn = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(pd, &qn, nullptr);
-    std::vector<VkQueueFamilyProperties> qf(qn);
-    vkGetPhysicalDeviceQueueFamilyProperties(pd, &qn, qf.data());
-    for (uint32_t i = 0; i < qn; ++i) {
-        if ((qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) && qf[i].timestampValidBits > 0) {
-            p.queueFamily = i;
-            break;
-        }
-    }
-    if (p.queueFamily == ~0u) {
-        missing.push_back("a compute queue with timestamps");
-        common = false;
-    }
-    p.common = common;
-    p.info.limits = readDeviceLimits(pd).named();
-    bool hasRq = hasExtension(exts, VK_KHR_RAY_QUERY_EXTENSION_NAME) && rq.rayQuery;
-    bool hasRtp = hasExtension(exts, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) && rtp.rayTracingPipeline;
-    if (!hasRq) missing.push_back("ray-query: VK_KHR_ray_query with feature rayQuery");
-    if (!hasRtp)
-        missing.push_back("rt-pipeline: VK_KHR_ray_tracing_pipeline with feature rayTracingPipeline");
-    p.info.rayQuery = common && hasRq;
-    p.info.rtPipeline = common && hasRtp;
-    return p;
-}
-
-VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                              VkDebugUtilsMessageTypeFlagsEXT,
-                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
-    if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
-        static_cast<Context*>(user)->countValidationMessage();
-        std::fprintf(stderr, "rthdist: validation: %s\n", data->pMessage);
-    }
-    return VK_FALSE;
-}
-
-struct InstanceHolder {
-    VkInstance instance = VK_NULL_HANDLE;
-    ~InstanceHolder() {
-        if (instance) vkDestroyInstance(instance, nullptr);
-    }
-};
-
-Result<VkInstance> createInstance(bool validation) {
-    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
-    app.pApplicationName = "rthdist";
-    app.apiVersion = VK_API_VERSION_1_2;
-    std::vector<const char*> layers, exts;
-    if (validation) {
-        uint32_t n = 0;
-        vkEnumerateInstanceLayerProperties(&n, nullptr);
-        std::vector<VkLayerProperties> props(n);
-        vkEnumerateInstanceLayerProperties(&n, props.data());
-        bool found = false;
-        for (const auto& l : props) found |= std::strcmp(l.layerName, "VK_LAYER_KHRONOS_validation") == 0;
-        if (!found)
-            return Error{ErrorCode::kNoDevice,
-                         "validation requested but VK_LAYER_KHRONOS_validation is not installed "
-                         "(Debian: vulkan-validationlayers)"};
-        layers.push_back("VK_LAYER_KHRONOS_validation");
-        exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-    }
-    VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-    ci.pApplicationInfo = &app;
-    ci.enabledLayerCount = uint32_t(layers.size());
-    ci.ppEnabledLayerNames = layers.data();
-    ci.enabledExtensionCount = uint32_t(exts.size());
-    ci.ppEnabledExtensionNames = exts.data();
-    VkInstance instance = VK_NULL_HANDLE;
-    VkResult r = vkCreateInstance(&ci, nullptr, &instance);
-    if (r != VK_SUCCESS)
-        return Error{ErrorCode::kNoDevice,
-                     std::string("no Vulkan driver could be loaded (vkCreateInstance: ") + vkResultName(r) +
-                         "); install a Vulkan ICD, e.g. Mesa lavapipe"};
-    return instance;
-}
-
-std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
-    uint32_t n = 0;
-    vkEnumeratePhysicalDevices(instance, &n, nullptr);
-    std::vector<VkPhysicalDevice> pds(n);
-    vkEnumeratePhysicalDevices(instance, &n, pds.data());
-    return pds;
-}
-
-}  // namespace
-
-}  // namespace rthdist::gpu
-
-namespace rthdist {
-
-Result<std::vector<DeviceInfo>> listDevices() {
-    auto inst = gpu::createInstance(false);
-    if (!inst) return inst.error();
-    gpu::InstanceHolder holder{inst.value()};
-    std::vector<DeviceInfo> out;
-    int i = 0;
-    for (VkPhysicalDevice pd : gpu::physicalDevices(holder.instance))
-        out.push_back(gpu::probeDevice(pd, i++).info);
-    return out;
-}
-
-}  // namespace rthdist
-
-namespace rthdist::gpu {
-
-namespace {
 
 // Preference among usable devices when none is named: discrete GPUs first,
 // then integrated, virtual, other, and software (CPU) devices last.
@@ -255,34 +92,123 @@ int typeRank(VkPhysicalDeviceType t) {
     }
 }
 
+// `into` followed by the entries of `more` it does not have yet.
+void appendNew(std::vector<std::string>& into, const std::vector<std::string>& more,
+               const std::string& prefix) {
+    for (const std::string& m : more)
+        if (std::find(into.begin(), into.end(), prefix + m) == into.end()) into.push_back(prefix + m);
+}
+
+// What --list-devices shows: both backends' requirements probed; what both
+// lack is listed once, what one lacks with the backend's name.
+DeviceInfo describeDevice(VkPhysicalDevice pd, int index) {
+    DeviceInfo info;
+    info.index = index;
+    VkPhysicalDeviceProperties props;
+    vkGetPhysicalDeviceProperties(pd, &props);
+    info.name = props.deviceName;
+    info.type = typeName(props.deviceType);
+    if (props.apiVersion >= VK_API_VERSION_1_2) {
+        VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+        VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver};
+        vkGetPhysicalDeviceProperties2(pd, &props2);
+        info.driver = std::string(driver.driverName) + " " + driver.driverInfo;
+        info.limits = readDeviceLimits(pd).named();
+    }
+    const std::vector<std::string> rq = unmetRequirements(pd, backendRequirements(Backend::kRayQuery));
+    const std::vector<std::string> rtp = unmetRequirements(pd, backendRequirements(Backend::kRtPipeline));
+    info.rayQuery = rq.empty();
+    info.rtPipeline = rtp.empty();
+    for (const std::string& m : rq) {
+        const bool both = std::find(rtp.begin(), rtp.end(), m) != rtp.end();
+        info.missing.push_back(both ? m : "ray-query: " + m);
+    }
+    for (const std::string& m : rtp)
+        if (std::find(rq.begin(), rq.end(), m) == rq.end()) info.missing.push_back("rt-pipeline: " + m);
+    return info;
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                              VkDebugUtilsMessageTypeFlagsEXT,
+                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+    if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
+        static_cast<Context*>(user)->countValidationMessage();
+        std::fprintf(stderr, "rthdist: validation: %s\n", data->pMessage);
+    }
+    return VK_FALSE;
+}
+
+// An instance of Vulkan 1.3 with VK_EXT_debug_utils where the loader offers
+// it, and the validation layer when asked for.
+Result<UniqueInstance> makeInstance(bool validation) {
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.pApplicationName = "rthdist";
+    app.apiVersion = VK_API_VERSION_1_3;
+    std::vector<const char*> layers, exts;
+    if (validation) {
+        if (!hasValidationLayer())
+            return Error{ErrorCode::kNoDevice,
+                         "validation requested but VK_LAYER_KHRONOS_validation is not installed "
+                         "(Debian: vulkan-validationlayers)"};
+        layers.push_back("VK_LAYER_KHRONOS_validation");
+    }
+    if (validation || instanceHasExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME))
+        exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    ci.pApplicationInfo = &app;
+    ci.enabledLayerCount = uint32_t(layers.size());
+    ci.ppEnabledLayerNames = layers.data();
+    ci.enabledExtensionCount = uint32_t(exts.size());
+    ci.ppEnabledExtensionNames = exts.data();
+    VkInstance instance = VK_NULL_HANDLE;
+    VkResult r = vkCreateInstance(&ci, nullptr, &instance);
+    if (r != VK_SUCCESS)
+        return Error{ErrorCode::kNoDevice,
+                     std::string("no Vulkan driver could be loaded (vkCreateInstance: ") + vkResultName(r) +
+                         "); install a Vulkan ICD, e.g. Mesa lavapipe"};
+    return UniqueInstance(instance, {});
+}
+
+std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
+    uint32_t n = 0;
+    vkEnumeratePhysicalDevices(instance, &n, nullptr);
+    std::vector<VkPhysicalDevice> pds(n);
+    vkEnumeratePhysicalDevices(instance, &n, pds.data());
+    return pds;
+}
+
 struct Choice {
-    int index = -1;
-    Probe probe;
+    size_t index = 0;        // of the device
+    size_t alternative = 0;  // the requirements it meets
 };
 
-// The device that runs `backend`: the one named (deviceIndex >= 0), else the
-// usable one of the best type (lowest index among equals). Appends why each
-// examined device that cannot run it was rejected to `reasons`.
-std::optional<Choice> chooseDevice(const std::vector<VkPhysicalDevice>& pds, Backend backend, int deviceIndex,
+// The device that meets one of `alternatives`: the one named (deviceIndex >=
+// 0), else the usable one of the best type (lowest index among equals).
+// Appends why each examined device that meets none was rejected to `reasons`.
+std::optional<Choice> chooseDevice(const std::vector<VkPhysicalDevice>& pds,
+                                   std::span<const DeviceRequirements> alternatives, int deviceIndex,
                                    std::string& reasons) {
     std::optional<Choice> best;
     int bestRank = 0;
-    for (int i = 0; i < int(pds.size()); ++i) {
-        if (deviceIndex >= 0 && i != deviceIndex) continue;
-        Probe p = probeDevice(pds[size_t(i)], i);
-        const bool usable = backend == Backend::kRayQuery     ? p.info.rayQuery
-                            : backend == Backend::kRtPipeline ? p.info.rtPipeline
-                                                              : (p.info.rayQuery || p.info.rtPipeline);
-        if (!usable) {
-            reasons += "\n  device " + std::to_string(i) + " (" + p.info.name + "): lacks ";
-            for (size_t m = 0; m < p.info.missing.size(); ++m) reasons += (m ? "; " : "") + p.info.missing[m];
-            continue;
+    for (size_t i = 0; i < pds.size(); ++i) {
+        if (deviceIndex >= 0 && i != size_t(deviceIndex)) continue;
+        std::optional<size_t> met;
+        std::vector<std::string> lacks;
+        for (size_t a = 0; a < alternatives.size() && !met; ++a) {
+            const std::vector<std::string> unmet = unmetRequirements(pds[i], alternatives[a]);
+            if (unmet.empty()) met = a;
+            appendNew(lacks, unmet, "");
         }
         VkPhysicalDeviceProperties props;
-        vkGetPhysicalDeviceProperties(pds[size_t(i)], &props);
+        vkGetPhysicalDeviceProperties(pds[i], &props);
+        if (!met) {
+            reasons += "\n  device " + std::to_string(i) + " (" + props.deviceName + "): lacks ";
+            for (size_t m = 0; m < lacks.size(); ++m) reasons += (m ? "; " : "") + lacks[m];
+            continue;
+        }
         const int rank = typeRank(props.deviceType);
         if (!best || rank < bestRank) {
-            best = Choice{i, p};
+            best = Choice{i, *met};
             bestRank = rank;
         }
     }
@@ -291,171 +217,218 @@ std::optional<Choice> chooseDevice(const std::vector<VkPhysicalDevice>& pds, Bac
 
 }  // namespace
 
+}  // namespace rthdist::gpu
+
+namespace rthdist {
+
+Result<std::vector<DeviceInfo>> listDevices() {
+    auto instance = gpu::makeInstance(false);
+    if (!instance) return instance.error();
+    std::vector<DeviceInfo> out;
+    int i = 0;
+    for (VkPhysicalDevice pd : gpu::physicalDevices(instance->get()))
+        out.push_back(gpu::describeDevice(pd, i++));
+    return out;
+}
+
+}  // namespace rthdist
+
+namespace rthdist::gpu {
+
 Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceIndex, bool validation) {
-    auto inst = createInstance(validation);
-    if (!inst) return inst.error();
+    std::vector<DeviceRequirements> alternatives;
+    if (backend != Backend::kRtPipeline) alternatives.push_back(backendRequirements(Backend::kRayQuery));
+    if (backend != Backend::kRayQuery) alternatives.push_back(backendRequirements(Backend::kRtPipeline));
+    return create(alternatives, std::string("backend ") + backendName(backend), deviceIndex, validation);
+}
+
+Result<std::unique_ptr<Context>> Context::create(std::span<const DeviceRequirements> alternatives,
+                                                 const std::string& purpose, int deviceIndex,
+                                                 bool validation) {
     std::unique_ptr<Context> ctx(new Context());
-    ctx->m_instance = inst.value();
     try {
-        if (validation) {
-            auto createMessenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-                vkGetInstanceProcAddr(ctx->m_instance, "vkCreateDebugUtilsMessengerEXT"));
-            VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-            mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                                 VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-            mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                             VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                             VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-            mi.pfnUserCallback = onDebugMessage;
-            mi.pUserData = ctx.get();
-            RTHDIST_VK_CHECK(createMessenger(ctx->m_instance, &mi, nullptr, &ctx->m_messenger));
-            ctx->m_setObjectName = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
-                vkGetInstanceProcAddr(ctx->m_instance, "vkSetDebugUtilsObjectNameEXT"));
-        }
-        std::vector<VkPhysicalDevice> pds = physicalDevices(ctx->m_instance);
+        if (std::optional<Error> err = ctx->createInstance(validation)) return *err;
+        const std::vector<VkPhysicalDevice> pds = physicalDevices(ctx->m_instance.get());
         if (pds.empty()) return Error{ErrorCode::kNoDevice, "no Vulkan physical device found"};
         std::string reasons;
-        const std::optional<Choice> choice = chooseDevice(pds, backend, deviceIndex, reasons);
-        const Probe chosen = choice ? choice->probe : Probe{};
-        const VkPhysicalDevice chosenPd = choice ? pds[size_t(choice->index)] : VK_NULL_HANDLE;
-        if (!chosenPd) {
+        const std::optional<Choice> choice = chooseDevice(pds, alternatives, deviceIndex, reasons);
+        if (!choice) {
             if (deviceIndex >= int(pds.size()))
                 return Error{ErrorCode::kNoDevice, "device " + std::to_string(deviceIndex) +
                                                        " does not exist (" + std::to_string(pds.size()) +
                                                        " device(s))"};
-            return Error{ErrorCode::kNoDevice, std::string("no Vulkan device can run backend ") +
-                                                   backendName(backend) + ":" + reasons};
+            return Error{ErrorCode::kNoDevice, "no Vulkan device can run " + purpose + ":" + reasons};
         }
-        ctx->m_physical = chosenPd;
-        ctx->m_name = chosen.info.name;
-        ctx->m_queueFamily = chosen.queueFamily;
-        ctx->m_backend = backend == Backend::kAuto
-                             ? (chosen.info.rayQuery ? Backend::kRayQuery : Backend::kRtPipeline)
-                             : backend;
-        const bool useRq = ctx->m_backend == Backend::kRayQuery;
-
-        std::vector<const char*> exts(std::begin(kCommonExtensions), std::end(kCommonExtensions));
-        exts.push_back(useRq ? VK_KHR_RAY_QUERY_EXTENSION_NAME : VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
-        // Optional: the device reads the caller's arrays in place (gpu/host_import.hpp).
-        ctx->m_hostImport = wantsHostImport() && hasExtension(deviceExtensions(chosenPd),
-                                                              VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
-        if (ctx->m_hostImport) exts.push_back(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
-
-        VkPhysicalDeviceRayQueryFeaturesKHR rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
-        rq.rayQuery = VK_TRUE;
-        VkPhysicalDeviceRayTracingPipelineFeaturesKHR rtp{
-            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
-        rtp.rayTracingPipeline = VK_TRUE;
-        VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
-            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
-        as.accelerationStructure = VK_TRUE;
-        as.pNext = useRq ? static_cast<void*>(&rq) : static_cast<void*>(&rtp);
-        VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as};
-        v12.bufferDeviceAddress = VK_TRUE;
-        v12.shaderBufferInt64Atomics = VK_TRUE;
-        v12.scalarBlockLayout = VK_TRUE;
-        VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &v12};
-        f2.features.shaderInt64 = VK_TRUE;
-
-        float priority = 1.0f;
-        VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-        qci.queueFamilyIndex = ctx->m_queueFamily;
-        qci.queueCount = 1;
-        qci.pQueuePriorities = &priority;
-        VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &f2};
-        dci.queueCreateInfoCount = 1;
-        dci.pQueueCreateInfos = &qci;
-        dci.enabledExtensionCount = uint32_t(exts.size());
-        dci.ppEnabledExtensionNames = exts.data();
-        RTHDIST_VK_CHECK(vkCreateDevice(chosenPd, &dci, nullptr, &ctx->m_device));
-        vkGetDeviceQueue(ctx->m_device, ctx->m_queueFamily, 0, &ctx->m_queue);
-
-        VkDevice d = ctx->m_device;
-        auto& rt = ctx->m_rt;
-#define RTHDIST_LOAD(member, name) rt.member = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(d, #name))
-        RTHDIST_LOAD(getBuildSizes, vkGetAccelerationStructureBuildSizesKHR);
-        RTHDIST_LOAD(createAccel, vkCreateAccelerationStructureKHR);
-        RTHDIST_LOAD(destroyAccel, vkDestroyAccelerationStructureKHR);
-        RTHDIST_LOAD(cmdBuildAccel, vkCmdBuildAccelerationStructuresKHR);
-        RTHDIST_LOAD(getAccelAddress, vkGetAccelerationStructureDeviceAddressKHR);
-        if (!useRq) {
-            RTHDIST_LOAD(createRtPipelines, vkCreateRayTracingPipelinesKHR);
-            RTHDIST_LOAD(getGroupHandles, vkGetRayTracingShaderGroupHandlesKHR);
-            RTHDIST_LOAD(cmdTraceRays, vkCmdTraceRaysKHR);
-        }
-#undef RTHDIST_LOAD
-        if (!rt.getBuildSizes || !rt.createAccel || !rt.cmdBuildAccel || (!useRq && !rt.cmdTraceRays))
-            return Error{ErrorCode::kNoDevice,
-                         "the driver does not expose the acceleration-structure entry points"};
-
-        ctx->m_rtProps.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR;
-        ctx->m_asProps.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
-        ctx->m_asProps.pNext = &ctx->m_rtProps;
-        VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &ctx->m_asProps};
-        vkGetPhysicalDeviceProperties2(chosenPd, &p2);
-        ctx->m_timestampPeriod = p2.properties.limits.timestampPeriod;
-        if (ctx->m_hostImport) {
-            VkPhysicalDeviceExternalMemoryHostPropertiesEXT hp{
-                VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_MEMORY_HOST_PROPERTIES_EXT};
-            VkPhysicalDeviceProperties2 hp2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &hp};
-            vkGetPhysicalDeviceProperties2(chosenPd, &hp2);
-            ctx->m_importAlignment = hp.minImportedHostPointerAlignment;
-            ctx->m_getHostPointerProperties = reinterpret_cast<PFN_vkGetMemoryHostPointerPropertiesEXT>(
-                vkGetDeviceProcAddr(d, "vkGetMemoryHostPointerPropertiesEXT"));
-            ctx->m_hostImport = ctx->m_getHostPointerProperties != nullptr && ctx->m_importAlignment > 0;
-        }
-        vkGetPhysicalDeviceMemoryProperties(chosenPd, &ctx->m_memProps);
-        ctx->m_limits = readDeviceLimits(chosenPd);
-
-        VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-        pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-        pci.queueFamilyIndex = ctx->m_queueFamily;
-        RTHDIST_VK_CHECK(vkCreateCommandPool(d, &pci, nullptr, &ctx->m_pool));
-        VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-        ai.commandPool = ctx->m_pool;
-        ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-        ai.commandBufferCount = 1;
-        RTHDIST_VK_CHECK(vkAllocateCommandBuffers(d, &ai, &ctx->m_cmd));
-        VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-        RTHDIST_VK_CHECK(vkCreateFence(d, &fci, nullptr, &ctx->m_fence));
-        VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-        qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-        qpi.queryCount = kTimestampSlots;
-        RTHDIST_VK_CHECK(vkCreateQueryPool(d, &qpi, nullptr, &ctx->m_timestamps));
-        uint32_t qn = 0;
-        vkGetPhysicalDeviceQueueFamilyProperties(chosenPd, &qn, nullptr);
-        std::vector<VkQueueFamilyProperties> qf(qn);
-        vkGetPhysicalDeviceQueueFamilyProperties(chosenPd, &qn, qf.data());
-        ctx->m_timestampBits = qf[ctx->m_queueFamily].timestampValidBits;
+        const DeviceRequirements& req = alternatives[choice->alternative];
+        ctx->m_physical = pds[choice->index];
+        ctx->m_backend = req.backend;
+        ctx->createDevice(req);
+        if (std::optional<Error> err = ctx->loadRtFunctions(req)) return *err;
+        ctx->readProperties(req);
+        ctx->createCommandObjects();
     } catch (const VulkanError& e) {
         return Error{ErrorCode::kNoDevice, e.what()};
     }
     return ctx;
 }
 
+std::optional<Error> Context::createInstance(bool validation) {
+    Result<UniqueInstance> instance = makeInstance(validation);
+    if (!instance) return instance.error();
+    m_instance = std::move(instance.value());
+    const VkInstance inst = m_instance.get();
+    // Null where the instance has no VK_EXT_debug_utils: the helpers then do nothing.
+    m_setObjectName = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+        vkGetInstanceProcAddr(inst, "vkSetDebugUtilsObjectNameEXT"));
+    if (!validation) return std::nullopt;
+    auto createMessenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(inst, "vkCreateDebugUtilsMessengerEXT"));
+    auto destroyMessenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(inst, "vkDestroyDebugUtilsMessengerEXT"));
+    if (!createMessenger || !destroyMessenger)
+        return Error{ErrorCode::kNoDevice, "validation requested but VK_EXT_debug_utils has no messenger"};
+    VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    mi.messageSeverity =
+        VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                     VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    mi.pfnUserCallback = onDebugMessage;
+    mi.pUserData = this;
+    VkDebugUtilsMessengerEXT messenger;
+    RTHDIST_VK_CHECK(createMessenger(inst, &mi, nullptr, &messenger));
+    m_messenger = UniqueMessenger(messenger, {inst, destroyMessenger});
+    return std::nullopt;
+}
+
+// The device with exactly the extensions and features of `req` (plus the
+// optional host import), and its one compute queue.
+void Context::createDevice(const DeviceRequirements& req) {
+    m_queueFamily = computeQueueFamily(m_physical);
+    // Optional: the device reads the caller's arrays in place (gpu/host_import.hpp).
+    m_hostImport =
+        wantsHostImport() && deviceHasExtension(m_physical, VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
+    std::vector<const char*> optional;
+    if (m_hostImport) optional.push_back(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
+    VkDevice device;
+    RTHDIST_VK_CHECK(createDeviceFor(m_physical, req, optional, m_queueFamily, &device));
+    m_device = UniqueDevice(device, {});
+    vkGetDeviceQueue(device, m_queueFamily, 0, &m_queue);
+    if (m_setObjectName) {  // the instance has VK_EXT_debug_utils
+        m_cmdBeginLabel = reinterpret_cast<PFN_vkCmdBeginDebugUtilsLabelEXT>(
+            vkGetDeviceProcAddr(device, "vkCmdBeginDebugUtilsLabelEXT"));
+        m_cmdEndLabel = reinterpret_cast<PFN_vkCmdEndDebugUtilsLabelEXT>(
+            vkGetDeviceProcAddr(device, "vkCmdEndDebugUtilsLabelEXT"));
+        if (!m_cmdBeginLabel || !m_cmdEndLabel) {  // labels come in pairs or not at all
+            m_cmdBeginLabel = nullptr;
+            m_cmdEndLabel = nullptr;
+        }
+    }
+}
+
+// Device-level entry points of the ray-tracing extensions `req` enables.
+std::optional<Error> Context::loadRtFunctions(const DeviceRequirements& req) {
+    const VkDevice d = m_device.get();
+    auto& rt = m_rt;
+#define RTHDIST_LOAD(member, name) rt.member = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(d, #name))
+    if (req.needs(DeviceFeature::kAccelerationStructure)) {
+        RTHDIST_LOAD(getBuildSizes, vkGetAccelerationStructureBuildSizesKHR);
+        RTHDIST_LOAD(createAccel, vkCreateAccelerationStructureKHR);
+        RTHDIST_LOAD(destroyAccel, vkDestroyAccelerationStructureKHR);
+        RTHDIST_LOAD(cmdBuildAccel, vkCmdBuildAccelerationStructuresKHR);
+        RTHDIST_LOAD(getAccelAddress, vkGetAccelerationStructureDeviceAddressKHR);
+        if (!rt.getBuildSizes || !rt.createAccel || !rt.destroyAccel || !rt.cmdBuildAccel ||
+            !rt.getAccelAddress)
+            return Error{ErrorCode::kNoDevice,
+                         "the driver does not expose the acceleration-structure entry points"};
+    }
+    if (req.needs(DeviceFeature::kRayTracingPipeline)) {
+        RTHDIST_LOAD(createRtPipelines, vkCreateRayTracingPipelinesKHR);
+        RTHDIST_LOAD(getGroupHandles, vkGetRayTracingShaderGroupHandlesKHR);
+        RTHDIST_LOAD(cmdTraceRays, vkCmdTraceRaysKHR);
+        if (!rt.createRtPipelines || !rt.getGroupHandles || !rt.cmdTraceRays)
+            return Error{ErrorCode::kNoDevice,
+                         "the driver does not expose the ray-tracing pipeline entry points"};
+    }
+#undef RTHDIST_LOAD
+    return std::nullopt;
+}
+
+void Context::readProperties(const DeviceRequirements& req) {
+    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    // Only structures of extensions the device has enabled go into the chain.
+    m_rtProps.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR;
+    m_asProps.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
+    VkPhysicalDeviceExternalMemoryHostPropertiesEXT hostProps{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_MEMORY_HOST_PROPERTIES_EXT};
+    const auto chain = [&](auto& s) {
+        s.pNext = p2.pNext;
+        p2.pNext = &s;
+    };
+    if (req.needs(DeviceFeature::kRayTracingPipeline)) chain(m_rtProps);
+    if (req.needs(DeviceFeature::kAccelerationStructure)) chain(m_asProps);
+    if (m_hostImport) chain(hostProps);
+    vkGetPhysicalDeviceProperties2(m_physical, &p2);
+    m_name = p2.properties.deviceName;
+    m_timestampPeriod = p2.properties.limits.timestampPeriod;
+    if (m_hostImport) {
+        m_importAlignment = hostProps.minImportedHostPointerAlignment;
+        m_getHostPointerProperties = reinterpret_cast<PFN_vkGetMemoryHostPointerPropertiesEXT>(
+            vkGetDeviceProcAddr(m_device.get(), "vkGetMemoryHostPointerPropertiesEXT"));
+        m_hostImport = m_getHostPointerProperties != nullptr && m_importAlignment > 0;
+    }
+    vkGetPhysicalDeviceMemoryProperties(m_physical, &m_memProps);
+    m_limits = readDeviceLimits(m_physical);
+    uint32_t qn = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(m_physical, &qn, nullptr);
+    std::vector<VkQueueFamilyProperties> qf(qn);
+    vkGetPhysicalDeviceQueueFamilyProperties(m_physical, &qn, qf.data());
+    m_timestampBits = qf[m_queueFamily].timestampValidBits;
+}
+
+// The one command buffer, its fence and the timestamp queries.
+void Context::createCommandObjects() {
+    const VkDevice d = m_device.get();
+    VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pci.queueFamilyIndex = m_queueFamily;
+    m_pool = RTHDIST_VK_CREATE(UniqueCommandPool, vkCreateCommandPool, d, pci);
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = m_pool.get();
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    RTHDIST_VK_CHECK(vkAllocateCommandBuffers(d, &ai, &m_cmd));
+    const VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    m_fence = RTHDIST_VK_CREATE(UniqueFence, vkCreateFence, d, fci);
+    VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qpi.queryCount = kTimestampSlots;
+    m_timestamps = RTHDIST_VK_CREATE(UniqueQueryPool, vkCreateQueryPool, d, qpi);
+}
+
 Context::~Context() {
-    if (m_device) {
-        vkDeviceWaitIdle(m_device);
-        if (m_fence) vkDestroyFence(m_device, m_fence, nullptr);
-        if (m_timestamps) vkDestroyQueryPool(m_device, m_timestamps, nullptr);
-        if (m_pool) vkDestroyCommandPool(m_device, m_pool, nullptr);
-        vkDestroyDevice(m_device, nullptr);
-    }
-    if (m_messenger) {
-        auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-            vkGetInstanceProcAddr(m_instance, "vkDestroyDebugUtilsMessengerEXT"));
-        if (destroy) destroy(m_instance, m_messenger, nullptr);
-    }
-    if (m_instance) vkDestroyInstance(m_instance, nullptr);
+    // Nothing submitted may still run when the children go.
+    if (m_device) vkDeviceWaitIdle(m_device.get());
 }
 
 void Context::setDebugName(VkObjectType type, uint64_t handle, const char* name) const {
-    if (!m_setObjectName || !handle) return;
+    if (!m_setObjectName || !m_device || !handle) return;
     VkDebugUtilsObjectNameInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT};
     info.objectType = type;
     info.objectHandle = handle;
     info.pObjectName = name;
-    m_setObjectName(m_device, &info);
+    m_setObjectName(m_device.get(), &info);
+}
+
+void Context::cmdBeginLabel(VkCommandBuffer cmd, const char* name) const {
+    if (!m_cmdBeginLabel) return;
+    VkDebugUtilsLabelEXT label{VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT};
+    label.pLabelName = name;
+    m_cmdBeginLabel(cmd, &label);
+}
+
+void Context::cmdEndLabel(VkCommandBuffer cmd) const {
+    if (m_cmdEndLabel) m_cmdEndLabel(cmd);
 }
 
 uint32_t Context::memoryTypeIndex(uint32_t typeBits, VkMemoryPropertyFlags wanted) const {
@@ -469,8 +442,8 @@ VkCommandBuffer Context::begin() {
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     RTHDIST_VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
-    vkCmdResetQueryPool(m_cmd, m_timestamps, 0, kTimestampSlots);
-    vkCmdWriteTimestamp(m_cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, m_timestamps, 0);
+    vkCmdResetQueryPool(m_cmd, m_timestamps.get(), 0, kTimestampSlots);
+    vkCmdWriteTimestamp(m_cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, m_timestamps.get(), 0);
     m_marks = 1;
     return m_cmd;
 }
@@ -478,7 +451,7 @@ VkCommandBuffer Context::begin() {
 uint32_t Context::cmdMark(VkCommandBuffer cmd) {
     if (m_marks + 1 >= kTimestampSlots)
         throw std::logic_error("Context::cmdMark: too many marks in one submission");
-    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps, m_marks);
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps.get(), m_marks);
     return m_marks++;
 }
 
@@ -490,26 +463,24 @@ double Context::gpuMsBetween(uint32_t from, uint32_t to) const {
 void Context::submitAndWait(VkCommandBuffer cmd) {
     // Every write of the submission made available to the host before the
     // fence signals: the caller reads counters and read-backs right after.
-    VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    toHost.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
-    toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost,
-                         0, nullptr, 0, nullptr);
+    cmdHostReadBarrier(cmd);
     const uint32_t last = m_marks;
-    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps, last);
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps.get(), last);
     RTHDIST_VK_CHECK(vkEndCommandBuffer(cmd));
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cmd;
-    RTHDIST_VK_CHECK(vkQueueSubmit(m_queue, 1, &si, m_fence));
+    const VkFence fence = m_fence.get();
+    RTHDIST_VK_CHECK(vkQueueSubmit(m_queue, 1, &si, fence));
     VkResult r;
     do {
-        r = vkWaitForFences(m_device, 1, &m_fence, VK_TRUE, 10'000'000'000ull);
+        r = vkWaitForFences(m_device.get(), 1, &fence, VK_TRUE, 10'000'000'000ull);
     } while (r == VK_TIMEOUT);
     RTHDIST_VK_CHECK(r);
-    RTHDIST_VK_CHECK(vkResetFences(m_device, 1, &m_fence));
-    r = vkGetQueryPoolResults(m_device, m_timestamps, 0, last + 1, sizeof(m_stamps), m_stamps.data(),
-                              sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+    RTHDIST_VK_CHECK(vkResetFences(m_device.get(), 1, &fence));
+    r = vkGetQueryPoolResults(m_device.get(), m_timestamps.get(), 0, last + 1, sizeof(m_stamps),
+                              m_stamps.data(), sizeof(uint64_t),
+                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
     RTHDIST_VK_CHECK(r);
     m_lastGpuMs = gpuMsBetween(0, last);
 }

@@ -1,6 +1,8 @@
-// Vulkan instance, device selection and the single compute queue of an Engine.
-// Device selection is headless, declares its requirements as data and records
-// why every rejected device was rejected (vk-bootstrap's habit).
+// Vulkan instance, device selection and the single compute queue of an Engine
+// or of the splat renderer. Device selection is headless, takes its
+// requirements as data (gpu/device_requirements.hpp) and records why every
+// rejected device was rejected (vk-bootstrap's habit). Every handle it creates
+// is owned (gpu/unique_handle.hpp): a failure midway releases what exists.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -9,10 +11,14 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "gpu/device_limits.hpp"
+#include "gpu/device_requirements.hpp"
+#include "gpu/unique_handle.hpp"
 #include "gpu/vk_check.hpp"
 #include "rthdist/rthdist.hpp"
 
@@ -33,16 +39,26 @@ struct RtFunctions {
 
 class Context {
 public:
-    // backend: kAuto, kRayQuery or kRtPipeline. deviceIndex -1 = first usable.
+    // backend: kAuto, kRayQuery or kRtPipeline (backendRequirements; kAuto:
+    // ray query where the chosen device has it, else the ray-tracing
+    // pipeline). deviceIndex -1 = the best usable device (discrete first).
     [[nodiscard]] static Result<std::unique_ptr<Context>> create(Backend backend, int deviceIndex,
                                                                  bool validation);
+    // The device (deviceIndex, or the best usable one) that meets one of
+    // `alternatives`, the first it meets on that device; backend() is that
+    // alternative's. kNoDevice names `purpose` ("backend ray-query", "the
+    // splat renderer") and every rejected device with what it lacks.
+    [[nodiscard]] static Result<std::unique_ptr<Context>> create(
+        std::span<const DeviceRequirements> alternatives, const std::string& purpose, int deviceIndex,
+        bool validation);
     ~Context();
     Context(const Context&) = delete;
     Context& operator=(const Context&) = delete;
 
-    [[nodiscard]] VkDevice device() const { return m_device; }
+    [[nodiscard]] VkDevice device() const { return m_device.get(); }
     [[nodiscard]] VkPhysicalDevice physicalDevice() const { return m_physical; }
     [[nodiscard]] VkQueue queue() const { return m_queue; }
+    // kRayQuery or kRtPipeline; kAuto for a compute-only context (no ray tracing).
     [[nodiscard]] Backend backend() const { return m_backend; }
     [[nodiscard]] const std::string& deviceName() const { return m_name; }
     [[nodiscard]] const RtFunctions& rt() const { return m_rt; }
@@ -83,24 +99,43 @@ public:
 
     void countValidationMessage() { ++m_validationMessages; }
 
+    // Debug utilities (VK_EXT_debug_utils, enabled whenever the instance
+    // offers it; with validation the layer provides it). Without it they do
+    // nothing, so callers never test for it.
+    //
     // Gives a Vulkan object a debug name (shown in validation messages and
-    // debuggers) when VK_EXT_debug_utils is on, i.e. with validation.
+    // captures).
     void setDebugName(VkObjectType type, uint64_t handle, const char* name) const;
+    // Opens / closes a labelled region of a command buffer: GPU captures
+    // (RenderDoc, Nsight) show the commands between as one named step, and
+    // validation messages name the region. Regions nest; each begin needs an
+    // end in the same command buffer (ScopedLabel below pairs them).
+    void cmdBeginLabel(VkCommandBuffer cmd, const char* name) const;
+    void cmdEndLabel(VkCommandBuffer cmd) const;
 
 private:
     Context() = default;
+    // The steps of create(), in order.
+    [[nodiscard]] std::optional<Error> createInstance(bool validation);
+    void createDevice(const DeviceRequirements& req);
+    [[nodiscard]] std::optional<Error> loadRtFunctions(const DeviceRequirements& req);
+    void readProperties(const DeviceRequirements& req);
+    void createCommandObjects();
 
-    VkInstance m_instance = VK_NULL_HANDLE;
-    VkDebugUtilsMessengerEXT m_messenger = VK_NULL_HANDLE;
+    // Declared in creation order: destroyed in reverse, children first.
+    UniqueInstance m_instance;
+    UniqueMessenger m_messenger;
     PFN_vkSetDebugUtilsObjectNameEXT m_setObjectName = nullptr;
+    PFN_vkCmdBeginDebugUtilsLabelEXT m_cmdBeginLabel = nullptr;
+    PFN_vkCmdEndDebugUtilsLabelEXT m_cmdEndLabel = nullptr;
     VkPhysicalDevice m_physical = VK_NULL_HANDLE;
-    VkDevice m_device = VK_NULL_HANDLE;
+    UniqueDevice m_device;
     VkQueue m_queue = VK_NULL_HANDLE;
     uint32_t m_queueFamily = 0;
-    VkCommandPool m_pool = VK_NULL_HANDLE;
-    VkCommandBuffer m_cmd = VK_NULL_HANDLE;
-    VkFence m_fence = VK_NULL_HANDLE;
-    VkQueryPool m_timestamps = VK_NULL_HANDLE;
+    UniqueCommandPool m_pool;
+    VkCommandBuffer m_cmd = VK_NULL_HANDLE;  // freed with m_pool
+    UniqueFence m_fence;
+    UniqueQueryPool m_timestamps;
     double m_lastGpuMs = 0.0;
     uint32_t m_marks = 1;                              // timestamps written since begin()
     std::array<uint64_t, kTimestampSlots> m_stamps{};  // of the last submission
@@ -117,6 +152,28 @@ private:
     VkDeviceSize m_importAlignment = 0;
     PFN_vkGetMemoryHostPointerPropertiesEXT m_getHostPointerProperties = nullptr;
     std::atomic<uint64_t> m_validationMessages{0};
+};
+
+// A debug-utils label over the commands recorded during its lifetime:
+//
+//     {
+//         gpu::ScopedLabel label(ctx, cmd, "cull");
+//         ... cmd* calls ...
+//     }
+//
+// Nothing is recorded when the instance has no VK_EXT_debug_utils.
+class ScopedLabel {
+public:
+    ScopedLabel(const Context& ctx, VkCommandBuffer cmd, const char* name) : m_ctx(ctx), m_cmd(cmd) {
+        m_ctx.cmdBeginLabel(m_cmd, name);
+    }
+    ~ScopedLabel() { m_ctx.cmdEndLabel(m_cmd); }
+    ScopedLabel(const ScopedLabel&) = delete;
+    ScopedLabel& operator=(const ScopedLabel&) = delete;
+
+private:
+    const Context& m_ctx;
+    VkCommandBuffer m_cmd;
 };
 
 }  // namespace rthdist::gpu

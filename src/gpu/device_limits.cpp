@@ -1,21 +1,12 @@
 #include "gpu/device_limits.hpp"
 
 #include <algorithm>
-#include <cstring>
+
+#include "gpu/device_requirements.hpp"
 
 namespace rthdist::gpu {
 
 namespace {
-
-bool deviceHasExtension(VkPhysicalDevice pd, const char* name) {
-    uint32_t n = 0;
-    vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, nullptr);
-    std::vector<VkExtensionProperties> exts(n);
-    vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, exts.data());
-    return std::any_of(exts.begin(), exts.end(), [&](const VkExtensionProperties& e) {
-        return std::strcmp(e.extensionName, name) == 0;
-    });
-}
 
 void readHeaps(VkPhysicalDevice pd, DeviceLimits& out) {
     VkPhysicalDeviceMemoryProperties mem;

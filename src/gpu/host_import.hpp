@@ -18,6 +18,8 @@
 #include <cstddef>
 #include <optional>
 
+#include "gpu/unique_handle.hpp"
+
 namespace rthdist::gpu {
 
 class Context;
@@ -25,23 +27,21 @@ class Context;
 class HostImport {
 public:
     [[nodiscard]] static std::optional<HostImport> create(Context& ctx, const void* data, size_t bytes);
-    HostImport(HostImport&& o) noexcept { *this = static_cast<HostImport&&>(o); }
-    HostImport& operator=(HostImport&& o) noexcept;
+    HostImport(HostImport&&) noexcept = default;
+    HostImport& operator=(HostImport&&) noexcept = default;
     HostImport(const HostImport&) = delete;
     HostImport& operator=(const HostImport&) = delete;
-    ~HostImport() { reset(); }
+    ~HostImport() = default;
 
-    [[nodiscard]] VkBuffer handle() const { return m_buffer; }
+    [[nodiscard]] VkBuffer handle() const { return m_buffer.get(); }
     // Where `data` lies in the buffer.
     [[nodiscard]] VkDeviceSize offset() const { return m_offset; }
 
 private:
     HostImport() = default;
-    void reset();
 
-    VkDevice m_device = VK_NULL_HANDLE;
-    VkBuffer m_buffer = VK_NULL_HANDLE;
-    VkDeviceMemory m_memory = VK_NULL_HANDLE;
+    UniqueMemory m_memory;  // declared first: released after the buffer bound to it
+    UniqueBuffer m_buffer;
     VkDeviceSize m_offset = 0;
 };
 

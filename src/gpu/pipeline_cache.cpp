@@ -86,21 +86,17 @@ PipelineCache::PipelineCache(VkDevice device, VkPhysicalDevice physical, const s
     VkPipelineCacheCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
     ci.initialDataSize = data.size();
     ci.pInitialData = data.empty() ? nullptr : data.data();
-    RTHDIST_VK_CHECK(vkCreatePipelineCache(device, &ci, nullptr, &m_cache));
+    m_cache = RTHDIST_VK_CREATE(UniquePipelineCache, vkCreatePipelineCache, device, ci);
     m_loadedBytes = data.size();
-}
-
-PipelineCache::~PipelineCache() {
-    if (m_cache != VK_NULL_HANDLE) vkDestroyPipelineCache(m_device, m_cache, nullptr);
 }
 
 void PipelineCache::save() {
     if (m_path.empty()) return;
     size_t size = 0;
-    if (vkGetPipelineCacheData(m_device, m_cache, &size, nullptr) != VK_SUCCESS || size == 0) return;
+    if (vkGetPipelineCacheData(m_device, m_cache.get(), &size, nullptr) != VK_SUCCESS || size == 0) return;
     if (m_status == "loaded" && size <= m_loadedBytes) return;  // nothing new
     std::vector<char> data(size);
-    if (vkGetPipelineCacheData(m_device, m_cache, &size, data.data()) != VK_SUCCESS) return;
+    if (vkGetPipelineCacheData(m_device, m_cache.get(), &size, data.data()) != VK_SUCCESS) return;
     std::error_code ec;
     std::filesystem::create_directories(std::filesystem::path(m_path).parent_path(), ec);
     const std::string tmp = m_path + ".tmp" + std::to_string(::getpid());

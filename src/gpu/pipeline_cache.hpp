@@ -18,6 +18,8 @@
 #include <cstdint>
 #include <string>
 
+#include "gpu/unique_handle.hpp"
+
 namespace rthdist::gpu {
 
 class PipelineCache {
@@ -26,11 +28,11 @@ public:
 
     // dir empty: an in-memory cache only (nothing read or written).
     PipelineCache(VkDevice device, VkPhysicalDevice physical, const std::string& dir);
-    ~PipelineCache();
+    ~PipelineCache() = default;
     PipelineCache(const PipelineCache&) = delete;
     PipelineCache& operator=(const PipelineCache&) = delete;
 
-    [[nodiscard]] VkPipelineCache handle() const { return m_cache; }
+    [[nodiscard]] VkPipelineCache handle() const { return m_cache.get(); }
     [[nodiscard]] const std::string& path() const { return m_path; }
     // "loaded", "none" (no file or no dir), or why a file was ignored.
     [[nodiscard]] const std::string& loadStatus() const { return m_status; }
@@ -41,7 +43,7 @@ public:
 
 private:
     VkDevice m_device;
-    VkPipelineCache m_cache = VK_NULL_HANDLE;
+    UniquePipelineCache m_cache;
     std::string m_path;
     std::string m_status = "none";
     size_t m_loadedBytes = 0;

@@ -1,9 +1,12 @@
 #include "gpu_algo/pipelines.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
+#include <span>
 #include <vector>
 
+#include "gpu/compute_pipeline.hpp"
 #include "gpu/context.hpp"
 #include "rthdist_shared.h"
 
@@ -41,123 +44,106 @@ namespace {
 constexpr uint32_t kPushBytes = 128;
 
 struct Spirv {
-    const uint32_t* code;
-    size_t bytes;
+    std::span<const uint32_t> code;
     const char* name;
 };
 
-template <size_t N>
-Spirv spirv(const uint32_t (&a)[N], const char* name) {
-    return {a, N * sizeof(uint32_t), name};
-}
-
 VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
+
+// The kernels' SPIR-V, in Kernel order.
+const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
+    {k_spv_cell_keys_comp, "cell_keys"},
+    {k_spv_scan_block_comp, "scan_block"},
+    {k_spv_scan_add_comp, "scan_add"},
+    {k_spv_scatter_comp, "scatter"},
+    {k_spv_cell_heads_comp, "cell_heads"},
+    {k_spv_cell_build_comp, "cell_build"},
+    {k_spv_cull_comp, "cull"},
+    {k_spv_compact_comp, "compact"},
+    {k_spv_grow_boxes_comp, "grow_boxes"},
+    {k_spv_search_rq_comp, "search_rq"},
+    {k_spv_refine_comp, "refine"},
+    {k_spv_resolve_comp, "resolve"},
+    {k_spv_coarsen_comp, "coarsen"},
+    {k_spv_check_index_comp, "check_index"},
+    {k_spv_check_queries_comp, "check_queries"},
+    {k_spv_leaf_slots_comp, "leaf_slots"},
+    {k_spv_leaf_keys_comp, "leaf_keys"},
+    {k_spv_leaf_scatter_comp, "leaf_scatter"},
+    {k_spv_cell_bounds_comp, "cell_bounds"},
+    {k_spv_cell_bounds_fix_comp, "cell_bounds_fix"},
+    {k_spv_ingest_comp, "ingest"},
+    {k_spv_refine_args_comp, "refine_args"},
+}};
 
 }  // namespace
 
 uint32_t groupsFor(uint64_t n, uint32_t groupSize) { return uint32_t((n + groupSize - 1) / groupSize); }
 
-VkShaderModule Pipelines::createModule(const uint32_t* code, size_t bytes) {
-    VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    ci.codeSize = bytes;
-    ci.pCode = code;
-    VkShaderModule m;
-    RTHDIST_VK_CHECK(vkCreateShaderModule(m_ctx.device(), &ci, nullptr, &m));
-    return m;
-}
-
-Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache) : m_ctx(ctx), m_rayQuery(rayQuery) {
-    VkDevice d = ctx.device();
-    VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT;
+Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache)
+    : m_ctx(ctx), m_rayQuery(rayQuery), m_stages(VK_SHADER_STAGE_COMPUTE_BIT) {
     if (!rayQuery) {
-        stages |= VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_INTERSECTION_BIT_KHR |
-                  VK_SHADER_STAGE_MISS_BIT_KHR;
+        m_stages |= VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_INTERSECTION_BIT_KHR |
+                    VK_SHADER_STAGE_MISS_BIT_KHR;
         m_shaderStages |= VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
     }
+    // Each step's handles are owned as soon as they exist: a throw in a later
+    // step releases them.
+    createLayout();
+    createComputePipelines(cache);
+    if (rayQuery) return;
+    createRtPipeline(cache);
+    createShaderBindingTable();
+}
+
+void Pipelines::createLayout() {
+    const VkDevice d = m_ctx.device();
     VkDescriptorSetLayoutBinding b{};
     b.binding = 0;
     b.descriptorType = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
     b.descriptorCount = 1;
-    b.stageFlags = stages;
+    b.stageFlags = m_stages;
     VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
     sl.bindingCount = 1;
     sl.pBindings = &b;
-    RTHDIST_VK_CHECK(vkCreateDescriptorSetLayout(d, &sl, nullptr, &m_setLayout));
-    VkPushConstantRange range{stages, 0, kPushBytes};
-    VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    pl.setLayoutCount = 1;
-    pl.pSetLayouts = &m_setLayout;
-    pl.pushConstantRangeCount = 1;
-    pl.pPushConstantRanges = &range;
-    RTHDIST_VK_CHECK(vkCreatePipelineLayout(d, &pl, nullptr, &m_layout));
+    m_setLayout = RTHDIST_VK_CREATE(UniqueDescriptorSetLayout, vkCreateDescriptorSetLayout, d, sl);
+    m_layout = createPipelineLayout(d, {m_setLayout.ptr(), 1}, m_stages, kPushBytes);
+
     VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1};
     VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     dp.maxSets = 1;
     dp.poolSizeCount = 1;
     dp.pPoolSizes = &ps;
-    RTHDIST_VK_CHECK(vkCreateDescriptorPool(d, &dp, nullptr, &m_pool));
+    m_pool = RTHDIST_VK_CREATE(UniqueDescriptorPool, vkCreateDescriptorPool, d, dp);
     VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    da.descriptorPool = m_pool;
+    da.descriptorPool = m_pool.get();
     da.descriptorSetCount = 1;
-    da.pSetLayouts = &m_setLayout;
+    da.pSetLayouts = m_setLayout.ptr();
     RTHDIST_VK_CHECK(vkAllocateDescriptorSets(d, &da, &m_set));
+}
 
-    const Spirv compute[size_t(Kernel::kCount)] = {
-        spirv(k_spv_cell_keys_comp, "cell_keys"),
-        spirv(k_spv_scan_block_comp, "scan_block"),
-        spirv(k_spv_scan_add_comp, "scan_add"),
-        spirv(k_spv_scatter_comp, "scatter"),
-        spirv(k_spv_cell_heads_comp, "cell_heads"),
-        spirv(k_spv_cell_build_comp, "cell_build"),
-        spirv(k_spv_cull_comp, "cull"),
-        spirv(k_spv_compact_comp, "compact"),
-        spirv(k_spv_grow_boxes_comp, "grow_boxes"),
-        spirv(k_spv_search_rq_comp, "search_rq"),
-        spirv(k_spv_refine_comp, "refine"),
-        spirv(k_spv_resolve_comp, "resolve"),
-        spirv(k_spv_coarsen_comp, "coarsen"),
-        spirv(k_spv_check_index_comp, "check_index"),
-        spirv(k_spv_check_queries_comp, "check_queries"),
-        spirv(k_spv_leaf_slots_comp, "leaf_slots"),
-        spirv(k_spv_leaf_keys_comp, "leaf_keys"),
-        spirv(k_spv_leaf_scatter_comp, "leaf_scatter"),
-        spirv(k_spv_cell_bounds_comp, "cell_bounds"),
-        spirv(k_spv_cell_bounds_fix_comp, "cell_bounds_fix"),
-        spirv(k_spv_ingest_comp, "ingest"),
-        spirv(k_spv_refine_args_comp, "refine_args"),
-    };
+void Pipelines::createComputePipelines(VkPipelineCache cache) {
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
-        if (Kernel(k) == Kernel::kSearchRayQuery && !rayQuery) continue;
-        VkShaderModule m = createModule(compute[k].code, compute[k].bytes);
-        VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-        ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-        ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-        ci.stage.module = m;
-        ci.stage.pName = "main";
-        ci.layout = m_layout;
-        ci.flags = VK_PIPELINE_CREATE_DISPATCH_BASE_BIT;
-        VkResult r = vkCreateComputePipelines(d, cache, 1, &ci, nullptr, &m_compute[k]);
-        vkDestroyShaderModule(d, m, nullptr);
-        RTHDIST_VK_CHECK(r);
-        ctx.setDebugName(VK_OBJECT_TYPE_PIPELINE, uint64_t(m_compute[k]), compute[k].name);
+        if (Kernel(k) == Kernel::kSearchRayQuery && !m_rayQuery) continue;
+        m_compute[k] = createComputePipeline(m_ctx, kComputeSpirv[k].code, m_layout.get(), cache,
+                                             VK_PIPELINE_CREATE_DISPATCH_BASE_BIT, kComputeSpirv[k].name);
     }
-    if (rayQuery) return;
+}
 
-    VkShaderModule rgen = createModule(k_spv_search_rgen, sizeof(k_spv_search_rgen));
-    VkShaderModule rmiss = createModule(k_spv_search_rmiss, sizeof(k_spv_search_rmiss));
-    VkShaderModule rint = createModule(k_spv_search_rint, sizeof(k_spv_search_rint));
-    VkPipelineShaderStageCreateInfo st[3]{};
+void Pipelines::createRtPipeline(VkPipelineCache cache) {
+    const VkDevice d = m_ctx.device();
+    const UniqueShaderModule mods[3] = {createShaderModule(d, k_spv_search_rgen),
+                                        createShaderModule(d, k_spv_search_rmiss),
+                                        createShaderModule(d, k_spv_search_rint)};
     const VkShaderStageFlagBits kinds[3] = {VK_SHADER_STAGE_RAYGEN_BIT_KHR, VK_SHADER_STAGE_MISS_BIT_KHR,
                                             VK_SHADER_STAGE_INTERSECTION_BIT_KHR};
-    const VkShaderModule mods[3] = {rgen, rmiss, rint};
+    VkPipelineShaderStageCreateInfo st[3]{};
+    VkRayTracingShaderGroupCreateInfoKHR g[3]{};
     for (int i = 0; i < 3; ++i) {
         st[i] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
         st[i].stage = kinds[i];
-        st[i].module = mods[i];
+        st[i].module = mods[i].get();
         st[i].pName = "main";
-    }
-    VkRayTracingShaderGroupCreateInfoKHR g[3]{};
-    for (int i = 0; i < 3; ++i) {
         g[i] = {VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR};
         g[i].generalShader = g[i].closestHitShader = g[i].anyHitShader = g[i].intersectionShader =
             VK_SHADER_UNUSED_KHR;
@@ -174,22 +160,25 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache) : m_ctx
     rci.groupCount = 3;
     rci.pGroups = g;
     rci.maxPipelineRayRecursionDepth = 1;
-    rci.layout = m_layout;
-    VkResult r = ctx.rt().createRtPipelines(d, VK_NULL_HANDLE, cache, 1, &rci, nullptr, &m_rtPipeline);
-    for (VkShaderModule m : mods) vkDestroyShaderModule(d, m, nullptr);
-    RTHDIST_VK_CHECK(r);
-    ctx.setDebugName(VK_OBJECT_TYPE_PIPELINE, uint64_t(m_rtPipeline), "search_rt_pipeline");
+    rci.layout = m_layout.get();
+    VkPipeline pipeline;
+    RTHDIST_VK_CHECK(m_ctx.rt().createRtPipelines(d, VK_NULL_HANDLE, cache, 1, &rci, nullptr, &pipeline));
+    m_rtPipeline = UniquePipeline(pipeline, d);
+    m_ctx.setDebugName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline), "search_rt_pipeline");
+}
 
-    // Shader binding table: raygen | miss | hit, each region aligned to the
-    // base alignment; the buffer's address is rounded up, so over-allocate.
-    const auto& props = ctx.rtProps();
+// Shader binding table: raygen | miss | hit, each region aligned to the base
+// alignment; the buffer's address is rounded up, so over-allocate.
+void Pipelines::createShaderBindingTable() {
+    const auto& props = m_ctx.rtProps();
     const uint32_t handleSize = props.shaderGroupHandleSize;
     const VkDeviceSize stride = alignUp(handleSize, props.shaderGroupHandleAlignment);
     const VkDeviceSize base = props.shaderGroupBaseAlignment;
     const VkDeviceSize region = alignUp(stride, base);
     std::vector<uint8_t> handles(3 * handleSize);
-    RTHDIST_VK_CHECK(ctx.rt().getGroupHandles(d, m_rtPipeline, 0, 3, handles.size(), handles.data()));
-    m_sbt = Buffer(ctx, 3 * region + base,
+    RTHDIST_VK_CHECK(
+        m_ctx.rt().getGroupHandles(m_ctx.device(), m_rtPipeline.get(), 0, 3, handles.size(), handles.data()));
+    m_sbt = Buffer(m_ctx, 3 * region + base,
                    VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
                    MemoryKind::kHost);
     const VkDeviceAddress start = alignUp(m_sbt.address(), base);
@@ -198,16 +187,6 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache) : m_ctx
     m_raygen = {start, stride, stride};
     m_miss = {start + region, stride, stride};
     m_hit = {start + 2 * region, stride, stride};
-}
-
-Pipelines::~Pipelines() {
-    VkDevice d = m_ctx.device();
-    for (VkPipeline p : m_compute)
-        if (p) vkDestroyPipeline(d, p, nullptr);
-    if (m_rtPipeline) vkDestroyPipeline(d, m_rtPipeline, nullptr);
-    if (m_pool) vkDestroyDescriptorPool(d, m_pool, nullptr);
-    if (m_layout) vkDestroyPipelineLayout(d, m_layout, nullptr);
-    if (m_setLayout) vkDestroyDescriptorSetLayout(d, m_setLayout, nullptr);
 }
 
 void Pipelines::bindTlas(VkAccelerationStructureKHR tlas) {
@@ -225,14 +204,11 @@ void Pipelines::bindTlas(VkAccelerationStructureKHR tlas) {
 
 void Pipelines::cmdBindCompute(VkCommandBuffer cmd, Kernel kernel, const void* push,
                                uint32_t pushSize) const {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_compute[size_t(kernel)]);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_compute[size_t(kernel)].get());
     if (kernel == Kernel::kSearchRayQuery)
-        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_layout, 0, 1, &m_set, 0, nullptr);
-    vkCmdPushConstants(cmd, m_layout,
-                       m_rayQuery ? VK_SHADER_STAGE_COMPUTE_BIT
-                                  : (VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_RAYGEN_BIT_KHR |
-                                     VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR),
-                       0, pushSize, push);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_layout.get(), 0, 1, &m_set, 0,
+                                nullptr);
+    vkCmdPushConstants(cmd, m_layout.get(), m_stages, 0, pushSize, push);
 }
 
 void Pipelines::cmdDispatch(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize,
@@ -256,12 +232,10 @@ void Pipelines::cmdDispatchIndirect(VkCommandBuffer cmd, Kernel kernel, const vo
 
 void Pipelines::cmdTraceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize, uint32_t width) const {
     if (width == 0) return;
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, m_rtPipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, m_layout, 0, 1, &m_set, 0, nullptr);
-    vkCmdPushConstants(cmd, m_layout,
-                       VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_RAYGEN_BIT_KHR |
-                           VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR,
-                       0, pushSize, push);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, m_rtPipeline.get());
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, m_layout.get(), 0, 1, &m_set, 0,
+                            nullptr);
+    vkCmdPushConstants(cmd, m_layout.get(), m_stages, 0, pushSize, push);
     m_ctx.rt().cmdTraceRays(cmd, &m_raygen, &m_miss, &m_hit, &m_callable, width, 1, 1);
 }
 

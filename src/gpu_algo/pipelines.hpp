@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include "gpu/buffer.hpp"
+#include "gpu/unique_handle.hpp"
 
 namespace rthdist::gpu {
 
@@ -44,7 +45,7 @@ class Pipelines {
 public:
     // cache: a VkPipelineCache (gpu/pipeline_cache.hpp) or VK_NULL_HANDLE.
     Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache);
-    ~Pipelines();
+    ~Pipelines() = default;
     Pipelines(const Pipelines&) = delete;
     Pipelines& operator=(const Pipelines&) = delete;
 
@@ -63,20 +64,26 @@ public:
     [[nodiscard]] VkPipelineStageFlags shaderStages() const { return m_shaderStages; }
 
 private:
-    VkShaderModule createModule(const uint32_t* code, size_t bytes);
+    // Construction steps: set 0 (the TLAS) and the shared layout; the compute
+    // kernels; the ray-tracing pipeline and its shader binding table.
+    void createLayout();
+    void createComputePipelines(VkPipelineCache cache);
+    void createRtPipeline(VkPipelineCache cache);
+    void createShaderBindingTable();
     // Binds a compute kernel (and the TLAS for ray queries) and its push constants.
     void cmdBindCompute(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize) const;
 
     Context& m_ctx;
     bool m_rayQuery;
-    VkDescriptorSetLayout m_setLayout = VK_NULL_HANDLE;
-    VkPipelineLayout m_layout = VK_NULL_HANDLE;
-    VkDescriptorPool m_pool = VK_NULL_HANDLE;
-    VkDescriptorSet m_set = VK_NULL_HANDLE;
-    std::array<VkPipeline, size_t(Kernel::kCount)> m_compute{};
-    VkPipeline m_rtPipeline = VK_NULL_HANDLE;
+    UniqueDescriptorSetLayout m_setLayout;
+    UniquePipelineLayout m_layout;
+    UniqueDescriptorPool m_pool;
+    VkDescriptorSet m_set = VK_NULL_HANDLE;  // freed with m_pool
+    std::array<UniquePipeline, size_t(Kernel::kCount)> m_compute;
+    UniquePipeline m_rtPipeline;
     Buffer m_sbt;
     VkStridedDeviceAddressRegionKHR m_raygen{}, m_miss{}, m_hit{}, m_callable{};
+    VkShaderStageFlags m_stages;  // that see set 0 and the push constants
     VkPipelineStageFlags m_shaderStages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
 };
 

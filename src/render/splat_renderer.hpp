@@ -8,9 +8,11 @@
 // word). The host reads the words back and splits them into depth and colour;
 // shading and annotation stay with the caller.
 //
-// Needs a device that rthdist's engine accepts (gpu::Context: Vulkan 1.2,
-// buffer device address, 64-bit buffer atomics, a ray-tracing extension);
-// lavapipe qualifies. No Vulkan types in this header.
+// Needs any Vulkan 1.3 compute device with buffer device addresses, 64-bit
+// integers and buffer atomics, scalar block layout and synchronization2
+// (gpu::computeRequirements); no ray tracing. lavapipe qualifies. Command
+// regions carry debug-utils labels ("splat: ...") for GPU captures. No Vulkan
+// types in this header.
 //
 // Threading: one SplatRenderer per thread. Precision: float projection, so a
 // splat may land a pixel away from the double-precision software renderer's.
@@ -53,8 +55,8 @@ struct SplatFrame {
 
 class SplatRenderer {
 public:
-    // deviceIndex -1 = the first usable device. kNoDevice with every rejected
-    // device's reasons when none qualifies.
+    // deviceIndex -1 = the best usable device (discrete first). kNoDevice with
+    // every rejected device's reasons when none qualifies.
     [[nodiscard]] static Result<std::unique_ptr<SplatRenderer>> create(int deviceIndex = -1,
                                                                        bool validation = false);
     ~SplatRenderer();
