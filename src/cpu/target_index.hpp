@@ -1,4 +1,4 @@
-// Target index of the CPU backend: the shared RT-HDIST grid (algo/index_space,
+// Target index of the CPU backend: the shared RT-HDIST grid (core/index_space,
 // Kim, Lee, Kim 2025, Sec. 4.1) with every occupied cell's points contiguous
 // and a tight box per cell, plus an implicit 8-wide bounding-volume hierarchy
 // over sub-cell buckets for exact nearest-neighbour search with early break

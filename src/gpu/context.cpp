@@ -217,23 +217,14 @@ std::optional<Choice> chooseDevice(const std::vector<VkPhysicalDevice>& pds,
 
 }  // namespace
 
-}  // namespace rthdist::gpu
-
-namespace rthdist {
-
-Result<std::vector<DeviceInfo>> listDevices() {
-    auto instance = gpu::makeInstance(false);
+Result<std::vector<DeviceInfo>> describeDevices() {
+    auto instance = makeInstance(false);
     if (!instance) return instance.error();
     std::vector<DeviceInfo> out;
     int i = 0;
-    for (VkPhysicalDevice pd : gpu::physicalDevices(instance->get()))
-        out.push_back(gpu::describeDevice(pd, i++));
+    for (VkPhysicalDevice pd : physicalDevices(instance->get())) out.push_back(describeDevice(pd, i++));
     return out;
 }
-
-}  // namespace rthdist
-
-namespace rthdist::gpu {
 
 Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceIndex, bool validation) {
     std::vector<DeviceRequirements> alternatives;

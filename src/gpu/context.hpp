@@ -37,6 +37,10 @@ struct RtFunctions {
     PFN_vkCmdTraceRaysKHR cmdTraceRays = nullptr;
 };
 
+// Every Vulkan physical device with what each backend it lacks (one
+// instance, no device created): the data behind rthdist::listDevices.
+[[nodiscard]] Result<std::vector<DeviceInfo>> describeDevices();
+
 class Context {
 public:
     // backend: kAuto, kRayQuery or kRtPipeline (backendRequirements; kAuto:

@@ -87,6 +87,7 @@ IterationCounts CandidateSearch::iterate(DirectionRun& d, int level, bool sameLe
 void CandidateSearch::cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv,
                                 bool sameLevel, double radius, Buffer& pairs, uint64_t pairCapacity,
                                 uint32_t numActive) {
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "candidate search");
     PointIndex& T = d.T;
     const float r = float(radius);
     // The ray only has to start inside the grown boxes: a short one

@@ -54,6 +54,7 @@ void IndexBuild::stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int 
 }
 
 void IndexBuild::cmdUpload(VkCommandBuffer cmd, PointIndex& ix) {
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "upload");
     const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
     Buffer& points = m_ws.grow(ix.scratch->points, bytes, ix.name + ".points");
     const VkBufferCopy region{0, 0, bytes};
@@ -63,6 +64,7 @@ void IndexBuild::cmdUpload(VkCommandBuffer cmd, PointIndex& ix) {
 }
 
 void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const CounterBlock& blk) {
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "index build");
     const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
     Buffer& points = m_ws.grow(ix.scratch->points, bytes, ix.name + ".points");
     const uint32_t numKeys = 1u << (3 * ix.grid.bits);

@@ -90,6 +90,20 @@ public:
     // counting sort by slot inside every cell, and the cells of the new order.
     void splitLeaves(PointIndex& ix);
 
+    // The buffers of one leaf-split round: cells, points and keys in and out.
+    struct LeafRound {
+        Buffer* cellsIn;
+        Buffer* sortedIn;
+        Buffer* keysIn;
+        Buffer* sortedOut;
+        Buffer* keysOut;
+        Buffer* cellsOut;
+        uint64_t numSlots;  // one per kept cell, 8^k <= count per split one
+    };
+    // Records one round: a counting sort by slot inside every cell, then the
+    // cells of the new order.
+    void cmdSplitRound(VkCommandBuffer cmd, const PointIndex& ix, const LeafRound& r);
+
     // Search cells of level `level` (>= 1) of T, coarsened from the level
     // below on first use (coarsen.comp: head flags, scan, build).
     const PointIndex::Level& searchLevel(PointIndex& T, int level);

@@ -53,6 +53,7 @@ void IndexBuild::stageSource(PointIndex& ix, std::span<const glm::vec3> pts) {
 }
 
 void IndexBuild::cmdUploadSource(VkCommandBuffer cmd, const PointIndex& ix) {
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "upload");
     const VkDeviceSize bytes = VkDeviceSize(ix.n) * 12;
     const VkBuffer from =
         ix.source ? ix.source->handle()
@@ -62,6 +63,7 @@ void IndexBuild::cmdUploadSource(VkCommandBuffer cmd, const PointIndex& ix) {
 }
 
 void IndexBuild::cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "ingest");
     auto& summary = blk.at<sh::IngestSummary>(RTHDIST_CTR_INGEST);
     for (int k = 0; k < 3; ++k) {
         summary.lo[k] = 0xffffffffu;

@@ -15,16 +15,63 @@
 
 namespace rthdist::gpu_algo {
 
+void IndexBuild::cmdSplitRound(VkCommandBuffer cmd, const PointIndex& ix, const LeafRound& r) {
+    LeafScratch& leaf = m_ws.scratch.leaves;
+    const uint64_t n = ix.n;
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "leaf split");
+    Buffer& slotBase = m_ws.grow(leaf.slotBase, VkDeviceSize(ix.numCells) * 4, "leaf.slotBase");
+    Buffer& dense = m_ws.grow(leaf.slotDense, VkDeviceSize(r.numSlots) * 4, "leaf.slotDense");
+    Buffer& slotKeys = m_ws.grow(leaf.slotKeys, n * 4, "leaf.slotKeys");
+    Buffer& outSlotKeys = m_ws.grow(leaf.outSlotKeys, n * 4, "leaf.outSlotKeys");
+    Buffer& flags = m_ws.grow(leaf.flags, n * 4, "leaf.flags");
+    sh::SplitPush sp{r.cellsIn->address(),
+                     slotBase.address(),
+                     r.sortedIn->address(),
+                     r.keysIn->address(),
+                     dense.address(),
+                     slotKeys.address(),
+                     r.sortedOut->address(),
+                     r.keysOut->address(),
+                     outSlotKeys.address(),
+                     m_ws.blocks[0].addr(RTHDIST_CTR_MIN_EDGE),
+                     ix.numCells,
+                     ix.n,
+                     kLeafMax};
+    m_ws.dispatch(cmd, Kernel::kLeafSlots, sp, ix.numCells);
+    vkCmdFillBuffer(cmd, dense.handle(), 0, VkDeviceSize(r.numSlots) * 4, 0);
+    m_ws.barrier(cmd);
+    m_ws.cmdScan(cmd, slotBase.address(), ix.numCells, leaf.scanSlots, "leaf.scanSlots");
+    m_ws.barrier(cmd);
+    m_ws.dispatch(cmd, Kernel::kLeafKeys, sp, ix.n);
+    m_ws.barrier(cmd);
+    m_ws.cmdScan(cmd, dense.address(), uint32_t(r.numSlots), leaf.scanDense, "leaf.scanDense");
+    m_ws.barrier(cmd);
+    m_ws.dispatch(cmd, Kernel::kLeafScatter, sp, ix.n);
+    m_ws.barrier(cmd);
+    sh::CellsPush cp{r.sortedOut->address(),
+                     outSlotKeys.address(),
+                     flags.address(),
+                     dense.address(),
+                     r.cellsOut->address(),
+                     m_ws.cellsCounterAddr(),
+                     m_ws.maxCountAddr(),
+                     m_ws.grow(leaf.boundsU, n * 24, "leaf.boundsU").address(),
+                     m_ws.blocks[0].addr(RTHDIST_CTR_LARGE_CELLS),
+                     ix.n,
+                     ix.n};
+    m_ws.dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
+    m_ws.barrier(cmd);
+    m_ws.cmdScan(cmd, flags.address(), ix.n, leaf.scanFlags, "leaf.scanFlags");
+    m_ws.barrier(cmd);
+    cmdCellBuild(cmd, cp);
+}
+
 void IndexBuild::splitLeaves(PointIndex& ix) {
     const VkDeviceSize n = ix.n;
-    LeafScratch& leaf = m_ws.scratch.leaves;
     Buffer* sorted[2] = {ix.sorted, &m_ws.setBuffer(ix, ix.store->sorted2, ".sorted2", n * 16)};
     Buffer* gridKeys[2] = {ix.sortedKeys, &m_ws.setBuffer(ix, ix.store->sortedKeys2, ".sortedKeys2", n * 4)};
     Buffer* leaves[2] = {&m_ws.setBuffer(ix, ix.store->leaves0, ".leaves0", n * sizeof(sh::Cell)),
                          &m_ws.setBuffer(ix, ix.store->leaves1, ".leaves1", n * sizeof(sh::Cell))};
-    Buffer& slotKeys = m_ws.grow(leaf.slotKeys, n * 4, "leaf.slotKeys");
-    Buffer& outSlotKeys = m_ws.grow(leaf.outSlotKeys, n * 4, "leaf.outSlotKeys");
-    Buffer& flags = m_ws.grow(leaf.flags, n * 4, "leaf.flags");
     Buffer* cells = ix.cells;
     int cur = 0;
     m_ws.counter<uint32_t>(RTHDIST_CTR_MIN_EDGE) = 0x7f800000u;  // +inf
@@ -32,56 +79,17 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
         // All slots together: one per kept cell, 8^k <= count per split one.
         const uint64_t numSlots = uint64_t(ix.n) + ix.numCells;
         gpu::requireWithin(numSlots, uint64_t(UINT32_MAX), "slots of a leaf split", "2^32 - 1");
-        Buffer& slotBase = m_ws.grow(leaf.slotBase, VkDeviceSize(ix.numCells) * 4, "leaf.slotBase");
-        Buffer& dense = m_ws.grow(leaf.slotDense, VkDeviceSize(numSlots) * 4, "leaf.slotDense");
-        Buffer* outCells = leaves[round % 2];
+        const LeafRound r{cells,           sorted[cur],       gridKeys[cur],
+                          sorted[1 - cur], gridKeys[1 - cur], leaves[round % 2],
+                          numSlots};
         m_ws.counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
         m_ws.counter<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
         VkCommandBuffer cmd = m_ws.ctx.begin();
-        sh::SplitPush sp{cells->address(),
-                         slotBase.address(),
-                         sorted[cur]->address(),
-                         gridKeys[cur]->address(),
-                         dense.address(),
-                         slotKeys.address(),
-                         sorted[1 - cur]->address(),
-                         gridKeys[1 - cur]->address(),
-                         outSlotKeys.address(),
-                         m_ws.blocks[0].addr(RTHDIST_CTR_MIN_EDGE),
-                         ix.numCells,
-                         ix.n,
-                         kLeafMax};
-        m_ws.dispatch(cmd, Kernel::kLeafSlots, sp, ix.numCells);
-        vkCmdFillBuffer(cmd, dense.handle(), 0, VkDeviceSize(numSlots) * 4, 0);
-        m_ws.barrier(cmd);
-        m_ws.cmdScan(cmd, slotBase.address(), ix.numCells, leaf.scanSlots, "leaf.scanSlots");
-        m_ws.barrier(cmd);
-        m_ws.dispatch(cmd, Kernel::kLeafKeys, sp, ix.n);
-        m_ws.barrier(cmd);
-        m_ws.cmdScan(cmd, dense.address(), uint32_t(numSlots), leaf.scanDense, "leaf.scanDense");
-        m_ws.barrier(cmd);
-        m_ws.dispatch(cmd, Kernel::kLeafScatter, sp, ix.n);
-        m_ws.barrier(cmd);
-        sh::CellsPush cp{sorted[1 - cur]->address(),
-                         outSlotKeys.address(),
-                         flags.address(),
-                         dense.address(),
-                         outCells->address(),
-                         m_ws.cellsCounterAddr(),
-                         m_ws.maxCountAddr(),
-                         m_ws.grow(leaf.boundsU, n * 24, "leaf.boundsU").address(),
-                         m_ws.blocks[0].addr(RTHDIST_CTR_LARGE_CELLS),
-                         ix.n,
-                         ix.n};
-        m_ws.dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
-        m_ws.barrier(cmd);
-        m_ws.cmdScan(cmd, flags.address(), ix.n, leaf.scanFlags, "leaf.scanFlags");
-        m_ws.barrier(cmd);
-        cmdCellBuild(cmd, cp);
+        cmdSplitRound(cmd, ix, r);
         m_ws.ctx.submitAndWait(cmd);
         m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
         cur = 1 - cur;
-        cells = outCells;
+        cells = r.cellsOut;
         ix.numCells = m_ws.counter<uint32_t>(RTHDIST_CTR_CELLS);
         if (m_ws.counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) <= kLeafMax) break;
     }

@@ -47,6 +47,7 @@ void NeighbourhoodPass::startDirection(DirectionRun& d, size_t direction) {
 }
 
 void NeighbourhoodPass::cmdCull(VkCommandBuffer cmd, DirectionRun& d) {
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "neighbourhood pass");
     std::memset(d.blk.host, 0, 32);  // ACTIVE .. PAIRS
     sh::CullPush cull{d.Q.sorted->address(),
                       d.T.sorted->address(),

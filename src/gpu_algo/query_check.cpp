@@ -12,6 +12,7 @@
 namespace rthdist::gpu_algo {
 
 void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, bool afterCull) {
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "query check");
     d.blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
     const VkDeviceSize readback = d.blk.offset + RTHDIST_CTR_READBACK;
     const VkDeviceSize witnessAt = readback + VkDeviceSize(d.checkSlots.size()) * 32;

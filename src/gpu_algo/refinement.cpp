@@ -6,6 +6,7 @@ namespace rthdist::gpu_algo {
 
 void Refinement::cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse,
                            float r, Buffer& pairs, uint64_t pairCapacity, uint32_t numActive) {
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "refinement");
     Buffer& args = m_ws.grow(m_ws.scratch.search.refineArgs, 16, "refineArgs");
     sh::RefineArgsPush ap{d.blk.device, args.address(), uint32_t(pairCapacity),
                           std::max<uint32_t>(1, m_ws.ctx.limits().maxGroupsX)};

@@ -31,6 +31,7 @@ const PointIndex::Level& IndexBuild::searchLevel(PointIndex& T, int level) {
         Buffer& flags = m_ws.grow(m_ws.scratch.levels.flags, VkDeviceSize(numFiner) * 4, "level.flags");
         auto t0 = Clock::now();
         VkCommandBuffer cmd = m_ws.ctx.begin();
+        m_ws.ctx.cmdBeginLabel(cmd, "search level");
         sh::CoarsenPush co{finer->address(),
                            T.sortedKeys->address(),
                            flags.address(),
@@ -47,6 +48,7 @@ const PointIndex::Level& IndexBuild::searchLevel(PointIndex& T, int level) {
         m_ws.barrier(cmd);
         co.mode = 1;
         m_ws.dispatch(cmd, Kernel::kCoarsen, co, numFiner);
+        m_ws.ctx.cmdEndLabel(cmd);
         m_ws.ctx.submitAndWait(cmd);
         m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
         m_ws.timings->index += msSince(t0);

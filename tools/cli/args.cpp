@@ -21,7 +21,7 @@ Error usageError(std::string message) { return Error{ErrorCode::kInvalidArgument
 // Documented ranges of the numeric options (README "Usage", --help).
 //
 // --radius-growth: the candidate search starts at a radius of 2 cells and
-// gives up after 4096 iterations (kMaxIterations in src/algo/gpu_hausdorff.cpp),
+// gives up after 4096 iterations (kMaxIterations in src/gpu_algo/candidate_search.hpp),
 // so growth^4096 must cover the largest possible ratio of a nearest distance
 // to a cell: at most 2^130 (float range, sqrt(3) across) over 2^-157 (a
 // subnormal extent split into 2^8 cells), 2^287 in all. 1.05^4096 = 2^288
@@ -31,7 +31,7 @@ Error usageError(std::string message) { return Error{ErrorCode::kInvalidArgument
 constexpr double kMinRadiusGrowth = 1.1;
 constexpr double kMaxRadiusGrowth = 16.0;
 // --bits: the library's largest index bit count (kMaxBits in
-// src/algo/index_space.hpp; the library rejects more, with exit code 3).
+// src/core/index_space.hpp; the library rejects more, with exit code 3).
 constexpr int kMaxBitsOption = 8;
 constexpr int kMaxDeviceIndex = 1023;
 constexpr int kMaxThreads = 1024;
