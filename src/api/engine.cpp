@@ -7,10 +7,9 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
-
 #include <string>
-#include "core/index_space.hpp"
 
+#include "core/index_space.hpp"
 #include "core/input_frame.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 #include "gpu/context.hpp"
@@ -20,26 +19,6 @@
 namespace rthdist {
 
 const char* versionString() { return RTHDIST_VERSION_STRING; }
-
-const char* backendName(Backend backend) {
-    switch (backend) {
-        case Backend::kAuto: return "auto";
-        case Backend::kRayQuery: return "ray-query";
-        case Backend::kRtPipeline: return "rt-pipeline";
-        case Backend::kCpu: return "cpu";
-    }
-    return "?";
-}
-
-bool parseBackend(const std::string& text, Backend& out) {
-    for (Backend b : {Backend::kAuto, Backend::kRayQuery, Backend::kRtPipeline, Backend::kCpu}) {
-        if (text == backendName(b)) {
-            out = b;
-            return true;
-        }
-    }
-    return false;
-}
 
 namespace {
 

@@ -103,9 +103,9 @@ public:
 
     void countValidationMessage() { ++m_validationMessages; }
 
-    // Debug utilities (VK_EXT_debug_utils, enabled whenever the instance
-    // offers it; with validation the layer provides it). Without it they do
-    // nothing, so callers never test for it.
+    // Debug utilities (VK_EXT_debug_utils, enabled with validation, or with
+    // RTHDIST_DEBUG_LABELS=1 in the environment for GPU captures). Without it
+    // they do nothing, so callers never test for it.
     //
     // Gives a Vulkan object a debug name (shown in validation messages and
     // captures).
