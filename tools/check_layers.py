@@ -12,7 +12,7 @@ import sys
 ALLOWED = {
     "core": set(),                                  # index space, input frame, parallel loop
     "cpu": {"core"},                                # the CPU backend
-    "gpu": set(),                                   # Vulkan plumbing
+    "gpu": {"core"},                                # Vulkan plumbing
     "gpu_algo": {"gpu", "core"},                    # the GPU algorithm, by stage
     "api": {"gpu_algo", "gpu", "cpu", "core"},      # the public entry points
     "io": set(),                                    # loaders, beside the engine

@@ -13,7 +13,7 @@
 #include "gpu/device_limits.hpp"
 #include "gpu_algo/self_check.hpp"
 
-namespace rthdist::core {
+namespace rthdist::gpu_algo {
 namespace {
 
 // Every float magnitude class: subnormal, tiny, ordinary, huge, near max.
@@ -33,7 +33,7 @@ const float kMagnitudes[] = {std::numeric_limits<float>::denorm_min(),
 TEST(ExactScale, IsAFinitePowerOfTwoForEveryFloatMagnitude) {
     for (float m : kMagnitudes) {
         SCOPED_TRACE(m);
-        const double s = exactScale(double(m));
+        const double s = core::exactScale(double(m));
         ASSERT_TRUE(std::isfinite(s));
         ASSERT_GT(s, 0.0);
         int e = 0;
@@ -47,17 +47,17 @@ TEST(ExactScale, IsAFinitePowerOfTwoForEveryFloatMagnitude) {
 }
 
 TEST(ExactScale, LeavesOrdinaryMagnitudesAlone) {
-    EXPECT_EQ(exactScale(0.0), 1.0);
-    EXPECT_EQ(exactScale(1.0), 1.0);
-    EXPECT_EQ(exactScale(0x1p-40), 1.0);
-    EXPECT_EQ(exactScale(0x1p40), 1.0);
-    EXPECT_EQ(exactScale(5.4e6), 1.0);
+    EXPECT_EQ(core::exactScale(0.0), 1.0);
+    EXPECT_EQ(core::exactScale(1.0), 1.0);
+    EXPECT_EQ(core::exactScale(0x1p-40), 1.0);
+    EXPECT_EQ(core::exactScale(0x1p40), 1.0);
+    EXPECT_EQ(core::exactScale(5.4e6), 1.0);
 }
 
 TEST(ExactScale, ScaledSquaredDistancesNeitherOverflowNorVanish) {
     for (float m : kMagnitudes) {
         SCOPED_TRACE(m);
-        const double s = exactScale(double(m));
+        const double s = core::exactScale(double(m));
         const float a = float(double(m) * s), b = float(double(-m) * s);
         const float d = a - b;
         const float d2 = d * d + d * d + d * d;  // the largest squared distance at this magnitude
@@ -166,4 +166,4 @@ TEST(DeviceLimits, RefuseWithTheLimitNamed) {
 }
 
 }  // namespace
-}  // namespace rthdist::core
+}  // namespace rthdist::gpu_algo
