@@ -10,11 +10,17 @@
 #include <vector>
 
 #include "core/index_space.hpp"
-#include "gpu_algo/self_check.hpp"
 #include "gpu/device_limits.hpp"
+#include "gpu_algo/self_check.hpp"
 
 namespace rthdist::core {
 namespace {
+
+using gpu_algo::indexCheckFailure;
+using gpu_algo::SampledQuery;
+using gpu_algo::sampledQueryFailure;
+using gpu_algo::sampleSlots;
+using gpu_algo::witnessFailure;
 
 // Every float magnitude class: subnormal, tiny, ordinary, huge, near max.
 const float kMagnitudes[] = {std::numeric_limits<float>::denorm_min(),
