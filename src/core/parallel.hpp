@@ -1,12 +1,15 @@
-// Minimal fork-join helpers for the CPU backend: std::thread only, dynamic
-// scheduling over fixed-size chunks through one atomic counter.
+// Fork-join over fixed-size chunks for the host work of both backends:
+// dynamic scheduling through one atomic counter, the helpers taken from the
+// one process-wide pool (core/thread_pool.hpp) instead of fresh threads.
 #pragma once
 
 #include <algorithm>
-#include <atomic>
 #include <cstddef>
+#include <memory>
 #include <thread>
-#include <vector>
+#include <type_traits>
+
+#include "core/thread_pool.hpp"
 
 namespace rthdist::core {
 
@@ -18,33 +21,38 @@ namespace rthdist::core {
     return t;
 }
 
-// Calls fn(chunkBegin, chunkEnd, threadIndex) for chunks of [0, count) of
-// `chunk` elements, pulled dynamically by `threads` workers (the caller is
-// worker 0). fn must not throw.
+// Calls fn(chunkBegin, chunkEnd, threadIndex) once for each chunk of [0, count)
+// of `chunk` elements (the last one shorter), pulled dynamically by up to
+// resolveThreads(threads, chunks) workers: the caller is worker 0, the others
+// are pool threads. threadIndex is used by one thread only within a call and
+// is below the resolved thread count, so it can index per-thread arrays.
+// Returns when every chunk has run; fn's writes are then visible to the caller.
+// Threading: any thread, also from inside another call's fn (nested) and from
+// many threads at once; it completes even when every pool thread is busy (the
+// caller then runs the chunks itself). One resolved thread runs inline, with
+// no pool involved. fn must not throw (with more than one worker a throw ends
+// the process through std::terminate).
 template <class Fn>
 void parallelChunks(size_t count, size_t chunk, int threads, Fn&& fn) {
     if (count == 0) return;
     chunk = std::max<size_t>(chunk, 1);
     const size_t chunks = (count + chunk - 1) / chunk;
     threads = resolveThreads(threads, chunks);
-    std::atomic<size_t> next{0};
-    auto worker = [&](int t) {
-        for (;;) {
-            const size_t c = next.fetch_add(1, std::memory_order_relaxed);
-            if (c >= chunks) break;
-            const size_t begin = c * chunk;
-            fn(begin, std::min(count, begin + chunk), t);
-        }
-    };
     if (threads == 1) {
-        worker(0);
+        for (size_t c = 0; c < chunks; ++c) fn(c * chunk, std::min(count, (c + 1) * chunk), 0);
         return;
     }
-    std::vector<std::thread> pool;
-    pool.reserve(size_t(threads - 1));
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker, t);
-    worker(0);
-    for (std::thread& th : pool) th.join();
+    using F = std::remove_reference_t<Fn>;
+    static_assert(std::is_object_v<F>, "pass a callable object (a lambda), not a function");
+    ChunkTask task;
+    task.count = count;
+    task.chunk = chunk;
+    task.threads = threads;
+    task.run = [](void* context, size_t begin, size_t end, int threadIndex) {
+        (*static_cast<F*>(context))(begin, end, threadIndex);
+    };
+    task.context = const_cast<void*>(static_cast<const void*>(std::addressof(fn)));
+    runOnPool(task);
 }
 
 }  // namespace rthdist::core

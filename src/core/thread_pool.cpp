@@ -1,0 +1,232 @@
+// The process-wide worker pool (core/thread_pool.hpp). A call posts one entry
+// asking for `threads - 1` helpers and runs chunks itself at once; idle
+// workers take the entry, one helper each, until it has its helpers or the
+// caller withdraws it. The state of a call lives in a ChunkJob held by
+// shared_ptr, so a helper that arrives after the caller has returned only
+// finds that nothing is left (no thread index or no chunk) and never touches
+// the caller's callable. A worker only takes work while idle, never while
+// waiting inside a nested call, so waits form no cycle.
+#include "core/thread_pool.hpp"
+
+#include <pthread.h>
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <system_error>
+#include <thread>
+#include <vector>
+
+namespace rthdist::core {
+namespace {
+
+class ChunkJob {
+public:
+    explicit ChunkJob(const ChunkTask& task)
+        : m_task(task), m_chunks((task.count + task.chunk - 1) / task.chunk) {}
+
+    // A pool worker joining: the next thread index (the caller is 0), or
+    // nothing when the call already has all its workers.
+    void help() {
+        const int threadIndex = m_nextThread.fetch_add(1, std::memory_order_relaxed);
+        if (threadIndex < m_task.threads) work(threadIndex);
+    }
+
+    // Claims and runs chunks until none is left. The chunks run are counted
+    // under the mutex, which orders their writes before the caller's return.
+    void work(int threadIndex) {
+        size_t ran = 0;
+        for (;;) {
+            const size_t c = m_nextChunk.fetch_add(1, std::memory_order_relaxed);
+            if (c >= m_chunks) break;
+            const size_t begin = c * m_task.chunk;
+            m_task.run(m_task.context, begin, std::min(m_task.count, begin + m_task.chunk), threadIndex);
+            ++ran;
+        }
+        if (ran == 0) return;
+        std::lock_guard lock(m_mutex);
+        m_done += ran;
+        if (m_done == m_chunks) m_finished.notify_all();
+    }
+
+    // Waits for the chunks other workers have claimed and not finished yet.
+    void waitAll() {
+        std::unique_lock lock(m_mutex);
+        m_finished.wait(lock, [this] { return m_done == m_chunks; });
+    }
+
+private:
+    const ChunkTask m_task;
+    const size_t m_chunks;
+    std::atomic<size_t> m_nextChunk{0};
+    std::atomic<int> m_nextThread{1};
+    std::mutex m_mutex;
+    std::condition_variable m_finished;
+    size_t m_done = 0;  // guarded by m_mutex
+};
+
+// A posted call and how many helpers it still asks for.
+struct Posting {
+    std::shared_ptr<ChunkJob> job;
+    size_t helpers = 0;
+};
+
+class WorkerPool {
+public:
+    // False once the pool has shut down: the caller then works alone.
+    bool post(const std::shared_ptr<ChunkJob>& job, size_t helpers) {
+        {
+            std::lock_guard lock(m_mutex);
+            if (m_stopping) return false;
+            m_queue.push_back({job, helpers});
+            m_wanted += helpers;
+            m_limit = std::max(m_limit, helpers);
+            // Idle workers first; new ones only while the posted calls want
+            // more than are idle, up to the most helpers one call asked for.
+            while (m_workers.size() < m_limit && m_workers.size() - m_busy < m_wanted) {
+                if (!startWorker()) break;
+            }
+        }
+        if (helpers == 1) {
+            m_wake.notify_one();
+        } else {
+            m_wake.notify_all();
+        }
+        return true;
+    }
+
+    // The caller has claimed every chunk: helpers that have not taken the
+    // call yet are no longer wanted.
+    void withdraw(const ChunkJob* job) {
+        std::lock_guard lock(m_mutex);
+        const auto it = std::find_if(m_queue.begin(), m_queue.end(),
+                                     [job](const Posting& p) { return p.job.get() == job; });
+        if (it == m_queue.end()) return;
+        m_wanted -= it->helpers;
+        m_queue.erase(it);
+    }
+
+    size_t workerCount() {
+        std::lock_guard lock(m_mutex);
+        return m_workers.size();
+    }
+
+    // At static destruction: stop taking calls and join the workers (a
+    // worker finishes the chunk it runs; the callers finish the rest).
+    void shutdown() {
+        std::vector<std::thread> workers;
+        {
+            std::lock_guard lock(m_mutex);
+            m_stopping = true;
+            m_queue.clear();
+            m_wanted = 0;
+            workers.swap(m_workers);
+        }
+        m_wake.notify_all();
+        for (std::thread& w : workers) {
+            if (w.get_id() == std::this_thread::get_id()) {
+                w.detach();  // exit() called from inside a chunk
+            } else {
+                w.join();
+            }
+        }
+    }
+
+    // fork(): the pool's mutex is held across it, so the child never
+    // inherits it locked by a thread that is not there.
+    void beforeFork() { m_mutex.lock(); }
+    void afterForkInParent() { m_mutex.unlock(); }
+    // In the child only the forking thread exists: the workers' handles name
+    // threads that are gone and can be neither joined nor destroyed, so they
+    // are kept, unused, forever; the condition variable may count their
+    // waits, so it starts afresh. The child starts its own workers.
+    void afterForkInChild() {
+        static auto* const orphans = new std::vector<std::thread>;
+        for (std::thread& w : m_workers) orphans->push_back(std::move(w));
+        m_workers.clear();
+        m_queue.clear();
+        m_busy = 0;
+        m_wanted = 0;
+        std::construct_at(&m_wake);
+        m_mutex.unlock();
+    }
+
+private:
+    // Called with m_mutex held. False when the system has no thread to give.
+    bool startWorker() {
+        try {
+            m_workers.emplace_back([this] { workerLoop(); });
+            return true;
+        } catch (const std::system_error&) {
+            return false;
+        }
+    }
+
+    void workerLoop() {
+        std::unique_lock lock(m_mutex);
+        for (;;) {
+            m_wake.wait(lock, [this] { return m_stopping || !m_queue.empty(); });
+            if (m_stopping) return;
+            Posting& front = m_queue.front();
+            std::shared_ptr<ChunkJob> job = front.job;
+            --m_wanted;
+            if (--front.helpers == 0) m_queue.pop_front();
+            ++m_busy;
+            lock.unlock();
+            job->help();
+            job.reset();
+            lock.lock();
+            --m_busy;
+        }
+    }
+
+    std::mutex m_mutex;
+    std::condition_variable m_wake;
+    std::deque<Posting> m_queue;  // calls still asking for helpers
+    std::vector<std::thread> m_workers;
+    size_t m_busy = 0;    // workers inside a call
+    size_t m_wanted = 0;  // helpers the queue still asks for
+    size_t m_limit = 0;   // most helpers one call has asked for
+    bool m_stopping = false;
+};
+
+WorkerPool& pool();
+
+// Joins the workers when the statics of the process (or of the module that
+// holds this library) are destroyed; the pool itself stays valid.
+class PoolShutdown {
+public:
+    PoolShutdown() = default;
+    PoolShutdown(const PoolShutdown&) = delete;
+    PoolShutdown& operator=(const PoolShutdown&) = delete;
+    ~PoolShutdown() { pool().shutdown(); }
+};
+
+WorkerPool& pool() {
+    static WorkerPool* const instance = [] {
+        auto* p = new WorkerPool;  // never freed: see thread_pool.hpp
+        pthread_atfork([] { pool().beforeFork(); }, [] { pool().afterForkInParent(); },
+                       [] { pool().afterForkInChild(); });
+        return p;
+    }();
+    static const PoolShutdown shutdown;
+    return *instance;
+}
+
+}  // namespace
+
+void runOnPool(const ChunkTask& task) noexcept {
+    auto job = std::make_shared<ChunkJob>(task);
+    WorkerPool& workers = pool();
+    const bool posted = workers.post(job, size_t(task.threads - 1));
+    job->work(0);
+    if (posted) workers.withdraw(job.get());
+    job->waitAll();
+}
+
+size_t poolWorkerCount() noexcept { return pool().workerCount(); }
+
+}  // namespace rthdist::core
