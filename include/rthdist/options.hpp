@@ -38,7 +38,9 @@ struct EngineOptions {
     // Enable VK_LAYER_KHRONOS_validation and count every message it emits
     // (Result::validationMessages). For tests; slow.
     bool validation = false;
-    // CPU backend threads; 0 = all hardware threads.
+    // Host threads: the CPU backend's, and the GPU backends' passes over the
+    // points (checks, bounds, copies); 0 = all hardware threads. The work
+    // runs on one persistent worker pool per process (core/thread_pool).
     int threads = 0;
     // GPU backends: the directory of the pipeline cache file, which spares a
     // new process the pipeline compilation on the same device and driver.
