@@ -179,13 +179,9 @@ Result<PcdLayout> layoutOf(const std::vector<PcdField>& fields, const std::strin
 
 Result<PointCloud> readBinaryRows(std::string_view bytes, const PcdHeader& h, const PcdLayout& l,
                                   const std::string& path, const ChunkPlan& plan) {
-    const uint64_t left = bytes.size() - h.bodyOffset;
-    if (h.points > left / l.bytesPerRow) {
-        return badInput(path, offsetWhere(h.bodyOffset),
-                        "declares " + std::to_string(h.points) + " points of " +
-                            std::to_string(l.bytesPerRow) + " bytes, but only " + std::to_string(left) +
-                            " bytes remain (truncated body or wrong count)");
-    }
+    if (auto e = checkRecordsFit(path, h.bodyOffset, "", h.points, l.bytesPerRow, bytes.size() - h.bodyOffset,
+                                 "remain (truncated body or wrong count)"))
+        return *e;
     const RecordLayout rows{bytes.data() + h.bodyOffset,
                             static_cast<size_t>(l.bytesPerRow),
                             h.points,
