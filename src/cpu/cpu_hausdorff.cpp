@@ -268,6 +268,9 @@ struct DirectedOutput {
     double indexMs = 0.0, cullMs = 0.0, searchMs = 0.0, refineMs = 0.0;
 };
 
+// Stage boundaries of one direction as fractions of it (search dominates).
+constexpr double kIndexDone = 0.1, kCullDone = 0.15, kSearchDone = 0.95;
+
 // CallOptions::progress for one direction, which covers [base, base + span)
 // of the call. Only the calling thread (worker 0 of parallelChunks) reports,
 // and at most once per percent of the direction, so a callback that prints
@@ -291,6 +294,13 @@ public:
         m_stage = stage;
         (*m_fn)(stage, m_base + m_span * std::clamp(fraction, 0.0, 1.0));
     }
+    // A worker finished `count` more of the direction's `total` queries.
+    void queriesDone(size_t count, size_t total, int worker) {
+        const size_t finished = m_queriesDone.fetch_add(count, std::memory_order_relaxed) + count;
+        if (worker == 0) {
+            report("search", kCullDone + (kSearchDone - kCullDone) * double(finished) / double(total));
+        }
+    }
 
 private:
     const std::function<void(const char*, double)>* m_fn;
@@ -298,273 +308,360 @@ private:
     double m_base, m_span;
     double m_last = -1.0;
     const char* m_stage = nullptr;
+    std::atomic<size_t> m_queriesDone{0};
 };
 
-// Stage boundaries of one direction as fractions of it (search dominates).
-constexpr double kIndexDone = 0.1, kCullDone = 0.15, kSearchDone = 0.95;
+// Cell keys of the queries in T's grid, and how far they reach outside BV(T).
+struct QueryKeys {
+    UninitVector<uint32_t> key;  // per query of the query order: its cell key (clamped outside the grid)
+    double farthest2 = 0.0;      // largest squared distance from a query to BV(T)
+};
 
-// Every query's exact float nearest neighbour (no early break): the previous
+// Queries in their own adaptive order, each with its cell key in the target
+// grid; the same pass finds the largest distance from a query to BV(T).
+QueryKeys keyQueries(const SetOrder& qOrder, const core::GridSpec& g, const core::Bounds& box, int threads) {
+    const size_t nq = qOrder.keyed.size();
+    QueryKeys out{UninitVector<uint32_t>(nq), 0.0};
+    std::vector<double> farthest(size_t(threads), 0.0);
+    parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int w) {
+        double far = 0.0;
+        for (size_t i = begin; i < end; ++i) {
+            const glm::dvec3 dp(qOrder.x[i], qOrder.y[i], qOrder.z[i]);
+            out.key[i] = core::mortonEncode(core::cellCoord(dp.x, g.origin.x, g.cellSize, g.cellsPerAxis),
+                                            core::cellCoord(dp.y, g.origin.y, g.cellSize, g.cellsPerAxis),
+                                            core::cellCoord(dp.z, g.origin.z, g.cellSize, g.cellsPerAxis));
+            const glm::dvec3 d = glm::max(glm::max(box.lo - dp, dp - box.hi), glm::dvec3(0.0));
+            far = std::max(far, d.x * d.x + d.y * d.y + d.z * d.z);
+        }
+        farthest[size_t(w)] = std::max(farthest[size_t(w)], far);
+    });
+    out.farthest2 = *std::max_element(farthest.begin(), farthest.end());
+    return out;
+}
+
+// One direction h(Q, T): the queries (input order and their adaptive order,
+// scaled, with cell keys) and the target index.
+struct Direction {
+    std::span<const glm::vec3> queries, targets;  // input order, before `scale`
+    const UninitVector<float>& qx;                // the scaled queries in their order
+    const UninitVector<float>& qy;
+    const UninitVector<float>& qz;
+    const UninitVector<uint64_t>& qKeyed;  // (fine key << 32 | input index) in that order
+    const UninitVector<uint32_t>& qKey;    // their cell keys in t's grid
+    const TargetIndex& t;
+    double scale;
+    int threads;
+
+    [[nodiscard]] size_t queryCount() const { return queries.size(); }
+    [[nodiscard]] Query query(size_t i) const { return {splat(qx[i]), splat(qy[i]), splat(qz[i])}; }
+    // Query i is a copy of query i - 1 (i > 0).
+    [[nodiscard]] bool sameAsPrevious(size_t i) const { return sameQuery(qx, qy, qz, i); }
+    // The cell cursor (findCell) of a chunk starting at query `begin`.
+    [[nodiscard]] uint32_t firstCell(size_t begin) const {
+        const uint32_t* keys = t.cellKey.data();
+        return uint32_t(std::lower_bound(keys, keys + t.cellCount(), qKey[begin]) - keys);
+    }
+};
+
+// Where the previous query's search ended, the seeds of the next one: its
+// nearest (or killing) point and that point's bucket; and the cell cursor.
+struct Seeds {
+    uint32_t bucket = kNone;  // kNone: no previous query in this chunk (or it was lost)
+    uint32_t pos = kNone;     // sorted position of the point
+    uint32_t cursor = 0;
+
+    void follow(const TargetIndex& t, const Best& best) {
+        pos = best.pos;
+        bucket = t.bucketOf[best.pos];
+    }
+};
+
+// The counters both kinds of pass fill alike.
+Counters passCounters(const Direction& d, const std::vector<SearchStats>& stats) {
+    Counters c;
+    c.bits = uint32_t(d.t.grid.bits);
+    c.occupiedCells = d.t.cellCount();
+    c.queries = d.queryCount();
+    c.iterations = 1;
+    for (const SearchStats& s : stats) c.candidatePairs += s.bucketsScanned;
+    return c;
+}
+
+// Query i's exact float nearest neighbour (no early break): the previous
 // query's nearest bucket and the query's own cell (when small) seed the best
-// distance, then the BVH search runs to the end with kill = 0. A query equal
-// to the previous one takes its nearest target. Fills `nearest` (input order)
-// with the target index and the double distance recomputed from the pair.
-void perPointPass(const TargetIndex& t, std::span<const glm::vec3> queries,
-                  std::span<const glm::vec3> targets, const UninitVector<float>& qx,
-                  const UninitVector<float>& qy, const UninitVector<float>& qz,
-                  const UninitVector<uint64_t>& qKeyed, const UninitVector<uint32_t>& qKey, int threads,
-                  PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress,
+// distance, then the BVH search runs to the end with kill = 0.
+inline Best nearestOf(const Direction& d, size_t i, Seeds& seeds, SearchStats& stat) {
+    const TargetIndex& t = d.t;
+    const Query q = d.query(i);
+    Best best;
+    if (seeds.bucket != kNone) {
+        ++stat.bucketsScanned;
+        scanRange(t, t.bucketFirst[seeds.bucket], t.bucketFirst[seeds.bucket + 1], q, best);
+    }
+    scanOwnCell(t, d.qKey[i], seeds.cursor, q, best, stat);
+    searchTree(t, q, 0.0f, best, stat);  // kill 0: never breaks early
+    return best;
+}
+
+// Every query's exact float nearest neighbour. A query equal to the previous
+// one takes its nearest target. Fills `nearest` (input order) with the target
+// index and the double distance recomputed from the pair.
+void perPointPass(const Direction& d, PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress,
                   std::atomic<bool>& lost) {
-    const size_t nq = queries.size();
+    const size_t nq = d.queryCount();
     nearest.distance.assign(nq, 0.0);
     nearest.nearest.assign(nq, 0);
-    const uint32_t cells = t.cellCount();
-    std::atomic<size_t> done{0};
-    parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int w) {
+    parallelChunks(nq, kQueryChunk, d.threads, [&](size_t begin, size_t end, int w) {
         if (progress.cancelled()) return;
         SearchStats stat;
-        uint32_t hint = kNone;
+        Seeds seeds{kNone, kNone, d.firstCell(begin)};
         uint32_t target = kNone;  // the previous query's nearest target (input index)
-        const uint32_t* keys = t.cellKey.data();
-        uint32_t cursor = uint32_t(std::lower_bound(keys, keys + cells, qKey[begin]) - keys);
         for (size_t i = begin; i < end; ++i) {
-            const uint32_t src = uint32_t(qKeyed[i]);  // input index
-            if (!(i > begin && hint != kNone && sameQuery(qx, qy, qz, i))) {
-                const Query q{splat(qx[i]), splat(qy[i]), splat(qz[i])};
-                Best best;
-                if (hint != kNone) {
-                    ++stat.bucketsScanned;
-                    scanRange(t, t.bucketFirst[hint], t.bucketFirst[hint + 1], q, best);
-                }
-                scanOwnCell(t, qKey[i], cursor, q, best, stat);
-                searchTree(t, q, 0.0f, best, stat);  // kill 0: never breaks early
+            const uint32_t src = uint32_t(d.qKeyed[i]);  // input index
+            if (!(i > begin && seeds.bucket != kNone && d.sameAsPrevious(i))) {
+                const Best best = nearestOf(d, i, seeds, stat);
                 if (best.pos == kNone) {
                     lost.store(true, std::memory_order_relaxed);
-                    hint = kNone;
+                    seeds.bucket = kNone;
                     continue;
                 }
-                hint = t.bucketOf[best.pos];
+                seeds.bucket = d.t.bucketOf[best.pos];
                 target = best.target;
             }
-            const glm::dvec3 diff = glm::dvec3(queries[src]) - glm::dvec3(targets[target]);
+            const glm::dvec3 diff = glm::dvec3(d.queries[src]) - glm::dvec3(d.targets[target]);
             nearest.distance[src] = std::sqrt(diff.x * diff.x + diff.y * diff.y + diff.z * diff.z);
             nearest.nearest[src] = target;
         }
         stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
-        const size_t finished = done.fetch_add(end - begin, std::memory_order_relaxed) + (end - begin);
-        if (w == 0) {
-            progress.report("search", kCullDone + (kSearchDone - kCullDone) * double(finished) / double(nq));
-        }
+        progress.queriesDone(end - begin, nq, w);
     });
+}
+
+// Every query's NN: no lower bound, no kill. The witness is the largest
+// double distance (smallest query index among ties), so it is consistent
+// with the per-point array by construction.
+void perPointDirection(const Direction& d, PerPoint& perPoint, Progress& progress, DirectedOutput& out) {
+    auto start = Clock::now();
+    std::vector<SearchStats> stats(static_cast<size_t>(d.threads));
+    std::atomic<bool> lost{false};
+    perPointPass(d, perPoint, stats, progress, lost);
+    out.lostQuery = lost.load();
+    out.cancelled = progress.cancelled();
+    if (out.cancelled) return;
+    out.searchMs = msSince(start);
+    progress.report("refine", kSearchDone);
+    start = Clock::now();
+    size_t win = 0;
+    for (size_t i = 1; i < d.queryCount(); ++i) {
+        if (perPoint.distance[i] > perPoint.distance[win]) win = i;
+    }
+    Directed& r = out.directed;
+    r.queryIndex = uint32_t(win);
+    r.targetIndex = perPoint.nearest[win];
+    r.queryPoint = d.queries[r.queryIndex];
+    r.targetPoint = d.targets[r.targetIndex];
+    r.distance = perPoint.distance[win];
+    r.counters = passCounters(d, stats);
+    r.counters.survivingQueries = d.queryCount();
+    out.refineMs = msSince(start);
+    progress.report("refine", 1.0);
+}
+
+// Per-worker results of the early-break pass (the sample's winners seed it).
+struct PassTally {
+    std::vector<Winner> winners;
+    std::vector<SearchStats> stats;
+    std::vector<uint64_t> culled, surviving;
+
+    explicit PassTally(int threads)
+        : winners(size_t(threads)),
+          stats(size_t(threads)),
+          culled(size_t(threads)),
+          surviving(size_t(threads)) {}
+};
+
+// The first kill threshold: the exact NN of a strided sample of the queries
+// (witnessed, offered to the tally's winners) or the box bound lowered by
+// kBoundShrink, whichever is larger.
+float lowerBound(const Direction& d, double boxBound2, PassTally& tally) {
+    const size_t nq = d.queryCount();
+    const size_t samples = std::min(nq, kSampleSize);
+    parallelChunks(samples, 32, d.threads, [&](size_t begin, size_t end, int w) {
+        Winner winner;
+        SearchStats stat;
+        for (size_t s = begin; s < end; ++s) {
+            const uint32_t i = uint32_t(s * nq / samples);
+            const glm::vec3 p = scaled(d.queries[i], d.scale);
+            const Query q{splat(p.x), splat(p.y), splat(p.z)};
+            Best best;
+            searchTree(d.t, q, 0.0f, best, stat);
+            winner.offer(best.d2, i, best.target);
+        }
+        tally.winners[size_t(w)].offer(winner.d2, winner.query, winner.target);
+        tally.stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
+    });
+    float sampleMax = 0.0f;
+    for (const Winner& w : tally.winners) sampleMax = std::max(sampleMax, w.d2);
+    const double bound2 = boxBound2 * (1.0 - kBoundShrink);
+    return std::max(sampleMax, float(bound2));
+}
+
+// One chunk's tallies of the early-break pass, published once: per-worker
+// slots share cache lines.
+struct ChunkTally {
+    Winner winner;
+    uint64_t culled = 0, surviving = 0;
+    bool lost = false;
+};
+
+// The seeds of query i before the full search: the previous query's killing
+// point alone (it kills most Morton neighbours), its bucket, the query's own
+// cell, then the subtree around the previous query's nearest bucket (its
+// ancestor kLocalLevel levels up, in cache). True when one of them holds a
+// point strictly closer than k; the seeds then follow that point, except
+// when the previous point itself killed.
+inline bool killedBySeeds(const Direction& d, size_t i, const Query& q, float k, Seeds& seeds, Best& best,
+                          SearchStats& stat) {
+    const TargetIndex& t = d.t;
+    if (seeds.bucket != kNone) {
+        const float dx = d.qx[i] - t.x[seeds.pos], dy = d.qy[i] - t.y[seeds.pos],
+                    dz = d.qz[i] - t.z[seeds.pos];
+        if (dx * dx + dy * dy + dz * dz < k) return true;
+        ++stat.bucketsScanned;
+        scanRange(t, t.bucketFirst[seeds.bucket], t.bucketFirst[seeds.bucket + 1], q, best);
+        if (best.d2 < k) {
+            seeds.follow(t, best);
+            return true;
+        }
+    }
+    scanOwnCell(t, d.qKey[i], seeds.cursor, q, best, stat);
+    if (best.d2 < k || (seeds.bucket != kNone && kLocalLevel + 1 < t.levels.size() &&
+                        searchTree(t, q, k, best, stat, kLocalLevel, seeds.bucket >> (3 * kLocalLevel)))) {
+        seeds.follow(t, best);
+        return true;
+    }
+    return false;
+}
+
+// Query i of the early-break pass: culled (a copy of the previous query, or
+// killed by a seed), killed in the BVH search, or searched to the end, when
+// it is offered as the witness and raises the kill threshold.
+inline void searchQuery(const Direction& d, size_t i, bool first, std::atomic<uint32_t>& kill, Seeds& seeds,
+                        ChunkTally& tally, SearchStats& stat) {
+    const float k = std::bit_cast<float>(kill.load(std::memory_order_relaxed));
+    if (!first && seeds.bucket != kNone && d.sameAsPrevious(i)) {
+        // A copy of the previous query (smaller input index, same nearest
+        // distance) was killed or offered already.
+        ++tally.culled;
+        return;
+    }
+    const Query q = d.query(i);
+    Best best;
+    if (killedBySeeds(d, i, q, k, seeds, best, stat)) {
+        ++tally.culled;
+        return;
+    }
+    ++tally.surviving;
+    const bool dead = searchTree(d.t, q, k, best, stat);
+    if (best.pos == kNone) {
+        tally.lost = true;
+        seeds.bucket = kNone;
+        return;
+    }
+    seeds.follow(d.t, best);
+    if (dead) return;
+    tally.winner.offer(best.d2, uint32_t(d.qKeyed[i]), best.target);
+    atomicMax(kill, best.d2);
+}
+
+// The pass over all queries, in chunks of consecutive queries; `kill` only grows.
+void searchPass(const Direction& d, std::atomic<uint32_t>& kill, PassTally& tally, Progress& progress,
+                std::atomic<bool>& lost) {
+    const size_t nq = d.queryCount();
+    parallelChunks(nq, kQueryChunk, d.threads, [&](size_t begin, size_t end, int w) {
+        if (progress.cancelled()) return;
+        ChunkTally chunk{tally.winners[size_t(w)]};
+        SearchStats stat;
+        Seeds seeds{kNone, kNone, d.firstCell(begin)};
+        for (size_t i = begin; i < end; ++i) searchQuery(d, i, i == begin, kill, seeds, chunk, stat);
+        if (chunk.lost) lost.store(true, std::memory_order_relaxed);
+        tally.winners[size_t(w)] = chunk.winner;
+        tally.stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
+        tally.culled[size_t(w)] += chunk.culled;
+        tally.surviving[size_t(w)] += chunk.surviving;
+        progress.queriesDone(end - begin, nq, w);
+    });
+}
+
+// The winning pair of the pass (largest float distance, smallest query index
+// among ties), its distance recomputed in double, and the pass's counters.
+Directed witnessOf(const Direction& d, const PassTally& tally) {
+    Winner win;
+    for (const Winner& w : tally.winners) {
+        if (w.query != kNone) win.offer(w.d2, w.query, w.target);
+    }
+    Directed r;
+    r.queryIndex = win.query;
+    r.targetIndex = win.target;
+    r.queryPoint = d.queries[win.query];
+    r.targetPoint = d.targets[win.target];
+    const glm::dvec3 diff = glm::dvec3(r.queryPoint) - glm::dvec3(r.targetPoint);
+    r.distance = std::sqrt(diff.x * diff.x + diff.y * diff.y + diff.z * diff.z);
+    r.counters = passCounters(d, tally.stats);
+    for (size_t w = 0; w < tally.culled.size(); ++w) {
+        r.counters.culledByNeighbourhood += tally.culled[w];
+        r.counters.survivingQueries += tally.surviving[w];
+    }
+    return r;
+}
+
+// The maximum with early break: the lower bound, the pass over all queries,
+// the witness.
+void earlyBreakDirection(const Direction& d, double boxBound2, Progress& progress, DirectedOutput& out) {
+    auto start = Clock::now();
+    PassTally tally(d.threads);
+    std::atomic<uint32_t> kill{std::bit_cast<uint32_t>(lowerBound(d, boxBound2, tally))};
+    out.cullMs = msSince(start);
+    progress.report("cull", kCullDone);
+
+    start = Clock::now();
+    std::atomic<bool> lost{false};
+    searchPass(d, kill, tally, progress, lost);
+    out.searchMs = msSince(start);
+    out.lostQuery = lost.load();
+    out.cancelled = progress.cancelled();
+    if (out.cancelled) return;
+    progress.report("refine", kSearchDone);
+
+    start = Clock::now();
+    out.directed = witnessOf(d, tally);
+    out.refineMs = msSince(start);
+    progress.report("refine", 1.0);
 }
 
 DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet, int threads,
                                  PerPoint* perPoint, Progress& progress) {
     DirectedOutput out;
     progress.report("index", 0.0);
-    auto start = Clock::now();
-
-    const std::span<const glm::vec3> queries = querySet.points, targets = targetSet.points;
-    const SetOrder& qOrder = querySet.order;
-    const double scale = querySet.scale;
+    const auto start = Clock::now();
     const TargetIndex& t = targetSet.targetIndex(threads);
-    const core::GridSpec& g = t.grid;
-    const glm::dvec3 boxLo = targetSet.order.bounds.lo, boxHi = targetSet.order.bounds.hi;
-
-    // Queries in their own adaptive order, each with its cell key in the
-    // target grid (clamped outside it); the same pass finds the largest
-    // distance from a query to BV(T).
-    const size_t nq = queries.size();
-    const UninitVector<float>&qx = qOrder.x, &qy = qOrder.y, &qz = qOrder.z;
-    UninitVector<uint32_t> qKey(nq);
-    std::vector<double> boxBound(size_t(threads), 0.0);
-    parallelChunks(nq, 1 << 16, threads, [&](size_t begin, size_t end, int w) {
-        double farthest = 0.0;
-        for (size_t i = begin; i < end; ++i) {
-            const glm::dvec3 dp(qOrder.x[i], qOrder.y[i], qOrder.z[i]);
-            qKey[i] = core::mortonEncode(core::cellCoord(dp.x, g.origin.x, g.cellSize, g.cellsPerAxis),
-                                         core::cellCoord(dp.y, g.origin.y, g.cellSize, g.cellsPerAxis),
-                                         core::cellCoord(dp.z, g.origin.z, g.cellSize, g.cellsPerAxis));
-            const glm::dvec3 d = glm::max(glm::max(boxLo - dp, dp - boxHi), glm::dvec3(0.0));
-            farthest = std::max(farthest, d.x * d.x + d.y * d.y + d.z * d.z);
-        }
-        boxBound[size_t(w)] = std::max(boxBound[size_t(w)], farthest);
-    });
+    const SetOrder& qOrder = querySet.order;
+    const QueryKeys keys = keyQueries(qOrder, t.grid, targetSet.order.bounds, threads);
+    const Direction d{querySet.points, targetSet.points, qOrder.x, qOrder.y,       qOrder.z,
+                      qOrder.keyed,    keys.key,         t,        querySet.scale, threads};
     out.indexMs = msSince(start);
     progress.report("index", kIndexDone);
-
     if (perPoint != nullptr) {
-        // Every query's NN: no lower bound, no kill. The witness is the
-        // largest double distance (smallest query index among ties), so it
-        // is consistent with the per-point array by construction.
-        start = Clock::now();
-        std::vector<SearchStats> stats(static_cast<size_t>(threads));
-        std::atomic<bool> lost{false};
-        perPointPass(t, queries, targets, qx, qy, qz, qOrder.keyed, qKey, threads, *perPoint, stats, progress,
-                     lost);
-        out.lostQuery = lost.load();
-        out.cancelled = progress.cancelled();
-        if (out.cancelled) return out;
-        out.searchMs = msSince(start);
-        progress.report("refine", kSearchDone);
-        start = Clock::now();
-        size_t win = 0;
-        for (size_t i = 1; i < nq; ++i) {
-            if (perPoint->distance[i] > perPoint->distance[win]) win = i;
-        }
-        Directed& d = out.directed;
-        d.queryIndex = uint32_t(win);
-        d.targetIndex = perPoint->nearest[win];
-        d.queryPoint = queries[d.queryIndex];
-        d.targetPoint = targets[d.targetIndex];
-        d.distance = perPoint->distance[win];
-        Counters& c = d.counters;
-        c.bits = uint32_t(g.bits);
-        c.occupiedCells = t.cellCount();
-        c.queries = nq;
-        c.survivingQueries = nq;
-        c.iterations = 1;
-        for (const SearchStats& s : stats) c.candidatePairs += s.bucketsScanned;
-        out.refineMs = msSince(start);
-        progress.report("refine", 1.0);
-        return out;
+        perPointDirection(d, *perPoint, progress, out);
+    } else {
+        earlyBreakDirection(d, keys.farthest2, progress, out);
     }
-
-    // Lower bound: exact NN of a strided sample (witnessed) and the box bound.
-    start = Clock::now();
-    std::vector<Winner> winners(static_cast<size_t>(threads));
-    std::vector<SearchStats> stats(static_cast<size_t>(threads));
-    const size_t samples = std::min(nq, kSampleSize);
-    parallelChunks(samples, 32, threads, [&](size_t begin, size_t end, int w) {
-        Winner winner;
-        SearchStats stat;
-        for (size_t s = begin; s < end; ++s) {
-            const uint32_t i = uint32_t(s * nq / samples);
-            const glm::vec3 p = scaled(queries[i], scale);
-            const Query q{splat(p.x), splat(p.y), splat(p.z)};
-            Best best;
-            searchTree(t, q, 0.0f, best, stat);
-            winner.offer(best.d2, i, best.target);
-        }
-        winners[size_t(w)].offer(winner.d2, winner.query, winner.target);
-        stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
-    });
-    float sampleMax = 0.0f;
-    for (const Winner& w : winners) sampleMax = std::max(sampleMax, w.d2);
-    const double bound2 = *std::max_element(boxBound.begin(), boxBound.end()) * (1.0 - kBoundShrink);
-    std::atomic<bool> lost{false};
-    std::atomic<uint32_t> kill{std::bit_cast<uint32_t>(std::max(sampleMax, float(bound2)))};
-    out.cullMs = msSince(start);
-    progress.report("cull", kCullDone);
-    std::atomic<size_t> done{0};
-
-    // The pass over all queries.
-    start = Clock::now();
-    std::vector<uint64_t> culled(size_t(threads), 0), surviving(size_t(threads), 0);
-    const uint32_t cells = t.cellCount();
-    parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int w) {
-        if (progress.cancelled()) return;
-        // Chunk-local tallies, published once: per-thread slots share cache lines.
-        Winner winner = winners[size_t(w)];
-        SearchStats stat;
-        uint64_t culledHere = 0, survivingHere = 0;
-        uint32_t hint = kNone;     // bucket of the previous query's nearest/killing point
-        uint32_t hintPos = kNone;  // that point (sorted position)
-        const uint32_t* keys = t.cellKey.data();
-        uint32_t cursor = uint32_t(std::lower_bound(keys, keys + cells, qKey[begin]) - keys);
-        for (size_t i = begin; i < end; ++i) {
-            const float k = std::bit_cast<float>(kill.load(std::memory_order_relaxed));
-            if (i > begin && hint != kNone && sameQuery(qx, qy, qz, i)) {
-                // A copy of the previous query (smaller input index, same
-                // nearest distance) was killed or offered already.
-                ++culledHere;
-                continue;
-            }
-            const Query q{splat(qx[i]), splat(qy[i]), splat(qz[i])};
-            Best best;
-            if (hint != kNone) {
-                // The previous query's point alone kills most Morton neighbours.
-                const float dx = qx[i] - t.x[hintPos], dy = qy[i] - t.y[hintPos], dz = qz[i] - t.z[hintPos];
-                if (dx * dx + dy * dy + dz * dz < k) {
-                    ++culledHere;
-                    continue;
-                }
-                ++stat.bucketsScanned;
-                scanRange(t, t.bucketFirst[hint], t.bucketFirst[hint + 1], q, best);
-                if (best.d2 < k) {
-                    hintPos = best.pos;
-                    hint = t.bucketOf[best.pos];
-                    ++culledHere;
-                    continue;
-                }
-            }
-            scanOwnCell(t, qKey[i], cursor, q, best, stat);
-            // The subtree around the previous query's nearest bucket (its
-            // ancestor kLocalLevel levels up) kills most of the others, in cache.
-            if (best.d2 < k || (hint != kNone && kLocalLevel + 1 < t.levels.size() &&
-                                searchTree(t, q, k, best, stat, kLocalLevel, hint >> (3 * kLocalLevel)))) {
-                hintPos = best.pos;
-                hint = t.bucketOf[best.pos];
-                ++culledHere;
-                continue;
-            }
-            ++survivingHere;
-            const bool dead = searchTree(t, q, k, best, stat);
-            if (best.pos == kNone) {
-                lost.store(true, std::memory_order_relaxed);
-                hint = kNone;
-                continue;
-            }
-            hintPos = best.pos;
-            hint = t.bucketOf[best.pos];
-            if (dead) continue;
-            winner.offer(best.d2, uint32_t(qOrder.keyed[i]), best.target);
-            atomicMax(kill, best.d2);
-        }
-        winners[size_t(w)] = winner;
-        stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
-        culled[size_t(w)] += culledHere;
-        surviving[size_t(w)] += survivingHere;
-        const size_t finished = done.fetch_add(end - begin, std::memory_order_relaxed) + (end - begin);
-        if (w == 0) {
-            progress.report("search", kCullDone + (kSearchDone - kCullDone) * double(finished) / double(nq));
-        }
-    });
-    out.searchMs = msSince(start);
-    out.lostQuery = lost.load();
-    out.cancelled = progress.cancelled();
-    if (out.cancelled) return out;
-    progress.report("refine", kSearchDone);
-
-    start = Clock::now();
-    Winner win;
-    for (const Winner& w : winners) {
-        if (w.query != kNone) win.offer(w.d2, w.query, w.target);
-    }
-    Directed& d = out.directed;
-    d.queryIndex = win.query;
-    d.targetIndex = win.target;
-    d.queryPoint = queries[win.query];
-    d.targetPoint = targets[win.target];
-    const glm::dvec3 diff = glm::dvec3(d.queryPoint) - glm::dvec3(d.targetPoint);
-    d.distance = std::sqrt(diff.x * diff.x + diff.y * diff.y + diff.z * diff.z);
-    Counters& c = d.counters;
-    c.bits = uint32_t(g.bits);
-    c.occupiedCells = cells;
-    c.queries = nq;
-    c.iterations = 1;
-    for (int w = 0; w < threads; ++w) {
-        c.culledByNeighbourhood += culled[size_t(w)];
-        c.survivingQueries += surviving[size_t(w)];
-        c.candidatePairs += stats[size_t(w)].bucketsScanned;
-    }
-    out.refineMs = msSince(start);
-    progress.report("refine", 1.0);
     return out;
 }
 
 // The shared scaling rule (core::exactScale) over both sets.
-double chooseScale(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
-    return core::exactScale(std::max(core::largestMagnitude(a), core::largestMagnitude(b)));
+double chooseScale(std::span<const glm::vec3> a, std::span<const glm::vec3> b, int threads) {
+    return core::exactScale(std::max(core::largestMagnitude(a, threads), core::largestMagnitude(b, threads)));
 }
 
 // One direction into `r` (its witness, per-point array and stage times), or
@@ -639,7 +736,7 @@ Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<con
     }
     const auto start = Clock::now();
     // Each set ordered once: the layout of its index and its query order.
-    const double scale = chooseScale(a, b);
+    const double scale = chooseScale(a, b, options.threads);
     const std::shared_ptr<CpuSet> setA = prepareCpuSet(a, scale, options.bits, options.threads);
     const std::shared_ptr<CpuSet> setB = prepareCpuSet(b, scale, options.bits, options.threads);
     const double orderMs = msSince(start);

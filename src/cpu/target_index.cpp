@@ -72,6 +72,125 @@ void buildCells(size_t m, CoarseKey coarseKey, int threads, TargetIndex& index,
     bucketFirst.back() = uint32_t(m);
 }
 
+// Positions of the order that the index stores: every one but the copies
+// after the first of an all-identical run (the smallest input index among
+// the copies: the one the tie rule reports anyway). Empty when every
+// position is stored.
+class StoredPositions {
+public:
+    explicit StoredPositions(const SetOrder& order) : m_count(order.keyed.size()) {
+        if (order.identical.empty()) return;
+        m_kept.reserve(m_count);
+        size_t next = 0;
+        for (size_t i = 0; i < m_count; ++i) {
+            const IdenticalRun* run = next < order.identical.size() ? &order.identical[next] : nullptr;
+            if (run != nullptr && i > run->first && i < run->end) {
+                if (i + 1 == run->end) ++next;
+                continue;
+            }
+            m_kept.push_back(uint32_t(i));
+        }
+    }
+    [[nodiscard]] bool all() const { return m_kept.empty(); }
+    [[nodiscard]] size_t size() const { return all() ? m_count : m_kept.size(); }
+    // Position in the order of stored target i.
+    [[nodiscard]] size_t operator[](size_t i) const { return all() ? i : size_t(m_kept[i]); }
+
+private:
+    size_t m_count;
+    std::vector<uint32_t> m_kept;
+};
+
+// The stored targets' input indices and coordinates, each padded with kPad
+// entries (sized without a fill: the copies are the first touch, in parallel).
+void storeTargets(const SetOrder& order, const StoredPositions& stored, int threads, TargetIndex& index) {
+    const size_t m = stored.size();
+    index.original.resize(m + kPad);
+    std::fill(index.original.begin() + ptrdiff_t(m), index.original.end(),
+              std::numeric_limits<uint32_t>::max());
+    index.bucketOf.resize(m);
+    parallelChunks(m, 1 << 16, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) index.original[i] = uint32_t(order.keyed[stored[i]]);
+    });
+    if (stored.all()) {  // the order's arrays as they are (padded by orderSet)
+        index.x = order.x, index.y = order.y, index.z = order.z;
+        return;
+    }
+    UninitVector<float>* to[3] = {&index.keptX, &index.keptY, &index.keptZ};
+    const UninitVector<float>* from[3] = {&order.x, &order.y, &order.z};
+    for (int a = 0; a < 3; ++a) {
+        to[a]->resize(m + kPad);
+        std::fill(to[a]->begin() + ptrdiff_t(m), to[a]->end(), kInf);
+        parallelChunks(m, 1 << 16, threads, [&](size_t begin, size_t end, int) {
+            for (size_t i = begin; i < end; ++i) (*to[a])[i] = (*from[a])[stored[i]];
+        });
+    }
+    index.x = index.keptX, index.y = index.keptY, index.z = index.keptZ;
+}
+
+// Level 0 of the BVH: tight bucket boxes; every stored target's bucket.
+void buildLeaves(std::vector<uint32_t> bucketFirst, int threads, TargetIndex& index) {
+    const uint32_t buckets = uint32_t(bucketFirst.size() - 1);
+    index.levels.emplace_back();
+    BoxLevel& leaves = index.levels.back();
+    leaves.resize(buckets);
+    parallelChunks(buckets, 4096, threads, [&](size_t begin, size_t end, int) {
+        for (size_t b = begin; b < end; ++b) {
+            glm::vec3 lo(kInf), hi(-kInf);
+            for (uint32_t j = bucketFirst[b]; j < bucketFirst[b + 1]; ++j) {
+                const glm::vec3 p(index.x[j], index.y[j], index.z[j]);
+                lo = glm::min(lo, p);
+                hi = glm::max(hi, p);
+                index.bucketOf[j] = uint32_t(b);
+            }
+            leaves.set(uint32_t(b), lo, hi);
+        }
+    });
+    index.bucketFirst = std::move(bucketFirst);
+}
+
+// Tight cell boxes: the union of the cell's buckets (cellBucket as buildCells).
+void buildCellBoxes(const std::vector<uint32_t>& cellBucket, int threads, TargetIndex& index) {
+    const BoxLevel& leaves = index.levels[0];
+    const uint32_t cells = index.cellCount();
+    index.cellLo.resize(cells);
+    index.cellHi.resize(cells);
+    parallelChunks(cells, 4096, threads, [&](size_t begin, size_t end, int) {
+        for (size_t c = begin; c < end; ++c) {
+            glm::vec3 lo(kInf), hi(-kInf);
+            for (uint32_t b = cellBucket[c]; b < cellBucket[c + 1]; ++b) {
+                lo = glm::min(lo, leaves.lo(b));
+                hi = glm::max(hi, leaves.hi(b));
+            }
+            index.cellLo[c] = lo;
+            index.cellHi[c] = hi;
+        }
+    });
+}
+
+// Upper levels: node j covers children kFanout*j .. kFanout*j + 7. At least
+// one level above the leaves so the search always starts at an inner node.
+void buildUpperLevels(int threads, TargetIndex& index) {
+    do {
+        const BoxLevel& child = index.levels.back();
+        const uint32_t parents = (child.count + kFanout - 1) / kFanout;
+        BoxLevel level;
+        level.resize(parents);
+        parallelChunks(parents, 4096, threads, [&](size_t begin, size_t end, int) {
+            for (size_t j = begin; j < end; ++j) {
+                glm::vec3 lo(kInf), hi(-kInf);
+                for (uint32_t c = uint32_t(j) * kFanout; c < (uint32_t(j) + 1) * kFanout;
+                     ++c) {  // padding is empty
+                    lo = glm::min(lo, child.lo(c));
+                    hi = glm::max(hi, child.hi(c));
+                }
+                level.set(uint32_t(j), lo, hi);
+            }
+        });
+        index.levels.push_back(std::move(level));
+    } while (index.levels.back().count > 1);
+}
+
 }  // namespace
 
 void BoxLevel::resize(uint32_t n) {
@@ -130,114 +249,21 @@ TargetIndex buildTargetIndex(double scale, const SetOrder& order, int threads) {
     index.scale = scale;
     index.grid = order.grid;
     index.fineBits = order.fineBits;
-    const int extra = order.fineBits - order.grid.bits;
-    const size_t n = order.keyed.size();
-
-    // All-identical runs collapsed to their first point (the smallest input
-    // index among the copies: the one the tie rule reports anyway).
-    std::vector<uint32_t> kept;  // positions of the order that are stored (when some are not)
-    if (!order.identical.empty()) {
-        kept.reserve(n);
-        size_t next = 0;
-        for (size_t i = 0; i < n; ++i) {
-            const IdenticalRun* run = next < order.identical.size() ? &order.identical[next] : nullptr;
-            if (run != nullptr && i > run->first && i < run->end) {
-                if (i + 1 == run->end) ++next;
-                continue;
-            }
-            kept.push_back(uint32_t(i));
-        }
-    }
-    const size_t m = kept.empty() ? n : kept.size();
-    auto positionOf = [&kept](size_t i) { return kept.empty() ? i : size_t(kept[i]); };
-    index.collapsed = n - m;
-
-    // Sized without a fill: the copies below are the first touch, in parallel.
-    index.original.resize(m + kPad);
-    std::fill(index.original.begin() + ptrdiff_t(m), index.original.end(),
-              std::numeric_limits<uint32_t>::max());
-    index.bucketOf.resize(m);
-    parallelChunks(m, 1 << 16, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) index.original[i] = uint32_t(order.keyed[positionOf(i)]);
-    });
-    if (kept.empty()) {  // the order's arrays as they are (padded by orderSet)
-        index.x = order.x, index.y = order.y, index.z = order.z;
-    } else {
-        UninitVector<float>* stored[3] = {&index.keptX, &index.keptY, &index.keptZ};
-        const UninitVector<float>* from[3] = {&order.x, &order.y, &order.z};
-        for (int a = 0; a < 3; ++a) {
-            stored[a]->resize(m + kPad);
-            std::fill(stored[a]->begin() + ptrdiff_t(m), stored[a]->end(), kInf);
-            parallelChunks(m, 1 << 16, threads, [&](size_t begin, size_t end, int) {
-                for (size_t i = begin; i < end; ++i) (*stored[a])[i] = (*from[a])[positionOf(i)];
-            });
-        }
-        index.x = index.keptX, index.y = index.keptY, index.z = index.keptZ;
-    }
-
-    // Cells (runs of the coarse key) and buckets (pieces of a cell).
-    const int coarseShift = 32 + 3 * extra;
+    // The stored targets, cells (runs of the coarse key) and buckets (pieces
+    // of a cell); the stored positions are freed before the boxes are built.
     std::vector<uint32_t> bucketFirst, cellBucket;
-    buildCells(
-        m, [&](size_t i) { return uint32_t(order.keyed[positionOf(i)] >> coarseShift); }, threads, index,
-        bucketFirst, cellBucket);
-    std::vector<uint32_t>().swap(kept);
-
-    // Level 0: tight bucket boxes.
-    const uint32_t buckets = uint32_t(bucketFirst.size() - 1);
-    index.levels.emplace_back();
-    BoxLevel& leaves = index.levels.back();
-    leaves.resize(buckets);
-    parallelChunks(buckets, 4096, threads, [&](size_t begin, size_t end, int) {
-        for (size_t b = begin; b < end; ++b) {
-            glm::vec3 lo(kInf), hi(-kInf);
-            for (uint32_t j = bucketFirst[b]; j < bucketFirst[b + 1]; ++j) {
-                const glm::vec3 p(index.x[j], index.y[j], index.z[j]);
-                lo = glm::min(lo, p);
-                hi = glm::max(hi, p);
-                index.bucketOf[j] = uint32_t(b);
-            }
-            leaves.set(uint32_t(b), lo, hi);
-        }
-    });
-    index.bucketFirst = std::move(bucketFirst);
-
-    // Tight cell boxes: the union of the cell's buckets.
-    const uint32_t cells = index.cellCount();
-    index.cellLo.resize(cells);
-    index.cellHi.resize(cells);
-    parallelChunks(cells, 4096, threads, [&](size_t begin, size_t end, int) {
-        for (size_t c = begin; c < end; ++c) {
-            glm::vec3 lo(kInf), hi(-kInf);
-            for (uint32_t b = cellBucket[c]; b < cellBucket[c + 1]; ++b) {
-                lo = glm::min(lo, leaves.lo(b));
-                hi = glm::max(hi, leaves.hi(b));
-            }
-            index.cellLo[c] = lo;
-            index.cellHi[c] = hi;
-        }
-    });
-
-    // Upper levels: node j covers children kFanout*j .. kFanout*j + 7. At least
-    // one level above the leaves so the search always starts at an inner node.
-    do {
-        const BoxLevel& child = index.levels.back();
-        const uint32_t parents = (child.count + kFanout - 1) / kFanout;
-        BoxLevel level;
-        level.resize(parents);
-        parallelChunks(parents, 4096, threads, [&](size_t begin, size_t end, int) {
-            for (size_t j = begin; j < end; ++j) {
-                glm::vec3 lo(kInf), hi(-kInf);
-                for (uint32_t c = uint32_t(j) * kFanout; c < (uint32_t(j) + 1) * kFanout;
-                     ++c) {  // padding is empty
-                    lo = glm::min(lo, child.lo(c));
-                    hi = glm::max(hi, child.hi(c));
-                }
-                level.set(uint32_t(j), lo, hi);
-            }
-        });
-        index.levels.push_back(std::move(level));
-    } while (index.levels.back().count > 1);
+    {
+        const StoredPositions stored(order);
+        index.collapsed = order.keyed.size() - stored.size();
+        storeTargets(order, stored, threads, index);
+        const int coarseShift = 32 + 3 * (order.fineBits - order.grid.bits);
+        buildCells(
+            stored.size(), [&](size_t i) { return uint32_t(order.keyed[stored[i]] >> coarseShift); }, threads,
+            index, bucketFirst, cellBucket);
+    }
+    buildLeaves(std::move(bucketFirst), threads, index);
+    buildCellBoxes(cellBucket, threads, index);
+    buildUpperLevels(threads, index);
     return index;
 }
 

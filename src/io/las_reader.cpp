@@ -56,7 +56,8 @@ struct LasHeader {
     std::array<double, 3> offset{};
 };
 
-Result<LasHeader> parseHeader(std::string_view bytes, const std::string& path) {
+// The signature, the minimum size and the version (1.0 to 1.4) into h.minor.
+std::optional<Error> checkVersion(std::string_view bytes, const std::string& path, LasHeader& h) {
     if (!bytes.starts_with("LASF")) {
         return badInput(path, offsetWhere(0), "not a LAS file (no 'LASF' signature)");
     }
@@ -65,7 +66,6 @@ Result<LasHeader> parseHeader(std::string_view bytes, const std::string& path) {
                         "the file has " + std::to_string(bytes.size()) + " bytes, fewer than the " +
                             std::to_string(kHeaderSize12) + "-byte LAS header (truncated file)");
     }
-    LasHeader h;
     const int major = static_cast<uint8_t>(bytes[kVersionMajorAt]);
     h.minor = static_cast<uint8_t>(bytes[kVersionMajorAt + 1]);
     if (major != 1 || h.minor > 4) {
@@ -73,6 +73,11 @@ Result<LasHeader> parseHeader(std::string_view bytes, const std::string& path) {
                         "unsupported LAS version " + std::to_string(major) + "." + std::to_string(h.minor) +
                             " (1.0 to 1.4 are read)");
     }
+    return std::nullopt;
+}
+
+// The header size and the offset to point data, each within the file.
+std::optional<Error> readPointOffset(std::string_view bytes, const std::string& path, LasHeader& h) {
     const uint64_t headerSize = read<uint16_t>(bytes, kHeaderSizeAt);
     const std::string version = "1." + std::to_string(h.minor);
     if (headerSize < minHeaderSize(h.minor)) {
@@ -92,6 +97,11 @@ Result<LasHeader> parseHeader(std::string_view bytes, const std::string& path) {
                             std::to_string(headerSize) + ", " + std::to_string(bytes.size()) +
                             "] (the header's end to the file's end)");
     }
+    return std::nullopt;
+}
+
+// The point data format (uncompressed, 0 to 10) and its record length.
+std::optional<Error> readFormat(std::string_view bytes, const std::string& path, LasHeader& h) {
     const uint8_t format = static_cast<uint8_t>(bytes[kFormatAt]);
     if ((format & kCompressedFormatBits) != 0) return lazError(path, offsetWhere(kFormatAt));
     if (format >= kFormatCount) {
@@ -106,6 +116,12 @@ Result<LasHeader> parseHeader(std::string_view bytes, const std::string& path) {
                             std::to_string(format) + "'s " + std::to_string(kLasMinRecordLength[format]) +
                             " bytes");
     }
+    return std::nullopt;
+}
+
+// The point count (1.4: the 64-bit count unless 0, which must agree with a
+// non-zero legacy count), and the records within the file.
+std::optional<Error> readPointCount(std::string_view bytes, const std::string& path, LasHeader& h) {
     const uint64_t legacyCount = read<uint32_t>(bytes, kLegacyCountAt);
     h.count = legacyCount;
     if (h.minor >= 4) {
@@ -117,13 +133,13 @@ Result<LasHeader> parseHeader(std::string_view bytes, const std::string& path) {
         }
         if (count != 0) h.count = count;
     }
-    const uint64_t left = bytes.size() - h.pointOffset;
-    if (h.count > left / h.recordLength) {
-        return badInput(path, offsetWhere(h.pointOffset),
-                        "the header declares " + std::to_string(h.count) + " points of " +
-                            std::to_string(h.recordLength) + " bytes, but only " + std::to_string(left) +
-                            " bytes follow the offset to point data (truncated file or wrong count)");
-    }
+    return checkRecordsFit(path, h.pointOffset, "the header ", h.count, h.recordLength,
+                           bytes.size() - h.pointOffset,
+                           "follow the offset to point data (truncated file or wrong count)");
+}
+
+// X, Y, Z scale factors (finite, non-zero) and offsets (finite).
+std::optional<Error> readScaleOffset(std::string_view bytes, const std::string& path, LasHeader& h) {
     for (size_t axis = 0; axis < 3; ++axis) {
         const std::string name(1, "XYZ"[axis]);
         h.scale[axis] = read<double>(bytes, kScaleAt + 8 * axis);
@@ -136,6 +152,14 @@ Result<LasHeader> parseHeader(std::string_view bytes, const std::string& path) {
         if (!std::isfinite(h.offset[axis])) {
             return badInput(path, offsetWhere(kOffsetAt + 8 * axis), name + " offset is not finite");
         }
+    }
+    return std::nullopt;
+}
+
+Result<LasHeader> parseHeader(std::string_view bytes, const std::string& path) {
+    LasHeader h;
+    for (auto step : {&checkVersion, &readPointOffset, &readFormat, &readPointCount, &readScaleOffset}) {
+        if (std::optional<Error> e = step(bytes, path, h)) return *e;
     }
     return h;
 }

@@ -179,13 +179,9 @@ Result<PcdLayout> layoutOf(const std::vector<PcdField>& fields, const std::strin
 
 Result<PointCloud> readBinaryRows(std::string_view bytes, const PcdHeader& h, const PcdLayout& l,
                                   const std::string& path, const ChunkPlan& plan) {
-    const uint64_t left = bytes.size() - h.bodyOffset;
-    if (h.points > left / l.bytesPerRow) {
-        return badInput(path, offsetWhere(h.bodyOffset),
-                        "declares " + std::to_string(h.points) + " points of " +
-                            std::to_string(l.bytesPerRow) + " bytes, but only " + std::to_string(left) +
-                            " bytes remain (truncated body or wrong count)");
-    }
+    if (auto e = checkRecordsFit(path, h.bodyOffset, "", h.points, l.bytesPerRow, bytes.size() - h.bodyOffset,
+                                 "remain (truncated body or wrong count)"))
+        return *e;
     const RecordLayout rows{bytes.data() + h.bodyOffset,
                             static_cast<size_t>(l.bytesPerRow),
                             h.points,
@@ -210,19 +206,13 @@ bool isRowLine(std::string_view line) { return !trimBlank(line).empty(); }
 // Counts the blank-separated values of line and picks those in columns.
 size_t pickColumns(std::string_view line, const std::array<uint64_t, 3>& columns,
                    std::array<std::string_view, 3>& picked) {
-    size_t n = 0;
-    size_t i = 0;
-    while (i < line.size()) {
-        while (i < line.size() && isBlank(line[i])) ++i;
-        if (i == line.size()) break;
-        const size_t start = i;
-        while (i < line.size() && !isBlank(line[i])) ++i;
-        for (size_t axis = 0; axis < 3; ++axis) {
-            if (columns[axis] == n) picked[axis] = line.substr(start, i - start);
-        }
-        ++n;
-    }
-    return n;
+    return forEachToken(
+        line, [](char c) { return isBlank(c); },
+        [&](size_t n, size_t begin, size_t end) {
+            for (size_t axis = 0; axis < 3; ++axis) {
+                if (columns[axis] == n) picked[axis] = line.substr(begin, end - begin);
+            }
+        });
 }
 
 // One row per non-blank line, parsed in parallel chunks.

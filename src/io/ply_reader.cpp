@@ -77,6 +77,77 @@ struct PlyHeader {
     size_t bodyLine = 0;    // line number of the first body line (ascii)
 };
 
+// One header line split into its first tokens (n counts past tok's size).
+struct HeaderLine {
+    std::array<std::string_view, 6> tok{};
+    size_t n = 0;
+    size_t lineNo = 0;
+};
+
+std::optional<Error> parseFormat(const HeaderLine& l, const std::string& path, PlyFormat& format) {
+    if (l.n < 2) return badInput(path, lineWhere(l.lineNo), "format line without a format");
+    if (l.tok[1] == "ascii") {
+        format = PlyFormat::kAscii;
+    } else if (l.tok[1] == "binary_little_endian") {
+        format = PlyFormat::kBinaryLittleEndian;
+    } else if (l.tok[1] == "binary_big_endian") {
+        format = PlyFormat::kBinaryBigEndian;
+    } else {
+        return badInput(path, lineWhere(l.lineNo), "unsupported format '" + std::string(l.tok[1]) + "'");
+    }
+    if (l.n >= 3 && l.tok[2] != "1.0" && l.tok[2] != "1") {
+        return badInput(path, lineWhere(l.lineNo), "unsupported PLY version '" + std::string(l.tok[2]) + "'");
+    }
+    return std::nullopt;
+}
+
+Result<PlyElement> parseElement(const HeaderLine& l, const std::string& path) {
+    uint64_t count = 0;
+    if (l.n != 3 || !parseUInt(l.tok[2], count)) {
+        return badInput(path, lineWhere(l.lineNo), "malformed element line (want 'element <name> <count>')");
+    }
+    return PlyElement{std::string(l.tok[1]), count, l.lineNo, {}};
+}
+
+// "property <type> <name>" or "property list <count type> <item type> <name>".
+Result<PlyProperty> parseProperty(const HeaderLine& l, const std::string& path) {
+    const std::string where = lineWhere(l.lineNo);
+    if (l.n >= 2 && l.tok[1] == "list") {
+        if (l.n != 5) {
+            return badInput(path, where,
+                            "malformed list property (want 'property list <count type> <item type> <name>')");
+        }
+        const auto countType = plyScalarType(l.tok[2]);
+        const auto itemType = plyScalarType(l.tok[3]);
+        if (!countType || !isIntegral(*countType)) {
+            return badInput(path, where, "unsupported list count type '" + std::string(l.tok[2]) + "'");
+        }
+        if (!itemType)
+            return badInput(path, where, "unsupported property type '" + std::string(l.tok[3]) + "'");
+        return PlyProperty{std::string(l.tok[4]), *itemType, true, *countType};
+    }
+    if (l.n != 3) return badInput(path, where, "malformed property line");
+    const auto type = plyScalarType(l.tok[1]);
+    if (!type) return badInput(path, where, "unsupported property type '" + std::string(l.tok[1]) + "'");
+    return PlyProperty{std::string(l.tok[2]), *type, false, ScalarType::kUInt8};
+}
+
+// A property line into the last element declared.
+std::optional<Error> addProperty(const HeaderLine& l, const std::string& path, PlyHeader& header) {
+    if (header.elements.empty()) return badInput(path, lineWhere(l.lineNo), "property before any element");
+    Result<PlyProperty> prop = parseProperty(l, path);
+    if (!prop) return prop.error();
+    PlyElement& element = header.elements.back();
+    for (const PlyProperty& seen : element.properties) {
+        if (seen.name == prop->name) {
+            return badInput(path, lineWhere(l.lineNo),
+                            "property '" + prop->name + "' declared twice in element " + element.name);
+        }
+    }
+    element.properties.push_back(std::move(*prop));
+    return std::nullopt;
+}
+
 Result<PlyHeader> parseHeader(std::string_view bytes, const std::string& path) {
     PlyHeader header;
     TextCursor cursor(bytes);
@@ -87,84 +158,31 @@ Result<PlyHeader> parseHeader(std::string_view bytes, const std::string& path) {
     bool haveFormat = false;
     for (;;) {
         if (!cursor.nextLine(line)) return badInput(path, "header", "no 'end_header' line");
-        const size_t lineNo = cursor.line();
-        std::array<std::string_view, 6> tok{};
-        const size_t n = splitTokens(line, tok.data(), tok.size());
-        if (n == 0) continue;
-        const std::string_view key = tok[0];
+        HeaderLine l;
+        l.lineNo = cursor.line();
+        l.n = splitTokens(line, l.tok.data(), l.tok.size());
+        if (l.n == 0) continue;
+        const std::string_view key = l.tok[0];
         if (key == "comment" || key == "obj_info") continue;
         if (key == "end_header") {
             header.bodyOffset = cursor.offset();
-            header.bodyLine = lineNo + 1;
+            header.bodyLine = l.lineNo + 1;
             break;
         }
+        std::optional<Error> error;
         if (key == "format") {
-            if (n < 2) return badInput(path, lineWhere(lineNo), "format line without a format");
-            if (tok[1] == "ascii") {
-                header.format = PlyFormat::kAscii;
-            } else if (tok[1] == "binary_little_endian") {
-                header.format = PlyFormat::kBinaryLittleEndian;
-            } else if (tok[1] == "binary_big_endian") {
-                header.format = PlyFormat::kBinaryBigEndian;
-            } else {
-                return badInput(path, lineWhere(lineNo), "unsupported format '" + std::string(tok[1]) + "'");
-            }
-            if (n >= 3 && tok[2] != "1.0" && tok[2] != "1") {
-                return badInput(path, lineWhere(lineNo),
-                                "unsupported PLY version '" + std::string(tok[2]) + "'");
-            }
+            error = parseFormat(l, path, header.format);
             haveFormat = true;
-            continue;
+        } else if (key == "element") {
+            Result<PlyElement> element = parseElement(l, path);
+            if (!element) return element.error();
+            header.elements.push_back(std::move(*element));
+        } else if (key == "property") {
+            error = addProperty(l, path, header);
+        } else {
+            return badInput(path, lineWhere(l.lineNo), "unknown header keyword '" + std::string(key) + "'");
         }
-        if (key == "element") {
-            uint64_t count = 0;
-            if (n != 3 || !parseUInt(tok[2], count)) {
-                return badInput(path, lineWhere(lineNo),
-                                "malformed element line (want 'element <name> <count>')");
-            }
-            header.elements.push_back(PlyElement{std::string(tok[1]), count, lineNo, {}});
-            continue;
-        }
-        if (key == "property") {
-            if (header.elements.empty())
-                return badInput(path, lineWhere(lineNo), "property before any element");
-            PlyProperty prop;
-            if (n >= 2 && tok[1] == "list") {
-                if (n != 5) {
-                    return badInput(
-                        path, lineWhere(lineNo),
-                        "malformed list property (want 'property list <count type> <item type> <name>')");
-                }
-                const auto countType = plyScalarType(tok[2]);
-                const auto itemType = plyScalarType(tok[3]);
-                if (!countType || !isIntegral(*countType)) {
-                    return badInput(path, lineWhere(lineNo),
-                                    "unsupported list count type '" + std::string(tok[2]) + "'");
-                }
-                if (!itemType) {
-                    return badInput(path, lineWhere(lineNo),
-                                    "unsupported property type '" + std::string(tok[3]) + "'");
-                }
-                prop = PlyProperty{std::string(tok[4]), *itemType, true, *countType};
-            } else {
-                if (n != 3) return badInput(path, lineWhere(lineNo), "malformed property line");
-                const auto type = plyScalarType(tok[1]);
-                if (!type)
-                    return badInput(path, lineWhere(lineNo),
-                                    "unsupported property type '" + std::string(tok[1]) + "'");
-                prop = PlyProperty{std::string(tok[2]), *type, false, ScalarType::kUInt8};
-            }
-            PlyElement& element = header.elements.back();
-            for (const PlyProperty& seen : element.properties) {
-                if (seen.name == prop.name) {
-                    return badInput(path, lineWhere(lineNo),
-                                    "property '" + prop.name + "' declared twice in element " + element.name);
-                }
-            }
-            element.properties.push_back(std::move(prop));
-            continue;
-        }
-        return badInput(path, lineWhere(lineNo), "unknown header keyword '" + std::string(key) + "'");
+        if (error) return *error;
     }
     if (!haveFormat) return badInput(path, "header", "no 'format' line");
     return header;

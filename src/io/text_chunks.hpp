@@ -8,16 +8,21 @@
 // serial parse gives for the first bad place in the file.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "io/io_error.hpp"
+#include "io/number_parse.hpp"
 #include "io/parallel_chunks.hpp"
 #include "io/text_cursor.hpp"
+#include "rthdist/io.hpp"
 #include "rthdist/result.hpp"
 
 namespace rthdist::io {
@@ -71,35 +76,56 @@ std::optional<Error> parseChunks(const TextChunks& chunks, std::string_view text
     });
 }
 
-// The points of a text format with one point per item line (XYZ, OBJ), in
-// parallel chunks: pointOf(line, cursor, point) parses an item line into
-// `point` or returns its error, naming cursor.line(). shortestLine: the
-// fewest bytes an item line takes with its line end; when the text holds
-// more item lines than that allows, one of them is bad, and it is found
-// before anything is allocated for all of them.
-template <class PointOf>
-Result<std::vector<glm::dvec3>> readPointLines(std::string_view text, const ChunkPlan& plan, ItemLine isItem,
-                                               size_t shortestLine, PointOf&& pointOf) {
-    const TextChunks chunks = splitLines(text, 1, isItem, plan);
+// A text format with one point per item line, x y z its first three
+// tokens (XYZ, OBJ).
+struct PointLineFormat {
+    ItemLine isItem;
+    // The fewest bytes an item line takes with its line end: when the text
+    // holds more item lines than that allows, one of them is bad, and it is
+    // found before anything is allocated for all of them.
+    size_t shortestLine;
+    size_t skip = 0;                   // characters before the coordinates of a trimmed item line
+    std::string_view separators = {};  // between tokens, besides blanks
+    // The error of an item line with n < 3 tokens: tooFew[0] n tooFew[1].
+    std::array<std::string_view, 2> tooFew;
+};
+
+// The points of such a format (a leading UTF-8 byte order mark skipped), in
+// parallel chunks; an error names the file line of the first bad item line.
+// The format is a template argument so that its separators and its item
+// test are constants in the per-line loop.
+template <const PointLineFormat& format>
+Result<PointCloud> readPointLines(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
+    const std::string_view text = bytes.substr(bomLength(bytes));
+    const TextChunks chunks = splitLines(text, 1, format.isItem, plan);
     std::vector<glm::dvec3> points;
     auto parse = [&](const TextChunk& chunk, TextCursor& cursor) -> std::optional<Error> {
         uint64_t k = chunk.firstItem;
         std::string_view line;
         while (cursor.nextLine(line)) {
-            if (!isItem(line)) continue;
+            if (!format.isItem(line)) continue;
+            std::array<std::string_view, 3> tok{};
+            const size_t n =
+                splitTokens(trimBlank(line).substr(format.skip), tok.data(), tok.size(), format.separators);
+            if (n < 3) {
+                std::string what(format.tooFew[0]);
+                what.append(std::to_string(n)).append(format.tooFew[1]);
+                return badInput(path, lineWhere(cursor.line()), what);
+            }
             glm::dvec3 p;
-            if (std::optional<Error> err = pointOf(line, cursor, p)) return err;
+            if (const auto bad = parsePoint(tok.data(), p))
+                return badInput(path, lineWhere(cursor.line()), notANumber(*bad));
             if (!points.empty()) points[k] = p;
             ++k;
         }
         return std::nullopt;
     };
-    if (chunks.items > (text.size() + 1) / shortestLine) {
+    if (chunks.items > (text.size() + 1) / format.shortestLine) {
         if (auto err = parseChunks(chunks, text, plan, parse)) return *err;
     }
     points.resize(static_cast<size_t>(chunks.items));
     if (auto err = parseChunks(chunks, text, plan, parse)) return *err;
-    return points;
+    return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }
 
 }  // namespace rthdist::io

@@ -27,6 +27,25 @@ inline constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 // Bytes of a UTF-8 byte order mark at the start of text (0 or 3).
 [[nodiscard]] inline size_t bomLength(std::string_view text) { return text.starts_with(kUtf8Bom) ? 3 : 0; }
 
+// Calls visit(n, begin, end) for the n-th run of characters of s that are
+// not separators (isSep), s[begin, end), in order; returns how many there
+// are. Offsets, not a substring: a caller that keeps only some tokens
+// builds only those (per-line parsing is hot).
+template <class IsSep, class Visit>
+inline size_t forEachToken(std::string_view s, IsSep isSep, Visit&& visit) {
+    size_t n = 0;
+    size_t i = 0;
+    while (i < s.size()) {
+        while (i < s.size() && isSep(s[i])) ++i;
+        if (i == s.size()) break;
+        const size_t start = i;
+        while (i < s.size() && !isSep(s[i])) ++i;
+        visit(n, start, i);
+        ++n;
+    }
+    return n;
+}
+
 // Splits s at blanks (and at any of extraSeparators) into at most maxTokens
 // tokens; returns how many were found, counting past maxTokens.
 inline size_t splitTokens(std::string_view s, std::string_view* tokens, size_t maxTokens,
@@ -38,17 +57,9 @@ inline size_t splitTokens(std::string_view s, std::string_view* tokens, size_t m
         }
         return false;
     };
-    size_t n = 0;
-    size_t i = 0;
-    while (i < s.size()) {
-        while (i < s.size() && isSep(s[i])) ++i;
-        if (i == s.size()) break;
-        const size_t start = i;
-        while (i < s.size() && !isSep(s[i])) ++i;
-        if (n < maxTokens) tokens[n] = s.substr(start, i - start);
-        ++n;
-    }
-    return n;
+    return forEachToken(s, isSep, [&](size_t n, size_t begin, size_t end) {
+        if (n < maxTokens) tokens[n] = s.substr(begin, end - begin);
+    });
 }
 
 class TextCursor {

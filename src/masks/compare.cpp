@@ -10,10 +10,12 @@
 // zeros still count in every mean, percentile and surface Dice. The deepmind
 // convention (surfels with areas) lives in deepmind.cpp.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <optional>
 
 #include "core/parallel.hpp"
 #include "masks/boundary.hpp"
@@ -136,18 +138,186 @@ void emptyValues(Convention c, EmptyStatus s, MaskResult& r) {
     }
 }
 
+// A mask without points (na or nb is 0): which one, the convention's empty
+// values, and NaN for every number.
+void setEmpty(uint64_t na, uint64_t nb, size_t percentiles, MaskResult& r) {
+    r.empty = na == 0 && nb == 0 ? EmptyStatus::kBothEmpty
+              : na == 0          ? EmptyStatus::kAEmpty
+                                 : EmptyStatus::kBEmpty;
+    emptyValues(r.convention, r.empty, r);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    r.hd = r.assd = r.msd = r.surfaceDice = nan;
+    r.hdPercentile.assign(percentiles, nan);
+    r.aToB.hd = r.bToA.hd = r.aToB.mean = r.bToA.mean = nan;
+    r.aToB.surfaceOverlap = r.bToA.surfaceOverlap = nan;
+}
+
+// The checks of compareMasks that every convention shares.
+std::optional<Error> checkInputs(const Volume& a, const Volume& b, const MaskOptions& options) {
+    if (auto e = checkSameGrid(a, b)) return e;
+    if (a.storedVoxels() != a.voxelCount() || b.storedVoxels() != b.voxelCount())
+        return Error{ErrorCode::kInvalidArgument, "masks: label array size differs from the dimensions"};
+    if (options.connectivity != 0 && options.connectivity != 6 && options.connectivity != 18 &&
+        options.connectivity != 26)
+        return Error{ErrorCode::kInvalidArgument, "masks: connectivity must be 6, 18 or 26"};
+    for (double p : options.percentiles)
+        if (!(p >= 0.0 && p <= 100.0))
+            return Error{ErrorCode::kInvalidArgument, "masks: percentile outside [0, 100]"};
+    if (!(options.tolerance >= 0.0))
+        return Error{ErrorCode::kInvalidArgument, "masks: tolerance must be >= 0"};
+    return std::nullopt;
+}
+
+// One direction's points: X's voxels that may be non-zero, how many more of
+// X's voxels are at distance 0, and one of those (0 when none).
+struct DirectionPoints {
+    std::vector<uint64_t> queries;
+    uint64_t zeros = 0;
+    uint64_t zeroWitness = 0;
+};
+
+// itk: all foreground voxels; a voxel of X inside Y has distance 0.
+std::array<DirectionPoints, 2> itkPoints(const Volume& a, LabelSelect selectA, uint64_t na, const Volume& b,
+                                         LabelSelect selectB, uint64_t nb, int threads) {
+    std::array<DirectionPoints, 2> d;
+    d[0].queries = detail::differenceVoxels(a, selectA, b, selectB, threads);
+    d[1].queries = detail::differenceVoxels(b, selectB, a, selectA, threads);
+    d[0].zeros = na - d[0].queries.size();
+    d[1].zeros = nb - d[1].queries.size();
+    // A zero-distance witness: a voxel in both masks.
+    if (d[0].zeros > 0 || d[1].zeros > 0)
+        d[0].zeroWitness = d[1].zeroWitness = detail::firstCommonVoxel(a, selectA, b, selectB).value_or(0);
+    return d;
+}
+
+// Boundary conventions: a boundary voxel of X that is also one of Y has distance 0.
+std::array<DirectionPoints, 2> boundaryPoints(const std::vector<uint64_t>& ba,
+                                              const std::vector<uint64_t>& bb) {
+    std::array<DirectionPoints, 2> d;
+    std::set_difference(ba.begin(), ba.end(), bb.begin(), bb.end(), std::back_inserter(d[0].queries));
+    std::set_difference(bb.begin(), bb.end(), ba.begin(), ba.end(), std::back_inserter(d[1].queries));
+    d[0].zeros = ba.size() - d[0].queries.size();
+    d[1].zeros = bb.size() - d[1].queries.size();
+    if (d[0].zeros > 0 || d[1].zeros > 0) {
+        std::vector<uint64_t> common;
+        std::set_intersection(ba.begin(), ba.end(), bb.begin(), bb.end(), std::back_inserter(common));
+        d[0].zeroWitness = d[1].zeroWitness = common.front();
+    }
+    return d;
+}
+
+// HD, ASSD, MSD, surface overlaps and surface Dice from both directions.
+void summarise(Direction& da, Direction& db, double tolerance, MaskResult& r) {
+    r.hd = std::max(da.out.hd, db.out.hd);
+    const double nAll = double(da.out.points + db.out.points);
+    r.assd = (da.sum + db.sum) / nAll;
+    r.msd = 0.5 * (da.out.mean + db.out.mean);
+    uint64_t within = 0;
+    for (Direction* d : {&da, &db}) {
+        const uint64_t w =
+            uint64_t(std::upper_bound(d->sorted.begin(), d->sorted.end(), tolerance) - d->sorted.begin());
+        d->out.surfaceOverlap = double(w) / double(d->out.points);
+        within += w;
+    }
+    r.surfaceDice = double(within) / nAll;
+}
+
+// Percentile p of each direction and their combination, in convention c
+// (pooled: both directions' distances merged, medpy only).
+struct PercentilePair {
+    double a = 0.0, b = 0.0, combined = 0.0;
+};
+
+PercentilePair percentilesOf(Convention c, const Direction& da, const Direction& db,
+                             const std::vector<double>& pooled, double p) {
+    PercentilePair v;
+    switch (c) {
+        case Convention::kRthdist:
+            v.a = percentileNearestRank(da.sorted, p);
+            v.b = percentileNearestRank(db.sorted, p);
+            v.combined = std::max(v.a, v.b);
+            break;
+        case Convention::kMonai:
+            v.a = percentileLinear(da.sorted, p);
+            v.b = percentileLinear(db.sorted, p);
+            v.combined = std::max(v.a, v.b);
+            break;
+        case Convention::kMedpy:
+            v.a = percentileLinear(da.sorted, p);
+            v.b = percentileLinear(db.sorted, p);
+            v.combined = percentileLinear(pooled, p);
+            break;
+        case Convention::kPlastimatch:
+            v.a = percentilePlastimatch(da.sorted, p);
+            v.b = percentilePlastimatch(db.sorted, p);
+            v.combined = 0.5 * (v.a + v.b);
+            break;
+        case Convention::kItk:
+        case Convention::kDeepmind: break;
+    }
+    return v;
+}
+
+// Every requested HD-p, per direction and combined (not for itk).
+void addPercentiles(Convention c, const std::vector<double>& percentiles, Direction& da, Direction& db,
+                    MaskResult& r) {
+    std::vector<double> pooled;
+    if (c == Convention::kMedpy) {
+        pooled.resize(da.sorted.size() + db.sorted.size());
+        std::merge(da.sorted.begin(), da.sorted.end(), db.sorted.begin(), db.sorted.end(), pooled.begin());
+    }
+    for (double p : percentiles) {
+        const PercentilePair v = percentilesOf(c, da, db, pooled, p);
+        da.out.percentiles.push_back(v.a);
+        db.out.percentiles.push_back(v.b);
+        r.hdPercentile.push_back(v.combined);
+    }
+}
+
+// Each convention's name and one-line rule, in kAllConventions order.
+struct ConventionText {
+    Convention convention;
+    const char* name;
+    const char* rule;
+};
+
+constexpr std::array<ConventionText, kAllConventions.size()> kConventionTexts{{
+    {Convention::kRthdist, "rthdist",
+     "boundary voxels (connectivity), world coordinates (affine); HD-p = max of the two directed "
+     "nearest-rank percentiles"},
+    {Convention::kMonai, "monai",
+     "mask XOR erosion (6-connected), spacing; HD-p = max of the two directed linear percentiles "
+     "(torch.quantile)"},
+    {Convention::kMedpy, "medpy",
+     "mask XOR erosion (connectivity), spacing; HD-p = linear percentile of both directions pooled"},
+    {Convention::kPlastimatch, "plastimatch",
+     "boundary voxels (6-connected), spacing; HD-p = mean of the two directed k-th smallest, "
+     "k = floor(p/100 n - 1)"},
+    {Convention::kItk, "itk",
+     "all foreground voxels (inside the other = 0), spacing; HD only; average = mean of the directed means"},
+    {Convention::kDeepmind, "deepmind",
+     "surfels on the half-voxel-shifted grid with marching-cubes areas, spacing; HD-p = max of the two "
+     "directed area-weighted percentiles (first cumulative area fraction >= p/100)"},
+}};
+
+constexpr bool conventionTextsInOrder() {
+    for (size_t i = 0; i < kConventionTexts.size(); ++i) {
+        if (kConventionTexts[i].convention != kAllConventions[i] || size_t(kAllConventions[i]) != i)
+            return false;
+    }
+    return true;
+}
+static_assert(conventionTextsInOrder(), "kConventionTexts[i] describes Convention(i)");
+
+const ConventionText* textOf(Convention c) {
+    return size_t(c) < kConventionTexts.size() ? &kConventionTexts[size_t(c)] : nullptr;
+}
+
 }  // namespace
 
 const char* conventionName(Convention c) {
-    switch (c) {
-        case Convention::kRthdist: return "rthdist";
-        case Convention::kMonai: return "monai";
-        case Convention::kMedpy: return "medpy";
-        case Convention::kPlastimatch: return "plastimatch";
-        case Convention::kItk: return "itk";
-        case Convention::kDeepmind: return "deepmind";
-    }
-    return "?";
+    const ConventionText* t = textOf(c);
+    return t != nullptr ? t->name : "?";
 }
 
 bool parseConvention(const std::string& text, Convention& out) {
@@ -161,29 +331,8 @@ bool parseConvention(const std::string& text, Convention& out) {
 }
 
 const char* conventionRule(Convention c) {
-    switch (c) {
-        case Convention::kRthdist:
-            return "boundary voxels (connectivity), world coordinates (affine); HD-p = max of the two "
-                   "directed "
-                   "nearest-rank percentiles";
-        case Convention::kMonai:
-            return "mask XOR erosion (6-connected), spacing; HD-p = max of the two directed linear "
-                   "percentiles "
-                   "(torch.quantile)";
-        case Convention::kMedpy:
-            return "mask XOR erosion (connectivity), spacing; HD-p = linear percentile of both directions "
-                   "pooled";
-        case Convention::kPlastimatch:
-            return "boundary voxels (6-connected), spacing; HD-p = mean of the two directed k-th smallest, "
-                   "k = floor(p/100 n - 1)";
-        case Convention::kItk:
-            return "all foreground voxels (inside the other = 0), spacing; HD only; average = mean of the "
-                   "directed means";
-        case Convention::kDeepmind:
-            return "surfels on the half-voxel-shifted grid with marching-cubes areas, spacing; HD-p = max of "
-                   "the two directed area-weighted percentiles (first cumulative area fraction >= p/100)";
-    }
-    return "?";
+    const ConventionText* t = textOf(c);
+    return t != nullptr ? t->rule : "?";
 }
 
 const char* emptyStatusName(EmptyStatus s) {
@@ -205,18 +354,7 @@ Result<Engine> makeMaskEngine(Options options) {
 Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect selectA, const Volume& b,
                                 LabelSelect selectB, const MaskOptions& options) {
     const auto start = Clock::now();
-    if (auto e = checkSameGrid(a, b)) return *e;
-    if (a.storedVoxels() != a.voxelCount() || b.storedVoxels() != b.voxelCount())
-        return Error{ErrorCode::kInvalidArgument, "masks: label array size differs from the dimensions"};
-    if (options.connectivity != 0 && options.connectivity != 6 && options.connectivity != 18 &&
-        options.connectivity != 26)
-        return Error{ErrorCode::kInvalidArgument, "masks: connectivity must be 6, 18 or 26"};
-    for (double p : options.percentiles)
-        if (!(p >= 0.0 && p <= 100.0))
-            return Error{ErrorCode::kInvalidArgument, "masks: percentile outside [0, 100]"};
-    if (!(options.tolerance >= 0.0))
-        return Error{ErrorCode::kInvalidArgument, "masks: tolerance must be >= 0"};
-
+    if (auto e = checkInputs(a, b, options)) return *e;
     const Convention c = options.convention;
     if (c == Convention::kDeepmind) return detail::compareDeepmind(engine, a, selectA, b, selectB, options);
     const int conn = connectivityOf(c, options.connectivity);
@@ -231,109 +369,33 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
     auto t0 = Clock::now();
     const detail::Extraction ea = detail::extractBoundary(a, selectA, itk ? 6 : conn, threads);
     const detail::Extraction eb = detail::extractBoundary(b, selectB, itk ? 6 : conn, threads);
-    const uint64_t na = ea.count, nb = eb.count;
-    if (na == 0 || nb == 0) {
-        r.empty = na == 0 && nb == 0 ? EmptyStatus::kBothEmpty
-                  : na == 0          ? EmptyStatus::kAEmpty
-                                     : EmptyStatus::kBEmpty;
-        emptyValues(c, r.empty, r);
-        const double nan = std::numeric_limits<double>::quiet_NaN();
-        r.hd = r.assd = r.msd = r.surfaceDice = nan;
-        r.hdPercentile.assign(itk ? 0 : options.percentiles.size(), nan);
-        r.aToB.hd = r.bToA.hd = r.aToB.mean = r.bToA.mean = nan;
-        r.aToB.surfaceOverlap = r.bToA.surfaceOverlap = nan;
+    if (ea.count == 0 || eb.count == 0) {
+        setEmpty(ea.count, eb.count, itk ? 0 : options.percentiles.size(), r);
         r.extractMs = msSince(t0);
         r.totalMs = msSince(start);
         return r;
     }
-
     // Queries (possibly non-zero), zero count and targets per direction.
-    const std::vector<uint64_t>& ba = ea.boundary;
-    const std::vector<uint64_t>& bb = eb.boundary;
-    std::vector<uint64_t> qa, qb;
-    uint64_t za = 0, zb = 0, zwa = 0, zwb = 0;
-    if (itk) {
-        qa = detail::differenceVoxels(a, selectA, b, selectB, threads);
-        qb = detail::differenceVoxels(b, selectB, a, selectA, threads);
-        za = na - qa.size();
-        zb = nb - qb.size();
-        // A zero-distance witness: a voxel in both masks.
-        if (za > 0 || zb > 0) zwa = zwb = detail::firstCommonVoxel(a, selectA, b, selectB).value_or(0);
-    } else {
-        std::set_difference(ba.begin(), ba.end(), bb.begin(), bb.end(), std::back_inserter(qa));
-        std::set_difference(bb.begin(), bb.end(), ba.begin(), ba.end(), std::back_inserter(qb));
-        za = ba.size() - qa.size();
-        zb = bb.size() - qb.size();
-        if (za > 0 || zb > 0) {
-            std::vector<uint64_t> common;
-            std::set_intersection(ba.begin(), ba.end(), bb.begin(), bb.end(), std::back_inserter(common));
-            zwa = zwb = common.front();
-        }
-    }
+    const std::array<DirectionPoints, 2> p =
+        itk ? itkPoints(a, selectA, ea.count, b, selectB, eb.count, threads)
+            : boundaryPoints(ea.boundary, eb.boundary);
     r.extractMs = msSince(t0);
 
-    Result<Direction> ab = directed(engine, a, qa, za, zwa, bb, world, threads, r.extractMs, r.distanceMs);
+    Result<Direction> ab = directed(engine, a, p[0].queries, p[0].zeros, p[0].zeroWitness, eb.boundary, world,
+                                    threads, r.extractMs, r.distanceMs);
     if (!ab) return ab.error();
-    Result<Direction> ba2 = directed(engine, b, qb, zb, zwb, ba, world, threads, r.extractMs, r.distanceMs);
-    if (!ba2) return ba2.error();
-    Direction& da = *ab;
-    Direction& db = *ba2;
-
-    r.hd = std::max(da.out.hd, db.out.hd);
-    const double nAll = double(da.out.points + db.out.points);
-    r.assd = (da.sum + db.sum) / nAll;
-    r.msd = 0.5 * (da.out.mean + db.out.mean);
-    uint64_t within = 0;
-    for (Direction* d : {&da, &db}) {
-        const uint64_t w = uint64_t(std::upper_bound(d->sorted.begin(), d->sorted.end(), options.tolerance) -
-                                    d->sorted.begin());
-        d->out.surfaceOverlap = double(w) / double(d->out.points);
-        within += w;
-    }
-    r.surfaceDice = double(within) / nAll;
-
-    std::vector<double> pooled;
-    if (c == Convention::kMedpy) {
-        pooled.resize(da.sorted.size() + db.sorted.size());
-        std::merge(da.sorted.begin(), da.sorted.end(), db.sorted.begin(), db.sorted.end(), pooled.begin());
-    }
-    for (double p : options.percentiles) {
-        double pa = 0.0, pb = 0.0, combined = 0.0;
-        switch (c) {
-            case Convention::kRthdist:
-                pa = percentileNearestRank(da.sorted, p);
-                pb = percentileNearestRank(db.sorted, p);
-                combined = std::max(pa, pb);
-                break;
-            case Convention::kMonai:
-                pa = percentileLinear(da.sorted, p);
-                pb = percentileLinear(db.sorted, p);
-                combined = std::max(pa, pb);
-                break;
-            case Convention::kMedpy:
-                pa = percentileLinear(da.sorted, p);
-                pb = percentileLinear(db.sorted, p);
-                combined = percentileLinear(pooled, p);
-                break;
-            case Convention::kPlastimatch:
-                pa = percentilePlastimatch(da.sorted, p);
-                pb = percentilePlastimatch(db.sorted, p);
-                combined = 0.5 * (pa + pb);
-                break;
-            case Convention::kItk:
-            case Convention::kDeepmind: break;
-        }
-        if (!itk) {
-            da.out.percentiles.push_back(pa);
-            db.out.percentiles.push_back(pb);
-            r.hdPercentile.push_back(combined);
-        }
-    }
-    if (itk)
-        r.assd = r.surfaceDice = da.out.surfaceOverlap = db.out.surfaceOverlap =
+    Result<Direction> ba = directed(engine, b, p[1].queries, p[1].zeros, p[1].zeroWitness, ea.boundary, world,
+                                    threads, r.extractMs, r.distanceMs);
+    if (!ba) return ba.error();
+    summarise(*ab, *ba, options.tolerance, r);
+    if (itk) {
+        r.assd = r.surfaceDice = ab->out.surfaceOverlap = ba->out.surfaceOverlap =
             std::numeric_limits<double>::quiet_NaN();
-    r.aToB = std::move(da.out);
-    r.bToA = std::move(db.out);
+    } else {
+        addPercentiles(c, options.percentiles, *ab, *ba, r);
+    }
+    r.aToB = std::move(ab->out);
+    r.bToA = std::move(ba->out);
     r.totalMs = msSince(start);
     return r;
 }

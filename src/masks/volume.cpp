@@ -4,6 +4,7 @@
 #include <nifti2_io.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -11,6 +12,7 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string_view>
 
@@ -77,6 +79,71 @@ struct NiftiFree {
     void operator()(nifti_image* p) const { nifti_image_free(p); }
 };
 
+// The scalar types a label array may hold: the NIfTI datatype, the NumPy
+// kind (dtype without its byte order; b1 reads as u1) and the conversion.
+struct LabelType {
+    int niftiType;
+    std::string_view npyKind;
+    size_t bytes;
+    std::optional<Error> (*toLabels)(const void* raw, size_t n, bool scale, double slope, double inter,
+                                     const std::string& path, std::vector<int32_t>& out);
+};
+
+constexpr LabelType kLabelTypes[] = {
+    {DT_UINT8, "u1", 1, &toLabels<uint8_t>},   {DT_INT8, "i1", 1, &toLabels<int8_t>},
+    {DT_UINT16, "u2", 2, &toLabels<uint16_t>}, {DT_INT16, "i2", 2, &toLabels<int16_t>},
+    {DT_UINT32, "u4", 4, &toLabels<uint32_t>}, {DT_INT32, "i4", 4, &toLabels<int32_t>},
+    {DT_UINT64, "u8", 8, &toLabels<uint64_t>}, {DT_INT64, "i8", 8, &toLabels<int64_t>},
+    {DT_FLOAT32, "f4", 4, &toLabels<float>},   {DT_FLOAT64, "f8", 8, &toLabels<double>},
+};
+
+const LabelType* niftiLabelType(int datatype) {
+    for (const LabelType& t : kLabelTypes)
+        if (t.niftiType == datatype) return &t;
+    return nullptr;
+}
+
+const LabelType* npyLabelType(std::string_view kind) {
+    if (kind == "b1") kind = "u1";
+    for (const LabelType& t : kLabelTypes)
+        if (t.npyKind == kind) return &t;
+    return nullptr;
+}
+
+// Voxel size along i, j, k, origin 0.
+glm::dmat4 diagonal(glm::dvec3 size) {
+    glm::dmat4 m(1.0);
+    m[0][0] = size.x;
+    m[1][1] = size.y;
+    m[2][2] = size.z;
+    return m;
+}
+
+// The voxel-to-world transform of a NIfTI image: its sform, else its qform,
+// else diag(pixdim[1..3]); finite and not singular.
+std::optional<Error> setNiftiTransform(const nifti_image& nim, const std::string& path, Volume& v) {
+    if (nim.sform_code > 0) {
+        v.voxelToWorld = fromNifti(nim.sto_xyz);
+        v.transform = "sform";
+    } else if (nim.qform_code > 0) {
+        v.voxelToWorld = fromNifti(nim.qto_xyz);
+        v.transform = "qform";
+    } else {
+        const double dx = std::fabs(nim.dx), dy = std::fabs(nim.dy), dz = std::fabs(nim.dz);
+        if (!(dx > 0 && dy > 0 && dz > 0 && std::isfinite(dx) && std::isfinite(dy) && std::isfinite(dz)))
+            return bad(path, "no sform/qform and pixdim[1..3] are not positive: no voxel size");
+        v.voxelToWorld = diagonal({dx, dy, dz});
+        v.transform = "pixdim";
+    }
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r)
+            if (!std::isfinite(v.voxelToWorld[c][r]))
+                return bad(path, v.transform + " has a non-finite entry");
+    if (std::fabs(glm::determinant(glm::dmat3(v.voxelToWorld))) == 0.0)
+        return bad(path, v.transform + " is singular (a voxel axis of length 0)");
+    return std::nullopt;
+}
+
 }  // namespace
 
 glm::dvec3 Volume::spacing() const {
@@ -106,54 +173,22 @@ Result<Volume> loadNifti(const std::string& path) {
     Volume v;
     v.path = path;
     v.dims = {nx, ny, nz};
-    if (nim->sform_code > 0) {
-        v.voxelToWorld = fromNifti(nim->sto_xyz);
-        v.transform = "sform";
-    } else if (nim->qform_code > 0) {
-        v.voxelToWorld = fromNifti(nim->qto_xyz);
-        v.transform = "qform";
-    } else {
-        const double dx = std::fabs(nim->dx), dy = std::fabs(nim->dy), dz = std::fabs(nim->dz);
-        if (!(dx > 0 && dy > 0 && dz > 0 && std::isfinite(dx) && std::isfinite(dy) && std::isfinite(dz)))
-            return bad(path, "no sform/qform and pixdim[1..3] are not positive: no voxel size");
-        v.voxelToWorld = glm::dmat4(1.0);
-        v.voxelToWorld[0][0] = dx;
-        v.voxelToWorld[1][1] = dy;
-        v.voxelToWorld[2][2] = dz;
-        v.transform = "pixdim";
-    }
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r)
-            if (!std::isfinite(v.voxelToWorld[c][r]))
-                return bad(path, v.transform + " has a non-finite entry");
-    if (std::fabs(glm::determinant(glm::dmat3(v.voxelToWorld))) == 0.0)
-        return bad(path, v.transform + " is singular (a voxel axis of length 0)");
+    if (auto e = setNiftiTransform(*nim, path, v)) return *e;
     const double slope = nim->scl_slope, inter = nim->scl_inter;
     const bool scale =
         std::isfinite(slope) && slope != 0.0 && std::isfinite(inter) && (slope != 1.0 || inter != 0.0);
     const size_t n = size_t(nim->nvox);
-    std::optional<Error> e;
     if (nim->datatype == DT_UINT8 && !scale) {
         const uint8_t* raw = static_cast<const uint8_t*>(nim->data);
         v.labels8.assign(raw, raw + n);
         return v;
     }
-    switch (nim->datatype) {
-        case DT_UINT8: e = toLabels<uint8_t>(nim->data, n, scale, slope, inter, path, v.labels); break;
-        case DT_INT8: e = toLabels<int8_t>(nim->data, n, scale, slope, inter, path, v.labels); break;
-        case DT_INT16: e = toLabels<int16_t>(nim->data, n, scale, slope, inter, path, v.labels); break;
-        case DT_UINT16: e = toLabels<uint16_t>(nim->data, n, scale, slope, inter, path, v.labels); break;
-        case DT_INT32: e = toLabels<int32_t>(nim->data, n, scale, slope, inter, path, v.labels); break;
-        case DT_UINT32: e = toLabels<uint32_t>(nim->data, n, scale, slope, inter, path, v.labels); break;
-        case DT_INT64: e = toLabels<int64_t>(nim->data, n, scale, slope, inter, path, v.labels); break;
-        case DT_UINT64: e = toLabels<uint64_t>(nim->data, n, scale, slope, inter, path, v.labels); break;
-        case DT_FLOAT32: e = toLabels<float>(nim->data, n, scale, slope, inter, path, v.labels); break;
-        case DT_FLOAT64: e = toLabels<double>(nim->data, n, scale, slope, inter, path, v.labels); break;
-        default:
-            return bad(path, std::string("voxel type ") + nifti_datatype_string(nim->datatype) +
-                                 " is not a label type (integers or float32/float64)");
+    const LabelType* type = niftiLabelType(nim->datatype);
+    if (type == nullptr) {
+        return bad(path, std::string("voxel type ") + nifti_datatype_string(nim->datatype) +
+                             " is not a label type (integers or float32/float64)");
     }
-    if (e) return *e;
+    if (auto e = type->toLabels(nim->data, n, scale, slope, inter, path, v.labels)) return *e;
     return v;
 }
 
@@ -182,12 +217,32 @@ std::optional<std::string> dictValue(const std::string& header, const std::strin
     return header.substr(at, end - at);
 }
 
-}  // namespace
+// The axes of a .npy shape tuple ("(4, 5, 6)").
+Result<std::vector<int64_t>> parseShape(const std::string& shape, const std::string& path) {
+    std::vector<int64_t> dims;
+    const std::string s = shape.substr(1, shape.size() - 2);
+    size_t at = 0;
+    while (at < s.size()) {
+        while (at < s.size() && (s[at] == ' ' || s[at] == ',')) ++at;
+        if (at >= s.size()) break;
+        size_t end = at;
+        while (end < s.size() && std::isdigit(static_cast<unsigned char>(s[end]))) ++end;
+        if (end == at) return bad(path, ".npy shape '" + shape + "' is malformed");
+        dims.push_back(std::stoll(s.substr(at, end - at)));
+        at = end;
+    }
+    return dims;
+}
 
-Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing, const std::optional<glm::dmat4>& affine) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return bad(path, "cannot open the file");
-    std::vector<char> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+// What a .npy header says of its 3-D array.
+struct NpyHeader {
+    size_t dataAt = 0;  // the array's first byte
+    std::string descr;  // dtype, with its byte order ("<u1")
+    bool fortran = false;
+    std::array<int64_t, 3> dims{0, 0, 0};
+};
+
+Result<NpyHeader> parseNpyHeader(const std::vector<char>& bytes, const std::string& path) {
     if (bytes.size() < 10 || std::memcmp(bytes.data(), "\x93NUMPY", 6) != 0)
         return bad(path, "not a .npy file");
     const int major = uint8_t(bytes[6]);
@@ -197,7 +252,6 @@ Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing, const std::o
         headerAt = 10;
     } else if (major == 2 || major == 3) {
         if (bytes.size() < 12) return bad(path, "truncated .npy header");
-        headerLen = 0;
         for (int i = 0; i < 4; ++i) headerLen |= size_t(uint8_t(bytes[8 + i])) << (8 * i);
         headerAt = 12;
     } else {
@@ -209,105 +263,88 @@ Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing, const std::o
     const auto order = dictValue(header, "fortran_order");
     const auto shape = dictValue(header, "shape");
     if (!descr || !order || !shape) return bad(path, ".npy header without descr/fortran_order/shape");
-    const bool fortran = order->find("True") != std::string::npos;
-    std::vector<int64_t> dims;
-    {
-        std::string s = shape->substr(1, shape->size() - 2);
-        size_t at = 0;
-        while (at < s.size()) {
-            while (at < s.size() && (s[at] == ' ' || s[at] == ',')) ++at;
-            if (at >= s.size()) break;
-            size_t end = at;
-            while (end < s.size() && std::isdigit(static_cast<unsigned char>(s[end]))) ++end;
-            if (end == at) return bad(path, ".npy shape '" + *shape + "' is malformed");
-            dims.push_back(std::stoll(s.substr(at, end - at)));
-            at = end;
-        }
-    }
-    if (dims.size() != 3)
-        return bad(path, ".npy array has " + std::to_string(dims.size()) + " axes; masks are 3-D");
-    const std::string& d = *descr;
+    const Result<std::vector<int64_t>> dims = parseShape(*shape, path);
+    if (!dims) return dims.error();
+    if (dims->size() != 3)
+        return bad(path, ".npy array has " + std::to_string(dims->size()) + " axes; masks are 3-D");
+    return NpyHeader{headerAt + headerLen,
+                     *descr,
+                     order->find("True") != std::string::npos,
+                     {(*dims)[0], (*dims)[1], (*dims)[2]}};
+}
+
+// The label type of a .npy dtype: little-endian, or one byte in any order.
+Result<const LabelType*> npyType(const std::string& d, const std::string& path) {
     if (d.size() < 3) return bad(path, ".npy dtype '" + d + "' is not supported");
     if (d[0] == '>' && d.substr(1) != "u1" && d.substr(1) != "i1" && d.substr(1) != "b1")
         return bad(path, "big-endian .npy arrays are not supported (dtype '" + d + "')");
-    const std::string kind = d.substr(1);
-    size_t itemBytes = 0;
-    if (kind == "b1" || kind == "u1" || kind == "i1")
-        itemBytes = 1;
-    else if (kind == "u2" || kind == "i2")
-        itemBytes = 2;
-    else if (kind == "u4" || kind == "i4" || kind == "f4")
-        itemBytes = 4;
-    else if (kind == "u8" || kind == "i8" || kind == "f8")
-        itemBytes = 8;
-    else
-        return bad(path, ".npy dtype '" + d + "' is not a label type");
-    const uint64_t n = uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
-    const size_t dataAt = headerAt + headerLen;
-    if (bytes.size() - dataAt < n * itemBytes)
-        return bad(path, ".npy data is truncated (" + std::to_string(bytes.size() - dataAt) + " bytes for " +
-                             std::to_string(n) + " voxels of " + std::to_string(itemBytes) + " bytes)");
-    std::vector<int32_t> flat;
-    const void* raw = bytes.data() + dataAt;
-    const bool bytesOnly = kind == "b1" || kind == "u1";
-    std::optional<Error> e;
-    if (kind == "b1" || kind == "u1")
-        e = toLabels<uint8_t>(raw, n, false, 1, 0, path, flat);
-    else if (kind == "i1")
-        e = toLabels<int8_t>(raw, n, false, 1, 0, path, flat);
-    else if (kind == "u2")
-        e = toLabels<uint16_t>(raw, n, false, 1, 0, path, flat);
-    else if (kind == "i2")
-        e = toLabels<int16_t>(raw, n, false, 1, 0, path, flat);
-    else if (kind == "u4")
-        e = toLabels<uint32_t>(raw, n, false, 1, 0, path, flat);
-    else if (kind == "i4")
-        e = toLabels<int32_t>(raw, n, false, 1, 0, path, flat);
-    else if (kind == "u8")
-        e = toLabels<uint64_t>(raw, n, false, 1, 0, path, flat);
-    else if (kind == "i8")
-        e = toLabels<int64_t>(raw, n, false, 1, 0, path, flat);
-    else if (kind == "f4")
-        e = toLabels<float>(raw, n, false, 1, 0, path, flat);
-    else
-        e = toLabels<double>(raw, n, false, 1, 0, path, flat);
-    if (e) return *e;
-    Volume v;
-    v.path = path;
-    v.dims = {dims[0], dims[1], dims[2]};
-    if (bytesOnly) {
-        const uint8_t* b8 = reinterpret_cast<const uint8_t*>(bytes.data() + dataAt);
+    const LabelType* type = npyLabelType(std::string_view(d).substr(1));
+    if (type == nullptr) return bad(path, ".npy dtype '" + d + "' is not a label type");
+    return type;
+}
+
+// A C-order array ((i, j, k) at (i * n1 + j) * n2 + k) stored i fastest.
+template <class T>
+void fromCOrder(const T* in, const std::array<int64_t, 3>& dims, T* out) {
+    const int64_t n0 = dims[0], n1 = dims[1], n2 = dims[2];
+    for (int64_t i = 0; i < n0; ++i)
+        for (int64_t j = 0; j < n1; ++j)
+            for (int64_t k = 0; k < n2; ++k)
+                out[size_t(i + n0 * (j + n1 * k))] = in[size_t((i * n1 + j) * n2 + k)];
+}
+
+// The array's labels into v, i fastest: bool and uint8 as bytes (labels8),
+// the other types converted to int32.
+std::optional<Error> readNpyLabels(const std::vector<char>& bytes, const NpyHeader& h, const LabelType& type,
+                                   const std::string& path, Volume& v) {
+    const uint64_t n = uint64_t(h.dims[0]) * uint64_t(h.dims[1]) * uint64_t(h.dims[2]);
+    if (bytes.size() - h.dataAt < n * type.bytes)
+        return bad(path, ".npy data is truncated (" + std::to_string(bytes.size() - h.dataAt) +
+                             " bytes for " + std::to_string(n) + " voxels of " + std::to_string(type.bytes) +
+                             " bytes)");
+    const char* raw = bytes.data() + h.dataAt;
+    if (type.npyKind == "u1") {
+        const uint8_t* b8 = reinterpret_cast<const uint8_t*>(raw);
         v.labels8.resize(n);
-        const int64_t n0 = dims[0], n1 = dims[1], n2 = dims[2];
-        if (fortran) {
+        if (h.fortran) {
             std::copy(b8, b8 + n, v.labels8.begin());
         } else {
-            for (int64_t i = 0; i < n0; ++i)
-                for (int64_t j = 0; j < n1; ++j)
-                    for (int64_t k = 0; k < n2; ++k)
-                        v.labels8[size_t(i + n0 * (j + n1 * k))] = b8[size_t((i * n1 + j) * n2 + k)];
+            fromCOrder(b8, h.dims, v.labels8.data());
         }
-    } else if (fortran) {
+        return std::nullopt;
+    }
+    std::vector<int32_t> flat;
+    if (auto e = type.toLabels(raw, n, false, 1, 0, path, flat)) return e;
+    if (h.fortran) {
         v.labels = std::move(flat);  // already i fastest
     } else {
-        // C order: (i, j, k) at (i * n1 + j) * n2 + k; store i fastest.
         v.labels.resize(n);
-        const int64_t n0 = dims[0], n1 = dims[1], n2 = dims[2];
-        for (int64_t i = 0; i < n0; ++i)
-            for (int64_t j = 0; j < n1; ++j)
-                for (int64_t k = 0; k < n2; ++k)
-                    v.labels[size_t(i + n0 * (j + n1 * k))] = flat[size_t((i * n1 + j) * n2 + k)];
+        fromCOrder(flat.data(), h.dims, v.labels.data());
     }
+    return std::nullopt;
+}
+
+}  // namespace
+
+Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing, const std::optional<glm::dmat4>& affine) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return bad(path, "cannot open the file");
+    const std::vector<char> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    const Result<NpyHeader> header = parseNpyHeader(bytes, path);
+    if (!header) return header.error();
+    const Result<const LabelType*> type = npyType(header->descr, path);
+    if (!type) return type.error();
+    Volume v;
+    v.path = path;
+    v.dims = header->dims;
+    if (auto e = readNpyLabels(bytes, *header, **type, path, v)) return *e;
     if (affine) {
         v.voxelToWorld = *affine;
         v.transform = "affine";
     } else {
         if (!(spacing.x > 0 && spacing.y > 0 && spacing.z > 0))
             return Error{ErrorCode::kInvalidArgument, path + ": spacing must be positive"};
-        v.voxelToWorld = glm::dmat4(1.0);
-        v.voxelToWorld[0][0] = spacing.x;
-        v.voxelToWorld[1][1] = spacing.y;
-        v.voxelToWorld[2][2] = spacing.z;
+        v.voxelToWorld = diagonal(spacing);
         v.transform = "spacing";
     }
     return v;

@@ -1,22 +1,23 @@
 #include "mpi/local_pass.hpp"
 
 #include <chrono>
+#include <iterator>
 
 namespace rthdist::mpi {
 
+namespace {
+
+// Every field of Timings (the static_assert catches one added later).
+constexpr double Timings::*kTimingFields[] = {
+    &Timings::setup,     &Timings::upload,    &Timings::index,    &Timings::cull,     &Timings::search,
+    &Timings::refine,    &Timings::check,     &Timings::total,    &Timings::gpuIndex, &Timings::gpuCull,
+    &Timings::gpuSearch, &Timings::gpuRefine, &Timings::gpuUpload};
+static_assert(sizeof(Timings) == std::size(kTimingFields) * sizeof(double), "a Timings field is missing");
+
+}  // namespace
+
 void addTimings(Timings& into, const Timings& t) {
-    into.setup += t.setup;
-    into.upload += t.upload;
-    into.index += t.index;
-    into.cull += t.cull;
-    into.search += t.search;
-    into.refine += t.refine;
-    into.check += t.check;
-    into.total += t.total;
-    into.gpuIndex += t.gpuIndex;
-    into.gpuCull += t.gpuCull;
-    into.gpuSearch += t.gpuSearch;
-    into.gpuRefine += t.gpuRefine;
+    for (double Timings::*field : kTimingFields) into.*field += t.*field;
 }
 
 namespace {

@@ -107,7 +107,6 @@ Result<bool> writeInPlace(const std::string& path, const std::string& target, st
     return true;
 }
 
-
 // Replaces the "XXXXXX" before ".tmp" in `temp` with random characters and
 // creates that file exclusively, arming `pending` with each name before it is
 // created (mkstemps would leave a window between creating and arming). Returns
