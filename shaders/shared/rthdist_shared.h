@@ -1,4 +1,4 @@
-// Shared between C++ (src/algo, src/gpu) and GLSL (shaders/): push-constant
+// Shared between C++ (src/gpu_algo) and GLSL (shaders/): push-constant
 // blocks, record layouts and constants. Every buffer is reached through its
 // device address (GL_EXT_buffer_reference), so shaders need no descriptor sets
 // except the TLAS of the ray-tracing stages (set 0, binding 0).
@@ -6,6 +6,7 @@
 #define RTHDIST_SHARED_H
 
 #ifdef __cplusplus
+#include <cstddef>
 #include <cstdint>
 namespace rthdist::shared {
 using uint = uint32_t;
@@ -307,6 +308,32 @@ struct ResolvePush {
 };
 
 #ifdef __cplusplus
+// The counters of a block as the host reads and zeroes them: one field per
+// RTHDIST_CTR_* offset the shaders use, each offset asserted here.
+struct CounterFields {
+    uint active;
+    uint maxCount;
+    uint nextActive;
+    uint cells;
+    uint64_t maxPacked;
+    uint64_t pairs;
+    uint64_t checkSum;
+    uint64_t checkBad;
+    uint minEdge;  // float bits
+    uint largeCells;
+};
+static_assert(offsetof(CounterFields, active) == RTHDIST_CTR_ACTIVE);
+static_assert(offsetof(CounterFields, maxCount) == RTHDIST_CTR_MAX_COUNT);
+static_assert(offsetof(CounterFields, nextActive) == RTHDIST_CTR_NEXT_ACTIVE);
+static_assert(offsetof(CounterFields, cells) == RTHDIST_CTR_CELLS);
+static_assert(offsetof(CounterFields, maxPacked) == RTHDIST_CTR_MAX_PACKED);
+static_assert(offsetof(CounterFields, pairs) == RTHDIST_CTR_PAIRS);
+static_assert(offsetof(CounterFields, checkSum) == RTHDIST_CTR_CHECK_SUM);
+static_assert(offsetof(CounterFields, checkBad) == RTHDIST_CTR_CHECK_BAD);
+static_assert(offsetof(CounterFields, minEdge) == RTHDIST_CTR_MIN_EDGE);
+static_assert(offsetof(CounterFields, largeCells) == RTHDIST_CTR_LARGE_CELLS);
+static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
+
 }  // namespace rthdist::shared
 #endif
 #endif

@@ -61,8 +61,8 @@ IterationCounts CandidateSearch::iterate(DirectionRun& d, int level, bool sameLe
                                          Buffer& pairs, uint64_t pairCapacity, uint32_t numActive) {
     const PointIndex::Level lv = m_index.levelCells(d.T, level);
     const auto t0 = Clock::now();
-    d.blk.at<uint64_t>(RTHDIST_CTR_PAIRS) = 0;
-    d.blk.at<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE) = 0;
+    d.blk.fields().pairs = 0;
+    d.blk.fields().nextActive = 0;
     VkCommandBuffer cmd = m_ws.ctx.begin();
     cmdSearch(cmd, d, lv, sameLevel, radius, pairs, pairCapacity, numActive);
     const uint32_t searched = m_ws.ctx.cmdMark(cmd);
@@ -77,8 +77,7 @@ IterationCounts CandidateSearch::iterate(DirectionRun& d, int level, bool sameLe
     m_ws.timings->search += wall * searchShare;
     m_ws.timings->refine += wall * (1.0 - searchShare);
     d.out.counters.rays += numActive;
-    IterationCounts counts{d.blk.at<uint64_t>(RTHDIST_CTR_PAIRS),
-                           d.blk.at<uint32_t>(RTHDIST_CTR_NEXT_ACTIVE)};
+    IterationCounts counts{d.blk.fields().pairs, d.blk.fields().nextActive};
     d.out.counters.candidatePairs += std::min<uint64_t>(counts.pairs, pairCapacity);
     d.cur = 1 - d.cur;
     return counts;
@@ -108,21 +107,15 @@ void CandidateSearch::cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const Poin
         m_ws.pipelines.bindTlas(m_ws.accel.tlas());
         m_ws.tlasBound = true;
     }
-    sh::SearchPush sp{d.Q.sorted->address(),
-                      T.sorted->address(),
-                      lv.cells->address(),
-                      d.state->address(),
-                      d.active[d.cur]->address(),
-                      pairs.address(),
-                      d.blk.device,
-                      d.blk.addr(RTHDIST_CTR_MAX_PACKED),
-                      numActive,
-                      uint32_t(pairCapacity),
-                      r,
-                      d.lowerBound2,
-                      rayTMax,
-                      sameLevel ? 1u : 0u,
-                      0u};
+    sh::SearchPush sp{};
+    setRadiusAddresses(sp, d, lv, pairs);
+    sp.numActive = numActive;
+    sp.pairCapacity = uint32_t(pairCapacity);
+    sp.radius = r;
+    sp.lowerBound2 = d.lowerBound2;
+    sp.rayTMax = rayTMax;
+    sp.skipScanned = sameLevel ? 1u : 0u;
+    sp.slotBase = 0u;
     if (m_ws.rayQuery)
         m_ws.dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
     else

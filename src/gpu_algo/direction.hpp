@@ -36,4 +36,18 @@ struct DirectionRun {
     [[nodiscard]] std::string name() const { return Q.name + "->" + T.name; }
 };
 
+// The addresses that the candidate search and the refinement of one radius
+// both push (SearchPush and RefinePush begin with the same fields).
+template <class Push>
+void setRadiusAddresses(Push& p, const DirectionRun& d, const PointIndex::Level& lv, const Buffer& pairs) {
+    p.queries = d.Q.sorted->address();
+    p.targets = d.T.sorted->address();
+    p.cells = lv.cells->address();
+    p.state = d.state->address();
+    p.activeList = d.active[d.cur]->address();
+    p.pairs = pairs.address();
+    p.counters = d.blk.device;
+    p.maxPacked = d.blk.addr(RTHDIST_CTR_MAX_PACKED);
+}
+
 }  // namespace rthdist::gpu_algo

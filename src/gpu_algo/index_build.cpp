@@ -79,8 +79,8 @@ void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const Counte
     ix.cells =
         &m_ws.setBuffer(ix, ix.store->cells, ".cells", VkDeviceSize(ix.cellCapacity) * sizeof(sh::Cell));
 
-    blk.at<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
-    blk.at<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
+    blk.fields().maxCount = 0;
+    blk.fields().largeCells = 0;
     vkCmdFillBuffer(cmd, ix.dense->handle(), 0, denseBytes, 0);
     m_ws.barrier(cmd);
     sh::KeysPush kp{points.address(), keys.address(), ix.dense->address(), gridParams(ix.grid), ix.n};
@@ -114,9 +114,9 @@ void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const Counte
 }
 
 void IndexBuild::finishIndex(PointIndex& ix, const CounterBlock& blk) {
-    ix.numCells = blk.at<uint32_t>(RTHDIST_CTR_CELLS);
+    ix.numCells = blk.fields().cells;
     verifyIndex(ix, ix.cellCapacity, blk);
-    if (blk.at<uint32_t>(RTHDIST_CTR_MAX_COUNT) > kCrowdedCell) splitLeaves(ix);
+    if (blk.fields().maxCount > kCrowdedCell) splitLeaves(ix);
 }
 
 void IndexBuild::buildIndexes(std::span<PointIndex* const> sets, bool ingested) {
@@ -147,8 +147,8 @@ void IndexBuild::cmdCellBuild(VkCommandBuffer cmd, const sh::CellsPush& cp) {
 }
 
 void IndexBuild::cmdCheckIndex(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {
-    blk.at<uint64_t>(RTHDIST_CTR_CHECK_SUM) = 0;
-    blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
+    blk.fields().checkSum = 0;
+    blk.fields().checkBad = 0;
     sh::CheckPush cp{
         ix.sorted->address(), ix.sortedKeys->address(), 0, blk.device, gridParams(ix.grid), ix.n, 0u};
     m_ws.dispatch(cmd, Kernel::kCheckIndex, cp, ix.n);
@@ -157,9 +157,8 @@ void IndexBuild::cmdCheckIndex(VkCommandBuffer cmd, const PointIndex& ix, const 
 void IndexBuild::verifyIndex(const PointIndex& ix, uint64_t cellCapacity, const CounterBlock& blk) {
     const uint64_t n = ix.n;
     const uint64_t expectedSum = n % 2 == 0 ? (n / 2) * (n - 1) : n * ((n - 1) / 2);
-    std::string why =
-        indexCheckFailure(n, blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD), blk.at<uint64_t>(RTHDIST_CTR_CHECK_SUM),
-                          expectedSum, ix.numCells, cellCapacity);
+    std::string why = indexCheckFailure(n, blk.fields().checkBad, blk.fields().checkSum, expectedSum,
+                                        ix.numCells, cellCapacity);
     if (!why.empty()) throw SelfCheckError("index of " + ix.name + ": " + why);
 }
 

@@ -64,7 +64,7 @@ void IndexBuild::cmdUploadSource(VkCommandBuffer cmd, const PointIndex& ix) {
 
 void IndexBuild::cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "ingest");
-    auto& summary = blk.at<sh::IngestSummary>(RTHDIST_CTR_INGEST);
+    auto& summary = blk.ingest();
     for (int k = 0; k < 3; ++k) {
         summary.lo[k] = 0xffffffffu;
         summary.hi[k] = 0u;
@@ -77,7 +77,7 @@ void IndexBuild::cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const Coun
 }
 
 void IndexBuild::finishIngest(PointIndex& ix, const CounterBlock& blk) {
-    const auto& summary = blk.at<sh::IngestSummary>(RTHDIST_CTR_INGEST);
+    const auto& summary = blk.ingest();
     if (summary.firstBad != 0xffffffffu)
         throw InputRejected{Error{ErrorCode::kInvalidArgument, "point set " + ix.name + ": point " +
                                                                    std::to_string(summary.firstBad) +

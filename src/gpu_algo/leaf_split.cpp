@@ -74,7 +74,7 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
                          &m_ws.setBuffer(ix, ix.store->leaves1, ".leaves1", n * sizeof(sh::Cell))};
     Buffer* cells = ix.cells;
     int cur = 0;
-    m_ws.counter<uint32_t>(RTHDIST_CTR_MIN_EDGE) = 0x7f800000u;  // +inf
+    m_ws.counters().minEdge = 0x7f800000u;  // +inf
     for (int round = 0; round < kMaxSplitRounds; ++round) {
         // All slots together: one per kept cell, 8^k <= count per split one.
         const uint64_t numSlots = uint64_t(ix.n) + ix.numCells;
@@ -82,22 +82,22 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
         const LeafRound r{cells,           sorted[cur],       gridKeys[cur],
                           sorted[1 - cur], gridKeys[1 - cur], leaves[round % 2],
                           numSlots};
-        m_ws.counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) = 0;
-        m_ws.counter<uint32_t>(RTHDIST_CTR_LARGE_CELLS) = 0;
+        m_ws.counters().maxCount = 0;
+        m_ws.counters().largeCells = 0;
         VkCommandBuffer cmd = m_ws.ctx.begin();
         cmdSplitRound(cmd, ix, r);
         m_ws.ctx.submitAndWait(cmd);
         m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
         cur = 1 - cur;
         cells = r.cellsOut;
-        ix.numCells = m_ws.counter<uint32_t>(RTHDIST_CTR_CELLS);
-        if (m_ws.counter<uint32_t>(RTHDIST_CTR_MAX_COUNT) <= kLeafMax) break;
+        ix.numCells = m_ws.counters().cells;
+        if (m_ws.counters().maxCount <= kLeafMax) break;
     }
     ix.sorted = sorted[cur];
     ix.sortedKeys = gridKeys[cur];
     ix.cells = cells;
     ix.split = true;
-    const float edge = std::bit_cast<float>(m_ws.counter<uint32_t>(RTHDIST_CTR_MIN_EDGE));
+    const float edge = std::bit_cast<float>(m_ws.counters().minEdge);
     ix.minEdge = std::isfinite(edge) ? double(edge) : 0.0;
     VkCommandBuffer cmd = m_ws.ctx.begin();
     cmdCheckIndex(cmd, ix, m_ws.blocks[0]);

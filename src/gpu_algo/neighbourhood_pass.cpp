@@ -48,7 +48,9 @@ void NeighbourhoodPass::startDirection(DirectionRun& d, size_t direction) {
 
 void NeighbourhoodPass::cmdCull(VkCommandBuffer cmd, DirectionRun& d) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "neighbourhood pass");
-    std::memset(d.blk.host, 0, 32);  // ACTIVE .. PAIRS
+    sh::CounterFields& c = d.blk.fields();
+    c.active = c.maxCount = c.nextActive = c.cells = 0;
+    c.maxPacked = c.pairs = 0;
     sh::CullPush cull{d.Q.sorted->address(),
                       d.T.sorted->address(),
                       d.T.dense->address(),
@@ -80,7 +82,7 @@ std::array<uint32_t, 2> NeighbourhoodPass::runCulls(std::span<DirectionRun* cons
     m_ws.timings->gpuCull += m_ws.ctx.gpuMsBetween(0, culled);
     std::array<uint32_t, 2> survivors{};
     for (size_t k = 0; k < dirs.size(); ++k) {
-        survivors[k] = dirs[k]->blk.at<uint32_t>(RTHDIST_CTR_ACTIVE);
+        survivors[k] = dirs[k]->blk.fields().active;
         dirs[k]->out.counters.survivingQueries = survivors[k];
         dirs[k]->out.counters.culledByNeighbourhood = dirs[k]->Q.n - survivors[k];
     }

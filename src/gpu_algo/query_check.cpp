@@ -13,7 +13,7 @@ namespace rthdist::gpu_algo {
 
 void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, bool afterCull) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "query check");
-    d.blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD) = 0;
+    d.blk.fields().checkBad = 0;
     const VkDeviceSize readback = d.blk.offset + RTHDIST_CTR_READBACK;
     const VkDeviceSize witnessAt = readback + VkDeviceSize(d.checkSlots.size()) * 32;
     sh::CheckPush cp{d.Q.sorted->address(),
@@ -40,7 +40,7 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, boo
 }
 
 SampledQuery QueryCheck::finishCheck(const DirectionRun& d) {
-    const uint64_t packed = d.blk.at<uint64_t>(RTHDIST_CTR_MAX_PACKED);
+    const uint64_t packed = d.blk.fields().maxPacked;
     const char* readback = d.blk.host + RTHDIST_CTR_READBACK;
     std::vector<SampledQuery> sampled(d.checkSlots.size() + 1);
     for (size_t k = 0; k < sampled.size(); ++k) {
@@ -48,7 +48,7 @@ SampledQuery QueryCheck::finishCheck(const DirectionRun& d) {
         std::memcpy(sampled[k].sorted, readback + k * 32, 16);
         std::memcpy(&sampled[k].state, readback + k * 32 + 16, 16);
     }
-    const uint64_t bad = d.blk.at<uint64_t>(RTHDIST_CTR_CHECK_BAD);
+    const uint64_t bad = d.blk.fields().checkBad;
     std::string why = bad != 0 ? std::to_string(bad) + " of " + std::to_string(d.Q.n) +
                                      " queries ended unsettled or above the maximum"
                                : sampledQueryFailure(sampled, d.qPts, d.tPts, packed, d.perPoint != nullptr);
@@ -63,8 +63,7 @@ Directed QueryCheck::finishDirection(DirectionRun& d, const SampledQuery& witnes
     out.queryPoint = d.qPts[out.queryIndex];
     out.targetPoint = d.tPts[out.targetIndex];
     out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
-    std::string why = witnessFailure(out.distance, d.blk.at<uint64_t>(RTHDIST_CTR_MAX_PACKED),
-                                     std::sqrt(d.lowerBound2Exact));
+    std::string why = witnessFailure(out.distance, d.blk.fields().maxPacked, std::sqrt(d.lowerBound2Exact));
     if (!why.empty()) throw SelfCheckError(d.name() + ": " + why);
     if (d.perPoint) readPerPoint(d.Q, *d.state, d.qPts, d.tPts, *d.perPoint);
     return out;

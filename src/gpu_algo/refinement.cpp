@@ -14,20 +14,14 @@ void Refinement::cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointInde
     gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                     VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                     VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
-    sh::RefinePush rp{d.Q.sorted->address(),
-                      d.T.sorted->address(),
-                      lv.cells->address(),
-                      d.state->address(),
-                      d.active[d.cur]->address(),
-                      pairs.address(),
-                      d.blk.device,
-                      d.blk.addr(RTHDIST_CTR_MAX_PACKED),
-                      d.T.cells->address(),
-                      coarse ? lv.fineFirst->address() : 0,
-                      uint32_t(pairCapacity),
-                      d.lowerBound2,
-                      lv.count,
-                      d.T.numCells};
+    sh::RefinePush rp{};
+    setRadiusAddresses(rp, d, lv, pairs);
+    rp.fineCells = d.T.cells->address();
+    rp.fineFirst = coarse ? lv.fineFirst->address() : 0;
+    rp.pairCapacity = uint32_t(pairCapacity);
+    rp.lowerBound2 = d.lowerBound2;
+    rp.numSearchCells = lv.count;
+    rp.numFineCells = d.T.numCells;
     m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kRefine, &rp, sizeof(rp), args.handle(), 0);
     m_ws.barrier(cmd);
     sh::ResolvePush rs{d.state->address(),

@@ -52,7 +52,7 @@ const PointIndex::Level& IndexBuild::searchLevel(PointIndex& T, int level) {
         m_ws.ctx.submitAndWait(cmd);
         m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
         m_ws.timings->index += msSince(t0);
-        lv.count = m_ws.counter<uint32_t>(RTHDIST_CTR_CELLS);
+        lv.count = m_ws.counters().cells;
         T.levels.push_back(lv);
     }
     return T.levels[size_t(level - 1)];

@@ -47,9 +47,11 @@ struct CounterBlock {
     char* host = nullptr;
     VkDeviceAddress device = 0;
     VkDeviceSize offset = 0;  // in the buffer that holds the blocks
-    template <class T>
-    T& at(size_t offset) const {
-        return *reinterpret_cast<T*>(host + offset);
+    // The counters (offsets asserted in rthdist_shared.h) and the ingest
+    // summary, where the host zeroes and reads them.
+    [[nodiscard]] sh::CounterFields& fields() const { return *reinterpret_cast<sh::CounterFields*>(host); }
+    [[nodiscard]] sh::IngestSummary& ingest() const {
+        return *reinterpret_cast<sh::IngestSummary*>(host + RTHDIST_CTR_INGEST);
     }
     [[nodiscard]] VkDeviceAddress addr(size_t offset) const { return device + offset; }
 };
@@ -109,10 +111,7 @@ struct Workspace {
     }
 
     // A counter of block 0 (offsets from rthdist_shared.h): the stages run one at a time.
-    template <class T>
-    T& counter(size_t offset) {
-        return blocks[0].at<T>(offset);
-    }
+    [[nodiscard]] sh::CounterFields& counters() const { return blocks[0].fields(); }
     [[nodiscard]] VkDeviceAddress cellsCounterAddr() const { return blocks[0].addr(RTHDIST_CTR_CELLS); }
     [[nodiscard]] VkDeviceAddress maxCountAddr() const { return blocks[0].addr(RTHDIST_CTR_MAX_COUNT); }
 
