@@ -94,10 +94,7 @@ struct GpuHausdorff::State {
         set.scale = scale;
         if (scale != 1.0) set.scaledCopy = scaledCopy(input, scale, ws.threads);
         set.points = scale != 1.0 ? std::span<const glm::vec3>(set.scaledCopy) : input;
-        set.ix.name = name;
-        set.ix.scratch = &scratch;
-        set.ix.owned = shared == nullptr;
-        set.ix.store = shared != nullptr ? shared : &set.own;
+        set.place(name, scratch, shared);
         index.stageIndex(set.ix, set.points, bits);
         ws.timings->upload += msSince(t0);
     }
@@ -115,9 +112,7 @@ struct GpuHausdorff::State {
         for (size_t k = 0; k < 2; ++k) {
             DeviceSet& set = *sets[k];
             set.input = set.points = inputs[k];
-            set.ix.name = k == 0 ? "A" : "B";
-            set.ix.scratch = &ws.scratch.builds[k];
-            set.ix.store = &ws.oneShot[k];
+            set.place(k == 0 ? "A" : "B", ws.scratch.builds[k], &ws.oneShot[k]);
             index.stageSource(set.ix, inputs[k]);
         }
         VkCommandBuffer cmd = ws.ctx.begin();

@@ -10,6 +10,7 @@
 #include <deque>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/index_space.hpp"
@@ -101,6 +102,17 @@ struct DeviceSet {
 
     SetBuffers own;  // a prepared set's buffers (empty for one-shot sets)
     PointIndex ix;
+
+    // Names the set and says where its build's scratch and its index's
+    // buffers live: the workspace's `shared` ones (a one-shot set) or, with
+    // shared null, its own (owned: a prepared set, exact sizes).
+    void place(std::string name, BuildScratch& scratch, SetBuffers* shared) {
+        ix.name = std::move(name);
+        ix.scratch = &scratch;
+        ix.owned = shared == nullptr;
+        ix.store = shared != nullptr ? shared : &own;
+    }
+
     std::span<const glm::vec3> input;   // the backend's input (float, before the scale)
     std::vector<glm::vec3> scaledCopy;  // input * scale when scale != 1
     std::span<const glm::vec3> points;  // what the device holds: input or scaledCopy
