@@ -5,7 +5,8 @@
 // shared_ptr, so a helper that arrives after the caller has returned only
 // finds that nothing is left (no thread index or no chunk) and never touches
 // the caller's callable. A worker only takes work while idle, never while
-// waiting inside a nested call, so waits form no cycle.
+// waiting inside a nested call, so waits form no cycle. In a fork() child
+// every call runs on its caller alone.
 #include "core/thread_pool.hpp"
 
 #include <pthread.h>
@@ -80,7 +81,7 @@ public:
     bool post(const std::shared_ptr<ChunkJob>& job, size_t helpers) {
         {
             std::lock_guard lock(m_mutex);
-            if (m_stopping) return false;
+            if (m_stopping || m_forkedChild) return false;
             m_queue.push_back({job, helpers});
             m_wanted += helpers;
             m_limit = std::max(m_limit, helpers);
@@ -111,7 +112,7 @@ public:
 
     size_t workerCount() {
         std::lock_guard lock(m_mutex);
-        return m_workers.size();
+        return m_forkedChild ? 0 : m_workers.size();
     }
 
     // At static destruction: stop taking calls and join the workers (a
@@ -121,6 +122,7 @@ public:
         {
             std::lock_guard lock(m_mutex);
             m_stopping = true;
+            if (m_forkedChild) return;  // the handles name the parent's threads
             m_queue.clear();
             m_wanted = 0;
             workers.swap(m_workers);
@@ -139,18 +141,13 @@ public:
     // inherits it locked by a thread that is not there.
     void beforeFork() { m_mutex.lock(); }
     void afterForkInParent() { m_mutex.unlock(); }
-    // In the child only the forking thread exists: the workers' handles name
-    // threads that are gone and can be neither joined nor destroyed, so they
-    // are kept, unused, forever; the condition variable may count their
-    // waits, so it starts afresh. The child starts its own workers.
+    // In the child only the forking thread exists. POSIX allows a child of a
+    // multithreaded process only async-signal-safe calls, so the child
+    // starts no threads and allocates nothing here: its calls run on the
+    // calling thread, and the workers' handles (threads that are gone, which
+    // can be neither joined nor destroyed) stay in the never-freed pool.
     void afterForkInChild() {
-        static auto* const orphans = new std::vector<std::thread>;
-        for (std::thread& w : m_workers) orphans->push_back(std::move(w));
-        m_workers.clear();
-        m_queue.clear();
-        m_busy = 0;
-        m_wanted = 0;
-        std::construct_at(&m_wake);
+        m_forkedChild = true;
         m_mutex.unlock();
     }
 
@@ -191,6 +188,7 @@ private:
     size_t m_wanted = 0;  // helpers the queue still asks for
     size_t m_limit = 0;   // most helpers one call has asked for
     bool m_stopping = false;
+    bool m_forkedChild = false;  // this process is a fork() child: no workers
 };
 
 WorkerPool& pool();

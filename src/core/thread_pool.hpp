@@ -9,8 +9,11 @@
 //   Python extension module); a call made after that, e.g. from another
 //   static's destructor, runs on the calling thread alone.
 // - The pool's memory is never freed, so no late call can touch a dead pool.
-// - After fork() the child forgets the parent's workers (they do not exist
-//   there) and starts its own on demand.
+// - A fork() child has none of the parent's workers and starts none (POSIX
+//   allows a child of a multithreaded process only async-signal-safe calls):
+//   its calls run on the calling thread alone, correct but with one thread.
+//   A fork must not happen from inside a call's run (its helpers would be
+//   gone in the child).
 #pragma once
 
 #include <cstddef>

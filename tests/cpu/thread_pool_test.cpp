@@ -2,7 +2,7 @@
 // core/thread_pool.hpp): every index once, thread indices owned by one
 // thread and below the resolved count, nested calls and many application
 // threads at once completing, the pool reusing its threads and growing only
-// to what calls ask for, and a forked child starting its own workers. Threads
+// to what calls ask for, and a forked child running its calls alone. Threads
 // are told apart by their kernel ids (gettid), which fresh threads do not
 // reuse the way std::thread::id values are. No timings.
 #include <gtest/gtest.h>
@@ -205,12 +205,13 @@ TEST(ThreadPool, GrowsOnlyToWhatACallAsksFor) {
     }
 }
 
-// The child of a fork has none of the parent's workers: its calls must
-// complete with workers of its own and its exit must not wait for the
-// parent's (std::exit runs the static destructors that join the pool).
-TEST(ThreadPool, ForkedChildStartsItsOwnWorkers) {
+// The child of a fork has none of the parent's workers and starts none: its
+// calls complete on the calling thread alone (every index once, one thread
+// id), and its exit does not wait for the parent's workers (std::exit runs
+// the static destructors that join the pool).
+TEST(ThreadPool, ForkedChildRunsCallsOnItsOwnThread) {
 #ifdef RTHDIST_TEST_TSAN
-    GTEST_SKIP() << "ThreadSanitizer does not support threads started after a multithreaded fork";
+    GTEST_SKIP() << "ThreadSanitizer does not support fork() of a multithreaded process";
 #else
     ASSERT_TRUE(coversEveryIndexOnce(10000, 16, 4));
     ASSERT_GT(poolWorkerCount(), 0u);
@@ -219,13 +220,22 @@ TEST(ThreadPool, ForkedChildStartsItsOwnWorkers) {
     ASSERT_GE(child, 0);
     if (child == 0) {
         alarm(120);  // a hang guard, not a timing: a hung child fails the test
-        const bool ok = coversEveryIndexOnce(10000, 16, 4) && coversEveryIndexOnce(10000, 1, 3);
+        ThreadLog log(4);
+        std::atomic<bool> bad{false};
+        parallelChunks(512, 1, 4, [&](size_t, size_t, int w) {
+            if (!log.record(w)) bad = true;
+        });
+        const bool oneThread = log.threads() == 1 && log.owner(0) == gettid();
+        const bool ok = !bad && oneThread && poolWorkerCount() == 0 && coversEveryIndexOnce(10000, 16, 4) &&
+                        coversEveryIndexOnce(10000, 1, 3);
         std::exit(ok ? 0 : 1);
     }
     int status = 0;
     ASSERT_EQ(waitpid(child, &status, 0), child);
     EXPECT_TRUE(WIFEXITED(status)) << "child status " << status;
     EXPECT_EQ(WEXITSTATUS(status), 0);
+    // The parent's pool still serves the parent.
+    EXPECT_TRUE(coversEveryIndexOnce(10000, 16, 4));
 #endif
 }
 
