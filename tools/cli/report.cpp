@@ -186,16 +186,16 @@ std::string devicesText(const std::vector<DeviceInfo>& devices) {
 std::string devicesJson(const std::vector<DeviceInfo>& devices) {
     Json list = Json::array();
     for (const DeviceInfo& d : devices) {
-        Json limits = Json::object();
+        Json& entry = list.emplace_back(Json::object());
+        entry["index"] = d.index;
+        entry["name"] = d.name;
+        entry["type"] = d.type;
+        entry["driver"] = d.driver;
+        entry["ray_query"] = d.rayQuery;
+        entry["rt_pipeline"] = d.rtPipeline;
+        entry["missing"] = d.missing;
+        Json& limits = entry["limits"] = Json::object();
         for (const auto& [name, value] : d.limits) limits[name] = value;
-        list.push_back({{"index", d.index},
-                        {"name", d.name},
-                        {"type", d.type},
-                        {"driver", d.driver},
-                        {"ray_query", d.rayQuery},
-                        {"rt_pipeline", d.rtPipeline},
-                        {"missing", d.missing},
-                        {"limits", std::move(limits)}});
     }
     return jsonText(Json{{"devices", std::move(list)}}) + "\n";
 }
