@@ -1,0 +1,151 @@
+// lattice-check: a large run whose answer is known without a nearest-neighbour
+// search, so that sizes no brute force reaches (issue 14: 200 M points on the
+// CPU backend) are checked against an independent answer, not against the
+// library itself.
+//
+//   lattice-check N [--backend cpu|ray-query|rt-pipeline] [--threads T]
+//
+// A is the integer lattice {0..N-1}^3 (N^3 points), B the same lattice moved
+// by (1/2, 1/2, 1/2) plus one outlier o far outside both. Every coordinate is
+// a float32 value (N <= 2^23), so the sets are exact as given.
+// - h(A, B): every lattice point of A has its nearest points of B at the
+//   corners of the unit cube around it that lie in B's lattice; the nearest
+//   is at distance sqrt(3)/2 for every point of A (B's lattice spans
+//   [1/2, N - 1/2] on each axis, so each point of A has at least one such
+//   corner), and o is farther than that from all of A.
+// - h(B, A): the lattice points of B are at sqrt(3)/2 from A too; o's nearest
+//   point of A is, per axis, o's coordinate rounded to the nearest integer
+//   and clamped to [0, N - 1] (o is chosen with no coordinate at a half), so
+//   h(B, A) = |o - that point| > sqrt(3)/2, witnessed by o (the last point of
+//   B) and that point of A.
+// The check: H, both directed distances, the h(B, A) witness pair, and that
+// the h(A, B) witness is a point of A with a point of B at sqrt(3)/2 from it.
+// Prints one JSON object (sizes, times, peak memory, each check) and exits 0
+// when every check holds, 1 when one fails, 2 on a usage error, 3 when the
+// library refuses or fails the call.
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rthdist/rthdist.hpp"
+
+using namespace rthdist;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+double peakRssGiB() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_maxrss) / (1024.0 * 1024.0);  // ru_maxrss is in KiB
+}
+
+// The lattice {0..n-1}^3 moved by `shift`, x fastest; point (x, y, z) has index
+// x + n * (y + n * z).
+std::vector<glm::vec3> lattice(size_t n, float shift) {
+    std::vector<glm::vec3> points(n * n * n);
+    size_t i = 0;
+    for (size_t z = 0; z < n; ++z)
+        for (size_t y = 0; y < n; ++y)
+            for (size_t x = 0; x < n; ++x) points[i++] = glm::vec3(float(x), float(y), float(z)) + shift;
+    return points;
+}
+
+// The nearest point of the lattice {0..n-1}^3 to p (no coordinate of p at a half).
+glm::dvec3 nearestLatticePoint(const glm::dvec3& p, size_t n) {
+    const double top = double(n - 1);
+    return glm::clamp(glm::round(p), glm::dvec3(0.0), glm::dvec3(top));
+}
+
+struct Check {
+    const char* name;
+    bool ok;
+};
+
+int usage() {
+    std::fprintf(stderr, "usage: lattice-check N [--backend cpu|ray-query|rt-pipeline] [--threads T]\n");
+    return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) return usage();
+    const long long side = std::atoll(argv[1]);
+    if (side < 2 || side > 4096) return usage();
+    Options options;
+    options.backend = Backend::kCpu;
+    for (int i = 2; i + 1 < argc; i += 2) {
+        const std::string flag = argv[i];
+        if (flag == "--backend" && parseBackend(argv[i + 1], options.backend)) continue;
+        if (flag == "--threads") {
+            options.threads = std::atoi(argv[i + 1]);
+            continue;
+        }
+        return usage();
+    }
+    if (argc % 2 != 0) return usage();
+    const size_t n = size_t(side);
+
+    auto start = Clock::now();
+    const std::vector<glm::vec3> a = lattice(n, 0.0f);
+    std::vector<glm::vec3> b = lattice(n, 0.5f);
+    const glm::vec3 outlier(float(n) + 100.25f, -40.375f, float(n / 3) + 0.125f);
+    b.push_back(outlier);
+    const double generateS = secondsSince(start);
+
+    start = Clock::now();
+    const Result<HausdorffResult> r = hausdorff(a, b, options);
+    const double computeS = secondsSince(start);
+    if (!r) {
+        std::fprintf(stderr, "lattice-check: %s\n", r.error().message.c_str());
+        return 3;
+    }
+
+    const double half = std::sqrt(0.75);
+    const glm::dvec3 o(outlier);
+    const glm::dvec3 oNearest = nearestLatticePoint(o, n);
+    const double hBA = glm::length(o - oNearest);
+    const uint64_t oNearestIndex =
+        uint64_t(oNearest.x) + n * (uint64_t(oNearest.y) + n * uint64_t(oNearest.z));
+    const Directed& ab = r->aToB;
+    const Directed& ba = r->bToA;
+    const glm::dvec3 abQuery(a[ab.queryIndex]);
+    const glm::dvec3 abTarget(b[ab.targetIndex]);
+    const Check checks[] = {
+        {"H", r->hausdorff == hBA},
+        {"h(A,B) = sqrt(3)/2", ab.distance == half},
+        {"h(B,A) = |o - nearest lattice point|", ba.distance == hBA},
+        {"h(B,A) witness is o", ba.queryIndex == b.size() - 1},
+        {"h(B,A) witness target is o's nearest", ba.targetIndex == oNearestIndex},
+        {"h(A,B) witness pair at sqrt(3)/2", glm::length(abQuery - abTarget) == half},
+    };
+    bool all = true;
+    std::printf("{\n  \"side\": %zu,\n  \"points_a\": %zu,\n  \"points_b\": %zu,\n", n, a.size(), b.size());
+    std::printf("  \"backend\": \"%s\",\n  \"device\": \"%s\",\n", backendName(r->backend),
+                r->device.c_str());
+    std::printf("  \"generate_s\": %.3f,\n  \"compute_s\": %.3f,\n", generateS, computeS);
+    std::printf("  \"index_ms\": %.1f,\n  \"search_ms\": %.1f,\n  \"total_ms\": %.1f,\n", r->timings.index,
+                r->timings.search, r->timings.total);
+    std::printf("  \"peak_rss_gib\": %.2f,\n  \"hausdorff\": %.17g,\n  \"expected\": %.17g,\n", peakRssGiB(),
+                r->hausdorff, hBA);
+    std::printf("  \"checks\": {");
+    for (size_t i = 0; i < std::size(checks); ++i) {
+        std::printf("%s\n    \"%s\": %s", i ? "," : "", checks[i].name, checks[i].ok ? "true" : "false");
+        all = all && checks[i].ok;
+    }
+    std::printf("\n  },\n  \"exact\": %s\n}\n", all ? "true" : "false");
+    return all ? 0 : 1;
+}
