@@ -84,15 +84,12 @@ inline std::ostream& operator<<(std::ostream& os, const CliRun& r) {
     return os << "exit " << r.exitCode << "\n--- stdout ---\n" << r.out << "--- stderr ---\n" << r.err;
 }
 
-// `shellPrefix` runs in the same /bin/sh before the CLI (e.g. "ulimit -f 8;");
-// `wrapper` is a command that runs the CLI (e.g. "timeout -s TERM 2").
-inline CliRun runCli(const std::vector<std::string>& args, const std::string& shellPrefix = "",
-                     const std::string& wrapper = "") {
+// Runs a /bin/sh command line with stdin closed; its stdout, stderr and exit
+// code (128 + the signal when a signal ended it).
+inline CliRun runShell(std::string command) {
     static int counter = 0;
     static const TempDir errDir;
     const std::string errPath = (errDir.path() / ("stderr-" + std::to_string(counter++))).string();
-    std::string command = shellPrefix + " exec " + wrapper + " " + shellQuote(kCli);
-    for (const std::string& a : args) command += " " + shellQuote(a);
     command += " 2>" + shellQuote(errPath) + " </dev/null";
 
     CliRun run;
@@ -105,6 +102,20 @@ inline CliRun runCli(const std::vector<std::string>& args, const std::string& sh
     run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     run.err = readFile(errPath);
     return run;
+}
+
+// The words, each quoted for /bin/sh, each after a space.
+inline std::string quotedWords(const std::vector<std::string>& words) {
+    std::string out;
+    for (const std::string& w : words) out += " " + shellQuote(w);
+    return out;
+}
+
+// `shellPrefix` runs in the same /bin/sh before the CLI (e.g. "ulimit -f 8;");
+// `wrapper` is a command that runs the CLI (e.g. "timeout -s TERM 2").
+inline CliRun runCli(const std::vector<std::string>& args, const std::string& shellPrefix = "",
+                     const std::string& wrapper = "") {
+    return runShell(shellPrefix + " exec " + wrapper + " " + shellQuote(kCli) + quotedWords(args));
 }
 
 // Parses stdout as one JSON document; a test failure (and null) when it is not.

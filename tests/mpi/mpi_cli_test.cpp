@@ -14,24 +14,7 @@ const std::string kMpiCli = RTHDIST_MPI_CLI_PATH;
 const std::string kMpirun = RTHDIST_MPIEXEC;
 
 // Runs argv[0] with the rest as arguments; stdout and stderr captured.
-CliRun runArgv(const std::vector<std::string>& argv) {
-    static int counter = 0;
-    static const TempDir errDir;
-    const std::string errPath = (errDir.path() / ("stderr-" + std::to_string(counter++))).string();
-    std::string command = "exec";
-    for (const std::string& a : argv) command += " " + shellQuote(a);
-    command += " 2>" + shellQuote(errPath) + " </dev/null";
-    CliRun run;
-    FILE* pipe = popen(command.c_str(), "r");
-    if (pipe == nullptr) throw std::runtime_error("popen failed");
-    char buf[4096];
-    size_t n = 0;
-    while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) run.out.append(buf, n);
-    const int status = pclose(pipe);
-    run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    run.err = readFile(errPath);
-    return run;
-}
+CliRun runArgv(const std::vector<std::string>& argv) { return runShell("exec" + quotedWords(argv)); }
 
 CliRun runMpi(int np, const std::vector<std::string>& args) {
     std::vector<std::string> argv = {kMpirun, "--allow-run-as-root", "--oversubscribe",
