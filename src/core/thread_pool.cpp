@@ -115,6 +115,11 @@ public:
         return m_forkedChild ? 0 : m_workers.size();
     }
 
+    size_t idleWorkerCount() {
+        std::lock_guard lock(m_mutex);
+        return m_forkedChild ? 0 : m_idle;
+    }
+
     // At static destruction: stop taking calls and join the workers (a
     // worker finishes the chunk it runs; the callers finish the rest).
     void shutdown() {
@@ -165,7 +170,9 @@ private:
     void workerLoop() {
         std::unique_lock lock(m_mutex);
         for (;;) {
+            ++m_idle;
             m_wake.wait(lock, [this] { return m_stopping || !m_queue.empty(); });
+            --m_idle;
             if (m_stopping) return;
             Posting& front = m_queue.front();
             std::shared_ptr<ChunkJob> job = front.job;
@@ -185,6 +192,7 @@ private:
     std::deque<Posting> m_queue;  // calls still asking for helpers
     std::vector<std::thread> m_workers;
     size_t m_busy = 0;    // workers inside a call
+    size_t m_idle = 0;    // workers waiting for work
     size_t m_wanted = 0;  // helpers the queue still asks for
     size_t m_limit = 0;   // most helpers one call has asked for
     bool m_stopping = false;
@@ -226,5 +234,7 @@ void runOnPool(const ChunkTask& task) noexcept {
 }
 
 size_t poolWorkerCount() noexcept { return pool().workerCount(); }
+
+size_t poolIdleWorkerCount() noexcept { return pool().idleWorkerCount(); }
 
 }  // namespace rthdist::core

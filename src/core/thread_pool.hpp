@@ -42,5 +42,10 @@ void runOnPool(const ChunkTask& task) noexcept;
 
 // Pool workers alive now (diagnostics and tests).
 [[nodiscard]] size_t poolWorkerCount() noexcept;
+// Pool workers waiting for work now. A process about to fork() can wait until
+// this equals poolWorkerCount(): then no worker is starting up or freeing
+// memory, which matters under an allocator without fork handlers (GCC 12's
+// AddressSanitizer: a child forked while a worker starts hangs in it).
+[[nodiscard]] size_t poolIdleWorkerCount() noexcept;
 
 }  // namespace rthdist::core
