@@ -3,7 +3,7 @@
 // CPU backend) are checked against an independent answer, not against the
 // library itself.
 //
-//   lattice-check N [--backend cpu|ray-query|rt-pipeline] [--threads T]
+//   lattice-check N [--backend cpu|ray-query|rt-pipeline] [--threads T]   (N in 2..4096)
 //
 // A is the integer lattice {0..N-1}^3 (N^3 points), B the same lattice moved
 // by (1/2, 1/2, 1/2) plus one outlier o far outside both. Every coordinate is
@@ -28,11 +28,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
+#include <iostream>
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include "rthdist/rthdist.hpp"
 
@@ -41,6 +43,7 @@ using namespace rthdist;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using Json = nlohmann::ordered_json;
 
 double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -69,35 +72,25 @@ glm::dvec3 nearestLatticePoint(const glm::dvec3& p, size_t n) {
     return glm::clamp(glm::round(p), glm::dvec3(0.0), glm::dvec3(top));
 }
 
-struct Check {
-    const char* name;
-    bool ok;
-};
-
-int usage() {
-    std::fprintf(stderr, "usage: lattice-check N [--backend cpu|ray-query|rt-pipeline] [--threads T]\n");
-    return 2;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc < 2) return usage();
-    const long long side = std::atoll(argv[1]);
-    if (side < 2 || side > 4096) return usage();
+    CLI::App app{"lattice-check: a large run checked against an answer known without a search"};
+    size_t n = 0;
+    std::string backend = "cpu";
     Options options;
-    options.backend = Backend::kCpu;
-    for (int i = 2; i + 1 < argc; i += 2) {
-        const std::string flag = argv[i];
-        if (flag == "--backend" && parseBackend(argv[i + 1], options.backend)) continue;
-        if (flag == "--threads") {
-            options.threads = std::atoi(argv[i + 1]);
-            continue;
-        }
-        return usage();
+    app.add_option("N", n, "lattice side: N^3 points per set")->required()->check(CLI::Range(2, 4096));
+    app.add_option("--backend", backend, "cpu, ray-query or rt-pipeline");
+    app.add_option("--threads", options.threads, "host threads, 0 = all")->check(CLI::NonNegativeNumber);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e) == 0 ? 0 : 2;  // --help: 0; anything else: a usage error
     }
-    if (argc % 2 != 0) return usage();
-    const size_t n = size_t(side);
+    if (!parseBackend(backend, options.backend)) {
+        std::fprintf(stderr, "lattice-check: unknown backend %s\n", backend.c_str());
+        return 2;
+    }
 
     auto start = Clock::now();
     const std::vector<glm::vec3> a = lattice(n, 0.0f);
@@ -124,28 +117,32 @@ int main(int argc, char** argv) {
     const Directed& ba = r->bToA;
     const glm::dvec3 abQuery(a[ab.queryIndex]);
     const glm::dvec3 abTarget(b[ab.targetIndex]);
-    const Check checks[] = {
-        {"H", r->hausdorff == hBA},
-        {"h(A,B) = sqrt(3)/2", ab.distance == half},
-        {"h(B,A) = |o - nearest lattice point|", ba.distance == hBA},
-        {"h(B,A) witness is o", ba.queryIndex == b.size() - 1},
-        {"h(B,A) witness target is o's nearest", ba.targetIndex == oNearestIndex},
-        {"h(A,B) witness pair at sqrt(3)/2", glm::length(abQuery - abTarget) == half},
-    };
-    bool all = true;
-    std::printf("{\n  \"side\": %zu,\n  \"points_a\": %zu,\n  \"points_b\": %zu,\n", n, a.size(), b.size());
-    std::printf("  \"backend\": \"%s\",\n  \"device\": \"%s\",\n", backendName(r->backend),
-                r->device.c_str());
-    std::printf("  \"generate_s\": %.3f,\n  \"compute_s\": %.3f,\n", generateS, computeS);
-    std::printf("  \"index_ms\": %.1f,\n  \"search_ms\": %.1f,\n  \"total_ms\": %.1f,\n", r->timings.index,
-                r->timings.search, r->timings.total);
-    std::printf("  \"peak_rss_gib\": %.2f,\n  \"hausdorff\": %.17g,\n  \"expected\": %.17g,\n", peakRssGiB(),
-                r->hausdorff, hBA);
-    std::printf("  \"checks\": {");
-    for (size_t i = 0; i < std::size(checks); ++i) {
-        std::printf("%s\n    \"%s\": %s", i ? "," : "", checks[i].name, checks[i].ok ? "true" : "false");
-        all = all && checks[i].ok;
-    }
-    std::printf("\n  },\n  \"exact\": %s\n}\n", all ? "true" : "false");
-    return all ? 0 : 1;
+    Json checks = Json::object();
+    checks["H"] = r->hausdorff == hBA;
+    checks["h(A,B) = sqrt(3)/2"] = ab.distance == half;
+    checks["h(B,A) = |o - nearest lattice point|"] = ba.distance == hBA;
+    checks["h(B,A) witness is o"] = ba.queryIndex == b.size() - 1;
+    checks["h(B,A) witness target is o's nearest"] = ba.targetIndex == oNearestIndex;
+    checks["h(A,B) witness pair at sqrt(3)/2"] = glm::length(abQuery - abTarget) == half;
+    bool exact = true;
+    for (const auto& [name, ok] : checks.items()) exact = exact && ok.get<bool>();
+
+    Json out = Json::object();
+    out["side"] = n;
+    out["points_a"] = a.size();
+    out["points_b"] = b.size();
+    out["backend"] = backendName(r->backend);
+    out["device"] = r->device;
+    out["generate_s"] = generateS;
+    out["compute_s"] = computeS;
+    out["index_ms"] = r->timings.index;
+    out["search_ms"] = r->timings.search;
+    out["total_ms"] = r->timings.total;
+    out["peak_rss_gib"] = peakRssGiB();
+    out["hausdorff"] = r->hausdorff;
+    out["expected"] = hBA;
+    out["checks"] = std::move(checks);
+    out["exact"] = exact;
+    std::cout << out.dump(2) << "\n";
+    return exact ? 0 : 1;
 }
