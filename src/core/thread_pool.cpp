@@ -77,7 +77,8 @@ struct Posting {
 
 class WorkerPool {
 public:
-    // False once the pool has shut down: the caller then works alone.
+    // False once the pool has shut down, and in a fork() child: the caller
+    // then works alone.
     bool post(const std::shared_ptr<ChunkJob>& job, size_t helpers) {
         {
             std::lock_guard lock(m_mutex);
