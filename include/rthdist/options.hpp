@@ -8,6 +8,7 @@
 #include <glm/vec3.hpp>
 
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -48,6 +49,17 @@ struct EngineOptions {
     // $HOME/.cache/rthdist; "off": no file. A missing, foreign or damaged
     // file only means compiling again (Engine::pipelineCacheStatus).
     std::string pipelineCacheDir;
+    // Out-of-core: the memory one backend call may hold, in bytes. A pair of
+    // sets larger than that is computed exactly as a sequence of calls over
+    // query chunks and target tiles (README, "Inputs larger than the
+    // device"; Counters::queryChunks/targetTiles). 0 = automatic: on the GPU
+    // backends three quarters of the device-local heap's budget
+    // (VK_EXT_memory_budget where the device has it, else the heap's size),
+    // with no set piece past maxMemoryAllocationSize / 32 points; on the CPU
+    // backend no limit. Set it to leave device memory to other work, or to
+    // force the split (tests use a few MB). Prepared sets are not split: a
+    // set that does not fit is refused by prepare() (kOutOfMemory).
+    uint64_t memoryBudget = 0;
 };
 
 // Settings of one compute call: changing one never rebuilds a device,

@@ -78,6 +78,10 @@ struct Counters {
     uint32_t iterations = 0;             // candidate-search radius iterations
     uint64_t rays = 0;                   // rays cast over all iterations
     uint64_t candidatePairs = 0;         // (query, cell) pairs refined
+    // Out-of-core (EngineOptions::memoryBudget): the calls this direction
+    // took, queryChunks x targetTiles; 1 x 1 when it fit one call.
+    uint32_t queryChunks = 1;
+    uint32_t targetTiles = 1;
 };
 
 // One directed distance h(Q,T) with its witness.

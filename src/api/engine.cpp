@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <string>
 
+#include "api/out_of_core.hpp"
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
 #include "cpu/cpu_hausdorff.hpp"
@@ -196,20 +198,73 @@ void finishResult(Engine::Impl& impl, HausdorffResult& r, std::chrono::steady_cl
     if (impl.device->context) r.validationMessages = impl.device->context->validationMessageCount();
 }
 
+// What one backend call may hold (out_of_core.hpp): the caller's
+// EngineOptions::memoryBudget, else on a GPU three quarters of the device's
+// budget; set pieces up to the largest allocation the device promises.
+api::MemoryBudget memoryBudget(const Engine::Impl& impl) {
+    api::MemoryBudget budget;
+    if (impl.options.memoryBudget > 0) {
+        budget.bytes = impl.options.memoryBudget;
+        budget.source = "EngineOptions::memoryBudget";
+    }
+    if (!impl.device->context) return budget;
+    const gpu::DeviceLimits& limits = impl.device->context->limits();
+    if (impl.options.memoryBudget == 0) {
+        budget.bytes = limits.deviceBudgetBytes / 4 * 3;
+        budget.source = "3/4 of the device's memory budget";
+    }
+    budget.maxPiecePoints =
+        std::min({limits.maxAllocationBytes / api::kLargestBufferBytesPerPoint,
+                  limits.maxBufferBytes / api::kLargestBufferBytesPerPoint, limits.maxPrimitives});
+    return budget;
+}
+
+// One call of the Engine's backend on float sets of one frame and scale.
+Result<HausdorffResult> runBackend(Engine::Impl& impl, std::span<const glm::vec3> a,
+                                   std::span<const glm::vec3> b, double scale, const CallOptions& call) {
+    if (impl.device->gpu) return impl.device->gpu->compute(a, b, scale, call);
+    Options options;
+    static_cast<CallOptions&>(options) = call;
+    static_cast<EngineOptions&>(options) = impl.options;
+    return cpu::cpuHausdorff(a, b, options);
+}
+
+// The pair in one backend call when it fits the memory budget, else (or when
+// the device runs out of memory under the automatic budget) in pieces.
+Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm::vec3> a,
+                                        std::span<const glm::vec3> b, double scale, const CallOptions& call) {
+    const api::MemoryBudget budget = memoryBudget(impl);
+    if (api::fitsOneCall(budget, a.size(), b.size())) {
+        Result<HausdorffResult> r = runBackend(impl, a, b, scale, call);
+        const bool automatic = impl.options.memoryBudget == 0 && impl.device->gpu;
+        if (r || r.error().code != ErrorCode::kOutOfMemory || !automatic) return r;
+    }
+    const std::function<void()> release = [&impl] {
+        if (impl.device->gpu) impl.device->gpu->releaseScratch();
+    };
+    release();
+    Result<HausdorffResult> r = api::computeInPieces(
+        a, b, scale, call, budget,
+        [&](std::span<const glm::vec3> q, std::span<const glm::vec3> t, const CallOptions& piece) {
+            return runBackend(impl, q, t, scale, piece);
+        },
+        release);
+    release();  // the pieces' scratch is no use to the next call
+    if (!r) return r;
+    r->backend = impl.backend;
+    r->device = impl.deviceName;
+    return r;
+}
+
 Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, const PointView& b,
                                      const CheckedInputs& checked, const CallOptions& call,
                                      std::chrono::steady_clock::time_point t0) {
     if (auto err = validateCallOptions(call)) return *err;
     const glm::dvec3 origin = core::searchOrigin(checked.a, checked.b);
     const core::FloatSet fa(a, origin, impl.options.threads), fb(b, origin, impl.options.threads);
-    Options options;
-    static_cast<CallOptions&>(options) = call;
-    static_cast<EngineOptions&>(options) = impl.options;
     const double scale = core::exactScale(
         std::max(core::searchMagnitude(checked.a, origin), core::searchMagnitude(checked.b, origin)));
-    Result<HausdorffResult> r = impl.device->gpu
-                                    ? impl.device->gpu->compute(fa.span(), fb.span(), scale, call)
-                                    : cpu::cpuHausdorff(fa.span(), fb.span(), options);
+    Result<HausdorffResult> r = runWithinBudget(impl, fa.span(), fb.span(), scale, call);
     if (!r) return r;
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
     if (copied) core::restoreOriginal(*r, a, b, impl.options.threads);
@@ -256,7 +311,8 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
 Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOptions& call) {
     const auto t0 = std::chrono::steady_clock::now();
     if (m_impl->device->gpu && a.packedFloat() && b.packedFloat() &&
-        gpu_algo::GpuHausdorff::ingests(a.count, b.count))
+        gpu_algo::GpuHausdorff::ingests(a.count, b.count) &&
+        api::fitsOneCall(memoryBudget(*m_impl), a.count, b.count))
         return computeIngested(*m_impl, a, b, call, t0);
     Result<CheckedInputs> checked = checkInputs(a, b, m_impl->options.threads);
     if (!checked) return checked.error();

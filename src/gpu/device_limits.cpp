@@ -9,16 +9,26 @@ namespace rthdist::gpu {
 namespace {
 
 void readHeaps(VkPhysicalDevice pd, DeviceLimits& out) {
-    VkPhysicalDeviceMemoryProperties mem;
-    vkGetPhysicalDeviceMemoryProperties(pd, &mem);
-    uint64_t device = 0, host = 0;
-    for (uint32_t h = 0; h < mem.memoryHeapCount; ++h)
-        if (mem.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
-            device = std::max<uint64_t>(device, mem.memoryHeaps[h].size);
+    VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT};
+    const bool hasBudget = deviceHasExtension(pd, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    VkPhysicalDeviceMemoryProperties2 mem2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2,
+                                           hasBudget ? &budget : nullptr};
+    vkGetPhysicalDeviceMemoryProperties2(pd, &mem2);
+    const VkPhysicalDeviceMemoryProperties& mem = mem2.memoryProperties;
+    uint64_t device = 0, host = 0, deviceBudget = 0;
+    for (uint32_t h = 0; h < mem.memoryHeapCount; ++h) {
+        if (!(mem.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) || mem.memoryHeaps[h].size < device)
+            continue;
+        device = mem.memoryHeaps[h].size;
+        deviceBudget =
+            hasBudget && budget.heapBudget[h] > 0 ? std::min(budget.heapBudget[h], device) : device;
+    }
     for (uint32_t t = 0; t < mem.memoryTypeCount; ++t)
         if (mem.memoryTypes[t].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)
             host = std::max<uint64_t>(host, mem.memoryHeaps[mem.memoryTypes[t].heapIndex].size);
     if (device > 0) out.deviceHeapBytes = device;
+    if (deviceBudget > 0) out.deviceBudgetBytes = deviceBudget;
     if (host > 0) out.hostHeapBytes = host;
 }
 

@@ -24,8 +24,11 @@ struct DeviceLimits {
     // names this limit.
     uint64_t maxAllocationBytes = UINT64_MAX;
     uint64_t deviceHeapBytes = UINT64_MAX;  // the largest DEVICE_LOCAL heap
-    uint64_t hostHeapBytes = UINT64_MAX;    // the largest heap with a HOST_VISIBLE type (staging)
-    uint32_t maxGroupsX = 65535;            // maxComputeWorkGroupCount[0]: dispatches are split
+    // VK_EXT_memory_budget's heapBudget of that heap when the device has the
+    // extension (what this process may use now), else deviceHeapBytes.
+    uint64_t deviceBudgetBytes = UINT64_MAX;
+    uint64_t hostHeapBytes = UINT64_MAX;  // the largest heap with a HOST_VISIBLE type (staging)
+    uint32_t maxGroupsX = 65535;          // maxComputeWorkGroupCount[0]: dispatches are split
     // Ray-tracing pipeline: invocations of one vkCmdTraceRaysKHR
     // (maxRayDispatchInvocationCount, and the width limit
     // maxComputeWorkGroupCount[0] * maxComputeWorkGroupSize[0]): traces are split.

@@ -243,6 +243,14 @@ void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
     m_state->ws.maxPairCapacity = std::max<uint64_t>(1, pairs);
 }
 
+void GpuHausdorff::releaseScratch() {
+    Workspace& ws = m_state->ws;
+    ws.accel.release();
+    ws.tlasBound = false;
+    ws.scratch = Scratch{};
+    ws.oneShot = {};
+}
+
 Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, const std::string& cacheDir,
                                                            int threads) {
     try {

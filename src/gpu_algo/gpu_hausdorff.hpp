@@ -83,6 +83,10 @@ public:
     // Caps the candidate-pair buffer (default 2^26 pairs); tests shrink it
     // so that queries must retry until their pairs fit.
     void setMaxPairCapacity(uint64_t pairs);
+    // Frees the scratch buffers and acceleration structures kept between
+    // one-shot calls (the next call allocates them again). Out-of-core calls
+    // free one direction's before the other's. Prepared sets keep theirs.
+    void releaseScratch();
 
     struct State;
 

@@ -90,6 +90,8 @@ TEST_F(CliUsage, OutOfRangeValuesNameTheRange) {
         {{"--range", "-1", "2"}, "0 <= MIN < MAX"},
         {{"--range", "0", "1e999"}, "0 <= MIN < MAX"},
         {{"--range", "1", "1"}, "0 <= MIN < MAX"},
+        {{"--memory-budget", "-1"}, "[0, 2^30]"},
+        {{"--memory-budget", "1073741825"}, "[0, 2^30]"},
     };
     for (const Case& c : cases) {
         std::vector<std::string> args = c.args;
@@ -122,6 +124,8 @@ TEST_F(CliUsage, RangeEndsAreAccepted) {
         {"--percentile", "0"},
         {"--percentile", "100"},
         {"--range", "0", "1e300"},
+        {"--memory-budget", "0"},
+        {"--memory-budget", "1073741824"},
     };
     for (const auto& c : cases) {
         std::vector<std::string> args = {"--backend", "cpu"};
@@ -298,7 +302,7 @@ void expectRunShape(const Json& j) {
         EXPECT_GE(j["timings_ms"][k].get<double>(), 0.0) << k;
     }
     for (const char* k : {"bits", "occupied_cells", "queries", "culled_by_neighbourhood", "surviving_queries",
-                          "iterations", "rays", "candidate_pairs"}) {
+                          "iterations", "rays", "candidate_pairs", "query_chunks", "target_tiles"}) {
         EXPECT_TRUE(j["counters"]["a_to_b"].contains(k)) << "missing counters.a_to_b." << k;
     }
     EXPECT_EQ(j["counters"]["a_to_b"]["queries"].get<uint64_t>(), na);
@@ -373,6 +377,28 @@ TEST(CliCpu, ThreadCountDoesNotChangeTheResult) {
     ASSERT_EQ(one.exitCode, 0) << one;
     ASSERT_EQ(all.exitCode, 0) << all;
     EXPECT_EQ(parseJson(one)["hausdorff"], parseJson(all)["hausdorff"]);
+}
+
+// --memory-budget 1 (MiB: 8192 points per call) splits the sample into query
+// chunks and target tiles; the JSON says so and H and both witnesses are
+// those of the unsplit run.
+TEST(CliCpu, MemoryBudgetSplitsWithTheSameResult) {
+    const CliRun whole = runCli({"--backend", "cpu", "--json", kSampleA, kSampleB});
+    const CliRun split = runCli({"--backend", "cpu", "--json", "--memory-budget", "1", kSampleA, kSampleB});
+    ASSERT_EQ(whole.exitCode, 0) << whole;
+    ASSERT_EQ(split.exitCode, 0) << split;
+    const Json w = parseJson(whole), s = parseJson(split);
+    expectRunShape(s);
+    EXPECT_EQ(s["hausdorff"], w["hausdorff"]);
+    EXPECT_EQ(s["a_to_b"], w["a_to_b"]);
+    EXPECT_EQ(s["b_to_a"], w["b_to_a"]);
+    for (const char* d : {"a_to_b", "b_to_a"}) {
+        EXPECT_EQ(w["counters"][d]["query_chunks"].get<int>() * w["counters"][d]["target_tiles"].get<int>(),
+                  1);
+        EXPECT_GT(s["counters"][d]["query_chunks"].get<int>() * s["counters"][d]["target_tiles"].get<int>(),
+                  1);
+        EXPECT_EQ(s["counters"][d]["queries"], w["counters"][d]["queries"]);
+    }
 }
 
 TEST(CliCpu, DoubleDashEndsOptions) {

@@ -35,6 +35,8 @@ constexpr double kMaxRadiusGrowth = 16.0;
 constexpr int kMaxBitsOption = 8;
 constexpr int kMaxDeviceIndex = 1023;
 constexpr int kMaxThreads = 1024;
+// --memory-budget in MiB: up to 2^30 MiB (1 PiB) fits EngineOptions::memoryBudget.
+constexpr int kMaxMemoryBudgetMib = 1 << 30;
 constexpr int kMaxHistogramBins = 10000;
 // LAS classification values are one byte (formats 0-5 use 0..31 of them).
 constexpr int kMaxLasClass = 255;
@@ -104,6 +106,9 @@ Options:
   --bits K            index-space bit count 0..8, 0 = choose from the data (default 0)
   --radius-growth F   candidate-search radius factor per iteration, 1.1..16 (default 2)
   --threads N         CPU backend threads 0..1024, 0 = all hardware threads (default 0)
+  --memory-budget MIB memory one backend call may hold, in MiB, 0..2^30; larger
+                      inputs are computed exactly in query chunks and target
+                      tiles (default 0: 3/4 of the device's budget; cpu: none)
   --verify            also run the CPU backend and compare (exit 1 on mismatch)
   --validation        enable the Vulkan validation layer, count its messages
   --list-devices      list Vulkan devices, the paths each supports, and why not
@@ -198,6 +203,11 @@ void addComputeOptions(CommandLine& line, CliArgs& out) {
            out.options.deviceIndex);
     addInt(line, "--threads", 0, kMaxThreads, "an integer in " + rangeText(0, kMaxThreads) + " (0 = all)",
            out.options.threads);
+    addValue(line, "--memory-budget", [&out](const std::string& v) {
+        const auto mib = parseInt(v, 0, kMaxMemoryBudgetMib);
+        if (!mib) outOfRange("--memory-budget", v, "an integer number of MiB in [0, 2^30]");
+        out.options.memoryBudget = uint64_t(*mib) << 20;
+    });
     addValue(line, "--radius-growth", [&out](const std::string& v) {
         const auto f = parseNumber(v);
         if (!f || !(*f >= kMinRadiusGrowth && *f <= kMaxRadiusGrowth))

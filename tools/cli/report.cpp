@@ -51,7 +51,9 @@ Json countersJson(const Counters& c) {
             {"surviving_queries", c.survivingQueries},
             {"iterations", c.iterations},
             {"rays", c.rays},
-            {"candidate_pairs", c.candidatePairs}};
+            {"candidate_pairs", c.candidatePairs},
+            {"query_chunks", c.queryChunks},
+            {"target_tiles", c.targetTiles}};
 }
 
 // One direction; `q`/`t` name the query and target sets ("a"/"b").
@@ -78,6 +80,8 @@ std::string countersText(const Counters& c) {
             (unsigned long long)c.queries, (unsigned long long)c.culledByNeighbourhood,
             (unsigned long long)c.survivingQueries, c.iterations, (unsigned long long)c.rays,
             (unsigned long long)c.candidatePairs, (unsigned long long)c.occupiedCells);
+    if (c.queryChunks > 1 || c.targetTiles > 1)
+        appendf(s, ", out of core in %u query chunks x %u target tiles", c.queryChunks, c.targetTiles);
     return s;
 }
 

@@ -1,0 +1,94 @@
+// Out-of-core: a pair of sets larger than the memory budget of one call is
+// computed as a sequence of smaller calls (DESIGN §9), each of which fits.
+//
+// Exactness. h(Q,T) = max over q of min over t of |q - t|.
+//   - Queries are split into chunks Q_1..Q_m of consecutive input indices:
+//     h(Q,T) = max_i h(Q_i,T), each chunk an ordinary directed call.
+//   - When the targets do not fit beside a chunk, they are split into tiles
+//     T_1..T_n of consecutive input indices, and every query of the chunk
+//     keeps its best over the tiles: NN(q,T) = min_j NN(q,T_j). Each tile's
+//     call returns every query's exact nearest distance (per-point mode), so
+//     the minimum over the tiles is q's exact nearest distance in T, whatever
+//     order the tiles come in: no tile order can lose the maximum, because
+//     the maximum is taken only after every tile has been seen by every query.
+//   - Pairs are compared as the backends compare them (float squared
+//     distances of the scaled points), and ties keep the first: the witness
+//     of the earliest chunk (smallest query index), the nearest point of the
+//     earliest tile (smallest target index), as the backends do within one
+//     call.
+// Each call searches the float sets in the frame and exact scale of the whole
+// pair, so its distances are those of the unsplit call; witnesses come back as
+// indices into the whole sets.
+//
+// Cost: every chunk indexes its tiles again (chunks x tiles index builds),
+// and with more than one tile the early break against the running maximum
+// works inside each call only (per-point mode: every query of a chunk finds
+// its nearest point in every tile).
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+
+#include "rthdist/rthdist.hpp"
+
+namespace rthdist::api {
+
+// Device bytes one point of a call is assumed to need (its records, keys,
+// cells, leaves, query state and scratch; the measured figure is about 110 B
+// on lavapipe and under 180 B on an H200 run of 400M + 400M points).
+inline constexpr uint64_t kBytesPerPoint = 128;
+// Bytes per point of the largest single buffer of a call (cells and leaves:
+// 32 B per point), which the device's maxMemoryAllocationSize bounds.
+inline constexpr uint64_t kLargestBufferBytesPerPoint = 32;
+
+// What one call may hold.
+struct MemoryBudget {
+    uint64_t bytes = UINT64_MAX;           // all buffers of one call together
+    uint64_t maxPiecePoints = UINT64_MAX;  // points of one set in one call (the largest buffer)
+    std::string source;                    // where `bytes` came from, for messages
+    // Points (query chunk + target tile) one call may hold.
+    [[nodiscard]] uint64_t pointsPerCall() const { return bytes / kBytesPerPoint; }
+};
+
+// How one direction is split: chunks of `queryChunk` queries, tiles of `targetTile` targets.
+struct DirectionSplit {
+    uint64_t queryChunk = 0;
+    uint64_t targetTile = 0;
+};
+
+// Whether the pair (na, nb) fits one call's bytes as it is. maxPiecePoints
+// bounds the pieces only: some drivers grant buffers past their advertised
+// maxMemoryAllocationSize, so the whole pair is tried first (Engine: a
+// kOutOfMemory under the automatic budget then falls back to pieces).
+[[nodiscard]] bool fitsOneCall(const MemoryBudget& budget, uint64_t na, uint64_t nb);
+
+// The split of direction Q -> T (nq queries, nt targets) within the budget:
+// one tile when the targets fit beside a chunk of at least half the call,
+// else tiles and chunks of half a call each. kOutOfMemory when the budget
+// holds fewer than two points.
+[[nodiscard]] Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, uint64_t nt);
+
+// One directed call of a backend on float sets of the whole pair's frame:
+// call.directedOnly is set; call.perPointDistances is set when the caller
+// needs every query's nearest point.
+using DirectedCall = std::function<Result<HausdorffResult>(
+    std::span<const glm::vec3> queries, std::span<const glm::vec3> targets, const CallOptions& call)>;
+
+// H(A,B) (or h(A,B) with call.directedOnly) of float sets searched at the
+// exact power-of-two `scale` (core::exactScale), as a sequence of calls of
+// `directed`, each within `budget`. `release` (may be empty) frees what the
+// calls keep between calls (the GPU backend's scratch): after h(A,B), and
+// before a direction is run again with half the budget after a call found
+// the device short of memory (kOutOfMemory). Counters add up over the calls
+// (iterations: the largest), with Counters::queryChunks/targetTiles set.
+[[nodiscard]] Result<HausdorffResult> computeInPieces(std::span<const glm::vec3> a,
+                                                      std::span<const glm::vec3> b, double scale,
+                                                      const CallOptions& call, const MemoryBudget& budget,
+                                                      const DirectedCall& directed,
+                                                      const std::function<void()>& release);
+
+}  // namespace rthdist::api

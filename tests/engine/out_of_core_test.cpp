@@ -1,0 +1,161 @@
+// Out-of-core (EngineOptions::memoryBudget, src/api/out_of_core.hpp): a
+// forced budget of a few thousand points per call splits every larger pair
+// into query chunks and target tiles; the results equal the unsplit call's
+// and the brute force's, on the backend under test.
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "api/out_of_core.hpp"
+#include "common/brute_force.hpp"
+#include "common/oracle_cases.hpp"
+#include "engine/engine_test_support.hpp"
+
+namespace rthdist::test {
+namespace {
+
+// An Engine of the backend under test whose calls hold `points` points each
+// (the test has made one of this backend already, so this one must work).
+Engine budgetEngine(uint64_t points) {
+    EngineOptions o = engineUnderTest();
+    o.memoryBudget = points * api::kBytesPerPoint;
+    auto engine = Engine::create(o);
+    if (!engine) throw std::runtime_error("second Engine: " + engine.error().message);
+    return std::move(engine.value());
+}
+
+// The split result against the unsplit one: the same distances (exactly on
+// the CPU backend, whose ties are deterministic; within the oracle's
+// tolerance on a GPU, whose cells order their points by atomics) and, on the
+// CPU, the same witnesses wherever the distance is not 0 (a query with a copy
+// in the other set may name any copy).
+void expectSameAsUnsplit(const OracleCase& c, const HausdorffResult& split, const HausdorffResult& whole) {
+    const bool cpu = whole.backend == Backend::kCpu;
+    const double tol = cpu ? 0.0 : oracleTolerance(c.a, c.b, whole.hausdorff);
+    EXPECT_NEAR(split.hausdorff, whole.hausdorff, tol);
+    for (auto [s, w] : {std::pair{&split.aToB, &whole.aToB}, std::pair{&split.bToA, &whole.bToA}}) {
+        EXPECT_NEAR(s->distance, w->distance, tol);
+        if (!cpu || w->distance == 0.0) continue;
+        EXPECT_EQ(s->queryIndex, w->queryIndex);
+        EXPECT_EQ(s->targetIndex, w->targetIndex);
+    }
+    for (auto [s, w] :
+         {std::pair{&split.aNearest, &whole.aNearest}, std::pair{&split.bNearest, &whole.bNearest}}) {
+        ASSERT_EQ(s->distance.size(), w->distance.size());
+        for (size_t i = 0; i < s->distance.size(); ++i) ASSERT_NEAR(s->distance[i], w->distance[i], tol) << i;
+    }
+    EXPECT_EQ(split.validationMessages, 0u);
+}
+
+// Every oracle case under a budget of a third of its points per call (at
+// least 2): each direction of every case with more than a few points runs
+// in several calls.
+TEST(OutOfCore, OracleSuiteUnderAForcedBudget) {
+    RTHDIST_REQUIRE_TEST_ENGINE(whole);
+    uint64_t splitCases = 0;
+    for (const OracleCase& c : makeOracleCases()) {
+        SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed));
+        const uint64_t points = std::max<uint64_t>(2, (c.a.size() + c.b.size()) / 3);
+        Engine split = budgetEngine(points);
+        auto want = whole->compute(c.a, c.b);
+        auto got = split.compute(c.a, c.b);
+        ASSERT_TRUE(want) << want.error().message;
+        ASSERT_TRUE(got) << got.error().message;
+        expectMatchesOracle(c, *got);
+        expectSameAsUnsplit(c, *got, *want);
+        const Counters& ab = got->aToB.counters;
+        const Counters& ba = got->bToA.counters;
+        if (c.a.size() + c.b.size() > points)
+            EXPECT_GT(uint64_t(ab.queryChunks) * ab.targetTiles * ba.queryChunks * ba.targetTiles, 1u);
+        EXPECT_EQ(ab.queries, c.a.size());
+        EXPECT_EQ(ba.queries, c.b.size());
+        if (ab.targetTiles > 1 && ba.targetTiles > 1) ++splitCases;
+    }
+    EXPECT_GT(splitCases, 100u);  // most cases split both sets
+}
+
+// Per-point distances and the directed form under a budget: every query's
+// nearest distance as in the unsplit call, with tiles on both sides.
+TEST(OutOfCore, PerPointAndDirectedUnderAForcedBudget) {
+    RTHDIST_REQUIRE_TEST_ENGINE(whole);
+    Engine split = budgetEngine(1500);
+    const OracleCase c{"out-of-core-per-point", 31, randomCloud(5000, 31),
+                       randomCloud(4000, 32, glm::vec3(0.3f, 0.0f, 0.1f))};
+    for (bool directed : {false, true}) {
+        CallOptions call;
+        call.perPointDistances = true;
+        call.directedOnly = directed;
+        auto want = whole->compute(c.a, c.b, call);
+        auto got = split.compute(c.a, c.b, call);
+        ASSERT_TRUE(want && got);
+        expectMatchesOracle(c, *got, directed);
+        expectSameAsUnsplit(c, *got, *want);
+        EXPECT_EQ(got->directedOnly, directed);
+        EXPECT_EQ(got->bNearest.distance.empty(), directed);
+        EXPECT_GT(got->aToB.counters.targetTiles, 1u);
+        EXPECT_GT(got->aToB.counters.queryChunks, 1u);
+    }
+}
+
+// Many queries against a handful of targets, and the reverse: one tile and
+// many chunks, many tiles and one chunk (the shape of 300M points against 3).
+TEST(OutOfCore, ManyPointsAgainstThree) {
+    RTHDIST_REQUIRE_TEST_ENGINE(whole);
+    Engine split = budgetEngine(2000);
+    const OracleCase c{
+        "many-against-three",
+        41,
+        randomCloud(20000, 41),
+        {glm::vec3(0.1f, 0.2f, 0.3f), glm::vec3(0.9f, 0.5f, 0.5f), glm::vec3(0.5f, 0.9f, 0.1f)}};
+    auto got = split.compute(c.a, c.b);
+    auto want = whole->compute(c.a, c.b);
+    ASSERT_TRUE(got && want);
+    expectMatchesOracle(c, *got);
+    expectSameAsUnsplit(c, *got, *want);
+    EXPECT_GT(got->aToB.counters.queryChunks, 1u);
+    EXPECT_EQ(got->aToB.counters.targetTiles, 1u);
+    EXPECT_EQ(got->bToA.counters.queryChunks, 1u);
+    EXPECT_GT(got->bToA.counters.targetTiles, 1u);
+}
+
+// A budget below two points is refused with the budget named, not run.
+TEST(OutOfCore, BudgetBelowTwoPointsIsRefused) {
+    EngineOptions o = engineUnderTest();
+    o.memoryBudget = api::kBytesPerPoint;  // one point
+    RTHDIST_REQUIRE_ENGINE(engine, o);
+    auto r = engine->compute(randomCloud(10, 1), randomCloud(10, 2));
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kOutOfMemory);
+    EXPECT_NE(r.error().message.find("memory budget of " + std::to_string(api::kBytesPerPoint)),
+              std::string::npos)
+        << r.error().message;
+}
+
+// The splitter's arithmetic: chunks and tiles within the budget and the
+// largest piece, each direction covered.
+TEST(OutOfCore, SplitStaysWithinTheBudget) {
+    api::MemoryBudget budget;
+    budget.bytes = 1000 * api::kBytesPerPoint;
+    budget.maxPiecePoints = 300;
+    for (uint64_t nq : {1u, 3u, 299u, 1000u, 123457u}) {
+        for (uint64_t nt : {1u, 3u, 301u, 999u, 98765u}) {
+            auto s = api::splitDirection(budget, nq, nt);
+            ASSERT_TRUE(s);
+            EXPECT_GE(s->queryChunk, 1u);
+            EXPECT_GE(s->targetTile, 1u);
+            EXPECT_LE(s->queryChunk, std::min<uint64_t>(nq, budget.maxPiecePoints));
+            EXPECT_LE(s->targetTile, budget.maxPiecePoints);
+            EXPECT_LE(s->queryChunk + s->targetTile, budget.pointsPerCall());
+            if (nt <= 300) EXPECT_EQ(s->targetTile, nt);  // small targets stay whole
+        }
+    }
+    // One call is tried whenever the bytes allow (a device may grant more
+    // than maxMemoryAllocationSize); pieces stay within it.
+    EXPECT_TRUE(api::fitsOneCall(budget, 300, 700));
+    EXPECT_TRUE(api::fitsOneCall(budget, 999, 1));
+    EXPECT_FALSE(api::fitsOneCall(budget, 300, 701));
+}
+
+}  // namespace
+}  // namespace rthdist::test
