@@ -1,7 +1,11 @@
 #include "api/out_of_core.hpp"
 
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <vector>
 
 namespace rthdist::api {
@@ -80,71 +84,197 @@ CallOptions pieceOptions(const CallOptions& call, bool perPoint, double from, do
     return piece;
 }
 
+// A tile of the targets: consecutive input indices from `offset`, and the box
+// of its points scaled as searched (searchDist2's frame).
+struct Tile {
+    Span points;
+    uint64_t offset = 0;
+    glm::vec3 lo{0.0f}, hi{0.0f};
+};
+
+glm::vec3 scaledPoint(const glm::vec3& p, double scale) { return glm::vec3(glm::dvec3(p) * scale); }
+
+// The float squared distance from q to a tile's box, computed as searchDist2
+// computes a pair: rounding is monotone, so it never exceeds searchDist2(q, p)
+// for a point p of the tile.
+float boxDist2(const glm::vec3& q, const Tile& tile, double scale) {
+    const glm::vec3 qs = scaledPoint(q, scale);
+    const glm::vec3 d = glm::max(glm::max(tile.lo - qs, qs - tile.hi), glm::vec3(0.0f));
+    const float xy = d.x * d.x + d.y * d.y;
+    return xy + d.z * d.z;
+}
+
+std::vector<Tile> makeTiles(Span t, uint64_t tileSize, double scale) {
+    std::vector<Tile> tiles;
+    for (uint64_t t0 = 0; t0 < t.size(); t0 += tileSize) {
+        Tile tile{t.subspan(t0, std::min<uint64_t>(tileSize, t.size() - t0)), t0};
+        tile.lo = tile.hi = tile.points[0];
+        for (const glm::vec3& p : tile.points) {
+            tile.lo = glm::min(tile.lo, p);
+            tile.hi = glm::max(tile.hi, p);
+        }
+        tile.lo = scaledPoint(tile.lo, scale);
+        tile.hi = scaledPoint(tile.hi, scale);
+        tiles.push_back(tile);
+    }
+    return tiles;
+}
+
+// The tiles nearest the chunk first (box to box), so that its queries' best
+// distances shrink early and later tiles are skipped.
+std::vector<size_t> tileOrder(Span chunk, const std::vector<Tile>& tiles, double scale) {
+    Tile box{chunk};
+    box.lo = box.hi = chunk[0];
+    for (const glm::vec3& p : chunk) {
+        box.lo = glm::min(box.lo, p);
+        box.hi = glm::max(box.hi, p);
+    }
+    std::vector<double> gap(tiles.size());
+    for (size_t j = 0; j < tiles.size(); ++j) {
+        const glm::dvec3 d = glm::max(glm::max(glm::dvec3(tiles[j].lo) - glm::dvec3(box.hi) * scale,
+                                               glm::dvec3(box.lo) * scale - glm::dvec3(tiles[j].hi)),
+                                      glm::dvec3(0.0));
+        gap[j] = glm::dot(d, d);
+    }
+    std::vector<size_t> order(tiles.size());
+    for (size_t j = 0; j < order.size(); ++j) order[j] = j;
+    std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return gap[x] < gap[y]; });
+    return order;
+}
+
+// Every query's best pair over the tiles seen so far (searchDist2, the
+// distance the call reported, the target's index in the whole set).
+struct ChunkBest {
+    std::vector<float> d2;
+    std::vector<double> distance;
+    std::vector<uint32_t> nearest;
+    explicit ChunkBest(size_t n)
+        : d2(n, std::numeric_limits<float>::infinity()), distance(n, 0.0), nearest(n, UINT32_MAX) {}
+};
+
+// The queries of the chunk that a tile may still improve: a query is skipped
+// when the tile's box is farther than its best pair (no point of the tile can
+// be nearer, nor tie with a smaller index: the box distance is a lower bound),
+// or, without per-point output, when its best pair is already no farther than
+// the running maximum of earlier chunks (their queries have smaller indices,
+// so it can neither exceed nor win a tie: DESIGN §3's early break).
+std::vector<uint32_t> queriesForTile(Span qc, const Tile& tile, const ChunkBest& best, float dropAtOrBelow,
+                                     double scale) {
+    std::vector<uint32_t> keep;
+    for (size_t i = 0; i < qc.size(); ++i) {
+        if (best.d2[i] <= dropAtOrBelow) continue;
+        if (boxDist2(qc[i], tile, scale) <= best.d2[i]) keep.push_back(uint32_t(i));
+    }
+    return keep;
+}
+
+// One tile's call for the selected queries (per-point), merged into `best`:
+// a nearer pair replaces, an equal one only with a smaller target index.
+std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, const Tile& tile,
+                                double scale, const CallOptions& piece, const DirectedCall& directed,
+                                ChunkBest& best, DirectionState& s) {
+    std::vector<glm::vec3> subset;
+    Span queries = qc;
+    if (selected.size() < qc.size()) {
+        subset.reserve(selected.size());
+        for (uint32_t i : selected) subset.push_back(qc[i]);
+        queries = subset;
+    }
+    Result<HausdorffResult> r = directed(queries, tile.points, piece);
+    if (!r) return r.error();
+    addCounters(s.witness.counters, r->aToB.counters, true);
+    addTimings(s.timings, r->timings);
+    const PerPoint& pp = r->aNearest;
+    for (size_t k = 0; k < selected.size(); ++k) {
+        const uint32_t i = selected[k];
+        const float d2 = searchDist2(qc[i], tile.points[pp.nearest[k]], scale);
+        const uint32_t target = uint32_t(pp.nearest[k] + tile.offset);
+        if (d2 < best.d2[i] || (d2 == best.d2[i] && target < best.nearest[i])) {
+            best.d2[i] = d2;
+            best.distance[i] = pp.distance[k];
+            best.nearest[i] = target;
+        }
+    }
+    return std::nullopt;
+}
+
+// A chunk against one tile holding every target: one directed call with the
+// backend's own early break, or per-point when the caller asked for it.
+std::optional<Error> chunkAgainstAll(Span qc, uint64_t q0, Span t, double scale, const CallOptions& piece,
+                                     const DirectedCall& directed, DirectionState& s) {
+    Result<HausdorffResult> r = directed(qc, t, piece);
+    if (!r) return r.error();
+    addCounters(s.witness.counters, r->aToB.counters, q0 == 0);
+    addTimings(s.timings, r->timings);
+    const Directed& w = r->aToB;
+    offerWitness(s, w, searchDist2(qc[w.queryIndex], t[w.targetIndex], scale), q0, 0);
+    if (piece.perPointDistances) {
+        std::copy(r->aNearest.distance.begin(), r->aNearest.distance.end(),
+                  s.perPoint.distance.begin() + ptrdiff_t(q0));
+        std::copy(r->aNearest.nearest.begin(), r->aNearest.nearest.end(),
+                  s.perPoint.nearest.begin() + ptrdiff_t(q0));
+    }
+    return std::nullopt;
+}
+
+// A chunk against several tiles: the nearest tiles first, each for the
+// queries it may still improve; then the chunk's witness (its largest best
+// pair, the smallest query index among ties).
+std::optional<Error> chunkAgainstTiles(Span qc, uint64_t q0, Span t, const std::vector<Tile>& tiles,
+                                       double scale, const CallOptions& call, const DirectedCall& directed,
+                                       DirectionState& s, double from, double step) {
+    ChunkBest best(qc.size());
+    const float drop = call.perPointDistances ? -1.0f : s.witnessD2;
+    const std::vector<size_t> order = tileOrder(qc, tiles, scale);
+    for (size_t k = 0; k < order.size(); ++k) {
+        const Tile& tile = tiles[order[k]];
+        const std::vector<uint32_t> selected = queriesForTile(qc, tile, best, drop, scale);
+        if (selected.empty()) continue;
+        const CallOptions piece = pieceOptions(call, true, from + step * double(k), step);
+        if (auto err = searchTile(qc, selected, tile, scale, piece, directed, best, s)) return err;
+    }
+    const size_t w = size_t(std::max_element(best.d2.begin(), best.d2.end()) - best.d2.begin());
+    Directed d;
+    d.distance = best.distance[w];
+    d.queryIndex = uint32_t(w);
+    d.targetIndex = best.nearest[w];
+    d.queryPoint = glm::dvec3(qc[w]);
+    d.targetPoint = glm::dvec3(t[best.nearest[w]]);
+    offerWitness(s, d, best.d2[w], q0, 0);
+    if (call.perPointDistances) {
+        std::copy(best.distance.begin(), best.distance.end(), s.perPoint.distance.begin() + ptrdiff_t(q0));
+        std::copy(best.nearest.begin(), best.nearest.end(), s.perPoint.nearest.begin() + ptrdiff_t(q0));
+    }
+    return std::nullopt;
+}
+
 // One direction Q -> T within `split`; `from`/`width`: its share of the progress.
 Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOptions& call,
                                     const DirectionSplit& split, const DirectedCall& directed, double from,
                                     double width) {
     const uint64_t chunks = (q.size() + split.queryChunk - 1) / split.queryChunk;
-    const uint64_t tiles = (t.size() + split.targetTile - 1) / split.targetTile;
-    const bool perPoint = tiles > 1 || call.perPointDistances;
+    const std::vector<Tile> tiles =
+        t.size() > split.targetTile ? makeTiles(t, split.targetTile, scale) : std::vector<Tile>{};
+    const uint64_t tileCount = std::max<uint64_t>(1, tiles.size());
     DirectionState s;
     if (call.perPointDistances) {
         s.perPoint.distance.resize(q.size());
         s.perPoint.nearest.resize(q.size());
     }
-    const double step = width / double(chunks * tiles);
-    std::vector<float> best2;  // per query of the chunk: the best pair's searchDist2
-    std::vector<double> best;  // its distance (as the call reported it)
-    std::vector<uint32_t> nearest;
+    const double step = width / double(chunks * tileCount);
     for (uint64_t c = 0; c < chunks; ++c) {
         const uint64_t q0 = c * split.queryChunk;
         const Span qc = q.subspan(q0, std::min<uint64_t>(split.queryChunk, q.size() - q0));
-        if (perPoint) {
-            best2.assign(qc.size(), std::numeric_limits<float>::infinity());
-            best.assign(qc.size(), 0.0);
-            nearest.assign(qc.size(), 0);
-        }
-        for (uint64_t j = 0; j < tiles; ++j) {
-            const uint64_t t0 = j * split.targetTile;
-            const Span tj = t.subspan(t0, std::min<uint64_t>(split.targetTile, t.size() - t0));
-            Result<HausdorffResult> r =
-                directed(qc, tj, pieceOptions(call, perPoint, from + step * double(c * tiles + j), step));
-            if (!r) return r.error();
-            addCounters(s.witness.counters, r->aToB.counters, c == 0);
-            addTimings(s.timings, r->timings);
-            if (!perPoint) {
-                const Directed& w = r->aToB;
-                offerWitness(s, w, searchDist2(qc[w.queryIndex], tj[w.targetIndex], scale), q0, t0);
-                continue;
-            }
-            const PerPoint& pp = r->aNearest;
-            for (size_t i = 0; i < qc.size(); ++i) {
-                const float d2 = searchDist2(qc[i], tj[pp.nearest[i]], scale);
-                if (d2 < best2[i]) {  // the earlier tile (smaller target index) among ties
-                    best2[i] = d2;
-                    best[i] = pp.distance[i];
-                    nearest[i] = uint32_t(pp.nearest[i] + t0);
-                }
-            }
-        }
-        if (!perPoint) continue;
-        // The chunk's witness: its largest best distance, the smallest index among ties.
-        const size_t w = size_t(std::max_element(best2.begin(), best2.end()) - best2.begin());
-        Directed d;
-        d.distance = best[w];
-        d.queryIndex = uint32_t(w);
-        d.targetIndex = nearest[w];
-        d.queryPoint = glm::dvec3(qc[w]);
-        d.targetPoint = glm::dvec3(t[nearest[w]]);
-        offerWitness(s, d, best2[w], q0, 0);
-        if (call.perPointDistances) {
-            std::copy(best.begin(), best.end(), s.perPoint.distance.begin() + ptrdiff_t(q0));
-            std::copy(nearest.begin(), nearest.end(), s.perPoint.nearest.begin() + ptrdiff_t(q0));
-        }
+        const double at = from + step * double(c * tileCount);
+        const std::optional<Error> err =
+            tiles.empty() ? chunkAgainstAll(qc, q0, t, scale,
+                                            pieceOptions(call, call.perPointDistances, at, step), directed, s)
+                          : chunkAgainstTiles(qc, q0, t, tiles, scale, call, directed, s, at, step);
+        if (err) return *err;
     }
-    s.witness.counters.queries = q.size();  // each tile's calls counted them again
+    s.witness.counters.queries = q.size();  // tiles' calls count their queries again
     s.witness.counters.queryChunks = uint32_t(chunks);
-    s.witness.counters.targetTiles = uint32_t(tiles);
+    s.witness.counters.targetTiles = uint32_t(tileCount);
     return s;
 }
 

@@ -6,24 +6,36 @@
 //     h(Q,T) = max_i h(Q_i,T), each chunk an ordinary directed call.
 //   - When the targets do not fit beside a chunk, they are split into tiles
 //     T_1..T_n of consecutive input indices, and every query of the chunk
-//     keeps its best over the tiles: NN(q,T) = min_j NN(q,T_j). Each tile's
-//     call returns every query's exact nearest distance (per-point mode), so
-//     the minimum over the tiles is q's exact nearest distance in T, whatever
-//     order the tiles come in: no tile order can lose the maximum, because
-//     the maximum is taken only after every tile has been seen by every query.
+//     keeps its best pair over the tiles: NN(q,T) = min_j NN(q,T_j). A
+//     tile's call returns the exact nearest point in that tile of every query
+//     sent to it (per-point mode), so the minimum over the tiles is q's exact
+//     nearest distance in T in whatever order the tiles come: no tile order
+//     can lose the maximum, which is taken only once every tile has been
+//     seen or ruled out for every query.
+//   - A tile is ruled out for a query (the query not sent) when the tile's
+//     bounding box is farther than the query's best pair so far: no point of
+//     the tile can be nearer, nor tie with a smaller index, because the box
+//     distance is computed as pairs are and rounding is monotone. Tiles go
+//     nearest the chunk first, so best pairs shrink early.
+//   - Early break across chunks (DESIGN §3): without per-point output, a
+//     query whose best pair is no farther than the running maximum M of the
+//     earlier chunks is sent to no further tile: its nearest distance is at
+//     most M and its index is larger than theirs, so it can neither exceed M
+//     nor win a tie. Within a call the backend's own early break applies
+//     (one tile), or none (per-point mode, several tiles).
 //   - Pairs are compared as the backends compare them (float squared
 //     distances of the scaled points), and ties keep the first: the witness
-//     of the earliest chunk (smallest query index), the nearest point of the
-//     earliest tile (smallest target index), as the backends do within one
-//     call.
+//     of the earliest chunk (smallest query index), the nearest point with
+//     the smallest target index, as the backends do within one call.
 // Each call searches the float sets in the frame and exact scale of the whole
 // pair, so its distances are those of the unsplit call; witnesses come back as
 // indices into the whole sets.
 //
-// Cost: every chunk indexes its tiles again (chunks x tiles index builds),
-// and with more than one tile the early break against the running maximum
-// works inside each call only (per-point mode: every query of a chunk finds
-// its nearest point in every tile).
+// Cost: every call indexes its tile again (up to chunks x tiles index
+// builds), and queries sent to a tile search it to the end (per-point).
+// Inputs in spatial order (scans, lattices, sorted files) give tiles with
+// small boxes, so most (chunk, tile) pairs are ruled out; a shuffled input
+// gives every tile the whole box and every query meets every tile.
 #pragma once
 
 #include <glm/vec3.hpp>

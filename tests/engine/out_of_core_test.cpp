@@ -6,6 +6,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include "api/out_of_core.hpp"
 #include "common/brute_force.hpp"
@@ -117,6 +118,71 @@ TEST(OutOfCore, ManyPointsAgainstThree) {
     EXPECT_EQ(got->aToB.counters.targetTiles, 1u);
     EXPECT_EQ(got->bToA.counters.queryChunks, 1u);
     EXPECT_GT(got->bToA.counters.targetTiles, 1u);
+}
+
+// A backend stand-in for computeInPieces: the brute force, counting the
+// calls and the queries sent.
+struct CountingBruteForce {
+    uint64_t calls = 0, queriesSent = 0;
+    Result<HausdorffResult> operator()(std::span<const glm::vec3> q, std::span<const glm::vec3> t,
+                                       const CallOptions& call) {
+        ++calls;
+        queriesSent += q.size();
+        HausdorffResult r;
+        r.directedOnly = true;
+        const oracle::DirectedExact d = oracle::bruteForceDirected(q, t, 1);
+        r.aToB.distance = d.distance;
+        r.aToB.queryIndex = d.queryIndex;
+        r.aToB.targetIndex = d.targetIndex;
+        r.aToB.counters.queries = q.size();
+        if (call.perPointDistances) {
+            for (const oracle::NearestExact& n : oracle::bruteForceNearestIndexed(q, t, 1)) {
+                r.aNearest.distance.push_back(n.distance);
+                r.aNearest.nearest.push_back(n.targetIndex);
+            }
+        }
+        r.hausdorff = d.distance;
+        return r;
+    }
+};
+
+// The lattice {0..n-1}^3 in z-slab order, moved by `shift`.
+std::vector<glm::vec3> slabLattice(int n, float shift) {
+    std::vector<glm::vec3> p;
+    for (int z = 0; z < n; ++z)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) p.push_back(glm::vec3(float(x), float(y), float(z)) + shift);
+    return p;
+}
+
+// Inputs in spatial order: tiles are slabs, so a chunk meets its own slab and
+// the boundary layers of its neighbours only, and once a chunk has set the
+// running maximum the later chunks' queries stop after their first tile.
+// The result is the brute force's, witnesses included.
+TEST(OutOfCore, TilesOutOfReachAreSkipped) {
+    const int n = 16;
+    const std::vector<glm::vec3> a = slabLattice(n, 0.0f);
+    std::vector<glm::vec3> b = slabLattice(n, 0.5f);
+    b.push_back(glm::vec3(40.25f, -3.5f, 7.125f));  // the outlier: h(B,A) is its
+    using Sets = const std::vector<glm::vec3>*;
+    api::MemoryBudget budget;
+    budget.bytes = 2 * 512 * api::kBytesPerPoint;  // chunks and tiles of 512 points: 2 z-layers
+    CountingBruteForce fake;
+    const api::DirectedCall call = [&fake](auto q, auto t, const CallOptions& o) { return fake(q, t, o); };
+    auto r = api::computeInPieces(a, b, 1.0, CallOptions{}, budget, call, {});
+    ASSERT_TRUE(r) << r.error().message;
+    for (auto [got, q, t] : {std::tuple<const Directed*, Sets, Sets>{&r->aToB, &a, &b},
+                             std::tuple<const Directed*, Sets, Sets>{&r->bToA, &b, &a}}) {
+        const oracle::DirectedExact want = oracle::bruteForceDirected(*q, *t);
+        EXPECT_EQ(got->distance, want.distance);
+        EXPECT_EQ(got->queryIndex, want.queryIndex);
+        EXPECT_EQ(got->targetIndex, want.targetIndex);
+        EXPECT_EQ(got->counters.queryChunks, (q->size() + 511) / 512);  // B: 4097 points, 9 pieces
+        EXPECT_EQ(got->counters.targetTiles, (t->size() + 511) / 512);
+    }
+    // Without skipping: 2 x 8 x 9 calls and every query sent to every tile.
+    EXPECT_LT(fake.calls, 2u * 8u * 9u / 2u);
+    EXPECT_LT(fake.queriesSent, 2u * 9u * a.size() / 4u);
 }
 
 // A budget below two points is refused with the budget named, not run.
