@@ -248,7 +248,7 @@ Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm:
         [&](std::span<const glm::vec3> q, std::span<const glm::vec3> t, const CallOptions& piece) {
             return runBackend(impl, q, t, scale, piece);
         },
-        release);
+        release, impl.options.threads);
     release();  // the pieces' scratch is no use to the next call
     if (!r) return r;
     r->backend = impl.backend;

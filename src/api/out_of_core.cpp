@@ -1,5 +1,7 @@
 #include "api/out_of_core.hpp"
 
+#include "core/parallel.hpp"
+
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
@@ -13,6 +15,9 @@ namespace rthdist::api {
 namespace {
 
 using Span = std::span<const glm::vec3>;
+
+// Points per task of the host passes over queries and targets.
+constexpr size_t kHostChunk = size_t(1) << 16;
 
 // The running state of one direction: its witness so far, every query's best
 // so far (with tiles, or when the caller asked for per-point output), and
@@ -104,31 +109,39 @@ float boxDist2(const glm::vec3& q, const Tile& tile, double scale) {
     return xy + d.z * d.z;
 }
 
-std::vector<Tile> makeTiles(Span t, uint64_t tileSize, double scale) {
-    std::vector<Tile> tiles;
-    for (uint64_t t0 = 0; t0 < t.size(); t0 += tileSize) {
-        Tile tile{t.subspan(t0, std::min<uint64_t>(tileSize, t.size() - t0)), t0};
-        tile.lo = tile.hi = tile.points[0];
-        for (const glm::vec3& p : tile.points) {
-            tile.lo = glm::min(tile.lo, p);
-            tile.hi = glm::max(tile.hi, p);
+// The box of `points` (non-empty), scaled as searched; on `threads` threads.
+Tile boxOf(Span points, uint64_t offset, double scale, int threads) {
+    threads = core::resolveThreads(threads, points.size() / kHostChunk + 1);
+    std::vector<Tile> parts(size_t(threads), Tile{{}, 0, points[0], points[0]});
+    core::parallelChunks(points.size(), kHostChunk, threads, [&](size_t begin, size_t end, int w) {
+        Tile& part = parts[size_t(w)];
+        for (size_t i = begin; i < end; ++i) {
+            part.lo = glm::min(part.lo, points[i]);
+            part.hi = glm::max(part.hi, points[i]);
         }
-        tile.lo = scaledPoint(tile.lo, scale);
-        tile.hi = scaledPoint(tile.hi, scale);
-        tiles.push_back(tile);
+    });
+    Tile box{points, offset, points[0], points[0]};
+    for (const Tile& part : parts) {
+        box.lo = glm::min(box.lo, part.lo);
+        box.hi = glm::max(box.hi, part.hi);
     }
+    box.lo = scaledPoint(box.lo, scale);  // an exact power of two: monotone
+    box.hi = scaledPoint(box.hi, scale);
+    return box;
+}
+
+std::vector<Tile> makeTiles(Span t, uint64_t tileSize, double scale, int threads) {
+    std::vector<Tile> tiles;
+    for (uint64_t t0 = 0; t0 < t.size(); t0 += tileSize)
+        tiles.push_back(
+            boxOf(t.subspan(t0, std::min<uint64_t>(tileSize, t.size() - t0)), t0, scale, threads));
     return tiles;
 }
 
 // The tiles nearest the chunk first (box to box), so that its queries' best
 // distances shrink early and later tiles are skipped.
-std::vector<size_t> tileOrder(Span chunk, const std::vector<Tile>& tiles, double scale) {
-    Tile box{chunk};
-    box.lo = box.hi = chunk[0];
-    for (const glm::vec3& p : chunk) {
-        box.lo = glm::min(box.lo, p);
-        box.hi = glm::max(box.hi, p);
-    }
+std::vector<size_t> tileOrder(Span chunk, const std::vector<Tile>& tiles, double scale, int threads) {
+    const Tile box = boxOf(chunk, 0, 1.0, threads);
     std::vector<double> gap(tiles.size());
     for (size_t j = 0; j < tiles.size(); ++j) {
         const glm::dvec3 d = glm::max(glm::max(glm::dvec3(tiles[j].lo) - glm::dvec3(box.hi) * scale,
@@ -159,12 +172,18 @@ struct ChunkBest {
 // the running maximum of earlier chunks (their queries have smaller indices,
 // so it can neither exceed nor win a tie: DESIGN §3's early break).
 std::vector<uint32_t> queriesForTile(Span qc, const Tile& tile, const ChunkBest& best, float dropAtOrBelow,
-                                     double scale) {
+                                     double scale, int threads) {
+    threads = core::resolveThreads(threads, qc.size() / kHostChunk + 1);
+    std::vector<std::vector<uint32_t>> parts((qc.size() + kHostChunk - 1) / kHostChunk);
+    core::parallelChunks(qc.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
+        std::vector<uint32_t>& keep = parts[begin / kHostChunk];
+        for (size_t i = begin; i < end; ++i) {
+            if (best.d2[i] <= dropAtOrBelow) continue;
+            if (boxDist2(qc[i], tile, scale) <= best.d2[i]) keep.push_back(uint32_t(i));
+        }
+    });
     std::vector<uint32_t> keep;
-    for (size_t i = 0; i < qc.size(); ++i) {
-        if (best.d2[i] <= dropAtOrBelow) continue;
-        if (boxDist2(qc[i], tile, scale) <= best.d2[i]) keep.push_back(uint32_t(i));
-    }
+    for (const std::vector<uint32_t>& part : parts) keep.insert(keep.end(), part.begin(), part.end());
     return keep;
 }
 
@@ -172,12 +191,15 @@ std::vector<uint32_t> queriesForTile(Span qc, const Tile& tile, const ChunkBest&
 // a nearer pair replaces, an equal one only with a smaller target index.
 std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, const Tile& tile,
                                 double scale, const CallOptions& piece, const DirectedCall& directed,
-                                ChunkBest& best, DirectionState& s) {
+                                int threads, ChunkBest& best, DirectionState& s) {
+    threads = core::resolveThreads(threads, selected.size() / kHostChunk + 1);
     std::vector<glm::vec3> subset;
     Span queries = qc;
     if (selected.size() < qc.size()) {
-        subset.reserve(selected.size());
-        for (uint32_t i : selected) subset.push_back(qc[i]);
+        subset.resize(selected.size());
+        core::parallelChunks(selected.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
+            for (size_t k = begin; k < end; ++k) subset[k] = qc[selected[k]];
+        });
         queries = subset;
     }
     Result<HausdorffResult> r = directed(queries, tile.points, piece);
@@ -185,16 +207,18 @@ std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, 
     addCounters(s.witness.counters, r->aToB.counters, true);
     addTimings(s.timings, r->timings);
     const PerPoint& pp = r->aNearest;
-    for (size_t k = 0; k < selected.size(); ++k) {
-        const uint32_t i = selected[k];
-        const float d2 = searchDist2(qc[i], tile.points[pp.nearest[k]], scale);
-        const uint32_t target = uint32_t(pp.nearest[k] + tile.offset);
-        if (d2 < best.d2[i] || (d2 == best.d2[i] && target < best.nearest[i])) {
-            best.d2[i] = d2;
-            best.distance[i] = pp.distance[k];
-            best.nearest[i] = target;
+    core::parallelChunks(selected.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t k = begin; k < end; ++k) {
+            const uint32_t i = selected[k];  // each query once
+            const float d2 = searchDist2(qc[i], tile.points[pp.nearest[k]], scale);
+            const uint32_t target = uint32_t(pp.nearest[k] + tile.offset);
+            if (d2 < best.d2[i] || (d2 == best.d2[i] && target < best.nearest[i])) {
+                best.d2[i] = d2;
+                best.distance[i] = pp.distance[k];
+                best.nearest[i] = target;
+            }
         }
-    }
+    });
     return std::nullopt;
 }
 
@@ -222,16 +246,16 @@ std::optional<Error> chunkAgainstAll(Span qc, uint64_t q0, Span t, double scale,
 // pair, the smallest query index among ties).
 std::optional<Error> chunkAgainstTiles(Span qc, uint64_t q0, Span t, const std::vector<Tile>& tiles,
                                        double scale, const CallOptions& call, const DirectedCall& directed,
-                                       DirectionState& s, double from, double step) {
+                                       int threads, DirectionState& s, double from, double step) {
     ChunkBest best(qc.size());
     const float drop = call.perPointDistances ? -1.0f : s.witnessD2;
-    const std::vector<size_t> order = tileOrder(qc, tiles, scale);
+    const std::vector<size_t> order = tileOrder(qc, tiles, scale, threads);
     for (size_t k = 0; k < order.size(); ++k) {
         const Tile& tile = tiles[order[k]];
-        const std::vector<uint32_t> selected = queriesForTile(qc, tile, best, drop, scale);
+        const std::vector<uint32_t> selected = queriesForTile(qc, tile, best, drop, scale, threads);
         if (selected.empty()) continue;
         const CallOptions piece = pieceOptions(call, true, from + step * double(k), step);
-        if (auto err = searchTile(qc, selected, tile, scale, piece, directed, best, s)) return err;
+        if (auto err = searchTile(qc, selected, tile, scale, piece, directed, threads, best, s)) return err;
     }
     const size_t w = size_t(std::max_element(best.d2.begin(), best.d2.end()) - best.d2.begin());
     Directed d;
@@ -250,11 +274,11 @@ std::optional<Error> chunkAgainstTiles(Span qc, uint64_t q0, Span t, const std::
 
 // One direction Q -> T within `split`; `from`/`width`: its share of the progress.
 Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOptions& call,
-                                    const DirectionSplit& split, const DirectedCall& directed, double from,
-                                    double width) {
+                                    const DirectionSplit& split, const DirectedCall& directed, int threads,
+                                    double from, double width) {
     const uint64_t chunks = (q.size() + split.queryChunk - 1) / split.queryChunk;
     const std::vector<Tile> tiles =
-        t.size() > split.targetTile ? makeTiles(t, split.targetTile, scale) : std::vector<Tile>{};
+        t.size() > split.targetTile ? makeTiles(t, split.targetTile, scale, threads) : std::vector<Tile>{};
     const uint64_t tileCount = std::max<uint64_t>(1, tiles.size());
     DirectionState s;
     if (call.perPointDistances) {
@@ -269,7 +293,7 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
         const std::optional<Error> err =
             tiles.empty() ? chunkAgainstAll(qc, q0, t, scale,
                                             pieceOptions(call, call.perPointDistances, at, step), directed, s)
-                          : chunkAgainstTiles(qc, q0, t, tiles, scale, call, directed, s, at, step);
+                          : chunkAgainstTiles(qc, q0, t, tiles, scale, call, directed, threads, s, at, step);
         if (err) return *err;
     }
     s.witness.counters.queries = q.size();  // tiles' calls count their queries again
@@ -282,11 +306,12 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
 // figure is an estimate; a device may hold less than it reports).
 Result<DirectionState> runDirectionWithin(Span q, Span t, double scale, const CallOptions& call,
                                           MemoryBudget budget, const DirectedCall& directed,
-                                          const std::function<void()>& release, double from, double width) {
+                                          const std::function<void()>& release, int threads, double from,
+                                          double width) {
     for (;;) {
         Result<DirectionSplit> split = splitDirection(budget, q.size(), t.size());
         if (!split) return split.error();
-        Result<DirectionState> s = runDirection(q, t, scale, call, *split, directed, from, width);
+        Result<DirectionState> s = runDirection(q, t, scale, call, *split, directed, threads, from, width);
         if (s || s.error().code != ErrorCode::kOutOfMemory || budget.pointsPerCall() < 4) return s;
         if (release) release();
         budget.bytes /= 2;
@@ -323,9 +348,10 @@ Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, u
 
 Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const CallOptions& call,
                                         const MemoryBudget& budget, const DirectedCall& directed,
-                                        const std::function<void()>& release) {
+                                        const std::function<void()>& release, int threads) {
     const double width = call.directedOnly ? 1.0 : 0.5;
-    Result<DirectionState> ab = runDirectionWithin(a, b, scale, call, budget, directed, release, 0.0, width);
+    Result<DirectionState> ab =
+        runDirectionWithin(a, b, scale, call, budget, directed, release, threads, 0.0, width);
     if (!ab) return ab.error();
     HausdorffResult r;
     r.directedOnly = call.directedOnly;
@@ -336,7 +362,7 @@ Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const Call
     if (!call.directedOnly) {
         if (release) release();
         Result<DirectionState> ba =
-            runDirectionWithin(b, a, scale, call, budget, directed, release, 0.5, 0.5);
+            runDirectionWithin(b, a, scale, call, budget, directed, release, threads, 0.5, 0.5);
         if (!ba) return ba.error();
         r.bToA = ba->witness;
         r.bNearest = std::move(ba->perPoint);

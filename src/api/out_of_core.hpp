@@ -97,10 +97,12 @@ using DirectedCall = std::function<Result<HausdorffResult>(
 // before a direction is run again with half the budget after a call found
 // the device short of memory (kOutOfMemory). Counters add up over the calls
 // (iterations: the largest), with Counters::queryChunks/targetTiles set.
+// The host's passes over the points (tile boxes, the queries a tile may
+// improve, merging) run on `threads` threads (0: all).
 [[nodiscard]] Result<HausdorffResult> computeInPieces(std::span<const glm::vec3> a,
                                                       std::span<const glm::vec3> b, double scale,
                                                       const CallOptions& call, const MemoryBudget& budget,
                                                       const DirectedCall& directed,
-                                                      const std::function<void()>& release);
+                                                      const std::function<void()>& release, int threads = 0);
 
 }  // namespace rthdist::api

@@ -1,5 +1,8 @@
 #include "gpu_algo/query_check.hpp"
 
+#include "core/parallel.hpp"
+
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -74,7 +77,7 @@ void QueryCheck::readPerPoint(const PointIndex& Q, const Buffer& state, std::spa
     const VkDeviceSize stateBytes = VkDeviceSize(Q.n) * sizeof(sh::QueryState);
     const VkDeviceSize pointBytes = VkDeviceSize(Q.n) * 16;
     Buffer& host =
-        m_ws.grow(m_ws.scratch.search.readback, stateBytes + pointBytes, "readback", MemoryKind::kHost);
+        m_ws.grow(m_ws.scratch.search.readback, stateBytes + pointBytes, "readback", MemoryKind::kReadback);
     VkCommandBuffer cmd = m_ws.ctx.begin();
     VkBufferCopy c1{0, 0, stateBytes};
     vkCmdCopyBuffer(cmd, state.handle(), host.handle(), 1, &c1);
@@ -85,14 +88,28 @@ void QueryCheck::readPerPoint(const PointIndex& Q, const Buffer& state, std::spa
     const auto* sorted = reinterpret_cast<const float*>(static_cast<const char*>(host.mapped()) + stateBytes);
     out.distance.assign(Q.n, 0.0);
     out.nearest.assign(Q.n, 0);
-    for (uint32_t i = 0; i < Q.n; ++i) {
-        const uint32_t qi = std::bit_cast<uint32_t>(sorted[4 * i + 3]);
-        const uint32_t ti = uint32_t(states[i].best & 0xffffffffu);
-        if (qi >= qPts.size() || ti >= tPts.size() || states[i].status != RTHDIST_EXACT)
-            throw std::runtime_error("per-point read-back: query " + std::to_string(i) + " has no exact NN");
-        out.nearest[qi] = ti;
-        out.distance[qi] = glm::length(glm::dvec3(qPts[qi]) - glm::dvec3(tPts[ti]));
-    }
+    // Cached host memory (MemoryKind::kReadback) read on every host thread:
+    // 32 bytes per query (per-point calls of out-of-core tiles read back
+    // 10^8 queries).
+    std::atomic<uint64_t> firstBad{UINT64_MAX};
+    const int threads = core::resolveThreads(m_ws.threads, Q.n / kHostChunk + 1);
+    core::parallelChunks(Q.n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) {
+            const uint32_t qi = std::bit_cast<uint32_t>(sorted[4 * i + 3]);
+            const uint32_t ti = uint32_t(states[i].best & 0xffffffffu);
+            if (qi >= qPts.size() || ti >= tPts.size() || states[i].status != RTHDIST_EXACT) {
+                uint64_t seen = firstBad.load();
+                while (i < seen && !firstBad.compare_exchange_weak(seen, i)) {
+                }
+                return;
+            }
+            out.nearest[qi] = ti;
+            out.distance[qi] = glm::length(glm::dvec3(qPts[qi]) - glm::dvec3(tPts[ti]));
+        }
+    });
+    if (firstBad.load() != UINT64_MAX)
+        throw std::runtime_error("per-point read-back: query " + std::to_string(firstBad.load()) +
+                                 " has no exact NN");
 }
 
 }  // namespace rthdist::gpu_algo
