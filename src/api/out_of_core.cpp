@@ -165,21 +165,48 @@ struct ChunkBest {
         : d2(n, std::numeric_limits<float>::infinity()), distance(n, 0.0), nearest(n, UINT32_MAX) {}
 };
 
-// The queries of the chunk that a tile may still improve: a query is skipped
-// when the tile's box is farther than its best pair (no point of the tile can
-// be nearer, nor tie with a smaller index: the box distance is a lower bound),
-// or, without per-point output, when its best pair is already no farther than
-// the running maximum of earlier chunks (their queries have smaller indices,
-// so it can neither exceed nor win a tie: DESIGN §3's early break).
-std::vector<uint32_t> queriesForTile(Span qc, const Tile& tile, const ChunkBest& best, float dropAtOrBelow,
-                                     double scale, int threads) {
+// Each query's home tile: the one whose box is nearest (the first among
+// ties). A query's first call goes to its home tile, so that a query inside
+// one tile's box meets its neighbourhood first and its best pair is short
+// before it is offered to any other tile.
+std::vector<uint32_t> homeTiles(Span qc, const std::vector<Tile>& tiles, double scale, int threads) {
+    std::vector<uint32_t> home(qc.size(), 0);
+    threads = core::resolveThreads(threads, qc.size() / kHostChunk + 1);
+    core::parallelChunks(qc.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) {
+            float nearest = boxDist2(qc[i], tiles[0], scale);
+            for (size_t j = 1; j < tiles.size() && nearest > 0.0f; ++j) {
+                const float d2 = boxDist2(qc[i], tiles[j], scale);
+                if (d2 < nearest) {
+                    nearest = d2;
+                    home[i] = uint32_t(j);
+                }
+            }
+        }
+    });
+    return home;
+}
+
+// The queries of the chunk that tile `j` may still improve. First round
+// (`homeRound`): the queries whose home it is. Second round: the others,
+// except where the tile's box is farther than the query's best pair (no point
+// of the tile can be nearer, nor tie with a smaller index: the box distance
+// is a lower bound) and, without per-point output, where the best pair is
+// already no farther than the running maximum of earlier chunks (their
+// queries have smaller indices, so it can neither exceed nor win a tie:
+// DESIGN §3's early break).
+std::vector<uint32_t> queriesForTile(Span qc, const std::vector<Tile>& tiles, uint32_t j,
+                                     const std::vector<uint32_t>& home, bool homeRound, const ChunkBest& best,
+                                     float dropAtOrBelow, double scale, int threads) {
     threads = core::resolveThreads(threads, qc.size() / kHostChunk + 1);
     std::vector<std::vector<uint32_t>> parts((qc.size() + kHostChunk - 1) / kHostChunk);
     core::parallelChunks(qc.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
         std::vector<uint32_t>& keep = parts[begin / kHostChunk];
         for (size_t i = begin; i < end; ++i) {
-            if (best.d2[i] <= dropAtOrBelow) continue;
-            if (boxDist2(qc[i], tile, scale) <= best.d2[i]) keep.push_back(uint32_t(i));
+            if ((home[i] == j) != homeRound) continue;
+            if (!homeRound && (best.d2[i] <= dropAtOrBelow || boxDist2(qc[i], tiles[j], scale) > best.d2[i]))
+                continue;
+            keep.push_back(uint32_t(i));
         }
     });
     std::vector<uint32_t> keep;
@@ -241,21 +268,29 @@ std::optional<Error> chunkAgainstAll(Span qc, uint64_t q0, Span t, double scale,
     return std::nullopt;
 }
 
-// A chunk against several tiles: the nearest tiles first, each for the
-// queries it may still improve; then the chunk's witness (its largest best
-// pair, the smallest query index among ties).
+// A chunk against several tiles: every query against its home tile, then the
+// other tiles nearest the chunk first, each for the queries it may still
+// improve; then the chunk's witness (its largest best pair, the smallest
+// query index among ties). `from`/`step`: the chunk's share of the progress.
 std::optional<Error> chunkAgainstTiles(Span qc, uint64_t q0, Span t, const std::vector<Tile>& tiles,
                                        double scale, const CallOptions& call, const DirectedCall& directed,
                                        int threads, DirectionState& s, double from, double step) {
     ChunkBest best(qc.size());
     const float drop = call.perPointDistances ? -1.0f : s.witnessD2;
+    const std::vector<uint32_t> home = homeTiles(qc, tiles, scale, threads);
     const std::vector<size_t> order = tileOrder(qc, tiles, scale, threads);
-    for (size_t k = 0; k < order.size(); ++k) {
-        const Tile& tile = tiles[order[k]];
-        const std::vector<uint32_t> selected = queriesForTile(qc, tile, best, drop, scale, threads);
-        if (selected.empty()) continue;
-        const CallOptions piece = pieceOptions(call, true, from + step * double(k), step);
-        if (auto err = searchTile(qc, selected, tile, scale, piece, directed, threads, best, s)) return err;
+    for (const bool homeRound : {true, false}) {
+        for (size_t k = 0; k < order.size(); ++k) {
+            const uint32_t j = uint32_t(order[k]);
+            const std::vector<uint32_t> selected =
+                queriesForTile(qc, tiles, j, home, homeRound, best, drop, scale, threads);
+            if (selected.empty()) continue;
+            const double at =
+                from + step * (0.5 * double(k) / double(order.size()) + (homeRound ? 0.0 : 0.5));
+            const CallOptions piece = pieceOptions(call, true, at, step * 0.5 / double(order.size()));
+            if (auto err = searchTile(qc, selected, tiles[j], scale, piece, directed, threads, best, s))
+                return err;
+        }
     }
     const size_t w = size_t(std::max_element(best.d2.begin(), best.d2.end()) - best.d2.begin());
     Directed d;
@@ -285,11 +320,11 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
         s.perPoint.distance.resize(q.size());
         s.perPoint.nearest.resize(q.size());
     }
-    const double step = width / double(chunks * tileCount);
+    const double step = width / double(chunks);  // each chunk's share of the progress
     for (uint64_t c = 0; c < chunks; ++c) {
         const uint64_t q0 = c * split.queryChunk;
         const Span qc = q.subspan(q0, std::min<uint64_t>(split.queryChunk, q.size() - q0));
-        const double at = from + step * double(c * tileCount);
+        const double at = from + step * double(c);
         const std::optional<Error> err =
             tiles.empty() ? chunkAgainstAll(qc, q0, t, scale,
                                             pieceOptions(call, call.perPointDistances, at, step), directed, s)

@@ -217,9 +217,10 @@ int main(int argc, char** argv) {
     out["check_s"] = checkS;
     out["query_chunks_a_to_b"] = r->aToB.counters.queryChunks;
     out["target_tiles_b_to_a"] = r->bToA.counters.targetTiles;
-    out["index_ms"] = r->timings.index;
-    out["search_ms"] = r->timings.search;
-    out["total_ms"] = r->timings.total;
+    const Timings& t = r->timings;
+    out["timings_ms"] = {{"upload", t.upload}, {"index", t.index},   {"cull", t.cull},
+                         {"search", t.search}, {"refine", t.refine}, {"check", t.check},
+                         {"total", t.total}};
     out["peak_rss_gib"] = peakRssGiB();
     out["hausdorff"] = r->hausdorff;
     out["expected"] = expected;
