@@ -28,6 +28,11 @@
 // that point; h(A, B) is the brute force over A x B in double (3 N^3
 // distances), and its witness pair must realize it with the target a nearest
 // of the three to the query. --memory-budget MIB forces the out-of-core split.
+//
+// --write-ply PREFIX writes A and B as binary PLY files PREFIX_a.ply and
+// PREFIX_b.ply instead of computing (for rthdist and rthdist-mpi runs on the
+// same sets: the JSON printed gives the expected H, and h(B,A)'s witness is
+// the last point of B).
 // Prints one JSON object (sizes, times, peak memory, each check) and exits 0
 // when every check holds, 1 when one fails, 2 on a usage error, 3 when the
 // library refuses or fails the call.
@@ -150,6 +155,18 @@ Json threeChecks(size_t n, const std::vector<glm::vec3>& a, const std::vector<gl
     return checks;
 }
 
+// A binary little-endian PLY of float x, y, z (glm::vec3 is three packed floats).
+bool writePly(const std::string& path, const std::vector<glm::vec3>& points) {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (f == nullptr) return false;
+    const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " +
+                               std::to_string(points.size()) +
+                               "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size();
+    ok = ok && std::fwrite(points.data(), sizeof(glm::vec3), points.size(), f) == points.size();
+    return std::fclose(f) == 0 && ok;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -163,6 +180,8 @@ int main(int argc, char** argv) {
     bool three = false;
     uint64_t budgetMib = 0;
     app.add_flag("--three", three, "B is three points (brute-force check of h(A,B))");
+    std::string plyPrefix;
+    app.add_option("--write-ply", plyPrefix, "write PREFIX_a.ply and PREFIX_b.ply instead of computing");
     app.add_option("--memory-budget", budgetMib, "MiB one backend call may hold, 0 = automatic")
         ->check(CLI::Range(uint64_t(0), uint64_t(1) << 30));
     try {
@@ -190,6 +209,22 @@ int main(int argc, char** argv) {
         b.push_back(glm::vec3(float(n) + 100.25f, -40.375f, float(n / 3) + 0.125f));  // the outlier o
     }
     const double generateS = secondsSince(start);
+    if (!plyPrefix.empty()) {
+        start = Clock::now();
+        if (!writePly(plyPrefix + "_a.ply", a) || !writePly(plyPrefix + "_b.ply", b)) {
+            std::fprintf(stderr, "lattice-check: cannot write %s_a.ply / %s_b.ply\n", plyPrefix.c_str(),
+                         plyPrefix.c_str());
+            return 3;
+        }
+        const glm::dvec3 o(b.back());
+        Json out = {{"side", n},
+                    {"points_a", a.size()},
+                    {"points_b", b.size()},
+                    {"write_s", secondsSince(start)},
+                    {"expected_hausdorff", three ? -1.0 : glm::length(o - nearestLatticePoint(o, n))}};
+        std::cout << out.dump(2) << "\n";
+        return 0;
+    }
 
     start = Clock::now();
     const Result<HausdorffResult> r = hausdorff(a, b, options);
