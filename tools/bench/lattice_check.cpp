@@ -253,9 +253,8 @@ int main(int argc, char** argv) {
     out["query_chunks_a_to_b"] = r->aToB.counters.queryChunks;
     out["target_tiles_b_to_a"] = r->bToA.counters.targetTiles;
     const Timings& t = r->timings;
-    out["timings_ms"] = {{"upload", t.upload}, {"index", t.index},   {"cull", t.cull},
-                         {"search", t.search}, {"refine", t.refine}, {"check", t.check},
-                         {"total", t.total}};
+    out["timings_ms"] = {{"upload", t.upload}, {"index", t.index}, {"cull", t.cull},  {"search", t.search},
+                         {"refine", t.refine}, {"check", t.check}, {"total", t.total}};
     out["peak_rss_gib"] = peakRssGiB();
     out["hausdorff"] = r->hausdorff;
     out["expected"] = expected;
