@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -155,79 +156,138 @@ std::vector<size_t> tileOrder(Span chunk, const std::vector<Tile>& tiles, double
     return order;
 }
 
-// Every query's best pair over the tiles seen so far (searchDist2, the
-// distance the call reported, the target's index in the whole set).
-struct ChunkBest {
-    std::vector<float> d2;
-    std::vector<double> distance;
-    std::vector<uint32_t> nearest;
-    explicit ChunkBest(size_t n)
-        : d2(n, std::numeric_limits<float>::infinity()), distance(n, 0.0), nearest(n, UINT32_MAX) {}
+// Host memory for up to 10^8 entries per chunk, kept for a whole direction:
+// new T[] leaves trivial types uninitialised (a std::vector would zero it on
+// one thread), so the first touch, and its page faults, happen in the
+// parallel passes that fill it.
+template <class T>
+class HostArray {
+public:
+    // Room for n entries (contents unspecified).
+    void resize(size_t n) {
+        if (n > m_capacity) {
+            m_data.reset(new T[n]);
+            m_capacity = n;
+        }
+        m_size = n;
+    }
+    [[nodiscard]] size_t size() const { return m_size; }
+    T& operator[](size_t i) { return m_data[i]; }
+    const T& operator[](size_t i) const { return m_data[i]; }
+    T* begin() { return m_data.get(); }
+    T* end() { return m_data.get() + m_size; }
+
+private:
+    std::unique_ptr<T[]> m_data;
+    size_t m_capacity = 0, m_size = 0;
 };
 
-// Each query's home tile: the one whose box is nearest (the first among
-// ties). A query's first call goes to its home tile, so that a query inside
-// one tile's box meets its neighbourhood first and its best pair is short
-// before it is offered to any other tile.
-std::vector<uint32_t> homeTiles(Span qc, const std::vector<Tile>& tiles, double scale, int threads) {
-    std::vector<uint32_t> home(qc.size(), 0);
+// What a direction's chunks reuse: every query's best pair over the tiles
+// seen so far (searchDist2, the distance the call reported, the target's index
+// in the whole set), its home tile, and the gathered queries of one call.
+struct ChunkScratch {
+    HostArray<float> d2;
+    HostArray<double> distance;
+    HostArray<uint32_t> nearest;
+    HostArray<uint32_t> home;
+    HostArray<glm::vec3> subset;
+};
+
+// Each query's best pair set to none, and its home tile: the one whose box
+// is nearest (the first among ties). A query's first call goes to its home
+// tile, so that a query inside one tile's box meets its neighbourhood first
+// and its best pair is short before it is offered to any other tile.
+void startChunk(Span qc, const std::vector<Tile>& tiles, double scale, int threads, ChunkScratch& x) {
+    x.d2.resize(qc.size());
+    x.distance.resize(qc.size());
+    x.nearest.resize(qc.size());
+    x.home.resize(qc.size());
     threads = core::resolveThreads(threads, qc.size() / kHostChunk + 1);
     core::parallelChunks(qc.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
+            x.d2[i] = std::numeric_limits<float>::infinity();
+            x.distance[i] = 0.0;
+            x.nearest[i] = UINT32_MAX;
+            uint32_t home = 0;
             float nearest = boxDist2(qc[i], tiles[0], scale);
             for (size_t j = 1; j < tiles.size() && nearest > 0.0f; ++j) {
                 const float d2 = boxDist2(qc[i], tiles[j], scale);
                 if (d2 < nearest) {
                     nearest = d2;
-                    home[i] = uint32_t(j);
+                    home = uint32_t(j);
                 }
             }
+            x.home[i] = home;
         }
     });
-    return home;
 }
 
-// The queries of the chunk that tile `j` may still improve. First round
-// (`homeRound`): the queries whose home it is. Second round: the others,
-// except where the tile's box is farther than the query's best pair (no point
-// of the tile can be nearer, nor tie with a smaller index: the box distance
-// is a lower bound) and, without per-point output, where the best pair is
-// already no farther than the running maximum of earlier chunks (their
-// queries have smaller indices, so it can neither exceed nor win a tie:
-// DESIGN §3's early break).
-std::vector<uint32_t> queriesForTile(Span qc, const std::vector<Tile>& tiles, uint32_t j,
-                                     const std::vector<uint32_t>& home, bool homeRound, const ChunkBest& best,
+// Ascending query indices gathered by parallel tasks, each task's list in
+// task order.
+std::vector<uint32_t> concatenate(const std::vector<std::vector<uint32_t>>& parts) {
+    size_t total = 0;
+    for (const std::vector<uint32_t>& part : parts) total += part.size();
+    std::vector<uint32_t> all;
+    all.reserve(total);
+    for (const std::vector<uint32_t>& part : parts) all.insert(all.end(), part.begin(), part.end());
+    return all;
+}
+
+// The queries of each tile's first round: those whose home it is (one pass).
+std::vector<std::vector<uint32_t>> queriesByHome(const ChunkScratch& x, size_t tiles, int threads) {
+    const size_t n = x.home.size();
+    threads = core::resolveThreads(threads, n / kHostChunk + 1);
+    std::vector<std::vector<std::vector<uint32_t>>> parts((n + kHostChunk - 1) / kHostChunk,
+                                                          std::vector<std::vector<uint32_t>>(tiles));
+    core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
+        std::vector<std::vector<uint32_t>>& mine = parts[begin / kHostChunk];
+        for (size_t i = begin; i < end; ++i) mine[x.home[i]].push_back(uint32_t(i));
+    });
+    std::vector<std::vector<uint32_t>> lists(tiles);
+    std::vector<std::vector<uint32_t>> column(parts.size());
+    for (size_t j = 0; j < tiles; ++j) {
+        for (size_t t = 0; t < parts.size(); ++t) column[t] = std::move(parts[t][j]);
+        lists[j] = concatenate(column);
+    }
+    return lists;
+}
+
+// The queries of the chunk that tile `j` may still improve after the first
+// round: those whose home it is not, except where the tile's box is farther
+// than the query's best pair (no point of the tile can be nearer, nor tie
+// with a smaller index: the box distance is a lower bound) and, without
+// per-point output, where the best pair is already no farther than the
+// running maximum of earlier chunks (their queries have smaller indices, so
+// it can neither exceed nor win a tie: DESIGN §3's early break).
+std::vector<uint32_t> queriesForTile(Span qc, const Tile& tile, uint32_t j, const ChunkScratch& x,
                                      float dropAtOrBelow, double scale, int threads) {
     threads = core::resolveThreads(threads, qc.size() / kHostChunk + 1);
     std::vector<std::vector<uint32_t>> parts((qc.size() + kHostChunk - 1) / kHostChunk);
     core::parallelChunks(qc.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
         std::vector<uint32_t>& keep = parts[begin / kHostChunk];
         for (size_t i = begin; i < end; ++i) {
-            if ((home[i] == j) != homeRound) continue;
-            if (!homeRound && (best.d2[i] <= dropAtOrBelow || boxDist2(qc[i], tiles[j], scale) > best.d2[i]))
+            if (x.home[i] == j || x.d2[i] <= dropAtOrBelow || boxDist2(qc[i], tile, scale) > x.d2[i])
                 continue;
             keep.push_back(uint32_t(i));
         }
     });
-    std::vector<uint32_t> keep;
-    for (const std::vector<uint32_t>& part : parts) keep.insert(keep.end(), part.begin(), part.end());
-    return keep;
+    return concatenate(parts);
 }
 
-// One tile's call for the selected queries (per-point), merged into `best`:
-// a nearer pair replaces, an equal one only with a smaller target index.
+// One tile's call for the selected queries (per-point), merged into the
+// chunk's best pairs: a nearer pair replaces, an equal one only with a
+// smaller target index.
 std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, const Tile& tile,
                                 double scale, const CallOptions& piece, const DirectedCall& directed,
-                                int threads, ChunkBest& best, DirectionState& s) {
+                                int threads, ChunkScratch& x, DirectionState& s) {
     threads = core::resolveThreads(threads, selected.size() / kHostChunk + 1);
-    std::vector<glm::vec3> subset;
     Span queries = qc;
     if (selected.size() < qc.size()) {
-        subset.resize(selected.size());
+        x.subset.resize(selected.size());
         core::parallelChunks(selected.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
-            for (size_t k = begin; k < end; ++k) subset[k] = qc[selected[k]];
+            for (size_t k = begin; k < end; ++k) x.subset[k] = qc[selected[k]];
         });
-        queries = subset;
+        queries = Span(x.subset.begin(), x.subset.size());
     }
     Result<HausdorffResult> r = directed(queries, tile.points, piece);
     if (!r) return r.error();
@@ -239,10 +299,10 @@ std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, 
             const uint32_t i = selected[k];  // each query once
             const float d2 = searchDist2(qc[i], tile.points[pp.nearest[k]], scale);
             const uint32_t target = uint32_t(pp.nearest[k] + tile.offset);
-            if (d2 < best.d2[i] || (d2 == best.d2[i] && target < best.nearest[i])) {
-                best.d2[i] = d2;
-                best.distance[i] = pp.distance[k];
-                best.nearest[i] = target;
+            if (d2 < x.d2[i] || (d2 == x.d2[i] && target < x.nearest[i])) {
+                x.d2[i] = d2;
+                x.distance[i] = pp.distance[k];
+                x.nearest[i] = target;
             }
         }
     });
@@ -274,35 +334,36 @@ std::optional<Error> chunkAgainstAll(Span qc, uint64_t q0, Span t, double scale,
 // query index among ties). `from`/`step`: the chunk's share of the progress.
 std::optional<Error> chunkAgainstTiles(Span qc, uint64_t q0, Span t, const std::vector<Tile>& tiles,
                                        double scale, const CallOptions& call, const DirectedCall& directed,
-                                       int threads, DirectionState& s, double from, double step) {
-    ChunkBest best(qc.size());
+                                       int threads, ChunkScratch& x, DirectionState& s, double from,
+                                       double step) {
     const float drop = call.perPointDistances ? -1.0f : s.witnessD2;
-    const std::vector<uint32_t> home = homeTiles(qc, tiles, scale, threads);
+    startChunk(qc, tiles, scale, threads, x);
     const std::vector<size_t> order = tileOrder(qc, tiles, scale, threads);
+    const std::vector<std::vector<uint32_t>> home = queriesByHome(x, tiles.size(), threads);
     for (const bool homeRound : {true, false}) {
         for (size_t k = 0; k < order.size(); ++k) {
             const uint32_t j = uint32_t(order[k]);
             const std::vector<uint32_t> selected =
-                queriesForTile(qc, tiles, j, home, homeRound, best, drop, scale, threads);
+                homeRound ? home[j] : queriesForTile(qc, tiles[j], j, x, drop, scale, threads);
             if (selected.empty()) continue;
             const double at =
                 from + step * (0.5 * double(k) / double(order.size()) + (homeRound ? 0.0 : 0.5));
             const CallOptions piece = pieceOptions(call, true, at, step * 0.5 / double(order.size()));
-            if (auto err = searchTile(qc, selected, tiles[j], scale, piece, directed, threads, best, s))
+            if (auto err = searchTile(qc, selected, tiles[j], scale, piece, directed, threads, x, s))
                 return err;
         }
     }
-    const size_t w = size_t(std::max_element(best.d2.begin(), best.d2.end()) - best.d2.begin());
+    const size_t w = size_t(std::max_element(x.d2.begin(), x.d2.end()) - x.d2.begin());
     Directed d;
-    d.distance = best.distance[w];
+    d.distance = x.distance[w];
     d.queryIndex = uint32_t(w);
-    d.targetIndex = best.nearest[w];
+    d.targetIndex = x.nearest[w];
     d.queryPoint = glm::dvec3(qc[w]);
-    d.targetPoint = glm::dvec3(t[best.nearest[w]]);
-    offerWitness(s, d, best.d2[w], q0, 0);
+    d.targetPoint = glm::dvec3(t[x.nearest[w]]);
+    offerWitness(s, d, x.d2[w], q0, 0);
     if (call.perPointDistances) {
-        std::copy(best.distance.begin(), best.distance.end(), s.perPoint.distance.begin() + ptrdiff_t(q0));
-        std::copy(best.nearest.begin(), best.nearest.end(), s.perPoint.nearest.begin() + ptrdiff_t(q0));
+        std::copy(x.distance.begin(), x.distance.end(), s.perPoint.distance.begin() + ptrdiff_t(q0));
+        std::copy(x.nearest.begin(), x.nearest.end(), s.perPoint.nearest.begin() + ptrdiff_t(q0));
     }
     return std::nullopt;
 }
@@ -321,14 +382,16 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
         s.perPoint.nearest.resize(q.size());
     }
     const double step = width / double(chunks);  // each chunk's share of the progress
+    ChunkScratch scratch;
     for (uint64_t c = 0; c < chunks; ++c) {
         const uint64_t q0 = c * split.queryChunk;
         const Span qc = q.subspan(q0, std::min<uint64_t>(split.queryChunk, q.size() - q0));
         const double at = from + step * double(c);
         const std::optional<Error> err =
-            tiles.empty() ? chunkAgainstAll(qc, q0, t, scale,
-                                            pieceOptions(call, call.perPointDistances, at, step), directed, s)
-                          : chunkAgainstTiles(qc, q0, t, tiles, scale, call, directed, threads, s, at, step);
+            tiles.empty()
+                ? chunkAgainstAll(qc, q0, t, scale, pieceOptions(call, call.perPointDistances, at, step),
+                                  directed, s)
+                : chunkAgainstTiles(qc, q0, t, tiles, scale, call, directed, threads, scratch, s, at, step);
         if (err) return *err;
     }
     s.witness.counters.queries = q.size();  // tiles' calls count their queries again
