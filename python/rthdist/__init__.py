@@ -122,10 +122,16 @@ class Engine:
     a time (calls from several threads wait for each other); give each thread
     its own Engine to run in parallel. close() (or leaving the with block)
     releases the device; prepared sets keep it alive until they go too.
+
+    memory_budget: bytes one backend call may hold (0 = automatic: 3/4 of
+    the device's memory budget on a GPU, none on the CPU backend). Larger
+    pairs of arrays are computed exactly in query chunks and target tiles
+    (README "Inputs larger than the device"; result counters query_chunks,
+    target_tiles). Prepared sets are not split.
     """
 
-    def __init__(self, backend="auto", *, device=None, threads=0, validation=False):
-        self._engine = _rthdist._Engine(str(backend), device, int(threads), bool(validation))
+    def __init__(self, backend="auto", *, device=None, threads=0, validation=False, memory_budget=0):
+        self._engine = _rthdist._Engine(str(backend), device, int(threads), bool(validation), int(memory_budget))
 
     def prepare(self, points, *, bits=0, origin=None):
         """points indexed once on this Engine's device: a PreparedSet for any number of calls.

@@ -117,7 +117,13 @@ class PreparedSet:
 
 class Engine:
     def __init__(
-        self, backend: BackendName = "auto", *, device: Optional[int] = None, threads: int = 0, validation: bool = False
+        self,
+        backend: BackendName = "auto",
+        *,
+        device: Optional[int] = None,
+        threads: int = 0,
+        validation: bool = False,
+        memory_budget: int = 0,
     ) -> None: ...
     def prepare(
         self, points: PointsLike, *, bits: int = 0, origin: Optional[Sequence[float]] = None

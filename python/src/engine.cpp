@@ -153,8 +153,11 @@ struct PyPrepared {
 // end of a `with` block); calls are serialized by m_mutex.
 class PyEngine {
 public:
-    PyEngine(const std::string& backend, std::optional<int> device, int threads, bool validation) {
-        const Options options = engineOptions(backend, device, threads, validation);
+    PyEngine(const std::string& backend, std::optional<int> device, int threads, bool validation,
+             int64_t memoryBudget) {
+        Options options = engineOptions(backend, device, threads, validation);
+        if (memoryBudget < 0) throw py::value_error("memory_budget must be >= 0 bytes (0 = automatic)");
+        options.memoryBudget = uint64_t(memoryBudget);
         std::optional<Result<Engine>> engine;
         {
             py::gil_scoped_release release;
@@ -349,8 +352,8 @@ void bindEngine(py::module_& m) {
         });
 
     py::class_<PyEngine>(m, "_Engine", "A device and its pipelines kept between calls (rthdist.Engine).")
-        .def(py::init<const std::string&, std::optional<int>, int, bool>(), py::arg("backend"),
-             py::arg("device"), py::arg("threads"), py::arg("validation"))
+        .def(py::init<const std::string&, std::optional<int>, int, bool, int64_t>(), py::arg("backend"),
+             py::arg("device"), py::arg("threads"), py::arg("validation"), py::arg("memory_budget"))
         .def("hausdorff", &PyEngine::hausdorff, py::arg("a"), py::arg("b"), py::arg("directed"),
              py::arg("per_point"), py::arg("bits"), py::arg("radius_growth"), py::arg("progress"))
         .def("prepare", &PyEngine::prepare, py::arg("points"), py::arg("bits"), py::arg("origin"))

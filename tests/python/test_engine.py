@@ -30,6 +30,21 @@ def test_engine_reuse_and_call_settings(backend, rng):
     engine.close()  # idempotent
 
 
+def test_memory_budget_splits_with_the_same_result(backend, rng):
+    a = rng.random((6000, 3)).astype(np.float32)
+    b = rng.random((5000, 3)).astype(np.float32) + 0.25
+    with rthdist.Engine(backend) as whole, rthdist.Engine(backend, memory_budget=2000 * 128) as split:
+        want = whole.hausdorff(a, b)
+        got = split.hausdorff(a, b)
+    check_result(got, a, b)
+    assert got.distance == pytest.approx(want.distance, rel=1e-6)
+    for d in ("a_to_b", "b_to_a"):
+        assert want.counters[d]["query_chunks"] * want.counters[d]["target_tiles"] == 1
+        assert got.counters[d]["query_chunks"] > 1 and got.counters[d]["target_tiles"] > 1
+    with pytest.raises(ValueError, match="memory_budget"):
+        rthdist.Engine("cpu", memory_budget=-1)
+
+
 def test_engine_errors():
     with pytest.raises(ValueError):
         rthdist.Engine("nope")
