@@ -1,13 +1,14 @@
 #include "api/out_of_core.hpp"
 
+#include "core/index_space.hpp"
 #include "core/parallel.hpp"
+#include "core/uninit_vector.hpp"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <limits>
-#include <memory>
 #include <optional>
 #include <vector>
 
@@ -21,12 +22,13 @@ using Span = std::span<const glm::vec3>;
 constexpr size_t kHostChunk = size_t(1) << 16;
 
 // The running state of one direction: its witness so far, every query's best
-// so far (with tiles, or when the caller asked for per-point output), and
-// the counters and timings of the calls.
+// pair (when the caller asked for per-point output), and the counters and
+// timings of the calls.
 struct DirectionState {
     Directed witness;
     float witnessD2 = -1.0f;  // the witness pair's searchDist2 (-1: none yet)
     PerPoint perPoint;
+    Counters counters;
     Timings timings;
 };
 
@@ -58,10 +60,13 @@ void addTimings(Timings& into, const Timings& t) {
 // The squared distance of a pair as the backends compare pairs: in float, on
 // the points scaled by the call's exact power of two (core::exactScale), so
 // that the pieces choose among near-ties as one call would.
-float searchDist2(const glm::vec3& q, const glm::vec3& t, double scale) {
-    const glm::vec3 d = glm::vec3(glm::dvec3(q) * scale) - glm::vec3(glm::dvec3(t) * scale);
+float squaredLength(const glm::vec3& d) {
     const float xy = d.x * d.x + d.y * d.y;
     return xy + d.z * d.z;
+}
+
+float searchDist2(const glm::vec3& q, const glm::vec3& t, double scale) {
+    return squaredLength(core::scaled(q, scale) - core::scaled(t, scale));
 }
 
 // A chunk's witness against the direction's: the larger distance wins, the
@@ -69,11 +74,9 @@ float searchDist2(const glm::vec3& q, const glm::vec3& t, double scale) {
 void offerWitness(DirectionState& s, const Directed& d, float d2, uint64_t queryOffset,
                   uint64_t targetOffset) {
     if (!(d2 > s.witnessD2)) return;
-    const Counters keep = s.witness.counters;
     s.witness = d;
     s.witness.queryIndex = uint32_t(d.queryIndex + queryOffset);
     s.witness.targetIndex = uint32_t(d.targetIndex + targetOffset);
-    s.witness.counters = keep;
     s.witnessD2 = d2;
 }
 
@@ -98,16 +101,12 @@ struct Tile {
     glm::vec3 lo{0.0f}, hi{0.0f};
 };
 
-glm::vec3 scaledPoint(const glm::vec3& p, double scale) { return glm::vec3(glm::dvec3(p) * scale); }
-
 // The float squared distance from q to a tile's box, computed as searchDist2
 // computes a pair: rounding is monotone, so it never exceeds searchDist2(q, p)
 // for a point p of the tile.
 float boxDist2(const glm::vec3& q, const Tile& tile, double scale) {
-    const glm::vec3 qs = scaledPoint(q, scale);
-    const glm::vec3 d = glm::max(glm::max(tile.lo - qs, qs - tile.hi), glm::vec3(0.0f));
-    const float xy = d.x * d.x + d.y * d.y;
-    return xy + d.z * d.z;
+    const glm::vec3 qs = core::scaled(q, scale);
+    return squaredLength(glm::max(glm::max(tile.lo - qs, qs - tile.hi), glm::vec3(0.0f)));
 }
 
 // The box of `points` (non-empty), scaled as searched; on `threads` threads.
@@ -126,8 +125,8 @@ Tile boxOf(Span points, uint64_t offset, double scale, int threads) {
         box.lo = glm::min(box.lo, part.lo);
         box.hi = glm::max(box.hi, part.hi);
     }
-    box.lo = scaledPoint(box.lo, scale);  // an exact power of two: monotone
-    box.hi = scaledPoint(box.hi, scale);
+    box.lo = core::scaled(box.lo, scale);  // an exact power of two: monotone
+    box.hi = core::scaled(box.hi, scale);
     return box;
 }
 
@@ -142,11 +141,11 @@ std::vector<Tile> makeTiles(Span t, uint64_t tileSize, double scale, int threads
 // The tiles nearest the chunk first (box to box), so that its queries' best
 // distances shrink early and later tiles are skipped.
 std::vector<size_t> tileOrder(Span chunk, const std::vector<Tile>& tiles, double scale, int threads) {
-    const Tile box = boxOf(chunk, 0, 1.0, threads);
+    const Tile box = boxOf(chunk, 0, scale, threads);
     std::vector<double> gap(tiles.size());
     for (size_t j = 0; j < tiles.size(); ++j) {
-        const glm::dvec3 d = glm::max(glm::max(glm::dvec3(tiles[j].lo) - glm::dvec3(box.hi) * scale,
-                                               glm::dvec3(box.lo) * scale - glm::dvec3(tiles[j].hi)),
+        const glm::dvec3 d = glm::max(glm::max(glm::dvec3(tiles[j].lo) - glm::dvec3(box.hi),
+                                               glm::dvec3(box.lo) - glm::dvec3(tiles[j].hi)),
                                       glm::dvec3(0.0));
         gap[j] = glm::dot(d, d);
     }
@@ -156,41 +155,17 @@ std::vector<size_t> tileOrder(Span chunk, const std::vector<Tile>& tiles, double
     return order;
 }
 
-// Host memory for up to 10^8 entries per chunk, kept for a whole direction:
-// new T[] leaves trivial types uninitialised (a std::vector would zero it on
-// one thread), so the first touch, and its page faults, happen in the
-// parallel passes that fill it.
-template <class T>
-class HostArray {
-public:
-    // Room for n entries (contents unspecified).
-    void resize(size_t n) {
-        if (n > m_capacity) {
-            m_data.reset(new T[n]);
-            m_capacity = n;
-        }
-        m_size = n;
-    }
-    [[nodiscard]] size_t size() const { return m_size; }
-    T& operator[](size_t i) { return m_data[i]; }
-    const T& operator[](size_t i) const { return m_data[i]; }
-    T* begin() { return m_data.get(); }
-    T* end() { return m_data.get() + m_size; }
-
-private:
-    std::unique_ptr<T[]> m_data;
-    size_t m_capacity = 0, m_size = 0;
-};
-
 // What a direction's chunks reuse: every query's best pair over the tiles
 // seen so far (searchDist2, the distance the call reported, the target's index
 // in the whole set), its home tile, and the gathered queries of one call.
+// UninitVector: filled, and first touched, by the parallel passes below
+// (10^8 entries per chunk).
 struct ChunkScratch {
-    HostArray<float> d2;
-    HostArray<double> distance;
-    HostArray<uint32_t> nearest;
-    HostArray<uint32_t> home;
-    HostArray<glm::vec3> subset;
+    core::UninitVector<float> d2;
+    core::UninitVector<double> distance;
+    core::UninitVector<uint32_t> nearest;
+    core::UninitVector<uint32_t> home;
+    core::UninitVector<glm::vec3> subset;
 };
 
 // Each query's best pair set to none, and its home tile: the one whose box
@@ -283,15 +258,16 @@ std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, 
     threads = core::resolveThreads(threads, selected.size() / kHostChunk + 1);
     Span queries = qc;
     if (selected.size() < qc.size()) {
+        x.subset.clear();  // a larger array is not copied when it grows
         x.subset.resize(selected.size());
         core::parallelChunks(selected.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
             for (size_t k = begin; k < end; ++k) x.subset[k] = qc[selected[k]];
         });
-        queries = Span(x.subset.begin(), x.subset.size());
+        queries = x.subset;
     }
     Result<HausdorffResult> r = directed(queries, tile.points, piece);
     if (!r) return r.error();
-    addCounters(s.witness.counters, r->aToB.counters, true);
+    addCounters(s.counters, r->aToB.counters, true);
     addTimings(s.timings, r->timings);
     const PerPoint& pp = r->aNearest;
     core::parallelChunks(selected.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
@@ -315,7 +291,7 @@ std::optional<Error> chunkAgainstAll(Span qc, uint64_t q0, Span t, double scale,
                                      const DirectedCall& directed, DirectionState& s) {
     Result<HausdorffResult> r = directed(qc, t, piece);
     if (!r) return r.error();
-    addCounters(s.witness.counters, r->aToB.counters, q0 == 0);
+    addCounters(s.counters, r->aToB.counters, q0 == 0);
     addTimings(s.timings, r->timings);
     const Directed& w = r->aToB;
     offerWitness(s, w, searchDist2(qc[w.queryIndex], t[w.targetIndex], scale), q0, 0);
@@ -394,9 +370,10 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
                 : chunkAgainstTiles(qc, q0, t, tiles, scale, call, directed, threads, scratch, s, at, step);
         if (err) return *err;
     }
-    s.witness.counters.queries = q.size();  // tiles' calls count their queries again
-    s.witness.counters.queryChunks = uint32_t(chunks);
-    s.witness.counters.targetTiles = uint32_t(tileCount);
+    s.counters.queries = q.size();  // tiles' calls count their queries again
+    s.counters.queryChunks = uint32_t(chunks);
+    s.counters.targetTiles = uint32_t(tileCount);
+    s.witness.counters = s.counters;
     return s;
 }
 

@@ -52,6 +52,13 @@ struct GridSpec {
 // every finite maxAbs, subnormals included; 1 for maxAbs = 0.
 [[nodiscard]] double exactScale(double maxAbs);
 
+// p * scale computed in double and rounded: exact for a power of two that
+// keeps the product a normal float (exactScale), never inf or NaN. What every
+// backend searches, and what the out-of-core pieces compare.
+[[nodiscard]] inline glm::vec3 scaled(const glm::vec3& p, double scale) {
+    return glm::vec3(glm::dvec3(p) * scale);
+}
+
 // The largest coordinate magnitude of a float set (the maxAbs of exactScale).
 // threads: as EngineOptions::threads (0: every hardware thread).
 [[nodiscard]] double largestMagnitude(std::span<const glm::vec3> points, int threads = 0);

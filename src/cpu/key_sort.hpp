@@ -28,9 +28,11 @@
 #include <span>
 #include <vector>
 
-#include "cpu/uninit_vector.hpp"
+#include "core/uninit_vector.hpp"
 
 namespace rthdist::cpu {
+
+using core::UninitVector;
 
 // Points in key order: what sortPointsByKey produces and the adaptive order
 // refines (cpu/adaptive_order.hpp).

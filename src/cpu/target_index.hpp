@@ -47,10 +47,13 @@
 #include <vector>
 
 #include "core/index_space.hpp"
+#include "core/uninit_vector.hpp"
 #include "cpu/adaptive_order.hpp"
-#include "cpu/uninit_vector.hpp"
 
 namespace rthdist::cpu {
+
+using core::scaled;
+using core::UninitVector;
 
 inline constexpr uint32_t kBucketSize = 8;  // points per BVH leaf (at most)
 inline constexpr uint32_t kFanout = 8;      // children per BVH node
@@ -117,12 +120,6 @@ struct TargetIndex {
     [[nodiscard]] uint32_t bucketCount() const { return levels.empty() ? 0 : levels[0].count; }
     [[nodiscard]] uint32_t size() const { return uint32_t(x.size() - kPad); }  // stored targets
 };
-
-// p * scale computed in double and rounded: exact for a power of two that
-// keeps the product a normal float (core::exactScale), never inf or NaN.
-[[nodiscard]] inline glm::vec3 scaled(const glm::vec3& p, double scale) {
-    return glm::vec3(glm::dvec3(p) * scale);
-}
 
 // A set's adaptive Morton order: the layout of its target index and, the
 // same order, the order in which it is queried (neighbours consecutive, copies

@@ -43,7 +43,7 @@ std::vector<glm::vec3> scaledCopy(std::span<const glm::vec3> pts, double scale, 
     std::vector<glm::vec3> out(pts.size());
     threads = core::resolveThreads(threads, pts.size() / kHostChunk + 1);
     core::parallelChunks(pts.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) out[i] = glm::vec3(glm::dvec3(pts[i]) * scale);
+        for (size_t i = begin; i < end; ++i) out[i] = core::scaled(pts[i], scale);
     });
     return out;
 }

@@ -69,12 +69,12 @@ std::optional<Error> globalSizeError(const GlobalSet& set, const char* name) {
 }
 
 // p - origin rounded to float32 (FloatSet's rounding), then times the exact
-// power-of-two scale (cpu::scaled's rounding): the values a one-process call
+// power-of-two scale (core::scaled's rounding): the values a one-process call
 // compares.
 void roundInto(GlobalSet& set, const glm::dvec3& origin, double scale) {
     set.floats.resize(set.local.count);
     for (size_t i = 0; i < set.local.count; ++i)
-        set.floats[i] = glm::vec3(glm::dvec3(glm::vec3(set.local.at(i) - origin)) * scale);
+        set.floats[i] = core::scaled(glm::vec3(set.local.at(i) - origin), scale);
 }
 
 // Largest |coordinate| of the slice after the shift, in float (core::largestMagnitude's measure).

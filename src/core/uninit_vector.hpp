@@ -1,4 +1,5 @@
-// UninitVector<T>: the CPU backend's large per-point arrays. A std::vector
+// UninitVector<T>: large per-point host arrays (the CPU backend's, the
+// out-of-core chunks' best pairs). A std::vector
 // whose resize(n) leaves new elements default-initialised (for the
 // arithmetic types stored here: not written at all), so an array that is
 // filled by parallel workers is first touched by those workers instead of
@@ -23,7 +24,7 @@
 #include <sys/mman.h>
 #endif
 
-namespace rthdist::cpu {
+namespace rthdist::core {
 
 namespace detail {
 
@@ -93,4 +94,4 @@ struct UninitAllocator {
 template <class T>
 using UninitVector = std::vector<T, UninitAllocator<T>>;
 
-}  // namespace rthdist::cpu
+}  // namespace rthdist::core
