@@ -43,12 +43,14 @@
 #include <cstdio>
 #include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "rthdist/io.hpp"
 #include "rthdist/rthdist.hpp"
 
 using namespace rthdist;
@@ -155,18 +157,6 @@ Json threeChecks(size_t n, const std::vector<glm::vec3>& a, const std::vector<gl
     return checks;
 }
 
-// A binary little-endian PLY of float x, y, z (glm::vec3 is three packed floats).
-bool writePly(const std::string& path, const std::vector<glm::vec3>& points) {
-    std::FILE* f = std::fopen(path.c_str(), "wb");
-    if (f == nullptr) return false;
-    const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " +
-                               std::to_string(points.size()) +
-                               "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-    bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size();
-    ok = ok && std::fwrite(points.data(), sizeof(glm::vec3), points.size(), f) == points.size();
-    return std::fclose(f) == 0 && ok;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -211,10 +201,13 @@ int main(int argc, char** argv) {
     const double generateS = secondsSince(start);
     if (!plyPrefix.empty()) {
         start = Clock::now();
-        if (!writePly(plyPrefix + "_a.ply", a) || !writePly(plyPrefix + "_b.ply", b)) {
-            std::fprintf(stderr, "lattice-check: cannot write %s_a.ply / %s_b.ply\n", plyPrefix.c_str(),
-                         plyPrefix.c_str());
-            return 3;
+        for (const auto& [suffix, points] :
+             {std::pair<const char*, const std::vector<glm::vec3>*>{"_a.ply", &a}, {"_b.ply", &b}}) {
+            const Result<bool> written = io::writePlyPoints(plyPrefix + suffix, *points);
+            if (!written) {
+                std::fprintf(stderr, "lattice-check: %s\n", written.error().message.c_str());
+                return 3;
+            }
         }
         const glm::dvec3 o(b.back());
         Json out = {{"side", n},
