@@ -12,6 +12,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "rthdist/export.hpp"
 
@@ -36,6 +37,18 @@ struct EngineOptions {
     // Vulkan physical device index as listed by listDevices(); -1 = the first
     // usable discrete GPU, else integrated, virtual, other, software last.
     int deviceIndex = -1;
+    // Several devices (listDevices() indices) for one Engine, GPU backends
+    // only. A one-shot compute(a, b) past the memory budget (out of core)
+    // spreads its pieces over the devices: each direction's query chunks (at
+    // least one per device) are taken by the devices in parallel, each
+    // indexing the targets (or the tiles) it needs, the early break shared
+    // between chunks; the result, witnesses included, is the one-device
+    // result (README, "Several GPUs"). A pair that fits one call runs on the
+    // first device (splitting it costs more than it gains: each device would
+    // index every target), as do prepared sets and batches. Empty:
+    // deviceIndex alone. An index given twice opens that device twice (tests
+    // on a one-device machine; no speedup). Every device must run the backend.
+    std::vector<int> devices;
     // Enable VK_LAYER_KHRONOS_validation and count every message it emits
     // (Result::validationMessages). For tests; slow.
     bool validation = false;

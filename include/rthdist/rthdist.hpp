@@ -27,9 +27,13 @@
 // Inputs: PointView (float or double, any stride; spans and vectors of
 //   glm::vec3 or glm::dvec3 convert), finite coordinates (NaN/Inf -> kInvalidArgument),
 //   at least one point per side (an empty set -> kInvalidArgument; H is
-//   undefined). Up to 2^31 - 1 points per side (more -> kInvalidArgument);
-//   a buffer past the device's maxBufferSize, a BLAS past maxPrimitiveCount
-//   or a failed allocation -> kOutOfMemory naming the limit (README, limits).
+//   undefined). Up to 2^40 points per side in one-shot calls: sets past
+//   2^31 - 1 points (the backends' 32-bit indices) or past the memory budget
+//   run in pieces (EngineOptions::memoryBudget), witness indices are 64-bit;
+//   per-point output needs both sets below 2^32 points and a prepared set at
+//   most 2^31 - 1 (more -> kInvalidArgument). A buffer past the device's
+//   maxBufferSize, a BLAS past maxPrimitiveCount or a failed allocation ->
+//   kOutOfMemory naming the limit (README, limits).
 //   Dispatches and traces are split by the device's limits.
 //
 // Self-check (GPU backends, every call): the index of each set is a
@@ -65,7 +69,8 @@ namespace rthdist {
 // Every point's nearest neighbour in the other set (perPointDistances).
 struct PerPoint {
     std::vector<double> distance;   // recomputed in double from the pair
-    std::vector<uint32_t> nearest;  // index of the nearest point in the other set
+    std::vector<uint32_t> nearest;  // index of the nearest point in the other set (which has
+                                    // < 2^32 points: per-point output is refused past it)
 };
 
 // Counters of one direction: what the algorithm did.
@@ -87,8 +92,8 @@ struct Counters {
 // One directed distance h(Q,T) with its witness.
 struct Directed {
     double distance = 0.0;       // recomputed in double from the pair
-    uint32_t queryIndex = 0;     // index into the query set
-    uint32_t targetIndex = 0;    // index into the target set (its nearest point)
+    uint64_t queryIndex = 0;     // index into the query set (64-bit: one-shot sets may exceed 2^32)
+    uint64_t targetIndex = 0;    // index into the target set (its nearest point)
     glm::dvec3 queryPoint{0.0};  // the input's coordinates (double; exact for float input)
     glm::dvec3 targetPoint{0.0};
     Counters counters;
@@ -218,7 +223,8 @@ public:
     [[nodiscard]] Result<HausdorffResult> compute(PointView a, PointView b, const CallOptions& call);
 
     // Checks and prepares one set (points as in compute: finite, non-empty,
-    // < 2^31). The view is read during this call only.
+    // at most 2^31 - 1: a prepared set is not split). The view is read during
+    // this call only.
     [[nodiscard]] Result<PreparedSet> prepare(PointView points, const PrepareOptions& options = {});
     // H(A, B) of two sets prepared by this Engine (either may be both).
     // Witness indices refer to each set's input order.

@@ -128,10 +128,20 @@ class Engine:
     pairs of arrays are computed exactly in query chunks and target tiles
     (README "Inputs larger than the device"; result counters query_chunks,
     target_tiles). Prepared sets are not split.
+
+    devices: several GPUs (device indices, e.g. [0, 1]) for one computation
+    of two arrays: each direction's queries are split over them and the
+    result is the one-device result (README "Several GPUs"). Prepared sets
+    live on the first. An index given twice opens that device twice.
     """
 
-    def __init__(self, backend="auto", *, device=None, threads=0, validation=False, memory_budget=0):
-        self._engine = _rthdist._Engine(str(backend), device, int(threads), bool(validation), int(memory_budget))
+    def __init__(
+        self, backend="auto", *, device=None, threads=0, validation=False, memory_budget=0, devices=None
+    ):
+        devices = [] if devices is None else [int(d) for d in devices]
+        self._engine = _rthdist._Engine(
+            str(backend), device, int(threads), bool(validation), int(memory_budget), devices
+        )
 
     def prepare(self, points, *, bits=0, origin=None):
         """points indexed once on this Engine's device: a PreparedSet for any number of calls.

@@ -124,6 +124,7 @@ class Engine:
         threads: int = 0,
         validation: bool = False,
         memory_budget: int = 0,
+        devices: Optional[Sequence[int]] = None,
     ) -> None: ...
     def prepare(
         self, points: PointsLike, *, bits: int = 0, origin: Optional[Sequence[float]] = None

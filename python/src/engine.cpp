@@ -154,10 +154,13 @@ struct PyPrepared {
 class PyEngine {
 public:
     PyEngine(const std::string& backend, std::optional<int> device, int threads, bool validation,
-             int64_t memoryBudget) {
+             int64_t memoryBudget, const std::vector<int>& devices) {
         Options options = engineOptions(backend, device, threads, validation);
         if (memoryBudget < 0) throw py::value_error("memory_budget must be >= 0 bytes (0 = automatic)");
         options.memoryBudget = uint64_t(memoryBudget);
+        for (int d : devices)
+            if (d < 0 || d > 1023) throw py::value_error("devices must be device indices in 0..1023");
+        options.devices = devices;
         std::optional<Result<Engine>> engine;
         {
             py::gil_scoped_release release;
@@ -352,8 +355,9 @@ void bindEngine(py::module_& m) {
         });
 
     py::class_<PyEngine>(m, "_Engine", "A device and its pipelines kept between calls (rthdist.Engine).")
-        .def(py::init<const std::string&, std::optional<int>, int, bool, int64_t>(), py::arg("backend"),
-             py::arg("device"), py::arg("threads"), py::arg("validation"), py::arg("memory_budget"))
+        .def(py::init<const std::string&, std::optional<int>, int, bool, int64_t, const std::vector<int>&>(),
+             py::arg("backend"), py::arg("device"), py::arg("threads"), py::arg("validation"),
+             py::arg("memory_budget"), py::arg("devices"))
         .def("hausdorff", &PyEngine::hausdorff, py::arg("a"), py::arg("b"), py::arg("directed"),
              py::arg("per_point"), py::arg("bits"), py::arg("radius_growth"), py::arg("progress"))
         .def("prepare", &PyEngine::prepare, py::arg("points"), py::arg("bits"), py::arg("origin"))

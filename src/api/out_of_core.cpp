@@ -8,8 +8,11 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
+#include <mutex>
 #include <optional>
+#include <thread>
 #include <vector>
 
 namespace rthdist::api {
@@ -30,6 +33,16 @@ struct DirectionState {
     PerPoint perPoint;
     Counters counters;
     Timings timings;
+};
+
+// A direction's state shared by its lanes (one per device: chunks run in
+// parallel): the witness, counters and timings under the mutex; per-point
+// output is written by chunk, each range by one lane.
+struct SharedDirection {
+    std::mutex mutex;
+    DirectionState state;
+    std::optional<Error> error;  // the first failure; the other lanes stop at their next chunk
+    std::atomic<bool> failed{false};
 };
 
 void addCounters(Counters& into, const Counters& c, bool countTargets) {
@@ -70,14 +83,41 @@ float searchDist2(const glm::vec3& q, const glm::vec3& t, double scale) {
 }
 
 // A chunk's witness against the direction's: the larger distance wins, the
-// earlier chunk (smaller query index) among ties.
-void offerWitness(DirectionState& s, const Directed& d, float d2, uint64_t queryOffset,
+// smaller query index among ties (chunks of several lanes finish in any order).
+void offerWitness(SharedDirection& shared, const Directed& d, float d2, uint64_t queryOffset,
                   uint64_t targetOffset) {
-    if (!(d2 > s.witnessD2)) return;
+    const uint64_t query = d.queryIndex + queryOffset;
+    std::lock_guard lock(shared.mutex);
+    DirectionState& s = shared.state;
+    if (!(d2 > s.witnessD2 || (d2 == s.witnessD2 && query < s.witness.queryIndex))) return;
     s.witness = d;
-    s.witness.queryIndex = uint32_t(d.queryIndex + queryOffset);
-    s.witness.targetIndex = uint32_t(d.targetIndex + targetOffset);
+    s.witness.queryIndex = query;
+    s.witness.targetIndex = d.targetIndex + targetOffset;
     s.witnessD2 = d2;
+}
+
+// What a call adds to the direction's counters and timings.
+void addCall(SharedDirection& shared, const HausdorffResult& r, bool countTargets) {
+    std::lock_guard lock(shared.mutex);
+    addCounters(shared.state.counters, r.aToB.counters, countTargets);
+    addTimings(shared.state.timings, r.timings);
+}
+
+// The early break of a chunk starting at query index q0 against the witness
+// of the chunks finished so far (DESIGN §3): a query whose best pair is
+// nearer than the witness's cannot be the maximum; one at the same distance
+// cannot win the tie when the witness's query index is smaller (an earlier
+// chunk). Per-point output: nothing is dropped.
+struct EarlyBreak {
+    float d2 = -1.0f;
+    bool dropTies = false;
+    [[nodiscard]] bool drops(float best) const { return best < d2 || (dropTies && best == d2); }
+};
+
+EarlyBreak earlyBreak(SharedDirection& shared, uint64_t q0, bool perPoint) {
+    if (perPoint) return {};
+    std::lock_guard lock(shared.mutex);
+    return {shared.state.witnessD2, shared.state.witness.queryIndex < q0};
 }
 
 // Progress of one call mapped into [from, from + width) of the whole.
@@ -163,7 +203,7 @@ std::vector<size_t> tileOrder(Span chunk, const std::vector<Tile>& tiles, double
 struct ChunkScratch {
     core::UninitVector<float> d2;
     core::UninitVector<double> distance;
-    core::UninitVector<uint32_t> nearest;
+    core::UninitVector<uint64_t> nearest;  // index into the whole target set
     core::UninitVector<uint32_t> home;
     core::UninitVector<glm::vec3> subset;
 };
@@ -182,7 +222,7 @@ void startChunk(Span qc, const std::vector<Tile>& tiles, double scale, int threa
         for (size_t i = begin; i < end; ++i) {
             x.d2[i] = std::numeric_limits<float>::infinity();
             x.distance[i] = 0.0;
-            x.nearest[i] = UINT32_MAX;
+            x.nearest[i] = UINT64_MAX;
             uint32_t home = 0;
             float nearest = boxDist2(qc[i], tiles[0], scale);
             for (size_t j = 1; j < tiles.size() && nearest > 0.0f; ++j) {
@@ -231,31 +271,43 @@ std::vector<std::vector<uint32_t>> queriesByHome(const ChunkScratch& x, size_t t
 // round: those whose home it is not, except where the tile's box is farther
 // than the query's best pair (no point of the tile can be nearer, nor tie
 // with a smaller index: the box distance is a lower bound) and, without
-// per-point output, where the best pair is already no farther than the
-// running maximum of earlier chunks (their queries have smaller indices, so
-// it can neither exceed nor win a tie: DESIGN §3's early break).
+// per-point output, where the best pair is dropped by the early break.
 std::vector<uint32_t> queriesForTile(Span qc, const Tile& tile, uint32_t j, const ChunkScratch& x,
-                                     float dropAtOrBelow, double scale, int threads) {
+                                     const EarlyBreak& drop, double scale, int threads) {
     threads = core::resolveThreads(threads, qc.size() / kHostChunk + 1);
     std::vector<std::vector<uint32_t>> parts((qc.size() + kHostChunk - 1) / kHostChunk);
     core::parallelChunks(qc.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
         std::vector<uint32_t>& keep = parts[begin / kHostChunk];
         for (size_t i = begin; i < end; ++i) {
-            if (x.home[i] == j || x.d2[i] <= dropAtOrBelow || boxDist2(qc[i], tile, scale) > x.d2[i])
-                continue;
+            if (x.home[i] == j || drop.drops(x.d2[i]) || boxDist2(qc[i], tile, scale) > x.d2[i]) continue;
             keep.push_back(uint32_t(i));
         }
     });
     return concatenate(parts);
 }
 
+// Where a lane's calls go: its device (the DirectedCall's lane argument),
+// its share of the host threads, and whether it reports progress (lane 0,
+// the calling thread, only).
+struct Lane {
+    int index = 0;
+    int threads = 0;
+    const DirectedCall* directed = nullptr;
+    [[nodiscard]] Result<HausdorffResult> call(Span q, Span t, const CallOptions& piece) const {
+        if (index == 0) return (*directed)(index, q, t, piece);
+        CallOptions quiet = piece;
+        quiet.progress = nullptr;
+        return (*directed)(index, q, t, quiet);
+    }
+};
+
 // One tile's call for the selected queries (per-point), merged into the
 // chunk's best pairs: a nearer pair replaces, an equal one only with a
 // smaller target index.
 std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, const Tile& tile,
-                                double scale, const CallOptions& piece, const DirectedCall& directed,
-                                int threads, ChunkScratch& x, DirectionState& s) {
-    threads = core::resolveThreads(threads, selected.size() / kHostChunk + 1);
+                                double scale, const CallOptions& piece, const Lane& lane, ChunkScratch& x,
+                                SharedDirection& shared) {
+    const int threads = core::resolveThreads(lane.threads, selected.size() / kHostChunk + 1);
     Span queries = qc;
     if (selected.size() < qc.size()) {
         x.subset.clear();  // a larger array is not copied when it grows
@@ -265,16 +317,15 @@ std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, 
         });
         queries = x.subset;
     }
-    Result<HausdorffResult> r = directed(queries, tile.points, piece);
+    Result<HausdorffResult> r = lane.call(queries, tile.points, piece);
     if (!r) return r.error();
-    addCounters(s.counters, r->aToB.counters, true);
-    addTimings(s.timings, r->timings);
+    addCall(shared, *r, true);
     const PerPoint& pp = r->aNearest;
     core::parallelChunks(selected.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t k = begin; k < end; ++k) {
             const uint32_t i = selected[k];  // each query once
             const float d2 = searchDist2(qc[i], tile.points[pp.nearest[k]], scale);
-            const uint32_t target = uint32_t(pp.nearest[k] + tile.offset);
+            const uint64_t target = pp.nearest[k] + tile.offset;
             if (d2 < x.d2[i] || (d2 == x.d2[i] && target < x.nearest[i])) {
                 x.d2[i] = d2;
                 x.distance[i] = pp.distance[k];
@@ -288,31 +339,31 @@ std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, 
 // A chunk against one tile holding every target: one directed call with the
 // backend's own early break, or per-point when the caller asked for it.
 std::optional<Error> chunkAgainstAll(Span qc, uint64_t q0, Span t, double scale, const CallOptions& piece,
-                                     const DirectedCall& directed, DirectionState& s) {
-    Result<HausdorffResult> r = directed(qc, t, piece);
+                                     const Lane& lane, SharedDirection& shared) {
+    Result<HausdorffResult> r = lane.call(qc, t, piece);
     if (!r) return r.error();
-    addCounters(s.counters, r->aToB.counters, q0 == 0);
-    addTimings(s.timings, r->timings);
+    addCall(shared, *r, q0 == 0);
     const Directed& w = r->aToB;
-    offerWitness(s, w, searchDist2(qc[w.queryIndex], t[w.targetIndex], scale), q0, 0);
+    offerWitness(shared, w, searchDist2(qc[w.queryIndex], t[w.targetIndex], scale), q0, 0);
     if (piece.perPointDistances) {
         std::copy(r->aNearest.distance.begin(), r->aNearest.distance.end(),
-                  s.perPoint.distance.begin() + ptrdiff_t(q0));
+                  shared.state.perPoint.distance.begin() + ptrdiff_t(q0));
         std::copy(r->aNearest.nearest.begin(), r->aNearest.nearest.end(),
-                  s.perPoint.nearest.begin() + ptrdiff_t(q0));
+                  shared.state.perPoint.nearest.begin() + ptrdiff_t(q0));
     }
     return std::nullopt;
 }
 
 // A chunk against several tiles: every query against its home tile, then the
 // other tiles nearest the chunk first, each for the queries it may still
-// improve; then the chunk's witness (its largest best pair, the smallest
-// query index among ties). `from`/`step`: the chunk's share of the progress.
+// improve (the early break read again before each tile: other lanes' chunks
+// may have raised the maximum); then the chunk's witness (its largest best
+// pair, the smallest query index among ties). `from`/`step`: the chunk's
+// share of the progress.
 std::optional<Error> chunkAgainstTiles(Span qc, uint64_t q0, Span t, const std::vector<Tile>& tiles,
-                                       double scale, const CallOptions& call, const DirectedCall& directed,
-                                       int threads, ChunkScratch& x, DirectionState& s, double from,
-                                       double step) {
-    const float drop = call.perPointDistances ? -1.0f : s.witnessD2;
+                                       double scale, const CallOptions& call, const Lane& lane,
+                                       ChunkScratch& x, SharedDirection& shared, double from, double step) {
+    const int threads = lane.threads;
     startChunk(qc, tiles, scale, threads, x);
     const std::vector<size_t> order = tileOrder(qc, tiles, scale, threads);
     const std::vector<std::vector<uint32_t>> home = queriesByHome(x, tiles.size(), threads);
@@ -320,59 +371,103 @@ std::optional<Error> chunkAgainstTiles(Span qc, uint64_t q0, Span t, const std::
         for (size_t k = 0; k < order.size(); ++k) {
             const uint32_t j = uint32_t(order[k]);
             const std::vector<uint32_t> selected =
-                homeRound ? home[j] : queriesForTile(qc, tiles[j], j, x, drop, scale, threads);
+                homeRound ? home[j]
+                          : queriesForTile(qc, tiles[j], j, x, earlyBreak(shared, q0, call.perPointDistances),
+                                           scale, threads);
             if (selected.empty()) continue;
             const double at =
                 from + step * (0.5 * double(k) / double(order.size()) + (homeRound ? 0.0 : 0.5));
             const CallOptions piece = pieceOptions(call, true, at, step * 0.5 / double(order.size()));
-            if (auto err = searchTile(qc, selected, tiles[j], scale, piece, directed, threads, x, s))
-                return err;
+            if (auto err = searchTile(qc, selected, tiles[j], scale, piece, lane, x, shared)) return err;
         }
     }
     const size_t w = size_t(std::max_element(x.d2.begin(), x.d2.end()) - x.d2.begin());
     Directed d;
     d.distance = x.distance[w];
-    d.queryIndex = uint32_t(w);
+    d.queryIndex = w;
     d.targetIndex = x.nearest[w];
     d.queryPoint = glm::dvec3(qc[w]);
     d.targetPoint = glm::dvec3(t[x.nearest[w]]);
-    offerWitness(s, d, x.d2[w], q0, 0);
+    offerWitness(shared, d, x.d2[w], q0, 0);
     if (call.perPointDistances) {
-        std::copy(x.distance.begin(), x.distance.end(), s.perPoint.distance.begin() + ptrdiff_t(q0));
-        std::copy(x.nearest.begin(), x.nearest.end(), s.perPoint.nearest.begin() + ptrdiff_t(q0));
+        PerPoint& pp = shared.state.perPoint;
+        std::copy(x.distance.begin(), x.distance.end(), pp.distance.begin() + ptrdiff_t(q0));
+        // Per-point output holds 32-bit indices: the Engine refuses it past 2^32 - 1 targets.
+        std::transform(x.nearest.begin(), x.nearest.end(), pp.nearest.begin() + ptrdiff_t(q0),
+                       [](uint64_t i) { return uint32_t(i); });
     }
     return std::nullopt;
 }
 
-// One direction Q -> T within `split`; `from`/`width`: its share of the progress.
-Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOptions& call,
-                                    const DirectionSplit& split, const DirectedCall& directed, int threads,
-                                    double from, double width) {
-    const uint64_t chunks = (q.size() + split.queryChunk - 1) / split.queryChunk;
-    const std::vector<Tile> tiles =
-        t.size() > split.targetTile ? makeTiles(t, split.targetTile, scale, threads) : std::vector<Tile>{};
-    const uint64_t tileCount = std::max<uint64_t>(1, tiles.size());
-    DirectionState s;
-    if (call.perPointDistances) {
-        s.perPoint.distance.resize(q.size());
-        s.perPoint.nearest.resize(q.size());
-    }
-    const double step = width / double(chunks);  // each chunk's share of the progress
+// The chunks of one direction as one lane takes them: the next chunk not yet
+// taken, until none is left or a lane has failed. Each lane keeps its own
+// scratch. `from`/`step`: the direction's start and each chunk's share of
+// the progress.
+struct ChunkQueue {
+    Span q, t;
+    const std::vector<Tile>* tiles = nullptr;
+    uint64_t chunkSize = 0, chunks = 0;
+    std::atomic<uint64_t> next{0};
+};
+
+void runLane(ChunkQueue& queue, double scale, const CallOptions& call, const Lane& lane,
+             SharedDirection& shared, double from, double step) {
     ChunkScratch scratch;
-    for (uint64_t c = 0; c < chunks; ++c) {
-        const uint64_t q0 = c * split.queryChunk;
-        const Span qc = q.subspan(q0, std::min<uint64_t>(split.queryChunk, q.size() - q0));
+    for (;;) {
+        const uint64_t c = queue.next.fetch_add(1);
+        if (c >= queue.chunks || shared.failed.load()) return;
+        const uint64_t q0 = c * queue.chunkSize;
+        const Span qc = queue.q.subspan(q0, std::min<uint64_t>(queue.chunkSize, queue.q.size() - q0));
         const double at = from + step * double(c);
         const std::optional<Error> err =
-            tiles.empty()
-                ? chunkAgainstAll(qc, q0, t, scale, pieceOptions(call, call.perPointDistances, at, step),
-                                  directed, s)
-                : chunkAgainstTiles(qc, q0, t, tiles, scale, call, directed, threads, scratch, s, at, step);
-        if (err) return *err;
+            queue.tiles->empty()
+                ? chunkAgainstAll(qc, q0, queue.t, scale,
+                                  pieceOptions(call, call.perPointDistances, at, step), lane, shared)
+                : chunkAgainstTiles(qc, q0, queue.t, *queue.tiles, scale, call, lane, scratch, shared, at,
+                                    step);
+        if (err) {
+            std::lock_guard lock(shared.mutex);
+            if (!shared.error) shared.error = *err;
+            shared.failed = true;
+            return;
+        }
     }
+}
+
+// One direction Q -> T within `split`, its chunks spread over `lanes` lanes
+// (lane 0 on the calling thread); `from`/`width`: its share of the progress.
+Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOptions& call,
+                                    const DirectionSplit& split, const DirectedCall& directed, int lanes,
+                                    int threads, double from, double width) {
+    const std::vector<Tile> tiles =
+        t.size() > split.targetTile ? makeTiles(t, split.targetTile, scale, threads) : std::vector<Tile>{};
+    ChunkQueue queue;
+    queue.q = q;
+    queue.t = t;
+    queue.tiles = &tiles;
+    queue.chunkSize = split.queryChunk;
+    queue.chunks = (q.size() + split.queryChunk - 1) / split.queryChunk;
+    SharedDirection shared;
+    if (call.perPointDistances) {
+        shared.state.perPoint.distance.resize(q.size());
+        shared.state.perPoint.nearest.resize(q.size());
+    }
+    const double step = width / double(queue.chunks);  // each chunk's share of the progress
+    lanes = int(std::min<uint64_t>(uint64_t(std::max(lanes, 1)), queue.chunks));
+    // Every lane asks for all host threads: the pool lends idle workers to
+    // whichever lane has host work while the others wait on their devices.
+    std::vector<std::thread> helpers;
+    for (int l = 1; l < lanes; ++l)
+        helpers.emplace_back([&, l] {
+            runLane(queue, scale, call, Lane{l, threads, &directed}, shared, from, step);
+        });
+    runLane(queue, scale, call, Lane{0, threads, &directed}, shared, from, step);
+    for (std::thread& h : helpers) h.join();
+    if (shared.error) return *shared.error;
+    DirectionState s = std::move(shared.state);
     s.counters.queries = q.size();  // tiles' calls count their queries again
-    s.counters.queryChunks = uint32_t(chunks);
-    s.counters.targetTiles = uint32_t(tileCount);
+    s.counters.queryChunks = uint32_t(queue.chunks);
+    s.counters.targetTiles = uint32_t(std::max<size_t>(1, tiles.size()));
     s.witness.counters = s.counters;
     return s;
 }
@@ -381,12 +476,13 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
 // figure is an estimate; a device may hold less than it reports).
 Result<DirectionState> runDirectionWithin(Span q, Span t, double scale, const CallOptions& call,
                                           MemoryBudget budget, const DirectedCall& directed,
-                                          const std::function<void()>& release, int threads, double from,
-                                          double width) {
+                                          const std::function<void()>& release, int lanes, int threads,
+                                          double from, double width) {
     for (;;) {
-        Result<DirectionSplit> split = splitDirection(budget, q.size(), t.size());
+        Result<DirectionSplit> split = splitDirection(budget, q.size(), t.size(), lanes);
         if (!split) return split.error();
-        Result<DirectionState> s = runDirection(q, t, scale, call, *split, directed, threads, from, width);
+        Result<DirectionState> s =
+            runDirection(q, t, scale, call, *split, directed, lanes, threads, from, width);
         if (s || s.error().code != ErrorCode::kOutOfMemory || budget.pointsPerCall() < 4) return s;
         if (release) release();
         budget.bytes /= 2;
@@ -397,10 +493,10 @@ Result<DirectionState> runDirectionWithin(Span q, Span t, double scale, const Ca
 }  // namespace
 
 bool fitsOneCall(const MemoryBudget& budget, uint64_t na, uint64_t nb) {
-    return na + nb <= budget.pointsPerCall();
+    return na <= kMaxCallPoints && nb <= kMaxCallPoints && na + nb <= budget.pointsPerCall();
 }
 
-Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, uint64_t nt) {
+Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, uint64_t nt, int lanes) {
     const uint64_t perCall = budget.pointsPerCall();
     if (perCall < 2 || budget.maxPiecePoints < 1) {
         return Error{ErrorCode::kOutOfMemory, "a memory budget of " + std::to_string(budget.bytes) +
@@ -410,23 +506,25 @@ Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, u
     }
     DirectionSplit split;
     const uint64_t half = perCall / 2;
-    if (nt <= std::min(half, budget.maxPiecePoints)) {
+    const uint64_t maxPiece = std::min(budget.maxPiecePoints, kMaxCallPoints);
+    if (nt <= std::min(half, maxPiece)) {
         split.targetTile = std::max<uint64_t>(nt, 1);
-        split.queryChunk = std::min(perCall - split.targetTile, budget.maxPiecePoints);
+        split.queryChunk = std::min(perCall - split.targetTile, maxPiece);
     } else {
-        split.targetTile = std::min(half, budget.maxPiecePoints);
-        split.queryChunk = std::min(perCall - split.targetTile, budget.maxPiecePoints);
+        split.targetTile = std::min(half, maxPiece);
+        split.queryChunk = std::min(perCall - split.targetTile, maxPiece);
     }
-    split.queryChunk = std::max<uint64_t>(1, std::min(split.queryChunk, nq));
+    const uint64_t perLane = (nq + uint64_t(std::max(lanes, 1)) - 1) / uint64_t(std::max(lanes, 1));
+    split.queryChunk = std::max<uint64_t>(1, std::min(split.queryChunk, perLane));
     return split;
 }
 
 Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const CallOptions& call,
                                         const MemoryBudget& budget, const DirectedCall& directed,
-                                        const std::function<void()>& release, int threads) {
+                                        const std::function<void()>& release, int lanes, int threads) {
     const double width = call.directedOnly ? 1.0 : 0.5;
     Result<DirectionState> ab =
-        runDirectionWithin(a, b, scale, call, budget, directed, release, threads, 0.0, width);
+        runDirectionWithin(a, b, scale, call, budget, directed, release, lanes, threads, 0.0, width);
     if (!ab) return ab.error();
     HausdorffResult r;
     r.directedOnly = call.directedOnly;
@@ -437,7 +535,7 @@ Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const Call
     if (!call.directedOnly) {
         if (release) release();
         Result<DirectionState> ba =
-            runDirectionWithin(b, a, scale, call, budget, directed, release, threads, 0.5, 0.5);
+            runDirectionWithin(b, a, scale, call, budget, directed, release, lanes, threads, 0.5, 0.5);
         if (!ba) return ba.error();
         r.bToA = ba->witness;
         r.bNearest = std::move(ba->perPoint);

@@ -53,6 +53,11 @@ namespace rthdist::api {
 // cells, leaves, query state and scratch; the measured figure is about 110 B
 // on lavapipe and under 180 B on an H200 run of 400M + 400M points).
 inline constexpr uint64_t kBytesPerPoint = 128;
+// Points of one set in one backend call: the backends index points with
+// 32-bit integers (and pack them beside 32-bit distances). Larger sets run in
+// pieces whatever the memory budget; a prepared set (one call's set) is
+// refused past it.
+inline constexpr uint64_t kMaxCallPoints = 0x7fffffff;
 // Bytes per point of the largest single buffer of a call (cells and leaves:
 // 32 B per point), which the device's maxMemoryAllocationSize bounds.
 inline constexpr uint64_t kLargestBufferBytesPerPoint = 32;
@@ -72,23 +77,29 @@ struct DirectionSplit {
     uint64_t targetTile = 0;
 };
 
-// Whether the pair (na, nb) fits one call's bytes as it is. maxPiecePoints
-// bounds the pieces only: some drivers grant buffers past their advertised
+// Whether the pair (na, nb) fits one call's bytes as it is, each set within
+// kMaxCallPoints. maxPiecePoints bounds the pieces only: some drivers grant buffers past their advertised
 // maxMemoryAllocationSize, so the whole pair is tried first (Engine: a
 // kOutOfMemory under the automatic budget then falls back to pieces).
 [[nodiscard]] bool fitsOneCall(const MemoryBudget& budget, uint64_t na, uint64_t nb);
 
 // The split of direction Q -> T (nq queries, nt targets) within the budget:
 // one tile when the targets fit beside a chunk of at least half the call,
-// else tiles and chunks of half a call each. kOutOfMemory when the budget
-// holds fewer than two points.
-[[nodiscard]] Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, uint64_t nt);
+// else tiles and chunks of half a call each; with several lanes, at least
+// one chunk per lane; no piece past maxPiecePoints or kMaxCallPoints. kOutOfMemory when the budget holds
+// fewer than two points.
+[[nodiscard]] Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, uint64_t nt,
+                                                    int lanes = 1);
 
-// One directed call of a backend on float sets of the whole pair's frame:
-// call.directedOnly is set; call.perPointDistances is set when the caller
-// needs every query's nearest point.
-using DirectedCall = std::function<Result<HausdorffResult>(
-    std::span<const glm::vec3> queries, std::span<const glm::vec3> targets, const CallOptions& call)>;
+// One directed call of a backend on float sets of the whole pair's frame, on
+// lane `lane` (a device of the Engine; 0..lanes-1): call.directedOnly is
+// set; call.perPointDistances is set when the caller needs every query's
+// nearest point. Lanes are called from their own threads at once; one lane's
+// calls come one at a time. Only lane 0 (the calling thread) gets
+// call.progress.
+using DirectedCall =
+    std::function<Result<HausdorffResult>(int lane, std::span<const glm::vec3> queries,
+                                          std::span<const glm::vec3> targets, const CallOptions& call)>;
 
 // H(A,B) (or h(A,B) with call.directedOnly) of float sets searched at the
 // exact power-of-two `scale` (core::exactScale), as a sequence of calls of
@@ -99,10 +110,20 @@ using DirectedCall = std::function<Result<HausdorffResult>(
 // (iterations: the largest), with Counters::queryChunks/targetTiles set.
 // The host's passes over the points (tile boxes, the queries a tile may
 // improve, merging) run on `threads` threads (0: all).
+//
+// Lanes (several devices): each direction's chunks are taken by `lanes`
+// lanes in parallel, lane 0 on the calling thread, each lane's calls on its
+// own device; a chunk's early break reads the witness of every chunk
+// finished so far, by any lane, before each tile (a tie drops a query only
+// when that witness's query index is smaller), and witnesses merge by
+// distance, then smallest query index: the result is the one-lane result.
+// `release` is called between directions and after a failure, with no lane
+// running.
 [[nodiscard]] Result<HausdorffResult> computeInPieces(std::span<const glm::vec3> a,
                                                       std::span<const glm::vec3> b, double scale,
                                                       const CallOptions& call, const MemoryBudget& budget,
                                                       const DirectedCall& directed,
-                                                      const std::function<void()>& release, int threads = 0);
+                                                      const std::function<void()>& release, int lanes = 1,
+                                                      int threads = 0);
 
 }  // namespace rthdist::api

@@ -15,7 +15,6 @@ namespace rthdist::core {
 namespace {
 
 constexpr size_t kChunk = size_t(1) << 16;
-constexpr size_t kMaxPoints = 0x7fffffffu;
 
 struct ChunkSummary {
     glm::dvec3 lo{0.0}, hi{0.0};
@@ -74,12 +73,16 @@ void merge(ChunkSummary& into, const ChunkSummary& part) {
 
 std::optional<Error> checkShape(const PointView& points, const char* name) {
     if (points.empty()) return setError(name, " is empty: the Hausdorff distance is undefined");
-    if (points.count > kMaxPoints) return setError(name, " has more than 2^31-1 points");
+    if (points.count > kMaxSetPoints) return setError(name, " has more than 2^40 points");
     const size_t scalar = scalarBytes(points.scalar);
     if (points.data == nullptr || points.strideBytes < 3 * scalar || points.strideBytes % scalar != 0)
         return setError(name, ": a stride of " + std::to_string(points.strideBytes) +
                                   " bytes cannot hold three " + (scalar == 8 ? "doubles" : "floats") +
                                   " per point (or the data pointer is null)");
+    if (points.count - 1 > (SIZE_MAX - 3 * scalar) / points.strideBytes)
+        return setError(name, ": " + std::to_string(points.count) + " points of " +
+                                  std::to_string(points.strideBytes) +
+                                  " bytes span more than the address space");
     return std::nullopt;
 }
 

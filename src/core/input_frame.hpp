@@ -9,6 +9,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <vector>
@@ -25,8 +26,14 @@ struct SetSummary {
     bool floatExact = true;
 };
 
+// Points per set of a one-shot call: sets past the backends' 32-bit indices
+// (api::kMaxCallPoints) run in pieces (api/out_of_core.hpp) and report
+// 64-bit witness indices. The bound keeps every byte offset within size_t.
+inline constexpr uint64_t kMaxSetPoints = uint64_t(1) << 40;
+
 // The view's shape alone (no pass over the points): the error for an empty
-// set, too many points, a stride that cannot hold a point or a null pointer.
+// set, more than kMaxSetPoints points, a stride that cannot hold a point, a
+// view past the address space, or a null pointer.
 [[nodiscard]] std::optional<Error> checkShape(const PointView& points, const char* name);
 
 // Box and precision of one set, or the error naming the first bad point

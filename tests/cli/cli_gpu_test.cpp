@@ -168,6 +168,25 @@ TEST_P(CliGpu, DeviceIndexOutOfRangeIsNoDevice) {
     EXPECT_EQ(run.err.rfind("rthdist: ", 0), 0u) << run;
 }
 
+// --devices 0,0 opens the device twice (two lanes, as two GPUs would be);
+// with --memory-budget 1 (8192 points per call) the sample is out of core:
+// the result agrees with the CPU backend, and each direction's queries were
+// split over both devices.
+TEST_P(CliGpu, TwoDevicesAgreeWithCpu) {
+    const Json j = runVerified({"--devices", "0,0", "--memory-budget", "1", kSampleA, kSampleB});
+    if (j.is_null()) return;
+    const std::string device = j["device"].get<std::string>();
+    EXPECT_NE(device.find(" + "), std::string::npos) << device;
+    for (const char* d : {"a_to_b", "b_to_a"}) EXPECT_GE(j["counters"][d]["query_chunks"].get<int>(), 2) << d;
+}
+
+// A device of --devices that does not exist is no device (exit 4), named.
+TEST_P(CliGpu, DevicesOutOfRangeIsNoDevice) {
+    const CliRun run = runCli({"--backend", GetParam(), "--devices", "0,999", kSampleA, kSampleB});
+    EXPECT_EQ(run.exitCode, 4) << run;
+    EXPECT_NE(run.err.find("device 999"), std::string::npos) << run;
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, CliGpu, ::testing::Values("ray-query", "rt-pipeline"),
                          [](const auto& info) {
                              std::string name = info.param;
@@ -190,6 +209,26 @@ TEST(CliGpuAuto, FollowsTheDeviceList) {
     const CliRun run = runCli({"--json", kSampleA, kSampleB});
     ASSERT_EQ(run.exitCode, 0) << run;
     EXPECT_EQ(parseJson(run)["backend"].get<std::string>(), expected) << list.out;
+}
+
+// --devices all takes hardware RT devices only: with lavapipe alone (CI) it
+// finds none and says so (exit 4); with a GPU it runs on every one.
+TEST(CliGpuAuto, AllDevicesMeansHardwareOnes) {
+    const CliRun list = runCli({"--list-devices", "--json"});
+    ASSERT_EQ(list.exitCode, 0) << list;
+    size_t hardware = 0;
+    const Json listed = parseJson(list);
+    for (const Json& d : listed["devices"])
+        if (d["type"] != "cpu" && (d["ray_query"].get<bool>() || d["rt_pipeline"].get<bool>())) ++hardware;
+    const CliRun run = runCli({"--json", "--devices", "all", kSampleA, kSampleB});
+    if (hardware == 0) {
+        EXPECT_EQ(run.exitCode, 4) << run;
+        EXPECT_NE(run.err.find("--devices all"), std::string::npos) << run;
+        return;
+    }
+    ASSERT_EQ(run.exitCode, 0) << run;
+    const std::string device = parseJson(run)["device"].get<std::string>();
+    EXPECT_EQ(size_t(std::count(device.begin(), device.end(), '+')), hardware - 1) << device;
 }
 
 // An explicit --device keeps auto on the Vulkan path, software device or not.

@@ -41,6 +41,9 @@ TEST_F(CliUsage, UnknownBackend) { expectUsageError({"--backend", "gpu", m_a, m_
 TEST_F(CliUsage, MissingValueAtEnd) { expectUsageError({m_a, m_b, "--bits"}, "--bits"); }
 TEST_F(CliUsage, MissingBackendValue) { expectUsageError({m_a, m_b, "--backend"}, "--backend"); }
 TEST_F(CliUsage, FlagWithValue) { expectUsageError({"--json=yes", m_a, m_b}, "--json"); }
+TEST_F(CliUsage, DevicesNeedAGpuBackend) {
+    expectUsageError({"--backend", "cpu", "--devices", "0,1", m_a, m_b}, "--devices");
+}
 TEST_F(CliUsage, ListDevicesWithFiles) { expectUsageError({"--list-devices", m_a}, "--list-devices"); }
 
 TEST_F(CliUsage, BadNumbers) {
@@ -92,6 +95,9 @@ TEST_F(CliUsage, OutOfRangeValuesNameTheRange) {
         {{"--range", "1", "1"}, "0 <= MIN < MAX"},
         {{"--memory-budget", "-1"}, "[0, 2^30]"},
         {{"--memory-budget", "1073741825"}, "[0, 2^30]"},
+        {{"--devices", "0,x"}, "[0, 1023]"},
+        {{"--devices", "1024"}, "[0, 1023]"},
+        {{"--devices", "0,,1"}, "[0, 1023]"},
     };
     for (const Case& c : cases) {
         std::vector<std::string> args = c.args;

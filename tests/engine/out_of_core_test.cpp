@@ -4,6 +4,7 @@
 // and the brute force's, on the backend under test.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -121,9 +122,9 @@ TEST(OutOfCore, ManyPointsAgainstThree) {
 }
 
 // A backend stand-in for computeInPieces: the brute force, counting the
-// calls and the queries sent.
+// calls and the queries sent (from every lane).
 struct CountingBruteForce {
-    uint64_t calls = 0, queriesSent = 0;
+    std::atomic<uint64_t> calls = 0, queriesSent = 0;
     Result<HausdorffResult> operator()(std::span<const glm::vec3> q, std::span<const glm::vec3> t,
                                        const CallOptions& call) {
         ++calls;
@@ -168,7 +169,9 @@ TEST(OutOfCore, TilesOutOfReachAreSkipped) {
     api::MemoryBudget budget;
     budget.bytes = 2 * 512 * api::kBytesPerPoint;  // chunks and tiles of 512 points: 2 z-layers
     CountingBruteForce fake;
-    const api::DirectedCall call = [&fake](auto q, auto t, const CallOptions& o) { return fake(q, t, o); };
+    const api::DirectedCall call = [&fake](int, auto q, auto t, const CallOptions& o) {
+        return fake(q, t, o);
+    };
     auto r = api::computeInPieces(a, b, 1.0, CallOptions{}, budget, call, {});
     ASSERT_TRUE(r) << r.error().message;
     for (auto [got, q, t] : {std::tuple<const Directed*, Sets, Sets>{&r->aToB, &a, &b},
@@ -183,6 +186,51 @@ TEST(OutOfCore, TilesOutOfReachAreSkipped) {
     // Without skipping: 2 x 8 x 9 calls and every query sent to every tile.
     EXPECT_LT(fake.calls, 2u * 8u * 9u / 2u);
     EXPECT_LT(fake.queriesSent, 2u * 9u * a.size() / 4u);
+}
+
+// Lanes (several devices) take a direction's chunks in parallel; the early
+// break reads other lanes' witnesses, and ties go to the smallest query
+// index: the result is the one-lane result, witnesses included, with tiles
+// (a small budget) and without (one chunk per lane), per-point too.
+TEST(OutOfCore, LanesGiveTheOneLaneResult) {
+    const std::vector<glm::vec3> a = slabLattice(12, 0.0f);
+    std::vector<glm::vec3> b = slabLattice(12, 0.5f);
+    b.insert(b.begin() + 700, glm::vec3(-9.5f, 4.25f, 6.0f));  // h(B,A) witnessed inside a middle chunk
+    b.push_back(glm::vec3(20.5f, 4.25f, 6.0f));                // and tied by the mirror outlier at the end
+    CountingBruteForce fake;
+    const api::DirectedCall call = [&fake](int, auto q, auto t, const CallOptions& o) {
+        return fake(q, t, o);
+    };
+    for (uint64_t budgetPoints : {uint64_t(600), uint64_t(1) << 40}) {
+        for (bool perPoint : {false, true}) {
+            api::MemoryBudget budget;
+            budget.bytes = budgetPoints * api::kBytesPerPoint;
+            CallOptions options;
+            options.perPointDistances = perPoint;
+            auto one = api::computeInPieces(a, b, 1.0, options, budget, call, {}, 1);
+            ASSERT_TRUE(one) << one.error().message;
+            for (int lanes : {2, 3, 5}) {
+                SCOPED_TRACE("budget " + std::to_string(budgetPoints) + " points, per-point " +
+                             std::to_string(perPoint) + ", " + std::to_string(lanes) + " lanes");
+                auto got = api::computeInPieces(a, b, 1.0, options, budget, call, {}, lanes);
+                ASSERT_TRUE(got) << got.error().message;
+                EXPECT_EQ(got->hausdorff, one->hausdorff);
+                for (auto [g, w] : {std::pair{&got->aToB, &one->aToB}, std::pair{&got->bToA, &one->bToA}}) {
+                    EXPECT_EQ(g->distance, w->distance);
+                    EXPECT_EQ(g->queryIndex, w->queryIndex);
+                    EXPECT_EQ(g->targetIndex, w->targetIndex);
+                    EXPECT_GE(g->counters.queryChunks, uint32_t(lanes));
+                }
+                EXPECT_EQ(got->aNearest.nearest, one->aNearest.nearest);
+                EXPECT_EQ(got->bNearest.distance, one->bNearest.distance);
+            }
+        }
+    }
+    // The outlier inserted at 700 is the witness: the first of the two ties.
+    auto r = api::computeInPieces(a, b, 1.0, CallOptions{}, api::MemoryBudget{}, call, {}, 4);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->bToA.queryIndex, 700u);
+    EXPECT_EQ(r->bToA.distance, oracle::bruteForceDirected(b, a).distance);
 }
 
 // A budget below two points is refused with the budget named, not run.

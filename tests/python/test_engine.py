@@ -45,6 +45,26 @@ def test_memory_budget_splits_with_the_same_result(backend, rng):
         rthdist.Engine("cpu", memory_budget=-1)
 
 
+def test_two_devices_give_the_one_device_result(backend, rng):
+    a = rng.random((3000, 3)).astype(np.float32)
+    b = rng.random((2500, 3)) + 0.25
+    if backend == "cpu":
+        with pytest.raises(ValueError, match="GPU backend"):
+            rthdist.Engine(backend, devices=[0, 0])
+        return
+    # Out of core (a budget of 2000 points per call), so that both devices take chunks.
+    with rthdist.Engine(backend) as one, rthdist.Engine(backend, devices=[0, 0], memory_budget=2000 * 128) as two:
+        want = one.hausdorff(a, b)
+        got = two.hausdorff(a, b)
+        assert " + " in two.device
+    check_result(got, a, b)
+    assert got.distance == pytest.approx(want.distance, rel=1e-6)
+    for d in ("a_to_b", "b_to_a"):
+        assert got.counters[d]["query_chunks"] >= 2
+    with pytest.raises(ValueError, match="devices"):
+        rthdist.Engine(backend, devices=[-1])
+
+
 def test_engine_errors():
     with pytest.raises(ValueError):
         rthdist.Engine("nope")

@@ -4,7 +4,7 @@
 // library itself.
 //
 //   lattice-check N [--backend cpu|ray-query|rt-pipeline] [--threads T] [--three]
-//                   [--memory-budget MIB]                                 (N in 2..4096)
+//                   [--memory-budget MIB] [--devices 0,1]                 (N in 2..4096)
 //
 // A is the integer lattice {0..N-1}^3 (N^3 points), B the same lattice moved
 // by (1/2, 1/2, 1/2) plus one outlier o far outside both. Every coordinate is
@@ -27,7 +27,8 @@
 // to its nearest lattice point (rounded and clamped, as above), witnessed by
 // that point; h(A, B) is the brute force over A x B in double (3 N^3
 // distances), and its witness pair must realize it with the target a nearest
-// of the three to the query. --memory-budget MIB forces the out-of-core split.
+// of the three to the query. --memory-budget MIB forces the out-of-core split;
+// --devices spreads the queries over several GPUs (EngineOptions::devices).
 //
 // --write-ply PREFIX writes A and B as binary PLY files PREFIX_a.ply and
 // PREFIX_b.ply instead of computing (for rthdist and rthdist-mpi runs on the
@@ -172,6 +173,9 @@ int main(int argc, char** argv) {
     app.add_flag("--three", three, "B is three points (brute-force check of h(A,B))");
     std::string plyPrefix;
     app.add_option("--write-ply", plyPrefix, "write PREFIX_a.ply and PREFIX_b.ply instead of computing");
+    app.add_option("--devices", options.devices, "device indices for several GPUs, e.g. 0,1")
+        ->delimiter(',')
+        ->check(CLI::NonNegativeNumber);
     app.add_option("--memory-budget", budgetMib, "MiB one backend call may hold, 0 = automatic")
         ->check(CLI::Range(uint64_t(0), uint64_t(1) << 30));
     try {
@@ -246,8 +250,8 @@ int main(int argc, char** argv) {
     out["query_chunks_a_to_b"] = r->aToB.counters.queryChunks;
     out["target_tiles_b_to_a"] = r->bToA.counters.targetTiles;
     const Timings& t = r->timings;
-    out["timings_ms"] = {{"upload", t.upload}, {"index", t.index}, {"cull", t.cull},  {"search", t.search},
-                         {"refine", t.refine}, {"check", t.check}, {"total", t.total}};
+    out["timings_ms"] = {{"setup", t.setup},   {"upload", t.upload}, {"index", t.index}, {"cull", t.cull},
+                         {"search", t.search}, {"refine", t.refine}, {"check", t.check}, {"total", t.total}};
     out["peak_rss_gib"] = peakRssGiB();
     out["hausdorff"] = r->hausdorff;
     out["expected"] = expected;

@@ -66,14 +66,15 @@ std::optional<double> parseNumber(std::string_view text) {
 }
 
 // "2,6,9": comma-separated integers in [0, kMaxLasClass], at least one.
-std::optional<std::vector<int>> parseClassList(std::string_view text) {
-    std::vector<int> classes;
+// Comma-separated integers, each in [lo, hi].
+std::optional<std::vector<int>> parseIntList(std::string_view text, int lo, int hi) {
+    std::vector<int> values;
     for (;;) {
         const size_t comma = text.find(',');
-        const auto n = parseInt(text.substr(0, comma), 0, kMaxLasClass);
+        const auto n = parseInt(text.substr(0, comma), lo, hi);
         if (!n) return std::nullopt;
-        classes.push_back(*n);
-        if (comma == std::string_view::npos) return classes;
+        values.push_back(*n);
+        if (comma == std::string_view::npos) return values;
         text.remove_prefix(comma + 1);
     }
 }
@@ -103,6 +104,9 @@ Options:
                       else rt-pipeline, on a hardware RT device; else cpu)
   --device N          Vulkan device index from --list-devices, 0..1023
                       (default: first usable)
+  --devices LIST      several GPUs for one computation: comma-separated device
+                      indices (e.g. 0,1), or all (every hardware RT device);
+                      queries are split over them, the result is one device's
   --bits K            index-space bit count 0..8, 0 = choose from the data (default 0)
   --radius-growth F   candidate-search radius factor per iteration, 1.1..16 (default 2)
   --threads N         CPU backend threads 0..1024, 0 = all hardware threads (default 0)
@@ -201,6 +205,18 @@ void addComputeOptions(CommandLine& line, CliArgs& out) {
            out.options.bits);
     addInt(line, "--device", 0, kMaxDeviceIndex, "a device index in " + rangeText(0, kMaxDeviceIndex),
            out.options.deviceIndex);
+    addValue(line, "--devices", [&out](const std::string& v) {
+        if (v == "all") {
+            out.allDevices = true;
+            return;
+        }
+        const auto devices = parseIntList(v, 0, kMaxDeviceIndex);
+        if (!devices)
+            outOfRange(
+                "--devices", v,
+                "all, or comma-separated device indices in " + rangeText(0, kMaxDeviceIndex) + " (e.g. 0,1)");
+        out.options.devices = *devices;
+    });
     addInt(line, "--threads", 0, kMaxThreads, "an integer in " + rangeText(0, kMaxThreads) + " (0 = all)",
            out.options.threads);
     addValue(line, "--memory-budget", [&out](const std::string& v) {
@@ -215,7 +231,7 @@ void addComputeOptions(CommandLine& line, CliArgs& out) {
         out.options.radiusGrowth = float(*f);
     });
     addValue(line, "--las-classes", [&out](const std::string& v) {
-        const auto classes = parseClassList(v);
+        const auto classes = parseIntList(v, 0, kMaxLasClass);
         if (!classes)
             outOfRange("--las-classes", v,
                        "comma-separated integers in " + rangeText(0, kMaxLasClass) + " (e.g. 2,6)");
@@ -268,6 +284,19 @@ void addPerPointOptions(CommandLine& line, CliArgs& out) {
 
 }  // namespace
 
+std::vector<int> everyRtDevice(Backend backend) {
+    std::vector<int> devices;
+    auto listed = listDevices();
+    if (!listed) return devices;
+    for (const DeviceInfo& d : listed.value()) {
+        const bool runs = backend == Backend::kRayQuery     ? d.rayQuery
+                          : backend == Backend::kRtPipeline ? d.rtPipeline
+                                                            : d.rayQuery || d.rtPipeline;
+        if (runs && d.type != "cpu") devices.push_back(d.index);
+    }
+    return devices;
+}
+
 Result<CliArgs> parseArgs(std::span<const std::string> args) {
     CliArgs out;
     std::vector<std::string> positional;
@@ -299,6 +328,8 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
     if (!out.lasClasses.empty() && !isLasPath(positional[0]) && !isLasPath(positional[1])) {
         return usageError("option '--las-classes' filters LAS files, but neither input is .las");
     }
+    if ((!out.options.devices.empty() || out.allDevices) && out.options.backend == Backend::kCpu)
+        return usageError("option '--devices' spreads the work over GPUs; the cpu backend uses --threads");
     out.options.perPointDistances = out.perPoint;
     out.pathA = positional[0];
     out.pathB = positional[1];

@@ -37,6 +37,7 @@ struct CliArgs {
     std::string histogramPng;     // --histogram-png FILE
     bool quiet = false;           // --quiet: no progress on stderr
     std::vector<int> lasClasses;  // --las-classes 2,6: LAS classification filter (empty = all)
+    bool allDevices = false;      // --devices all (options.devices: everyRtDevice)
 };
 
 // Parses argv[1..]. Accepts "--option value" and "--option=value"; "--" ends
@@ -47,5 +48,9 @@ struct CliArgs {
 
 // The --help text.
 [[nodiscard]] std::string usageText();
+
+// `--devices all`: the listDevices() indices of every device with a hardware
+// RT path for `backend` (software devices such as lavapipe only when named).
+[[nodiscard]] std::vector<int> everyRtDevice(Backend backend);
 
 }  // namespace rthdist::cli

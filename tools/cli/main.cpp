@@ -89,6 +89,13 @@ int run(const std::vector<std::string>& argv) {
     if (args.version)
         return writeStdout(std::string("rthdist ") + versionString() + "\n") ? kExitOk : kExitInternal;
     if (args.listDevices) return listDevicesCommand(args);
+    Options options = args.options;
+    if (args.allDevices) {
+        options.devices = everyRtDevice(options.backend);
+        if (options.devices.empty())
+            return fail(kExitNoDevice, "--devices all: no device with hardware ray tracing for the " +
+                                           std::string(backendName(options.backend)) + " backend");
+    }
 
     const Clock::time_point loadStart = Clock::now();
     io::LoadOptions loadOptions;
@@ -101,7 +108,6 @@ int run(const std::vector<std::string>& argv) {
 
     // Progress only on a terminal, for runs longer than a second, and never with --quiet.
     ProgressMeter meter(!args.quiet && ProgressMeter::stderrIsTerminal());
-    Options options = args.options;
     options.progress = [&meter](const char* stage, double fraction) { meter.update(stage, fraction); };
     Result<HausdorffResult> result = hausdorff(a->view(), b->view(), options);
     meter.finish();

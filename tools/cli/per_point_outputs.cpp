@@ -1,6 +1,7 @@
 #include "cli/per_point_outputs.hpp"
 
 #include <algorithm>
+#include <cinttypes>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -77,7 +78,8 @@ Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3
         scene.caption.push_back(line);
         double hd95 = 0.0;
         (void)percentileVariant(stats, "max", 95.0, hd95);
-        std::snprintf(line, sizeof line, "%s = %.6g (%s[%u] -> %s[%u])   HD95 = %.6g   %s backend",
+        std::snprintf(line, sizeof line,
+                      "%s = %.6g (%s[%" PRIu64 "] -> %s[%" PRIu64 "])   HD95 = %.6g   %s backend",
                       r.directedOnly ? "h(A,B)" : "H", r.hausdorff, fromB ? "B" : "A", d.queryIndex,
                       fromB ? "A" : "B", d.targetIndex, hd95, backendName(r.backend));
         scene.caption.push_back(line);

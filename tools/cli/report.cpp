@@ -1,6 +1,7 @@
 #include "cli/report.hpp"
 
 #include <charconv>
+#include <cinttypes>
 #include <cstdarg>
 #include <cstdio>
 
@@ -99,11 +100,12 @@ std::string summaryText(const RunReport& report) {
     } else {
         appendf(s, "H(A,B) = %.10g\n", r.hausdorff);
     }
-    appendf(s, "  h(A,B) = %.10g   A[%u] %s -> B[%u] %s\n", r.aToB.distance, r.aToB.queryIndex,
-            pointText(r.aToB.queryPoint).c_str(), r.aToB.targetIndex, pointText(r.aToB.targetPoint).c_str());
+    appendf(s, "  h(A,B) = %.10g   A[%" PRIu64 "] %s -> B[%" PRIu64 "] %s\n", r.aToB.distance,
+            r.aToB.queryIndex, pointText(r.aToB.queryPoint).c_str(), r.aToB.targetIndex,
+            pointText(r.aToB.targetPoint).c_str());
     if (!r.directedOnly) {
-        appendf(s, "  h(B,A) = %.10g   B[%u] %s -> A[%u] %s\n", r.bToA.distance, r.bToA.queryIndex,
-                pointText(r.bToA.queryPoint).c_str(), r.bToA.targetIndex,
+        appendf(s, "  h(B,A) = %.10g   B[%" PRIu64 "] %s -> A[%" PRIu64 "] %s\n", r.bToA.distance,
+                r.bToA.queryIndex, pointText(r.bToA.queryPoint).c_str(), r.bToA.targetIndex,
                 pointText(r.bToA.targetPoint).c_str());
     }
     if (r.directedOnly) {

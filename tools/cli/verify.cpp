@@ -25,6 +25,7 @@ Result<Verification> verifyAgainstCpu(PointView a, PointView b, const Options& o
     cpuOptions.backend = Backend::kCpu;
     cpuOptions.validation = false;
     cpuOptions.deviceIndex = -1;
+    cpuOptions.devices.clear();
     Result<HausdorffResult> cpu = hausdorff(a, b, cpuOptions);
     if (!cpu)
         return Error{cpu.error().code, "verification run on the cpu backend failed: " + cpu.error().message};
