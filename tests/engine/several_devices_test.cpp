@@ -1,9 +1,9 @@
 // Several devices in one Engine (EngineOptions::devices): one-shot calls
-// spread each direction's queries over the devices and give the one-device
-// result. On a machine with one GPU (lavapipe in CI) the device is opened
-// twice or three times: separate Vulkan devices, queues and memory, so the
-// lanes' calls, merges and early break run as on several GPUs. GPU backends
-// only (ctest leaves SeveralDevices.* but the refusal out of the cpu run).
+// out of core spread each direction's query chunks over the devices and give
+// the one-device result; a pair that fits runs on the first device. On a machine with one GPU (lavapipe in
+// CI) the device is opened twice or three times: separate Vulkan devices, queues and memory, so the lanes'
+// calls, merges and early break run as on several GPUs. GPU backends only (ctest leaves SeveralDevices.* out
+// of the cpu run; the refusals of SeveralDevicesOptions run on every backend).
 #include <gtest/gtest.h>
 
 #include <stdexcept>
@@ -122,7 +122,7 @@ TEST(SeveralDevices, PerPointDistances) {
 }
 
 // Several devices need a GPU backend; a negative index is refused.
-TEST(SeveralDevices, RefusedWhereTheyCannotRun) {
+TEST(SeveralDevicesOptions, RefusedWhereTheyCannotRun) {
     EngineOptions o;
     o.backend = Backend::kCpu;
     o.devices = {0, 0};
