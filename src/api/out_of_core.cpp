@@ -287,8 +287,8 @@ std::vector<uint32_t> queriesForTile(Span qc, const Tile& tile, uint32_t j, cons
 }
 
 // Where a lane's calls go: its device (the DirectedCall's lane argument),
-// its share of the host threads, and whether it reports progress (lane 0,
-// the calling thread, only).
+// the host threads of its passes, and whether its calls report progress
+// (lane 0, the calling thread, only).
 struct Lane {
     int index = 0;
     int threads = 0;

@@ -150,8 +150,11 @@ TEST(MpiCli, ExitCodesAndMessagesAsRthdist) {
 }
 
 TEST(MpiCli, UnsupportedOptionsAreUsageErrors) {
-    for (const std::vector<std::string>& extra :
-         {std::vector<std::string>{"--verify"}, {"--per-point"}, {"--png", "x.png"}, {"--out-csv=p"}}) {
+    for (const std::vector<std::string>& extra : {std::vector<std::string>{"--verify"},
+                                                  {"--per-point"},
+                                                  {"--png", "x.png"},
+                                                  {"--out-csv=p"},
+                                                  {"--devices", "0,1"}}) {
         std::vector<std::string> args = {kSampleA, kSampleB};
         args.insert(args.end(), extra.begin(), extra.end());
         const CliRun mpi = runMpi(2, args);

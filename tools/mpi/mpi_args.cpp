@@ -10,9 +10,9 @@ namespace {
 Error usageError(std::string message) { return Error{ErrorCode::kInvalidArgument, std::move(message)}; }
 
 // rthdist's options that rthdist-mpi refuses rather than ignores.
-constexpr std::string_view kUnsupported[] = {"--verify", "--per-point",    "--percentile", "--histogram-bins",
-                                             "--range",  "--out-ply",      "--out-csv",    "--png",
-                                             "--render", "--histogram-png"};
+constexpr std::string_view kUnsupported[] = {
+    "--verify",  "--per-point", "--percentile", "--histogram-bins", "--range",  "--out-ply",
+    "--out-csv", "--png",       "--render",     "--histogram-png",  "--devices"};
 
 // The option a token names ("--png=x" names "--png"), or empty.
 std::string_view optionName(std::string_view token) {
@@ -62,9 +62,9 @@ codes as rthdist. Every rank reads its slice of A and B; rank 0 prints.
                       fit 1 GiB, else each rank owns a slab of it plus an
                       exact halo)
 
-Not supported (exit 2): --verify and the per-point options (--per-point,
+Not supported (exit 2): --verify, the per-point options (--per-point,
 --percentile, --histogram-bins, --range, --out-ply, --out-csv, --png,
---render, --histogram-png).
+--render, --histogram-png), and --devices (one rank per GPU instead).
 
 Without --device, a GPU backend on a node with several usable devices gives
 each rank of the node its own (node-local rank modulo the device count).
