@@ -59,23 +59,23 @@ void expectOneDeviceResult(const OracleCase& c, const HausdorffResult& got, cons
     EXPECT_EQ(got.validationMessages, 0u);
 }
 
-// Every other oracle case on two openings of the device under a budget of
+// Every sixth oracle case on two openings of the device under a budget of
 // three quarters of its points (each device's share of the queries beside
-// all targets: a chunk per device and direction), and every fourth on three
-// under a third (chunks and tiles taken by three lanes). (Every case, or a
-// small fixed budget, takes minutes on lavapipe: an Engine per case, or
-// hundreds of calls per case.)
+// all targets: a chunk per device and direction), and every sixth (others)
+// on three under a third (chunks and tiles taken by three lanes): a third of
+// the suite. (Every case takes minutes under ASan on lavapipe: an Engine of
+// several devices per case; a small fixed budget, hundreds of calls per case.)
 TEST(SeveralDevices, OracleSuiteGivesTheOneDeviceResult) {
     RTHDIST_REQUIRE_TEST_ENGINE(one);
     size_t k = 0, spread = 0;
     for (const OracleCase& c : makeOracleCases()) {
         const size_t index = k++;
         const uint64_t points = c.a.size() + c.b.size();
-        if (index % 2 != 0 || points < 3) continue;  // a budget below the pair needs 3 points
+        if (index % 3 != 0 || points < 3) continue;  // a budget below the pair needs 3 points
         SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed));
         auto want = one->compute(c.a, c.b);
         ASSERT_TRUE(want) << want.error().message;
-        const bool third = index % 4 == 2;
+        const bool third = index % 6 == 3;
         const int devices = third ? 3 : 2;
         Engine several =
             severalDevices(*one, devices, std::max<uint64_t>(2, third ? points / 3 : points * 3 / 4));
@@ -84,7 +84,7 @@ TEST(SeveralDevices, OracleSuiteGivesTheOneDeviceResult) {
         expectOneDeviceResult(c, *got, *want, devices);
         ++spread;
     }
-    EXPECT_GT(spread, 100u);
+    EXPECT_GT(spread, 70u);
 }
 
 // A pair that fits one call runs on the first device alone (one chunk).
