@@ -104,9 +104,10 @@ Options:
                       else rt-pipeline, on a hardware RT device; else cpu)
   --device N          Vulkan device index from --list-devices, 0..1023
                       (default: first usable)
-  --devices LIST      several GPUs for one computation: comma-separated device
-                      indices (e.g. 0,1), or all (every hardware RT device);
-                      queries are split over them, the result is one device's
+  --devices LIST      several GPUs: comma-separated device indices (e.g. 0,1),
+                      or all (every hardware RT device); a pair past the
+                      memory budget spreads its pieces over them (the result
+                      is one device's); a pair that fits runs on the first
   --bits K            index-space bit count 0..8, 0 = choose from the data (default 0)
   --radius-growth F   candidate-search radius factor per iteration, 1.1..16 (default 2)
   --threads N         CPU backend threads 0..1024, 0 = all hardware threads (default 0)
