@@ -11,7 +11,9 @@
 #include <atomic>
 #include <limits>
 #include <mutex>
+#include <new>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -410,22 +412,34 @@ struct ChunkQueue {
     std::atomic<uint64_t> next{0};
 };
 
+// One chunk as a lane runs it; a failure of the host's own memory (the
+// lane may be a thread of its own, where nothing would catch it) becomes
+// kOutOfMemory.
+std::optional<Error> runChunk(const ChunkQueue& queue, uint64_t c, double scale, const CallOptions& call,
+                              const Lane& lane, ChunkScratch& scratch, SharedDirection& shared, double from,
+                              double step) {
+    const uint64_t q0 = c * queue.chunkSize;
+    const Span qc = queue.q.subspan(q0, std::min<uint64_t>(queue.chunkSize, queue.q.size() - q0));
+    const double at = from + step * double(c);
+    try {
+        return queue.tiles->empty()
+                   ? chunkAgainstAll(qc, q0, queue.t, scale,
+                                     pieceOptions(call, call.perPointDistances, at, step), lane, shared)
+                   : chunkAgainstTiles(qc, q0, queue.t, *queue.tiles, scale, call, lane, scratch, shared, at,
+                                       step);
+    } catch (const std::bad_alloc&) {
+        return Error{ErrorCode::kOutOfMemory, "out of host memory in query chunk " + std::to_string(c) +
+                                                  " (device lane " + std::to_string(lane.index) + ")"};
+    }
+}
+
 void runLane(ChunkQueue& queue, double scale, const CallOptions& call, const Lane& lane,
              SharedDirection& shared, double from, double step) {
     ChunkScratch scratch;
     for (;;) {
         const uint64_t c = queue.next.fetch_add(1);
         if (c >= queue.chunks || shared.failed.load()) return;
-        const uint64_t q0 = c * queue.chunkSize;
-        const Span qc = queue.q.subspan(q0, std::min<uint64_t>(queue.chunkSize, queue.q.size() - q0));
-        const double at = from + step * double(c);
-        const std::optional<Error> err =
-            queue.tiles->empty()
-                ? chunkAgainstAll(qc, q0, queue.t, scale,
-                                  pieceOptions(call, call.perPointDistances, at, step), lane, shared)
-                : chunkAgainstTiles(qc, q0, queue.t, *queue.tiles, scale, call, lane, scratch, shared, at,
-                                    step);
-        if (err) {
+        if (std::optional<Error> err = runChunk(queue, c, scale, call, lane, scratch, shared, from, step)) {
             std::lock_guard lock(shared.mutex);
             if (!shared.error) shared.error = *err;
             shared.failed = true;
