@@ -42,8 +42,10 @@
 //   with the input points, and h is not below its witness-less lower bound.
 //   A failure returns kInternal with the reason instead of a value.
 //
-// Threading: an Engine owns one Vulkan device and is not thread-safe; use one
-//   Engine per thread (with its own prepared sets). The free function
+// Threading: an Engine owns one Vulkan device (or several:
+//   EngineOptions::devices, whose out-of-core calls run one host thread per
+//   device inside the call) and is not thread-safe; use one Engine per
+//   thread (with its own prepared sets). The free function
 //   hausdorff() creates a temporary Engine (device + pipelines) per call:
 //   embedders that call repeatedly should keep an Engine, and prepare the
 //   sets they reuse (Engine::prepare).
