@@ -325,11 +325,15 @@ Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm:
                                            std::span<const glm::vec3> t, const CallOptions& piece) {
         return runBackend(impl, size_t(lane), q, t, scale, piece);
     };
+    const api::RecycleCall recycle = [&impl](int lane, PerPoint&& spent) {
+        if (laneDevice(impl, size_t(lane)).gpu)
+            laneDevice(impl, size_t(lane)).gpu->recyclePerPoint(std::move(spent));
+    };
     api::MemoryBudget pieces = budget;
     if (lanes > 1 && sharesFit) pieces.maxPiecePoints = UINT64_MAX;  // a kOutOfMemory halves the bytes
     release();
-    Result<HausdorffResult> r =
-        api::computeInPieces(a, b, scale, call, pieces, directed, release, int(lanes), impl.options.threads);
+    Result<HausdorffResult> r = api::computeInPieces(a, b, scale, call, pieces, directed, release, int(lanes),
+                                                     impl.options.threads, recycle);
     release();  // the pieces' scratch is no use to the next call
     if (!r) return r;
     r->backend = impl.backend;

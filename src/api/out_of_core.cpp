@@ -295,6 +295,10 @@ struct Lane {
     int index = 0;
     int threads = 0;
     const DirectedCall* directed = nullptr;
+    const RecycleCall* recycle = nullptr;
+    void giveBack(PerPoint&& spent) const {
+        if (recycle != nullptr && *recycle) (*recycle)(index, std::move(spent));
+    }
     [[nodiscard]] Result<HausdorffResult> call(Span q, Span t, const CallOptions& piece) const {
         if (index == 0) return (*directed)(index, q, t, piece);
         CallOptions quiet = piece;
@@ -335,6 +339,7 @@ std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, 
             }
         }
     });
+    lane.giveBack(std::move(r->aNearest));
     return std::nullopt;
 }
 
@@ -352,6 +357,7 @@ std::optional<Error> chunkAgainstAll(Span qc, uint64_t q0, Span t, double scale,
                   shared.state.perPoint.distance.begin() + ptrdiff_t(q0));
         std::copy(r->aNearest.nearest.begin(), r->aNearest.nearest.end(),
                   shared.state.perPoint.nearest.begin() + ptrdiff_t(q0));
+        lane.giveBack(std::move(r->aNearest));
     }
     return std::nullopt;
 }
@@ -451,8 +457,9 @@ void runLane(ChunkQueue& queue, double scale, const CallOptions& call, const Lan
 // One direction Q -> T within `split`, its chunks spread over `lanes` lanes
 // (lane 0 on the calling thread); `from`/`width`: its share of the progress.
 Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOptions& call,
-                                    const DirectionSplit& split, const DirectedCall& directed, int lanes,
-                                    int threads, double from, double width) {
+                                    const DirectionSplit& split, const DirectedCall& directed,
+                                    const RecycleCall& recycle, int lanes, int threads, double from,
+                                    double width) {
     const std::vector<Tile> tiles =
         t.size() > split.targetTile ? makeTiles(t, split.targetTile, scale, threads) : std::vector<Tile>{};
     ChunkQueue queue;
@@ -473,9 +480,9 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
     std::vector<std::thread> helpers;
     for (int l = 1; l < lanes; ++l)
         helpers.emplace_back([&, l] {
-            runLane(queue, scale, call, Lane{l, threads, &directed}, shared, from, step);
+            runLane(queue, scale, call, Lane{l, threads, &directed, &recycle}, shared, from, step);
         });
-    runLane(queue, scale, call, Lane{0, threads, &directed}, shared, from, step);
+    runLane(queue, scale, call, Lane{0, threads, &directed, &recycle}, shared, from, step);
     for (std::thread& h : helpers) h.join();
     if (shared.error) return *shared.error;
     DirectionState s = std::move(shared.state);
@@ -490,13 +497,13 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
 // figure is an estimate; a device may hold less than it reports).
 Result<DirectionState> runDirectionWithin(Span q, Span t, double scale, const CallOptions& call,
                                           MemoryBudget budget, const DirectedCall& directed,
-                                          const std::function<void()>& release, int lanes, int threads,
-                                          double from, double width) {
+                                          const RecycleCall& recycle, const std::function<void()>& release,
+                                          int lanes, int threads, double from, double width) {
     for (;;) {
         Result<DirectionSplit> split = splitDirection(budget, q.size(), t.size(), lanes);
         if (!split) return split.error();
         Result<DirectionState> s =
-            runDirection(q, t, scale, call, *split, directed, lanes, threads, from, width);
+            runDirection(q, t, scale, call, *split, directed, recycle, lanes, threads, from, width);
         if (s || s.error().code != ErrorCode::kOutOfMemory || budget.pointsPerCall() < 4) return s;
         if (release) release();
         budget.bytes /= 2;
@@ -535,10 +542,11 @@ Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, u
 
 Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const CallOptions& call,
                                         const MemoryBudget& budget, const DirectedCall& directed,
-                                        const std::function<void()>& release, int lanes, int threads) {
+                                        const std::function<void()>& release, int lanes, int threads,
+                                        const RecycleCall& recycle) {
     const double width = call.directedOnly ? 1.0 : 0.5;
     Result<DirectionState> ab =
-        runDirectionWithin(a, b, scale, call, budget, directed, release, lanes, threads, 0.0, width);
+        runDirectionWithin(a, b, scale, call, budget, directed, recycle, release, lanes, threads, 0.0, width);
     if (!ab) return ab.error();
     HausdorffResult r;
     r.directedOnly = call.directedOnly;
@@ -548,8 +556,8 @@ Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const Call
     r.timings = ab->timings;
     if (!call.directedOnly) {
         if (release) release();
-        Result<DirectionState> ba =
-            runDirectionWithin(b, a, scale, call, budget, directed, release, lanes, threads, 0.5, 0.5);
+        Result<DirectionState> ba = runDirectionWithin(b, a, scale, call, budget, directed, recycle, release,
+                                                       lanes, threads, 0.5, 0.5);
         if (!ba) return ba.error();
         r.bToA = ba->witness;
         r.bNearest = std::move(ba->perPoint);

@@ -100,6 +100,9 @@ struct DirectionSplit {
 using DirectedCall =
     std::function<Result<HausdorffResult>(int lane, std::span<const glm::vec3> queries,
                                           std::span<const glm::vec3> targets, const CallOptions& call)>;
+// Hands the per-point arrays of a lane's call, once merged, back to that
+// lane's backend for its next call (GpuHausdorff::recyclePerPoint); may be empty.
+using RecycleCall = std::function<void(int lane, PerPoint&& spent)>;
 
 // H(A,B) (or h(A,B) with call.directedOnly) of float sets searched at the
 // exact power-of-two `scale` (core::exactScale), as a sequence of calls of
@@ -124,6 +127,6 @@ using DirectedCall =
                                                       const CallOptions& call, const MemoryBudget& budget,
                                                       const DirectedCall& directed,
                                                       const std::function<void()>& release, int lanes = 1,
-                                                      int threads = 0);
+                                                      int threads = 0, const RecycleCall& recycle = {});
 
 }  // namespace rthdist::api

@@ -63,6 +63,7 @@ struct GpuHausdorff::State {
           search(ws, index, refine) {}
 
     Workspace ws;
+    PerPoint spare;  // recyclePerPoint: the next per-point result's h(A,B) arrays
     IndexBuild index;
     QueryCheck check;
     NeighbourhoodPass cull;
@@ -162,6 +163,8 @@ struct GpuHausdorff::State {
     // [from, 1] of the call.
     void runPair(DeviceSet& a, DeviceSet& b, const CallOptions& options, HausdorffResult& res, double from) {
         const bool pp = options.perPointDistances;
+        if (pp) res.aNearest = std::move(spare);  // filled whole: read-back writes every entry
+        spare = PerPoint{};
         const double mid = options.directedOnly ? 1.0 : from + 0.5 * (1.0 - from);
         DirectionRun ab{a.ix, b.ix, a.points, b.points, ws.blocks[0], pp ? &res.aNearest : nullptr};
         DirectionRun ba{b.ix, a.ix, b.points, a.points, ws.blocks[1], pp ? &res.bNearest : nullptr};
@@ -243,12 +246,15 @@ void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
     m_state->ws.maxPairCapacity = std::max<uint64_t>(1, pairs);
 }
 
+void GpuHausdorff::recyclePerPoint(PerPoint&& spare) { m_state->spare = std::move(spare); }
+
 void GpuHausdorff::releaseScratch() {
     Workspace& ws = m_state->ws;
     ws.accel.release();
     ws.tlasBound = false;
     ws.scratch = Scratch{};
     ws.oneShot = {};
+    m_state->spare = PerPoint{};
 }
 
 Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, const std::string& cacheDir,

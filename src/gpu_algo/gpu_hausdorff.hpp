@@ -87,6 +87,11 @@ public:
     // one-shot calls (the next call allocates them again). Out-of-core calls
     // free one direction's before the other's. Prepared sets keep theirs.
     void releaseScratch();
+    // Takes back the per-point arrays of an earlier result (out-of-core tile
+    // calls, one after another): the next per-point call fills them in place
+    // of fresh ones, whose zero-fill on one thread and first-touch page
+    // faults cost about as much as the read-back itself (10^8 queries).
+    void recyclePerPoint(PerPoint&& spare);
 
     struct State;
 

@@ -86,8 +86,10 @@ void QueryCheck::readPerPoint(const PointIndex& Q, const Buffer& state, std::spa
     m_ws.ctx.submitAndWait(cmd);
     const auto* states = static_cast<const sh::QueryState*>(host.mapped());
     const auto* sorted = reinterpret_cast<const float*>(static_cast<const char*>(host.mapped()) + stateBytes);
-    out.distance.assign(Q.n, 0.0);
-    out.nearest.assign(Q.n, 0);
+    // Every entry is written below (the sorted queries are a permutation),
+    // so arrays recycled from an earlier call are not cleared first.
+    out.distance.resize(Q.n);
+    out.nearest.resize(Q.n);
     // Cached host memory (MemoryKind::kReadback) read on every host thread:
     // 32 bytes per query (per-point calls of out-of-core tiles read back
     // 10^8 queries).
