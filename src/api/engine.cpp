@@ -311,8 +311,6 @@ Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm:
     const api::MemoryBudget budget = memoryBudget(impl);
     const uint64_t lanes = laneCount(impl);
     const bool automatic = impl.options.memoryBudget == 0 && impl.device->gpu;
-    const bool sharesFit = api::fitsOneCall(budget, (a.size() + lanes - 1) / lanes, b.size()) &&
-                           api::fitsOneCall(budget, (b.size() + lanes - 1) / lanes, a.size());
     if (api::fitsOneCall(budget, a.size(), b.size())) {
         Result<HausdorffResult> r = runBackend(impl, 0, a, b, scale, call);
         if (r || r.error().code != ErrorCode::kOutOfMemory || !automatic) return r;
@@ -329,6 +327,8 @@ Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm:
         if (laneDevice(impl, size_t(lane)).gpu)
             laneDevice(impl, size_t(lane)).gpu->recyclePerPoint(std::move(spent));
     };
+    const bool sharesFit = api::fitsOneCall(budget, (a.size() + lanes - 1) / lanes, b.size()) &&
+                           api::fitsOneCall(budget, (b.size() + lanes - 1) / lanes, a.size());
     api::MemoryBudget pieces = budget;
     if (lanes > 1 && sharesFit) pieces.maxPiecePoints = UINT64_MAX;  // a kOutOfMemory halves the bytes
     release();

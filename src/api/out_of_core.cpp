@@ -84,17 +84,17 @@ float searchDist2(const glm::vec3& q, const glm::vec3& t, double scale) {
     return squaredLength(core::scaled(q, scale) - core::scaled(t, scale));
 }
 
-// A chunk's witness against the direction's: the larger distance wins, the
-// smaller query index among ties (chunks of several lanes finish in any order).
-void offerWitness(SharedDirection& shared, const Directed& d, float d2, uint64_t queryOffset,
-                  uint64_t targetOffset) {
+// A chunk's witness (its query index within the chunk, its target index
+// into the whole target set) against the direction's: the larger distance
+// wins, the smaller query index among ties (chunks of several lanes finish in
+// any order).
+void offerWitness(SharedDirection& shared, const Directed& d, float d2, uint64_t queryOffset) {
     const uint64_t query = d.queryIndex + queryOffset;
     std::lock_guard lock(shared.mutex);
     DirectionState& s = shared.state;
     if (!(d2 > s.witnessD2 || (d2 == s.witnessD2 && query < s.witness.queryIndex))) return;
     s.witness = d;
     s.witness.queryIndex = query;
-    s.witness.targetIndex = d.targetIndex + targetOffset;
     s.witnessD2 = d2;
 }
 
@@ -351,7 +351,7 @@ std::optional<Error> chunkAgainstAll(Span qc, uint64_t q0, Span t, double scale,
     if (!r) return r.error();
     addCall(shared, *r, q0 == 0);
     const Directed& w = r->aToB;
-    offerWitness(shared, w, searchDist2(qc[w.queryIndex], t[w.targetIndex], scale), q0, 0);
+    offerWitness(shared, w, searchDist2(qc[w.queryIndex], t[w.targetIndex], scale), q0);
     if (piece.perPointDistances) {
         std::copy(r->aNearest.distance.begin(), r->aNearest.distance.end(),
                   shared.state.perPoint.distance.begin() + ptrdiff_t(q0));
@@ -396,7 +396,7 @@ std::optional<Error> chunkAgainstTiles(Span qc, uint64_t q0, Span t, const std::
     d.targetIndex = x.nearest[w];
     d.queryPoint = glm::dvec3(qc[w]);
     d.targetPoint = glm::dvec3(t[x.nearest[w]]);
-    offerWitness(shared, d, x.d2[w], q0, 0);
+    offerWitness(shared, d, x.d2[w], q0);
     if (call.perPointDistances) {
         PerPoint& pp = shared.state.perPoint;
         std::copy(x.distance.begin(), x.distance.end(), pp.distance.begin() + ptrdiff_t(q0));
