@@ -1,13 +1,15 @@
 // Mask comparison in a named convention (masks.hpp has the definitions;
 // ../shared/MASKS.md the peers' sources they were read from).
 //
-// Both directions run on the exact engine with per-point distances. Work the
-// convention makes trivially zero is not sent to the engine: a boundary voxel
-// of X that is also a boundary voxel of Y has distance 0, and (itk) a voxel of
-// X inside Y has distance 0 while the nearest voxel of Y to any voxel outside
-// Y is one of Y's 6-connected boundary voxels (a step from an interior voxel
-// towards the query along its largest axis gets closer and stays in Y). The
-// zeros still count in every mean, percentile and surface Dice. The deepmind
+// Both directions run on the exact engine with per-point distances: the
+// boundary conventions in one call (both boundaries uploaded and indexed
+// once; a voxel on both boundaries comes back at distance 0). itk sends less:
+// a voxel of X inside Y has distance 0 while the nearest voxel of Y to any
+// voxel outside Y is one of Y's 6-connected boundary voxels (a step from an
+// interior voxel towards the query along its largest axis gets closer and
+// stays in Y), so each direction queries X's voxels outside Y against Y's
+// boundary; the zeros still count in every mean. Percentiles and counts come
+// from selection, not sorting (order_statistics.hpp). The deepmind
 // convention (surfels with areas) lives in deepmind.cpp.
 #include <algorithm>
 #include <array>
@@ -21,7 +23,8 @@
 #include "masks/boundary.hpp"
 #include "masks/deepmind.hpp"
 #include "masks/masks.hpp"
-#include "rthdist/stats.hpp"
+#include "masks/order_statistics.hpp"
+#include "masks/per_point_call.hpp"
 
 namespace rthdist::masks {
 namespace {
@@ -31,31 +34,8 @@ double msSince(Clock::time_point t) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
-// Linear interpolation between order statistics (numpy.percentile's and
-// torch.quantile's default): rank q (n - 1), lerp written as numpy writes it.
-double percentileLinear(const std::vector<double>& sorted, double p) {
-    const size_t n = sorted.size();
-    if (n == 0) return std::numeric_limits<double>::quiet_NaN();
-    const double rank = (p / 100.0) * double(n - 1);
-    const double lo = std::floor(rank);
-    const size_t i = std::min(size_t(lo), n - 1), j = std::min(i + 1, n - 1);
-    const double t = rank - lo;
-    const double a = sorted[i], b = sorted[j];
-    const double diff = b - a;
-    return t >= 0.5 ? b - diff * (1.0 - t) : a + diff * t;
-}
-
-// plastimatch: the k-th smallest (0-based), k = floor(f n - 1) clamped to [0, n-1].
-double percentilePlastimatch(const std::vector<double>& sorted, double p) {
-    const size_t n = sorted.size();
-    if (n == 0) return 0.0;
-    double k = std::floor((p / 100.0) * double(n) - 1.0);
-    k = std::clamp(k, 0.0, double(n - 1));
-    return sorted[size_t(k)];
-}
-
 struct Direction {
-    std::vector<double> sorted;  // all of X's distances, ascending (zeros included)
+    std::vector<double> distances;  // all of X's distances, in no particular order (zeros included)
     DirectedMask out;
     double sum = 0.0;
 };
@@ -86,40 +66,83 @@ std::vector<glm::dvec3> coordinates(const std::vector<uint64_t>& voxels, const V
     return out;
 }
 
-// One direction: `queries` (X's voxels that may be non-zero), `zeros` more of
-// X's voxels at distance 0 (zeroWitness: one of them, or ~0 when none),
-// `targets` (Y's voxels). Fills the direction's sorted distances and witness.
-Result<Direction> directed(Engine& engine, const Volume& v, const std::vector<uint64_t>& queries,
-                           uint64_t zeros, uint64_t zeroWitness, const std::vector<uint64_t>& targets,
-                           bool world, int threads, double& extractMs, double& distanceMs) {
+// X's side of an engine call: `queries` (X's voxels sent, in the call's
+// order), `nearest` their per-point output, `witness` the call's directed
+// result, plus `zeros` more of X's voxels at distance 0 that were not sent.
+// Voxel indices and world points on X's grid `v`.
+Result<Direction> directionOf(const Volume& v, const std::vector<uint64_t>& queries, const PerPoint& nearest,
+                              const Directed& witness, const std::vector<uint64_t>& targets, uint64_t zeros) {
+    if (nearest.distance.size() != queries.size())
+        return Error{ErrorCode::kInternal, "masks: the engine returned no per-point distances"};
     Direction d;
     d.out.points = queries.size() + zeros;
-    d.sorted.assign(size_t(zeros), 0.0);
-    if (!queries.empty()) {
-        auto t0 = Clock::now();
-        const std::vector<glm::dvec3> q = coordinates(queries, v, world, threads);
-        const std::vector<glm::dvec3> t = coordinates(targets, v, world, threads);
-        extractMs += msSince(t0);
-        t0 = Clock::now();
-        Result<HausdorffResult> r = engine.compute(PointView(q), PointView(t));
-        distanceMs += msSince(t0);
-        if (!r) return r.error();
-        const std::vector<double>& dist = r->aNearest.distance;
-        if (dist.size() != queries.size())
-            return Error{ErrorCode::kInternal, "masks: the engine returned no per-point distances"};
-        d.sorted.insert(d.sorted.end(), dist.begin(), dist.end());
-        std::sort(d.sorted.begin() + ptrdiff_t(zeros), d.sorted.end());
-        for (double x : dist) d.sum += x;
-        d.out.hd = r->aToB.distance;
-        d.out.voxel = detail::voxelOf(queries[r->aToB.queryIndex], v.dims);
-        d.out.nearestVoxel = detail::voxelOf(targets[r->aToB.targetIndex], v.dims);
-    } else {
-        d.out.hd = 0.0;
-        d.out.voxel = d.out.nearestVoxel = detail::voxelOf(zeroWitness, v.dims);
-    }
+    d.distances.reserve(size_t(d.out.points));
+    d.distances.assign(size_t(zeros), 0.0);
+    d.distances.insert(d.distances.end(), nearest.distance.begin(), nearest.distance.end());
+    for (double x : nearest.distance) d.sum += x;
+    d.out.hd = witness.distance;
+    d.out.voxel = detail::voxelOf(queries[witness.queryIndex], v.dims);
+    d.out.nearestVoxel = detail::voxelOf(targets[witness.targetIndex], v.dims);
+    return d;
+}
+
+// The mean and world points of a filled direction on X's grid `v`.
+void finishDirection(const Volume& v, Direction& d) {
     d.out.point = worldOf(v, d.out.voxel);
     d.out.nearestPoint = worldOf(v, d.out.nearestVoxel);
     d.out.mean = d.out.points ? d.sum / double(d.out.points) : 0.0;
+}
+
+// Boundary conventions: both directions in one engine call (each set
+// uploaded and indexed once), every boundary voxel a query (a voxel on both
+// boundaries comes back at distance 0). Both sets take A's grid (B's equals
+// it: checkSameGrid).
+Result<std::array<Direction, 2>> bothDirections(Engine& engine, const Volume& a,
+                                                const std::vector<uint64_t>& ba, const Volume& b,
+                                                const std::vector<uint64_t>& bb, bool world, int threads,
+                                                double& extractMs, double& distanceMs) {
+    auto t0 = Clock::now();
+    const std::vector<glm::dvec3> pa = coordinates(ba, a, world, threads);
+    const std::vector<glm::dvec3> pb = coordinates(bb, a, world, threads);
+    extractMs += msSince(t0);
+    t0 = Clock::now();
+    Result<HausdorffResult> r = engine.compute(PointView(pa), PointView(pb), detail::perPointCall(false));
+    distanceMs += msSince(t0);
+    if (!r) return r.error();
+    Result<Direction> ab = directionOf(a, ba, r->aNearest, r->aToB, bb, 0);
+    if (!ab) return ab.error();
+    Result<Direction> bA = directionOf(b, bb, r->bNearest, r->bToA, ba, 0);
+    if (!bA) return bA.error();
+    finishDirection(a, *ab);
+    finishDirection(b, *bA);
+    return std::array<Direction, 2>{std::move(*ab), std::move(*bA)};
+}
+
+// One direction (itk): `queries` (X's voxels that may be non-zero), `zeros`
+// more of X's voxels at distance 0 (zeroWitness: one of them, or ~0 when
+// none), `targets` (Y's voxels), all on X's grid `v`.
+Result<Direction> directed(Engine& engine, const Volume& v, const std::vector<uint64_t>& queries,
+                           uint64_t zeros, uint64_t zeroWitness, const std::vector<uint64_t>& targets,
+                           int threads, double& extractMs, double& distanceMs) {
+    Result<Direction> d = Direction{};
+    if (!queries.empty()) {
+        auto t0 = Clock::now();
+        const std::vector<glm::dvec3> q = coordinates(queries, v, false, threads);
+        const std::vector<glm::dvec3> t = coordinates(targets, v, false, threads);
+        extractMs += msSince(t0);
+        t0 = Clock::now();
+        Result<HausdorffResult> r = engine.compute(PointView(q), PointView(t), detail::perPointCall(true));
+        distanceMs += msSince(t0);
+        if (!r) return r.error();
+        d = directionOf(v, queries, r->aNearest, r->aToB, targets, zeros);
+        if (!d) return d.error();
+    } else {
+        d->out.points = zeros;
+        d->distances.assign(size_t(zeros), 0.0);
+        d->out.hd = 0.0;
+        d->out.voxel = d->out.nearestVoxel = detail::voxelOf(zeroWitness, v.dims);
+    }
+    finishDirection(v, *d);
     return d;
 }
 
@@ -190,20 +213,21 @@ std::array<DirectionPoints, 2> itkPoints(const Volume& a, LabelSelect selectA, u
     return d;
 }
 
-// Boundary conventions: a boundary voxel of X that is also one of Y has distance 0.
-std::array<DirectionPoints, 2> boundaryPoints(const std::vector<uint64_t>& ba,
-                                              const std::vector<uint64_t>& bb) {
-    std::array<DirectionPoints, 2> d;
-    std::set_difference(ba.begin(), ba.end(), bb.begin(), bb.end(), std::back_inserter(d[0].queries));
-    std::set_difference(bb.begin(), bb.end(), ba.begin(), ba.end(), std::back_inserter(d[1].queries));
-    d[0].zeros = ba.size() - d[0].queries.size();
-    d[1].zeros = bb.size() - d[1].queries.size();
-    if (d[0].zeros > 0 || d[1].zeros > 0) {
-        std::vector<uint64_t> common;
-        std::set_intersection(ba.begin(), ba.end(), bb.begin(), bb.end(), std::back_inserter(common));
-        d[0].zeroWitness = d[1].zeroWitness = common.front();
-    }
-    return d;
+// itk: each direction its own call (X's voxels outside Y against Y's boundary).
+Result<std::array<Direction, 2>> itkDirections(Engine& engine, const Volume& a, LabelSelect selectA,
+                                               const detail::Extraction& ea, const Volume& b,
+                                               LabelSelect selectB, const detail::Extraction& eb, int threads,
+                                               MaskResult& r) {
+    const auto t0 = Clock::now();
+    const std::array<DirectionPoints, 2> p = itkPoints(a, selectA, ea.count, b, selectB, eb.count, threads);
+    r.extractMs += msSince(t0);
+    Result<Direction> ab = directed(engine, a, p[0].queries, p[0].zeros, p[0].zeroWitness, eb.boundary,
+                                    threads, r.extractMs, r.distanceMs);
+    if (!ab) return ab.error();
+    Result<Direction> ba = directed(engine, b, p[1].queries, p[1].zeros, p[1].zeroWitness, ea.boundary,
+                                    threads, r.extractMs, r.distanceMs);
+    if (!ba) return ba.error();
+    return std::array<Direction, 2>{std::move(*ab), std::move(*ba)};
 }
 
 // HD, ASSD, MSD, surface overlaps and surface Dice from both directions.
@@ -214,8 +238,7 @@ void summarise(Direction& da, Direction& db, double tolerance, MaskResult& r) {
     r.msd = 0.5 * (da.out.mean + db.out.mean);
     uint64_t within = 0;
     for (Direction* d : {&da, &db}) {
-        const uint64_t w =
-            uint64_t(std::upper_bound(d->sorted.begin(), d->sorted.end(), tolerance) - d->sorted.begin());
+        const uint64_t w = detail::countAtMost(d->distances, tolerance);
         d->out.surfaceOverlap = double(w) / double(d->out.points);
         within += w;
     }
@@ -228,28 +251,28 @@ struct PercentilePair {
     double a = 0.0, b = 0.0, combined = 0.0;
 };
 
-PercentilePair percentilesOf(Convention c, const Direction& da, const Direction& db,
-                             const std::vector<double>& pooled, double p) {
+PercentilePair percentilesOf(Convention c, Direction& da, Direction& db, std::vector<double>& pooled,
+                             double p) {
     PercentilePair v;
     switch (c) {
         case Convention::kRthdist:
-            v.a = percentileNearestRank(da.sorted, p);
-            v.b = percentileNearestRank(db.sorted, p);
+            v.a = detail::percentileNearestRank(da.distances, p);
+            v.b = detail::percentileNearestRank(db.distances, p);
             v.combined = std::max(v.a, v.b);
             break;
         case Convention::kMonai:
-            v.a = percentileLinear(da.sorted, p);
-            v.b = percentileLinear(db.sorted, p);
+            v.a = detail::percentileLinear(da.distances, p);
+            v.b = detail::percentileLinear(db.distances, p);
             v.combined = std::max(v.a, v.b);
             break;
         case Convention::kMedpy:
-            v.a = percentileLinear(da.sorted, p);
-            v.b = percentileLinear(db.sorted, p);
-            v.combined = percentileLinear(pooled, p);
+            v.a = detail::percentileLinear(da.distances, p);
+            v.b = detail::percentileLinear(db.distances, p);
+            v.combined = detail::percentileLinear(pooled, p);
             break;
         case Convention::kPlastimatch:
-            v.a = percentilePlastimatch(da.sorted, p);
-            v.b = percentilePlastimatch(db.sorted, p);
+            v.a = detail::percentilePlastimatch(da.distances, p);
+            v.b = detail::percentilePlastimatch(db.distances, p);
             v.combined = 0.5 * (v.a + v.b);
             break;
         case Convention::kItk:
@@ -263,8 +286,9 @@ void addPercentiles(Convention c, const std::vector<double>& percentiles, Direct
                     MaskResult& r) {
     std::vector<double> pooled;
     if (c == Convention::kMedpy) {
-        pooled.resize(da.sorted.size() + db.sorted.size());
-        std::merge(da.sorted.begin(), da.sorted.end(), db.sorted.begin(), db.sorted.end(), pooled.begin());
+        pooled.reserve(da.distances.size() + db.distances.size());
+        pooled.assign(da.distances.begin(), da.distances.end());
+        pooled.insert(pooled.end(), db.distances.begin(), db.distances.end());
     }
     for (double p : percentiles) {
         const PercentilePair v = percentilesOf(c, da, db, pooled, p);
@@ -366,27 +390,22 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
     const int threads = options.threads;
     const bool world = c == Convention::kRthdist;
 
-    auto t0 = Clock::now();
+    const auto t0 = Clock::now();
     const detail::Extraction ea = detail::extractBoundary(a, selectA, itk ? 6 : conn, threads);
     const detail::Extraction eb = detail::extractBoundary(b, selectB, itk ? 6 : conn, threads);
+    r.extractMs = msSince(t0);
     if (ea.count == 0 || eb.count == 0) {
         setEmpty(ea.count, eb.count, itk ? 0 : options.percentiles.size(), r);
-        r.extractMs = msSince(t0);
         r.totalMs = msSince(start);
         return r;
     }
-    // Queries (possibly non-zero), zero count and targets per direction.
-    const std::array<DirectionPoints, 2> p =
-        itk ? itkPoints(a, selectA, ea.count, b, selectB, eb.count, threads)
-            : boundaryPoints(ea.boundary, eb.boundary);
-    r.extractMs = msSince(t0);
-
-    Result<Direction> ab = directed(engine, a, p[0].queries, p[0].zeros, p[0].zeroWitness, eb.boundary, world,
-                                    threads, r.extractMs, r.distanceMs);
-    if (!ab) return ab.error();
-    Result<Direction> ba = directed(engine, b, p[1].queries, p[1].zeros, p[1].zeroWitness, ea.boundary, world,
-                                    threads, r.extractMs, r.distanceMs);
-    if (!ba) return ba.error();
+    Result<std::array<Direction, 2>> both =
+        itk ? itkDirections(engine, a, selectA, ea, b, selectB, eb, threads, r)
+            : bothDirections(engine, a, ea.boundary, b, eb.boundary, world, threads, r.extractMs,
+                             r.distanceMs);
+    if (!both) return both.error();
+    Direction* ab = &(*both)[0];
+    Direction* ba = &(*both)[1];
     summarise(*ab, *ba, options.tolerance, r);
     if (itk) {
         r.assd = r.surfaceDice = ab->out.surfaceOverlap = ba->out.surfaceOverlap =

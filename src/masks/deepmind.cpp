@@ -15,6 +15,7 @@
 
 #include "core/parallel.hpp"
 #include "masks/area_weighted.hpp"
+#include "masks/per_point_call.hpp"
 #include "masks/surfel_area.hpp"
 #include "masks/surfels.hpp"
 
@@ -107,7 +108,7 @@ Result<SurfelDirection> directed(Engine& engine, const Volume& v, const Surfels&
         const std::vector<glm::dvec3> t = cornerCoordinates(y.corners, v, threads);
         timing.extractMs += msSince(t0);
         t0 = Clock::now();
-        Result<HausdorffResult> r = engine.compute(PointView(q), PointView(t));
+        Result<HausdorffResult> r = engine.compute(PointView(q), PointView(t), perPointCall(true));
         timing.distanceMs += msSince(t0);
         if (!r) return r.error();
         const std::vector<uint32_t>& nearest = r->aNearest.nearest;

@@ -192,8 +192,9 @@ struct MaskResult {
 };
 
 // Compares label `selectA` of `a` with `selectB` of `b` (same grid: checked).
-// `engine` must have been created with perPointDistances and directedOnly set
-// (makeMaskEngine); each direction is one compute() call.
+// Any Engine (makeMaskEngine, or the caller's); the calls set their own
+// options (per-point distances). Boundary conventions: one compute() call for
+// both directions, on A's grid; itk and deepmind: one call per direction.
 [[nodiscard]] Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect selectA,
                                               const Volume& b, LabelSelect selectB,
                                               const MaskOptions& options);

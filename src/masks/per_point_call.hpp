@@ -1,0 +1,17 @@
+// The options of every engine call of compareMasks: each query's exact
+// nearest distance (per-point), one direction or both. Set per call, so any
+// Engine serves (its own call defaults are not used). Internal to rthdist_masks.
+#pragma once
+
+#include "rthdist/options.hpp"
+
+namespace rthdist::masks::detail {
+
+[[nodiscard]] inline CallOptions perPointCall(bool directedOnly) {
+    CallOptions call;
+    call.perPointDistances = true;
+    call.directedOnly = directedOnly;
+    return call;
+}
+
+}  // namespace rthdist::masks::detail

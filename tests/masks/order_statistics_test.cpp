@@ -1,0 +1,70 @@
+// Selection-based order statistics (masks/order_statistics.hpp) against the
+// same rules written on a sorted copy, on values with many ties (distances of
+// voxel lattices repeat) and on every size from 1 to 40.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "masks/order_statistics.hpp"
+
+namespace rthdist::masks::detail {
+namespace {
+
+double sortedLinear(const std::vector<double>& s, double p) {
+    const double rank = (p / 100.0) * double(s.size() - 1);
+    const double lo = std::floor(rank);
+    const size_t i = std::min(size_t(lo), s.size() - 1), j = std::min(i + 1, s.size() - 1);
+    const double t = rank - lo, diff = s[j] - s[i];
+    return t >= 0.5 ? s[j] - diff * (1.0 - t) : s[i] + diff * t;
+}
+
+double sortedPlastimatch(const std::vector<double>& s, double p) {
+    const double k = std::clamp(std::floor((p / 100.0) * double(s.size()) - 1.0), 0.0, double(s.size() - 1));
+    return s[size_t(k)];
+}
+
+double sortedNearestRank(const std::vector<double>& s, double p) {
+    const double rank = std::clamp(std::ceil(p * double(s.size()) / 100.0), 1.0, double(s.size()));
+    return s[size_t(rank) - 1];
+}
+
+TEST(OrderStatistics, SelectionEqualsTheSortedRule) {
+    std::mt19937 rng(7);
+    const std::vector<double> ps{0.0, 1.0, 5.0, 25.0, 50.0, 90.0, 95.0, 99.0, 99.9, 100.0, 33.3};
+    for (size_t n = 1; n <= 40; ++n) {
+        for (int trial = 0; trial < 5; ++trial) {
+            std::vector<double> values(n);
+            // sqrt of small integers: the ties of lattice distances.
+            for (double& v : values) v = std::sqrt(double(rng() % 12));
+            std::vector<double> sorted = values;
+            std::sort(sorted.begin(), sorted.end());
+            for (double p : ps) {
+                std::vector<double> work = values;
+                EXPECT_EQ(percentileLinear(work, p), sortedLinear(sorted, p)) << n << " p" << p;
+                work = values;
+                EXPECT_EQ(percentilePlastimatch(work, p), sortedPlastimatch(sorted, p)) << n << " p" << p;
+                work = values;
+                EXPECT_EQ(percentileNearestRank(work, p), sortedNearestRank(sorted, p)) << n << " p" << p;
+                // Reused without restoring the order (several percentiles in a row).
+                EXPECT_EQ(percentileLinear(work, p), sortedLinear(sorted, p)) << n << " p" << p;
+            }
+            for (double limit : {-1.0, 0.0, 1.0, std::sqrt(2.0), 10.0})
+                EXPECT_EQ(countAtMost(values, limit),
+                          size_t(std::upper_bound(sorted.begin(), sorted.end(), limit) - sorted.begin()));
+        }
+    }
+}
+
+TEST(OrderStatistics, EmptyValuesFollowTheConventions) {
+    std::vector<double> none;
+    EXPECT_TRUE(std::isnan(percentileLinear(none, 95.0)));
+    EXPECT_EQ(percentilePlastimatch(none, 95.0), 0.0);
+    EXPECT_EQ(percentileNearestRank(none, 95.0), 0.0);
+    EXPECT_EQ(countAtMost(none, 1.0), 0u);
+}
+
+}  // namespace
+}  // namespace rthdist::masks::detail
