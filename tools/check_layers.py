@@ -17,7 +17,8 @@ ALLOWED = {
     "api": {"gpu_algo", "gpu", "cpu", "core"},      # the public entry points
     "io": set(),                                    # loaders, beside the engine
     "render": {"gpu"},                              # the CLI's pictures
-    "masks": {"core"},                              # segmentation masks, on the public API
+    "masks_gpu": {"gpu", "core"},                   # the masks' boundary pass (compute)
+    "masks": {"masks_gpu", "core"},                 # segmentation masks, on the public API
     "mpi": {"core"},                                # MPI, on the public API
 }
 

@@ -22,9 +22,11 @@
 #include "core/parallel.hpp"
 #include "masks/boundary.hpp"
 #include "masks/deepmind.hpp"
+#include "masks/gpu_boundary.hpp"
 #include "masks/masks.hpp"
 #include "masks/order_statistics.hpp"
 #include "masks/per_point_call.hpp"
+#include "masks_gpu/boundary_pass.hpp"
 
 namespace rthdist::masks {
 namespace {
@@ -230,6 +232,23 @@ Result<std::array<Direction, 2>> itkDirections(Engine& engine, const Volume& a, 
     return std::array<Direction, 2>{std::move(*ab), std::move(*ba)};
 }
 
+// One mask's boundary: through the device pass when there is one, else (or
+// when its box does not fit the pass) on the host. `where` becomes "device"
+// when the pass found it.
+Result<detail::Extraction> extract(masks_gpu::BoundaryPass* pass, const Volume& v, LabelSelect select,
+                                   int connectivity, int threads, std::string& where) {
+    if (pass != nullptr) {
+        Result<detail::Extraction> e =
+            detail::extractBoundaryOnDevice(*pass, v, select, connectivity, threads);
+        if (e) {
+            where = "device";
+            return e;
+        }
+        if (e.error().code != ErrorCode::kOutOfMemory) return e.error();
+    }
+    return detail::extractBoundary(v, select, connectivity, threads);
+}
+
 // HD, ASSD, MSD, surface overlaps and surface Dice from both directions.
 void summarise(Direction& da, Direction& db, double tolerance, MaskResult& r) {
     r.hd = std::max(da.out.hd, db.out.hd);
@@ -369,16 +388,25 @@ const char* emptyStatusName(EmptyStatus s) {
     return "?";
 }
 
-Result<Engine> makeMaskEngine(Options options) {
+Result<MaskEngine> makeMaskEngine(Options options) {
     options.perPointDistances = true;
     options.directedOnly = true;
-    return Engine::create(options);
+    Result<Engine> engine = Engine::create(options);
+    if (!engine) return engine.error();
+    MaskEngine m{std::move(*engine), nullptr};
+    if (m.engine.backend() != Backend::kCpu) {
+        auto pass = masks_gpu::BoundaryPass::create(options.deviceIndex, options.validation);
+        if (!pass) return pass.error();
+        m.boundaryPass = std::move(*pass);
+    }
+    return m;
 }
 
-Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect selectA, const Volume& b,
+Result<MaskResult> compareMasks(MaskEngine& maskEngine, const Volume& a, LabelSelect selectA, const Volume& b,
                                 LabelSelect selectB, const MaskOptions& options) {
     const auto start = Clock::now();
     if (auto e = checkInputs(a, b, options)) return *e;
+    Engine& engine = maskEngine.engine;
     const Convention c = options.convention;
     if (c == Convention::kDeepmind) return detail::compareDeepmind(engine, a, selectA, b, selectB, options);
     const int conn = connectivityOf(c, options.connectivity);
@@ -391,17 +419,20 @@ Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect sel
     const bool world = c == Convention::kRthdist;
 
     const auto t0 = Clock::now();
-    const detail::Extraction ea = detail::extractBoundary(a, selectA, itk ? 6 : conn, threads);
-    const detail::Extraction eb = detail::extractBoundary(b, selectB, itk ? 6 : conn, threads);
+    masks_gpu::BoundaryPass* pass = options.hostExtraction ? nullptr : maskEngine.boundaryPass.get();
+    Result<detail::Extraction> ea = extract(pass, a, selectA, itk ? 6 : conn, threads, r.extraction);
+    if (!ea) return ea.error();
+    Result<detail::Extraction> eb = extract(pass, b, selectB, itk ? 6 : conn, threads, r.extraction);
+    if (!eb) return eb.error();
     r.extractMs = msSince(t0);
-    if (ea.count == 0 || eb.count == 0) {
-        setEmpty(ea.count, eb.count, itk ? 0 : options.percentiles.size(), r);
+    if (ea->count == 0 || eb->count == 0) {
+        setEmpty(ea->count, eb->count, itk ? 0 : options.percentiles.size(), r);
         r.totalMs = msSince(start);
         return r;
     }
     Result<std::array<Direction, 2>> both =
-        itk ? itkDirections(engine, a, selectA, ea, b, selectB, eb, threads, r)
-            : bothDirections(engine, a, ea.boundary, b, eb.boundary, world, threads, r.extractMs,
+        itk ? itkDirections(engine, a, selectA, *ea, b, selectB, *eb, threads, r)
+            : bothDirections(engine, a, ea->boundary, b, eb->boundary, world, threads, r.extractMs,
                              r.distanceMs);
     if (!both) return both.error();
     Direction* ab = &(*both)[0];

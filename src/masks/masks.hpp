@@ -66,12 +66,17 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
+
+namespace rthdist::masks_gpu {
+class BoundaryPass;
+}
 
 namespace rthdist::masks {
 
@@ -146,6 +151,9 @@ struct MaskOptions {
     std::vector<double> percentiles{95.0};  // each in [0, 100]
     double tolerance = 1.0;                 // surface Dice tolerance, in mm (>= 0)
     int threads = 0;                        // boundary extraction; 0 = all hardware threads
+    // Extract boundaries on the host even when the MaskEngine has a device
+    // pass (benchmarks and tests compare the two; the voxels are the same).
+    bool hostExtraction = false;
 };
 
 enum class EmptyStatus { kNone, kBothEmpty, kAEmpty, kBEmpty };
@@ -189,17 +197,31 @@ struct MaskResult {
     double surfaceDice = 0.0;
     DirectedMask aToB, bToA;
     double extractMs = 0.0, distanceMs = 0.0, totalMs = 0.0;
+    // Where the boundary voxels were found: "device" (the compute pass) or
+    // "host" (the CPU backend, itk's foreground, deepmind's surfels, a box
+    // too large for the pass, or MaskOptions::hostExtraction).
+    std::string extraction = "host";
+};
+
+// The engine of compareMasks and, on a GPU backend, the boundary pass
+// (masks_gpu/boundary_pass.hpp) opened on the same device index: boundary
+// voxels are then found by a compute shader, the points' distances by the
+// engine. Not thread-safe (one per thread), as Engine.
+struct MaskEngine {
+    Engine engine;
+    std::shared_ptr<masks_gpu::BoundaryPass> boundaryPass;  // null: extraction on the host
 };
 
 // Compares label `selectA` of `a` with `selectB` of `b` (same grid: checked).
-// Any Engine (makeMaskEngine, or the caller's); the calls set their own
-// options (per-point distances). Boundary conventions: one compute() call for
-// both directions, on A's grid; itk and deepmind: one call per direction.
-[[nodiscard]] Result<MaskResult> compareMasks(Engine& engine, const Volume& a, LabelSelect selectA,
+// The calls set their own options (per-point distances). Boundary
+// conventions: one compute() call for both directions, on A's grid; itk and
+// deepmind: one call per direction.
+[[nodiscard]] Result<MaskResult> compareMasks(MaskEngine& engine, const Volume& a, LabelSelect selectA,
                                               const Volume& b, LabelSelect selectB,
                                               const MaskOptions& options);
 
-// An Engine configured for compareMasks from the caller's options.
-[[nodiscard]] Result<Engine> makeMaskEngine(Options options);
+// The Engine of `options` (backend, device, threads, validation) and, when
+// it runs a GPU backend, the boundary pass on options.deviceIndex.
+[[nodiscard]] Result<MaskEngine> makeMaskEngine(Options options);
 
 }  // namespace rthdist::masks

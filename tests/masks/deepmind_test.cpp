@@ -202,7 +202,7 @@ Volume unitVolume(std::array<int64_t, 3> dims) {
 TEST(DeepmindBackend, OneVoxelEachByHand) {
     Options o;
     o.backend = backendUnderTest();
-    Result<Engine> engine = makeMaskEngine(o);
+    Result<MaskEngine> engine = makeMaskEngine(o);
     ASSERT_TRUE(engine.ok()) << engine.error().message;
     Volume a = unitVolume({7, 3, 3}), b = a;
     a.labels[size_t(1 + 7 * (1 + 3 * 1))] = 1;
@@ -229,7 +229,7 @@ TEST(DeepmindBackend, OneVoxelEachByHand) {
 TEST(DeepmindBackend, EmptyMasksReportInf) {
     Options o;
     o.backend = backendUnderTest();
-    Result<Engine> engine = makeMaskEngine(o);
+    Result<MaskEngine> engine = makeMaskEngine(o);
     ASSERT_TRUE(engine.ok()) << engine.error().message;
     Volume empty = unitVolume({5, 5, 5}), one = empty;
     one.labels[62] = 1;

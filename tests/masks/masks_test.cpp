@@ -13,7 +13,9 @@
 #include <string>
 
 #include "masks/boundary.hpp"
+#include "masks/gpu_boundary.hpp"
 #include "masks/masks.hpp"
+#include "masks_gpu/boundary_pass.hpp"
 
 namespace rthdist::masks {
 namespace {
@@ -174,10 +176,59 @@ TEST(MasksBoundary, MatchesBruteForce) {
     }
 }
 
+// The compute pass (masks_gpu, on lavapipe here) finds the host extraction's
+// voxels, in its order: 8- and 32-bit labels, a label value, any non-zero,
+// every connectivity, labels confined to a few rows and slices (the pass
+// sees only their box), touching the volume's faces, or absent.
+TEST(MasksBoundary, DevicePassEqualsHost) {
+    auto pass = masks_gpu::BoundaryPass::create(-1, true);
+    ASSERT_TRUE(pass.has_value()) << pass.error().message;
+    std::mt19937 rng(29);
+    struct Case {
+        detail::Dims dims;
+        std::array<int64_t, 6> region;  // x0, x1, y0, y1, z0, z1 (inclusive) holding labels
+        bool eightBit;
+    };
+    const std::vector<Case> cases{
+        {{9, 8, 7}, {0, 8, 0, 7, 0, 6}, false},     // labels everywhere, faces touched
+        {{33, 17, 12}, {4, 20, 3, 9, 2, 5}, true},  // a box inside; 33 x 17: rows across words
+        {{1, 5, 6}, {0, 0, 1, 3, 0, 5}, true},      // one voxel wide
+        {{40, 3, 2}, {0, 39, 2, 2, 1, 1}, false},   // one row
+        {{16, 16, 16}, {0, 0, 0, 0, 0, 0}, true},   // labels in voxel 0 only
+    };
+    for (const Case& c : cases) {
+        Volume v = makeVolume(c.dims, glm::dvec3(1.0));
+        for (int64_t k = c.region[4]; k <= c.region[5]; ++k)
+            for (int64_t j = c.region[2]; j <= c.region[3]; ++j)
+                for (int64_t i = c.region[0]; i <= c.region[1]; ++i)
+                    v.labels[size_t(i + c.dims[0] * (j + c.dims[1] * k))] = int32_t(rng() % 4);
+        if (c.eightBit) {
+            v.labels8.assign(v.labels.begin(), v.labels.end());
+            v.labels.clear();
+        }
+        for (LabelSelect select :
+             {LabelSelect{2, false}, LabelSelect{1, true}, LabelSelect{7, false}, LabelSelect{258, false}}) {
+            for (int conn : {6, 18, 26}) {
+                const detail::Extraction host = detail::extractBoundary(v, select, conn, 2);
+                Result<detail::Extraction> device =
+                    detail::extractBoundaryOnDevice(**pass, v, select, conn, 2);
+                ASSERT_TRUE(device.has_value()) << device.error().message;
+                const std::string what =
+                    "dims " + std::to_string(c.dims[0]) + "x" + std::to_string(c.dims[1]) + "x" +
+                    std::to_string(c.dims[2]) + " label " + std::to_string(select.value) +
+                    (select.anyNonZero ? " (any)" : "") + " connectivity " + std::to_string(conn);
+                EXPECT_EQ(device->count, host.count) << what;
+                EXPECT_EQ(device->boundary, host.boundary) << what;
+            }
+        }
+    }
+    EXPECT_EQ((*pass)->validationMessageCount(), 0u);
+}
+
 TEST(MasksCompare, InvalidOptions) {
     Options o;
     o.backend = Backend::kCpu;
-    Result<Engine> engine = makeMaskEngine(o);
+    Result<MaskEngine> engine = makeMaskEngine(o);
     ASSERT_TRUE(engine.ok());
     Volume v = makeVolume({6, 6, 6}, glm::dvec3(1.0));
     ball(v, glm::dvec3(3.0), 2.0, 1);
@@ -193,11 +244,11 @@ TEST(MasksCompare, InvalidOptions) {
 TEST(MasksBackend, AllConventionsMatchCpu) {
     Options o;
     o.backend = backendUnderTest();
-    Result<Engine> engine = makeMaskEngine(o);
+    Result<MaskEngine> engine = makeMaskEngine(o);
     ASSERT_TRUE(engine.ok()) << engine.error().message;
     Options oc;
     oc.backend = Backend::kCpu;
-    Result<Engine> cpu = makeMaskEngine(oc);
+    Result<MaskEngine> cpu = makeMaskEngine(oc);
     ASSERT_TRUE(cpu.ok());
     Volume a = makeVolume({30, 28, 10}, glm::dvec3(0.5, 0.7, 3.0));
     Volume b = a;
@@ -219,13 +270,18 @@ TEST(MasksBackend, AllConventionsMatchCpu) {
             EXPECT_NEAR(r->hdPercentile[i], w->hdPercentile[i], 1e-6 * diag) << conventionName(c);
         EXPECT_EQ(r->aToB.points, w->aToB.points);
         EXPECT_GT(r->hd, 6.0);  // the outlier voxel (about 8 mm from b)
+        // A GPU backend finds boundary voxels with its compute pass (not
+        // deepmind's surfels); the CPU backend on the host.
+        const bool devicePass = o.backend != Backend::kCpu && c != Convention::kDeepmind;
+        EXPECT_EQ(r->extraction, devicePass ? "device" : "host") << conventionName(c);
+        EXPECT_EQ(w->extraction, "host") << conventionName(c);
     }
 }
 
 TEST(MasksBackend, EmptyMasksHaveAStatus) {
     Options o;
     o.backend = backendUnderTest();
-    Result<Engine> engine = makeMaskEngine(o);
+    Result<MaskEngine> engine = makeMaskEngine(o);
     ASSERT_TRUE(engine.ok()) << engine.error().message;
     Volume empty = makeVolume({8, 8, 8}, glm::dvec3(1.0));
     Volume full = empty;

@@ -5,7 +5,7 @@
 //   rthdist-masks A B [--label N | --labels all] [--convention NAME|all]
 //                 [--percentile P]... [--connectivity 6|18|26] [--tolerance MM]
 //                 [--spacing X,Y,Z | --affine 12 numbers] [--backend B] [--device N]
-//                 [--threads N]
+//                 [--threads N] [--host-extraction]
 //                 [--json | --csv]
 //
 // A separate executable from `rthdist` (tools/cli/main.cpp), with its own
@@ -51,6 +51,7 @@ struct MasksArgs {
     std::optional<glm::dmat4> affine;  // --affine: voxel-to-world of .npy inputs
     Options options;
     bool json = false, csv = false, help = false, version = false;
+    bool hostExtraction = false;  // --host-extraction
 };
 
 const char* kUsage =
@@ -69,6 +70,8 @@ const char* kUsage =
     "  --affine R00,R01,R02,T0,R10,...,T2  voxel-to-world of .npy inputs: 3x4, row-major\n"
     "  --backend B          auto, cpu, ray-query, rt-pipeline (default auto)\n"
     "  --device N           Vulkan device index;  --threads N  CPU threads (0 = all)\n"
+    "  --host-extraction    find boundary voxels on the host even with a GPU backend\n"
+    "                       (default there: a compute shader)\n"
     "  --json | --csv       output format (default: text)\n"
     "Exit codes: 0 ok, 1 internal error, 2 usage, 3 bad input or different grids, 4 no device.\n";
 
@@ -203,8 +206,9 @@ Result<MasksArgs> parse(std::span<const std::string> argv) {
         }
     });
     // Flags ignore a value ("--json=x" is --json).
-    for (auto [name, target] : {std::pair{"--help", &a.help}, std::pair{"--version", &a.version},
-                                std::pair{"--json", &a.json}, std::pair{"--csv", &a.csv}}) {
+    for (auto [name, target] :
+         {std::pair{"--help", &a.help}, std::pair{"--version", &a.version}, std::pair{"--json", &a.json},
+          std::pair{"--csv", &a.csv}, std::pair{"--host-extraction", &a.hostExtraction}}) {
         line.flag(name, [target = target](bool) { *target = true; });
     }
     addMeasureOptions(line, a, conventionSet);
@@ -297,6 +301,7 @@ Json rowJson(const Row& row) {
     out["surface_dice"] = r.surfaceDice;
     out["a_to_b"] = directedJson(r.aToB, r, ok);
     out["b_to_a"] = directedJson(r.bToA, r, ok);
+    out["extraction"] = r.extraction;
     out["timings_ms"] = {{"extract", r.extractMs}, {"distance", r.distanceMs}, {"total", r.totalMs}};
     return out;
 }
@@ -403,7 +408,7 @@ int run(int argc, char** argv) {
         selections.push_back({"nonzero", masks::LabelSelect{1, true}});
     }
 
-    Result<Engine> engine = masks::makeMaskEngine(args.options);
+    Result<masks::MaskEngine> engine = masks::makeMaskEngine(args.options);
     if (!engine) return fail(exitCodeFor(engine.error().code), engine.error().message);
 
     std::vector<Row> rows;
@@ -415,14 +420,15 @@ int run(int argc, char** argv) {
             mo.percentiles = args.percentiles;
             mo.tolerance = args.tolerance;
             mo.threads = args.options.threads;
+            mo.hostExtraction = args.hostExtraction;
             Result<MaskResult> r = masks::compareMasks(*engine, *a, select, *b, select, mo);
             if (!r) return fail(exitCodeFor(r.error().code), "label " + name + ": " + r.error().message);
             rows.push_back({name, std::move(*r)});
         }
     }
-    const std::string text = args.json  ? jsonReport(args, *a, *b, *engine, rows)
+    const std::string text = args.json  ? jsonReport(args, *a, *b, engine->engine, rows)
                              : args.csv ? csvReport(args, rows)
-                                        : textReport(args, *engine, rows);
+                                        : textReport(args, engine->engine, rows);
     if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
         return fail(kExitInternal, "cannot write to stdout");
     return kExitOk;

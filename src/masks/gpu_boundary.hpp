@@ -1,0 +1,28 @@
+// Boundary extraction with the compute pass of masks_gpu (boundary_pass.hpp):
+// the same voxels as extractBoundary (boundary.hpp), in the same ascending
+// order. Internal to rthdist_masks.
+//
+// The host's part: one pass over the volume that counts the selected voxels
+// of each row (the vectorized count of the host extraction) and finds the box
+// of whole rows holding them (rows outside it select nothing, so they are
+// background to the pass); the box's rows are copied into the pass's staging
+// memory, one submission uploads and marks them, and the bitmask read back
+// becomes linear indices. What the device saves the host is the neighbour
+// tests of every selected voxel.
+#pragma once
+
+#include "masks/boundary.hpp"
+#include "rthdist/result.hpp"
+
+namespace rthdist::masks_gpu {
+class BoundaryPass;
+}
+
+namespace rthdist::masks::detail {
+
+// kOutOfMemory when the box does not fit the pass (more than 2^32 - 1 voxels,
+// or the device's buffers): the caller extracts on the host instead.
+[[nodiscard]] Result<Extraction> extractBoundaryOnDevice(masks_gpu::BoundaryPass& pass, const Volume& v,
+                                                         LabelSelect select, int connectivity, int threads);
+
+}  // namespace rthdist::masks::detail
