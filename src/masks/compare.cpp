@@ -26,6 +26,7 @@
 #include "masks/masks.hpp"
 #include "masks/order_statistics.hpp"
 #include "masks/per_point_call.hpp"
+#include "masks/voxel_metric.hpp"
 #include "masks_gpu/boundary_pass.hpp"
 
 namespace rthdist::masks {
@@ -53,38 +54,26 @@ glm::dvec3 worldOf(const Volume& v, std::array<int64_t, 3> ijk) {
     return glm::dvec3(v.voxelToWorld * glm::dvec4(double(ijk[0]), double(ijk[1]), double(ijk[2]), 1.0));
 }
 
-// Coordinates of voxels: the full affine (world) or the spacing only.
-std::vector<glm::dvec3> coordinates(const std::vector<uint64_t>& voxels, const Volume& v, bool world,
-                                    int threads) {
-    std::vector<glm::dvec3> out(voxels.size());
-    const glm::dvec3 s = v.spacing();
-    core::parallelChunks(voxels.size(), size_t(1) << 16, threads, [&](size_t b, size_t e, int) {
-        for (size_t i = b; i < e; ++i) {
-            const auto ijk = detail::voxelOf(voxels[i], v.dims);
-            out[i] = world ? worldOf(v, ijk)
-                           : glm::dvec3(double(ijk[0]) * s.x, double(ijk[1]) * s.y, double(ijk[2]) * s.z);
-        }
-    });
-    return out;
-}
-
 // X's side of an engine call: `queries` (X's voxels sent, in the call's
-// order), `nearest` their per-point output, `witness` the call's directed
-// result, plus `zeros` more of X's voxels at distance 0 that were not sent.
-// Voxel indices and world points on X's grid `v`.
-Result<Direction> directionOf(const Volume& v, const std::vector<uint64_t>& queries, const PerPoint& nearest,
-                              const Directed& witness, const std::vector<uint64_t>& targets, uint64_t zeros) {
-    if (nearest.distance.size() != queries.size())
-        return Error{ErrorCode::kInternal, "masks: the engine returned no per-point distances"};
+// order), `nearest` the engine's per-point output (indices into `targets`),
+// plus `zeros` more of X's voxels at distance 0 that were not sent. Distances
+// recomputed in double on X's grid `v` (voxel_metric.hpp).
+Result<Direction> directionOf(const Volume& v, const detail::VoxelMetric& metric,
+                              const std::vector<uint64_t>& queries, const PerPoint& nearest,
+                              const std::vector<uint64_t>& targets, uint64_t zeros, int threads) {
+    if (nearest.nearest.size() != queries.size())
+        return Error{ErrorCode::kInternal, "masks: the engine returned no per-point nearest points"};
+    detail::RecomputedDirection r =
+        detail::recompute(metric, v.dims, queries, targets, nearest.nearest, threads);
     Direction d;
     d.out.points = queries.size() + zeros;
     d.distances.reserve(size_t(d.out.points));
     d.distances.assign(size_t(zeros), 0.0);
-    d.distances.insert(d.distances.end(), nearest.distance.begin(), nearest.distance.end());
-    for (double x : nearest.distance) d.sum += x;
-    d.out.hd = witness.distance;
-    d.out.voxel = detail::voxelOf(queries[witness.queryIndex], v.dims);
-    d.out.nearestVoxel = detail::voxelOf(targets[witness.targetIndex], v.dims);
+    d.distances.insert(d.distances.end(), r.distances.begin(), r.distances.end());
+    d.sum = r.sum;
+    d.out.hd = r.distances[r.witness];
+    d.out.voxel = detail::voxelOf(queries[r.witness], v.dims);
+    d.out.nearestVoxel = detail::voxelOf(targets[nearest.nearest[r.witness]], v.dims);
     return d;
 }
 
@@ -95,26 +84,44 @@ void finishDirection(const Volume& v, Direction& d) {
     d.out.mean = d.out.points ? d.sum / double(d.out.points) : 0.0;
 }
 
+// Adds one call's stage timings to `sum`.
+void addTimings(Timings& sum, const Timings& t) {
+    sum.upload += t.upload;
+    sum.index += t.index;
+    sum.cull += t.cull;
+    sum.search += t.search;
+    sum.refine += t.refine;
+    sum.check += t.check;
+    sum.total += t.total;
+    sum.gpuIndex += t.gpuIndex;
+    sum.gpuCull += t.gpuCull;
+    sum.gpuSearch += t.gpuSearch;
+    sum.gpuRefine += t.gpuRefine;
+    sum.gpuUpload += t.gpuUpload;
+}
+
 // Boundary conventions: both directions in one engine call (each set
 // uploaded and indexed once), every boundary voxel a query (a voxel on both
 // boundaries comes back at distance 0). Both sets take A's grid (B's equals
-// it: checkSameGrid).
+// it: checkSameGrid); `timed` gains the extraction, distance and engine times.
 Result<std::array<Direction, 2>> bothDirections(Engine& engine, const Volume& a,
                                                 const std::vector<uint64_t>& ba, const Volume& b,
                                                 const std::vector<uint64_t>& bb, bool world, int threads,
-                                                double& extractMs, double& distanceMs) {
+                                                MaskResult& timed) {
     auto t0 = Clock::now();
-    const std::vector<glm::dvec3> pa = coordinates(ba, a, world, threads);
-    const std::vector<glm::dvec3> pb = coordinates(bb, a, world, threads);
-    extractMs += msSince(t0);
+    const detail::VoxelMetric metric(a, world);
+    const std::vector<glm::vec3> pa = metric.searchPoints(ba, threads);
+    const std::vector<glm::vec3> pb = metric.searchPoints(bb, threads);
+    timed.extractMs += msSince(t0);
     t0 = Clock::now();
     Result<HausdorffResult> r = engine.compute(PointView(pa), PointView(pb), detail::perPointCall(false));
-    distanceMs += msSince(t0);
     if (!r) return r.error();
-    Result<Direction> ab = directionOf(a, ba, r->aNearest, r->aToB, bb, 0);
+    addTimings(timed.engine, r->timings);
+    Result<Direction> ab = directionOf(a, metric, ba, r->aNearest, bb, 0, threads);
     if (!ab) return ab.error();
-    Result<Direction> bA = directionOf(b, bb, r->bNearest, r->bToA, ba, 0);
+    Result<Direction> bA = directionOf(b, metric, bb, r->bNearest, ba, 0, threads);
     if (!bA) return bA.error();
+    timed.distanceMs += msSince(t0);
     finishDirection(a, *ab);
     finishDirection(b, *bA);
     return std::array<Direction, 2>{std::move(*ab), std::move(*bA)};
@@ -125,19 +132,21 @@ Result<std::array<Direction, 2>> bothDirections(Engine& engine, const Volume& a,
 // none), `targets` (Y's voxels), all on X's grid `v`.
 Result<Direction> directed(Engine& engine, const Volume& v, const std::vector<uint64_t>& queries,
                            uint64_t zeros, uint64_t zeroWitness, const std::vector<uint64_t>& targets,
-                           int threads, double& extractMs, double& distanceMs) {
+                           int threads, MaskResult& timed) {
     Result<Direction> d = Direction{};
     if (!queries.empty()) {
         auto t0 = Clock::now();
-        const std::vector<glm::dvec3> q = coordinates(queries, v, false, threads);
-        const std::vector<glm::dvec3> t = coordinates(targets, v, false, threads);
-        extractMs += msSince(t0);
+        const detail::VoxelMetric metric(v, false);
+        const std::vector<glm::vec3> q = metric.searchPoints(queries, threads);
+        const std::vector<glm::vec3> t = metric.searchPoints(targets, threads);
+        timed.extractMs += msSince(t0);
         t0 = Clock::now();
         Result<HausdorffResult> r = engine.compute(PointView(q), PointView(t), detail::perPointCall(true));
-        distanceMs += msSince(t0);
         if (!r) return r.error();
-        d = directionOf(v, queries, r->aNearest, r->aToB, targets, zeros);
+        addTimings(timed.engine, r->timings);
+        d = directionOf(v, metric, queries, r->aNearest, targets, zeros, threads);
         if (!d) return d.error();
+        timed.distanceMs += msSince(t0);
     } else {
         d->out.points = zeros;
         d->distances.assign(size_t(zeros), 0.0);
@@ -223,11 +232,11 @@ Result<std::array<Direction, 2>> itkDirections(Engine& engine, const Volume& a, 
     const auto t0 = Clock::now();
     const std::array<DirectionPoints, 2> p = itkPoints(a, selectA, ea.count, b, selectB, eb.count, threads);
     r.extractMs += msSince(t0);
-    Result<Direction> ab = directed(engine, a, p[0].queries, p[0].zeros, p[0].zeroWitness, eb.boundary,
-                                    threads, r.extractMs, r.distanceMs);
+    Result<Direction> ab =
+        directed(engine, a, p[0].queries, p[0].zeros, p[0].zeroWitness, eb.boundary, threads, r);
     if (!ab) return ab.error();
-    Result<Direction> ba = directed(engine, b, p[1].queries, p[1].zeros, p[1].zeroWitness, ea.boundary,
-                                    threads, r.extractMs, r.distanceMs);
+    Result<Direction> ba =
+        directed(engine, b, p[1].queries, p[1].zeros, p[1].zeroWitness, ea.boundary, threads, r);
     if (!ba) return ba.error();
     return std::array<Direction, 2>{std::move(*ab), std::move(*ba)};
 }
@@ -432,8 +441,7 @@ Result<MaskResult> compareMasks(MaskEngine& maskEngine, const Volume& a, LabelSe
     }
     Result<std::array<Direction, 2>> both =
         itk ? itkDirections(engine, a, selectA, *ea, b, selectB, *eb, threads, r)
-            : bothDirections(engine, a, ea->boundary, b, eb->boundary, world, threads, r.extractMs,
-                             r.distanceMs);
+            : bothDirections(engine, a, ea->boundary, b, eb->boundary, world, threads, r);
     if (!both) return both.error();
     Direction* ab = &(*both)[0];
     Direction* ba = &(*both)[1];

@@ -197,6 +197,7 @@ struct MaskResult {
     double surfaceDice = 0.0;
     DirectedMask aToB, bToA;
     double extractMs = 0.0, distanceMs = 0.0, totalMs = 0.0;
+    Timings engine;  // the engine calls' stages, summed over the calls (distanceMs is their wall time)
     // Where the boundary voxels were found: "device" (the compute pass) or
     // "host" (the CPU backend, itk's foreground, deepmind's surfels, a box
     // too large for the pass, or MaskOptions::hostExtraction).

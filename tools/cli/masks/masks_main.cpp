@@ -5,7 +5,7 @@
 //   rthdist-masks A B [--label N | --labels all] [--convention NAME|all]
 //                 [--percentile P]... [--connectivity 6|18|26] [--tolerance MM]
 //                 [--spacing X,Y,Z | --affine 12 numbers] [--backend B] [--device N]
-//                 [--threads N] [--host-extraction]
+//                 [--threads N] [--host-extraction] [--repeat N]
 //                 [--json | --csv]
 //
 // A separate executable from `rthdist` (tools/cli/main.cpp), with its own
@@ -52,6 +52,7 @@ struct MasksArgs {
     Options options;
     bool json = false, csv = false, help = false, version = false;
     bool hostExtraction = false;  // --host-extraction
+    int repeat = 1;               // --repeat N: each comparison N times (benchmarks)
 };
 
 const char* kUsage =
@@ -72,6 +73,8 @@ const char* kUsage =
     "  --device N           Vulkan device index;  --threads N  CPU threads (0 = all)\n"
     "  --host-extraction    find boundary voxels on the host even with a GPU backend\n"
     "                       (default there: a compute shader)\n"
+    "  --repeat N           run each comparison N times in this process (benchmarks: JSON\n"
+    "                       lists every run's time; the numbers are the last run's)\n"
     "  --json | --csv       output format (default: text)\n"
     "Exit codes: 0 ok, 1 internal error, 2 usage, 3 bad input or different grids, 4 no device.\n";
 
@@ -188,6 +191,9 @@ void addMeasureOptions(CommandLine& line, MasksArgs& a, bool& conventionSet) {
     value("--threads", [&a](const std::string& v) {
         a.options.threads = int(integerIn(v, 0, 1024, "--threads expects [0, 1024]"));
     });
+    value("--repeat", [&a](const std::string& v) {
+        a.repeat = int(integerIn(v, 1, 1000, "--repeat expects [1, 1000]"));
+    });
 }
 
 Result<MasksArgs> parse(std::span<const std::string> argv) {
@@ -226,8 +232,9 @@ Result<MasksArgs> parse(std::span<const std::string> argv) {
 }
 
 struct Row {
-    std::string label;  // "nonzero" or the label value
-    MaskResult r;
+    std::string label;             // "nonzero" or the label value
+    MaskResult r;                  // the last run's
+    std::vector<double> totalsMs;  // --repeat: every run's total
 };
 
 std::string num(double v) {
@@ -303,6 +310,12 @@ Json rowJson(const Row& row) {
     out["b_to_a"] = directedJson(r.bToA, r, ok);
     out["extraction"] = r.extraction;
     out["timings_ms"] = {{"extract", r.extractMs}, {"distance", r.distanceMs}, {"total", r.totalMs}};
+    if (row.totalsMs.size() > 1) out["repeat_total_ms"] = row.totalsMs;
+    const Timings& e = r.engine;
+    out["engine_ms"] = {{"upload", e.upload},    {"index", e.index},          {"cull", e.cull},
+                        {"search", e.search},    {"refine", e.refine},        {"check", e.check},
+                        {"total", e.total},      {"gpu_upload", e.gpuUpload}, {"gpu_index", e.gpuIndex},
+                        {"gpu_cull", e.gpuCull}, {"gpu_search", e.gpuSearch}, {"gpu_refine", e.gpuRefine}};
     return out;
 }
 
@@ -421,9 +434,14 @@ int run(int argc, char** argv) {
             mo.tolerance = args.tolerance;
             mo.threads = args.options.threads;
             mo.hostExtraction = args.hostExtraction;
-            Result<MaskResult> r = masks::compareMasks(*engine, *a, select, *b, select, mo);
-            if (!r) return fail(exitCodeFor(r.error().code), "label " + name + ": " + r.error().message);
-            rows.push_back({name, std::move(*r)});
+            Row row{name, {}, {}};
+            for (int run = 0; run < args.repeat; ++run) {
+                Result<MaskResult> r = masks::compareMasks(*engine, *a, select, *b, select, mo);
+                if (!r) return fail(exitCodeFor(r.error().code), "label " + name + ": " + r.error().message);
+                row.totalsMs.push_back(r->totalMs);
+                row.r = std::move(*r);
+            }
+            rows.push_back(std::move(row));
         }
     }
     const std::string text = args.json  ? jsonReport(args, *a, *b, engine->engine, rows)

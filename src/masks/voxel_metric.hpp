@@ -1,0 +1,57 @@
+// How compareMasks hands voxels to the engine and measures the pairs it
+// finds. Internal to rthdist_masks.
+//
+// The engine searches float coordinates of the voxels relative to the
+// volume's centre, through the affine's 3x3 part (the rthdist convention's
+// world metric) or the spacing (every other convention): |p| <= D/2, D the
+// volume's diagonal, so rounding to float moves each coordinate by at most
+// 2^-24 D/2 and the search finds every query a neighbour within 2 eps
+// (eps = sqrt(3) 2^-24 D, about 1e-7 D) of its nearest, the bound of the
+// engine's own double path (rthdist.hpp). Packed floats take the engine's
+// device ingest (no host pass over the points). Each distance is then
+// recomputed in double from the two voxels' indices (translation leaves it
+// alone), so every number reported comes from the grid, not from the floats.
+#pragma once
+
+#include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "masks/boundary.hpp"
+#include "masks/masks.hpp"
+
+namespace rthdist::masks::detail {
+
+class VoxelMetric {
+public:
+    // world: the affine's 3x3 part; else the spacing (column norms).
+    VoxelMetric(const Volume& v, bool world);
+
+    // Float coordinates of `voxels` (linear indices) in the search frame.
+    [[nodiscard]] std::vector<glm::vec3> searchPoints(const std::vector<uint64_t>& voxels, int threads) const;
+    // |linear (p - q)| in double.
+    [[nodiscard]] double distance(std::array<int64_t, 3> p, std::array<int64_t, 3> q) const;
+
+private:
+    Dims m_dims;
+    glm::dmat3 m_linear;  // voxel offset -> mm
+    glm::dvec3 m_centre;  // voxel coordinates of the search frame's origin
+};
+
+// Every query's distance to the target the engine found for it
+// (nearest[i]: index into targets), recomputed in double; the largest of
+// them (smallest query index among ties) is the direction's witness.
+struct RecomputedDirection {
+    std::vector<double> distances;  // in query order
+    double sum = 0.0;               // summed in query order
+    size_t witness = 0;             // query index of the largest distance
+};
+[[nodiscard]] RecomputedDirection recompute(const VoxelMetric& metric, Dims dims,
+                                            const std::vector<uint64_t>& queries,
+                                            const std::vector<uint64_t>& targets,
+                                            const std::vector<uint32_t>& nearest, int threads);
+
+}  // namespace rthdist::masks::detail
