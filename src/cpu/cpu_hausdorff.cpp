@@ -387,9 +387,55 @@ Counters passCounters(const Direction& d, const std::vector<SearchStats>& stats)
     return c;
 }
 
+// Grid cells of [lo, hi] on one axis (cellCoord is monotone, so every
+// target with a coordinate in the interval lies in one of them).
+struct CellSpan {
+    uint32_t first, last;
+};
+inline CellSpan cellSpan(double lo, double hi, double origin, const core::GridSpec& g) {
+    return {core::cellCoord(lo, origin, g.cellSize, g.cellsPerAxis),
+            core::cellCoord(hi, origin, g.cellSize, g.cellsPerAxis)};
+}
+
+// The exact float nearest neighbour by the grid instead of the BVH, when the
+// cube of half-width r around the query (r: the seeds' best distance, raised
+// past the float rounding of any squared distance that could tie or beat it)
+// meets at most two cells per axis, each of at most kMaxCellScan targets:
+// every target that could beat or tie the best lies in those cells
+// (cellCoord is the target keys' own, monotone function), and scanning them
+// all applies the search's (distance, input index) order. False (best
+// untouched beyond what it scanned) when the cube is larger or a cell
+// denser: the BVH search then runs.
+inline bool nearestInCells(const TargetIndex& t, const Query& q, float qx, float qy, float qz,
+                           uint32_t& cursor, Best& best, SearchStats& stats) {
+    if (!(best.d2 < kInf)) return false;
+    const core::GridSpec& g = t.grid;
+    const double r = std::sqrt(double(best.d2) * (1.0 + 1e-5)) * (1.0 + 1e-12);
+    const CellSpan sx = cellSpan(double(qx) - r, double(qx) + r, g.origin.x, g);
+    const CellSpan sy = cellSpan(double(qy) - r, double(qy) + r, g.origin.y, g);
+    const CellSpan sz = cellSpan(double(qz) - r, double(qz) + r, g.origin.z, g);
+    if (sx.last - sx.first > 1 || sy.last - sy.first > 1 || sz.last - sz.first > 1) return false;
+    std::array<uint32_t, 8> found{};
+    int cells = 0;
+    for (uint32_t z = sz.first; z <= sz.last; ++z)
+        for (uint32_t y = sy.first; y <= sy.last; ++y)
+            for (uint32_t x = sx.first; x <= sx.last; ++x) {
+                if (!findCell(t, core::mortonEncode(x, y, z), cursor)) continue;
+                if (t.cellFirst[cursor + 1] - t.cellFirst[cursor] > kMaxCellScan) return false;
+                found[size_t(cells++)] = cursor;
+            }
+    for (int c = 0; c < cells; ++c) {
+        const uint32_t first = t.cellFirst[found[size_t(c)]], end = t.cellFirst[found[size_t(c)] + 1];
+        stats.bucketsScanned += (end - first + 7) / 8;
+        scanRange(t, first, end, q, best);
+    }
+    return true;
+}
+
 // Query i's exact float nearest neighbour (no early break): the previous
 // query's nearest bucket and the query's own cell (when small) seed the best
-// distance, then the BVH search runs to the end with kill = 0.
+// distance; then the grid cells around the query when few (nearestInCells),
+// else the BVH search to the end with kill = 0.
 inline Best nearestOf(const Direction& d, size_t i, Seeds& seeds, SearchStats& stat) {
     const TargetIndex& t = d.t;
     const Query q = d.query(i);
@@ -399,7 +445,9 @@ inline Best nearestOf(const Direction& d, size_t i, Seeds& seeds, SearchStats& s
         scanRange(t, t.bucketFirst[seeds.bucket], t.bucketFirst[seeds.bucket + 1], q, best);
     }
     scanOwnCell(t, d.qKey[i], seeds.cursor, q, best, stat);
-    searchTree(t, q, 0.0f, best, stat);  // kill 0: never breaks early
+    if (best.d2 == 0.0f) return best;  // nothing is closer; among zeros the first found is kept
+    if (!nearestInCells(t, q, d.qx[i], d.qy[i], d.qz[i], seeds.cursor, best, stat))
+        searchTree(t, q, 0.0f, best, stat);  // kill 0: never breaks early
     return best;
 }
 

@@ -3,8 +3,10 @@
 // the progress callback's contract.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <string>
 #include <thread>
 #include <utility>
@@ -110,6 +112,49 @@ INSTANTIATE_TEST_SUITE_P(Cases, CpuPerPoint, ::testing::Range<size_t>(0, cases()
                          [](const ::testing::TestParamInfo<size_t>& info) {
                              return cases()[info.param].name;
                          });
+
+// Voxel-like lattices (masks' boundaries): every coordinate a multiple of a
+// power of two, so every float squared distance is exact and ties are real.
+// Each query's nearest must be at the smallest distance and, among the
+// targets at that distance, the one with the smallest input index, however
+// the search reached it (grid cells around the query or the BVH).
+TEST(CpuPerPointLattice, TiesPickTheSmallestIndex) {
+    std::mt19937 rng(5);
+    for (const glm::vec3 spacing :
+         {glm::vec3(1.0f), glm::vec3(0.5f, 0.5f, 2.0f), glm::vec3(0.25f, 1.0f, 4.0f)}) {
+        for (int trial = 0; trial < 4; ++trial) {
+            std::vector<glm::vec3> a, b;
+            const int side = 6 + 10 * trial;
+            for (int k = 0; k < side; ++k)
+                for (int j = 0; j < side; ++j)
+                    for (int i = 0; i < side; ++i) {
+                        const glm::vec3 p = glm::vec3(float(i), float(j), float(k)) * spacing;
+                        const unsigned roll = rng() % 100;
+                        if (roll < 6) a.push_back(p);
+                        if (roll >= 3 && roll < 10) b.push_back(p);
+                    }
+            std::shuffle(b.begin(), b.end(), rng);
+            const HausdorffResult r = runPerPoint(a, b);
+            ASSERT_EQ(r.aNearest.nearest.size(), a.size());
+            size_t failures = 0;
+            for (size_t i = 0; i < a.size() && failures < 5; ++i) {
+                double best = INFINITY;
+                uint32_t bestIndex = 0;
+                for (size_t j = 0; j < b.size(); ++j) {
+                    const double d = pairDistance(a[i], b[j]);
+                    if (d < best) best = d, bestIndex = uint32_t(j);
+                }
+                if (r.aNearest.nearest[i] != bestIndex || r.aNearest.distance[i] != best) {
+                    ADD_FAILURE() << "spacing " << spacing.x << "," << spacing.y << "," << spacing.z
+                                  << " side " << side << " query " << i << ": nearest "
+                                  << r.aNearest.nearest[i] << " at " << r.aNearest.distance[i] << ", want "
+                                  << bestIndex << " at " << best;
+                    ++failures;
+                }
+            }
+        }
+    }
+}
 
 TEST(CpuPerPointOptions, OffLeavesArraysEmpty) {
     const std::vector<glm::vec3> a{{0, 0, 0}, {1, 0, 0}}, b{{0, 0, 0}};
