@@ -145,6 +145,15 @@ inline v8f boxDistance8(const BoxLevel& level, uint32_t node, const Query& q) {
     return dx * dx + dy * dy + dz * dz;
 }
 
+// Squared float distance from (qx, qy, qz) to the box [lo, hi], with
+// boxDistance8's operations (so a box is never farther than its points).
+inline float boxDistance(const glm::vec3& lo, const glm::vec3& hi, float qx, float qy, float qz) {
+    const float dx = std::max(std::max(lo.x - qx, qx - hi.x), 0.0f);
+    const float dy = std::max(std::max(lo.y - qy, qy - hi.y), 0.0f);
+    const float dz = std::max(std::max(lo.z - qz, qz - hi.z), 0.0f);
+    return dx * dx + dy * dy + dz * dz;
+}
+
 struct SearchStats {
     uint64_t bucketsScanned = 0;  // (query, 8 targets) scans: hint, own cell and BVH buckets
 };
@@ -387,6 +396,25 @@ Counters passCounters(const Direction& d, const std::vector<SearchStats>& stats)
     return c;
 }
 
+// The cells of recent lookups (key -> position in cellKey, or kNone when not
+// occupied), direct-mapped: consecutive queries of a chunk are Morton
+// neighbours and look up the same few cells, so most lookups skip findCell.
+struct CellCache {
+    static constexpr uint32_t kSlots = 64;
+    std::array<uint32_t, kSlots> key;
+    std::array<uint32_t, kSlots> cell;
+    CellCache() { key.fill(kNone); }
+
+    // Position of `k` in t.cellKey, or kNone.
+    uint32_t find(const TargetIndex& t, uint32_t k, uint32_t& cursor) {
+        const uint32_t slot = (k ^ (k >> 6) ^ (k >> 12)) % kSlots;
+        if (key[slot] == k) return cell[slot];
+        key[slot] = k;
+        cell[slot] = findCell(t, k, cursor) ? cursor : kNone;
+        return cell[slot];
+    }
+};
+
 // Grid cells of [lo, hi] on one axis (cellCoord is monotone, so every
 // target with a coordinate in the interval lies in one of them).
 struct CellSpan {
@@ -407,7 +435,8 @@ inline CellSpan cellSpan(double lo, double hi, double origin, const core::GridSp
 // untouched beyond what it scanned) when the cube is larger or a cell
 // denser: the BVH search then runs.
 inline bool nearestInCells(const TargetIndex& t, const Query& q, float qx, float qy, float qz,
-                           uint32_t& cursor, Best& best, SearchStats& stats) {
+                           uint32_t ownKey, uint32_t& cursor, CellCache& cache, Best& best,
+                           SearchStats& stats) {
     if (!(best.d2 < kInf)) return false;
     const core::GridSpec& g = t.grid;
     const double r = std::sqrt(double(best.d2) * (1.0 + 1e-5)) * (1.0 + 1e-12);
@@ -415,17 +444,34 @@ inline bool nearestInCells(const TargetIndex& t, const Query& q, float qx, float
     const CellSpan sy = cellSpan(double(qy) - r, double(qy) + r, g.origin.y, g);
     const CellSpan sz = cellSpan(double(qz) - r, double(qz) + r, g.origin.z, g);
     if (sx.last - sx.first > 1 || sy.last - sy.first > 1 || sz.last - sz.first > 1) return false;
-    std::array<uint32_t, 8> found{};
-    int cells = 0;
+    // The cells with their box distances, nearest first (the query's own
+    // cell, when small, was scanned already by scanOwnCell).
+    struct Near {
+        float d2;
+        uint32_t cell;
+    };
+    std::array<Near, 8> near{};
+    int count = 0;
     for (uint32_t z = sz.first; z <= sz.last; ++z)
         for (uint32_t y = sy.first; y <= sy.last; ++y)
             for (uint32_t x = sx.first; x <= sx.last; ++x) {
-                if (!findCell(t, core::mortonEncode(x, y, z), cursor)) continue;
-                if (t.cellFirst[cursor + 1] - t.cellFirst[cursor] > kMaxCellScan) return false;
-                found[size_t(cells++)] = cursor;
+                const uint32_t key = core::mortonEncode(x, y, z);
+                const uint32_t cell = cache.find(t, key, cursor);
+                if (cell == kNone) continue;
+                const uint32_t size = t.cellFirst[cell + 1] - t.cellFirst[cell];
+                if (size > kMaxCellScan) return false;
+                if (key == ownKey) continue;
+                Near c{boxDistance(t.cellLo[cell], t.cellHi[cell], qx, qy, qz), cell};
+                int k = count++;
+                while (k > 0 && near[size_t(k - 1)].d2 > c.d2) {
+                    near[size_t(k)] = near[size_t(k - 1)];
+                    --k;
+                }
+                near[size_t(k)] = c;
             }
-    for (int c = 0; c < cells; ++c) {
-        const uint32_t first = t.cellFirst[found[size_t(c)]], end = t.cellFirst[found[size_t(c)] + 1];
+    for (int c = 0; c < count; ++c) {
+        if (near[size_t(c)].d2 > best.d2 * (1.0f + kPruneSlack)) break;
+        const uint32_t first = t.cellFirst[near[size_t(c)].cell], end = t.cellFirst[near[size_t(c)].cell + 1];
         stats.bucketsScanned += (end - first + 7) / 8;
         scanRange(t, first, end, q, best);
     }
@@ -436,7 +482,7 @@ inline bool nearestInCells(const TargetIndex& t, const Query& q, float qx, float
 // query's nearest bucket and the query's own cell (when small) seed the best
 // distance; then the grid cells around the query when few (nearestInCells),
 // else the BVH search to the end with kill = 0.
-inline Best nearestOf(const Direction& d, size_t i, Seeds& seeds, SearchStats& stat) {
+inline Best nearestOf(const Direction& d, size_t i, Seeds& seeds, CellCache& cells, SearchStats& stat) {
     const TargetIndex& t = d.t;
     const Query q = d.query(i);
     Best best;
@@ -446,7 +492,7 @@ inline Best nearestOf(const Direction& d, size_t i, Seeds& seeds, SearchStats& s
     }
     scanOwnCell(t, d.qKey[i], seeds.cursor, q, best, stat);
     if (best.d2 == 0.0f) return best;  // nothing is closer; among zeros the first found is kept
-    if (!nearestInCells(t, q, d.qx[i], d.qy[i], d.qz[i], seeds.cursor, best, stat))
+    if (!nearestInCells(t, q, d.qx[i], d.qy[i], d.qz[i], d.qKey[i], seeds.cursor, cells, best, stat))
         searchTree(t, q, 0.0f, best, stat);  // kill 0: never breaks early
     return best;
 }
@@ -463,11 +509,12 @@ void perPointPass(const Direction& d, PerPoint& nearest, std::vector<SearchStats
         if (progress.cancelled()) return;
         SearchStats stat;
         Seeds seeds{kNone, kNone, d.firstCell(begin)};
+        CellCache cells;
         uint32_t target = kNone;  // the previous query's nearest target (input index)
         for (size_t i = begin; i < end; ++i) {
             const uint32_t src = uint32_t(d.qKeyed[i]);  // input index
             if (!(i > begin && seeds.bucket != kNone && d.sameAsPrevious(i))) {
-                const Best best = nearestOf(d, i, seeds, stat);
+                const Best best = nearestOf(d, i, seeds, cells, stat);
                 if (best.pos == kNone) {
                     lost.store(true, std::memory_order_relaxed);
                     seeds.bucket = kNone;
