@@ -61,7 +61,7 @@ glm::dvec3 worldOf(const Volume& v, std::array<int64_t, 3> ijk) {
 Result<Direction> directionOf(const Volume& v, const detail::VoxelMetric& metric,
                               const std::vector<uint64_t>& queries, const PerPoint& nearest,
                               const std::vector<uint64_t>& targets, uint64_t zeros, int threads) {
-    if (nearest.nearest.size() != queries.size())
+    if (queries.empty() || nearest.nearest.size() != queries.size())
         return Error{ErrorCode::kInternal, "masks: the engine returned no per-point nearest points"};
     detail::RecomputedDirection r =
         detail::recompute(metric, v.dims, queries, targets, nearest.nearest, threads);
