@@ -241,21 +241,25 @@ Result<std::array<Direction, 2>> itkDirections(Engine& engine, const Volume& a, 
     return std::array<Direction, 2>{std::move(*ab), std::move(*ba)};
 }
 
-// One mask's boundary: through the device pass when there is one, else (or
-// when its box does not fit the pass) on the host. `where` becomes "device"
-// when the pass found it.
-Result<detail::Extraction> extract(masks_gpu::BoundaryPass* pass, const Volume& v, LabelSelect select,
-                                   int connectivity, int threads, std::string& where) {
+// Both masks' boundaries: through the device pass (one submission) when
+// there is one, else (or when a box does not fit the pass) on the host.
+// `where` becomes "device" when the pass found them.
+Result<std::vector<detail::Extraction>> extractBoth(masks_gpu::BoundaryPass* pass,
+                                                    const std::array<detail::MaskRef, 2>& masks,
+                                                    int connectivity, int threads, std::string& where) {
     if (pass != nullptr) {
-        Result<detail::Extraction> e =
-            detail::extractBoundaryOnDevice(*pass, v, select, connectivity, threads);
+        Result<std::vector<detail::Extraction>> e =
+            detail::extractBoundariesOnDevice(*pass, masks, connectivity, threads);
         if (e) {
             where = "device";
             return e;
         }
         if (e.error().code != ErrorCode::kOutOfMemory) return e.error();
     }
-    return detail::extractBoundary(v, select, connectivity, threads);
+    std::vector<detail::Extraction> out;
+    for (const detail::MaskRef& m : masks)
+        out.push_back(detail::extractBoundary(*m.volume, m.select, connectivity, threads));
+    return out;
 }
 
 // HD, ASSD, MSD, surface overlaps and surface Dice from both directions.
@@ -429,10 +433,12 @@ Result<MaskResult> compareMasks(MaskEngine& maskEngine, const Volume& a, LabelSe
 
     const auto t0 = Clock::now();
     masks_gpu::BoundaryPass* pass = options.hostExtraction ? nullptr : maskEngine.boundaryPass.get();
-    Result<detail::Extraction> ea = extract(pass, a, selectA, itk ? 6 : conn, threads, r.extraction);
-    if (!ea) return ea.error();
-    Result<detail::Extraction> eb = extract(pass, b, selectB, itk ? 6 : conn, threads, r.extraction);
-    if (!eb) return eb.error();
+    Result<std::vector<detail::Extraction>> extracted =
+        extractBoth(pass, {detail::MaskRef{&a, selectA}, detail::MaskRef{&b, selectB}}, itk ? 6 : conn,
+                    threads, r.extraction);
+    if (!extracted) return extracted.error();
+    const detail::Extraction* ea = &(*extracted)[0];
+    const detail::Extraction* eb = &(*extracted)[1];
     r.extractMs = msSince(t0);
     if (ea->count == 0 || eb->count == 0) {
         setEmpty(ea->count, eb->count, itk ? 0 : options.percentiles.size(), r);

@@ -96,33 +96,69 @@ std::vector<uint64_t> decodeBits(std::span<const uint32_t> bits, Dims dims, cons
 
 }  // namespace
 
-Result<Extraction> extractBoundaryOnDevice(masks_gpu::BoundaryPass& pass, const Volume& v, LabelSelect select,
-                                           int connectivity, int threads) {
-    const bool eightBit = !v.labels8.empty();
-    const RowBox rows =
-        withLabels(v, [&](const auto* labels) { return findRows(labels, v.dims, select, threads); });
-    Extraction e;
-    e.count = rows.count;
-    if (rows.count == 0) return e;
-    if (v.dims[0] > int64_t(std::numeric_limits<uint32_t>::max()))
-        return Error{ErrorCode::kOutOfMemory,
-                     "masks: rows longer than 2^32 - 1 voxels for the GPU boundary pass"};
+namespace {
+
+// The pass's box of `rows` in volume `v`.
+masks_gpu::LabelBox boxOf(const Volume& v, const RowBox& rows, LabelSelect select, int connectivity) {
     masks_gpu::LabelBox box;
     box.nx = uint32_t(v.dims[0]);
     box.ny = uint32_t(rows.y1 - rows.y0 + 1);
     box.nz = uint32_t(rows.z1 - rows.z0 + 1);
-    box.eightBit = eightBit;
+    box.eightBit = !v.labels8.empty();
     box.value = select.value;
     box.anyNonZero = select.anyNonZero;
     box.connectivity = connectivity;
-    Result<std::span<uint8_t>> staging = pass.stagingFor(box);
+    return box;
+}
+
+const uint8_t* labelBytes(const Volume& v) {
+    return v.labels8.empty() ? reinterpret_cast<const uint8_t*>(v.labels.data()) : v.labels8.data();
+}
+
+}  // namespace
+
+Result<std::vector<Extraction>> extractBoundariesOnDevice(masks_gpu::BoundaryPass& pass,
+                                                          std::span<const MaskRef> masks, int connectivity,
+                                                          int threads) {
+    std::vector<Extraction> out(masks.size());
+    std::vector<RowBox> rows(masks.size());
+    std::vector<size_t> marked;  // masks with a selected voxel, in box order
+    std::vector<masks_gpu::LabelBox> boxes;
+    for (size_t k = 0; k < masks.size(); ++k) {
+        const Volume& v = *masks[k].volume;
+        rows[k] = withLabels(
+            v, [&](const auto* labels) { return findRows(labels, v.dims, masks[k].select, threads); });
+        out[k].count = rows[k].count;
+        if (rows[k].count == 0) continue;
+        if (v.dims[0] > int64_t(std::numeric_limits<uint32_t>::max()))
+            return Error{ErrorCode::kOutOfMemory,
+                         "masks: rows longer than 2^32 - 1 voxels for the GPU boundary pass"};
+        marked.push_back(k);
+        boxes.push_back(boxOf(v, rows[k], masks[k].select, connectivity));
+    }
+    if (boxes.empty()) return out;
+    Result<std::vector<std::span<uint8_t>>> staging = pass.stagingFor(boxes);
     if (!staging) return staging.error();
-    const auto* bytes = eightBit ? v.labels8.data() : reinterpret_cast<const uint8_t*>(v.labels.data());
-    stageRows(bytes, eightBit ? 1 : sizeof(int32_t), v.dims, rows, *staging, threads);
-    Result<std::span<const uint32_t>> bits = pass.mark(box);
+    for (size_t b = 0; b < boxes.size(); ++b) {
+        const Volume& v = *masks[marked[b]].volume;
+        stageRows(labelBytes(v), boxes[b].eightBit ? 1 : sizeof(int32_t), v.dims, rows[marked[b]],
+                  (*staging)[b], threads);
+    }
+    Result<std::vector<std::span<const uint32_t>>> bits = pass.mark(boxes);
     if (!bits) return bits.error();
-    e.boundary = decodeBits(*bits, v.dims, rows, threads);
-    return e;
+    for (size_t b = 0; b < boxes.size(); ++b)
+        out[marked[b]].boundary =
+            decodeBits((*bits)[b], masks[marked[b]].volume->dims, rows[marked[b]], threads);
+    return out;
+}
+
+Result<Extraction> extractBoundaryOnDevice(masks_gpu::BoundaryPass& pass, const Volume& v, LabelSelect select,
+                                           int connectivity, int threads) {
+    const MaskRef mask{&v, select};
+    Result<std::vector<Extraction>> e =
+        extractBoundariesOnDevice(pass, std::span(&mask, 1), connectivity, threads);
+    if (!e) return e.error();
+    return std::move(e->front());
 }
 
 }  // namespace rthdist::masks::detail

@@ -11,6 +11,9 @@
 // tests of every selected voxel.
 #pragma once
 
+#include <span>
+#include <vector>
+
 #include "masks/boundary.hpp"
 #include "rthdist/result.hpp"
 
@@ -20,8 +23,20 @@ class BoundaryPass;
 
 namespace rthdist::masks::detail {
 
-// kOutOfMemory when the box does not fit the pass (more than 2^32 - 1 voxels,
-// or the device's buffers): the caller extracts on the host instead.
+// One mask: a volume and the label selected in it.
+struct MaskRef {
+    const Volume* volume = nullptr;
+    LabelSelect select;
+};
+
+// The boundaries of several masks through one submission of the pass
+// (extraction i is masks[i]'s). kOutOfMemory when a box does not fit the
+// pass (more than 2^32 - 1 voxels, or the device's buffers): the caller
+// extracts on the host instead.
+[[nodiscard]] Result<std::vector<Extraction>> extractBoundariesOnDevice(masks_gpu::BoundaryPass& pass,
+                                                                        std::span<const MaskRef> masks,
+                                                                        int connectivity, int threads);
+// One mask (as above).
 [[nodiscard]] Result<Extraction> extractBoundaryOnDevice(masks_gpu::BoundaryPass& pass, const Volume& v,
                                                          LabelSelect select, int connectivity, int threads);
 

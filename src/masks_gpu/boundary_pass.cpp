@@ -10,6 +10,7 @@
 #include <limits>
 #include <new>
 #include <optional>
+#include <vector>
 
 #include "gpu/buffer.hpp"
 #include "gpu/compute_pipeline.hpp"
@@ -28,6 +29,24 @@ namespace {
 
 uint64_t wordsOf(const LabelBox& box) { return (box.voxels() + 31) / 32; }
 uint64_t labelWordsOf(const LabelBox& box) { return (box.labelBytes() + 3) / 4; }
+
+constexpr uint64_t kAlign = 256;  // every box's region starts at a multiple (device addresses)
+uint64_t aligned(uint64_t bytes) { return (bytes + kAlign - 1) / kAlign * kAlign; }
+
+// Where each box's labels and bitmask sit in the shared buffers.
+struct Layout {
+    std::vector<uint64_t> labelAt, bitAt;
+    uint64_t labelBytes = 0, bitBytes = 0;
+
+    explicit Layout(std::span<const LabelBox> boxes) {
+        for (const LabelBox& b : boxes) {
+            labelAt.push_back(labelBytes);
+            bitAt.push_back(bitBytes);
+            labelBytes += aligned(labelWordsOf(b) * 4);
+            bitBytes += aligned(wordsOf(b) * 4);
+        }
+    }
+};
 
 std::optional<Error> checkBox(const LabelBox& box) {
     if (box.connectivity != 6 && box.connectivity != 18 && box.connectivity != 26)
@@ -70,10 +89,10 @@ struct BoundaryPass::Impl {
                                               "masks boundary");
     }
 
-    sh::BoundaryPush pushOf(const LabelBox& box) const {
+    sh::BoundaryPush pushOf(const LabelBox& box, uint64_t labelAt, uint64_t bitAt) const {
         sh::BoundaryPush pc{};
-        pc.labels = labels.address();
-        pc.bits = bits.address();
+        pc.labels = labels.address() + labelAt;
+        pc.bits = bits.address() + bitAt;
         pc.nx = box.nx;
         pc.ny = box.ny;
         pc.nz = box.nz;
@@ -85,30 +104,31 @@ struct BoundaryPass::Impl {
         return pc;
     }
 
-    // Upload, pass and read-back in one command buffer.
-    void record(VkCommandBuffer cmd, const LabelBox& box) {
-        const VkDeviceSize labelBytes = labelWordsOf(box) * 4, bitBytes = wordsOf(box) * 4;
+    // Upload, the pass of every box and read-back in one command buffer.
+    void record(VkCommandBuffer cmd, std::span<const LabelBox> boxes, const Layout& at) {
         {
             gpu::ScopedLabel label(*ctx, cmd, "masks: upload");
-            const VkBufferCopy copy{0, 0, labelBytes};
+            const VkBufferCopy copy{0, 0, at.labelBytes};
             vkCmdCopyBuffer(cmd, staging.handle(), labels.handle(), 1, &copy);
             gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                              VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
         }
         {
             gpu::ScopedLabel label(*ctx, cmd, "masks: boundary");
-            sh::BoundaryPush pc = pushOf(box);
-            const uint64_t groups = std::min<uint64_t>(
-                (pc.words + RTHDIST_BOUNDARY_WG - 1) / RTHDIST_BOUNDARY_WG, ctx->limits().maxGroupsX);
-            pc.wordStride = uint32_t(groups * RTHDIST_BOUNDARY_WG);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.get());
-            vkCmdPushConstants(cmd, layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
-            vkCmdDispatch(cmd, uint32_t(groups), 1, 1);
+            for (size_t k = 0; k < boxes.size(); ++k) {
+                sh::BoundaryPush pc = pushOf(boxes[k], at.labelAt[k], at.bitAt[k]);
+                const uint64_t groups = std::min<uint64_t>(
+                    (pc.words + RTHDIST_BOUNDARY_WG - 1) / RTHDIST_BOUNDARY_WG, ctx->limits().maxGroupsX);
+                pc.wordStride = uint32_t(groups * RTHDIST_BOUNDARY_WG);
+                vkCmdPushConstants(cmd, layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+                vkCmdDispatch(cmd, uint32_t(groups), 1, 1);
+            }
         }
         gpu::ScopedLabel label(*ctx, cmd, "masks: read back");
         gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                          VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-        const VkBufferCopy copy{0, 0, bitBytes};
+        const VkBufferCopy copy{0, 0, at.bitBytes};
         vkCmdCopyBuffer(cmd, bits.handle(), readBack.handle(), 1, &copy);
     }
 };
@@ -134,30 +154,47 @@ Result<std::unique_ptr<BoundaryPass>> BoundaryPass::create(int deviceIndex, bool
     return std::unique_ptr<BoundaryPass>(new BoundaryPass(std::move(impl)));
 }
 
-Result<std::span<uint8_t>> BoundaryPass::stagingFor(const LabelBox& box) {
-    if (auto err = checkBox(box)) return *err;
+namespace {
+
+std::optional<Error> checkBoxes(std::span<const LabelBox> boxes) {
+    if (boxes.empty()) return Error{ErrorCode::kInvalidArgument, "masks: no label box"};
+    for (const LabelBox& box : boxes)
+        if (auto err = checkBox(box)) return err;
+    return std::nullopt;
+}
+
+}  // namespace
+
+Result<std::vector<std::span<uint8_t>>> BoundaryPass::stagingFor(std::span<const LabelBox> boxes) {
+    if (auto err = checkBoxes(boxes)) return *err;
     Impl& m = *m_impl;
+    const Layout at(boxes);
     try {
-        ensure(*m.ctx, m.staging, labelWordsOf(box) * 4, gpu::MemoryKind::kHost);
+        ensure(*m.ctx, m.staging, at.labelBytes, gpu::MemoryKind::kHost);
     } catch (const gpu::VulkanError& e) {
         return errorOf(e);
     } catch (const gpu::LimitError& e) {
         return Error{ErrorCode::kOutOfMemory, std::string("masks: ") + e.what()};
     }
-    return std::span<uint8_t>(static_cast<uint8_t*>(m.staging.mapped()), size_t(box.labelBytes()));
+    std::vector<std::span<uint8_t>> out;
+    for (size_t k = 0; k < boxes.size(); ++k)
+        out.emplace_back(static_cast<uint8_t*>(m.staging.mapped()) + at.labelAt[k],
+                         size_t(boxes[k].labelBytes()));
+    return out;
 }
 
-Result<std::span<const uint32_t>> BoundaryPass::mark(const LabelBox& box) {
-    if (auto err = checkBox(box)) return *err;
+Result<std::vector<std::span<const uint32_t>>> BoundaryPass::mark(std::span<const LabelBox> boxes) {
+    if (auto err = checkBoxes(boxes)) return *err;
     Impl& m = *m_impl;
-    if (!m.staging || m.staging.size() < labelWordsOf(box) * 4)
-        return Error{ErrorCode::kInvalidArgument, "masks: mark() of a box larger than the one staged"};
+    const Layout at(boxes);
+    if (!m.staging || m.staging.size() < at.labelBytes)
+        return Error{ErrorCode::kInvalidArgument, "masks: mark() of boxes larger than those staged"};
     try {
-        ensure(*m.ctx, m.labels, labelWordsOf(box) * 4, gpu::MemoryKind::kDevice);
-        ensure(*m.ctx, m.bits, wordsOf(box) * 4, gpu::MemoryKind::kDevice);
-        ensure(*m.ctx, m.readBack, wordsOf(box) * 4, gpu::MemoryKind::kReadback);
+        ensure(*m.ctx, m.labels, at.labelBytes, gpu::MemoryKind::kDevice);
+        ensure(*m.ctx, m.bits, at.bitBytes, gpu::MemoryKind::kDevice);
+        ensure(*m.ctx, m.readBack, at.bitBytes, gpu::MemoryKind::kReadback);
         VkCommandBuffer cmd = m.ctx->begin();
-        m.record(cmd, box);
+        m.record(cmd, boxes, at);
         m.ctx->submitAndWait(cmd);
     } catch (const gpu::VulkanError& e) {
         return errorOf(e);
@@ -166,7 +203,11 @@ Result<std::span<const uint32_t>> BoundaryPass::mark(const LabelBox& box) {
     } catch (const std::bad_alloc&) {
         return Error{ErrorCode::kOutOfMemory, "masks: host memory for the boundary pass"};
     }
-    return std::span<const uint32_t>(static_cast<const uint32_t*>(m.readBack.mapped()), size_t(wordsOf(box)));
+    std::vector<std::span<const uint32_t>> out;
+    const auto* base = static_cast<const uint8_t*>(m.readBack.mapped());
+    for (size_t k = 0; k < boxes.size(); ++k)
+        out.emplace_back(reinterpret_cast<const uint32_t*>(base + at.bitAt[k]), size_t(wordsOf(boxes[k])));
+    return out;
 }
 
 }  // namespace rthdist::masks_gpu

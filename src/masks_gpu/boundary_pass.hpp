@@ -12,8 +12,8 @@
 // Limits: a box of at most 2^32 - 1 voxels (32-bit voxel indices in the
 // shader); more, or a buffer past the device's limits -> kOutOfMemory naming
 // it (the caller may extract on the host instead).
-// Threading: one BoundaryPass per thread; the staging area it returns belongs
-// to it until the next call.
+// Threading: one BoundaryPass per thread; the staging and bitmask memory it
+// returns belongs to it until the next call.
 #pragma once
 
 #include <cstdint>
@@ -49,13 +49,15 @@ public:
     BoundaryPass(const BoundaryPass&) = delete;
     BoundaryPass& operator=(const BoundaryPass&) = delete;
 
-    // Host memory of box.labelBytes() bytes (rounded up to whole words) that
-    // the next mark() uploads: the caller writes the box's labels there.
-    [[nodiscard]] Result<std::span<uint8_t>> stagingFor(const LabelBox& box);
-    // The boundary bitmask of the box staged by stagingFor: ceil(voxels / 32)
-    // words, bit (i & 31) of word (i >> 5) for voxel i. The same box
-    // (dimensions and label width) as the stagingFor call before it.
-    [[nodiscard]] Result<std::span<const uint32_t>> mark(const LabelBox& box);
+    // Host memory for the labels of `boxes` (one span of box.labelBytes()
+    // bytes each) that the next mark(boxes) uploads: the caller writes each
+    // box's labels there.
+    [[nodiscard]] Result<std::vector<std::span<uint8_t>>> stagingFor(std::span<const LabelBox> boxes);
+    // The boundary bitmask of each box staged by stagingFor (the same boxes:
+    // dimensions and label widths), all in one submission: ceil(voxels / 32)
+    // words per box, bit (i & 31) of word (i >> 5) for voxel i. Valid until
+    // the next call.
+    [[nodiscard]] Result<std::vector<std::span<const uint32_t>>> mark(std::span<const LabelBox> boxes);
 
     [[nodiscard]] const std::string& deviceName() const;
     // Device milliseconds of the last mark() (upload, pass, read-back).

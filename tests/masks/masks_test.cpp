@@ -225,6 +225,38 @@ TEST(MasksBoundary, DevicePassEqualsHost) {
     EXPECT_EQ((*pass)->validationMessageCount(), 0u);
 }
 
+// Several masks in one submission of the pass (8- and 32-bit labels, boxes
+// of different sizes, a mask with nothing selected in between): each equals
+// its own host extraction.
+TEST(MasksBoundary, DevicePassTakesSeveralMasks) {
+    auto pass = masks_gpu::BoundaryPass::create(-1, true);
+    ASSERT_TRUE(pass.has_value()) << pass.error().message;
+    std::mt19937 rng(31);
+    Volume a = makeVolume({20, 11, 9}, glm::dvec3(1.0));
+    Volume b = makeVolume({7, 30, 5}, glm::dvec3(1.0));
+    for (auto& l : a.labels) l = int32_t(rng() % 3);
+    for (size_t i = 0; i < b.labels.size(); i += 2) b.labels[i] = int32_t(rng() % 2);
+    b.labels8.assign(b.labels.begin(), b.labels.end());
+    b.labels.clear();
+    const std::array<detail::MaskRef, 3> masks{detail::MaskRef{&a, LabelSelect{2, false}},
+                                               detail::MaskRef{&b, LabelSelect{9, false}},
+                                               detail::MaskRef{&b, LabelSelect{1, true}}};
+    for (int conn : {6, 26}) {
+        Result<std::vector<detail::Extraction>> device =
+            detail::extractBoundariesOnDevice(**pass, masks, conn, 2);
+        ASSERT_TRUE(device.has_value()) << device.error().message;
+        ASSERT_EQ(device->size(), masks.size());
+        for (size_t k = 0; k < masks.size(); ++k) {
+            const detail::Extraction host =
+                detail::extractBoundary(*masks[k].volume, masks[k].select, conn, 2);
+            EXPECT_EQ((*device)[k].count, host.count) << "mask " << k << " connectivity " << conn;
+            EXPECT_EQ((*device)[k].boundary, host.boundary) << "mask " << k << " connectivity " << conn;
+        }
+        EXPECT_EQ((*device)[1].count, 0u);
+    }
+    EXPECT_EQ((*pass)->validationMessageCount(), 0u);
+}
+
 TEST(MasksCompare, InvalidOptions) {
     Options o;
     o.backend = Backend::kCpu;
