@@ -282,7 +282,12 @@ def compare_masks(
 
 class MaskEngine:
     def __init__(
-        self, backend: BackendName = "auto", *, device: Optional[int] = None, threads: int = 0, validation: bool = False
+        self,
+        backend: BackendName = "auto",
+        *,
+        device: Optional[int] = None,
+        threads: int = 0,
+        validation: bool = False,
     ) -> None: ...
     def compare(
         self,
