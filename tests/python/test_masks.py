@@ -379,3 +379,40 @@ def test_result_accessors(pair):
     itk = rthdist.compare_masks(a, b, convention="itk", backend="cpu")
     assert itk.hd_percentile == [] and itk.assd is None and itk.surface_dice is None and itk.msd is not None
     assert "MaskResult(" in repr(itk)
+
+
+def test_threads_share_or_own_engines(rng):
+    """The GIL is released while comparing: threads with their own engines, or one shared
+    engine (calls wait for each other; its properties stay readable meanwhile), give the
+    serial results."""
+    import threading
+
+    pairs = [(blobs((18, 16, 10), rng), blobs((18, 16, 10), rng)) for _ in range(4)]
+    want = [without_timings(rthdist.compare_masks(a, b, convention="all", backend="cpu")[i].to_dict())
+            for a, b in pairs for i in range(len(rthdist.CONVENTIONS))]
+    got = {}
+
+    def work(engine, k):
+        a, b = pairs[k]
+        rows = engine.compare(a, b, convention="all")
+        got[k] = [without_timings(r.to_dict()) for r in rows]
+
+    own = [rthdist.MaskEngine("cpu") for _ in pairs]
+    threads = [threading.Thread(target=work, args=(own[k], k)) for k in range(len(pairs))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert [row for k in range(len(pairs)) for row in got[k]] == want
+    got.clear()
+    with rthdist.MaskEngine("cpu") as shared:
+        threads = [threading.Thread(target=work, args=(shared, k)) for k in range(len(pairs))]
+        for t in threads:
+            t.start()
+        while any(t.is_alive() for t in threads):
+            assert not shared.closed and shared.backend == "cpu"
+        for t in threads:
+            t.join()
+    assert [row for k in range(len(pairs)) for row in got[k]] == want
+    for e in own:
+        e.close()
