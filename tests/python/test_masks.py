@@ -416,3 +416,31 @@ def test_threads_share_or_own_engines(rng):
     assert [row for k in range(len(pairs)) for row in got[k]] == want
     for e in own:
         e.close()
+
+
+def test_an_image_without_sform_or_qform(tmp_path, pair):
+    """nibabel's fallback affine (x flipped, centred) instead of the CLI's diag(pixdim): the
+    same spacing, hence the same numbers; the witness points differ."""
+    nib = pytest.importorskip("nibabel")
+    a, b = pair
+    images = []
+    for name, x in (("a.nii", a), ("b.nii", b)):
+        img = nib.Nifti1Image(x.astype(np.int16), None)
+        img.header.set_zooms(SPACING)
+        img.header.set_sform(None, code=0)
+        img.header.set_qform(None, code=0)
+        nib.save(img, tmp_path / name)
+        images.append(nib.load(tmp_path / name))
+    want = cli_rows(str(tmp_path / "a.nii"), str(tmp_path / "b.nii"), "--convention", "all", "--backend", "cpu")
+    assert want["a"]["transform"] == "pixdim"
+    volume = rthdist.MaskVolume(images[0])
+    assert volume.transform == "image" and volume.affine[0, 0] < 0
+    np.testing.assert_allclose(volume.spacing, SPACING, rtol=1e-7)
+    got = rthdist.compare_masks(images[0], images[1], convention="all", backend="cpu")
+    for r, w in zip(got, want["results"]):
+        assert r.convention == w["convention"] and r.status == w["status"] == "ok"
+        for key in ("hd", "assd", "msd", "surface_dice"):
+            assert r.to_dict()[key] == pytest.approx(w[key], rel=1e-12, abs=1e-12), (r.convention, key)
+        assert [e["value"] for e in r.hd_percentile] == pytest.approx([e["value"] for e in w["hd_percentile"]],
+                                                                     rel=1e-12)
+        assert r.a_to_b.points == w["a_to_b"]["points"] and r.b_to_a.points == w["b_to_a"]["points"]
