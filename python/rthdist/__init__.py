@@ -17,11 +17,16 @@ Inputs (rthdist._points): (N, 3) array-likes of float32/float64 (C order
 and row slices read in place; Fortran order copied), objects with .points
 or .vertices (Open3D, trimesh), PyTorch/CuPy tensors (CPU without a copy,
 CUDA copied to the host). docs/python.md has the guide.
+
+Segmentation masks (rthdist._masks): rthdist.compare_masks(a, b, ...) on
+3-D label arrays or nibabel images, in a named tool's convention, and a
+MaskEngine for many comparisons on one device.
 """
 
 import os as _os
 
 from . import _rthdist
+from ._masks import CONVENTIONS, DirectedMask, MaskEngine, MaskResult, MaskVolume, compare_masks
 from ._points import as_points
 from ._rthdist import (  # noqa: F401 - re-exported
     CancelledError,
@@ -50,6 +55,12 @@ __all__ = [
     "OutOfMemoryError",
     "InternalError",
     "CancelledError",
+    "compare_masks",
+    "MaskEngine",
+    "MaskVolume",
+    "MaskResult",
+    "DirectedMask",
+    "CONVENTIONS",
     "__version__",
 ]
 

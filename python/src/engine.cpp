@@ -29,6 +29,22 @@ Backend backendFrom(const std::string& name) {
     return b;
 }
 
+}  // namespace
+
+Options engineOptions(const std::string& backend, std::optional<int> device, int threads, bool validation) {
+    Options o;
+    o.backend = backendFrom(backend);
+    if (device && (*device < 0 || *device > 1023))
+        throw py::value_error("device must be in 0..1023 (or None)");
+    o.deviceIndex = device.value_or(-1);
+    if (threads < 0 || threads > 1024) throw py::value_error("threads must be in 0..1024 (0 = all)");
+    o.threads = threads;
+    o.validation = validation;
+    return o;
+}
+
+namespace {
+
 // The settings of one call, checked against the CLI's ranges.
 struct CallSettings {
     int bits = 0;
@@ -43,19 +59,6 @@ struct CallSettings {
     }
     bool operator==(const CallSettings&) const = default;
 };
-
-// The device part of Options (backend, device, threads, validation).
-Options engineOptions(const std::string& backend, std::optional<int> device, int threads, bool validation) {
-    Options o;
-    o.backend = backendFrom(backend);
-    if (device && (*device < 0 || *device > 1023))
-        throw py::value_error("device must be in 0..1023 (or None)");
-    o.deviceIndex = device.value_or(-1);
-    if (threads < 0 || threads > 1024) throw py::value_error("threads must be in 0..1024 (0 = all)");
-    o.threads = threads;
-    o.validation = validation;
-    return o;
-}
 
 Options optionsFrom(const Options& engine, const CallSettings& call) {
     Options o = engine;

@@ -15,7 +15,16 @@
 
 #include <pybind11/pybind11.h>
 
+#include <optional>
+#include <string>
+
+#include "rthdist/rthdist.hpp"
+
 namespace rthdist::python {
+
+// The device part of Options (backend, device, threads, validation), checked
+// against the CLI's ranges (ValueError); also the masks' engines (masks.cpp).
+Options engineOptions(const std::string& backend, std::optional<int> device, int threads, bool validation);
 
 void bindEngine(pybind11::module_& m);
 

@@ -2,12 +2,13 @@
 // (python/rthdist/__init__.py is the public face; docs/python.md the guide).
 // One file per concept: errors (Error -> exceptions), points (NumPy ->
 // PointView), result (HausdorffResult), engine (hausdorff, Engine), io
-// (loaders, device list).
+// (loaders, device list), masks (segmentation masks: volumes, MaskEngine).
 #include <pybind11/pybind11.h>
 
 #include "engine.hpp"
 #include "errors.hpp"
 #include "io.hpp"
+#include "masks.hpp"
 #include "result.hpp"
 #include "rthdist/rthdist.hpp"
 
@@ -18,4 +19,5 @@ PYBIND11_MODULE(_rthdist, m) {
     rthdist::python::bindResult(m);
     rthdist::python::bindEngine(m);
     rthdist::python::bindIo(m);
+    rthdist::python::bindMasks(m);
 }

@@ -69,6 +69,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "rthdist/result.hpp"
@@ -102,7 +103,8 @@ struct Volume {
     [[nodiscard]] glm::dvec3 spacing() const;
 };
 
-// Reads a NIfTI-1 or NIfTI-2 file (.nii, .nii.gz) through libnifti2. The
+// Reads a NIfTI-1 or NIfTI-2 file (.nii, .nii.gz) through libnifti2
+// (nifti.cpp: in target rthdist_masks, not rthdist_masks_core). The
 // transform is the sform when sform_code > 0, else the qform when
 // qform_code > 0, else diag(pixdim[1..3]) with origin 0. scl_slope/scl_inter
 // are applied when the slope is finite and non-zero. A 4-D file must have
@@ -116,9 +118,30 @@ struct Volume {
 [[nodiscard]] Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing,
                                      const std::optional<glm::dmat4>& affine = std::nullopt);
 
-// Loads by extension: .nii / .nii.gz through loadNifti, .npy through loadNpy.
+// Loads by extension: .nii / .nii.gz through loadNifti, .npy through loadNpy
+// (rthdist_masks, as loadNifti).
 [[nodiscard]] Result<Volume> loadVolume(const std::string& path, glm::dvec3 spacing = glm::dvec3(1.0),
                                         const std::optional<glm::dmat4>& affine = std::nullopt);
+
+// A 3-D label array in memory (a NumPy array): C order ((i, j, k) at
+// (i * n1 + j) * n2 + k) or, when `fortran`, i fastest; scalars of NumPy
+// kind `kind` in the host's byte order: "b1", "u1", "i1", "u2", "i2", "u4",
+// "i4", "u8", "i8", "f4" or "f8".
+struct LabelArray {
+    const void* data = nullptr;
+    std::array<int64_t, 3> dims{0, 0, 0};
+    bool fortran = false;
+    std::string_view kind;
+};
+
+// A Volume holding a copy of the array's labels, as loadNpy reads them (the
+// same types and checks: non-integral or non-int32 values are kBadInput),
+// with `voxelToWorld` (finite, last row 0 0 0 1, not singular; else
+// kInvalidArgument). `name` is the Volume's path: every error and grid
+// mismatch names it; `transform` says where the affine came from.
+[[nodiscard]] Result<Volume> volumeFromArray(const LabelArray& array, const glm::dmat4& voxelToWorld,
+                                             const std::string& name,
+                                             const std::string& transform = "affine");
 
 // Empty when a and b share a grid (same dims, affines equal within 1e-5 of
 // an entry's magnitude, at least 1e-6); else the reason, naming both files.
