@@ -199,6 +199,31 @@ def run_cli(cli, backend, a_path, b_path, extra):
     return json.loads(p.stdout)
 
 
+def check_host_extraction(name, cli, backend, a_path, b_path, extra, out):
+    """--host-extraction --repeat 2 gives every row of `out` unchanged (the device
+    pass and the host find the same voxels, in the same order), says where each
+    extraction ran, and lists both runs' times."""
+    again = run_cli(cli, backend, a_path, b_path, extra + ["--host-extraction", "--repeat", "2"])
+    if again is None:
+        return
+    timing_keys = {"timings_ms", "engine_ms", "extraction", "repeat_total_ms"}
+    for row, other in zip(out["results"], again["results"]):
+        tag = f"{name} label {row['label']} {row['convention']}"
+        if {k: v for k, v in row.items() if k not in timing_keys} != \
+                {k: v for k, v in other.items() if k not in timing_keys}:
+            FAILURES.append(f"{tag}: --host-extraction changed the row")
+        if other.get("extraction") != "host" or len(other.get("repeat_total_ms", [])) != 2:
+            FAILURES.append(f"{tag}: --host-extraction --repeat 2 reported {other.get('extraction')}, "
+                            f"{other.get('repeat_total_ms')}")
+        # GPU backends run the device pass for every convention but deepmind
+        # (surfels), also when it finds a mask empty.
+        device = backend != "cpu" and row["convention"] != "deepmind"
+        if row.get("extraction") != ("device" if device else "host"):
+            FAILURES.append(f"{tag}: extraction {row.get('extraction')} on {backend}")
+    if len(out["results"]) != len(again["results"]):
+        FAILURES.append(f"{name}: --host-extraction gave {len(again['results'])} rows, not {len(out['results'])}")
+
+
 def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_volumes=None, npy=False,
                npy_affine=False):
     """Writes the pair (label volumes or binary masks), runs every convention, compares."""
@@ -227,6 +252,7 @@ def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_vol
     out = run_cli(cli, backend, a_path, b_path, extra)
     if out is None:
         return
+    check_host_extraction(f"[{backend}] {name}", cli, backend, a_path, b_path, extra, out)
     eps = 1e-6 * diagonal(a.shape, affine)
     for row in out["results"]:
         conv = row["convention"]
