@@ -36,10 +36,13 @@ cases=("organ $W/organ_ref.npy $W/organ_pred.npy --spacing 0.8,0.8,2.5"
 for c in "${cases[@]}"; do
   set -- $c; name=$1; a=$2; b=$3; shift 3
   for mode in "$BACKEND" "$BACKEND --host-extraction" "cpu"; do
-    tag=$(echo "$mode" | tr -d ' -')
-    $B/rthdist-masks $a $b "$@" --convention monai --backend $mode --repeat 7 --json > $OUT/${name}_$tag.json 2>> $OUT/err.txt
+    # One JSON line per run in rows.jsonl (the device tool returns a bounded number of files).
+    $B/rthdist-masks $a $b "$@" --convention monai --backend $mode --repeat 7 --json > /tmp/row.json 2>> $OUT/err.txt
     python3 -c "
-import json, statistics; j=json.load(open('$OUT/${name}_$tag.json')); r=j['results'][0]; t=r['repeat_total_ms']
+import json; j=json.load(open('/tmp/row.json')); j['case']='$name'; j['mode']='$mode'
+open('$OUT/rows.jsonl', 'a').write(json.dumps(j) + '\\n')"
+    python3 -c "
+import json, statistics; j=json.load(open('/tmp/row.json')); r=j['results'][0]; t=r['repeat_total_ms']
 print('$name', '$mode'.ljust(28), r['extraction'], 'median %.2f ms (min %.2f, first %.2f)' % (statistics.median(t[1:]), min(t), t[0]),
       'last: extract %.2f distance %.2f' % (r['timings_ms']['extract'], r['timings_ms']['distance']),
       'hd95 %.7f' % r['hd_percentile'][0]['value'], 'points', r['a_to_b']['points'], r['b_to_a']['points'])"
