@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "gpu_algo/set_points.hpp"
+
 #include "rthdist_shared.h"
 
 namespace rthdist::gpu_algo {
@@ -50,8 +52,8 @@ struct SampledQuery {
 // maxPacked. The last sample is the witness: its best is the maximum.
 // "" when every sample holds, else the first failure.
 [[nodiscard]] std::string sampledQueryFailure(std::span<const SampledQuery> samples,
-                                              std::span<const glm::vec3> qPts,
-                                              std::span<const glm::vec3> tPts, uint64_t maxPacked,
+                                              const SetPoints& qPts, const SetPoints& tPts,
+                                              uint64_t maxPacked,
                                               bool perPoint);
 
 // The reported value against the device's: the double distance of the
