@@ -30,6 +30,19 @@ uint64_t orderedBits64(double d) {
     return (b & kSign) != 0ul ? ~b : b | kSign;
 }
 
+// Whether d is a float32 value, from its bits (double(float(d)) == d may be
+// folded to true by a compiler): zero, or a normal float's exponent with the
+// low 29 mantissa bits clear, or a subnormal float's value (a multiple of 2^-149).
+bool floatValue(double d) {
+    uint64_t b = doubleBitsToUint64(d) & ~kSign;
+    if (b == 0ul) return true;
+    int e = int(b >> 52) - 1023;
+    uint64_t mantissa = b & 0xffffffffffffful;
+    if (e > 127 || e < -149) return false;
+    int dropped = e >= -126 ? 29 : 29 + (-126 - e);  // mantissa bits a float cannot hold
+    return (mantissa & ((1ul << uint(dropped)) - 1ul)) == 0ul;
+}
+
 dvec3 readPoint(uint i) {
     uint64_t at = pc.source + uint64_t(i) * uint64_t(pc.stride);
     if (pc.isDouble != 0u) return dvec3(DoubleRef(at).v, DoubleRef(at + 8ul).v, DoubleRef(at + 16ul).v);
@@ -45,7 +58,8 @@ void summarize(uint i, uint t) {
         if (finite64(p.x) && finite64(p.y) && finite64(p.z)) {
             lo = p;
             hi = p;
-            if (dvec3(vec3(p)) != p) atomicOr(UintRef(pc.summary + 52ul).v, 1u);
+            if (!floatValue(p.x) || !floatValue(p.y) || !floatValue(p.z))
+                atomicOr(UintRef(pc.summary + 52ul).v, 1u);
         } else {
             atomicMin(UintRef(pc.summary + 48ul).v, i);
         }
