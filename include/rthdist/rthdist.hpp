@@ -246,7 +246,8 @@ public:
     [[nodiscard]] Result<HausdorffResult> compute(const DevicePointView& a, const DevicePointView& b);
     [[nodiscard]] Result<HausdorffResult> compute(const DevicePointView& a, const DevicePointView& b,
                                                   const CallOptions& call);
-    [[nodiscard]] Result<PreparedSet> prepare(const DevicePointView& points, const PrepareOptions& options = {});
+    [[nodiscard]] Result<PreparedSet> prepare(const DevicePointView& points,
+                                              const PrepareOptions& options = {});
     // H(A, B) of two sets prepared by this Engine (either may be both).
     // Witness indices refer to each set's input order.
     [[nodiscard]] Result<HausdorffResult> compute(const PreparedSet& a, const PreparedSet& b,

@@ -527,8 +527,9 @@ namespace {
 // The Engine's device when it can read device views, or why not.
 std::optional<Error> deviceInputEngine(const Engine::Impl& impl) {
     if (!impl.device->gpu)
-        return Error{ErrorCode::kInvalidArgument,
-                     "device views (DevicePointView) need a GPU backend: the cpu backend cannot read VkBuffers"};
+        return Error{
+            ErrorCode::kInvalidArgument,
+            "device views (DevicePointView) need a GPU backend: the cpu backend cannot read VkBuffers"};
     if (!impl.device->context->borrowed())
         return Error{ErrorCode::kInvalidArgument,
                      "device views (DevicePointView) need an Engine created on your VkDevice "

@@ -23,10 +23,11 @@ sh::IngestSummary64& summary64(const CounterBlock& blk) {
 
 void requireFloat64(const gpu::Context& ctx) {
     if (!ctx.shaderFloat64())
-        throw InputRejected{Error{ErrorCode::kNoDevice,
-                                  "double device views (or a float view beside one) are read in double on the "
-                                  "device: enable the feature shaderFloat64 on the VkDevice "
-                                  "(VulkanDeviceSetup::features2) and set VulkanDevice::shaderFloat64"}};
+        throw InputRejected{
+            Error{ErrorCode::kNoDevice,
+                  "double device views (or a float view beside one) are read in double on the "
+                  "device: enable the feature shaderFloat64 on the VkDevice "
+                  "(VulkanDeviceSetup::features2) and set VulkanDevice::shaderFloat64"}};
 }
 
 }  // namespace

@@ -197,9 +197,11 @@ struct GpuHausdorff::State {
         if (together) {
             deviceIngest.ingest(std::array{&da.ix, &db.ix}, views, origin, options.bits, !doubles);
         } else {
-            deviceIngest.ingest(std::array{&da.ix}, std::span(views).first(1), origin, options.bits, !doubles);
+            deviceIngest.ingest(std::array{&da.ix}, std::span(views).first(1), origin, options.bits,
+                                !doubles);
         }
-        if (!doubles) requireUnitScale(std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds)));
+        if (!doubles)
+            requireUnitScale(std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds)));
         if (together) {
             index.buildIndexes(std::array{&da.ix, &db.ix}, /*ingested=*/true);
         } else {

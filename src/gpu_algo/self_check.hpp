@@ -51,10 +51,8 @@ struct SampledQuery {
 // shaders do) equals the stored one, and it is not above the final maximum
 // maxPacked. The last sample is the witness: its best is the maximum.
 // "" when every sample holds, else the first failure.
-[[nodiscard]] std::string sampledQueryFailure(std::span<const SampledQuery> samples,
-                                              const SetPoints& qPts, const SetPoints& tPts,
-                                              uint64_t maxPacked,
-                                              bool perPoint);
+[[nodiscard]] std::string sampledQueryFailure(std::span<const SampledQuery> samples, const SetPoints& qPts,
+                                              const SetPoints& tPts, uint64_t maxPacked, bool perPoint);
 
 // The reported value against the device's: the double distance of the
 // witness pair must agree with the maximum's float squared distance

@@ -63,7 +63,8 @@ void SetPoints::fetch(std::span<const uint32_t> indices) {
 glm::dvec3 SetPoints::original(uint32_t i) const {
     if (!m_ctx) return glm::dvec3(m_host[i]);
     const auto it = m_fetched.find(i);
-    if (it == m_fetched.end()) throw std::logic_error("SetPoints: point " + std::to_string(i) + " not fetched");
+    if (it == m_fetched.end())
+        throw std::logic_error("SetPoints: point " + std::to_string(i) + " not fetched");
     return it->second;
 }
 
@@ -90,7 +91,8 @@ std::span<const glm::vec3> SetPoints::all() {
     m_all.assign(m_n, glm::vec3(0.0f));
     for (size_t s = 0; s < m_n; ++s) {
         const uint32_t i = std::bit_cast<uint32_t>(rec[4 * s + 3]);
-        if (i >= m_n) throw std::runtime_error("per-point read-back: a record names point " + std::to_string(i));
+        if (i >= m_n)
+            throw std::runtime_error("per-point read-back: a record names point " + std::to_string(i));
         m_all[i] = glm::vec3(rec[4 * s], rec[4 * s + 1], rec[4 * s + 2]);
     }
     return m_all;

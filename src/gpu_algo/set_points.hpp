@@ -42,7 +42,8 @@ public:
     void useHost(std::span<const glm::vec3> searched);
     // Device input: `view`, searched as float(p - origin); `ix` is the set's
     // index (per-point output reads its records back).
-    void useDevice(gpu::Context& ctx, const DeviceInput& view, const glm::dvec3& origin, const PointIndex& ix);
+    void useDevice(gpu::Context& ctx, const DeviceInput& view, const glm::dvec3& origin,
+                   const PointIndex& ix);
 
     [[nodiscard]] size_t size() const { return m_n; }
     [[nodiscard]] bool onDevice() const { return m_ctx != nullptr; }

@@ -43,7 +43,15 @@ public:
         app.apiVersion = VK_API_VERSION_1_3;
         const char* layer = "VK_LAYER_KHRONOS_validation";
         const char* ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+        // Synchronization validation on (the embedder's writes and the
+        // Engine's reads meet on one queue).
+        const VkValidationFeatureEnableEXT syncval =
+            VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+        VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+        features.enabledValidationFeatureCount = 1;
+        features.pEnabledValidationFeatures = &syncval;
         VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+        ci.pNext = &features;
         ci.pApplicationInfo = &app;
         ci.enabledLayerCount = 1;
         ci.ppEnabledLayerNames = &layer;
@@ -98,8 +106,9 @@ public:
     VkBuffer upload(const void* bytes, VkDeviceSize size) {
         const VkBufferUsageFlags usage = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
                                          VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-        VkBuffer staging = makeBuffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                                                                  VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+        VkBuffer staging =
+            makeBuffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                       VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
         void* mapped = nullptr;
         vkMapMemory(m_device, m_buffers.back().second, 0, size, 0, &mapped);
         std::memcpy(mapped, bytes, size);
@@ -161,8 +170,8 @@ private:
             return;
         }
         m_physical = pd;
-        m_handles = VulkanDevice{m_instance, pd, m_device, VK_NULL_HANDLE, setup.queueFamily, setup.shaderFloat64,
-                                 true};
+        m_handles = VulkanDevice{m_instance,          pd,  m_device, VK_NULL_HANDLE, setup.queueFamily,
+                                 setup.shaderFloat64, true};
         vkGetDeviceQueue(m_device, setup.queueFamily, 0, &m_handles.queue);
         VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
         pci.queueFamilyIndex = setup.queueFamily;
@@ -180,7 +189,8 @@ private:
         VkPhysicalDeviceMemoryProperties props;
         vkGetPhysicalDeviceMemoryProperties(m_physical, &props);
         uint32_t type = 0;
-        while (!((req.memoryTypeBits >> type) & 1u) || (props.memoryTypes[type].propertyFlags & wanted) != wanted)
+        while (!((req.memoryTypeBits >> type) & 1u) ||
+               (props.memoryTypes[type].propertyFlags & wanted) != wanted)
             ++type;
         VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
         flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
@@ -242,18 +252,19 @@ std::vector<glm::dvec3> randomDoubles(size_t n, uint64_t seed, glm::dvec3 offset
 }
 
 // The embedder and an Engine on it (a skip, which CI fails, without a device).
-#define RTHDIST_REQUIRE_EMBEDDER(emb, engine)                                                     \
+#define RTHDIST_REQUIRE_EMBEDDER(emb, engine)                                                    \
     if (backendUnderTest() == Backend::kCpu) GTEST_SKIP() << "device input needs a GPU backend"; \
-    Embedder emb(backendUnderTest());                                                              \
+    Embedder emb(backendUnderTest());                                                            \
     if (!emb.ok()) GTEST_SKIP() << "no device for this backend: " << emb.why();                  \
-    Result<Engine> engine = Engine::create(emb.handles(), engineUnderTest());                     \
+    Result<Engine> engine = Engine::create(emb.handles(), engineUnderTest());                    \
     ASSERT_TRUE(engine) << engine.error().message
 
 TEST(DeviceInput, FloatPackedAndStridedMatchHostArrays) {
     RTHDIST_REQUIRE_EMBEDDER(emb, engine);
     const std::vector<glm::dvec3> a = randomDoubles(3000, 11, glm::dvec3(0.0), 1.0);
     const std::vector<glm::dvec3> b = randomDoubles(2200, 12, glm::dvec3(0.3, 0.0, 0.1), 1.0);
-    const std::vector<float> fa = interleaved<float>(a, 3), fb = interleaved<float>(b, 8);  // b: 32-byte stride
+    const std::vector<float> fa = interleaved<float>(a, 3),
+                             fb = interleaved<float>(b, 8);  // b: 32-byte stride
     const Result<HausdorffResult> host =
         engine->compute(PointView::floats(fa.data(), a.size()), PointView::floats(fb.data(), b.size(), 32));
     ASSERT_TRUE(host) << host.error().message;
@@ -273,7 +284,8 @@ TEST(DeviceInput, DoubleStridedMatchesHostArrays) {
     // UTM-like coordinates: not float values, so both paths shift by the union's centre.
     const std::vector<glm::dvec3> a = randomDoubles(2500, 21, glm::dvec3(512345.25, 5401234.5, 120.0), 200.0);
     const std::vector<glm::dvec3> b = randomDoubles(1800, 22, glm::dvec3(512350.0, 5401230.0, 118.0), 200.0);
-    const std::vector<double> da = interleaved<double>(a, 3), db = interleaved<double>(b, 4);  // 32-byte stride
+    const std::vector<double> da = interleaved<double>(a, 3),
+                              db = interleaved<double>(b, 4);  // 32-byte stride
     const Result<HausdorffResult> host =
         engine->compute(PointView::doubles(da.data(), a.size()), PointView::doubles(db.data(), b.size(), 32));
     ASSERT_TRUE(host) << host.error().message;
@@ -288,8 +300,20 @@ TEST(DeviceInput, DoubleStridedMatchesHostArrays) {
                         DevicePointView::doubles(bb, db.size() * 8, b.size(), 0, 32));
     ASSERT_TRUE(dev) << dev.error().message;
     expectIdentical(*dev, *host);
-    const Result<HausdorffResult> offset = engine->compute(
-        DevicePointView::doubles(bs, shifted.size() * 8, a.size(), 64), DevicePointView::doubles(bb, db.size() * 8, b.size(), 0, 32));
+    // Doubles that hold float values are searched unshifted (origin 0), as on the host.
+    std::vector<glm::dvec3> fv(a.size());
+    for (size_t i = 0; i < a.size(); ++i)
+        fv[i] = glm::dvec3(glm::vec3(a[i] - glm::dvec3(512345.0, 5401234.0, 0.0)));
+    const Result<HausdorffResult> hostFv = engine->compute(fv, std::span<const glm::dvec3>(fv).first(900));
+    const Result<HausdorffResult> devFv =
+        engine->compute(DevicePointView::doubles(emb.upload(fv), fv.size() * 24, fv.size()),
+                        DevicePointView::doubles(emb.upload(fv), fv.size() * 24, 900));
+    ASSERT_TRUE(hostFv && devFv);
+    EXPECT_EQ(devFv->origin, glm::dvec3(0.0));
+    expectIdentical(*devFv, *hostFv);
+    const Result<HausdorffResult> offset =
+        engine->compute(DevicePointView::doubles(bs, shifted.size() * 8, a.size(), 64),
+                        DevicePointView::doubles(bb, db.size() * 8, b.size(), 0, 32));
     ASSERT_TRUE(offset) << offset.error().message;
     expectIdentical(*offset, *host);
     EXPECT_EQ(emb.messages(), 0);
@@ -317,7 +341,8 @@ TEST(DeviceInput, PerPointMatchesHostArrays) {
     RTHDIST_REQUIRE_EMBEDDER(emb, engine);
     const std::vector<glm::dvec3> a = randomDoubles(1200, 41, glm::dvec3(0.0), 2.0);
     const std::vector<glm::dvec3> b = randomDoubles(900, 42, glm::dvec3(0.5), 2.0);
-    const std::vector<float> fa = interleaved<float>(a, 4), fb = interleaved<float>(b, 3);  // a: 16-byte stride
+    const std::vector<float> fa = interleaved<float>(a, 4),
+                             fb = interleaved<float>(b, 3);  // a: 16-byte stride
     CallOptions call;
     call.perPointDistances = true;
     const Result<HausdorffResult> host = engine->compute(PointView::floats(fa.data(), a.size(), 16),
@@ -365,8 +390,10 @@ TEST(DeviceInput, PreparedDoubleSetsShareAFrame) {
     frame.origin = glm::dvec3(4.9e6 + 2.5, 1.2e5 + 2.5, -3.0e5 + 2.5);
     Result<PreparedSet> ha = engine->prepare(PointView::doubles(da.data(), a.size()), frame);
     Result<PreparedSet> hb = engine->prepare(PointView::doubles(db.data(), b.size()), frame);
-    Result<PreparedSet> pa = engine->prepare(DevicePointView::doubles(emb.upload(da), da.size() * 8, a.size()), frame);
-    Result<PreparedSet> pb = engine->prepare(DevicePointView::doubles(emb.upload(db), db.size() * 8, b.size()), frame);
+    Result<PreparedSet> pa =
+        engine->prepare(DevicePointView::doubles(emb.upload(da), da.size() * 8, a.size()), frame);
+    Result<PreparedSet> pb =
+        engine->prepare(DevicePointView::doubles(emb.upload(db), db.size() * 8, b.size()), frame);
     ASSERT_TRUE(ha && hb && pa && pb);
     EXPECT_EQ(pa->origin(), *frame.origin);
     const Result<HausdorffResult> host = engine->compute(*ha, *hb);
@@ -375,7 +402,8 @@ TEST(DeviceInput, PreparedDoubleSetsShareAFrame) {
     ASSERT_TRUE(dev) << dev.error().message;
     expectIdentical(*dev, *host);
     // Without a shared frame the sets cannot be re-indexed from the host: an error, not a guess.
-    Result<PreparedSet> own = engine->prepare(DevicePointView::doubles(emb.upload(db), db.size() * 8, b.size()));
+    Result<PreparedSet> own =
+        engine->prepare(DevicePointView::doubles(emb.upload(db), db.size() * 8, b.size()));
     ASSERT_TRUE(own);
     const Result<HausdorffResult> mixed = engine->compute(*pa, *own);
     ASSERT_FALSE(mixed);
@@ -394,10 +422,14 @@ TEST(DeviceInput, BadViewsAreErrors) {
         EXPECT_EQ(r.error().code, code);
         EXPECT_NE(r.error().message.find(words), std::string::npos) << r.error().message;
     };
-    expectError(DevicePointView::floats(good, p.size() * 4, 100, 0, 8), ErrorCode::kInvalidArgument, "strideBytes 8");
-    expectError(DevicePointView::floats(good, p.size() * 4, 100, 0, 14), ErrorCode::kInvalidArgument, "multiple of 4");
-    expectError(DevicePointView::floats(good, p.size() * 4, 101), ErrorCode::kInvalidArgument, "past bufferBytes");
-    expectError(DevicePointView::floats(good, p.size() * 4, 100, 4), ErrorCode::kInvalidArgument, "past bufferBytes");
+    expectError(DevicePointView::floats(good, p.size() * 4, 100, 0, 8), ErrorCode::kInvalidArgument,
+                "strideBytes 8");
+    expectError(DevicePointView::floats(good, p.size() * 4, 100, 0, 14), ErrorCode::kInvalidArgument,
+                "multiple of 4");
+    expectError(DevicePointView::floats(good, p.size() * 4, 101), ErrorCode::kInvalidArgument,
+                "past bufferBytes");
+    expectError(DevicePointView::floats(good, p.size() * 4, 100, 4), ErrorCode::kInvalidArgument,
+                "past bufferBytes");
     expectError(DevicePointView::floats(good, p.size() * 4, 99, 2), ErrorCode::kInvalidArgument, "offset 2");
     expectError(DevicePointView::floats(good, p.size() * 4, 0), ErrorCode::kInvalidArgument, "empty");
     expectError(DevicePointView::floats(VK_NULL_HANDLE, 1200, 100), ErrorCode::kInvalidArgument, "no buffer");
@@ -429,7 +461,8 @@ TEST(DeviceInput, OracleOnRandomSets) {
             engine->compute(DevicePointView::floats(emb.upload(a), na * 12, na),
                             DevicePointView::floats(emb.upload(b), nb * 12, nb));
         ASSERT_TRUE(r) << r.error().message;
-        const oracle::DirectedExact ab = oracle::bruteForceDirected(a, b), ba = oracle::bruteForceDirected(b, a);
+        const oracle::DirectedExact ab = oracle::bruteForceDirected(a, b),
+                                    ba = oracle::bruteForceDirected(b, a);
         EXPECT_EQ(r->aToB.distance, ab.distance);
         EXPECT_EQ(r->bToA.distance, ba.distance);
         EXPECT_EQ(r->aToB.queryIndex, ab.queryIndex);
@@ -438,9 +471,9 @@ TEST(DeviceInput, OracleOnRandomSets) {
     }
     if (emb.handles().shaderFloat64) {
         for (const GeoCase& c : makeGeoCases()) {
-            const Result<HausdorffResult> r = engine->compute(
-                DevicePointView::doubles(emb.upload(c.a), c.a.size() * 24, c.a.size()),
-                DevicePointView::doubles(emb.upload(c.b), c.b.size() * 24, c.b.size()));
+            const Result<HausdorffResult> r =
+                engine->compute(DevicePointView::doubles(emb.upload(c.a), c.a.size() * 24, c.a.size()),
+                                DevicePointView::doubles(emb.upload(c.b), c.b.size() * 24, c.b.size()));
             ASSERT_TRUE(r) << c.name << ": " << r.error().message;
             expectMatchesGeoOracle(c, *r);
         }
