@@ -34,7 +34,9 @@
 //   most 2^31 - 1 (more -> kInvalidArgument). A buffer past the device's
 //   maxBufferSize, a BLAS past maxPrimitiveCount or a failed allocation ->
 //   kOutOfMemory naming the limit (README, limits).
-//   Dispatches and traces are split by the device's limits.
+//   Dispatches and traces are split by the device's limits. Point sets that
+//   already lie in an embedding application's VkBuffers: vulkan_interop.hpp
+//   (Engine::create(const VulkanDevice&, ...), DevicePointView).
 //
 // Self-check (GPU backends, every call): the index of each set is a
 //   permutation under its own cell keys, every query ends exact or dominated

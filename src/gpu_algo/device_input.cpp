@@ -9,6 +9,11 @@
 #include "gpu/barriers.hpp"
 
 namespace rthdist::gpu_algo {
+
+static_assert(RTHDIST_CTR_INGEST + sizeof(sh::IngestSummary) <= RTHDIST_CTR_INGEST64 &&
+              RTHDIST_CTR_INGEST64 % 8 == 0 &&
+              RTHDIST_CTR_INGEST64 + sizeof(sh::IngestSummary64) <= kCounterBlockBytes);
+
 namespace {
 
 // The double of orderedBits64 (ingest_f64.comp).
