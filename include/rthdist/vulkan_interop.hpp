@@ -85,8 +85,8 @@
 // Limits (kInvalidArgument naming the limit unless said otherwise):
 //   - a view: buffer not VK_NULL_HANDLE; 1 .. 2^31 - 1 points (device input is
 //     not split into out-of-core pieces; a pair past the memory budget is
-//     kOutOfMemory); strideBytes >= 3 scalars and a multiple of the scalar
-//     size; offset a multiple of the scalar size; offset + (count - 1) *
+//     kOutOfMemory); strideBytes >= 3 scalars, a multiple of the scalar
+//     size and below 2^32; offset a multiple of the scalar size; offset + (count - 1) *
 //     strideBytes + 3 scalars <= bufferBytes (the size you created the buffer
 //     with: Vulkan cannot report it). A NaN or infinite coordinate is
 //     kInvalidArgument naming the set and the point, as for host arrays.
@@ -95,9 +95,12 @@
 //     applies that scale.
 //   - the CPU backend and Engines that own their device take no device views
 //     (kInvalidArgument); one Engine per borrowed device and thread.
-//   - a prepared set from a device view keeps no host copy of its points: two
-//     prepared sets that do not share a frame (PrepareOptions::origin) cannot
-//     be re-indexed in their union's frame; that call is kInvalidArgument.
+//   - a prepared set from a device view keeps a device copy of the view's
+//     bytes ((count - 1) * strideBytes + 3 scalars, in deviceBytes()), where
+//     its self-checks and witnesses read later, and no host copy: two
+//     prepared sets that do not share a frame (PrepareOptions::origin), or a
+//     device set beside a host double set that is not float-exact, cannot be
+//     re-indexed in their union's frame; that call is kInvalidArgument.
 //
 // Threading: as Engine (rthdist.hpp): not thread-safe; plus the queue rule
 //   above.

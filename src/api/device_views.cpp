@@ -67,10 +67,12 @@ Result<gpu_algo::DeviceInput> checkDeviceView(const DevicePointView& view, const
     if (view.offset % scalar != 0)
         return refuse("offset " + std::to_string(view.offset) + " is not a multiple of " +
                       std::to_string(scalar));
-    const VkDeviceSize end = view.offset + VkDeviceSize(view.count - 1) * view.strideBytes + 3 * scalar;
-    if (end > view.bufferBytes)
-        return refuse("offset + (count - 1) * strideBytes + 3 scalars = " + std::to_string(end) +
-                      " bytes, past bufferBytes " + std::to_string(view.bufferBytes));
+    // Compared without overflow: offset first, then what follows it.
+    const VkDeviceSize span = VkDeviceSize(view.count - 1) * view.strideBytes + 3 * scalar;
+    if (view.offset > view.bufferBytes || view.bufferBytes - view.offset < span)
+        return refuse("offset " + std::to_string(view.offset) + " + (count - 1) * strideBytes + 3 scalars (" +
+                      std::to_string(span) + " bytes) is past bufferBytes " +
+                      std::to_string(view.bufferBytes));
     VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
     info.buffer = view.buffer;
     gpu_algo::DeviceInput in;

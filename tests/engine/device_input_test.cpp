@@ -430,6 +430,9 @@ TEST(DeviceInput, BadViewsAreErrors) {
                 "past bufferBytes");
     expectError(DevicePointView::floats(good, p.size() * 4, 100, 4), ErrorCode::kInvalidArgument,
                 "past bufferBytes");
+    expectError(DevicePointView::floats(good, p.size() * 4, 100, ~VkDeviceSize(0) - 3),
+                ErrorCode::kInvalidArgument,
+                "past bufferBytes");  // offset + size would wrap
     expectError(DevicePointView::floats(good, p.size() * 4, 99, 2), ErrorCode::kInvalidArgument, "offset 2");
     expectError(DevicePointView::floats(good, p.size() * 4, 0), ErrorCode::kInvalidArgument, "empty");
     expectError(DevicePointView::floats(VK_NULL_HANDLE, 1200, 100), ErrorCode::kInvalidArgument, "no buffer");
@@ -446,6 +449,26 @@ TEST(DeviceInput, BadViewsAreErrors) {
     const Result<HausdorffResult> r = engine->compute(ok, ok);
     ASSERT_TRUE(r) << r.error().message;
     EXPECT_EQ(r->hausdorff, 0.0);
+    EXPECT_EQ(emb.messages(), 0);
+}
+
+TEST(DeviceInput, DoubleViewsNeedShaderFloat64) {
+    RTHDIST_REQUIRE_EMBEDDER(emb, engine);
+    VulkanDevice without = emb.handles();
+    without.shaderFloat64 = false;  // as for a device created without the feature
+    Result<Engine> e = Engine::create(without, engineUnderTest());
+    ASSERT_TRUE(e) << e.error().message;
+    const std::vector<double> d = interleaved<double>(randomDoubles(40, 91, glm::dvec3(0.5), 1.0), 3);
+    const std::vector<float> f = interleaved<float>(randomDoubles(40, 92, glm::dvec3(0.0), 1.0), 3);
+    const DevicePointView dv = DevicePointView::doubles(emb.upload(d), d.size() * 8, 40);
+    const DevicePointView fv = DevicePointView::floats(emb.upload(f), f.size() * 4, 40);
+    const Result<HausdorffResult> r = e->compute(fv, dv);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kNoDevice);
+    EXPECT_NE(r.error().message.find("shaderFloat64"), std::string::npos) << r.error().message;
+    const Result<HausdorffResult> floats = e->compute(fv, fv);  // float views need no Float64
+    ASSERT_TRUE(floats) << floats.error().message;
+    EXPECT_EQ(floats->hausdorff, 0.0);
     EXPECT_EQ(emb.messages(), 0);
 }
 
@@ -481,7 +504,7 @@ TEST(DeviceInput, OracleOnRandomSets) {
     EXPECT_EQ(emb.messages(), 0);
 }
 
-TEST(DeviceInput, RefusedWhereNoDeviceReadsIt) {
+TEST(DeviceInputRefused, OnTheCpuBackend) {
     // The CPU backend takes no Vulkan device and no device views.
     Options cpu;
     cpu.backend = Backend::kCpu;
