@@ -118,8 +118,9 @@
 
 namespace rthdist {
 
-// What a VkDevice needs for one backend (step 1 above). Copyable: chain()
-// links the feature structures of this copy.
+// What a VkDevice needs for one backend (step 1 above). Copyable; the
+// feature structures come unlinked (pNext null): call chain() on the copy
+// you pass to vkCreateDevice.
 struct VulkanDeviceSetup {
     Backend backend = Backend::kRayQuery;  // kRayQuery or kRtPipeline (kAuto resolved)
     uint32_t apiVersion = VK_API_VERSION_1_3;

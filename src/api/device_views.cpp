@@ -44,8 +44,7 @@ Result<VulkanDeviceSetup> vulkanDeviceSetup(VkPhysicalDevice pd, Backend backend
     if (setup.shaderFloat64) req.features.push_back(gpu::DeviceFeature::kShaderFloat64);
     gpu::describeForEmbedder(req, setup);
     setup.queueFamily = gpu::computeQueueFamily(pd);
-    setup.chain();
-    return setup;
+    return setup;  // unlinked: chain() links the caller's copy
 }
 
 namespace api {
