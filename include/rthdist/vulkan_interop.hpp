@@ -59,8 +59,9 @@
 //   float32 value; the host reads those 56 bytes per set, picks the origin
 //   with core's rule (centre of the union box, or 0) and the second pass
 //   stores float(p - origin) computed in double on the device (round to
-//   nearest, as the host path; the self-check below compares sampled records
-//   with the host's rounding bit for bit). Double views need the device
+//   nearest, as the host path; the self-check of rthdist.hpp compares sampled
+//   records with the host's rounding of your coordinates bit for bit, so a
+//   driver that rounds otherwise fails loudly with kInternal). Double views need the device
 //   feature shaderFloat64 enabled (VulkanDevice::shaderFloat64); without it the
 //   call returns kNoDevice naming the feature. Results (H, both directed
 //   values, witness indices and points) equal those of the host-array call on
@@ -94,13 +95,19 @@
 //     magnitudes past 2^40 or all below 2^-40) are refused: the host path
 //     applies that scale.
 //   - the CPU backend and Engines that own their device take no device views
-//     (kInvalidArgument); one Engine per borrowed device and thread.
+//     (kInvalidArgument). Several Engines may borrow one device; calls that
+//     share a queue must not overlap (the queue rule above).
 //   - a prepared set from a device view keeps a device copy of the view's
 //     bytes ((count - 1) * strideBytes + 3 scalars, in deviceBytes()), where
 //     its self-checks and witnesses read later, and no host copy: two
 //     prepared sets that do not share a frame (PrepareOptions::origin), or a
 //     device set beside a host double set that is not float-exact, cannot be
 //     re-indexed in their union's frame; that call is kInvalidArgument.
+//
+// Validation: the validation layer is yours to enable on your instance. With
+//   EngineOptions::validation and VulkanDevice::debugUtils the Engine adds a
+//   messenger of its own and counts warnings and errors in
+//   HausdorffResult::validationMessages.
 //
 // Threading: as Engine (rthdist.hpp): not thread-safe; plus the queue rule
 //   above.

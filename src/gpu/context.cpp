@@ -351,7 +351,10 @@ Result<std::unique_ptr<Context>> Context::borrow(const VulkanDevice& handles, Ba
     std::unique_ptr<Context> ctx(new Context());
     try {
         if (std::optional<Error> err = ctx->adopt(handles, req, validation)) return *err;
-        if (std::optional<Error> err = ctx->loadRtFunctions(req)) return *err;
+        if (std::optional<Error> err = ctx->loadRtFunctions(req))
+            return Error{err->code, err->message +
+                                        " on the VkDevice given: was it created with vulkanDeviceSetup(pd, " +
+                                        backendName(backend) + ")?"};
         ctx->readProperties(req);
         ctx->createCommandObjects();
     } catch (const VulkanError& e) {

@@ -472,6 +472,20 @@ TEST(DeviceInput, DoubleViewsNeedShaderFloat64) {
     EXPECT_EQ(emb.messages(), 0);
 }
 
+TEST(DeviceInput, OwnedEnginesRefuseDeviceViews) {
+    RTHDIST_REQUIRE_EMBEDDER(emb, engine);
+    RTHDIST_REQUIRE_TEST_ENGINE(owned);  // on a device of its own: it cannot read the embedder's buffers
+    const std::vector<float> f = interleaved<float>(randomDoubles(10, 93, glm::dvec3(0.0), 1.0), 3);
+    const DevicePointView v = DevicePointView::floats(emb.upload(f), f.size() * 4, 10);
+    const Result<HausdorffResult> r = owned->compute(v, v);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(r.error().message.find("created on your VkDevice"), std::string::npos) << r.error().message;
+    EXPECT_FALSE(owned->prepare(v));
+    EXPECT_TRUE(engine->compute(v, v));
+    EXPECT_EQ(emb.messages(), 0);
+}
+
 TEST(DeviceInput, OracleOnRandomSets) {
     RTHDIST_REQUIRE_EMBEDDER(emb, engine);
     for (uint64_t seed : {81u, 82u, 83u}) {
@@ -519,6 +533,12 @@ TEST(DeviceInputRefused, OnTheCpuBackend) {
     const Result<Engine> borrowed = Engine::create(VulkanDevice{}, static_cast<const EngineOptions&>(cpu));
     ASSERT_FALSE(borrowed);
     EXPECT_EQ(borrowed.error().code, ErrorCode::kInvalidArgument);
+    EngineOptions gpu;
+    gpu.backend = Backend::kRayQuery;
+    const Result<Engine> empty = Engine::create(VulkanDevice{}, gpu);  // no handles
+    ASSERT_FALSE(empty);
+    EXPECT_EQ(empty.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(empty.error().message.find("must all be set"), std::string::npos) << empty.error().message;
 }
 
 }  // namespace
