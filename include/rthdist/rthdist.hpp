@@ -34,7 +34,9 @@
 //   most 2^31 - 1 (more -> kInvalidArgument). A buffer past the device's
 //   maxBufferSize, a BLAS past maxPrimitiveCount or a failed allocation ->
 //   kOutOfMemory naming the limit (README, limits).
-//   Dispatches and traces are split by the device's limits.
+//   Dispatches and traces are split by the device's limits. Point sets that
+//   already lie in an embedding application's VkBuffers: vulkan_interop.hpp
+//   (Engine::create(const VulkanDevice&, ...), DevicePointView).
 //
 // Self-check (GPU backends, every call): the index of each set is a
 //   permutation under its own cell keys, every query ends exact or dominated
@@ -160,6 +162,11 @@ struct DeviceInfo {
 [[nodiscard]] RTHDIST_API Result<std::vector<DeviceInfo>> listDevices();
 
 class Engine;
+// Device-resident input (rthdist/vulkan_interop.hpp: the only public header
+// with Vulkan types): an Engine on the embedder's VkDevice reads point sets
+// from its VkBuffers.
+struct VulkanDevice;
+struct DevicePointView;
 
 // A point set prepared once on an Engine's device (or, on the CPU backend,
 // in host memory): its frame (origin), exact power-of-two scale, bounds, bit
@@ -216,6 +223,11 @@ public:
     [[nodiscard]] static Result<Engine> create(const EngineOptions& options);
     // As above; compute(a, b) without call options then uses the call part of `options`.
     [[nodiscard]] static Result<Engine> create(const Options& options);
+    // On the embedder's Vulkan device, queue and instance (vulkan_interop.hpp:
+    // borrowed, never destroyed; EngineOptions::backend kRayQuery,
+    // kRtPipeline or kAuto; deviceIndex and devices are ignored). The only
+    // Engines that take DevicePointViews.
+    [[nodiscard]] static Result<Engine> create(const VulkanDevice& device, const EngineOptions& options);
     Engine(Engine&&) noexcept;
     Engine& operator=(Engine&&) noexcept;
     ~Engine();
@@ -228,6 +240,16 @@ public:
     // at most 2^31 - 1: a prepared set is not split). The view is read during
     // this call only.
     [[nodiscard]] Result<PreparedSet> prepare(PointView points, const PrepareOptions& options = {});
+
+    // Device input (vulkan_interop.hpp: synchronisation contract, buffer
+    // usage, precision, limits): sets in the embedder's VkBuffers, read on
+    // the device. The same results as the host-array calls on the same
+    // coordinates. kInvalidArgument on an Engine not created on a VulkanDevice.
+    [[nodiscard]] Result<HausdorffResult> compute(const DevicePointView& a, const DevicePointView& b);
+    [[nodiscard]] Result<HausdorffResult> compute(const DevicePointView& a, const DevicePointView& b,
+                                                  const CallOptions& call);
+    [[nodiscard]] Result<PreparedSet> prepare(const DevicePointView& points,
+                                              const PrepareOptions& options = {});
     // H(A, B) of two sets prepared by this Engine (either may be both).
     // Witness indices refer to each set's input order.
     [[nodiscard]] Result<HausdorffResult> compute(const PreparedSet& a, const PreparedSet& b,

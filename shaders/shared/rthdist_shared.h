@@ -42,6 +42,7 @@ struct vec3f {
 #define RTHDIST_CTR_LARGE_CELLS 52  // uint: cell_build, 1 when a cell needs the parallel box
 #define RTHDIST_CTR_READBACK 64     // host read-back area after the counters
 #define RTHDIST_CTR_INGEST 1152     // IngestSummary: ingest.comp, one set's bounds and first bad point
+#define RTHDIST_CTR_INGEST64 1184   // IngestSummary64: ingest_f64.comp, one device view's box in double
 #define RTHDIST_CTR_BYTES 2048
 
 // Query status values.
@@ -98,6 +99,34 @@ struct IngestSummary {
     uint hi[3];
     uint firstBad;
     uint pad;
+};
+
+// ingest_f64.comp: a device view of the embedder's points (three floats or
+// doubles at source + i * stride) in two passes. Mode 0 reduces its box in
+// double into an IngestSummary64; mode 1 writes float(p - origin), computed
+// in double, into vec4 records and their float bounds into an IngestSummary.
+// The origin travels as the bits of three doubles (no double type here:
+// every shader includes this header, and only this one may need Float64).
+struct IngestDevicePush {
+    uint64_t source;
+    uint64_t points;     // vec4[n] out (mode 1)
+    uint64_t summary;    // IngestSummary64 (mode 0) or IngestSummary (mode 1), initialised by the host
+    uint64_t origin[3];  // double bits (mode 1)
+    uint n;
+    uint stride;    // bytes, a multiple of the scalar size
+    uint isDouble;  // 1: three doubles per point, 0: three floats
+    uint mode;
+};
+
+// What mode 0 of ingest_f64.comp reports of a device view: its box in double
+// as order-preserving bits (lo starts at ~0, hi at 0), the smallest index of
+// a non-finite point (0xffffffff: none), and whether a coordinate is not a
+// float32 value (notFloat != 0).
+struct IngestSummary64 {
+    uint64_t lo[3];
+    uint64_t hi[3];
+    uint firstBad;
+    uint notFloat;
 };
 
 // scan_block.comp / scan_add.comp: exclusive scan of uint[n] in place.
@@ -333,6 +362,8 @@ static_assert(offsetof(CounterFields, checkBad) == RTHDIST_CTR_CHECK_BAD);
 static_assert(offsetof(CounterFields, minEdge) == RTHDIST_CTR_MIN_EDGE);
 static_assert(offsetof(CounterFields, largeCells) == RTHDIST_CTR_LARGE_CELLS);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
+static_assert(sizeof(IngestDevicePush) == 64 && offsetof(IngestDevicePush, n) == 48);
+static_assert(sizeof(IngestSummary64) == 56 && offsetof(IngestSummary64, firstBad) == 48);
 
 }  // namespace rthdist::shared
 #endif

@@ -2,6 +2,7 @@
 // that keeps a Vulkan device and its pipelines between calls.
 #include "rthdist/rthdist.hpp"
 #include "rthdist/version.hpp"
+#include "rthdist/vulkan_interop.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -10,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "api/device_views.hpp"
 #include "api/out_of_core.hpp"
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
@@ -118,6 +120,10 @@ struct PreparedSet::Impl {
     double ownScale = 1.0;              // core::exactScale of `floats` alone
     std::shared_ptr<gpu_algo::DeviceSet> gpuSet;
     std::shared_ptr<cpu::CpuSet> cpuSet;
+    size_t count = 0;
+    // Prepared from a device view: no host copy of its points (floats and
+    // originals empty); its witnesses come from its device copy.
+    bool onDevice = false;
 
     // The input as given (for witnesses in double and for the union frame).
     [[nodiscard]] PointView input() const {
@@ -133,7 +139,7 @@ PreparedSet::PreparedSet(PreparedSet&&) noexcept = default;
 PreparedSet& PreparedSet::operator=(PreparedSet&&) noexcept = default;
 PreparedSet::~PreparedSet() = default;
 
-size_t PreparedSet::size() const { return m_impl->floats.size(); }
+size_t PreparedSet::size() const { return m_impl->count; }
 glm::dvec3 PreparedSet::origin() const { return m_impl->origin; }
 int PreparedSet::bits() const {
     return m_impl->gpuSet ? gpu_algo::GpuHausdorff::bits(*m_impl->gpuSet) : m_impl->cpuSet->order.grid.bits;
@@ -156,9 +162,11 @@ Engine::~Engine() = default;
 namespace {
 
 // One device of an Engine: its context and the GPU algorithm on it.
+// `borrowed`: the embedder's device (vulkan_interop.hpp) instead of one of ours.
 std::optional<Error> openDevice(const EngineOptions& options, Backend backend, int deviceIndex,
-                                Device& device) {
-    auto ctx = gpu::Context::create(backend, deviceIndex, options.validation);
+                                Device& device, const VulkanDevice* borrowed = nullptr) {
+    auto ctx = borrowed ? gpu::Context::borrow(*borrowed, backend, options.validation)
+                        : gpu::Context::create(backend, deviceIndex, options.validation);
     if (!ctx) return ctx.error();
     device.context = std::move(ctx.value());
     const std::string cacheDir = options.pipelineCacheDir == "off"  ? std::string()
@@ -213,6 +221,22 @@ Result<Engine> Engine::create(const Options& options) {
     Result<Engine> engine = create(static_cast<const EngineOptions&>(options));
     if (engine) engine->m_impl->callDefaults = static_cast<const CallOptions&>(options);
     return engine;
+}
+
+Result<Engine> Engine::create(const VulkanDevice& device, const EngineOptions& given) {
+    if (auto err = validateEngineOptions(given)) return *err;
+    if (given.backend == Backend::kCpu)
+        return Error{ErrorCode::kInvalidArgument, "the cpu backend takes no Vulkan device (VulkanDevice)"};
+    auto t0 = std::chrono::steady_clock::now();
+    auto impl = std::make_unique<Impl>();
+    impl->options = given;
+    impl->options.devices.clear();
+    impl->device = std::make_shared<Device>();
+    if (auto err = openDevice(impl->options, given.backend, -1, *impl->device, &device)) return *err;
+    impl->backend = impl->device->context->backend();
+    impl->deviceName = impl->device->context->deviceName();
+    impl->setupMs = msSince(t0);
+    return Engine(std::move(impl));
 }
 
 const std::string& Engine::deviceName() const { return m_impl->deviceName; }
@@ -413,6 +437,7 @@ Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& opti
     auto set = std::make_shared<PreparedSet::Impl>();
     set->device = m_impl->device;
     set->summary = *summary;
+    set->count = points.count;
     set->origin = core::preparedOrigin(*summary, options.origin);
     set->floats = core::roundedCopy(points, set->origin, m_impl->options.threads);
     if (!summary->floatExact) {
@@ -439,6 +464,13 @@ Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet&
     const PreparedSet::Impl& ib = *b.m_impl;
     if (ia.device != m_impl->device || ib.device != m_impl->device)
         return Error{ErrorCode::kInvalidArgument, "a prepared set belongs to another Engine"};
+    if ((ia.onDevice || ib.onDevice) &&
+        (!shareFrame(ia, ib) || !ia.originals.empty() || !ib.originals.empty())) {
+        return Error{ErrorCode::kInvalidArgument,
+                     "a set prepared from a device view keeps no host copy: it meets only sets of its frame "
+                     "(prepare both with one PrepareOptions::origin) whose coordinates are float values or "
+                     "also device views"};
+    }
     if (!shareFrame(ia, ib)) {
         // Different frames or scales: both indexed afresh in the union's frame.
         return computeViews(*m_impl, ia.input(), ib.input(), CheckedInputs{ia.summary, ib.summary}, call, t0);
@@ -484,6 +516,73 @@ Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& optio
     auto engine = Engine::create(static_cast<const EngineOptions&>(options));
     if (!engine) return engine.error();
     return computeViews(*engine->m_impl, a, b, *checked, options, std::chrono::steady_clock::now());
+}
+
+}  // namespace rthdist
+
+namespace rthdist {
+
+namespace {
+
+// The Engine's device when it can read device views, or why not.
+std::optional<Error> deviceInputEngine(const Engine::Impl& impl) {
+    if (!impl.device->gpu)
+        return Error{
+            ErrorCode::kInvalidArgument,
+            "device views (DevicePointView) need a GPU backend: the cpu backend cannot read VkBuffers"};
+    if (!impl.device->context->borrowed())
+        return Error{ErrorCode::kInvalidArgument,
+                     "device views (DevicePointView) need an Engine created on your VkDevice "
+                     "(Engine::create(const VulkanDevice&, ...))"};
+    return std::nullopt;
+}
+
+}  // namespace
+
+Result<HausdorffResult> Engine::compute(const DevicePointView& a, const DevicePointView& b) {
+    return compute(a, b, m_impl->callDefaults);
+}
+
+Result<HausdorffResult> Engine::compute(const DevicePointView& a, const DevicePointView& b,
+                                        const CallOptions& call) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (auto err = deviceInputEngine(*m_impl)) return *err;
+    if (auto err = validateCallOptions(call)) return *err;
+    const VkDevice device = m_impl->device->context->device();
+    Result<gpu_algo::DeviceInput> da = api::checkDeviceView(a, "A", device);
+    if (!da) return da.error();
+    Result<gpu_algo::DeviceInput> db = api::checkDeviceView(b, "B", device);
+    if (!db) return db.error();
+    if (!api::fitsOneCall(memoryBudget(*m_impl), a.count, b.count))
+        return Error{ErrorCode::kOutOfMemory, "device views of " + std::to_string(a.count) + " and " +
+                                                  std::to_string(b.count) +
+                                                  " points do not fit the memory budget of one call "
+                                                  "(device input is not split into pieces)"};
+    Result<HausdorffResult> r = m_impl->device->gpu->computeDevice(*da, *db, call);
+    if (!r) return r;
+    finishResult(*m_impl, *r, t0);
+    return r;
+}
+
+Result<PreparedSet> Engine::prepare(const DevicePointView& points, const PrepareOptions& options) {
+    if (auto err = deviceInputEngine(*m_impl)) return *err;
+    if (auto err = validateBits(options.bits)) return *err;
+    Result<gpu_algo::DeviceInput> view =
+        api::checkDeviceView(points, "to prepare", m_impl->device->context->device());
+    if (!view) return view.error();
+    Timings timings;
+    const std::string name = "set#" + std::to_string(++m_impl->preparedCount);
+    auto g = m_impl->device->gpu->prepareDevice(*view, options.origin, options.bits, name, timings);
+    if (!g) return g.error();
+    auto set = std::make_shared<PreparedSet::Impl>();
+    set->device = m_impl->device;
+    set->summary = g->summary;
+    set->origin = g->origin;
+    set->count = points.count;
+    set->onDevice = true;
+    set->ownScale = 1.0;  // prepareDevice refuses sets that need the exact scale
+    set->gpuSet = std::move(g->set);
+    return PreparedSet(std::move(set));
 }
 
 }  // namespace rthdist

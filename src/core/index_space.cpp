@@ -93,10 +93,10 @@ std::array<size_t, kMaxBits + 1> distinctCellsPerLevel(const std::vector<uint32_
     return distinct;
 }
 
-// Every stride-th target is sampled: about kSampleSize points.
+}  // namespace
+
 size_t sampleStride(size_t n) { return std::max<size_t>(1, n / kSampleSize); }
 
-// The rule of chooseBits over the sample (sample[j] = targets[j * sampleStride(n)]).
 int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Bounds& bounds,
                          double targetPointsPerCell) {
     if (n <= 1) return kMinBits;
@@ -133,8 +133,6 @@ int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Boun
     }
     return chosen;
 }
-
-}  // namespace
 
 int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds, double targetPointsPerCell) {
     const size_t stride = sampleStride(targets.size());

@@ -41,6 +41,13 @@ struct GridSpec {
 // a strided sample's occupancy extrapolated to the full set (DESIGN §5).
 [[nodiscard]] int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds,
                              double targetPointsPerCell = kTargetPointsPerCell);
+// chooseBits samples every sampleStride(n)-th point (about 32k of them).
+[[nodiscard]] size_t sampleStride(size_t n);
+// The rule of chooseBits over a sample taken elsewhere (sample[j] = point
+// j * sampleStride(n) of a set of n points): the same bit count as chooseBits
+// on the whole set (device input reads back only the sample).
+[[nodiscard]] int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Bounds& bounds,
+                                       double targetPointsPerCell = kTargetPointsPerCell);
 
 // The one scaling rule of both backends (squared distances are float there):
 // 1 when the largest coordinate magnitude maxAbs lies in [2^-40, 2^40] (then

@@ -277,16 +277,21 @@ std::optional<Error> Context::createInstance(bool validation) {
     Result<UniqueInstance> instance = makeInstance(validation);
     if (!instance) return instance.error();
     m_instance = std::move(instance.value());
-    const VkInstance inst = m_instance.get();
+    m_instanceHandle = m_instance.get();
     // Null where the instance has no VK_EXT_debug_utils: the helpers then do nothing.
     m_setObjectName = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
-        vkGetInstanceProcAddr(inst, "vkSetDebugUtilsObjectNameEXT"));
+        vkGetInstanceProcAddr(m_instanceHandle, "vkSetDebugUtilsObjectNameEXT"));
     if (!validation) return std::nullopt;
-    auto createMessenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+    return createMessenger();
+}
+
+std::optional<Error> Context::createMessenger() {
+    const VkInstance inst = m_instanceHandle;
+    auto createFn = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(inst, "vkCreateDebugUtilsMessengerEXT"));
     auto destroyMessenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(inst, "vkDestroyDebugUtilsMessengerEXT"));
-    if (!createMessenger || !destroyMessenger)
+    if (!createFn || !destroyMessenger)
         return Error{ErrorCode::kNoDevice, "validation requested but VK_EXT_debug_utils has no messenger"};
     VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
     mi.messageSeverity =
@@ -297,7 +302,7 @@ std::optional<Error> Context::createInstance(bool validation) {
     mi.pfnUserCallback = onDebugMessage;
     mi.pUserData = this;
     VkDebugUtilsMessengerEXT messenger;
-    RTHDIST_VK_CHECK(createMessenger(inst, &mi, nullptr, &messenger));
+    RTHDIST_VK_CHECK(createFn(inst, &mi, nullptr, &messenger));
     m_messenger = UniqueMessenger(messenger, {inst, destroyMessenger});
     return std::nullopt;
 }
@@ -314,22 +319,86 @@ void Context::createDevice(const DeviceRequirements& req) {
     VkDevice device;
     RTHDIST_VK_CHECK(createDeviceFor(m_physical, req, optional, m_queueFamily, &device));
     m_device = UniqueDevice(device, {});
+    m_deviceHandle = device;
     vkGetDeviceQueue(device, m_queueFamily, 0, &m_queue);
-    if (m_setObjectName) {  // the instance has VK_EXT_debug_utils
-        m_cmdBeginLabel = reinterpret_cast<PFN_vkCmdBeginDebugUtilsLabelEXT>(
-            vkGetDeviceProcAddr(device, "vkCmdBeginDebugUtilsLabelEXT"));
-        m_cmdEndLabel = reinterpret_cast<PFN_vkCmdEndDebugUtilsLabelEXT>(
-            vkGetDeviceProcAddr(device, "vkCmdEndDebugUtilsLabelEXT"));
-        if (!m_cmdBeginLabel || !m_cmdEndLabel) {  // labels come in pairs or not at all
-            m_cmdBeginLabel = nullptr;
-            m_cmdEndLabel = nullptr;
-        }
+    loadLabelFunctions();
+}
+
+void Context::loadLabelFunctions() {
+    if (!m_setObjectName) return;  // the instance has no VK_EXT_debug_utils
+    m_cmdBeginLabel = reinterpret_cast<PFN_vkCmdBeginDebugUtilsLabelEXT>(
+        vkGetDeviceProcAddr(m_deviceHandle, "vkCmdBeginDebugUtilsLabelEXT"));
+    m_cmdEndLabel = reinterpret_cast<PFN_vkCmdEndDebugUtilsLabelEXT>(
+        vkGetDeviceProcAddr(m_deviceHandle, "vkCmdEndDebugUtilsLabelEXT"));
+    if (!m_cmdBeginLabel || !m_cmdEndLabel) {  // labels come in pairs or not at all
+        m_cmdBeginLabel = nullptr;
+        m_cmdEndLabel = nullptr;
     }
+}
+
+Result<std::unique_ptr<Context>> Context::borrow(const VulkanDevice& handles, Backend backend,
+                                                 bool validation) {
+    if (!handles.instance || !handles.physicalDevice || !handles.device || !handles.queue)
+        return Error{ErrorCode::kInvalidArgument,
+                     "VulkanDevice: instance, physicalDevice, device and queue must all be set"};
+    if (backend == Backend::kCpu)
+        return Error{ErrorCode::kInvalidArgument, "the cpu backend takes no Vulkan device"};
+    if (backend == Backend::kAuto)
+        backend = unmetRequirements(handles.physicalDevice, backendRequirements(Backend::kRayQuery)).empty()
+                      ? Backend::kRayQuery
+                      : Backend::kRtPipeline;
+    const DeviceRequirements req = backendRequirements(backend);
+    std::unique_ptr<Context> ctx(new Context());
+    try {
+        if (std::optional<Error> err = ctx->adopt(handles, req, validation)) return *err;
+        if (std::optional<Error> err = ctx->loadRtFunctions(req))
+            return Error{err->code, err->message +
+                                        " on the VkDevice given: was it created with vulkanDeviceSetup(pd, " +
+                                        backendName(backend) + ")?"};
+        ctx->readProperties(req);
+        ctx->createCommandObjects();
+    } catch (const VulkanError& e) {
+        return Error{ErrorCode::kNoDevice, e.what()};
+    }
+    return ctx;
+}
+
+std::optional<Error> Context::adopt(const VulkanDevice& handles, const DeviceRequirements& req,
+                                    bool validation) {
+    const std::vector<std::string> unmet = unmetRequirements(handles.physicalDevice, req);
+    if (!unmet.empty()) {
+        std::string lacks;
+        for (size_t m = 0; m < unmet.size(); ++m) lacks += (m ? "; " : "") + unmet[m];
+        return Error{ErrorCode::kNoDevice, std::string("the VkPhysicalDevice given cannot run backend ") +
+                                               backendName(req.backend) + ": lacks " + lacks};
+    }
+    uint32_t n = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(handles.physicalDevice, &n, nullptr);
+    std::vector<VkQueueFamilyProperties> families(n);
+    vkGetPhysicalDeviceQueueFamilyProperties(handles.physicalDevice, &n, families.data());
+    if (handles.queueFamily >= n || !(families[handles.queueFamily].queueFlags & VK_QUEUE_COMPUTE_BIT) ||
+        families[handles.queueFamily].timestampValidBits == 0)
+        return Error{ErrorCode::kInvalidArgument, "VulkanDevice::queueFamily " +
+                                                      std::to_string(handles.queueFamily) +
+                                                      " is not a queue family with compute and timestamps"};
+    m_instanceHandle = handles.instance;
+    m_physical = handles.physicalDevice;
+    m_deviceHandle = handles.device;
+    m_queue = handles.queue;
+    m_queueFamily = handles.queueFamily;
+    m_backend = req.backend;
+    m_borrowed = true;
+    m_shaderFloat64 = handles.shaderFloat64;
+    if (!handles.debugUtils) return std::nullopt;  // no names, labels or message count
+    m_setObjectName = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+        vkGetInstanceProcAddr(m_instanceHandle, "vkSetDebugUtilsObjectNameEXT"));
+    loadLabelFunctions();
+    return validation ? createMessenger() : std::nullopt;
 }
 
 // Device-level entry points of the ray-tracing extensions `req` enables.
 std::optional<Error> Context::loadRtFunctions(const DeviceRequirements& req) {
-    const VkDevice d = m_device.get();
+    const VkDevice d = m_deviceHandle;
     auto& rt = m_rt;
 #define RTHDIST_LOAD(member, name) rt.member = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(d, #name))
     if (req.needs(DeviceFeature::kAccelerationStructure)) {
@@ -375,7 +444,7 @@ void Context::readProperties(const DeviceRequirements& req) {
     if (m_hostImport) {
         m_importAlignment = hostProps.minImportedHostPointerAlignment;
         m_getHostPointerProperties = reinterpret_cast<PFN_vkGetMemoryHostPointerPropertiesEXT>(
-            vkGetDeviceProcAddr(m_device.get(), "vkGetMemoryHostPointerPropertiesEXT"));
+            vkGetDeviceProcAddr(m_deviceHandle, "vkGetMemoryHostPointerPropertiesEXT"));
         m_hostImport = m_getHostPointerProperties != nullptr && m_importAlignment > 0;
     }
     vkGetPhysicalDeviceMemoryProperties(m_physical, &m_memProps);
@@ -389,7 +458,7 @@ void Context::readProperties(const DeviceRequirements& req) {
 
 // The one command buffer, its fence and the timestamp queries.
 void Context::createCommandObjects() {
-    const VkDevice d = m_device.get();
+    const VkDevice d = m_deviceHandle;
     VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
     pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     pci.queueFamilyIndex = m_queueFamily;
@@ -408,17 +477,19 @@ void Context::createCommandObjects() {
 }
 
 Context::~Context() {
-    // Nothing submitted may still run when the children go.
-    if (m_device) vkDeviceWaitIdle(m_device.get());
+    // Nothing submitted may still run when the children go. Every submission
+    // of a borrowed device has been waited for (submitAndWait): its other
+    // queues are the embedder's, not ours to wait on.
+    if (m_device) vkDeviceWaitIdle(m_deviceHandle);
 }
 
 void Context::setDebugName(VkObjectType type, uint64_t handle, const char* name) const {
-    if (!m_setObjectName || !m_device || !handle) return;
+    if (!m_setObjectName || !m_deviceHandle || !handle) return;
     VkDebugUtilsObjectNameInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT};
     info.objectType = type;
     info.objectHandle = handle;
     info.pObjectName = name;
-    m_setObjectName(m_device.get(), &info);
+    m_setObjectName(m_deviceHandle, &info);
 }
 
 void Context::cmdBeginLabel(VkCommandBuffer cmd, const char* name) const {
@@ -475,11 +546,11 @@ void Context::submitAndWait(VkCommandBuffer cmd) {
     RTHDIST_VK_CHECK(vkQueueSubmit(m_queue, 1, &si, fence));
     VkResult r;
     do {
-        r = vkWaitForFences(m_device.get(), 1, &fence, VK_TRUE, 10'000'000'000ull);
+        r = vkWaitForFences(m_deviceHandle, 1, &fence, VK_TRUE, 10'000'000'000ull);
     } while (r == VK_TIMEOUT);
     RTHDIST_VK_CHECK(r);
-    RTHDIST_VK_CHECK(vkResetFences(m_device.get(), 1, &fence));
-    r = vkGetQueryPoolResults(m_device.get(), m_timestamps.get(), 0, last + 1, sizeof(m_stamps),
+    RTHDIST_VK_CHECK(vkResetFences(m_deviceHandle, 1, &fence));
+    r = vkGetQueryPoolResults(m_deviceHandle, m_timestamps.get(), 0, last + 1, sizeof(m_stamps),
                               m_stamps.data(), sizeof(uint64_t),
                               VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
     RTHDIST_VK_CHECK(r);

@@ -21,6 +21,7 @@
 #include "gpu/unique_handle.hpp"
 #include "gpu/vk_check.hpp"
 #include "rthdist/rthdist.hpp"
+#include "rthdist/vulkan_interop.hpp"
 
 namespace rthdist::gpu {
 
@@ -55,16 +56,29 @@ public:
     [[nodiscard]] static Result<std::unique_ptr<Context>> create(
         std::span<const DeviceRequirements> alternatives, const std::string& purpose, int deviceIndex,
         bool validation);
+    // Wraps an embedder's instance, device and queue (rthdist/vulkan_interop.hpp)
+    // without owning them: the context creates and destroys only its own
+    // children (command pool, fence, query pool, messenger). `backend`
+    // (kRayQuery, kRtPipeline, kAuto: ray query where the device has it) must
+    // be the one whose VulkanDeviceSetup the device was created with; the
+    // physical device must meet its requirements (kNoDevice naming what it
+    // lacks), and the queue family must have compute and timestamps.
+    [[nodiscard]] static Result<std::unique_ptr<Context>> borrow(const VulkanDevice& handles, Backend backend,
+                                                                 bool validation);
     ~Context();
     Context(const Context&) = delete;
     Context& operator=(const Context&) = delete;
 
-    [[nodiscard]] VkDevice device() const { return m_device.get(); }
+    [[nodiscard]] VkDevice device() const { return m_deviceHandle; }
     [[nodiscard]] VkPhysicalDevice physicalDevice() const { return m_physical; }
     [[nodiscard]] VkQueue queue() const { return m_queue; }
     // kRayQuery or kRtPipeline; kAuto for a compute-only context (no ray tracing).
     [[nodiscard]] Backend backend() const { return m_backend; }
     [[nodiscard]] const std::string& deviceName() const { return m_name; }
+    // The device is the embedder's (borrow): device input is possible.
+    [[nodiscard]] bool borrowed() const { return m_borrowed; }
+    // shaderFloat64 is enabled on the device (double views of device input).
+    [[nodiscard]] bool shaderFloat64() const { return m_shaderFloat64; }
     [[nodiscard]] const RtFunctions& rt() const { return m_rt; }
     [[nodiscard]] const VkPhysicalDeviceRayTracingPipelinePropertiesKHR& rtProps() const { return m_rtProps; }
     [[nodiscard]] const VkPhysicalDeviceAccelerationStructurePropertiesKHR& asProps() const {
@@ -121,19 +135,29 @@ private:
     Context() = default;
     // The steps of create(), in order.
     [[nodiscard]] std::optional<Error> createInstance(bool validation);
+    // The messenger that counts validation messages on m_instanceHandle.
+    [[nodiscard]] std::optional<Error> createMessenger();
+    // borrow(): the handles checked and adopted, the debug-utils entry points.
+    [[nodiscard]] std::optional<Error> adopt(const VulkanDevice& handles, const DeviceRequirements& req,
+                                             bool validation);
+    void loadLabelFunctions();
     void createDevice(const DeviceRequirements& req);
     [[nodiscard]] std::optional<Error> loadRtFunctions(const DeviceRequirements& req);
     void readProperties(const DeviceRequirements& req);
     void createCommandObjects();
 
     // Declared in creation order: destroyed in reverse, children first.
-    UniqueInstance m_instance;
+    UniqueInstance m_instance;  // empty when borrowed
+    VkInstance m_instanceHandle = VK_NULL_HANDLE;
     UniqueMessenger m_messenger;
     PFN_vkSetDebugUtilsObjectNameEXT m_setObjectName = nullptr;
     PFN_vkCmdBeginDebugUtilsLabelEXT m_cmdBeginLabel = nullptr;
     PFN_vkCmdEndDebugUtilsLabelEXT m_cmdEndLabel = nullptr;
     VkPhysicalDevice m_physical = VK_NULL_HANDLE;
-    UniqueDevice m_device;
+    UniqueDevice m_device;  // empty when borrowed
+    VkDevice m_deviceHandle = VK_NULL_HANDLE;
+    bool m_borrowed = false;
+    bool m_shaderFloat64 = false;
     VkQueue m_queue = VK_NULL_HANDLE;
     uint32_t m_queueFamily = 0;
     UniqueCommandPool m_pool;

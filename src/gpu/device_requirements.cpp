@@ -40,6 +40,9 @@ const FeatureEntry kFeatures[] = {
     {"rayTracingPipeline", Holder::kRtPipeline,
      offsetof(VkPhysicalDeviceRayTracingPipelineFeaturesKHR, rayTracingPipeline),
      VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME},
+    {"shaderFloat64", Holder::kCore,
+     offsetof(VkPhysicalDeviceFeatures2, features) + offsetof(VkPhysicalDeviceFeatures, shaderFloat64),
+     nullptr},
 };
 static_assert(std::size(kFeatures) == size_t(DeviceFeature::kCount));
 
@@ -150,6 +153,24 @@ DeviceRequirements backendRequirements(Backend backend) {
         r.features.push_back(DeviceFeature::kRayTracingPipeline);
     }
     return r;
+}
+
+void describeForEmbedder(const DeviceRequirements& req, VulkanDeviceSetup& setup) {
+    setup.apiVersion = req.apiVersion;
+    setup.extensions = req.extensions;
+    for (DeviceFeature f : req.features) {
+        void* holder = nullptr;
+        switch (entry(f).holder) {
+            case Holder::kCore: holder = &setup.features2; break;
+            case Holder::kVulkan12: holder = &setup.vulkan12; break;
+            case Holder::kVulkan13: holder = &setup.vulkan13; break;
+            case Holder::kAccel: holder = &setup.accel; break;
+            case Holder::kRayQuery: holder = &setup.rayQuery; break;
+            case Holder::kRtPipeline: holder = &setup.rtPipeline; break;
+        }
+        *reinterpret_cast<VkBool32*>(static_cast<char*>(holder) + entry(f).offset) = VK_TRUE;
+        setup.features.emplace_back(featureName(f));
+    }
 }
 
 bool deviceHasExtension(VkPhysicalDevice pd, const char* name) {

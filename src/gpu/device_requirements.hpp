@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "rthdist/options.hpp"
+#include "rthdist/vulkan_interop.hpp"
 
 namespace rthdist::gpu {
 
@@ -31,6 +32,7 @@ enum class DeviceFeature : uint32_t {
     kAccelerationStructure,     // VK_KHR_acceleration_structure
     kRayQuery,                  // VK_KHR_ray_query
     kRayTracingPipeline,        // VK_KHR_ray_tracing_pipeline
+    kShaderFloat64,             // VkPhysicalDeviceFeatures: double views of device input (ingest_f64.comp)
     kCount
 };
 
@@ -60,6 +62,11 @@ struct DeviceRequirements {
 // (device offers 1.2)", "extension VK_KHR_ray_query", "feature rayQuery",
 // "a compute queue with timestamps"); empty when it can.
 [[nodiscard]] std::vector<std::string> unmetRequirements(VkPhysicalDevice pd, const DeviceRequirements& req);
+
+// Sets the flag of every feature of `req` in the embedder's feature
+// structures (rthdist/vulkan_interop.hpp), and lists the extensions and the
+// features' names there.
+void describeForEmbedder(const DeviceRequirements& req, VulkanDeviceSetup& setup);
 
 // Whether `pd` offers the device extension `name`.
 [[nodiscard]] bool deviceHasExtension(VkPhysicalDevice pd, const char* name);

@@ -22,7 +22,8 @@ namespace rthdist::gpu_algo {
 struct DirectionRun {
     const PointIndex& Q;
     PointIndex& T;
-    std::span<const glm::vec3> qPts, tPts;  // the host's copies of what the device holds
+    SetPoints& qPts;  // where the host reads what the device holds (set_points.hpp)
+    SetPoints& tPts;
     const CounterBlock& blk;
     PerPoint* perPoint = nullptr;
     Directed out;

@@ -14,6 +14,7 @@
 #include "core/parallel.hpp"
 #include "gpu/device_limits.hpp"
 #include "gpu_algo/candidate_search.hpp"
+#include "gpu_algo/device_input.hpp"
 #include "gpu_algo/direction.hpp"
 #include "gpu_algo/index_build.hpp"
 #include "gpu_algo/neighbourhood_pass.hpp"
@@ -60,7 +61,8 @@ struct GpuHausdorff::State {
           check(ws),
           cull(ws, check),
           refine(ws),
-          search(ws, index, refine) {}
+          search(ws, index, refine),
+          deviceIngest(ws, index) {}
 
     Workspace ws;
     PerPoint spare;  // recyclePerPoint: the next per-point result's h(A,B) arrays
@@ -69,6 +71,7 @@ struct GpuHausdorff::State {
     NeighbourhoodPass cull;
     Refinement refine;
     CandidateSearch search;
+    DeviceIngest deviceIngest;
 
     // The search of a direction that has survivors, then its self-check
     // (one more submission); returns the checked witness.
@@ -96,6 +99,7 @@ struct GpuHausdorff::State {
         if (scale != 1.0) set.scaledCopy = scaledCopy(input, scale, ws.threads);
         set.points = scale != 1.0 ? std::span<const glm::vec3>(set.scaledCopy) : input;
         set.place(name, scratch, shared);
+        set.pts.useHost(set.points);
         index.stageIndex(set.ix, set.points, bits);
         ws.timings->upload += msSince(t0);
     }
@@ -113,6 +117,7 @@ struct GpuHausdorff::State {
         for (size_t k = 0; k < 2; ++k) {
             DeviceSet& set = *sets[k];
             set.input = set.points = inputs[k];
+            set.pts.useHost(inputs[k]);
             set.place(k == 0 ? "A" : "B", ws.scratch.builds[k], &ws.oneShot[k]);
             index.stageSource(set.ix, inputs[k]);
         }
@@ -159,6 +164,92 @@ struct GpuHausdorff::State {
         runPair(da, db, options, res, 0.1);
     }
 
+    // Device input: refuses a frame whose searched magnitudes need the exact
+    // power-of-two scale (the host path applies it; vulkan_interop.hpp).
+    static void requireUnitScale(double magnitude) {
+        if (exactScale(magnitude) != 1.0)
+            throw InputRejected{Error{ErrorCode::kInvalidArgument,
+                                      "device input: searched coordinates of magnitude " +
+                                          std::to_string(magnitude) +
+                                          " need the exact power-of-two scale (past 2^40 or all below "
+                                          "2^-40), which only the host-array path applies"}};
+    }
+
+    // Device input: both views ingested into da, db (one submission when
+    // they fit kFusedBuildPoints together, else one after the other in one
+    // scratch) and indexed. Double views first have their boxes reduced on
+    // the device for the origin. Returns the origin.
+    glm::dvec3 devicePair(DeviceSet& da, DeviceSet& db, const DeviceInput& a, const DeviceInput& b,
+                          const CallOptions& options) {
+        const std::array<DeviceInput, 2> views = {a, b};
+        glm::dvec3 origin(0.0);
+        const bool doubles = a.scalar == Scalar::kFloat64 || b.scalar == Scalar::kFloat64;
+        if (doubles) {
+            const std::array<std::string, 2> names = {"A", "B"};
+            const std::array<core::SetSummary, 2> sums = deviceIngest.summarize(views, names);
+            origin = core::searchOrigin(sums[0], sums[1]);
+            requireUnitScale(
+                std::max(core::searchMagnitude(sums[0], origin), core::searchMagnitude(sums[1], origin)));
+        }
+        const bool together = size_t(a.n) + b.n <= kFusedBuildPoints;
+        da.place("A", ws.scratch.builds[0], &ws.oneShot[0]);
+        db.place("B", ws.scratch.builds[together ? 1 : 0], &ws.oneShot[1]);
+        if (together) {
+            deviceIngest.ingest(std::array{&da.ix, &db.ix}, views, origin, options.bits, !doubles);
+        } else {
+            deviceIngest.ingest(std::array{&da.ix}, std::span(views).first(1), origin, options.bits,
+                                !doubles);
+        }
+        if (!doubles)
+            requireUnitScale(std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds)));
+        if (together) {
+            index.buildIndexes(std::array{&da.ix, &db.ix}, /*ingested=*/true);
+        } else {
+            index.buildIndexes(std::array{&da.ix}, true);
+            deviceIngest.ingest(std::array{&db.ix}, std::span(views).last(1), origin, options.bits, false);
+            if (!doubles) requireUnitScale(largestMagnitude(db.ix.bounds));
+            index.buildIndexes(std::array{&db.ix}, true);
+        }
+        da.pts.useDevice(ws.ctx, a, origin, da.ix);
+        db.pts.useDevice(ws.ctx, b, origin, db.ix);
+        return origin;
+    }
+
+    // Device input prepared: the view ingested and indexed into buffers of
+    // the set's own, with a copy of the view's bytes that its witnesses and
+    // self-checks read from then on.
+    void deviceSet(GpuHausdorff::PreparedDevice& out, const DeviceInput& view,
+                   const std::optional<glm::dvec3>& wanted, int bits, const std::string& name) {
+        DeviceSet& set = *out.set;
+        set.place(name, ws.scratch.builds[0], nullptr);
+        const bool isDouble = view.scalar == Scalar::kFloat64;
+        if (isDouble) {
+            const std::array<std::string, 1> names = {name};
+            out.summary = deviceIngest.summarize(std::span(&view, 1), names)[0];
+            out.origin = core::preparedOrigin(out.summary, wanted);
+            requireUnitScale(core::searchMagnitude(out.summary, out.origin));
+        }
+        deviceIngest.ingest(std::array{&set.ix}, std::span(&view, 1), out.origin, bits, !isDouble);
+        if (!isDouble) {
+            out.summary.box = set.ix.bounds;  // float bounds: exact in double
+            out.summary.floatExact = true;
+            requireUnitScale(largestMagnitude(set.ix.bounds));
+        }
+        DeviceInput copy = view;
+        const VkDeviceSize bytes = VkDeviceSize(view.n - 1) * view.stride + view.pointBytes();
+        set.inputCopy = Buffer(ws.ctx, bytes, gpu::kStorageUsage, MemoryKind::kDevice);
+        VkCommandBuffer cmd = ws.ctx.begin();
+        const VkBufferCopy region{view.offset, 0, bytes};
+        vkCmdCopyBuffer(cmd, view.buffer, set.inputCopy.handle(), 1, &region);
+        ws.ctx.submitAndWait(cmd);
+        copy.buffer = set.inputCopy.handle();
+        copy.address = set.inputCopy.address();
+        copy.offset = 0;
+        index.buildIndexes(std::array{&set.ix}, /*ingested=*/true);
+        set.own.releaseUnused(set.ix);
+        set.pts.useDevice(ws.ctx, copy, out.origin, set.ix);
+    }
+
     // H (or h) of two indexed sets of one scale into `res`; progress covers
     // [from, 1] of the call.
     void runPair(DeviceSet& a, DeviceSet& b, const CallOptions& options, HausdorffResult& res, double from) {
@@ -166,8 +257,8 @@ struct GpuHausdorff::State {
         if (pp) res.aNearest = std::move(spare);  // filled whole: read-back writes every entry
         spare = PerPoint{};
         const double mid = options.directedOnly ? 1.0 : from + 0.5 * (1.0 - from);
-        DirectionRun ab{a.ix, b.ix, a.points, b.points, ws.blocks[0], pp ? &res.aNearest : nullptr};
-        DirectionRun ba{b.ix, a.ix, b.points, a.points, ws.blocks[1], pp ? &res.bNearest : nullptr};
+        DirectionRun ab{a.ix, b.ix, a.pts, b.pts, ws.blocks[0], pp ? &res.aNearest : nullptr};
+        DirectionRun ba{b.ix, a.ix, b.pts, a.pts, ws.blocks[1], pp ? &res.bNearest : nullptr};
         cull.startDirection(ab, 0);
         if (!options.directedOnly) cull.startDirection(ba, 1);
         // Both culls (and their checks) in one submission; a direction with
@@ -331,7 +422,33 @@ Result<HausdorffResult> GpuHausdorff::compute(DeviceSet& a, DeviceSet& b, const 
     return res;
 }
 
-uint64_t GpuHausdorff::deviceBytes(const DeviceSet& set) { return set.own.bytes(); }
+Result<HausdorffResult> GpuHausdorff::computeDevice(const DeviceInput& a, const DeviceInput& b,
+                                                    const CallOptions& options) {
+    State& st = *m_state;
+    HausdorffResult res = st.emptyResult(options);
+    auto err = st.guarded(res.timings, [&] {
+        throwIfCancelled(options);
+        DeviceSet da, db;
+        res.origin = st.devicePair(da, db, a, b, options);
+        reportProgress(options, "index", 0.1);
+        st.runPair(da, db, options, res, 0.1);
+    });
+    if (err) return *err;
+    return res;
+}
+
+Result<GpuHausdorff::PreparedDevice> GpuHausdorff::prepareDevice(const DeviceInput& view,
+                                                                 const std::optional<glm::dvec3>& origin,
+                                                                 int bits, const std::string& name,
+                                                                 Timings& timings) {
+    PreparedDevice out;
+    out.set = std::make_shared<DeviceSet>();
+    auto err = m_state->guarded(timings, [&] { m_state->deviceSet(out, view, origin, bits, name); });
+    if (err) return *err;
+    return out;
+}
+
+uint64_t GpuHausdorff::deviceBytes(const DeviceSet& set) { return set.own.bytes() + set.inputCopy.size(); }
 
 int GpuHausdorff::bits(const DeviceSet& set) { return set.ix.grid.bits; }
 

@@ -17,9 +17,12 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
+#include "core/input_frame.hpp"
+#include "gpu_algo/set_points.hpp"
 #include "rthdist/rthdist.hpp"
 
 namespace rthdist::gpu {
@@ -73,6 +76,26 @@ public:
     // H (or h) of two prepared sets of the same scale. Their coarse search
     // levels are built on first use and kept.
     [[nodiscard]] Result<HausdorffResult> compute(DeviceSet& a, DeviceSet& b, const CallOptions& options);
+
+    // Device input (rthdist/vulkan_interop.hpp; device_input.hpp): one-shot H
+    // of two views of the embedder's buffers, ingested on the device; the
+    // result's origin is the frame chosen (core::searchOrigin of the boxes
+    // the device reduced). The caller checked the views against the
+    // contract's limits and the memory budget.
+    [[nodiscard]] Result<HausdorffResult> computeDevice(const DeviceInput& a, const DeviceInput& b,
+                                                        const CallOptions& options);
+    // A set prepared from a view: as prepare, with its frame (`origin` as
+    // PrepareOptions::origin) and summary returned. It keeps a device copy of
+    // the view's bytes (its witnesses are read there, never in the
+    // embedder's buffer after this call).
+    struct PreparedDevice {
+        std::shared_ptr<DeviceSet> set;
+        core::SetSummary summary;
+        glm::dvec3 origin{0.0};
+    };
+    [[nodiscard]] Result<PreparedDevice> prepareDevice(const DeviceInput& view,
+                                                       const std::optional<glm::dvec3>& origin, int bits,
+                                                       const std::string& name, Timings& timings);
     [[nodiscard]] static uint64_t deviceBytes(const DeviceSet& set);
     [[nodiscard]] static int bits(const DeviceSet& set);
 

@@ -77,8 +77,11 @@ public:
     void cmdUploadSource(VkCommandBuffer cmd, const PointIndex& ix);
 
     // Records the ingest of an uploaded source into the set's vec4 points
-    // and its summary in `blk`.
-    void cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk);
+    // and its summary in `blk`. `source`: the points' device address (three
+    // floats every `stride` bytes; device input, device_input.hpp); 0: the
+    // uploaded copy (packed).
+    void cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk,
+                   VkDeviceAddress source = 0, uint32_t stride = 12);
 
     // After the ingest's submission: the set's bounds from `blk`, or the
     // error naming its first point that is not finite (as summarizeSet

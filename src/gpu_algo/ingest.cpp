@@ -62,7 +62,8 @@ void IndexBuild::cmdUploadSource(VkCommandBuffer cmd, const PointIndex& ix) {
     vkCmdCopyBuffer(cmd, from, m_ws.grow(ix.scratch->raw, bytes, ix.name + ".raw").handle(), 1, &region);
 }
 
-void IndexBuild::cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {
+void IndexBuild::cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk,
+                           VkDeviceAddress source, uint32_t stride) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "ingest");
     auto& summary = blk.ingest();
     for (int k = 0; k < 3; ++k) {
@@ -70,9 +71,10 @@ void IndexBuild::cmdIngest(VkCommandBuffer cmd, const PointIndex& ix, const Coun
         summary.hi[k] = 0u;
     }
     summary.firstBad = 0xffffffffu;
-    sh::IngestPush ip{m_ws.grow(ix.scratch->raw, VkDeviceSize(ix.n) * 12, ix.name + ".raw").address(),
+    if (source == 0) source = m_ws.grow(ix.scratch->raw, VkDeviceSize(ix.n) * 12, ix.name + ".raw").address();
+    sh::IngestPush ip{source,
                       m_ws.grow(ix.scratch->points, VkDeviceSize(ix.n) * 16, ix.name + ".points").address(),
-                      blk.addr(RTHDIST_CTR_INGEST), ix.n, 12u};
+                      blk.addr(RTHDIST_CTR_INGEST), ix.n, stride};
     m_ws.dispatch(cmd, Kernel::kIngest, ip, ix.n);
 }
 

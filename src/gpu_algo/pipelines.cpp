@@ -23,6 +23,7 @@
 #include "cull.comp.h"
 #include "grow_boxes.comp.h"
 #include "ingest.comp.h"
+#include "ingest_f64.comp.h"
 #include "leaf_keys.comp.h"
 #include "leaf_scatter.comp.h"
 #include "leaf_slots.comp.h"
@@ -74,6 +75,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_cell_bounds_fix_comp, "cell_bounds_fix"},
     {k_spv_ingest_comp, "ingest"},
     {k_spv_refine_args_comp, "refine_args"},
+    {k_spv_ingest_f64_comp, "ingest_f64"},
 }};
 
 }  // namespace
@@ -125,6 +127,8 @@ void Pipelines::createLayout() {
 void Pipelines::createComputePipelines(VkPipelineCache cache) {
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !m_rayQuery) continue;
+        // Float64 SPIR-V is valid only on a device with shaderFloat64 enabled.
+        if (Kernel(k) == Kernel::kIngestF64 && !m_ctx.shaderFloat64()) continue;
         m_compute[k] = createComputePipeline(m_ctx, kComputeSpirv[k].code, m_layout.get(), cache,
                                              VK_PIPELINE_CREATE_DISPATCH_BASE_BIT, kComputeSpirv[k].name);
     }

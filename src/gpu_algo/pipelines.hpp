@@ -38,6 +38,7 @@ enum class Kernel : uint32_t {
     kCellBoundsFix,
     kIngest,      // the caller's points into vec4 records, bounds, validation (ingest.comp)
     kRefineArgs,  // refine.comp's indirect dispatch size (refine_args.comp)
+    kIngestF64,   // device input views read in double (ingest_f64.comp): only with shaderFloat64
     kCount
 };
 

@@ -16,6 +16,7 @@
 #include "core/index_space.hpp"
 #include "gpu/buffer.hpp"
 #include "gpu_algo/scratch.hpp"
+#include "gpu_algo/set_points.hpp"
 #include "rthdist_shared.h"
 
 namespace rthdist::gpu {
@@ -117,6 +118,10 @@ struct DeviceSet {
     std::vector<glm::vec3> scaledCopy;  // input * scale when scale != 1
     std::span<const glm::vec3> points;  // what the device holds: input or scaledCopy
     double scale = 1.0;
+    // A set prepared from device input: its own copy of the view's bytes
+    // (set_points.hpp reads witnesses there after the embedder's call returned).
+    Buffer inputCopy;
+    SetPoints pts;  // where the host reads its points: `points`, or the embedder's buffer (device input)
 };
 
 // The grid as the shaders read it (rthdist_shared.h).

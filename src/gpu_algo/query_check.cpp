@@ -42,6 +42,16 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, boo
                     stateCopies.data());
 }
 
+void QueryCheck::fetchSampled(const DirectionRun& d, std::span<const SampledQuery> sampled) {
+    std::vector<uint32_t> queries, targets;
+    for (const SampledQuery& s : sampled) {
+        queries.push_back(std::bit_cast<uint32_t>(s.sorted[3]));
+        targets.push_back(uint32_t(s.state.best & 0xffffffffu));
+    }
+    d.qPts.fetch(queries);
+    d.tPts.fetch(targets);
+}
+
 SampledQuery QueryCheck::finishCheck(const DirectionRun& d) {
     const uint64_t packed = d.blk.fields().maxPacked;
     const char* readback = d.blk.host + RTHDIST_CTR_READBACK;
@@ -52,6 +62,7 @@ SampledQuery QueryCheck::finishCheck(const DirectionRun& d) {
         std::memcpy(&sampled[k].state, readback + k * 32 + 16, 16);
     }
     const uint64_t bad = d.blk.fields().checkBad;
+    if (bad == 0) fetchSampled(d, sampled);
     std::string why = bad != 0 ? std::to_string(bad) + " of " + std::to_string(d.Q.n) +
                                      " queries ended unsettled or above the maximum"
                                : sampledQueryFailure(sampled, d.qPts, d.tPts, packed, d.perPoint != nullptr);
@@ -63,12 +74,17 @@ Directed QueryCheck::finishDirection(DirectionRun& d, const SampledQuery& witnes
     Directed& out = d.out;
     out.queryIndex = std::bit_cast<uint32_t>(witness.sorted[3]);
     out.targetIndex = uint32_t(witness.state.best & 0xffffffffu);
-    out.queryPoint = d.qPts[out.queryIndex];
-    out.targetPoint = d.tPts[out.targetIndex];
-    out.distance = glm::length(glm::dvec3(out.queryPoint) - glm::dvec3(out.targetPoint));
-    std::string why = witnessFailure(out.distance, d.blk.fields().maxPacked, std::sqrt(d.lowerBound2Exact));
+    const uint32_t qi = uint32_t(out.queryIndex), ti = uint32_t(out.targetIndex);
+    // The check compares the pair as searched with the device's float
+    // maximum; the result carries the points as given (device input: the
+    // embedder's own coordinates, in double).
+    const double searched = glm::length(glm::dvec3(d.qPts.searched(qi)) - glm::dvec3(d.tPts.searched(ti)));
+    std::string why = witnessFailure(searched, d.blk.fields().maxPacked, std::sqrt(d.lowerBound2Exact));
     if (!why.empty()) throw SelfCheckError(d.name() + ": " + why);
-    if (d.perPoint) readPerPoint(d.Q, *d.state, d.qPts, d.tPts, *d.perPoint);
+    out.queryPoint = d.qPts.original(qi);
+    out.targetPoint = d.tPts.original(ti);
+    out.distance = glm::length(out.queryPoint - out.targetPoint);
+    if (d.perPoint) readPerPoint(d.Q, *d.state, d.qPts.all(), d.tPts.all(), *d.perPoint);
     return out;
 }
 

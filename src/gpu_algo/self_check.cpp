@@ -22,12 +22,12 @@ bool sameFloat(float a, float b) { return std::bit_cast<uint32_t>(a) == std::bit
 
 std::string describe(const SampledQuery& s) { return "query slot " + std::to_string(s.slot); }
 
-std::string checkOne(const SampledQuery& s, std::span<const glm::vec3> qPts, std::span<const glm::vec3> tPts,
-                     float maxD2, bool perPoint) {
+std::string checkOne(const SampledQuery& s, const SetPoints& qPts, const SetPoints& tPts, float maxD2,
+                     bool perPoint) {
     const uint32_t qi = std::bit_cast<uint32_t>(s.sorted[3]);
     if (qi >= qPts.size())
         return describe(s) + " names query " + std::to_string(qi) + " of " + std::to_string(qPts.size());
-    const glm::vec3& q = qPts[qi];
+    const glm::vec3 q = qPts.searched(qi);
     if (!sameFloat(q.x, s.sorted[0]) || !sameFloat(q.y, s.sorted[1]) || !sameFloat(q.z, s.sorted[2]))
         return describe(s) + " holds coordinates that are not query " + std::to_string(qi) + "'s";
     const bool settled = s.state.status == RTHDIST_EXACT || (s.state.status == RTHDIST_DEAD && !perPoint);
@@ -36,7 +36,7 @@ std::string checkOne(const SampledQuery& s, std::span<const glm::vec3> qPts, std
     if (ti >= tPts.size())
         return describe(s) + " names target " + std::to_string(ti) + " of " + std::to_string(tPts.size());
     const float stored = packedDist2(s.state.best);
-    const float recomputed = shaderDist2(q, tPts[ti]);
+    const float recomputed = shaderDist2(q, tPts.searched(ti));
     // Equal bit for bit where the driver rounds as the host does; a few ulps
     // of slack for drivers that reassociate the sum.
     if (!(std::fabs(stored - recomputed) <= 4e-7f * std::fabs(recomputed) + 1e-37f))
@@ -75,8 +75,8 @@ std::string indexCheckFailure(uint64_t n, uint64_t badRecords, uint64_t indexSum
     return "";
 }
 
-std::string sampledQueryFailure(std::span<const SampledQuery> samples, std::span<const glm::vec3> qPts,
-                                std::span<const glm::vec3> tPts, uint64_t maxPacked, bool perPoint) {
+std::string sampledQueryFailure(std::span<const SampledQuery> samples, const SetPoints& qPts,
+                                const SetPoints& tPts, uint64_t maxPacked, bool perPoint) {
     const float maxD2 = packedDist2(maxPacked);
     for (const SampledQuery& s : samples) {
         std::string why = checkOne(s, qPts, tPts, maxD2, perPoint);

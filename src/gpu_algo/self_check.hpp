@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "gpu_algo/set_points.hpp"
+
 #include "rthdist_shared.h"
 
 namespace rthdist::gpu_algo {
@@ -43,16 +45,25 @@ struct SampledQuery {
 };
 
 // Compares sampled device records of a finished direction with the host's
-// points (those uploaded: qPts queries, tPts targets): the record holds the
+// points (those uploaded or, for device input, copied back from the
+// embedder's buffer: qPts queries, tPts targets): the record holds the
 // point it claims, its state is settled (EXACT, or DEAD without perPoint),
 // its best names a real target whose float squared distance (computed as the
 // shaders do) equals the stored one, and it is not above the final maximum
 // maxPacked. The last sample is the witness: its best is the maximum.
 // "" when every sample holds, else the first failure.
-[[nodiscard]] std::string sampledQueryFailure(std::span<const SampledQuery> samples,
-                                              std::span<const glm::vec3> qPts,
-                                              std::span<const glm::vec3> tPts, uint64_t maxPacked,
-                                              bool perPoint);
+[[nodiscard]] std::string sampledQueryFailure(std::span<const SampledQuery> samples, const SetPoints& qPts,
+                                              const SetPoints& tPts, uint64_t maxPacked, bool perPoint);
+// The same over host arrays.
+[[nodiscard]] inline std::string sampledQueryFailure(std::span<const SampledQuery> samples,
+                                                     std::span<const glm::vec3> qPts,
+                                                     std::span<const glm::vec3> tPts, uint64_t maxPacked,
+                                                     bool perPoint) {
+    SetPoints q, t;
+    q.useHost(qPts);
+    t.useHost(tPts);
+    return sampledQueryFailure(samples, q, t, maxPacked, perPoint);
+}
 
 // The reported value against the device's: the double distance of the
 // witness pair must agree with the maximum's float squared distance

@@ -1,0 +1,66 @@
+// Device input (include/rthdist/vulkan_interop.hpp): point sets that lie in
+// the embedder's VkBuffers, ingested into the index build's vec4 records on
+// the device. Float views with origin 0 take ingest.comp, as packed host
+// arrays do; double views (and float views that meet one) take the two
+// passes of ingest_f64.comp: the box in double, then float(p - origin). The
+// host reads back only the summaries and the bit count's sample.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <glm/vec3.hpp>
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/input_frame.hpp"
+#include "gpu_algo/index_build.hpp"
+#include "gpu_algo/point_index.hpp"
+#include "gpu_algo/set_points.hpp"
+#include "gpu_algo/workspace.hpp"
+#include "rthdist/point_view.hpp"
+
+namespace rthdist::gpu_algo {
+
+class DeviceIngest {
+public:
+    DeviceIngest(Workspace& workspace, IndexBuild& index) : m_ws(workspace), m_index(index) {}
+
+    // Mode 0 of ingest_f64.comp over each view, in one submission: its box in
+    // double and whether it is float-exact (what summarizeSet finds on the
+    // host), or InputRejected naming the set (PointIndex::name of `names`)
+    // and its first non-finite point. At most two views.
+    [[nodiscard]] std::array<core::SetSummary, 2> summarize(std::span<const DeviceInput> views,
+                                                            std::span<const std::string> names);
+
+    // The records of each view into its set's points (ix.scratch->points),
+    // shifted by `origin` (ingest_f64.comp mode 1 unless the view is float
+    // and the origin 0: ingest.comp), in one submission; then each set's
+    // bounds (of its float records) and grid, the bit count from a sample
+    // of its records read back (core::chooseBitsFromSample) unless `bits` > 0.
+    // Sets ix.n. The caller indexes them after (IndexBuild::buildIndexes,
+    // ingested). `first`: this is the call's first submission (it then opens
+    // with the barrier from the embedder's writes).
+    void ingest(std::span<PointIndex* const> sets, std::span<const DeviceInput> views,
+                const glm::dvec3& origin, int bits, bool first);
+
+    // The first command of a call on device input: every earlier memory write
+    // on the queue -> the shader and transfer reads of the call (the
+    // synchronisation contract of vulkan_interop.hpp).
+    static void cmdEmbedderWritesBarrier(VkCommandBuffer cmd);
+
+private:
+    void cmdConvert(VkCommandBuffer cmd, PointIndex& ix, const DeviceInput& view, const CounterBlock& blk,
+                    const glm::dvec3& origin);
+    // Copies every sampleStride-th record of an ingested set (about 32k) into
+    // `sample` (host-visible, 12 bytes per record), for the bit count.
+    void cmdCopySample(VkCommandBuffer cmd, PointIndex& ix, Buffer& sample);
+
+    Workspace& m_ws;
+    IndexBuild& m_index;
+};
+
+}  // namespace rthdist::gpu_algo
