@@ -65,7 +65,9 @@
 //   feature shaderFloat64 enabled (VulkanDevice::shaderFloat64); without it the
 //   call returns kNoDevice naming the feature. Results (H, both directed
 //   values, witness indices and points) equal those of the host-array call on
-//   the same coordinates.
+//   the same coordinates, except that a directed distance of 0 (every query
+//   has a copy in the other set) may name another of its queries: each is a
+//   witness, and which one is the GPU's pick.
 //
 // What the host reads (small transfers only; the set never comes back whole):
 //   - the bounds of each set (the ingest summary, 32 or 56 bytes);

@@ -315,6 +315,15 @@ struct RefinePush {
     uint numFineCells;
 };
 
+// sample_gather.comp: records j * stride (j < count) of `points` (vec4) into
+// `gathered` (float[3 count]), the bit count's sample of a device-input set.
+struct SampleGatherPush {
+    uint64_t points;
+    uint64_t gathered;  // float[3 count] out
+    uint count;
+    uint stride;
+};
+
 // refine_args.comp: VkDispatchIndirectCommand for refine.comp from the pair
 // counter (groups of RTHDIST_WG pairs, at most maxGroups).
 struct RefineArgsPush {

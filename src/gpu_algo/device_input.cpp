@@ -113,14 +113,14 @@ void DeviceIngest::cmdConvert(VkCommandBuffer cmd, PointIndex& ix, const DeviceI
     m_ws.dispatch(cmd, Kernel::kIngestF64, p, ix.n);
 }
 
-void DeviceIngest::cmdCopySample(VkCommandBuffer cmd, PointIndex& ix, Buffer& sample) {
+size_t DeviceIngest::cmdGatherSample(VkCommandBuffer cmd, PointIndex& ix, Buffer& sample) {
     const size_t stride = core::sampleStride(ix.n);
     const size_t count = (size_t(ix.n) + stride - 1) / stride;
-    sample = Buffer(m_ws.ctx, VkDeviceSize(count) * 12, gpu::kStorageUsage, MemoryKind::kReadback);
-    std::vector<VkBufferCopy> regions(count);
-    for (size_t j = 0; j < count; ++j) regions[j] = {VkDeviceSize(j * stride) * 16, VkDeviceSize(j) * 12, 12};
+    m_ws.grow(sample, VkDeviceSize(count) * 12, ix.name + ".sample", MemoryKind::kReadback);
     const Buffer& points = m_ws.grow(ix.scratch->points, VkDeviceSize(ix.n) * 16, ix.name + ".points");
-    vkCmdCopyBuffer(cmd, points.handle(), sample.handle(), uint32_t(count), regions.data());
+    const sh::SampleGatherPush p{points.address(), sample.address(), uint32_t(count), uint32_t(stride)};
+    m_ws.dispatch(cmd, Kernel::kSampleGather, p, count);
+    return count;
 }
 
 void DeviceIngest::ingest(std::span<PointIndex* const> sets, std::span<const DeviceInput> views,
@@ -134,9 +134,9 @@ void DeviceIngest::ingest(std::span<PointIndex* const> sets, std::span<const Dev
         cmdConvert(cmd, *sets[k], views[k], m_ws.blocks[k], origin);
     }
     m_ws.barrier(cmd);
-    std::vector<Buffer> samples(sets.size());
+    std::array<size_t, 2> sampled{};
     if (bits <= 0)
-        for (size_t k = 0; k < sets.size(); ++k) cmdCopySample(cmd, *sets[k], samples[k]);
+        for (size_t k = 0; k < sets.size(); ++k) sampled[k] = cmdGatherSample(cmd, *sets[k], m_samples[k]);
     m_ws.ctx.submitAndWait(cmd);
     m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
     for (size_t k = 0; k < sets.size(); ++k) {
@@ -144,9 +144,9 @@ void DeviceIngest::ingest(std::span<PointIndex* const> sets, std::span<const Dev
         m_index.finishIngest(ix, m_ws.blocks[k]);
         int chosen = bits;
         if (bits <= 0) {
-            const size_t count = samples[k].size() / 12;
+            const size_t count = sampled[k];
             std::vector<glm::vec3> sample(count);
-            std::memcpy(sample.data(), samples[k].mapped(), count * 12);
+            std::memcpy(sample.data(), m_samples[k].mapped(), count * 12);
             chosen = clampedBits(core::chooseBitsFromSample(sample, ix.n, ix.bounds), ix.n);
         }
         ix.grid = core::makeGrid(ix.bounds, chosen);

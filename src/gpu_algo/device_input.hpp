@@ -55,12 +55,14 @@ public:
 private:
     void cmdConvert(VkCommandBuffer cmd, PointIndex& ix, const DeviceInput& view, const CounterBlock& blk,
                     const glm::dvec3& origin);
-    // Copies every sampleStride-th record of an ingested set (about 32k) into
-    // `sample` (host-visible, 12 bytes per record), for the bit count.
-    void cmdCopySample(VkCommandBuffer cmd, PointIndex& ix, Buffer& sample);
+    // Gathers every sampleStride-th record of an ingested set (about 32k)
+    // into `sample` (host-visible, 12 bytes per record, grown and kept), for
+    // the bit count: one dispatch of sample_gather.comp. Returns the count.
+    size_t cmdGatherSample(VkCommandBuffer cmd, PointIndex& ix, Buffer& sample);
 
     Workspace& m_ws;
     IndexBuild& m_index;
+    std::array<Buffer, 2> m_samples;  // the sample of each set of a call (host-visible)
 };
 
 }  // namespace rthdist::gpu_algo

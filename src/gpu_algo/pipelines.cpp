@@ -30,6 +30,7 @@
 #include "refine.comp.h"
 #include "refine_args.comp.h"
 #include "resolve.comp.h"
+#include "sample_gather.comp.h"
 #include "scan_add.comp.h"
 #include "scan_block.comp.h"
 #include "scatter.comp.h"
@@ -76,6 +77,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_ingest_comp, "ingest"},
     {k_spv_refine_args_comp, "refine_args"},
     {k_spv_ingest_f64_comp, "ingest_f64"},
+    {k_spv_sample_gather_comp, "sample_gather"},
 }};
 
 }  // namespace
