@@ -43,15 +43,12 @@ public:
         app.apiVersion = VK_API_VERSION_1_3;
         const char* layer = "VK_LAYER_KHRONOS_validation";
         const char* ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
-        // Synchronization validation on (the embedder's writes and the
-        // Engine's reads meet on one queue).
-        const VkValidationFeatureEnableEXT syncval =
-            VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
-        VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
-        features.enabledValidationFeatureCount = 1;
-        features.pEnabledValidationFeatures = &syncval;
+        // Synchronization validation as in the other GPU suites: VK_LAYER_ENABLES=
+        // VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT in the
+        // environment (docs/gpu.md). Not forced here: under the asan preset the
+        // layer's synchronization validation leaves allocations LeakSanitizer
+        // cannot attribute to it.
         VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-        ci.pNext = &features;
         ci.pApplicationInfo = &app;
         ci.enabledLayerCount = 1;
         ci.ppEnabledLayerNames = &layer;
