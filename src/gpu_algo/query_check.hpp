@@ -42,7 +42,7 @@ public:
 private:
     // The sampled records' query and target points, for the host to compare
     // (device input: copied from the embedder's buffers, a few dozen points).
-    static void fetchSampled(const DirectionRun& d, std::span<const SampledQuery> sampled);
+    void fetchSampled(const DirectionRun& d, std::span<const SampledQuery> sampled);
 
     Workspace& m_ws;
 };

@@ -54,6 +54,7 @@ struct SearchScratch {
     Buffer aabbs;       // the search cells' grown boxes (BLAS input)
     Buffer refineArgs;  // the refinement's indirect dispatch
     Buffer readback;    // host: per-point states and points
+    Buffer fetched;     // host: the self-check's points of device input (SetPoints::cmdCopy)
 };
 
 struct Scratch {

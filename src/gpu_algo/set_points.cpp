@@ -29,31 +29,36 @@ void SetPoints::useDevice(gpu::Context& ctx, const DeviceInput& view, const glm:
     m_ix = &ix;
 }
 
-void SetPoints::fetch(std::span<const uint32_t> indices) {
-    if (!m_ctx) return;
+std::vector<uint32_t> SetPoints::missing(std::span<const uint32_t> indices) const {
     std::vector<uint32_t> wanted;
+    if (!m_ctx) return wanted;
     for (uint32_t i : indices)
         if (i < m_n && !m_fetched.count(i) && std::find(wanted.begin(), wanted.end(), i) == wanted.end())
             wanted.push_back(i);
+    return wanted;
+}
+
+void SetPoints::cmdCopy(VkCommandBuffer cmd, std::span<const uint32_t> wanted, VkBuffer host,
+                        VkDeviceSize at) const {
     if (wanted.empty()) return;
     const VkDeviceSize bytes = m_view.pointBytes();
-    gpu::Buffer host(*m_ctx, bytes * wanted.size(), gpu::kStorageUsage, gpu::MemoryKind::kReadback);
     std::vector<VkBufferCopy> regions;
     for (size_t k = 0; k < wanted.size(); ++k)
-        regions.push_back({m_view.offset + VkDeviceSize(wanted[k]) * m_view.stride, k * bytes, bytes});
-    VkCommandBuffer cmd = m_ctx->begin();
-    vkCmdCopyBuffer(cmd, m_view.buffer, host.handle(), uint32_t(regions.size()), regions.data());
-    m_ctx->submitAndWait(cmd);
-    const char* at = static_cast<const char*>(host.mapped());
-    for (size_t k = 0; k < wanted.size(); ++k, at += bytes) {
+        regions.push_back({m_view.offset + VkDeviceSize(wanted[k]) * m_view.stride, at + k * bytes, bytes});
+    vkCmdCopyBuffer(cmd, m_view.buffer, host, uint32_t(regions.size()), regions.data());
+}
+
+void SetPoints::store(std::span<const uint32_t> wanted, const char* bytes) {
+    const VkDeviceSize size = m_view.pointBytes();
+    for (size_t k = 0; k < wanted.size(); ++k, bytes += size) {
         glm::dvec3 p;
         if (m_view.scalar == Scalar::kFloat64) {
             double v[3];
-            std::memcpy(v, at, sizeof(v));
+            std::memcpy(v, bytes, sizeof(v));
             p = {v[0], v[1], v[2]};
         } else {
             float v[3];
-            std::memcpy(v, at, sizeof(v));
+            std::memcpy(v, bytes, sizeof(v));
             p = {v[0], v[1], v[2]};
         }
         m_fetched[wanted[k]] = p;

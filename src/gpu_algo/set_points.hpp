@@ -47,9 +47,18 @@ public:
 
     [[nodiscard]] size_t size() const { return m_n; }
     [[nodiscard]] bool onDevice() const { return m_ctx != nullptr; }
-    // Device input: copies the points `indices` not fetched yet from the
-    // embedder's buffer to the host (one small submission). Host: nothing.
-    void fetch(std::span<const uint32_t> indices);
+    // Device input: the points of `indices` not fetched yet (each once);
+    // host arrays: none. With cmdCopy and store, a caller fetches the points
+    // of several sets in one submission into one kept host buffer.
+    [[nodiscard]] std::vector<uint32_t> missing(std::span<const uint32_t> indices) const;
+    // Bytes of one fetched point (three scalars of the view).
+    [[nodiscard]] VkDeviceSize pointBytes() const { return m_view.pointBytes(); }
+    // Records copies of points `wanted` from the embedder's buffer to `host`
+    // at byte `at`, pointBytes() each, in order.
+    void cmdCopy(VkCommandBuffer cmd, std::span<const uint32_t> wanted, VkBuffer host, VkDeviceSize at) const;
+    // Takes the points `wanted` from `bytes` (as cmdCopy laid them out,
+    // after the submission completed).
+    void store(std::span<const uint32_t> wanted, const char* bytes);
     // Point i as the device holds it (device input: fetched first).
     [[nodiscard]] glm::vec3 searched(uint32_t i) const;
     // Point i as the caller gave it, in double (host arrays: the searched float).
