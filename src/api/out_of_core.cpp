@@ -2,6 +2,7 @@
 
 #include "core/index_space.hpp"
 #include "core/parallel.hpp"
+#include "core/timings.hpp"
 #include "core/uninit_vector.hpp"
 
 #include <glm/common.hpp>
@@ -58,20 +59,6 @@ void addCounters(Counters& into, const Counters& c, bool countTargets) {
     into.candidatePairs += c.candidatePairs;
 }
 
-void addTimings(Timings& into, const Timings& t) {
-    into.upload += t.upload;
-    into.index += t.index;
-    into.cull += t.cull;
-    into.search += t.search;
-    into.refine += t.refine;
-    into.check += t.check;
-    into.gpuIndex += t.gpuIndex;
-    into.gpuCull += t.gpuCull;
-    into.gpuSearch += t.gpuSearch;
-    into.gpuRefine += t.gpuRefine;
-    into.gpuUpload += t.gpuUpload;
-}
-
 // The squared distance of a pair as the backends compare pairs: in float, on
 // the points scaled by the call's exact power of two (core::exactScale), so
 // that the pieces choose among near-ties as one call would.
@@ -102,7 +89,7 @@ void offerWitness(SharedDirection& shared, const Directed& d, float d2, uint64_t
 void addCall(SharedDirection& shared, const HausdorffResult& r, bool countTargets) {
     std::lock_guard lock(shared.mutex);
     addCounters(shared.state.counters, r.aToB.counters, countTargets);
-    addTimings(shared.state.timings, r.timings);
+    core::addStageTimings(shared.state.timings, r.timings);
 }
 
 // The early break of a chunk starting at query index q0 against the witness
@@ -562,7 +549,7 @@ Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const Call
         r.bToA = ba->witness;
         r.bNearest = std::move(ba->perPoint);
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
-        addTimings(r.timings, ba->timings);
+        core::addStageTimings(r.timings, ba->timings);
     }
     return r;
 }

@@ -14,6 +14,10 @@ class VulkanError : public std::runtime_error {
 public:
     VulkanError(VkResult result, const std::string& what) : std::runtime_error(what), m_result(result) {}
     [[nodiscard]] VkResult result() const { return m_result; }
+    // The device or the host ran out of memory (kOutOfMemory at the API).
+    [[nodiscard]] bool outOfMemory() const {
+        return m_result == VK_ERROR_OUT_OF_DEVICE_MEMORY || m_result == VK_ERROR_OUT_OF_HOST_MEMORY;
+    }
 
 private:
     VkResult m_result;

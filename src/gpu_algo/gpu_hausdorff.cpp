@@ -308,11 +308,9 @@ struct GpuHausdorff::State {
         } catch (const CallCancelled&) {
             err = Error{ErrorCode::kCancelled, "the call was cancelled (CallOptions::cancel)"};
         } catch (const gpu::VulkanError& e) {
-            const bool oom =
-                e.result() == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result() == VK_ERROR_OUT_OF_HOST_MEMORY;
-            err = oom ? Error{ErrorCode::kOutOfMemory,
-                              std::string("the inputs do not fit the device: ") + e.what()}
-                      : Error{ErrorCode::kInternal, e.what()};
+            err = e.outOfMemory() ? Error{ErrorCode::kOutOfMemory,
+                                          std::string("the inputs do not fit the device: ") + e.what()}
+                                  : Error{ErrorCode::kInternal, e.what()};
             err->vkResult = int(e.result());
         } catch (const gpu::LimitError& e) {
             err =

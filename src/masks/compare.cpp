@@ -19,7 +19,7 @@
 #include <limits>
 #include <optional>
 
-#include "core/parallel.hpp"
+#include "core/timings.hpp"
 #include "masks/boundary.hpp"
 #include "masks/deepmind.hpp"
 #include "masks/gpu_boundary.hpp"
@@ -84,20 +84,11 @@ void finishDirection(const Volume& v, Direction& d) {
     d.out.mean = d.out.points ? d.sum / double(d.out.points) : 0.0;
 }
 
-// Adds one call's stage timings to `sum`.
+// Adds one call's stage timings and its total to `sum` (the masks' calls
+// run one after another, so their totals add up).
 void addTimings(Timings& sum, const Timings& t) {
-    sum.upload += t.upload;
-    sum.index += t.index;
-    sum.cull += t.cull;
-    sum.search += t.search;
-    sum.refine += t.refine;
-    sum.check += t.check;
+    core::addStageTimings(sum, t);
     sum.total += t.total;
-    sum.gpuIndex += t.gpuIndex;
-    sum.gpuCull += t.gpuCull;
-    sum.gpuSearch += t.gpuSearch;
-    sum.gpuRefine += t.gpuRefine;
-    sum.gpuUpload += t.gpuUpload;
 }
 
 // Boundary conventions: both directions in one engine call (each set

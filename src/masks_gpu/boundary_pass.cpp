@@ -67,9 +67,8 @@ void ensure(gpu::Context& ctx, gpu::Buffer& buffer, uint64_t bytes, gpu::MemoryK
 }
 
 Error errorOf(const gpu::VulkanError& e) {
-    const bool memory =
-        e.result() == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result() == VK_ERROR_OUT_OF_HOST_MEMORY;
-    Error err{memory ? ErrorCode::kOutOfMemory : ErrorCode::kInternal, std::string("masks: ") + e.what()};
+    Error err{e.outOfMemory() ? ErrorCode::kOutOfMemory : ErrorCode::kInternal,
+              std::string("masks: ") + e.what()};
     err.vkResult = int(e.result());
     return err;
 }

@@ -171,9 +171,7 @@ Result<SplatFrame> SplatRenderer::render(std::span<const glm::vec3> points, std:
     try {
         return m_impl->renderFrame(points, rgba, camera, width, height, radius);
     } catch (const gpu::VulkanError& e) {
-        const bool memory =
-            e.result() == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result() == VK_ERROR_OUT_OF_HOST_MEMORY;
-        return Error{memory ? ErrorCode::kOutOfMemory : ErrorCode::kInternal, e.what()};
+        return Error{e.outOfMemory() ? ErrorCode::kOutOfMemory : ErrorCode::kInternal, e.what()};
     } catch (const gpu::LimitError& e) {  // an image past the device's maxBufferSize
         return Error{ErrorCode::kOutOfMemory, std::string("splat: ") + e.what()};
     } catch (const std::bad_alloc&) {
