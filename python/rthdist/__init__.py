@@ -26,6 +26,7 @@ MaskEngine for many comparisons on one device.
 import os as _os
 
 from . import _rthdist
+from ._device_owner import DeviceOwner as _DeviceOwner
 from ._masks import CONVENTIONS, DirectedMask, MaskEngine, MaskResult, MaskVolume, compare_masks
 from ._points import as_points
 from ._rthdist import (  # noqa: F401 - re-exported
@@ -120,7 +121,7 @@ def _points_or_prepared(x, name):
     return x if isinstance(x, PreparedSet) else as_points(x, name)
 
 
-class Engine:
+class Engine(_DeviceOwner):
     """A backend's device and pipelines, kept between calls.
 
         with rthdist.Engine(backend="ray-query") as engine:
@@ -187,35 +188,6 @@ class Engine:
                                            directed=bool(directed), per_point=bool(per_point), bits=int(bits),
                                            radius_growth=float(radius_growth), progress=_progress_callable(progress))
 
-    @property
-    def backend(self):
-        """The backend this Engine runs: "cpu", "ray-query" or "rt-pipeline"."""
-        return self._engine.backend
-
-    @property
-    def device(self):
-        """Its device's name ("cpu" for the CPU backend)."""
-        return self._engine.device
-
-    @property
-    def closed(self):
-        return self._engine.closed
-
-    def close(self):
-        """Releases the device now (idempotent)."""
-        self._engine.close()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-        return False
-
-    def __repr__(self):
-        if self.closed:
-            return "Engine(closed)"
-        return f"Engine(backend={self.backend!r}, device={self.device!r})"
 
 
 def load(path, *, las_classes=None):

@@ -12,6 +12,7 @@ import os as _os
 import numpy as _np
 
 from . import _rthdist
+from ._device_owner import DeviceOwner
 
 CONVENTIONS = tuple(_rthdist._conventions())
 
@@ -210,7 +211,7 @@ def _percentiles(percentiles):
     return [float(p) for p in percentiles]
 
 
-class MaskEngine:
+class MaskEngine(DeviceOwner):
     """The masks' engine kept between calls: the Vulkan device (and, on a GPU
     backend, the boundary compute pass) opened once.
 
@@ -243,38 +244,9 @@ class MaskEngine:
         return results
 
     @property
-    def backend(self):
-        """"cpu", "ray-query" or "rt-pipeline"."""
-        return self._engine.backend
-
-    @property
-    def device(self):
-        return self._engine.device
-
-    @property
     def device_extraction(self):
         """Whether boundary voxels are found by the compute pass (GPU backends)."""
         return self._engine.device_extraction
-
-    @property
-    def closed(self):
-        return self._engine.closed
-
-    def close(self):
-        """Releases the device now (idempotent)."""
-        self._engine.close()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-        return False
-
-    def __repr__(self):
-        if self.closed:
-            return "MaskEngine(closed)"
-        return f"MaskEngine(backend={self.backend!r}, device={self.device!r})"
 
 
 def compare_masks(a, b, *, spacing=None, affine=None, convention="rthdist", percentiles=(95,),
