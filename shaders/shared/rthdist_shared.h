@@ -324,6 +324,46 @@ struct SampleGatherPush {
     uint stride;
 };
 
+// The small-pair batch (batch_nearest.comp, batch_witness.comp): pairs of a
+// computeBatch small enough for an exact scan of every target by every query,
+// all directions of all pairs in one submission. One direction of one pair:
+struct BatchDirection {
+    uint64_t queries;  // vec4 records of the query set (xyz searched, w = input index bits)
+    uint64_t targets;  // the same of the target set
+    uint64_t nearest;  // uint per query, by input index (out): its nearest target's input index
+    float queryScale;  // powers of two into the pair's frame (exact multiplications)
+    float targetScale;
+    uint queryCount;
+    uint targetCount;
+    uint step;          // the scan visits target (j * step) mod targetCount: step coprime with it
+    uint sampleStride;  // the seed pass scans queries 0, stride, 2 stride, ... (RTHDIST_WG of them)
+};
+#define RTHDIST_BATCH_DIRECTION_BYTES 48
+
+// batch_nearest.comp: one workgroup per chunk (uvec2: direction, first query)
+// of RTHDIST_WG queries. A query that finished its scan puts (bits of its
+// nearest distance^2 << 32) | its input index into maxPacked[direction]
+// (atomicMax) and its nearest target into `nearest`; with earlyBreak, a query
+// stops once it has a target at most maxPacked's distance away (it cannot
+// raise h). seed (earlyBreak 0): chunk (direction, 0) scans the direction's sample queries
+// (the first lower bound of h, with its witness).
+struct BatchNearestPush {
+    uint64_t directions;  // BatchDirection[]
+    uint64_t chunks;      // uvec2 per workgroup
+    uint64_t maxPacked;   // uint64 per direction, zeroed before the seed pass
+    uint earlyBreak;      // 0: per-point distances (every query scans every target)
+    uint seed;
+};
+
+// batch_witness.comp: per direction, uvec4 (query input index, its nearest
+// target's input index, bits of h^2, 0) from maxPacked and `nearest`.
+struct BatchWitnessPush {
+    uint64_t directions;
+    uint64_t maxPacked;
+    uint64_t witnesses;  // uvec4 per direction (out)
+    uint count;
+};
+
 // refine_args.comp: VkDispatchIndirectCommand for refine.comp from the pair
 // counter (groups of RTHDIST_WG pairs, at most maxGroups).
 struct RefineArgsPush {
@@ -372,6 +412,7 @@ static_assert(offsetof(CounterFields, minEdge) == RTHDIST_CTR_MIN_EDGE);
 static_assert(offsetof(CounterFields, largeCells) == RTHDIST_CTR_LARGE_CELLS);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
 static_assert(sizeof(IngestDevicePush) == 64 && offsetof(IngestDevicePush, n) == 48);
+static_assert(sizeof(BatchDirection) == RTHDIST_BATCH_DIRECTION_BYTES);
 static_assert(sizeof(IngestSummary64) == 56 && offsetof(IngestSummary64, firstBad) == 48);
 
 }  // namespace rthdist::shared

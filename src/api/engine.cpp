@@ -10,6 +10,8 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "api/device_views.hpp"
 #include "api/out_of_core.hpp"
@@ -486,24 +488,83 @@ Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet&
     return r;
 }
 
+namespace {
+
+using SetPair = std::pair<const PreparedSet::Impl*, const PreparedSet::Impl*>;
+
+// A pair of computeBatch that the GPU scans whole with the batch's other
+// small pairs (gpu_algo/small_pairs.hpp): sets of this Engine's GPU, host
+// arrays, one origin that keeps the bound (their scales may differ).
+bool scannedWhole(const Engine::Impl& impl, const SetPair& p) {
+    const PreparedSet::Impl& a = *p.first;
+    const PreparedSet::Impl& b = *p.second;
+    return impl.device->gpu && a.device == impl.device && b.device == impl.device && !a.onDevice &&
+           !b.onDevice && a.origin == b.origin && core::frameKeepsBound(a.summary, b.summary, a.origin) &&
+           impl.device->gpu->scansWhole(*a.gpuSet, *b.gpuSet);
+}
+
+// The small pairs in one submission; each reports an equal share of the
+// call's wall time.
+std::vector<Result<HausdorffResult>> scanSmallPairs(Engine::Impl& impl, std::span<const SetPair> pairs,
+                                                    const CallOptions& call) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<std::pair<const gpu_algo::DeviceSet*, const gpu_algo::DeviceSet*>> sets;
+    for (const auto& [a, b] : pairs) sets.emplace_back(a->gpuSet.get(), b->gpuSet.get());
+    std::vector<Result<HausdorffResult>> out = impl.device->gpu->computeSmallPairs(sets, call);
+    const double share = msSince(t0) / double(pairs.size());
+    for (size_t i = 0; i < out.size(); ++i) {
+        if (!out[i]) continue;
+        const PreparedSet::Impl& a = *pairs[i].first;
+        const PreparedSet::Impl& b = *pairs[i].second;
+        if (!a.originals.empty() || !b.originals.empty())
+            core::restoreOriginal(*out[i], a.input(), b.input(), impl.options.threads);
+        out[i]->origin = a.origin;
+        finishResult(impl, *out[i], t0);
+        out[i]->timings.total = share;
+    }
+    return out;
+}
+
+}  // namespace
+
 std::vector<Result<HausdorffResult>> Engine::computeBatch(std::span<const PreparedSet> sets,
                                                           std::span<const PairRef> pairs,
                                                           const CallOptions& call) {
-    std::vector<Result<HausdorffResult>> out;
-    out.reserve(pairs.size());
-    for (const PairRef& p : pairs) {
+    std::vector<std::optional<Result<HausdorffResult>>> out(pairs.size());
+    const bool cancelled = call.cancel != nullptr && call.cancel->load();
+    const bool callValid = !validateCallOptions(call).has_value();
+    std::vector<size_t> scanned;
+    std::vector<SetPair> scannedSets;
+    for (size_t i = 0; i < pairs.size(); ++i) {
+        const PairRef& p = pairs[i];
         if (p.a >= sets.size() || p.b >= sets.size()) {
-            out.emplace_back(Error{ErrorCode::kInvalidArgument,
-                                   "pair (" + std::to_string(p.a) + ", " + std::to_string(p.b) +
-                                       ") names a set past the " + std::to_string(sets.size()) + " given"});
+            out[i] = Error{ErrorCode::kInvalidArgument, "pair (" + std::to_string(p.a) + ", " +
+                                                            std::to_string(p.b) + ") names a set past the " +
+                                                            std::to_string(sets.size()) + " given"};
             continue;
         }
-        const bool cancelled = call.cancel != nullptr && call.cancel->load();
-        out.push_back(cancelled ? Result<HausdorffResult>(Error{
-                                      ErrorCode::kCancelled, "the call was cancelled (CallOptions::cancel)"})
-                                : compute(sets[p.a], sets[p.b], call));
+        const SetPair setPair{sets[p.a].m_impl.get(), sets[p.b].m_impl.get()};
+        if (cancelled || !callValid || !scannedWhole(*m_impl, setPair)) continue;
+        scanned.push_back(i);
+        scannedSets.push_back(setPair);
     }
-    return out;
+    if (!scannedSets.empty()) {
+        std::vector<Result<HausdorffResult>> results = scanSmallPairs(*m_impl, scannedSets, call);
+        for (size_t k = 0; k < scanned.size(); ++k) out[scanned[k]] = std::move(results[k]);
+    }
+    // The other pairs one after another, the cancel flag checked before each.
+    std::vector<Result<HausdorffResult>> done;
+    done.reserve(pairs.size());
+    for (size_t i = 0; i < pairs.size(); ++i) {
+        if (!out[i]) {
+            const bool stop = call.cancel != nullptr && call.cancel->load();
+            out[i] = stop ? Result<HausdorffResult>(
+                                Error{ErrorCode::kCancelled, "the call was cancelled (CallOptions::cancel)"})
+                          : compute(sets[pairs[i].a], sets[pairs[i].b], call);
+        }
+        done.push_back(std::move(*out[i]));
+    }
+    return done;
 }
 
 Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& options) {

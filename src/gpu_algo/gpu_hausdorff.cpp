@@ -22,6 +22,7 @@
 #include "gpu_algo/query_check.hpp"
 #include "gpu_algo/refinement.hpp"
 #include "gpu_algo/self_check.hpp"
+#include "gpu_algo/small_pairs.hpp"
 #include "gpu_algo/workspace.hpp"
 
 namespace rthdist::gpu_algo {
@@ -62,7 +63,8 @@ struct GpuHausdorff::State {
           cull(ws, check),
           refine(ws),
           search(ws, index, refine),
-          deviceIngest(ws, index) {}
+          deviceIngest(ws, index),
+          smallPairs(ws) {}
 
     Workspace ws;
     PerPoint spare;  // recyclePerPoint: the next per-point result's h(A,B) arrays
@@ -72,6 +74,7 @@ struct GpuHausdorff::State {
     Refinement refine;
     CandidateSearch search;
     DeviceIngest deviceIngest;
+    SmallPairScan smallPairs;
 
     // The search of a direction that has survivors, then its self-check
     // (one more submission); returns the checked witness.
@@ -418,6 +421,40 @@ Result<HausdorffResult> GpuHausdorff::compute(DeviceSet& a, DeviceSet& b, const 
     });
     if (err) return *err;
     return res;
+}
+
+bool GpuHausdorff::scansWhole(const DeviceSet& a, const DeviceSet& b) const {
+    const SmallPairScan& scan = m_state->smallPairs;
+    return !a.pts.onDevice() && !b.pts.onDevice() && scan.takes(a.ix.n, b.ix.n) && scan.takes(b.ix.n, a.ix.n);
+}
+
+std::vector<Result<HausdorffResult>> GpuHausdorff::computeSmallPairs(
+    std::span<const std::pair<const DeviceSet*, const DeviceSet*>> pairs, const CallOptions& options) {
+    std::vector<SmallPair> scans;
+    for (const auto& [a, b] : pairs) {
+        const double pairScale = std::min(a->scale, b->scale);  // of the larger magnitude
+        scans.push_back({a, b, float(pairScale / a->scale), float(pairScale / b->scale)});
+    }
+    SmallPairScan::Outcome outcome;
+    Timings timings;
+    auto err = m_state->guarded(timings, [&] {
+        throwIfCancelled(options);
+        outcome = m_state->smallPairs.run(scans, options, m_state->emptyResult(options));
+    });
+    std::vector<Result<HausdorffResult>> out;
+    for (size_t i = 0; i < pairs.size(); ++i) {
+        if (err) {
+            out.emplace_back(*err);
+        } else if (!outcome.failed[i].empty()) {
+            out.emplace_back(Error{ErrorCode::kInternal, "self-check failed: " + outcome.failed[i]});
+        } else {
+            HausdorffResult& r = outcome.results[i];
+            core::restoreOriginal(r, PointView(pairs[i].first->input), PointView(pairs[i].second->input),
+                                  m_state->ws.threads);
+            out.emplace_back(std::move(r));
+        }
+    }
+    return out;
 }
 
 Result<HausdorffResult> GpuHausdorff::computeDevice(const DeviceInput& a, const DeviceInput& b,

@@ -20,6 +20,8 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/input_frame.hpp"
 #include "gpu_algo/set_points.hpp"
@@ -76,6 +78,17 @@ public:
     // H (or h) of two prepared sets of the same scale. Their coarse search
     // levels are built on first use and kept.
     [[nodiscard]] Result<HausdorffResult> compute(DeviceSet& a, DeviceSet& b, const CallOptions& options);
+
+    // computeBatch's small pairs (small_pairs.hpp): whether two prepared sets
+    // of host arrays are small enough to be scanned whole, and every such pair
+    // of a batch in one submission, witnesses and per-point distances
+    // recomputed in double from the sets' inputs (as compute(DeviceSet&, ...)
+    // returns them). The sets must share an origin; their scales may differ
+    // (both brought to the smaller, exactly). A device error fails every
+    // pair; a pair that breaks the self-check fails alone (kInternal).
+    [[nodiscard]] bool scansWhole(const DeviceSet& a, const DeviceSet& b) const;
+    [[nodiscard]] std::vector<Result<HausdorffResult>> computeSmallPairs(
+        std::span<const std::pair<const DeviceSet*, const DeviceSet*>> pairs, const CallOptions& options);
 
     // Device input (rthdist/vulkan_interop.hpp; device_input.hpp): one-shot H
     // of two views of the embedder's buffers, ingested on the device; the

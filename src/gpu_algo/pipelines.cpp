@@ -11,6 +11,8 @@
 #include "rthdist_shared.h"
 
 // SPIR-V embedded at build time (cmake/Shaders.cmake).
+#include "batch_nearest.comp.h"
+#include "batch_witness.comp.h"
 #include "cell_bounds.comp.h"
 #include "cell_bounds_fix.comp.h"
 #include "cell_build.comp.h"
@@ -78,6 +80,8 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_refine_args_comp, "refine_args"},
     {k_spv_ingest_f64_comp, "ingest_f64"},
     {k_spv_sample_gather_comp, "sample_gather"},
+    {k_spv_batch_nearest_comp, "batch_nearest"},
+    {k_spv_batch_witness_comp, "batch_witness"},
 }};
 
 }  // namespace

@@ -40,6 +40,8 @@ enum class Kernel : uint32_t {
     kRefineArgs,    // refine.comp's indirect dispatch size (refine_args.comp)
     kIngestF64,     // device input views read in double (ingest_f64.comp): only with shaderFloat64
     kSampleGather,  // the bit count's sample of a device-input set (sample_gather.comp)
+    kBatchNearest,  // computeBatch's small pairs: exact scans (batch_nearest.comp)
+    kBatchWitness,  // and their witnesses (batch_witness.comp)
     kCount
 };
 

@@ -57,12 +57,23 @@ struct SearchScratch {
     Buffer fetched;     // host: the self-check's points of device input (SetPoints::cmdCopy)
 };
 
+// computeBatch's small pairs (small_pairs.hpp).
+struct BatchScratch {
+    Buffer directions;  // host: BatchDirection per direction
+    Buffer chunks;      // host: uvec2 per workgroup (seed chunks, then the scans')
+    Buffer maxPacked;   // uint64 per direction
+    Buffer nearest;     // uint per query of every direction
+    Buffer witnesses;   // host: uvec4 per direction
+    Buffer perPoint;    // host: `nearest` read back (per-point calls)
+};
+
 struct Scratch {
     std::array<BuildScratch, 2> builds;  // set A (and every single build), set B
     LeafScratch leaves;
     LevelScratch levels;
     std::array<DirectionBuffers, 2> directions;  // A->B, B->A
     SearchScratch search;
+    BatchScratch batch;
 };
 
 }  // namespace rthdist::gpu_algo

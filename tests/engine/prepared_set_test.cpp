@@ -6,6 +6,9 @@
 
 #include <array>
 
+#include <glm/geometric.hpp>
+
+#include "common/brute_force.hpp"
 #include "common/geo_cases.hpp"
 #include "common/oracle_cases.hpp"
 #include "engine/engine_test_support.hpp"
@@ -127,6 +130,92 @@ TEST(PreparedSet, BatchEqualsSingleCalls) {
                          oracleTolerance(clouds[pairs[i].a], clouds[pairs[i].b], once->hausdorff));
         OracleCase c{"batch", i, clouds[pairs[i].a], clouds[pairs[i].b]};
         expectMatchesOracle(c, *results[i]);
+    }
+}
+
+// Batches of small pairs (on GPU backends scanned whole, every pair in one
+// submission: gpu_algo/small_pairs.hpp): every oracle case small enough for
+// that on every device, in one computeBatch, exact against the brute force;
+// directed and per-point batches too (each query's nearest distance and a
+// nearest target at that distance).
+TEST(PreparedSet, SmallPairBatchMatchesTheOracle) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    std::vector<OracleCase> cases;
+    for (OracleCase& c : makeOracleCases())
+        if (c.a.size() * c.b.size() <= (size_t(1) << 22)) cases.push_back(std::move(c));
+    ASSERT_GE(cases.size(), 100u);
+    std::vector<PreparedSet> sets;
+    std::vector<PairRef> pairs;
+    for (const OracleCase& c : cases) {
+        for (const auto* points : {&c.a, &c.b}) {
+            auto s = prepare(*engine, *points);
+            ASSERT_TRUE(s) << c.name << ": " << s.error().message;
+            sets.push_back(*s);
+        }
+        pairs.push_back({sets.size() - 2, sets.size() - 1});
+    }
+    for (bool directed : {false, true}) {
+        for (bool perPoint : {false, true}) {
+            SCOPED_TRACE("directed " + std::to_string(directed) + " perPoint " + std::to_string(perPoint));
+            CallOptions call;
+            call.directedOnly = directed;
+            call.perPointDistances = perPoint;
+            const auto results = engine->computeBatch(sets, pairs, call);
+            ASSERT_EQ(results.size(), pairs.size());
+            for (size_t i = 0; i < cases.size(); ++i) {
+                const OracleCase& c = cases[i];
+                ASSERT_TRUE(results[i]) << c.name << ": " << results[i].error().message;
+                const HausdorffResult& r = *results[i];
+                expectMatchesOracle(c, r, directed);
+                EXPECT_EQ(r.validationMessages, 0u);
+                if (!perPoint) continue;
+                const double tol = oracleTolerance(c.a, c.b, r.hausdorff);
+                const std::vector<double> nn = oracle::bruteForceNearest(c.a, c.b);
+                ASSERT_EQ(r.aNearest.distance.size(), c.a.size()) << c.name;
+                for (size_t q = 0; q < c.a.size(); ++q) {
+                    ASSERT_NEAR(r.aNearest.distance[q], nn[q], tol) << c.name << " query " << q;
+                    ASSERT_LT(r.aNearest.nearest[q], c.b.size());
+                    ASSERT_EQ(r.aNearest.distance[q],
+                              glm::length(glm::dvec3(c.a[q]) - glm::dvec3(c.b[r.aNearest.nearest[q]])));
+                }
+                EXPECT_EQ(r.bNearest.distance.size(), directed ? 0u : c.b.size()) << c.name;
+            }
+        }
+    }
+}
+
+// A batch mixing small pairs, a pair too large to be scanned whole, the same
+// set on both sides and a bad reference: each result as its single call's.
+TEST(PreparedSet, MixedBatchEqualsSingleCalls) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    std::vector<std::vector<glm::vec3>> clouds{randomCloud(40000, 70),
+                                               randomCloud(30000, 71, glm::vec3(0.02f))};
+    for (uint64_t k = 0; k < 4; ++k)
+        clouds.push_back(
+            randomCloud(300 + 400 * k, 72 + k, glm::vec3(0.1f * float(k)), 1.0f + 0.5f * float(k)));
+    std::vector<PreparedSet> sets;
+    for (const auto& cloud : clouds) {
+        auto s = prepare(*engine, cloud);
+        ASSERT_TRUE(s) << s.error().message;
+        sets.push_back(*s);
+    }
+    const std::vector<PairRef> pairs{{2, 3}, {0, 1}, {4, 4}, {5, 2}, {3, 7}, {1, 5}, {4, 5}};
+    const auto results = engine->computeBatch(sets, pairs);
+    ASSERT_EQ(results.size(), pairs.size());
+    for (size_t i = 0; i < pairs.size(); ++i) {
+        SCOPED_TRACE("pair " + std::to_string(i));
+        if (pairs[i].b >= sets.size()) {
+            ASSERT_FALSE(results[i]);
+            EXPECT_EQ(results[i].error().code, ErrorCode::kInvalidArgument);
+            continue;
+        }
+        ASSERT_TRUE(results[i]) << results[i].error().message;
+        const auto& a = clouds[pairs[i].a];
+        const auto& b = clouds[pairs[i].b];
+        auto once = engine->compute(a, b, CallOptions{});
+        ASSERT_TRUE(once) << once.error().message;
+        expectSameResult(*results[i], *once, oracleTolerance(a, b, once->hausdorff));
+        expectMatchesOracle(OracleCase{"mixed", i, a, b}, *results[i]);
     }
 }
 
