@@ -258,7 +258,7 @@ public:
     // (or its error; one failing pair does not stop the others, a cancelled
     // call fills the rest with kCancelled). On a GPU backend the small pairs
     // (sets of host arrays with one origin, queries x targets at most 2^28 per
-    // direction, 2^24 on a CPU device such as lavapipe) are scanned exactly,
+    // direction, 2^20 on a CPU device such as lavapipe) are scanned exactly,
     // every query against every target with the early break, all of them in
     // one submission; each reports an equal share of that submission's time
     // (Timings::total, refine, gpuRefine) and counters without iterations. The

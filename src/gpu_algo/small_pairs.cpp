@@ -15,7 +15,7 @@ namespace rthdist::gpu_algo {
 namespace {
 
 constexpr uint64_t kMaxWorkGpu = uint64_t(1) << 28;
-constexpr uint64_t kMaxWorkCpuDevice = uint64_t(1) << 24;
+constexpr uint64_t kMaxWorkCpuDevice = uint64_t(1) << 20;
 
 // A step coprime with n near n / golden ratio: the scan's order
 // (j * step) mod n visits the cell-sorted targets spread over the set.

@@ -48,8 +48,8 @@ public:
     explicit SmallPairScan(Workspace& ws);
 
     // Whether a direction of `queries` x `targets` is scanned whole: the
-    // product at most 2^28 on a GPU, 2^24 on a CPU device (lavapipe), where
-    // one pair of the RT path costs a few milliseconds instead of ~1. The
+    // product at most 2^28 on a GPU, 2^20 on a CPU device (lavapipe: its
+    // scan of 2,000-10,000-point pairs took 3x the RT path's time). The
     // environment variable RTHDIST_SMALL_PAIR_WORK replaces the limit
     // (benchmarks of both paths; 0: none is scanned whole).
     [[nodiscard]] bool takes(uint64_t queries, uint64_t targets) const;

@@ -142,7 +142,7 @@ TEST(PreparedSet, SmallPairBatchMatchesTheOracle) {
     RTHDIST_REQUIRE_TEST_ENGINE(engine);
     std::vector<OracleCase> cases;
     for (OracleCase& c : makeOracleCases())
-        if (c.a.size() * c.b.size() <= (size_t(1) << 22)) cases.push_back(std::move(c));
+        if (c.a.size() * c.b.size() <= (size_t(1) << 20)) cases.push_back(std::move(c));
     ASSERT_GE(cases.size(), 100u);
     std::vector<PreparedSet> sets;
     std::vector<PairRef> pairs;
