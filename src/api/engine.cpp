@@ -421,7 +421,10 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
 
 Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOptions& call) {
     const auto t0 = std::chrono::steady_clock::now();
+    // Small pairs are scanned whole from the host's float copies
+    // (GpuHausdorff::scansWhole): the points are checked on the host.
     if (m_impl->device->gpu && a.packedFloat() && b.packedFloat() &&
+        !m_impl->device->gpu->scansWhole(a.count, b.count, call) &&
         gpu_algo::GpuHausdorff::ingests(a.count, b.count) &&
         api::fitsOneCall(memoryBudget(*m_impl), a.count, b.count))
         return computeIngested(*m_impl, a, b, call, t0);

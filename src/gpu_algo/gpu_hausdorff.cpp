@@ -289,6 +289,23 @@ struct GpuHausdorff::State {
         if (a.scale != 1.0) core::restoreOriginal(res, PointView(a.input), PointView(b.input), ws.threads);
     }
 
+    // A one-shot pair small enough to be scanned whole (small_pairs.hpp).
+    Result<HausdorffResult> scanHostPair(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                         double scale, const CallOptions& options) {
+        SmallPairScan::Outcome outcome;
+        Timings timings;
+        auto err = guarded(timings, [&] {
+            throwIfCancelled(options);
+            outcome = smallPairs.runHostArrays(a, b, scale, options, emptyResult(options));
+        });
+        if (err) return *err;
+        if (!outcome.failed[0].empty())
+            return Error{ErrorCode::kInternal, "self-check failed: " + outcome.failed[0]};
+        HausdorffResult& r = outcome.results[0];
+        core::restoreOriginal(r, PointView(a), PointView(b), ws.threads);
+        return std::move(r);
+    }
+
     HausdorffResult emptyResult(const CallOptions& options) const {
         HausdorffResult res;
         res.backend = ws.ctx.backend();
@@ -362,6 +379,7 @@ Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, co
 Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                               double scale, const CallOptions& options) {
     State& st = *m_state;
+    if (scansWhole(a.size(), b.size(), options)) return st.scanHostPair(a, b, scale, options);
     HausdorffResult res = st.emptyResult(options);
     // Squared distances are float on the device: coordinates so large (or so
     // small) that they overflow (or underflow) are scaled by a power of two,
@@ -428,12 +446,17 @@ bool GpuHausdorff::scansWhole(const DeviceSet& a, const DeviceSet& b) const {
     return !a.pts.onDevice() && !b.pts.onDevice() && scan.takes(a.ix.n, b.ix.n) && scan.takes(b.ix.n, a.ix.n);
 }
 
+bool GpuHausdorff::scansWhole(size_t aPoints, size_t bPoints, const CallOptions& options) const {
+    const SmallPairScan& scan = m_state->smallPairs;
+    return options.bits == 0 && scan.takes(aPoints, bPoints) && scan.takes(bPoints, aPoints);
+}
+
 std::vector<Result<HausdorffResult>> GpuHausdorff::computeSmallPairs(
     std::span<const std::pair<const DeviceSet*, const DeviceSet*>> pairs, const CallOptions& options) {
     std::vector<SmallPair> scans;
     for (const auto& [a, b] : pairs) {
         const double pairScale = std::min(a->scale, b->scale);  // of the larger magnitude
-        scans.push_back({a, b, float(pairScale / a->scale), float(pairScale / b->scale)});
+        scans.push_back({scanSetOf(*a, pairScale / a->scale), scanSetOf(*b, pairScale / b->scale)});
     }
     SmallPairScan::Outcome outcome;
     Timings timings;

@@ -87,6 +87,11 @@ public:
     // (both brought to the smaller, exactly). A device error fails every
     // pair; a pair that breaks the self-check fails alone (kInternal).
     [[nodiscard]] bool scansWhole(const DeviceSet& a, const DeviceSet& b) const;
+    // Whether one-shot sets of these sizes are scanned whole instead (with
+    // the automatic bit count only: a call that sets bits asks for the index).
+    // compute(a, b, scale, options) then stages and scans them in one
+    // submission.
+    [[nodiscard]] bool scansWhole(size_t aPoints, size_t bPoints, const CallOptions& options) const;
     [[nodiscard]] std::vector<Result<HausdorffResult>> computeSmallPairs(
         std::span<const std::pair<const DeviceSet*, const DeviceSet*>> pairs, const CallOptions& options);
 

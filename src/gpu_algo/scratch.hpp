@@ -65,6 +65,8 @@ struct BatchScratch {
     Buffer nearest;     // uint per query of every direction
     Buffer witnesses;   // host: uvec4 per direction
     Buffer perPoint;    // host: `nearest` read back (per-point calls)
+    Buffer staged;      // host: records of a one-shot pair's host arrays
+    Buffer records;     // the same on the device
 };
 
 struct Scratch {

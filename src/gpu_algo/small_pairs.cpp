@@ -3,6 +3,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cstdlib>
 #include <cstring>
 #include <numeric>
@@ -58,21 +59,20 @@ SmallPairScan::Layout SmallPairScan::layOut(std::span<const SmallPair> pairs, bo
     for (const SmallPair& p : pairs) {
         for (size_t k = 0; k < l.perPair; ++k) {
             l.nearestAt.push_back(l.queries);
-            l.queries += (k == 0 ? p.a : p.b)->ix.n;
+            l.queries += (k == 0 ? p.a : p.b).points.size();
         }
     }
     BatchScratch& s = m_ws.scratch.batch;
     const VkDeviceAddress nearest = m_ws.grow(s.nearest, l.queries * 4, "batch.nearest").address();
-    for (size_t i = 0; i < pairs.size(); ++i) {
+    for (const SmallPair& p : pairs) {
         for (size_t k = 0; k < l.perPair; ++k) {
-            const bool ab = k == 0;
-            const DeviceSet& q = ab ? *pairs[i].a : *pairs[i].b;
-            const DeviceSet& t = ab ? *pairs[i].b : *pairs[i].a;
-            const uint32_t dir = uint32_t(l.directions.size());
-            l.directions.push_back(sh::BatchDirection{
-                q.ix.sorted->address(), t.ix.sorted->address(), nearest + 4 * l.nearestAt[dir],
-                ab ? pairs[i].aScale : pairs[i].bScale, ab ? pairs[i].bScale : pairs[i].aScale, q.ix.n,
-                t.ix.n, spreadStep(t.ix.n), std::max<uint32_t>(1, (q.ix.n + RTHDIST_WG - 1) / RTHDIST_WG)});
+            const ScanSet& q = k == 0 ? p.a : p.b;
+            const ScanSet& t = k == 0 ? p.b : p.a;
+            const auto nq = uint32_t(q.points.size()), nt = uint32_t(t.points.size());
+            const VkDeviceAddress out = nearest + 4 * l.nearestAt[l.directions.size()];
+            l.directions.push_back(
+                sh::BatchDirection{q.records, t.records, out, q.scale, t.scale, nq, nt, spreadStep(nt),
+                                   std::max<uint32_t>(1, (nq + RTHDIST_WG - 1) / RTHDIST_WG)});
         }
     }
     const auto dirs = uint32_t(l.directions.size());
@@ -129,45 +129,46 @@ std::string SmallPairScan::finishPair(const SmallPair& pair, size_t first, const
     const auto* witnesses = static_cast<const uint32_t*>(s.witnesses.mapped());
     for (size_t k = 0; k < l.perPair; ++k) {
         const bool ab = k == 0;
-        const DeviceSet& q = ab ? *pair.a : *pair.b;
-        const DeviceSet& t = ab ? *pair.b : *pair.a;
+        const ScanSet& q = ab ? pair.a : pair.b;
+        const ScanSet& t = ab ? pair.b : pair.a;
         const std::string name = ab ? "h(A,B)" : "h(B,A)";
         const uint32_t* w = witnesses + 4 * (first + k);
-        if (w[0] >= q.ix.n || w[1] >= t.ix.n)
+        const size_t nq = q.points.size(), nt = t.points.size();
+        if (w[0] >= nq || w[1] >= nt)
             return name + ": the device named query " + std::to_string(w[0]) + " and target " +
-                   std::to_string(w[1]) + " of sets of " + std::to_string(q.ix.n) + " and " +
-                   std::to_string(t.ix.n) + " points";
-        const double qScale = ab ? pair.aScale : pair.bScale, tScale = ab ? pair.bScale : pair.aScale;
-        const double searched =
-            glm::length(glm::dvec3(q.points[w[0]]) * qScale - glm::dvec3(t.points[w[1]]) * tScale);
+                   std::to_string(w[1]) + " of sets of " + std::to_string(nq) + " and " + std::to_string(nt) +
+                   " points";
+        const double searched = glm::length(glm::dvec3(q.points[w[0]]) * q.pointsScale -
+                                            glm::dvec3(t.points[w[1]]) * t.pointsScale);
         const std::string why = witnessFailure(searched, uint64_t(w[2]) << 32, 0.0);
         if (!why.empty()) return name + ": " + why;
         Directed& d = ab ? out.aToB : out.bToA;
         d.queryIndex = w[0];
         d.targetIndex = w[1];
-        d.counters.bits = uint32_t(t.ix.grid.bits);
-        d.counters.occupiedCells = t.ix.numCells;
-        d.counters.queries = q.ix.n;
+        d.counters.bits = uint32_t(t.bits);
+        d.counters.occupiedCells = t.cells;
+        d.counters.queries = nq;
         if (!perPoint) continue;
         PerPoint& pp = ab ? out.aNearest : out.bNearest;
         const uint32_t* nearest = static_cast<const uint32_t*>(s.perPoint.mapped()) + l.nearestAt[first + k];
-        pp.nearest.assign(nearest, nearest + q.ix.n);
-        if (std::any_of(pp.nearest.begin(), pp.nearest.end(), [&](uint32_t i) { return i >= t.ix.n; }))
-            return name + ": a per-point nearest index lies past the target set's " + std::to_string(t.ix.n) +
+        pp.nearest.assign(nearest, nearest + nq);
+        if (std::any_of(pp.nearest.begin(), pp.nearest.end(), [&](uint32_t i) { return i >= nt; }))
+            return name + ": a per-point nearest index lies past the target set's " + std::to_string(nt) +
                    " points";
-        pp.distance.resize(q.ix.n);
+        pp.distance.resize(nq);
     }
     return "";
 }
 
-SmallPairScan::Outcome SmallPairScan::run(std::span<const SmallPair> pairs, const CallOptions& options,
-                                          const HausdorffResult& blank) {
+SmallPairScan::Outcome SmallPairScan::submit(std::span<const SmallPair> pairs, const Layout& l,
+                                             const CallOptions& options, const HausdorffResult& blank,
+                                             const std::function<void(VkCommandBuffer)>& before) {
     const auto t0 = Clock::now();
     const bool perPoint = options.perPointDistances;
-    const Layout l = layOut(pairs, options.directedOnly, perPoint);
     VkCommandBuffer cmd = m_ws.ctx.begin();
     {
         const gpu::ScopedLabel label(m_ws.ctx, cmd, "small pairs");
+        if (before) before(cmd);
         record(cmd, l, perPoint);
     }
     m_ws.ctx.submitAndWait(cmd);
@@ -184,6 +185,56 @@ SmallPairScan::Outcome SmallPairScan::run(std::span<const SmallPair> pairs, cons
         r.timings.gpuRefine = gpuMs * share;
     }
     return out;
+}
+
+SmallPairScan::Outcome SmallPairScan::run(std::span<const SmallPair> pairs, const CallOptions& options,
+                                          const HausdorffResult& blank) {
+    const Layout l = layOut(pairs, options.directedOnly, options.perPointDistances);
+    return submit(pairs, l, options, blank, nullptr);
+}
+
+SmallPairScan::Outcome SmallPairScan::runHostArrays(std::span<const glm::vec3> a,
+                                                    std::span<const glm::vec3> b, double scale,
+                                                    const CallOptions& options,
+                                                    const HausdorffResult& blank) {
+    const auto t0 = Clock::now();
+    BatchScratch& s = m_ws.scratch.batch;
+    const VkDeviceSize bytes = VkDeviceSize(a.size() + b.size()) * 16;
+    auto* staged =
+        static_cast<uint32_t*>(m_ws.grow(s.staged, bytes, "batch.staged", MemoryKind::kHost).mapped());
+    size_t at = 0;
+    for (std::span<const glm::vec3> set : {a, b}) {
+        for (size_t i = 0; i < set.size(); ++i, at += 4) {
+            // Scaled as the RT path's host copy is (exact: a power of two
+            // into float range; the scale itself may lie outside it).
+            const glm::vec3 p(glm::dvec3(set[i]) * scale);
+            staged[at] = std::bit_cast<uint32_t>(p.x);
+            staged[at + 1] = std::bit_cast<uint32_t>(p.y);
+            staged[at + 2] = std::bit_cast<uint32_t>(p.z);
+            staged[at + 3] = uint32_t(i);  // the input index, as the records' w bits
+        }
+    }
+    const VkDeviceAddress records = m_ws.grow(s.records, bytes, "batch.records").address();
+    const SmallPair pair{ScanSet{records, 1.0f, a, scale}, ScanSet{records + a.size() * 16, 1.0f, b, scale}};
+    const Layout l = layOut(std::span(&pair, 1), options.directedOnly, options.perPointDistances);
+    const double staging = msSince(t0);
+    uint32_t copied = 0;
+    Outcome out = submit(std::span(&pair, 1), l, options, blank, [&](VkCommandBuffer cmd) {
+        const VkBufferCopy all{0, 0, bytes};
+        vkCmdCopyBuffer(cmd, s.staged.handle(), s.records.handle(), 1, &all);
+        copied = m_ws.ctx.cmdMark(cmd);
+        m_ws.barrier(cmd);
+    });
+    Timings& t = out.results[0].timings;
+    t.upload = staging;
+    t.gpuUpload = m_ws.ctx.gpuMsBetween(0, copied);
+    t.gpuRefine -= t.gpuUpload;
+    return out;
+}
+
+ScanSet scanSetOf(const DeviceSet& set, double scale) {
+    return ScanSet{set.ix.sorted->address(), float(scale),   set.points, scale,
+                   set.ix.grid.bits,         set.ix.numCells};
 }
 
 }  // namespace rthdist::gpu_algo

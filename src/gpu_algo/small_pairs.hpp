@@ -26,6 +26,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -34,13 +35,25 @@
 
 namespace rthdist::gpu_algo {
 
-// One pair of a batch: two sets prepared from host arrays, and the powers of
-// two that bring each set's searched points into the pair's frame.
+// One side of a pair as the scan reads it: vec4 records on the device (xyz,
+// w = input index bits; any order) and the power of two that brings them into
+// the pair's frame; the same points by input index on the host with the power
+// of two that brings those there (the self-check's); its index's size for the
+// counters (0 for a set that has none).
+struct ScanSet {
+    VkDeviceAddress records = 0;
+    float scale = 1.0f;
+    std::span<const glm::vec3> points;
+    double pointsScale = 1.0;
+    int bits = 0;
+    uint64_t cells = 0;
+};
+
+// A prepared set (its cell-sorted records) as a scan's side.
+[[nodiscard]] ScanSet scanSetOf(const DeviceSet& set, double scale);
+
 struct SmallPair {
-    const DeviceSet* a = nullptr;
-    const DeviceSet* b = nullptr;
-    float aScale = 1.0f;
-    float bScale = 1.0f;
+    ScanSet a, b;
 };
 
 class SmallPairScan {
@@ -64,11 +77,21 @@ public:
     };
     [[nodiscard]] Outcome run(std::span<const SmallPair> pairs, const CallOptions& options,
                               const HausdorffResult& blank);
+    // One pair of host arrays (float, before the power of two `scale`): the
+    // records staged by the host and copied to the device in the scan's own
+    // submission (upload times in the result's timings).
+    [[nodiscard]] Outcome runHostArrays(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                        double scale, const CallOptions& options,
+                                        const HausdorffResult& blank);
 
 private:
     struct Layout;  // the directions' records and chunks, their offsets
     [[nodiscard]] Layout layOut(std::span<const SmallPair> pairs, bool directedOnly, bool perPoint);
     void record(VkCommandBuffer cmd, const Layout& layout, bool perPoint);
+    // Records, submits and waits; then every pair's result.
+    [[nodiscard]] Outcome submit(std::span<const SmallPair> pairs, const Layout& layout,
+                                 const CallOptions& options, const HausdorffResult& blank,
+                                 const std::function<void(VkCommandBuffer)>& before);
     // Pair i's result from the read-back witnesses (and per-point indices).
     [[nodiscard]] std::string finishPair(const SmallPair& pair, size_t first, const Layout& layout,
                                          bool perPoint, HausdorffResult& out) const;

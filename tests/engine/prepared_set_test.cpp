@@ -184,6 +184,42 @@ TEST(PreparedSet, SmallPairBatchMatchesTheOracle) {
     }
 }
 
+// One-shot calls of small pairs (on GPU backends scanned whole in one
+// submission, from the host's float copies): every oracle case small enough
+// on every device, exact against the brute force, for H, directed and
+// per-point calls; georeferenced doubles through their own frame.
+TEST(PreparedSet, SmallOneShotPairsMatchTheOracle) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    size_t tested = 0;
+    for (const OracleCase& c : makeOracleCases()) {
+        if (c.a.size() * c.b.size() > (size_t(1) << 20)) continue;
+        ++tested;
+        SCOPED_TRACE(c.name);
+        for (bool directed : {false, true}) {
+            CallOptions call;
+            call.directedOnly = directed;
+            call.perPointDistances = (c.seed % 2) == 0;
+            auto r = engine->compute(c.a, c.b, call);
+            ASSERT_TRUE(r) << r.error().message;
+            expectMatchesOracle(c, *r, directed);
+            EXPECT_EQ(r->validationMessages, 0u);
+            if (!call.perPointDistances) continue;
+            const std::vector<double> nn = oracle::bruteForceNearest(c.a, c.b);
+            ASSERT_EQ(r->aNearest.distance.size(), c.a.size());
+            for (size_t q = 0; q < c.a.size(); ++q)
+                ASSERT_NEAR(r->aNearest.distance[q], nn[q], oracleTolerance(c.a, c.b, r->hausdorff)) << q;
+        }
+    }
+    EXPECT_GE(tested, 100u);
+    for (const GeoCase& g : makeGeoCases()) {
+        if (g.a.size() * g.b.size() > (size_t(1) << 20)) continue;
+        SCOPED_TRACE(g.name);
+        auto r = engine->compute(g.a, g.b, CallOptions{});
+        ASSERT_TRUE(r) << r.error().message;
+        expectMatchesGeoOracle(g, *r);
+    }
+}
+
 // A batch mixing small pairs, a pair too large to be scanned whole, the same
 // set on both sides and a bad reference: each result as its single call's.
 TEST(PreparedSet, MixedBatchEqualsSingleCalls) {
