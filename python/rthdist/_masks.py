@@ -215,9 +215,9 @@ def _percentiles(percentiles):
 class PreparedReference:
     """A reference (ground-truth) mask prepared once on a MaskEngine
     (MaskEngine.prepare_reference; src/masks/prepared_reference.hpp): its
-    boundary voxels (itk: its foreground, deepmind: its surfels) extracted
-    and indexed on the engine's device, so that each comparison with a
-    prediction extracts and indexes only the prediction.
+    boundary voxels (itk: also its foreground) extracted and indexed on the
+    engine's device (deepmind: its surfels extracted), so that each
+    comparison with a prediction extracts and indexes only the prediction.
 
     Pass it as a or b to that engine's compare() (or to compare_masks, which
     then runs on that engine): as a, the rows equal compare(reference,

@@ -188,7 +188,7 @@ std::optional<Error> extractReference(MaskEngine& engine, const Volume& ref, con
     const int threads = options.threads;
     if (s.convention == Convention::kDeepmind) {
         s.surfels = detail::extractSurfels(ref, s.select, threads);
-        if (s.surfels.corners.empty()) return std::nullopt;
+        return std::nullopt;  // no prepared set: see the header
     } else {
         Result<detail::Extraction> e =
             extractOne(engine, ref, s.select, s.connectivity, options, s.extraction);
@@ -197,9 +197,7 @@ std::optional<Error> extractReference(MaskEngine& engine, const Volume& ref, con
         if (s.extracted.count == 0) return std::nullopt;
         if (s.convention == Convention::kItk) s.bits = detail::SelectionBits(ref, s.select, threads);
     }
-    const std::vector<uint64_t>& points =
-        s.convention == Convention::kDeepmind ? s.surfels.corners : s.extracted.boundary;
-    Result<PreparedSet> set = prepareSet(engine.engine, metricOf(s), points, threads);
+    Result<PreparedSet> set = prepareSet(engine.engine, metricOf(s), s.extracted.boundary, threads);
     if (!set) return set.error();
     s.set = std::move(*set);
     return std::nullopt;
@@ -271,11 +269,8 @@ Result<MaskResult> compareMasks(MaskEngine& engine, const PreparedReference& ref
         return compareVoxels(engine, s, prediction, select, options, start);
     const auto t0 = Clock::now();
     const detail::Surfels sb = detail::extractSurfels(prediction, select, options.threads);
-    const double extractMs = msSince(t0);
-    const detail::NearestCall toA =
-        s.set ? againstReference(engine.engine, *s.set) : detail::NearestCall(nullptr);
-    return detail::compareSurfels(engine.engine, s.grid, s.surfels, prediction, sb, options,
-                                  s.set ? &toA : nullptr, extractMs, start);
+    return detail::compareSurfels(engine.engine, s.grid, s.surfels, prediction, sb, options, nullptr,
+                                  msSince(t0), start);
 }
 
 }  // namespace rthdist::masks

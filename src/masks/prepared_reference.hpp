@@ -24,11 +24,15 @@
 //   itk       the selection as one bit per voxel (selection_bits.hpp: the
 //       voxels inside the reference are at 0 in both directions) and its
 //       6-connected boundary with its PreparedSet: the prediction's voxels
-//       outside the reference query it; the reference's voxels outside the
-//       prediction query the prediction's boundary in a one-shot call.
-//   deepmind  the surfels (corners, codes) and the PreparedSet of the
-//       corners (VoxelMetric::corners frame): the prediction's surfels the
-//       reference lacks query it; the other direction is one-shot.
+//       outside the reference query it (prepared, then one call on the two
+//       sets); the reference's voxels outside the prediction query the
+//       prediction's boundary in a one-shot call.
+//   deepmind  the surfels (corners, codes) only: both directions stay
+//       one-shot calls, as in compareMasks. Each direction queries a subset
+//       that depends on the prediction, and a PreparedSet of the reference's
+//       surfels needs the prediction's queries prepared too (indexed, which a
+//       one-shot directed call does not do): 0.73x on the CPU backend when
+//       tried (docs/bench/masks). What it saves is the reference's surfels.
 // Options: the convention's point set is fixed at preparation: a comparison
 // whose options need another set (convention with other points or metric,
 // another connectivity) is refused with kInvalidArgument naming both; it is
