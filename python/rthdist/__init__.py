@@ -27,7 +27,7 @@ import os as _os
 
 from . import _rthdist
 from ._device_owner import DeviceOwner as _DeviceOwner
-from ._masks import CONVENTIONS, DirectedMask, MaskEngine, MaskResult, MaskVolume, compare_masks
+from ._masks import CONVENTIONS, DirectedMask, MaskEngine, MaskResult, MaskVolume, PreparedReference, compare_masks
 from ._points import as_points
 from ._rthdist import (  # noqa: F401 - re-exported
     CancelledError,
@@ -59,6 +59,7 @@ __all__ = [
     "compare_masks",
     "MaskEngine",
     "MaskVolume",
+    "PreparedReference",
     "MaskResult",
     "DirectedMask",
     "CONVENTIONS",

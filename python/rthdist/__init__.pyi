@@ -168,6 +168,8 @@ def list_devices() -> list[dict[str, Any]]: ...
 ConventionName = Literal["rthdist", "monai", "medpy", "plastimatch", "itk", "deepmind"]
 CONVENTIONS: tuple[str, ...]
 MaskLike = Any  # 3-D label array (bool/int/uint/integral float), nibabel spatial image, or MaskVolume
+# A mask, or (a or b of MaskEngine.compare / compare_masks) a PreparedReference.
+MaskOrReference = Union[MaskLike, "PreparedReference"]
 
 class MaskVolume:
     def __init__(
@@ -261,9 +263,21 @@ class MaskResult:
     def hd95(self) -> Optional[float]: ...
     def to_dict(self) -> dict[str, Any]: ...
 
+class PreparedReference:
+    @property
+    def engine(self) -> "MaskEngine": ...
+    @property
+    def volume(self) -> MaskVolume: ...
+    @property
+    def prepared(self) -> list[dict[str, Any]]: ...
+    @property
+    def host_bytes(self) -> int: ...
+    @property
+    def device_bytes(self) -> int: ...
+
 def compare_masks(
-    a: MaskLike,
-    b: MaskLike,
+    a: MaskOrReference,
+    b: MaskOrReference,
     *,
     spacing: Optional[Sequence[float]] = None,
     affine: Optional[npt.ArrayLike] = None,
@@ -289,10 +303,22 @@ class MaskEngine:
         threads: int = 0,
         validation: bool = False,
     ) -> None: ...
+    def prepare_reference(
+        self,
+        reference: MaskLike,
+        *,
+        spacing: Optional[Sequence[float]] = None,
+        affine: Optional[npt.ArrayLike] = None,
+        convention: Union[ConventionName, Literal["all"], Sequence[ConventionName]] = "rthdist",
+        connectivity: Optional[Literal[6, 18, 26]] = None,
+        label: Optional[int] = None,
+        labels: Optional[Union[Literal["all"], Sequence[int]]] = None,
+        host_extraction: bool = False,
+    ) -> PreparedReference: ...
     def compare(
         self,
-        a: MaskLike,
-        b: MaskLike,
+        a: MaskOrReference,
+        b: MaskOrReference,
         *,
         spacing: Optional[Sequence[float]] = None,
         affine: Optional[npt.ArrayLike] = None,

@@ -1,4 +1,5 @@
-"""Segmentation masks from Python: rthdist.compare_masks, MaskEngine, MaskVolume.
+"""Segmentation masks from Python: rthdist.compare_masks, MaskEngine, MaskVolume,
+PreparedReference.
 
 The C++ masks library (src/masks/masks.hpp, README "Segmentation masks") on
 NumPy label arrays and nibabel images: HD, HD-p, ASSD/MSD and surface Dice in
@@ -211,6 +212,63 @@ def _percentiles(percentiles):
     return [float(p) for p in percentiles]
 
 
+class PreparedReference:
+    """A reference (ground-truth) mask prepared once on a MaskEngine
+    (MaskEngine.prepare_reference; src/masks/prepared_reference.hpp): its
+    boundary voxels (itk: also its foreground) extracted and indexed on the
+    engine's device (deepmind: its surfels extracted), so that each
+    comparison with a prediction extracts and indexes only the prediction.
+
+    Pass it as a or b to that engine's compare() (or to compare_masks, which
+    then runs on that engine): as a, the rows equal compare(reference,
+    prediction) value for value; as b, those of compare(prediction,
+    reference) (the directions exchanged; bit for bit when the two affines
+    are equal, as when the prediction is an array taking the reference's
+    affine). A label or convention not prepared yet is prepared on first use
+    and kept (the reference's MaskVolume is kept for that).
+
+    volume: the reference's MaskVolume. prepared: one dict per prepared
+    (label, convention): label (None: every non-zero voxel), convention,
+    connectivity, points, selected_voxels, host_bytes, device_bytes,
+    prepare_ms, extraction. host_bytes / device_bytes: their sums. The memory
+    is released with the object (and its engine's device with the last of
+    them and the engine).
+    """
+
+    def __init__(self, engine, handle):
+        self._engine = engine
+        self._p = handle
+
+    @property
+    def engine(self):
+        """The MaskEngine it was prepared on (and is compared on)."""
+        return self._engine
+
+    @property
+    def volume(self):
+        v = MaskVolume.__new__(MaskVolume)
+        v._v = self._p.volume
+        return v
+
+    @property
+    def prepared(self):
+        return self._p.sets()
+
+    @property
+    def host_bytes(self):
+        return sum(s["host_bytes"] for s in self._p.sets())
+
+    @property
+    def device_bytes(self):
+        return sum(s["device_bytes"] for s in self._p.sets())
+
+    def __repr__(self):
+        sets = self._p.sets()
+        return (f"PreparedReference(name={self._p.volume.name!r}, sets={len(sets)}, "
+                f"points={sum(s['points'] for s in sets)}, host_bytes={self.host_bytes}, "
+                f"device_bytes={self.device_bytes})")
+
+
 class MaskEngine(DeviceOwner):
     """The masks' engine kept between calls: the Vulkan device (and, on a GPU
     backend, the boundary compute pass) opened once.
@@ -221,6 +279,13 @@ class MaskEngine(DeviceOwner):
                 r = engine.compare(nib.load(path), ref, convention="monai")
 
     compare() takes compare_masks's arguments but backend/device/threads.
+    prepare_reference() prepares a reference compared with many predictions
+    (PreparedReference: extracted and indexed once):
+
+        with rthdist.MaskEngine("ray-query") as engine:
+            ref = engine.prepare_reference(nib.load("gt.nii.gz"), convention="monai")
+            rows = [engine.compare(nib.load(p), ref, convention="monai") for p in predictions]
+
     One call at a time (threads wait for each other); close() or the with
     block releases the device.
     """
@@ -228,15 +293,48 @@ class MaskEngine(DeviceOwner):
     def __init__(self, backend="auto", *, device=None, threads=0, validation=False):
         self._engine = _rthdist._MaskEngine(str(backend), device, int(threads), bool(validation))
 
+    def prepare_reference(self, reference, *, spacing=None, affine=None, convention="rthdist",
+                          connectivity=None, label=None, labels=None, host_extraction=False):
+        """A PreparedReference of `reference` (compare_masks's inputs: a 3-D
+        label array with spacing/affine, a nibabel image or a MaskVolume) on
+        this engine, for every convention (a name, a list, or "all") and
+        label (label=N, labels=[...] or "all": those present in the
+        reference; default every non-zero voxel) asked now; others are
+        prepared when a comparison first asks for them."""
+        if isinstance(reference, MaskVolume):
+            if spacing is not None or affine is not None:
+                raise ValueError("a MaskVolume carries its affine: spacing/affine apply to arrays only")
+            volume = reference
+        elif _is_image(reference):
+            volume = MaskVolume(reference, spacing=spacing, affine=affine)
+        else:
+            volume = MaskVolume(reference, spacing=spacing, affine=affine, name="reference")
+        selection, _ = _selection(label, labels)
+        handle = self._engine.prepare(volume._v, selection, _conventions(convention),
+                                      0 if connectivity is None else int(connectivity), bool(host_extraction))
+        return PreparedReference(self, handle)
+
     def compare(self, a, b, *, spacing=None, affine=None, convention="rthdist", percentiles=(95,),
                 connectivity=None, tolerance=1.0, label=None, labels=None, host_extraction=False):
-        """As rthdist.compare_masks on this engine's device."""
-        va, vb = _volumes(a, b, spacing, affine)
+        """As rthdist.compare_masks on this engine's device; a or b may be a
+        PreparedReference of this engine."""
         names = _conventions(convention)
         selection, per_label = _selection(label, labels)
-        rows = self._engine.compare(va._v, vb._v, selection, names, _percentiles(percentiles),
-                                    0 if connectivity is None else int(connectivity), float(tolerance),
-                                    bool(host_extraction))
+        settings = (names, _percentiles(percentiles), 0 if connectivity is None else int(connectivity),
+                    float(tolerance), bool(host_extraction))
+        prepared = a if isinstance(a, PreparedReference) else b if isinstance(b, PreparedReference) else None
+        if prepared is not None:
+            if isinstance(a, PreparedReference) and isinstance(b, PreparedReference):
+                raise ValueError("compare a PreparedReference with a mask, not with another PreparedReference")
+            if prepared.engine is not self:
+                raise ValueError("this PreparedReference was prepared on another MaskEngine: compare it there")
+            ref = prepared.volume
+            other = b if prepared is a else a
+            _, vo = _volumes(ref, other, spacing, affine)
+            rows = self._engine.compare_prepared(prepared._p, vo._v, prepared is b, selection, *settings)
+        else:
+            va, vb = _volumes(a, b, spacing, affine)
+            rows = self._engine.compare(va._v, vb._v, selection, *settings)
         backend, device = self.backend, self.device
         results = [MaskResult(row, backend, device) for row in rows]
         if len(names) == 1 and not per_label:
@@ -278,7 +376,16 @@ def compare_masks(a, b, *, spacing=None, affine=None, convention="rthdist", perc
     Raises ValueError (shapes or affines that differ, not 3-D, non-integral
     or non-int32 labels, bad convention or options), DeviceError,
     OutOfMemoryError, InternalError.
+
+    With a PreparedReference as a or b (MaskEngine.prepare_reference), the
+    comparison runs on the engine that prepared it (backend, device, threads
+    and validation are not used).
     """
+    for x in (a, b):
+        if isinstance(x, PreparedReference):
+            return x.engine.compare(a, b, spacing=spacing, affine=affine, convention=convention,
+                                    percentiles=percentiles, connectivity=connectivity, tolerance=tolerance,
+                                    label=label, labels=labels, host_extraction=host_extraction)
     with MaskEngine(backend, device=device, threads=threads, validation=validation) as engine:
         return engine.compare(a, b, spacing=spacing, affine=affine, convention=convention,
                               percentiles=percentiles, connectivity=connectivity, tolerance=tolerance,

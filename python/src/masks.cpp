@@ -4,18 +4,22 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
 #include "engine.hpp"
 #include "errors.hpp"
 #include "masks/masks.hpp"
+#include "masks/prepared_reference.hpp"
 
 namespace py = pybind11;
 
@@ -185,6 +189,33 @@ struct Selection {
     masks::LabelSelect select;
 };
 
+// A reference prepared on one _MaskEngine: its volume (kept, so that a label
+// or convention asked later is prepared on first use) and one
+// masks::PreparedReference per (label, convention, connectivity).
+struct PyPrepared {
+    using Key = std::tuple<int32_t, bool, int, int>;  // label, any non-zero, convention, connectivity
+    PyVolume volume;
+    const void* owner = nullptr;  // the _MaskEngine that prepared it
+    std::map<Key, masks::PreparedReference> sets;
+
+    static Key key(masks::LabelSelect s, const masks::MaskOptions& o) {
+        return {s.anyNonZero ? 0 : s.value, s.anyNonZero, int(o.convention), o.connectivity};
+    }
+};
+
+// The result of compare(b, a) from compare(a, b): the directions and the
+// empty sides exchanged (the numbers of both directions are symmetric).
+MaskResult swapped(MaskResult r) {
+    std::swap(r.aToB, r.bToA);
+    std::swap(r.emptyMeanAToB, r.emptyMeanBToA);
+    if (r.empty == masks::EmptyStatus::kAEmpty) {
+        r.empty = masks::EmptyStatus::kBEmpty;
+    } else if (r.empty == masks::EmptyStatus::kBEmpty) {
+        r.empty = masks::EmptyStatus::kAEmpty;
+    }
+    return r;
+}
+
 // The rows' labels as the CLI chooses them: every non-zero voxel (None),
 // the given labels, or ("all") every label present in either volume (every
 // non-zero voxel when there is none).
@@ -232,60 +263,63 @@ public:
     py::list compare(const PyVolume& a, const PyVolume& b, const py::object& labels,
                      const std::vector<std::string>& conventions, const std::vector<double>& percentiles,
                      int connectivity, double tolerance, bool hostExtraction) {
-        if (conventions.empty()) throw py::value_error("no convention given");
-        std::vector<Convention> list;
-        for (const std::string& name : conventions) list.push_back(conventionFrom(name));
-        for (double p : percentiles)
-            if (!(p >= 0.0 && p <= 100.0))
-                throw py::value_error("percentile outside [0, 100]: " + std::string(py::str(py::float_(p))));
-        if (connectivity != 0 && connectivity != 6 && connectivity != 18 && connectivity != 26)
-            throw py::value_error("connectivity must be 6, 18 or 26 (or None: 6)");
-        if (!(tolerance >= 0.0 && std::isfinite(tolerance)))
-            throw py::value_error("tolerance must be a finite number >= 0 (mm)");
+        const std::vector<Convention> list =
+            checkedConventions(conventions, percentiles, connectivity, tolerance);
         if (auto e = masks::checkSameGrid(*a.volume, *b.volume)) raise(*e);
         const std::vector<Selection> rows = selectionsOf(labels, *a.volume, *b.volume);
+        const Settings settings{percentiles, connectivity, tolerance, hostExtraction};
+        return rowsOf(rows, list, settings, [&](const Selection& row, const masks::MaskOptions& mo) {
+            return masks::compareMasks(*m_engine, *a.volume, row.select, *b.volume, row.select, mo);
+        });
+    }
 
-        std::vector<std::pair<std::string, MaskResult>> results;
+    // The reference's labels (selectionsOf(labels, reference, reference)) x
+    // conventions, prepared now.
+    PyPrepared prepare(const PyVolume& reference, const py::object& labels,
+                       const std::vector<std::string>& conventions, int connectivity, bool hostExtraction) {
+        const std::vector<Convention> list = checkedConventions(conventions, {}, connectivity, 0.0);
+        const std::vector<Selection> rows = selectionsOf(labels, *reference.volume, *reference.volume);
+        PyPrepared out{reference, this, {}};
         std::optional<Error> error;
-        std::optional<py::error_already_set> interrupt;
         {
             py::gil_scoped_release release;
             std::lock_guard<std::mutex> lock(m_mutex);
             for (const Selection& row : rows) {
                 for (Convention c : list) {
-                    if (!m_engine) {
-                        error = Error{ErrorCode::kInvalidArgument, "this MaskEngine is closed"};
-                        break;
-                    }
-                    masks::MaskOptions mo;
-                    mo.convention = c;
-                    mo.connectivity = connectivity;
-                    mo.percentiles = percentiles;
-                    mo.tolerance = tolerance;
-                    mo.threads = m_threads;
-                    mo.hostExtraction = hostExtraction;
-                    Result<MaskResult> r =
-                        masks::compareMasks(*m_engine, *a.volume, row.select, *b.volume, row.select, mo);
-                    if (!r) {
-                        error = r.error();
-                        error->message = "label " + row.name + ": " + error->message;
-                        break;
-                    }
-                    results.emplace_back(row.name, std::move(*r));
-                    py::gil_scoped_acquire gil;  // Ctrl-C between rows
-                    if (PyErr_CheckSignals() != 0) {
-                        interrupt.emplace();
-                        break;
-                    }
+                    if (!error)
+                        error = prepared(out, row.select, options(c, {}, connectivity, 0.0, hostExtraction))
+                                    .error;
                 }
-                if (error || interrupt) break;
             }
         }
-        if (interrupt) throw std::move(*interrupt);
         if (error) raise(*error);
-        py::list out;
-        for (const auto& [name, r] : results) out.append(rowDict(name, r));
         return out;
+    }
+
+    // compare() with a prepared reference as A (or, referenceIsB, as B: the
+    // rows of compare(other, reference)).
+    py::list comparePrepared(PyPrepared& reference, const PyVolume& other, bool referenceIsB,
+                             const py::object& labels, const std::vector<std::string>& conventions,
+                             const std::vector<double>& percentiles, int connectivity, double tolerance,
+                             bool hostExtraction) {
+        if (reference.owner != this)
+            throw py::value_error(
+                "this PreparedReference was prepared on another MaskEngine: compare it there");
+        const std::vector<Convention> list =
+            checkedConventions(conventions, percentiles, connectivity, tolerance);
+        const masks::Volume& ref = *reference.volume.volume;
+        auto e = referenceIsB ? masks::checkSameGrid(*other.volume, ref)
+                              : masks::checkSameGrid(ref, *other.volume);
+        if (e) raise(*e);
+        const std::vector<Selection> rows = selectionsOf(labels, ref, *other.volume);
+        const Settings settings{percentiles, connectivity, tolerance, hostExtraction};
+        return rowsOf(rows, list, settings, [&](const Selection& row, const masks::MaskOptions& mo) {
+            Prepared p = prepared(reference, row.select, mo);
+            if (p.error) return Result<MaskResult>(*p.error);
+            Result<MaskResult> r = masks::compareMasks(*m_engine, *p.set, *other.volume, row.select, mo);
+            if (r && referenceIsB) return Result<MaskResult>(swapped(std::move(*r)));
+            return r;
+        });
     }
 
     void close() {
@@ -323,6 +357,96 @@ public:
     }
 
 private:
+    struct Settings {
+        std::vector<double> percentiles;
+        int connectivity = 0;
+        double tolerance = 1.0;
+        bool hostExtraction = false;
+    };
+    using CompareOne = std::function<Result<MaskResult>(const Selection&, const masks::MaskOptions&)>;
+
+    static std::vector<Convention> checkedConventions(const std::vector<std::string>& conventions,
+                                                      const std::vector<double>& percentiles,
+                                                      int connectivity, double tolerance) {
+        if (conventions.empty()) throw py::value_error("no convention given");
+        std::vector<Convention> list;
+        for (const std::string& name : conventions) list.push_back(conventionFrom(name));
+        for (double p : percentiles)
+            if (!(p >= 0.0 && p <= 100.0))
+                throw py::value_error("percentile outside [0, 100]: " + std::string(py::str(py::float_(p))));
+        if (connectivity != 0 && connectivity != 6 && connectivity != 18 && connectivity != 26)
+            throw py::value_error("connectivity must be 6, 18 or 26 (or None: 6)");
+        if (!(tolerance >= 0.0 && std::isfinite(tolerance)))
+            throw py::value_error("tolerance must be a finite number >= 0 (mm)");
+        return list;
+    }
+
+    masks::MaskOptions options(Convention c, const std::vector<double>& percentiles, int connectivity,
+                               double tolerance, bool hostExtraction) const {
+        masks::MaskOptions mo;
+        mo.convention = c;
+        mo.connectivity = connectivity;
+        mo.percentiles = percentiles;
+        mo.tolerance = tolerance;
+        mo.threads = m_threads;
+        mo.hostExtraction = hostExtraction;
+        return mo;
+    }
+
+    // The reference's set for (select, options), prepared on first use. Holds m_mutex.
+    struct Prepared {
+        const masks::PreparedReference* set = nullptr;
+        std::optional<Error> error;
+    };
+    Prepared prepared(PyPrepared& reference, masks::LabelSelect select, const masks::MaskOptions& mo) {
+        if (!m_engine) return {nullptr, Error{ErrorCode::kInvalidArgument, "this MaskEngine is closed"}};
+        const PyPrepared::Key key = PyPrepared::key(select, mo);
+        auto it = reference.sets.find(key);
+        if (it == reference.sets.end()) {
+            Result<masks::PreparedReference> p =
+                masks::prepareReference(*m_engine, *reference.volume.volume, select, mo);
+            if (!p) return {nullptr, p.error()};
+            it = reference.sets.emplace(key, std::move(*p)).first;
+        }
+        return {&it->second, std::nullopt};
+    }
+
+    // compareOne(row, options) per (label, convention), label-major, without
+    // the GIL (taken back between rows for Ctrl-C); the rows as dicts.
+    py::list rowsOf(const std::vector<Selection>& rows, const std::vector<Convention>& list,
+                    const Settings& s, const CompareOne& compareOne) {
+        std::vector<std::pair<std::string, MaskResult>> results;
+        std::optional<Error> error;
+        std::optional<py::error_already_set> interrupt;
+        {
+            py::gil_scoped_release release;
+            std::lock_guard<std::mutex> lock(m_mutex);
+            for (size_t i = 0; i < rows.size() * list.size() && !error && !interrupt; ++i) {
+                const Selection& row = rows[i / list.size()];
+                if (!m_engine) {
+                    error = Error{ErrorCode::kInvalidArgument, "this MaskEngine is closed"};
+                    break;
+                }
+                const Convention c = list[i % list.size()];
+                Result<MaskResult> r =
+                    compareOne(row, options(c, s.percentiles, s.connectivity, s.tolerance, s.hostExtraction));
+                if (!r) {
+                    error = r.error();
+                    error->message = "label " + row.name + ": " + error->message;
+                    break;
+                }
+                results.emplace_back(row.name, std::move(*r));
+                py::gil_scoped_acquire gil;  // Ctrl-C between rows
+                if (PyErr_CheckSignals() != 0) interrupt.emplace();
+            }
+        }
+        if (interrupt) throw std::move(*interrupt);
+        if (error) raise(*error);
+        py::list out;
+        for (const auto& [name, r] : results) out.append(rowDict(name, r));
+        return out;
+    }
+
     std::mutex m_mutex;
     std::optional<masks::MaskEngine> m_engine;
     int m_threads = 0;
@@ -363,6 +487,28 @@ void bindMasks(py::module_& m) {
         return out;
     });
 
+    py::class_<PyPrepared>(m, "_PreparedReference",
+                           "A reference prepared on one _MaskEngine (rthdist.PreparedReference).")
+        .def_property_readonly("volume", [](const PyPrepared& p) { return p.volume; })
+        .def("sets", [](const PyPrepared& p) {
+            py::list out;
+            for (const auto& [key, set] : p.sets) {
+                py::dict d;
+                d["label"] =
+                    std::get<1>(key) ? py::object(py::none()) : py::object(py::int_(std::get<0>(key)));
+                d["convention"] = masks::conventionName(set.convention());
+                d["connectivity"] = set.connectivity();
+                d["points"] = set.points();
+                d["selected_voxels"] = set.selectedVoxels();
+                d["host_bytes"] = set.hostBytes();
+                d["device_bytes"] = set.deviceBytes();
+                d["prepare_ms"] = set.prepareMs();
+                d["extraction"] = set.extraction();
+                out.append(d);
+            }
+            return out;
+        });
+
     py::class_<PyMaskEngine>(m, "_MaskEngine",
                              "The masks' Engine and boundary pass kept between calls (rthdist.MaskEngine).")
         .def(py::init<const std::string&, std::optional<int>, int, bool>(), py::arg("backend"),
@@ -370,6 +516,11 @@ void bindMasks(py::module_& m) {
         .def("compare", &PyMaskEngine::compare, py::arg("a"), py::arg("b"), py::arg("labels"),
              py::arg("conventions"), py::arg("percentiles"), py::arg("connectivity"), py::arg("tolerance"),
              py::arg("host_extraction"))
+        .def("prepare", &PyMaskEngine::prepare, py::arg("reference"), py::arg("labels"),
+             py::arg("conventions"), py::arg("connectivity"), py::arg("host_extraction"))
+        .def("compare_prepared", &PyMaskEngine::comparePrepared, py::arg("reference"), py::arg("other"),
+             py::arg("reference_is_b"), py::arg("labels"), py::arg("conventions"), py::arg("percentiles"),
+             py::arg("connectivity"), py::arg("tolerance"), py::arg("host_extraction"))
         .def("close", &PyMaskEngine::close)
         .def_property_readonly("closed", &PyMaskEngine::closed)
         .def_property_readonly("device", &PyMaskEngine::deviceName)

@@ -1,10 +1,12 @@
 // DeepMind surface-distance on the exact engine (masks.hpp has the
 // definition). Per direction X -> Y: X's surfels that are also surfels of Y
 // are at distance 0 and are not sent to the engine; the others query Y's
-// surfels in the spacing metric, and each distance is recomputed from the
-// engine's nearest surfel the way SciPy's EDT computes it. The (distance,
-// area) pairs are then sorted as DeepMind sorts them and every statistic is
-// summed in NumPy's order.
+// surfels in the spacing metric, as float coordinates centred on the volume
+// (VoxelMetric::corners: the frame and bound of voxel_metric.hpp, one frame
+// for both directions, so a prepared reference's surfels serve either), and
+// each distance is recomputed from the engine's nearest surfel the way
+// SciPy's EDT computes it. The (distance, area) pairs are then sorted as
+// DeepMind sorts them and every statistic is summed in NumPy's order.
 #include "masks/deepmind.hpp"
 
 #include <algorithm>
@@ -13,7 +15,6 @@
 #include <limits>
 #include <utility>
 
-#include "core/parallel.hpp"
 #include "masks/area_weighted.hpp"
 #include "masks/per_point_call.hpp"
 #include "masks/surfel_area.hpp"
@@ -21,11 +22,6 @@
 
 namespace rthdist::masks::detail {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 struct SurfelDirection {
     std::vector<double> distances, areas;  // sorted by (distance, area)
@@ -36,22 +32,6 @@ struct SurfelDirection {
 struct Timing {
     double extractMs = 0.0, distanceMs = 0.0;
 };
-
-// Corner (i, j, k) at voxel coordinates (i - 1/2, ...), in the spacing metric.
-std::vector<glm::dvec3> cornerCoordinates(const std::vector<uint64_t>& corners, const Volume& v,
-                                          int threads) {
-    std::vector<glm::dvec3> out(corners.size());
-    const glm::dvec3 s = v.spacing();
-    core::parallelChunks(corners.size(), size_t(1) << 16, threads, [&](size_t b, size_t e, int) {
-        for (size_t i = b; i < e; ++i) {
-            const auto c = cornerOf(corners[i], v.dims);
-            const glm::dvec3 at(static_cast<double>(c[0]), static_cast<double>(c[1]),
-                                static_cast<double>(c[2]));
-            out[i] = (at - 0.5) * s;
-        }
-    });
-    return out;
-}
 
 glm::dvec3 cornerWorld(const Volume& v, std::array<int64_t, 3> c) {
     return glm::dvec3(v.voxelToWorld *
@@ -91,8 +71,46 @@ void finish(std::vector<std::pair<double, double>>& pairs, SurfelDirection& d) {
     d.out.mean = d.weightedSum / d.out.area;
 }
 
-Result<SurfelDirection> directed(Engine& engine, const Volume& v, const Surfels& x, const Surfels& y,
-                                 const std::array<double, 256>& area, int threads, Timing& timing) {
+// The engine's nearest surfel of Y for each of `rest` (X's corners Y lacks),
+// searched in `metric`; the (distance, area) pairs with EDT distances on X's
+// grid `v`, and the farthest pair's corners in from/to.
+Result<std::vector<std::pair<double, double>>> searched(
+    const VoxelMetric& metric, const Volume& v, const Surfels& x, const Surfels& y,
+    const std::vector<size_t>& rest, const std::array<double, 256>& area, const NearestCall& nearestOf,
+    int threads, Timing& timing, std::array<int64_t, 3>& from, std::array<int64_t, 3>& to) {
+    auto t0 = Clock::now();
+    std::vector<uint64_t> queries(rest.size());
+    for (size_t i = 0; i < rest.size(); ++i) queries[i] = x.corners[rest[i]];
+    const std::vector<glm::vec3> q = metric.searchPoints(queries, threads);
+    timing.extractMs += msSince(t0);
+    t0 = Clock::now();
+    Result<HausdorffResult> r = nearestOf(q);
+    timing.distanceMs += msSince(t0);
+    if (!r) return r.error();
+    const std::vector<uint32_t>& nearest = r->aNearest.nearest;
+    if (nearest.size() != rest.size())
+        return Error{ErrorCode::kInternal, "masks: the engine returned no per-point nearest points"};
+    const glm::dvec3 s = v.spacing();
+    std::vector<std::pair<double, double>> pairs;
+    pairs.reserve(rest.size());
+    double worst = -1.0;
+    for (size_t i = 0; i < rest.size(); ++i) {
+        const auto p = cornerOf(queries[i], v.dims), n = cornerOf(y.corners[nearest[i]], v.dims);
+        const double dist = edtDistance(p, n, s);
+        pairs.push_back({dist, area[x.codes[rest[i]]]});
+        if (dist > worst) {
+            worst = dist;
+            from = p;
+            to = n;
+        }
+    }
+    return pairs;
+}
+
+// X -> Y: X's surfels that Y also has at 0, the others through `nearestOf`.
+Result<SurfelDirection> directed(const VoxelMetric& metric, const Volume& v, const Surfels& x,
+                                 const Surfels& y, const std::array<double, 256>& area,
+                                 const NearestCall& nearestOf, int threads, Timing& timing) {
     SurfelDirection d;
     std::vector<size_t> common, rest;
     splitCommon(x, y, common, rest);
@@ -101,31 +119,10 @@ Result<SurfelDirection> directed(Engine& engine, const Volume& v, const Surfels&
     for (size_t i : common) pairs.push_back({0.0, area[x.codes[i]]});
     std::array<int64_t, 3> from = cornerOf(x.corners[common.empty() ? 0 : common[0]], v.dims), to = from;
     if (!rest.empty()) {
-        auto t0 = Clock::now();
-        std::vector<uint64_t> queries(rest.size());
-        for (size_t i = 0; i < rest.size(); ++i) queries[i] = x.corners[rest[i]];
-        const std::vector<glm::dvec3> q = cornerCoordinates(queries, v, threads);
-        const std::vector<glm::dvec3> t = cornerCoordinates(y.corners, v, threads);
-        timing.extractMs += msSince(t0);
-        t0 = Clock::now();
-        Result<HausdorffResult> r = engine.compute(PointView(q), PointView(t), perPointCall(true));
-        timing.distanceMs += msSince(t0);
-        if (!r) return r.error();
-        const std::vector<uint32_t>& nearest = r->aNearest.nearest;
-        if (nearest.size() != rest.size())
-            return Error{ErrorCode::kInternal, "masks: the engine returned no per-point nearest points"};
-        const glm::dvec3 s = v.spacing();
-        double worst = -1.0;
-        for (size_t i = 0; i < rest.size(); ++i) {
-            const auto p = cornerOf(queries[i], v.dims), n = cornerOf(y.corners[nearest[i]], v.dims);
-            const double dist = edtDistance(p, n, s);
-            pairs.push_back({dist, area[x.codes[rest[i]]]});
-            if (dist > worst) {
-                worst = dist;
-                from = p;
-                to = n;
-            }
-        }
+        Result<std::vector<std::pair<double, double>>> far =
+            searched(metric, v, x, y, rest, area, nearestOf, threads, timing, from, to);
+        if (!far) return far.error();
+        pairs.insert(pairs.end(), far->begin(), far->end());
     }
     finish(pairs, d);
     d.out.voxel = from;
@@ -133,6 +130,18 @@ Result<SurfelDirection> directed(Engine& engine, const Volume& v, const Surfels&
     d.out.point = cornerWorld(v, from);
     d.out.nearestPoint = cornerWorld(v, to);
     return d;
+}
+
+// One-shot searches against Y's surfels.
+NearestCall oneShot(Engine& engine, const VoxelMetric& metric, const Surfels& y, int threads,
+                    Timing& timing) {
+    return
+        [&engine, &metric, &y, threads, &timing](const std::vector<glm::vec3>& q) -> Result<HausdorffResult> {
+            auto t0 = Clock::now();
+            const std::vector<glm::vec3> t = metric.searchPoints(y.corners, threads);
+            timing.extractMs += msSince(t0);
+            return engine.compute(PointView(q), PointView(t), perPointCall(true));
+        };
 }
 
 // Area of the direction's surfels within `tolerance` (a prefix of the sorted distances).
@@ -159,6 +168,33 @@ MaskResult emptyResult(uint64_t na, uint64_t nb, size_t percentiles) {
     return r;
 }
 
+// The numbers of both directions, area-weighted.
+MaskResult summary(const MaskOptions& options, SurfelDirection& ab, SurfelDirection& ba, const Timing& timing,
+                   Clock::time_point start) {
+    MaskResult r;
+    r.convention = Convention::kDeepmind;
+    r.connectivity = 0;
+    r.percentiles = options.percentiles;
+    r.hd = std::max(ab.out.hd, ba.out.hd);
+    for (double p : options.percentiles) {
+        ab.out.percentiles.push_back(areaWeightedPercentile(ab.distances, ab.areas, p));
+        ba.out.percentiles.push_back(areaWeightedPercentile(ba.distances, ba.areas, p));
+        r.hdPercentile.push_back(std::max(ab.out.percentiles.back(), ba.out.percentiles.back()));
+    }
+    const double withinA = areaWithin(ab, options.tolerance), withinB = areaWithin(ba, options.tolerance);
+    ab.out.surfaceOverlap = withinA / ab.out.area;
+    ba.out.surfaceOverlap = withinB / ba.out.area;
+    r.surfaceDice = (withinA + withinB) / (ab.out.area + ba.out.area);
+    r.assd = (ab.weightedSum + ba.weightedSum) / (ab.out.area + ba.out.area);
+    r.msd = 0.5 * (ab.out.mean + ba.out.mean);
+    r.aToB = std::move(ab.out);
+    r.bToA = std::move(ba.out);
+    r.extractMs = timing.extractMs;
+    r.distanceMs = timing.distanceMs;
+    r.totalMs = msSince(start);
+    return r;
+}
+
 }  // namespace
 
 Result<MaskResult> compareDeepmind(Engine& engine, const Volume& a, LabelSelect selectA, const Volume& b,
@@ -166,8 +202,14 @@ Result<MaskResult> compareDeepmind(Engine& engine, const Volume& a, LabelSelect 
     const auto start = Clock::now();
     const Surfels sa = extractSurfels(a, selectA, options.threads);
     const Surfels sb = extractSurfels(b, selectB, options.threads);
+    return compareSurfels(engine, a, sa, b, sb, options, nullptr, msSince(start), start);
+}
+
+Result<MaskResult> compareSurfels(Engine& engine, const Volume& a, const Surfels& sa, const Volume& b,
+                                  const Surfels& sb, const MaskOptions& options, const NearestCall* toA,
+                                  double extractMs, Clock::time_point start) {
     Timing timing;
-    timing.extractMs = msSince(start);
+    timing.extractMs = extractMs;
     if (sa.selected == 0 || sb.selected == 0) {
         MaskResult r = emptyResult(sa.selected, sb.selected, options.percentiles.size());
         r.convention = Convention::kDeepmind;
@@ -180,33 +222,16 @@ Result<MaskResult> compareDeepmind(Engine& engine, const Volume& a, LabelSelect 
         return r;
     }
     const std::array<double, 256> area = surfelAreaTable(a.spacing());
-    Result<SurfelDirection> ab = directed(engine, a, sa, sb, area, options.threads, timing);
+    const VoxelMetric metric = VoxelMetric::corners(a);
+    Result<SurfelDirection> ab =
+        directed(metric, a, sa, sb, area, oneShot(engine, metric, sb, options.threads, timing),
+                 options.threads, timing);
     if (!ab) return ab.error();
-    Result<SurfelDirection> ba = directed(engine, b, sb, sa, area, options.threads, timing);
+    Result<SurfelDirection> ba =
+        directed(metric, b, sb, sa, area, toA ? *toA : oneShot(engine, metric, sa, options.threads, timing),
+                 options.threads, timing);
     if (!ba) return ba.error();
-
-    MaskResult r;
-    r.convention = Convention::kDeepmind;
-    r.connectivity = 0;
-    r.percentiles = options.percentiles;
-    r.hd = std::max(ab->out.hd, ba->out.hd);
-    for (double p : options.percentiles) {
-        ab->out.percentiles.push_back(areaWeightedPercentile(ab->distances, ab->areas, p));
-        ba->out.percentiles.push_back(areaWeightedPercentile(ba->distances, ba->areas, p));
-        r.hdPercentile.push_back(std::max(ab->out.percentiles.back(), ba->out.percentiles.back()));
-    }
-    const double withinA = areaWithin(*ab, options.tolerance), withinB = areaWithin(*ba, options.tolerance);
-    ab->out.surfaceOverlap = withinA / ab->out.area;
-    ba->out.surfaceOverlap = withinB / ba->out.area;
-    r.surfaceDice = (withinA + withinB) / (ab->out.area + ba->out.area);
-    r.assd = (ab->weightedSum + ba->weightedSum) / (ab->out.area + ba->out.area);
-    r.msd = 0.5 * (ab->out.mean + ba->out.mean);
-    r.aToB = std::move(ab->out);
-    r.bToA = std::move(ba->out);
-    r.extractMs = timing.extractMs;
-    r.distanceMs = timing.distanceMs;
-    r.totalMs = msSince(start);
-    return r;
+    return summary(options, *ab, *ba, timing, start);
 }
 
 }  // namespace rthdist::masks::detail

@@ -161,4 +161,20 @@ Result<Extraction> extractBoundaryOnDevice(masks_gpu::BoundaryPass& pass, const 
     return std::move(e->front());
 }
 
+Result<std::vector<Extraction>> extractBoundaries(masks_gpu::BoundaryPass* pass,
+                                                  std::span<const MaskRef> masks, int connectivity,
+                                                  int threads, std::string& where) {
+    if (pass != nullptr) {
+        Result<std::vector<Extraction>> e = extractBoundariesOnDevice(*pass, masks, connectivity, threads);
+        if (e) {
+            where = "device";
+            return e;
+        }
+        if (e.error().code != ErrorCode::kOutOfMemory) return e.error();
+    }
+    std::vector<Extraction> out;
+    for (const MaskRef& m : masks) out.push_back(extractBoundary(*m.volume, m.select, connectivity, threads));
+    return out;
+}
+
 }  // namespace rthdist::masks::detail

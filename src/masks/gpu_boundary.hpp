@@ -12,6 +12,7 @@
 #pragma once
 
 #include <span>
+#include <string>
 #include <vector>
 
 #include "masks/boundary.hpp"
@@ -39,5 +40,13 @@ struct MaskRef {
 // One mask (as above).
 [[nodiscard]] Result<Extraction> extractBoundaryOnDevice(masks_gpu::BoundaryPass& pass, const Volume& v,
                                                          LabelSelect select, int connectivity, int threads);
+
+// The masks' boundaries through the pass (one submission) when there is one
+// (`pass` not null), else, or when a box does not fit it, on the host
+// (extractBoundary). `where` becomes "device" when the pass found them.
+[[nodiscard]] Result<std::vector<Extraction>> extractBoundaries(masks_gpu::BoundaryPass* pass,
+                                                                std::span<const MaskRef> masks,
+                                                                int connectivity, int threads,
+                                                                std::string& where);
 
 }  // namespace rthdist::masks::detail

@@ -28,6 +28,17 @@ VoxelMetric::VoxelMetric(const Volume& v, bool world)
     }
 }
 
+VoxelMetric::VoxelMetric(Dims dims, const glm::dmat3& linear, glm::dvec3 centre)
+    : m_dims(dims), m_linear(linear), m_centre(centre) {}
+
+VoxelMetric VoxelMetric::corners(const Volume& v) {
+    const glm::dvec3 s = v.spacing();
+    // Corner (n - 1) / 2 + 1/2 of an axis is the voxels' centre (n - 1) / 2.
+    return VoxelMetric({v.dims[0] + 1, v.dims[1] + 1, v.dims[2] + 1},
+                       glm::dmat3(s.x, 0.0, 0.0, 0.0, s.y, 0.0, 0.0, 0.0, s.z),
+                       glm::dvec3(0.5 * double(v.dims[0]), 0.5 * double(v.dims[1]), 0.5 * double(v.dims[2])));
+}
+
 std::vector<glm::vec3> VoxelMetric::searchPoints(const std::vector<uint64_t>& voxels, int threads) const {
     std::vector<glm::vec3> out(voxels.size());
     core::parallelChunks(voxels.size(), kChunk, threads, [&](size_t b, size_t e, int) {

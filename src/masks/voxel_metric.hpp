@@ -29,6 +29,11 @@ class VoxelMetric {
 public:
     // world: the affine's 3x3 part; else the spacing (column norms).
     VoxelMetric(const Volume& v, bool world);
+    // deepmind's surfel corners of v's grid ((nx + 1) x (ny + 1) x (nz + 1),
+    // corner c at voxel coordinates c - 1/2; surfels.hpp) in the spacing
+    // metric, centred as the voxels are: linear indices passed to
+    // searchPoints and distance are corner indices.
+    [[nodiscard]] static VoxelMetric corners(const Volume& v);
 
     // Float coordinates of `voxels` (linear indices) in the search frame.
     [[nodiscard]] std::vector<glm::vec3> searchPoints(const std::vector<uint64_t>& voxels, int threads) const;
@@ -36,6 +41,8 @@ public:
     [[nodiscard]] double distance(std::array<int64_t, 3> p, std::array<int64_t, 3> q) const;
 
 private:
+    VoxelMetric(Dims dims, const glm::dmat3& linear, glm::dvec3 centre);
+
     Dims m_dims;
     glm::dmat3 m_linear;  // voxel offset -> mm
     glm::dvec3 m_centre;  // voxel coordinates of the search frame's origin

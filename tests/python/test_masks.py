@@ -444,3 +444,67 @@ def test_an_image_without_sform_or_qform(tmp_path, pair):
         assert [e["value"] for e in r.hd_percentile] == pytest.approx([e["value"] for e in w["hd_percentile"]],
                                                                      rel=1e-12)
         assert r.a_to_b.points == w["a_to_b"]["points"] and r.b_to_a.points == w["b_to_a"]["points"]
+
+
+def values_only(r):
+    """A row without timings and extraction (where the boundary was found)."""
+    d = without_timings(r.to_dict())
+    d.pop("extraction")
+    return d
+
+
+def test_prepared_reference_equals_compare(backend, rng):
+    """One reference prepared once, 12 predictions (noisy, empty, one voxel,
+    identical): as a, every row equals compare(reference, prediction); as b,
+    compare(prediction, reference); every convention and label."""
+    shape = (22, 18, 10)
+    ref = blobs(shape, rng)
+    preds = [blobs(shape, rng) for _ in range(8)]
+    one = np.zeros(shape, np.uint8)
+    one[3, 4, 5] = 1
+    preds += [np.zeros(shape, np.int16), one, ref.copy(), (ref == 2).astype(np.bool_)]
+    kw = dict(convention="all", labels="all", percentiles=(50, 95, 100), tolerance=1.5)
+    with rthdist.MaskEngine(backend) as engine:
+        prepared = engine.prepare_reference(ref, spacing=SPACING, convention="all", labels="all")
+        assert isinstance(prepared, rthdist.PreparedReference) and prepared.engine is engine
+        assert len(prepared.prepared) == 2 * len(rthdist.CONVENTIONS)
+        assert prepared.host_bytes > 0 and (prepared.device_bytes > 0) == (backend != "cpu")
+        assert prepared.volume.shape == shape and np.allclose(prepared.volume.spacing, SPACING)
+        statuses = set()
+        for p in preds:
+            want_ab = engine.compare(ref, p, spacing=SPACING, **kw)
+            want_ba = engine.compare(p, ref, spacing=SPACING, **kw)
+            got_ab = engine.compare(prepared, p, **kw)
+            got_ba = engine.compare(p, prepared, **kw)
+            assert [values_only(r) for r in got_ab] == [values_only(r) for r in want_ab]
+            assert [values_only(r) for r in got_ba] == [values_only(r) for r in want_ba]
+            statuses |= {r.status for r in got_ba}
+        assert {"ok", "a_empty"} <= statuses
+        # A convention or connectivity asked later is prepared on first use.
+        before = len(prepared.prepared)
+        got = engine.compare(preds[0], prepared, convention="medpy", connectivity=26)
+        want = engine.compare(preds[0], ref, spacing=SPACING, convention="medpy", connectivity=26)
+        assert values_only(got) == values_only(want)
+        assert len(prepared.prepared) == before + 1
+        # compare_masks runs on the reference's engine.
+        assert values_only(rthdist.compare_masks(preds[1], prepared, convention="itk")) == \
+            values_only(engine.compare(preds[1], ref, spacing=SPACING, convention="itk"))
+
+
+def test_prepared_reference_refusals(rng):
+    shape = (12, 10, 8)
+    ref = blobs(shape, rng, labels=(1,))
+    with rthdist.MaskEngine("cpu") as engine, rthdist.MaskEngine("cpu") as other:
+        prepared = engine.prepare_reference(ref, spacing=SPACING, convention="monai")
+        with pytest.raises(ValueError, match="another MaskEngine"):
+            other.compare(ref, prepared)
+        with pytest.raises(ValueError, match="different grids"):
+            engine.compare(np.zeros((12, 10, 9), np.uint8), prepared)
+        with pytest.raises(ValueError, match="different grids"):
+            engine.compare(ref, prepared, spacing=(1.0, 1.0, 1.0))
+        with pytest.raises(ValueError, match="another PreparedReference"):
+            engine.compare(prepared, prepared)
+        with pytest.raises(ValueError, match="percentile"):
+            engine.compare(ref, prepared, percentiles=(101,))
+    with pytest.raises(ValueError, match="closed"):
+        engine.compare(ref, prepared)

@@ -2,12 +2,16 @@
 // segmentation masks (NIfTI-1/2 .nii/.nii.gz, NumPy .npy) in a named tool's
 // convention (src/masks/masks.hpp; README "Segmentation masks").
 //
-//   rthdist-masks A B [--label N | --labels all] [--convention NAME|all]
+//   rthdist-masks A B [B2 ...] [--label N | --labels all] [--convention NAME|all]
 //                 [--percentile P]... [--connectivity 6|18|26] [--tolerance MM]
 //                 [--spacing X,Y,Z | --affine 12 numbers] [--backend B] [--device N]
 //                 [--threads N] [--host-extraction] [--repeat N]
-//                 [--json | --csv]
+//                 [--unprepared] [--json | --csv]
 //
+// With more than one B, A is a reference compared with each B in turn
+// through a prepared reference (masks/prepared_reference.hpp: A extracted
+// and indexed once per label and convention); one row per (B, label,
+// convention), each naming its B.
 // A separate executable from `rthdist` (tools/cli/main.cpp), with its own
 // options on the same CLI11 front end (cli/command_line.hpp). Exit codes are
 // the point CLI's (cli/exit_codes.hpp): 0 ok, 1 internal, 2 usage, 3 bad
@@ -18,6 +22,7 @@
 #include <cstdio>
 #include <exception>
 #include <functional>
+#include <map>
 #include <new>
 #include <optional>
 #include <set>
@@ -32,6 +37,7 @@
 #include "cli/exit_codes.hpp"
 #include "cli/json_output.hpp"
 #include "masks/masks.hpp"
+#include "masks/prepared_reference.hpp"
 
 namespace rthdist::cli {
 namespace {
@@ -40,9 +46,10 @@ using masks::Convention;
 using masks::MaskResult;
 
 struct MasksArgs {
-    std::string pathA, pathB;
-    std::optional<int32_t> label;  // --label N (both volumes)
-    bool allLabels = false;        // --labels all
+    std::string pathA;
+    std::vector<std::string> pathsB;  // one, or several predictions of the reference A
+    std::optional<int32_t> label;     // --label N (both volumes)
+    bool allLabels = false;           // --labels all
     std::vector<Convention> conventions{Convention::kRthdist};
     std::vector<double> percentiles;
     int connectivity = 0;
@@ -52,13 +59,16 @@ struct MasksArgs {
     Options options;
     bool json = false, csv = false, help = false, version = false;
     bool hostExtraction = false;  // --host-extraction
+    bool unprepared = false;      // --unprepared: several Bs without a prepared reference
     int repeat = 1;               // --repeat N: each comparison N times (benchmarks)
 };
 
 const char* kUsage =
-    "usage: rthdist-masks A B [options]\n"
+    "usage: rthdist-masks A B [B2 ...] [options]\n"
     "Hausdorff distance, HD-p, ASSD/MSD and surface Dice between two segmentation masks\n"
     "(.nii, .nii.gz: NIfTI-1/2 with sform, else qform, else pixdim; .npy with --spacing).\n"
+    "With several Bs, A is a reference compared with each (one row per B, label and\n"
+    "convention), extracted and indexed once per label and convention.\n"
     "  --label N            compare label N in both volumes (default: every non-zero voxel)\n"
     "  --labels all         one row per label present in either volume\n"
     "  --convention NAME    rthdist (default), monai, medpy, plastimatch, itk, deepmind,\n"
@@ -75,6 +85,8 @@ const char* kUsage =
     "                       (default there: a compute shader)\n"
     "  --repeat N           run each comparison N times in this process (benchmarks: JSON\n"
     "                       lists every run's time; the numbers are the last run's)\n"
+    "  --unprepared         several Bs: extract and index A again for each (benchmarks;\n"
+    "                       the same numbers)\n"
     "  --json | --csv       output format (default: text)\n"
     "Exit codes: 0 ok, 1 internal error, 2 usage, 3 bad input or different grids, 4 no device.\n";
 
@@ -214,24 +226,28 @@ Result<MasksArgs> parse(std::span<const std::string> argv) {
     // Flags ignore a value ("--json=x" is --json).
     for (auto [name, target] :
          {std::pair{"--help", &a.help}, std::pair{"--version", &a.version}, std::pair{"--json", &a.json},
-          std::pair{"--csv", &a.csv}, std::pair{"--host-extraction", &a.hostExtraction}}) {
+          std::pair{"--csv", &a.csv}, std::pair{"--host-extraction", &a.hostExtraction},
+          std::pair{"--unprepared", &a.unprepared}}) {
         line.flag(name, [target = target](bool) { *target = true; });
     }
     addMeasureOptions(line, a, conventionSet);
     if (auto error = line.parse(argv)) return usage(*error);
 
     if (a.help || a.version) return a;
-    if (files.size() != 2) return usage("expected two mask files A B, got " + std::to_string(files.size()));
+    if (files.size() < 2)
+        return usage("expected two mask files A B (or a reference A and several B), got " +
+                     std::to_string(files.size()));
     if (a.label && a.allLabels) return usage("--label and --labels all exclude each other");
     if (a.json && a.csv) return usage("--json and --csv exclude each other");
     if (a.affine && a.spacing != glm::dvec3(1.0)) return usage("--spacing and --affine exclude each other");
     a.pathA = files[0];
-    a.pathB = files[1];
+    a.pathsB.assign(files.begin() + 1, files.end());
     if (a.percentiles.empty()) a.percentiles.push_back(95.0);
     return a;
 }
 
 struct Row {
+    std::string b;                 // the B compared (several Bs only; else "")
     std::string label;             // "nonzero" or the label value
     MaskResult r;                  // the last run's
     std::vector<double> totalsMs;  // --repeat: every run's total
@@ -281,15 +297,17 @@ Json directedJson(const masks::DirectedMask& d, const MaskResult& r, bool ok) {
 Json rowJson(const Row& row) {
     const MaskResult& r = row.r;
     const bool ok = r.empty == masks::EmptyStatus::kNone;
-    Json out = {{"label", row.label},
-                {"convention", masks::conventionName(r.convention)},
-                {"rule", masks::conventionRule(r.convention)},
-                {"connectivity", r.connectivity},
-                {"geometry", r.convention == Convention::kRthdist ? "world" : "spacing"},
-                {"points_are", r.convention == Convention::kDeepmind ? "surfels"
-                               : r.convention == Convention::kItk    ? "voxels"
-                                                                     : "boundary_voxels"},
-                {"status", masks::emptyStatusName(r.empty)}};
+    Json out = Json::object();
+    if (!row.b.empty()) out["b"] = row.b;
+    out.update(Json{{"label", row.label},
+                    {"convention", masks::conventionName(r.convention)},
+                    {"rule", masks::conventionRule(r.convention)},
+                    {"connectivity", r.connectivity},
+                    {"geometry", r.convention == Convention::kRthdist ? "world" : "spacing"},
+                    {"points_are", r.convention == Convention::kDeepmind ? "surfels"
+                                   : r.convention == Convention::kItk    ? "voxels"
+                                                                         : "boundary_voxels"},
+                    {"status", masks::emptyStatusName(r.empty)}});
     if (!ok) {
         out["convention_value"] = {{"hd", r.emptyHd}, {"hd_percentile", r.emptyHdPercentile}};
         if (!r.emptySurfaceDice.empty()) {
@@ -319,27 +337,62 @@ Json rowJson(const Row& row) {
     return out;
 }
 
-std::string jsonReport(const MasksArgs& args, const masks::Volume& a, const masks::Volume& b,
-                       const Engine& engine, const std::vector<Row>& rows) {
+// A prepared reference of a run with several Bs, as the JSON reports it.
+struct PreparedInfo {
+    std::string label;
+    Convention convention;
+    uint64_t points = 0, hostBytes = 0, deviceBytes = 0;
+    double prepareMs = 0.0;
+    std::string extraction;
+};
+
+// The volumes compared with A: {"b": B} with one, {"predictions": [...]} with several.
+struct Report {
+    const masks::Volume* a = nullptr;
+    std::vector<Json> bs;
+    std::vector<PreparedInfo> prepared;
+    std::vector<Row> rows;
+};
+
+Json preparedJson(const std::vector<PreparedInfo>& prepared) {
+    Json out = Json::array();
+    for (const PreparedInfo& p : prepared)
+        out.push_back({{"label", p.label},
+                       {"convention", masks::conventionName(p.convention)},
+                       {"points", p.points},
+                       {"host_bytes", p.hostBytes},
+                       {"device_bytes", p.deviceBytes},
+                       {"prepare_ms", p.prepareMs},
+                       {"extraction", p.extraction}});
+    return out;
+}
+
+std::string jsonReport(const MasksArgs& args, const Report& report, const Engine& engine) {
     Json results = Json::array();
-    for (const Row& row : rows) results.push_back(rowJson(row));
-    const Json j = {{"tool", "rthdist-masks"},
-                    {"version", versionString()},
-                    {"a", volumeJson(a)},
-                    {"b", volumeJson(b)},
-                    {"backend", backendName(engine.backend())},
-                    {"device", engine.deviceName()},
-                    {"tolerance_mm", args.tolerance},
-                    {"results", std::move(results)}};
+    for (const Row& row : report.rows) results.push_back(rowJson(row));
+    Json j = {{"tool", "rthdist-masks"}, {"version", versionString()}, {"a", volumeJson(*report.a)}};
+    if (args.pathsB.size() == 1) {
+        j["b"] = report.bs.front();
+    } else {
+        j["predictions"] = report.bs;
+        j["prepared_reference"] = !args.unprepared;
+        j["prepared"] = preparedJson(report.prepared);
+    }
+    j.update(Json{{"backend", backendName(engine.backend())},
+                  {"device", engine.deviceName()},
+                  {"tolerance_mm", args.tolerance},
+                  {"results", std::move(results)}});
     return jsonText(j) + "\n";
 }
 
 std::string csvReport(const MasksArgs& args, const std::vector<Row>& rows) {
-    std::string out = "label,convention,status,hd";
+    const bool several = args.pathsB.size() > 1;
+    std::string out = several ? "b,label,convention,status,hd" : "label,convention,status,hd";
     for (double p : args.percentiles) out += ",hd" + num(p);
     out += ",assd,msd,surface_dice,a_to_b_hd,b_to_a_hd,a_points,b_points,total_ms\n";
     for (const Row& row : rows) {
         const MaskResult& r = row.r;
+        if (several) out += row.b + ",";
         out += row.label + "," + masks::conventionName(r.convention) + "," + masks::emptyStatusName(r.empty) +
                "," + num(r.hd);
         for (size_t i = 0; i < args.percentiles.size(); ++i)
@@ -357,6 +410,7 @@ std::string textReport(const MasksArgs& args, const Engine& engine, const std::v
     char line[512];
     for (const Row& row : rows) {
         const MaskResult& r = row.r;
+        if (!row.b.empty()) out += row.b + "  ";
         std::snprintf(line, sizeof line, "label %s  %-11s ", row.label.c_str(),
                       masks::conventionName(r.convention));
         out += line;
@@ -394,6 +448,103 @@ int fail(int code, const std::string& message) {
     return code;
 }
 
+using Selections = std::vector<std::pair<std::string, masks::LabelSelect>>;
+
+// The rows' labels: every label present in A or B (--labels all), one
+// label, or every non-zero voxel.
+Selections selectionsOf(const MasksArgs& args, const masks::Volume& a, const masks::Volume& b) {
+    Selections selections;
+    if (args.allLabels) {
+        std::set<int32_t> labels;
+        for (int32_t l : masks::labelsPresent(a)) labels.insert(l);
+        for (int32_t l : masks::labelsPresent(b)) labels.insert(l);
+        for (int32_t l : labels) selections.push_back({std::to_string(l), masks::LabelSelect{l, false}});
+        if (selections.empty()) selections.push_back({"nonzero", masks::LabelSelect{1, true}});
+    } else if (args.label) {
+        selections.push_back({std::to_string(*args.label), masks::LabelSelect{*args.label, false}});
+    } else {
+        selections.push_back({"nonzero", masks::LabelSelect{1, true}});
+    }
+    return selections;
+}
+
+masks::MaskOptions maskOptions(const MasksArgs& args, Convention c) {
+    masks::MaskOptions mo;
+    mo.convention = c;
+    mo.connectivity = args.connectivity;
+    mo.percentiles = args.percentiles;
+    mo.tolerance = args.tolerance;
+    mo.threads = args.options.threads;
+    mo.hostExtraction = args.hostExtraction;
+    return mo;
+}
+
+// A's prepared references of a run with several Bs, one per (label, convention).
+using PreparedCache = std::map<std::pair<std::string, Convention>, masks::PreparedReference>;
+
+// The comparison of A's `select` with B's, args.repeat times, as one row:
+// through A's prepared reference (created on first use) when `cache` is given.
+Result<Row> compareRow(const MasksArgs& args, masks::MaskEngine& engine, const masks::Volume& a,
+                       const masks::Volume& b, const std::string& label, masks::LabelSelect select,
+                       Convention c, PreparedCache* cache, Report& report) {
+    const masks::MaskOptions mo = maskOptions(args, c);
+    const masks::PreparedReference* prepared = nullptr;
+    if (cache != nullptr) {
+        auto it = cache->find({label, c});
+        if (it == cache->end()) {
+            Result<masks::PreparedReference> p = masks::prepareReference(engine, a, select, mo);
+            if (!p) return p.error();
+            report.prepared.push_back(
+                {label, c, p->points(), p->hostBytes(), p->deviceBytes(), p->prepareMs(), p->extraction()});
+            it = cache->emplace(std::pair{label, c}, std::move(*p)).first;
+        }
+        prepared = &it->second;
+    }
+    Row row{args.pathsB.size() > 1 ? b.path : "", label, {}, {}};
+    for (int run = 0; run < args.repeat; ++run) {
+        Result<MaskResult> r = prepared ? masks::compareMasks(engine, *prepared, b, select, mo)
+                                        : masks::compareMasks(engine, a, select, b, select, mo);
+        if (!r) return r.error();
+        row.totalsMs.push_back(r->totalMs);
+        row.r = std::move(*r);
+    }
+    return row;
+}
+
+// B read and checked against A's grid.
+Result<masks::Volume> loadB(const MasksArgs& args, const masks::Volume& a, const std::string& path) {
+    Result<masks::Volume> b = masks::loadVolume(path, args.spacing, args.affine);
+    if (!b) return b;
+    if (auto e = masks::checkSameGrid(a, *b)) return *e;
+    return b;
+}
+
+// Every B in turn (loaded one at a time; the first may be given), its rows
+// appended to `report`; 0 or the exit code after the message.
+int compareAll(const MasksArgs& args, masks::MaskEngine& engine, const masks::Volume& a,
+               std::optional<masks::Volume> first, Report& report) {
+    PreparedCache cache;
+    const bool prepare = args.pathsB.size() > 1 && !args.unprepared;
+    for (const std::string& path : args.pathsB) {
+        Result<masks::Volume> b = first ? Result<masks::Volume>(std::move(*first)) : loadB(args, a, path);
+        first.reset();
+        if (!b) return fail(exitCodeFor(b.error().code), b.error().message);
+        report.bs.push_back(volumeJson(*b));
+        for (const auto& [name, select] : selectionsOf(args, a, *b)) {
+            for (Convention c : args.conventions) {
+                Result<Row> row =
+                    compareRow(args, engine, a, *b, name, select, c, prepare ? &cache : nullptr, report);
+                if (!row) {
+                    const std::string where = args.pathsB.size() > 1 ? path + ": label " : "label ";
+                    return fail(exitCodeFor(row.error().code), where + name + ": " + row.error().message);
+                }
+                report.rows.push_back(std::move(*row));
+            }
+        }
+    }
+    return kExitOk;
+}
+
 int run(int argc, char** argv) {
     std::vector<std::string> list(argv + 1, argv + argc);
     Result<MasksArgs> parsed = parse(list);
@@ -404,49 +555,21 @@ int run(int argc, char** argv) {
 
     Result<masks::Volume> a = masks::loadVolume(args.pathA, args.spacing, args.affine);
     if (!a) return fail(exitCodeFor(a.error().code), a.error().message);
-    Result<masks::Volume> b = masks::loadVolume(args.pathB, args.spacing, args.affine);
-    if (!b) return fail(exitCodeFor(b.error().code), b.error().message);
-    if (auto e = masks::checkSameGrid(*a, *b)) return fail(exitCodeFor(e->code), e->message);
-
-    std::vector<std::pair<std::string, masks::LabelSelect>> selections;
-    if (args.allLabels) {
-        std::set<int32_t> labels;
-        for (int32_t l : masks::labelsPresent(*a)) labels.insert(l);
-        for (int32_t l : masks::labelsPresent(*b)) labels.insert(l);
-        for (int32_t l : labels) selections.push_back({std::to_string(l), masks::LabelSelect{l, false}});
-        if (selections.empty()) selections.push_back({"nonzero", masks::LabelSelect{1, true}});
-    } else if (args.label) {
-        selections.push_back({std::to_string(*args.label), masks::LabelSelect{*args.label, false}});
-    } else {
-        selections.push_back({"nonzero", masks::LabelSelect{1, true}});
+    std::optional<masks::Volume> first;  // both files read and checked before the engine starts
+    if (args.pathsB.size() == 1) {
+        Result<masks::Volume> b = loadB(args, *a, args.pathsB[0]);
+        if (!b) return fail(exitCodeFor(b.error().code), b.error().message);
+        first = std::move(*b);
     }
-
     Result<masks::MaskEngine> engine = masks::makeMaskEngine(args.options);
     if (!engine) return fail(exitCodeFor(engine.error().code), engine.error().message);
-
-    std::vector<Row> rows;
-    for (const auto& [name, select] : selections) {
-        for (Convention c : args.conventions) {
-            masks::MaskOptions mo;
-            mo.convention = c;
-            mo.connectivity = args.connectivity;
-            mo.percentiles = args.percentiles;
-            mo.tolerance = args.tolerance;
-            mo.threads = args.options.threads;
-            mo.hostExtraction = args.hostExtraction;
-            Row row{name, {}, {}};
-            for (int run = 0; run < args.repeat; ++run) {
-                Result<MaskResult> r = masks::compareMasks(*engine, *a, select, *b, select, mo);
-                if (!r) return fail(exitCodeFor(r.error().code), "label " + name + ": " + r.error().message);
-                row.totalsMs.push_back(r->totalMs);
-                row.r = std::move(*r);
-            }
-            rows.push_back(std::move(row));
-        }
-    }
-    const std::string text = args.json  ? jsonReport(args, *a, *b, engine->engine, rows)
-                             : args.csv ? csvReport(args, rows)
-                                        : textReport(args, engine->engine, rows);
+    Report report;
+    report.a = &*a;
+    if (const int code = compareAll(args, *engine, *a, std::move(first), report); code != kExitOk)
+        return code;
+    const std::string text = args.json  ? jsonReport(args, report, engine->engine)
+                             : args.csv ? csvReport(args, report.rows)
+                                        : textReport(args, engine->engine, report.rows);
     if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
         return fail(kExitInternal, "cannot write to stdout");
     return kExitOk;

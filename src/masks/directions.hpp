@@ -1,0 +1,79 @@
+// The two directions of a voxel comparison (every convention but deepmind)
+// and the numbers made from them, shared by compareMasks (compare.cpp) and
+// the prepared reference's comparisons (prepared_reference.cpp), so a
+// prepared reference reports what the one-shot call reports. Internal to
+// rthdist_masks.
+//
+// A direction X -> Y: X's points (voxels) sent to the engine as queries,
+// Y's as targets, both in ONE float search frame (VoxelMetric: the first
+// volume's, A's, for both directions), every distance then recomputed in
+// double from the voxel pair (voxel_metric.hpp), zeros (X's voxels inside Y,
+// itk) added without a search.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "masks/masks.hpp"
+#include "masks/voxel_metric.hpp"
+
+namespace rthdist::masks::detail {
+
+using Clock = std::chrono::steady_clock;
+[[nodiscard]] double msSince(Clock::time_point t);
+
+struct Direction {
+    std::vector<double> distances;  // all of X's distances, in no particular order (zeros included)
+    DirectedMask out;
+    double sum = 0.0;
+};
+
+// The connectivity convention c measures boundaries with (`requested`: MaskOptions::connectivity).
+[[nodiscard]] int connectivityOf(Convention c, int requested);
+
+// compareMasks's checks of the options (connectivity, percentiles, tolerance).
+[[nodiscard]] std::optional<Error> checkOptions(const MaskOptions& options);
+
+// Adds one call's stage timings and its total to `sum`.
+void addTimings(Timings& sum, const Timings& t);
+
+// X's side of an engine call: `queries` (X's voxels sent, in the call's
+// order), `nearest` the engine's per-point output (indices into `targets`),
+// plus `zeros` more of X's voxels at distance 0 that were not sent. Distances
+// in `metric`, witness points on X's grid `v`; the mean and points filled.
+[[nodiscard]] Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric,
+                                            const std::vector<uint64_t>& queries, const PerPoint& nearest,
+                                            const std::vector<uint64_t>& targets, uint64_t zeros,
+                                            int threads);
+
+// The engine's per-point search of float query points against one target
+// set it already holds (or is given with the call).
+using NearestCall = std::function<Result<HausdorffResult>(const std::vector<glm::vec3>& queries)>;
+
+// A one-shot call against `targets` (voxels, put in `metric`'s frame at each
+// call; `timed.extractMs` gains that); the arguments must outlive it.
+[[nodiscard]] NearestCall oneShotCall(Engine& engine, const VoxelMetric& metric,
+                                      const std::vector<uint64_t>& targets, int threads, MaskResult& timed);
+
+// One direction of itk: `queries` (X's voxels outside Y), `zeros` more of
+// X's voxels at distance 0 (zeroWitness: one of them), `targets` (Y's
+// boundary voxels, searched by `nearest`); X's grid `v`. `timed` gains the
+// extraction, distance and engine times.
+[[nodiscard]] Result<Direction> directed(const VoxelMetric& metric, const Volume& v,
+                                         const std::vector<uint64_t>& queries, uint64_t zeros,
+                                         uint64_t zeroWitness, const std::vector<uint64_t>& targets,
+                                         const NearestCall& nearest, int threads, MaskResult& timed);
+
+// The convention's empty status and values for masks with na and nb points
+// (one of them 0), NaN in every number.
+void setEmpty(uint64_t na, uint64_t nb, size_t percentiles, MaskResult& r);
+
+// HD, ASSD, MSD, surface overlaps and Dice and (but for itk) the HD-p of
+// options.convention from both directions, moved into r.aToB and r.bToA.
+void combine(const MaskOptions& options, Direction& ab, Direction& ba, MaskResult& r);
+
+}  // namespace rthdist::masks::detail

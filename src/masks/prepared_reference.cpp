@@ -1,0 +1,276 @@
+// A reference prepared once (prepared_reference.hpp): the reference's side
+// of every convention is extracted and indexed here, and each comparison
+// does the prediction's side and the same arithmetic as compareMasks
+// (directions.hpp, deepmind.hpp).
+#include "masks/prepared_reference.hpp"
+
+#include <array>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "masks/boundary.hpp"
+#include "masks/deepmind.hpp"
+#include "masks/directions.hpp"
+#include "masks/gpu_boundary.hpp"
+#include "masks/per_point_call.hpp"
+#include "masks/selection_bits.hpp"
+#include "masks/surfels.hpp"
+#include "masks/voxel_metric.hpp"
+#include "masks_gpu/boundary_pass.hpp"
+
+namespace rthdist::masks {
+
+struct PreparedReference::State {
+    Volume grid;  // the reference without its labels
+    LabelSelect select;
+    Convention convention = Convention::kRthdist;
+    int connectivity = 6;          // of the boundary (itk: 6; deepmind: unused)
+    detail::Extraction extracted;  // boundary conventions and itk: count and boundary voxels
+    detail::SelectionBits bits;    // itk
+    detail::Surfels surfels;       // deepmind
+    std::optional<PreparedSet> set;
+    double prepareMs = 0.0;
+    std::string extraction = "host";
+};
+
+namespace {
+
+using detail::Clock;
+using detail::Direction;
+using detail::msSince;
+using State = PreparedReference::State;
+
+enum class PointKind { kBoundary, kForeground, kSurfels };
+
+PointKind kindOf(Convention c) {
+    return c == Convention::kItk        ? PointKind::kForeground
+           : c == Convention::kDeepmind ? PointKind::kSurfels
+                                        : PointKind::kBoundary;
+}
+
+// The frame both directions search in: the reference's (A's) grid.
+detail::VoxelMetric metricOf(const State& s) {
+    return s.convention == Convention::kDeepmind
+               ? detail::VoxelMetric::corners(s.grid)
+               : detail::VoxelMetric(s.grid, s.convention == Convention::kRthdist);
+}
+
+std::string pointsText(Convention c, int connectivity) {
+    switch (kindOf(c)) {
+        case PointKind::kForeground: return "all foreground voxels";
+        case PointKind::kSurfels: return "surfels";
+        case PointKind::kBoundary: break;
+    }
+    return std::to_string(connectivity) + "-connected boundary voxels in the " +
+           (c == Convention::kRthdist ? "world" : "spacing") + " metric";
+}
+
+// Empty when `options` measure the point set the reference was prepared with.
+std::optional<Error> checkPreparedFor(const State& s, const MaskOptions& options) {
+    const Convention c = options.convention;
+    const int conn = detail::connectivityOf(c, options.connectivity);
+    const bool same =
+        kindOf(c) == kindOf(s.convention) &&
+        (kindOf(c) != PointKind::kBoundary ||
+         (conn == s.connectivity && (c == Convention::kRthdist) == (s.convention == Convention::kRthdist)));
+    if (same) return std::nullopt;
+    return Error{ErrorCode::kInvalidArgument,
+                 std::string("masks: the reference ") + s.grid.path + " was prepared for convention '" +
+                     conventionName(s.convention) + "' (" + pointsText(s.convention, s.connectivity) +
+                     "); convention '" + conventionName(c) + "' needs " + pointsText(c, conn) +
+                     ": prepare the reference for it"};
+}
+
+// Prepares `points` (voxels or corners of the reference) in the search frame.
+Result<PreparedSet> prepareSet(Engine& engine, const detail::VoxelMetric& metric,
+                               const std::vector<uint64_t>& points, int threads) {
+    const std::vector<glm::vec3> p = metric.searchPoints(points, threads);
+    return engine.prepare(PointView(p));
+}
+
+// Searches float queries against the reference's prepared set.
+detail::NearestCall againstReference(Engine& engine, const PreparedSet& reference) {
+    return [&engine, &reference](const std::vector<glm::vec3>& q) -> Result<HausdorffResult> {
+        Result<PreparedSet> queries = engine.prepare(PointView(q));
+        if (!queries) return queries.error();
+        return engine.compute(*queries, reference, detail::perPointCall(true));
+    };
+}
+
+// The prediction's boundary (one mask through extractBoundaries).
+Result<detail::Extraction> extractOne(MaskEngine& engine, const Volume& v, LabelSelect select,
+                                      int connectivity, const MaskOptions& options, std::string& where) {
+    masks_gpu::BoundaryPass* pass = options.hostExtraction ? nullptr : engine.boundaryPass.get();
+    const detail::MaskRef mask{&v, select};
+    Result<std::vector<detail::Extraction>> e =
+        detail::extractBoundaries(pass, std::span(&mask, 1), connectivity, options.threads, where);
+    if (!e) return e.error();
+    return std::move(e->front());
+}
+
+// rthdist, monai, medpy, plastimatch: the prediction's boundary prepared,
+// both directions in one call on the two prepared sets.
+Result<std::array<Direction, 2>> boundaryDirections(Engine& engine, const State& s, const Volume& b,
+                                                    const detail::Extraction& eb, int threads,
+                                                    MaskResult& r) {
+    auto t0 = Clock::now();
+    const detail::VoxelMetric metric = metricOf(s);
+    const std::vector<glm::vec3> pb = metric.searchPoints(eb.boundary, threads);
+    r.extractMs += msSince(t0);
+    t0 = Clock::now();
+    Result<PreparedSet> prediction = engine.prepare(PointView(pb));
+    if (!prediction) return prediction.error();
+    Result<HausdorffResult> h = engine.compute(*s.set, *prediction, detail::perPointCall(false));
+    if (!h) return h.error();
+    detail::addTimings(r.engine, h->timings);
+    const std::vector<uint64_t>& ba = s.extracted.boundary;
+    Result<Direction> ab = detail::directionOf(s.grid, metric, ba, h->aNearest, eb.boundary, 0, threads);
+    if (!ab) return ab.error();
+    Result<Direction> bA = detail::directionOf(b, metric, eb.boundary, h->bNearest, ba, 0, threads);
+    if (!bA) return bA.error();
+    r.distanceMs += msSince(t0);
+    return std::array<Direction, 2>{std::move(*ab), std::move(*bA)};
+}
+
+// itk: the reference's voxels outside the prediction query the prediction's
+// boundary (one-shot); the prediction's voxels outside the reference query
+// the reference's prepared boundary.
+Result<std::array<Direction, 2>> itkDirections(Engine& engine, const State& s, const Volume& b,
+                                               LabelSelect sb, const detail::Extraction& eb, int threads,
+                                               MaskResult& r) {
+    const auto t0 = Clock::now();
+    const std::vector<uint64_t> outsideB = s.bits.minus(b, sb, threads);
+    const std::vector<uint64_t> outsideA = s.bits.missingFrom(b, sb, threads);
+    const uint64_t zerosA = s.extracted.count - outsideB.size(), zerosB = eb.count - outsideA.size();
+    const uint64_t zeroWitness = zerosA > 0 || zerosB > 0 ? s.bits.firstCommon(b, sb).value_or(0) : 0;
+    r.extractMs += msSince(t0);
+    const detail::VoxelMetric metric = metricOf(s);
+    Result<Direction> ab =
+        detail::directed(metric, s.grid, outsideB, zerosA, zeroWitness, eb.boundary,
+                         detail::oneShotCall(engine, metric, eb.boundary, threads, r), threads, r);
+    if (!ab) return ab.error();
+    Result<Direction> ba = detail::directed(metric, b, outsideA, zerosB, zeroWitness, s.extracted.boundary,
+                                            againstReference(engine, *s.set), threads, r);
+    if (!ba) return ba.error();
+    return std::array<Direction, 2>{std::move(*ab), std::move(*ba)};
+}
+
+// Every convention but deepmind.
+Result<MaskResult> compareVoxels(MaskEngine& engine, const State& s, const Volume& b, LabelSelect sb,
+                                 const MaskOptions& options, Clock::time_point start) {
+    const bool itk = options.convention == Convention::kItk;
+    MaskResult r;
+    r.convention = options.convention;
+    r.connectivity = itk ? 0 : s.connectivity;
+    r.percentiles = options.percentiles;
+    const auto t0 = Clock::now();
+    Result<detail::Extraction> eb = extractOne(engine, b, sb, s.connectivity, options, r.extraction);
+    if (!eb) return eb.error();
+    r.extractMs = msSince(t0);
+    if (s.extracted.count == 0 || eb->count == 0) {
+        detail::setEmpty(s.extracted.count, eb->count, itk ? 0 : options.percentiles.size(), r);
+        r.totalMs = msSince(start);
+        return r;
+    }
+    Result<std::array<Direction, 2>> both =
+        itk ? itkDirections(engine.engine, s, b, sb, *eb, options.threads, r)
+            : boundaryDirections(engine.engine, s, b, *eb, options.threads, r);
+    if (!both) return both.error();
+    detail::combine(options, (*both)[0], (*both)[1], r);
+    r.totalMs = msSince(start);
+    return r;
+}
+
+// The reference's side of its convention, into `s`.
+std::optional<Error> extractReference(MaskEngine& engine, const Volume& ref, const MaskOptions& options,
+                                      State& s) {
+    const int threads = options.threads;
+    if (s.convention == Convention::kDeepmind) {
+        s.surfels = detail::extractSurfels(ref, s.select, threads);
+        return std::nullopt;  // no prepared set: see the header
+    } else {
+        Result<detail::Extraction> e =
+            extractOne(engine, ref, s.select, s.connectivity, options, s.extraction);
+        if (!e) return e.error();
+        s.extracted = std::move(*e);
+        if (s.extracted.count == 0) return std::nullopt;
+        if (s.convention == Convention::kItk) s.bits = detail::SelectionBits(ref, s.select, threads);
+    }
+    Result<PreparedSet> set = prepareSet(engine.engine, metricOf(s), s.extracted.boundary, threads);
+    if (!set) return set.error();
+    s.set = std::move(*set);
+    return std::nullopt;
+}
+
+}  // namespace
+
+PreparedReference::PreparedReference(std::shared_ptr<const State> state) : m_state(std::move(state)) {}
+
+const Volume& PreparedReference::grid() const { return m_state->grid; }
+LabelSelect PreparedReference::select() const { return m_state->select; }
+Convention PreparedReference::convention() const { return m_state->convention; }
+int PreparedReference::connectivity() const {
+    return kindOf(m_state->convention) == PointKind::kBoundary ? m_state->connectivity : 0;
+}
+uint64_t PreparedReference::selectedVoxels() const {
+    return m_state->convention == Convention::kDeepmind ? m_state->surfels.selected
+                                                        : m_state->extracted.count;
+}
+uint64_t PreparedReference::points() const {
+    switch (kindOf(m_state->convention)) {
+        case PointKind::kForeground: return m_state->extracted.count;
+        case PointKind::kSurfels: return m_state->surfels.corners.size();
+        case PointKind::kBoundary: break;
+    }
+    return m_state->extracted.boundary.size();
+}
+uint64_t PreparedReference::hostBytes() const {
+    const State& s = *m_state;
+    return s.extracted.boundary.capacity() * sizeof(uint64_t) +
+           s.surfels.corners.capacity() * sizeof(uint64_t) + s.surfels.codes.capacity() + s.bits.bytes() +
+           (s.set ? s.set->hostBytes() : 0);
+}
+uint64_t PreparedReference::deviceBytes() const { return m_state->set ? m_state->set->deviceBytes() : 0; }
+double PreparedReference::prepareMs() const { return m_state->prepareMs; }
+const std::string& PreparedReference::extraction() const { return m_state->extraction; }
+
+Result<PreparedReference> prepareReference(MaskEngine& engine, const Volume& reference, LabelSelect select,
+                                           const MaskOptions& options) {
+    const auto start = Clock::now();
+    if (reference.storedVoxels() != reference.voxelCount())
+        return Error{ErrorCode::kInvalidArgument, "masks: label array size differs from the dimensions"};
+    if (auto e = detail::checkOptions(options)) return *e;
+    auto s = std::make_shared<State>();
+    s->grid.path = reference.path;
+    s->grid.dims = reference.dims;
+    s->grid.voxelToWorld = reference.voxelToWorld;
+    s->grid.transform = reference.transform;
+    s->select = select;
+    s->convention = options.convention;
+    s->connectivity = kindOf(options.convention) == PointKind::kBoundary
+                          ? detail::connectivityOf(options.convention, options.connectivity)
+                          : 6;
+    if (auto e = extractReference(engine, reference, options, *s)) return *e;
+    s->prepareMs = msSince(start);
+    return PreparedReference(std::move(s));
+}
+
+Result<MaskResult> compareMasks(MaskEngine& engine, const PreparedReference& reference,
+                                const Volume& prediction, LabelSelect select, const MaskOptions& options) {
+    const auto start = Clock::now();
+    const State& s = *reference.m_state;
+    if (auto e = checkSameGrid(s.grid, prediction)) return *e;
+    if (prediction.storedVoxels() != prediction.voxelCount())
+        return Error{ErrorCode::kInvalidArgument, "masks: label array size differs from the dimensions"};
+    if (auto e = detail::checkOptions(options)) return *e;
+    if (auto e = checkPreparedFor(s, options)) return *e;
+    if (options.convention != Convention::kDeepmind)
+        return compareVoxels(engine, s, prediction, select, options, start);
+    const auto t0 = Clock::now();
+    const detail::Surfels sb = detail::extractSurfels(prediction, select, options.threads);
+    return detail::compareSurfels(engine.engine, s.grid, s.surfels, prediction, sb, options, nullptr,
+                                  msSince(t0), start);
+}
+
+}  // namespace rthdist::masks
