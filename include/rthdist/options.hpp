@@ -93,7 +93,9 @@ struct CallOptions {
     bool perPointDistances = false;
     // Called from the calling thread between stages and iterations with a
     // stage name ("index", "cull", "search", "refine") and the fraction of
-    // the whole call done so far (0..1). Must not throw.
+    // the whole call done so far (0..1); a pair scanned whole (small pairs on
+    // a GPU backend: Engine::computeBatch) reports "search" once, before its
+    // submission. Must not throw.
     std::function<void(const char* stage, double fraction)> progress;
     // Cancellation: when the flag (owned by the caller, settable from any
     // thread or from `progress`) reads true at a stage boundary, a search

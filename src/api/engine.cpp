@@ -462,35 +462,6 @@ Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& opti
     return PreparedSet(std::move(set));
 }
 
-Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet& b, const CallOptions& call) {
-    const auto t0 = std::chrono::steady_clock::now();
-    if (auto err = validateCallOptions(call)) return *err;
-    const PreparedSet::Impl& ia = *a.m_impl;
-    const PreparedSet::Impl& ib = *b.m_impl;
-    if (ia.device != m_impl->device || ib.device != m_impl->device)
-        return Error{ErrorCode::kInvalidArgument, "a prepared set belongs to another Engine"};
-    if ((ia.onDevice || ib.onDevice) &&
-        (!shareFrame(ia, ib) || !ia.originals.empty() || !ib.originals.empty())) {
-        return Error{ErrorCode::kInvalidArgument,
-                     "a set prepared from a device view keeps no host copy: it meets only sets of its frame "
-                     "(prepare both with one PrepareOptions::origin) whose coordinates are float values or "
-                     "also device views"};
-    }
-    if (!shareFrame(ia, ib)) {
-        // Different frames or scales: both indexed afresh in the union's frame.
-        return computeViews(*m_impl, ia.input(), ib.input(), CheckedInputs{ia.summary, ib.summary}, call, t0);
-    }
-    Result<HausdorffResult> r =
-        m_impl->device->gpu ? m_impl->device->gpu->compute(*ia.gpuSet, *ib.gpuSet, call)
-                            : cpu::cpuHausdorff(*ia.cpuSet, *ib.cpuSet, call, m_impl->options.threads);
-    if (!r) return r;
-    if (!ia.originals.empty() || !ib.originals.empty())
-        core::restoreOriginal(*r, ia.input(), ib.input(), m_impl->options.threads);
-    r->origin = ia.origin;
-    finishResult(*m_impl, *r, t0);
-    return r;
-}
-
 namespace {
 
 using SetPair = std::pair<const PreparedSet::Impl*, const PreparedSet::Impl*>;
@@ -529,6 +500,37 @@ std::vector<Result<HausdorffResult>> scanSmallPairs(Engine::Impl& impl, std::spa
 }
 
 }  // namespace
+
+Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet& b, const CallOptions& call) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (auto err = validateCallOptions(call)) return *err;
+    const PreparedSet::Impl& ia = *a.m_impl;
+    const PreparedSet::Impl& ib = *b.m_impl;
+    if (ia.device != m_impl->device || ib.device != m_impl->device)
+        return Error{ErrorCode::kInvalidArgument, "a prepared set belongs to another Engine"};
+    if ((ia.onDevice || ib.onDevice) &&
+        (!shareFrame(ia, ib) || !ia.originals.empty() || !ib.originals.empty())) {
+        return Error{ErrorCode::kInvalidArgument,
+                     "a set prepared from a device view keeps no host copy: it meets only sets of its frame "
+                     "(prepare both with one PrepareOptions::origin) whose coordinates are float values or "
+                     "also device views"};
+    }
+    if (const SetPair pair{&ia, &ib}; scannedWhole(*m_impl, pair))
+        return std::move(scanSmallPairs(*m_impl, std::span(&pair, 1), call)[0]);
+    if (!shareFrame(ia, ib)) {
+        // Different frames or scales: both indexed afresh in the union's frame.
+        return computeViews(*m_impl, ia.input(), ib.input(), CheckedInputs{ia.summary, ib.summary}, call, t0);
+    }
+    Result<HausdorffResult> r =
+        m_impl->device->gpu ? m_impl->device->gpu->compute(*ia.gpuSet, *ib.gpuSet, call)
+                            : cpu::cpuHausdorff(*ia.cpuSet, *ib.cpuSet, call, m_impl->options.threads);
+    if (!r) return r;
+    if (!ia.originals.empty() || !ib.originals.empty())
+        core::restoreOriginal(*r, ia.input(), ib.input(), m_impl->options.threads);
+    r->origin = ia.origin;
+    finishResult(*m_impl, *r, t0);
+    return r;
+}
 
 std::vector<Result<HausdorffResult>> Engine::computeBatch(std::span<const PreparedSet> sets,
                                                           std::span<const PairRef> pairs,

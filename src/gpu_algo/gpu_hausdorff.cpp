@@ -295,7 +295,7 @@ struct GpuHausdorff::State {
         SmallPairScan::Outcome outcome;
         Timings timings;
         auto err = guarded(timings, [&] {
-            throwIfCancelled(options);
+            reportProgress(options, "search", 0.0);  // the scan is the search; honours the cancel flag
             outcome = smallPairs.runHostArrays(a, b, scale, options, emptyResult(options));
         });
         if (err) return *err;
@@ -461,7 +461,7 @@ std::vector<Result<HausdorffResult>> GpuHausdorff::computeSmallPairs(
     SmallPairScan::Outcome outcome;
     Timings timings;
     auto err = m_state->guarded(timings, [&] {
-        throwIfCancelled(options);
+        reportProgress(options, "search", 0.0);  // the scan is the search; honours the cancel flag
         outcome = m_state->smallPairs.run(scans, options, m_state->emptyResult(options));
     });
     std::vector<Result<HausdorffResult>> out;
