@@ -50,5 +50,5 @@ print('$name', '$mode'.ljust(28), r['extraction'], 'median %.2f ms (min %.2f, fi
 done
 head -5 $OUT/err.txt
 export VK_LAYER_PATH=$B/layers VK_LAYER_ENABLES=VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT
-RTHDIST_TEST_BACKEND=$BACKEND timeout 200 $B/rthdist_masks_tests --gtest_filter='MasksBoundary.*:MasksBackend.*:OrderStatistics.*' > $OUT/masks_tests.txt 2>&1
+RTHDIST_TEST_BACKEND=$BACKEND timeout 200 $B/rthdist_masks_tests --gtest_filter='MasksBoundary.*:MasksBackend.*:MasksPrepared*:OrderStatistics.*' > $OUT/masks_tests.txt 2>&1
 echo "masks tests rc=$?"; grep -h "PASSED\|FAILED" $OUT/masks_tests.txt | head
