@@ -232,7 +232,9 @@ public:
     Engine& operator=(Engine&&) noexcept;
     ~Engine();
 
-    // One-shot: indexes both sets for this call only.
+    // One-shot: indexes both sets for this call only (on a GPU backend a
+    // small pair with the automatic bit count is scanned whole instead, as
+    // computeBatch describes; the result is the same H to float rounding).
     [[nodiscard]] Result<HausdorffResult> compute(PointView a, PointView b);
     [[nodiscard]] Result<HausdorffResult> compute(PointView a, PointView b, const CallOptions& call);
 
@@ -251,7 +253,8 @@ public:
     [[nodiscard]] Result<PreparedSet> prepare(const DevicePointView& points,
                                               const PrepareOptions& options = {});
     // H(A, B) of two sets prepared by this Engine (either may be both).
-    // Witness indices refer to each set's input order.
+    // Witness indices refer to each set's input order. Small pairs on a GPU
+    // backend are scanned whole (computeBatch below).
     [[nodiscard]] Result<HausdorffResult> compute(const PreparedSet& a, const PreparedSet& b,
                                                   const CallOptions& call = {});
     // Many pairs in one call: result i is H(sets[pairs[i].a], sets[pairs[i].b])
