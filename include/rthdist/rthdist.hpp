@@ -260,12 +260,13 @@ public:
     // Many pairs in one call: result i is H(sets[pairs[i].a], sets[pairs[i].b])
     // (or its error; one failing pair does not stop the others, a cancelled
     // call fills the rest with kCancelled). On a GPU backend the small pairs
-    // (sets of host arrays with one origin, queries x targets at most 2^28 per
-    // direction, 2^20 on a CPU device such as lavapipe) are scanned exactly,
-    // every query against every target with the early break, all of them in
-    // one submission; each reports an equal share of that submission's time
-    // (Timings::total, refine, gpuRefine) and counters without iterations. The
-    // other pairs run one after another as compute() does.
+    // (sets of host arrays with one origin, each at most 2^22 points, queries
+    // x targets at most 2^28 per direction, 2^20 on a CPU device such as
+    // lavapipe) are scanned exactly, every query against every target with
+    // the early break, in one submission per 2^24 queries; each reports an
+    // equal share of its submission's time (Timings::total, refine,
+    // gpuRefine) and counters without iterations. The other pairs run one
+    // after another as compute() does.
     [[nodiscard]] std::vector<Result<HausdorffResult>> computeBatch(std::span<const PreparedSet> sets,
                                                                     std::span<const PairRef> pairs,
                                                                     const CallOptions& call = {});

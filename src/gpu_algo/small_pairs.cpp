@@ -6,6 +6,7 @@
 #include <bit>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <numeric>
 #include <string>
 
@@ -17,6 +18,11 @@ namespace {
 
 constexpr uint64_t kMaxWorkGpu = uint64_t(1) << 28;
 constexpr uint64_t kMaxWorkCpuDevice = uint64_t(1) << 20;
+// Points of one side at most, and queries of one submission.
+constexpr uint64_t kMaxSide = uint64_t(1) << 22;
+constexpr uint64_t kMaxQueries = uint64_t(1) << 24;
+
+uint64_t pairQueries(const SmallPair& p) { return p.a.points.size() + p.b.points.size(); }
 
 // A step coprime with n near n / golden ratio: the scan's order
 // (j * step) mod n visits the cell-sorted targets spread over the set.
@@ -49,7 +55,8 @@ SmallPairScan::SmallPairScan(Workspace& ws) : m_ws(ws) {
 }
 
 bool SmallPairScan::takes(uint64_t queries, uint64_t targets) const {
-    return queries > 0 && targets > 0 && queries <= m_maxWork / targets;
+    return queries > 0 && targets > 0 && queries <= kMaxSide && targets <= kMaxSide &&
+           queries <= m_maxWork / targets;
 }
 
 SmallPairScan::Layout SmallPairScan::layOut(std::span<const SmallPair> pairs, bool directedOnly,
@@ -189,8 +196,22 @@ SmallPairScan::Outcome SmallPairScan::submit(std::span<const SmallPair> pairs, c
 
 SmallPairScan::Outcome SmallPairScan::run(std::span<const SmallPair> pairs, const CallOptions& options,
                                           const HausdorffResult& blank) {
-    const Layout l = layOut(pairs, options.directedOnly, options.perPointDistances);
-    return submit(pairs, l, options, blank, nullptr);
+    // One submission per group of pairs with at most kMaxQueries queries
+    // (the scratch per query stays bounded however long the batch).
+    Outcome out;
+    for (size_t first = 0; first < pairs.size();) {
+        size_t end = first;
+        uint64_t queries = 0;
+        while (end < pairs.size() && (end == first || queries + pairQueries(pairs[end]) <= kMaxQueries))
+            queries += pairQueries(pairs[end++]);
+        const std::span<const SmallPair> group = pairs.subspan(first, end - first);
+        const Layout l = layOut(group, options.directedOnly, options.perPointDistances);
+        Outcome part = submit(group, l, options, blank, nullptr);
+        std::move(part.results.begin(), part.results.end(), std::back_inserter(out.results));
+        std::move(part.failed.begin(), part.failed.end(), std::back_inserter(out.failed));
+        first = end;
+    }
+    return out;
 }
 
 SmallPairScan::Outcome SmallPairScan::runHostArrays(std::span<const glm::vec3> a,

@@ -60,15 +60,17 @@ class SmallPairScan {
 public:
     explicit SmallPairScan(Workspace& ws);
 
-    // Whether a direction of `queries` x `targets` is scanned whole: the
-    // product at most 2^28 on a GPU, 2^20 on a CPU device (lavapipe: its
-    // scan of 2,000-10,000-point pairs took 3x the RT path's time). The
-    // environment variable RTHDIST_SMALL_PAIR_WORK replaces the limit
-    // (benchmarks of both paths; 0: none is scanned whole).
+    // Whether a direction of `queries` x `targets` is scanned whole: each at
+    // most 2^22 points and the product at most 2^28 on a GPU, 2^20 on a CPU
+    // device (lavapipe: its scan of 2,000-10,000-point pairs took 3x the RT
+    // path's time). The environment variable RTHDIST_SMALL_PAIR_WORK
+    // replaces the product's limit (benchmarks of both paths; 0: none is
+    // scanned whole).
     [[nodiscard]] bool takes(uint64_t queries, uint64_t targets) const;
 
     // Every pair's witnesses (input indices) and, with perPointDistances,
-    // nearest indices, in `results` (one per pair, filled from `blank`);
+    // nearest indices, in `results` (one per pair, filled from `blank`); the
+    // pairs in one submission per 2^24 queries (their scratch stays bounded);
     // distances and points are left to the caller (core::restoreOriginal).
     // An entry of `failed` names a pair whose result broke the self-check.
     struct Outcome {
