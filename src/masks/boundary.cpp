@@ -9,21 +9,10 @@
 
 #include "core/parallel.hpp"
 #include "masks/selected.hpp"
+#include "masks/slice_lists.hpp"
 
 namespace rthdist::masks::detail {
 namespace {
-
-std::vector<uint64_t> joinSlabs(std::vector<std::vector<uint64_t>>& slabs) {
-    size_t total = 0;
-    for (const auto& s : slabs) total += s.size();
-    std::vector<uint64_t> out;
-    out.reserve(total);
-    for (auto& s : slabs) {
-        out.insert(out.end(), s.begin(), s.end());
-        std::vector<uint64_t>().swap(s);
-    }
-    return out;
-}
 
 template <class T>
 Extraction extractFrom(const T* labels, Dims dims, LabelSelect select, int connectivity, int threads) {
@@ -40,39 +29,34 @@ Extraction extractFrom(const T* labels, Dims dims, LabelSelect select, int conne
                 if (l1 == 0 || l1 > maxL1) continue;
                 offsets.push_back(dx + dy * sy + dz * sz);
             }
-    std::vector<std::vector<uint64_t>> slabs(size_t(std::max<int64_t>(nz, 0)));
-    std::vector<uint64_t> counts(slabs.size(), 0);
-    core::parallelChunks(size_t(nz), 1, threads, [&](size_t zb, size_t ze, int) {
-        for (int64_t z = int64_t(zb); z < int64_t(ze); ++z) {
-            std::vector<uint64_t>& out = slabs[size_t(z)];
-            uint64_t count = 0;
-            for (int64_t y = 0; y < ny; ++y) {
-                const int64_t row = y * sy + z * sz;
-                const unsigned inRow = sel.countRow(row, row + nx);
-                if (inRow == 0) continue;
-                count += inRow;
-                const bool edgeRow = y == 0 || y == ny - 1 || z == 0 || z == nz - 1;
-                for (int64_t x = 0; x < nx; ++x) {
-                    const int64_t at = row + x;
-                    if (!sel(at)) continue;
-                    bool boundary = edgeRow || x == 0 || x == nx - 1;
-                    if (!boundary) {
-                        for (int64_t o : offsets) {
-                            if (!sel(at + o)) {
-                                boundary = true;
-                                break;
-                            }
+    std::vector<uint64_t> counts(size_t(std::max<int64_t>(nz, 0)), 0);
+    Extraction e;
+    e.boundary = perSlice(nz, threads, [&](int64_t z, std::vector<uint64_t>& out) {
+        uint64_t count = 0;
+        for (int64_t y = 0; y < ny; ++y) {
+            const int64_t row = y * sy + z * sz;
+            const unsigned inRow = sel.countRow(row, row + nx);
+            if (inRow == 0) continue;
+            count += inRow;
+            const bool edgeRow = y == 0 || y == ny - 1 || z == 0 || z == nz - 1;
+            for (int64_t x = 0; x < nx; ++x) {
+                const int64_t at = row + x;
+                if (!sel(at)) continue;
+                bool boundary = edgeRow || x == 0 || x == nx - 1;
+                if (!boundary) {
+                    for (int64_t o : offsets) {
+                        if (!sel(at + o)) {
+                            boundary = true;
+                            break;
                         }
                     }
-                    if (boundary) out.push_back(uint64_t(at));
                 }
+                if (boundary) out.push_back(uint64_t(at));
             }
-            counts[size_t(z)] = count;
         }
+        counts[size_t(z)] = count;
     });
-    Extraction e;
     for (uint64_t c : counts) e.count += c;
-    e.boundary = joinSlabs(slabs);
     return e;
 }
 
@@ -82,19 +66,14 @@ std::vector<uint64_t> differenceFrom(const A* a, LabelSelect sa, const B* b, Lab
     const Selected<A> inA(a, sa);
     const Selected<B> inB(b, sb);
     const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
-    std::vector<std::vector<uint64_t>> slabs(size_t(std::max<int64_t>(nz, 0)));
-    core::parallelChunks(size_t(nz), 1, threads, [&](size_t zb, size_t ze, int) {
-        for (int64_t z = int64_t(zb); z < int64_t(ze); ++z) {
-            std::vector<uint64_t>& out = slabs[size_t(z)];
-            for (int64_t y = 0; y < ny; ++y) {
-                const int64_t row = (y + ny * z) * nx;
-                if (inA.countRow(row, row + nx) == 0) continue;
-                for (int64_t x = row; x < row + nx; ++x)
-                    if (inA(x) && !inB(x)) out.push_back(uint64_t(x));
-            }
+    return perSlice(nz, threads, [&](int64_t z, std::vector<uint64_t>& out) {
+        for (int64_t y = 0; y < ny; ++y) {
+            const int64_t row = (y + ny * z) * nx;
+            if (inA.countRow(row, row + nx) == 0) continue;
+            for (int64_t x = row; x < row + nx; ++x)
+                if (inA(x) && !inB(x)) out.push_back(uint64_t(x));
         }
     });
-    return joinSlabs(slabs);
 }
 
 template <class A, class B>

@@ -8,33 +8,12 @@
 
 #include "core/parallel.hpp"
 #include "masks/selected.hpp"
+#include "masks/slice_lists.hpp"
 
 namespace rthdist::masks::detail {
 namespace {
 
 constexpr size_t kWordsPerChunk = size_t(1) << 12;
-
-std::vector<uint64_t> joined(std::vector<std::vector<uint64_t>>& slabs) {
-    size_t total = 0;
-    for (const auto& s : slabs) total += s.size();
-    std::vector<uint64_t> out;
-    out.reserve(total);
-    for (auto& s : slabs) {
-        out.insert(out.end(), s.begin(), s.end());
-        std::vector<uint64_t>().swap(s);
-    }
-    return out;
-}
-
-// fn(z, out) for every slice z, each with its own list; the lists joined.
-template <class Fn>
-std::vector<uint64_t> perSlice(Dims dims, int threads, Fn&& fn) {
-    std::vector<std::vector<uint64_t>> slabs(size_t(std::max<int64_t>(dims[2], 0)));
-    core::parallelChunks(slabs.size(), 1, threads, [&](size_t zb, size_t ze, int) {
-        for (size_t z = zb; z < ze; ++z) fn(int64_t(z), slabs[z]);
-    });
-    return joined(slabs);
-}
 
 }  // namespace
 
@@ -58,7 +37,7 @@ std::vector<uint64_t> SelectionBits::minus(const Volume& b, LabelSelect sb, int 
     const uint64_t slice = uint64_t(m_dims[0] * m_dims[1]);
     return withLabels(b, [&](const auto* labels) {
         const Selected inB(labels, sb);
-        return perSlice(m_dims, threads, [&](int64_t z, std::vector<uint64_t>& out) {
+        return perSlice(m_dims[2], threads, [&](int64_t z, std::vector<uint64_t>& out) {
             const uint64_t begin = uint64_t(z) * slice, end = begin + slice;
             for (uint64_t w = begin / 64; w * 64 < end; ++w) {
                 uint64_t word = m_words[w];
@@ -76,7 +55,7 @@ std::vector<uint64_t> SelectionBits::missingFrom(const Volume& b, LabelSelect sb
     const int64_t nx = m_dims[0], ny = m_dims[1];
     return withLabels(b, [&](const auto* labels) {
         const Selected inB(labels, sb);
-        return perSlice(m_dims, threads, [&](int64_t z, std::vector<uint64_t>& out) {
+        return perSlice(m_dims[2], threads, [&](int64_t z, std::vector<uint64_t>& out) {
             for (int64_t y = 0; y < ny; ++y) {
                 const int64_t row = (y + ny * z) * nx;
                 if (inB.countRow(row, row + nx) == 0) continue;
