@@ -289,21 +289,31 @@ struct GpuHausdorff::State {
         if (a.scale != 1.0) core::restoreOriginal(res, PointView(a.input), PointView(b.input), ws.threads);
     }
 
-    // A one-shot pair small enough to be scanned whole (small_pairs.hpp).
-    Result<HausdorffResult> scanHostPair(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                         double scale, const CallOptions& options) {
+    // A scan of small pairs (small_pairs.hpp) under the guard: each pair's
+    // result with its witnesses and per-point distances in double from its
+    // inputs (`inputs[i]`), or its self-check failure, or the scan's error.
+    template <class Scan>
+    std::vector<Result<HausdorffResult>> scanPairs(std::span<const std::pair<PointView, PointView>> inputs,
+                                                   const CallOptions& options, Scan&& scan) {
         SmallPairScan::Outcome outcome;
         Timings timings;
         auto err = guarded(timings, [&] {
             reportProgress(options, "search", 0.0);  // the scan is the search; honours the cancel flag
-            outcome = smallPairs.runHostArrays(a, b, scale, options, emptyResult(options));
+            outcome = scan(emptyResult(options));
         });
-        if (err) return *err;
-        if (!outcome.failed[0].empty())
-            return Error{ErrorCode::kInternal, "self-check failed: " + outcome.failed[0]};
-        HausdorffResult& r = outcome.results[0];
-        core::restoreOriginal(r, PointView(a), PointView(b), ws.threads);
-        return std::move(r);
+        std::vector<Result<HausdorffResult>> out;
+        for (size_t i = 0; i < inputs.size(); ++i) {
+            if (err) {
+                out.emplace_back(*err);
+            } else if (!outcome.failed[i].empty()) {
+                out.emplace_back(Error{ErrorCode::kInternal, "self-check failed: " + outcome.failed[i]});
+            } else {
+                HausdorffResult& r = outcome.results[i];
+                core::restoreOriginal(r, inputs[i].first, inputs[i].second, ws.threads);
+                out.emplace_back(std::move(r));
+            }
+        }
+        return out;
     }
 
     HausdorffResult emptyResult(const CallOptions& options) const {
@@ -379,7 +389,12 @@ Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, co
 Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                               double scale, const CallOptions& options) {
     State& st = *m_state;
-    if (scansWhole(a.size(), b.size(), options)) return st.scanHostPair(a, b, scale, options);
+    if (scansWhole(a.size(), b.size(), options)) {
+        const std::pair<PointView, PointView> inputs{PointView(a), PointView(b)};
+        return std::move(st.scanPairs(std::span(&inputs, 1), options, [&](const HausdorffResult& blank) {
+            return st.smallPairs.runHostArrays(a, b, scale, options, blank);
+        })[0]);
+    }
     HausdorffResult res = st.emptyResult(options);
     // Squared distances are float on the device: coordinates so large (or so
     // small) that they overflow (or underflow) are scaled by a power of two,
@@ -454,30 +469,15 @@ bool GpuHausdorff::scansWhole(size_t aPoints, size_t bPoints, const CallOptions&
 std::vector<Result<HausdorffResult>> GpuHausdorff::computeSmallPairs(
     std::span<const std::pair<const DeviceSet*, const DeviceSet*>> pairs, const CallOptions& options) {
     std::vector<SmallPair> scans;
+    std::vector<std::pair<PointView, PointView>> inputs;
     for (const auto& [a, b] : pairs) {
         const double pairScale = std::min(a->scale, b->scale);  // of the larger magnitude
         scans.push_back({scanSetOf(*a, pairScale / a->scale), scanSetOf(*b, pairScale / b->scale)});
+        inputs.emplace_back(PointView(a->input), PointView(b->input));
     }
-    SmallPairScan::Outcome outcome;
-    Timings timings;
-    auto err = m_state->guarded(timings, [&] {
-        reportProgress(options, "search", 0.0);  // the scan is the search; honours the cancel flag
-        outcome = m_state->smallPairs.run(scans, options, m_state->emptyResult(options));
+    return m_state->scanPairs(inputs, options, [&](const HausdorffResult& blank) {
+        return m_state->smallPairs.run(scans, options, blank);
     });
-    std::vector<Result<HausdorffResult>> out;
-    for (size_t i = 0; i < pairs.size(); ++i) {
-        if (err) {
-            out.emplace_back(*err);
-        } else if (!outcome.failed[i].empty()) {
-            out.emplace_back(Error{ErrorCode::kInternal, "self-check failed: " + outcome.failed[i]});
-        } else {
-            HausdorffResult& r = outcome.results[i];
-            core::restoreOriginal(r, PointView(pairs[i].first->input), PointView(pairs[i].second->input),
-                                  m_state->ws.threads);
-            out.emplace_back(std::move(r));
-        }
-    }
-    return out;
 }
 
 Result<HausdorffResult> GpuHausdorff::computeDevice(const DeviceInput& a, const DeviceInput& b,

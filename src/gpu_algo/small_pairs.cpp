@@ -187,8 +187,9 @@ SmallPairScan::Outcome SmallPairScan::submit(std::span<const SmallPair> pairs, c
         out.failed[i] = finishPair(pairs[i], i * l.perPair, l, perPoint, out.results[i]);
     // The pairs ran together: each reports an equal share of the scan.
     const double share = 1.0 / double(std::max<size_t>(1, pairs.size()));
+    const double wallMs = msSince(t0);
     for (HausdorffResult& r : out.results) {
-        r.timings.refine = msSince(t0) * share;
+        r.timings.refine = wallMs * share;
         r.timings.gpuRefine = gpuMs * share;
     }
     return out;

@@ -20,6 +20,37 @@ Result<PreparedSet> prepare(Engine& engine, const std::vector<glm::vec3>& points
     return engine.prepare(points);
 }
 
+// Prepares every cloud, runs one computeBatch of `pairs` and checks each
+// result against its pair's one-shot call and the brute force; a pair naming
+// a set past the clouds must be an error of its own.
+void expectBatchEqualsSingleCalls(Engine& engine, const std::vector<std::vector<glm::vec3>>& clouds,
+                                  const std::vector<PairRef>& pairs, const CallOptions& call,
+                                  const std::string& name) {
+    std::vector<PreparedSet> sets;
+    for (const auto& cloud : clouds) {
+        auto s = prepare(engine, cloud);
+        ASSERT_TRUE(s) << s.error().message;
+        sets.push_back(*s);
+    }
+    const auto results = engine.computeBatch(sets, pairs, call);
+    ASSERT_EQ(results.size(), pairs.size());
+    for (size_t i = 0; i < pairs.size(); ++i) {
+        SCOPED_TRACE("pair " + std::to_string(i));
+        if (pairs[i].b >= sets.size()) {
+            ASSERT_FALSE(results[i]);
+            EXPECT_EQ(results[i].error().code, ErrorCode::kInvalidArgument);
+            continue;
+        }
+        ASSERT_TRUE(results[i]) << results[i].error().message;
+        const auto& a = clouds[pairs[i].a];
+        const auto& b = clouds[pairs[i].b];
+        auto once = engine.compute(a, b, call);
+        ASSERT_TRUE(once) << once.error().message;
+        expectSameResult(*results[i], *once, oracleTolerance(a, b, once->hausdorff));
+        expectMatchesOracle(OracleCase{name, i, a, b}, *results[i]);
+    }
+}
+
 // Every oracle case through prepared sets: exact, and identical to one-shot.
 TEST(PreparedSet, OracleCasesMatchOneShot) {
     RTHDIST_REQUIRE_TEST_ENGINE(engine);
@@ -104,33 +135,12 @@ TEST(PreparedSet, QueryAndTargetRoles) {
 TEST(PreparedSet, BatchEqualsSingleCalls) {
     RTHDIST_REQUIRE_TEST_ENGINE(engine);
     std::vector<std::vector<glm::vec3>> clouds;
-    std::vector<PreparedSet> sets;
-    for (uint64_t k = 0; k < 6; ++k) {
+    for (uint64_t k = 0; k < 6; ++k)
         clouds.push_back(randomCloud(2000 + 500 * k, 40 + k, glm::vec3(0.05f * float(k))));
-        auto s = prepare(*engine, clouds.back());
-        ASSERT_TRUE(s) << s.error().message;
-        sets.push_back(*s);
-    }
-    const std::vector<PairRef> pairs{{0, 1}, {0, 2}, {3, 4}, {5, 0}, {2, 2}, {1, 9}, {4, 3}};
     CallOptions call;
     call.perPointDistances = true;
-    const auto results = engine->computeBatch(sets, pairs, call);
-    ASSERT_EQ(results.size(), pairs.size());
-    for (size_t i = 0; i < pairs.size(); ++i) {
-        SCOPED_TRACE("pair " + std::to_string(i));
-        if (pairs[i].b >= sets.size()) {
-            ASSERT_FALSE(results[i]);
-            EXPECT_EQ(results[i].error().code, ErrorCode::kInvalidArgument);
-            continue;
-        }
-        ASSERT_TRUE(results[i]) << results[i].error().message;
-        auto once = engine->compute(clouds[pairs[i].a], clouds[pairs[i].b], call);
-        ASSERT_TRUE(once) << once.error().message;
-        expectSameResult(*results[i], *once,
-                         oracleTolerance(clouds[pairs[i].a], clouds[pairs[i].b], once->hausdorff));
-        OracleCase c{"batch", i, clouds[pairs[i].a], clouds[pairs[i].b]};
-        expectMatchesOracle(c, *results[i]);
-    }
+    expectBatchEqualsSingleCalls(*engine, clouds, {{0, 1}, {0, 2}, {3, 4}, {5, 0}, {2, 2}, {1, 9}, {4, 3}},
+                                 call, "batch");
 }
 
 // Batches of small pairs (on GPU backends scanned whole, every pair in one
@@ -229,30 +239,8 @@ TEST(PreparedSet, MixedBatchEqualsSingleCalls) {
     for (uint64_t k = 0; k < 4; ++k)
         clouds.push_back(
             randomCloud(300 + 400 * k, 72 + k, glm::vec3(0.1f * float(k)), 1.0f + 0.5f * float(k)));
-    std::vector<PreparedSet> sets;
-    for (const auto& cloud : clouds) {
-        auto s = prepare(*engine, cloud);
-        ASSERT_TRUE(s) << s.error().message;
-        sets.push_back(*s);
-    }
-    const std::vector<PairRef> pairs{{2, 3}, {0, 1}, {4, 4}, {5, 2}, {3, 7}, {1, 5}, {4, 5}};
-    const auto results = engine->computeBatch(sets, pairs);
-    ASSERT_EQ(results.size(), pairs.size());
-    for (size_t i = 0; i < pairs.size(); ++i) {
-        SCOPED_TRACE("pair " + std::to_string(i));
-        if (pairs[i].b >= sets.size()) {
-            ASSERT_FALSE(results[i]);
-            EXPECT_EQ(results[i].error().code, ErrorCode::kInvalidArgument);
-            continue;
-        }
-        ASSERT_TRUE(results[i]) << results[i].error().message;
-        const auto& a = clouds[pairs[i].a];
-        const auto& b = clouds[pairs[i].b];
-        auto once = engine->compute(a, b, CallOptions{});
-        ASSERT_TRUE(once) << once.error().message;
-        expectSameResult(*results[i], *once, oracleTolerance(a, b, once->hausdorff));
-        expectMatchesOracle(OracleCase{"mixed", i, a, b}, *results[i]);
-    }
+    expectBatchEqualsSingleCalls(*engine, clouds, {{2, 3}, {0, 1}, {4, 4}, {5, 2}, {3, 7}, {1, 5}, {4, 5}},
+                                 CallOptions{}, "mixed");
 }
 
 // Georeferenced doubles: sets prepared in their own frames meet in the
