@@ -31,6 +31,13 @@ U64Ref u64At(uint64_t base, uint i) { return U64Ref(base + uint64_t(i) * 8ul); }
 CellRef cellAt(uint64_t base, uint i) { return CellRef(base + uint64_t(i) * 32ul); }
 StateRef stateAt(uint64_t base, uint i) { return StateRef(base + uint64_t(i) * 16ul); }
 
+// The queries the radius in flight searches (set by the host, then by
+// search_advance.comp between the radii of one submission), at most the
+// slots dispatched.
+uint searchedCount(uint64_t counters, uint dispatched) {
+    return min(dispatched, UintRef(counters + RTHDIST_CTR_SEARCH_ACTIVE).v);
+}
+
 uint spreadBits(uint v) {
     v &= 0x3ffu;
     v = (v | (v << 16)) & 0x030000ffu;

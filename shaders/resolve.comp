@@ -10,7 +10,7 @@ layout(push_constant) uniform Push { ResolvePush pc; };
 
 void main() {
     uint slot = gl_GlobalInvocationID.x;
-    if (slot >= pc.numActive) return;
+    if (slot >= searchedCount(pc.counters, pc.numActive)) return;
     uint qi = uintAt(pc.activeList, slot).v;
     uint64_t state = pc.state;
     QueryState st = stateAt(state, qi).v;

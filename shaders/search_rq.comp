@@ -11,7 +11,7 @@ layout(set = 0, binding = 0) uniform accelerationStructureEXT u_tlas;
 
 void main() {
     uint slot = gl_GlobalInvocationID.x;
-    if (slot >= pc.numActive) return;
+    if (slot >= searchedCount(pc.counters, pc.numActive)) return;
     uint qi = uintAt(pc.activeList, slot).v;
     vec3 q = vec4At(pc.queries, qi).v.xyz;
     QueryState st = stateAt(pc.state, qi).v;

@@ -40,10 +40,14 @@ struct vec3f {
 #define RTHDIST_CTR_CHECK_BAD 40    // uint64: self-check, records that broke an invariant
 #define RTHDIST_CTR_MIN_EDGE 48     // float bits: leaf_slots, the narrowest sub-cell edge of a split
 #define RTHDIST_CTR_LARGE_CELLS 52  // uint: cell_build, 1 when a cell needs the parallel box
+#define RTHDIST_CTR_SEARCH_ACTIVE 56  // uint: queries the radius in flight searches (search_advance.comp)
 #define RTHDIST_CTR_READBACK 64     // host read-back area after the counters
 #define RTHDIST_CTR_INGEST 1152     // IngestSummary: ingest.comp, one set's bounds and first bad point
 #define RTHDIST_CTR_INGEST64 1184   // IngestSummary64: ingest_f64.comp, one device view's box in double
+#define RTHDIST_CTR_SEARCH_LOG 1280  // SearchLogEntry[RTHDIST_SEARCH_LOG_MAX]: the radii of one submission
 #define RTHDIST_CTR_BYTES 2048
+// Radii of the candidate search recorded in one submission, at most.
+#define RTHDIST_SEARCH_LOG_MAX 16
 
 // Query status values.
 #define RTHDIST_OPEN 0u
@@ -270,7 +274,7 @@ struct SearchPush {
     uint64_t pairs;       // uvec2[capacity]: (active slot, cell)
     uint64_t counters;    // the counter block (RTHDIST_CTR_PAIRS)
     uint64_t maxPacked;
-    uint numActive;
+    uint numActive;  // slots dispatched: at least RTHDIST_CTR_SEARCH_ACTIVE, the ones searched
     uint pairCapacity;
     float radius;  // R: cells with box distance <= R are candidates
     float lowerBound2;
@@ -380,9 +384,24 @@ struct ResolvePush {
     uint64_t nextActive;  // out
     uint64_t counters;    // the counter block (RTHDIST_CTR_NEXT_ACTIVE)
     uint64_t maxPacked;
-    uint numActive;
+    uint numActive;  // slots dispatched: at least RTHDIST_CTR_SEARCH_ACTIVE, the ones resolved
     float radius;
     float lowerBound2;
+};
+
+// search_advance.comp: between two radii of one submission, the radius just
+// run is logged (entry `iteration` of RTHDIST_CTR_SEARCH_LOG) and the next
+// one set up: its queries are the ones going on, or none once the pair buffer
+// overflowed (the host resumes from the logged radius with more room).
+struct SearchLogEntry {
+    uint searched;   // queries this radius searched
+    uint goingOn;    // queries going on
+    uint64_t pairs;  // (query, cell) pairs the rays appended (some lost when > capacity)
+};
+struct SearchAdvancePush {
+    uint64_t counters;  // the counter block
+    uint iteration;     // the log entry of the radius just run
+    uint pairCapacity;
 };
 
 #ifdef __cplusplus
@@ -399,6 +418,7 @@ struct CounterFields {
     uint64_t checkBad;
     uint minEdge;  // float bits
     uint largeCells;
+    uint searchActive;
 };
 static_assert(offsetof(CounterFields, active) == RTHDIST_CTR_ACTIVE);
 static_assert(offsetof(CounterFields, maxCount) == RTHDIST_CTR_MAX_COUNT);
@@ -410,6 +430,9 @@ static_assert(offsetof(CounterFields, checkSum) == RTHDIST_CTR_CHECK_SUM);
 static_assert(offsetof(CounterFields, checkBad) == RTHDIST_CTR_CHECK_BAD);
 static_assert(offsetof(CounterFields, minEdge) == RTHDIST_CTR_MIN_EDGE);
 static_assert(offsetof(CounterFields, largeCells) == RTHDIST_CTR_LARGE_CELLS);
+static_assert(offsetof(CounterFields, searchActive) == RTHDIST_CTR_SEARCH_ACTIVE);
+static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDIST_CTR_SEARCH_LOG &&
+              RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
 static_assert(sizeof(IngestDevicePush) == 64 && offsetof(IngestDevicePush, n) == 48);
 static_assert(sizeof(BatchDirection) == RTHDIST_BATCH_DIRECTION_BYTES);

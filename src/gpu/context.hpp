@@ -113,7 +113,7 @@ public:
     // commands between them (e.g. the uploads of a submission).
     uint32_t cmdMark(VkCommandBuffer cmd);
     [[nodiscard]] double gpuMsBetween(uint32_t from, uint32_t to) const;
-    static constexpr uint32_t kTimestampSlots = 8;
+    static constexpr uint32_t kTimestampSlots = 40;
 
     void countValidationMessage() { ++m_validationMessages; }
 

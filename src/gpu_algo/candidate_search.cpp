@@ -2,9 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
+#include <utility>
+
+#include "gpu/barriers.hpp"
 
 namespace rthdist::gpu_algo {
+
+// Two timestamps per radius of a submission, and the submission's own two.
+static_assert(2 * RTHDIST_SEARCH_LOG_MAX + 2 < gpu::Context::kTimestampSlots);
+
+CandidateSearch::CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, Refinement& refinement)
+    : m_ws(workspace), m_index(indexBuild), m_refine(refinement) {
+    if (const char* env = std::getenv("RTHDIST_SEARCH_RADII"))
+        radiiPerSubmission =
+            uint32_t(std::clamp<unsigned long>(std::strtoul(env, nullptr, 10), 1, RTHDIST_SEARCH_LOG_MAX));
+}
 
 void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options,
                                 double progressFrom, double progressTo) {
@@ -28,59 +42,101 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
     Buffer* pairs = nullptr;
     int builtLevel = -1;  // level of the BLAS now built (-1: none yet)
     while (numActive > 0) {
-        if (++d.out.counters.iterations > kMaxIterations)
-            throw std::runtime_error("candidate search did not converge");
         if (!pairs) {
             pairs = &m_ws.grow(m_ws.scratch.search.pairs, pairCapacity * 8, "pairs");
             pairCapacity = std::min<uint64_t>(pairs->size() / 8, m_ws.maxPairCapacity);
         }
         const int level = IndexBuild::searchLevelFor(T, radius);
-        const IterationCounts counts =
-            iterate(d, level, level == builtLevel, radius, *pairs, pairCapacity, numActive);
-        const uint64_t pairCount = counts.pairs;
+        const std::vector<double> radii = radiiAtLevel(T, radius, double(options.radiusGrowth));
+        const RadiiOutcome out =
+            runRadii(d, level, level == builtLevel, radii, *pairs, pairCapacity, numActive);
         builtLevel = level;
-        numActive = counts.stillOpen;
+        d.out.counters.iterations += out.run;
+        if (d.out.counters.iterations > kMaxIterations)
+            throw std::runtime_error("candidate search did not converge");
+        numActive = out.stillOpen;
         reportProgress(
             options, "search",
             progressFrom +
                 (progressTo - progressFrom) *
                     (0.2 + 0.8 * (1.0 - double(numActive) /
                                             double(std::max<uint64_t>(1, d.out.counters.survivingQueries)))));
-        if (pairCount > pairCapacity && pairCapacity < m_ws.maxPairCapacity) {
+        radius = radii[out.run - 1];
+        if (!out.overflowed) {
+            radius *= double(options.radiusGrowth);
+        } else if (pairCapacity < m_ws.maxPairCapacity) {
             // Some queries lost pairs: redo them at the same radius with room.
             pairCapacity =
-                std::min<uint64_t>(m_ws.maxPairCapacity, std::max<uint64_t>(pairCount, pairCapacity * 2));
+                std::min<uint64_t>(m_ws.maxPairCapacity, std::max<uint64_t>(out.lastPairs, pairCapacity * 2));
             pairs = nullptr;
-        } else if (pairCount <= pairCapacity) {
-            radius *= double(options.radiusGrowth);
         }
     }
 }
 
-IterationCounts CandidateSearch::iterate(DirectionRun& d, int level, bool sameLevel, double radius,
-                                         Buffer& pairs, uint64_t pairCapacity, uint32_t numActive) {
-    const PointIndex::Level lv = m_index.levelCells(d.T, level);
+std::vector<double> CandidateSearch::radiiAtLevel(const PointIndex& T, double radius, double growth) const {
+    const int level = IndexBuild::searchLevelFor(T, radius);
+    std::vector<double> radii{radius};
+    while (radii.size() < radiiPerSubmission) {
+        const double next = radii.back() * growth;
+        if (IndexBuild::searchLevelFor(T, next) != level) break;
+        radii.push_back(next);
+    }
+    return radii;
+}
+
+RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLevel,
+                                       std::span<const double> radii, Buffer& pairs, uint64_t pairCapacity,
+                                       uint32_t numActive) {
+    const PointIndex::Level lv = m_index.levelCells(d.T, level);  // may build the level (a submission)
     const auto t0 = Clock::now();
-    d.blk.fields().pairs = 0;
-    d.blk.fields().nextActive = 0;
+    sh::CounterFields& counters = d.blk.fields();
+    counters.pairs = 0;
+    counters.nextActive = 0;
+    counters.searchActive = numActive;
+    const int firstActive = d.cur;
+    std::vector<std::pair<uint32_t, uint32_t>> marks;  // before and after each radius's search
     VkCommandBuffer cmd = m_ws.ctx.begin();
-    cmdSearch(cmd, d, lv, sameLevel, radius, pairs, pairCapacity, numActive);
-    const uint32_t searched = m_ws.ctx.cmdMark(cmd);
-    m_ws.barrier(cmd);
-    m_refine.cmdRefine(cmd, d, lv, level > 0, float(radius), pairs, pairCapacity, numActive);
+    for (size_t i = 0; i < radii.size(); ++i) {
+        if (i > 0)  // everything of the radius before, before anything of this one
+            gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                             VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                             VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+        const uint32_t before = i == 0 ? 0 : marks.back().second + 1;
+        cmdSearch(cmd, d, lv, sameLevel || i > 0, radii[i], pairs, pairCapacity, numActive);
+        marks.emplace_back(before, m_ws.ctx.cmdMark(cmd));
+        m_ws.barrier(cmd);
+        m_refine.cmdRefine(cmd, d, lv, level > 0, float(radii[i]), pairs, pairCapacity, numActive);
+        m_ws.barrier(cmd);
+        const sh::SearchAdvancePush ap{d.blk.device, uint32_t(i), uint32_t(pairCapacity)};
+        m_ws.pipelines.cmdDispatch(cmd, Kernel::kSearchAdvance, &ap, sizeof(ap), 1);
+        if (i + 1 < radii.size()) m_ws.ctx.cmdMark(cmd);
+        d.cur = 1 - d.cur;
+    }
     m_ws.ctx.submitAndWait(cmd);
-    const double searchGpu = m_ws.ctx.gpuMsBetween(0, searched), allGpu = m_ws.ctx.lastGpuMs();
+    double searchGpu = 0.0;
+    for (const auto& [from, to] : marks) searchGpu += m_ws.ctx.gpuMsBetween(from, to);
+    const double allGpu = m_ws.ctx.lastGpuMs();
     m_ws.timings->gpuSearch += searchGpu;
     m_ws.timings->gpuRefine += allGpu - searchGpu;
     // The wall time split between the two stages as their device time is.
     const double wall = msSince(t0), searchShare = allGpu > 0.0 ? searchGpu / allGpu : 1.0;
     m_ws.timings->search += wall * searchShare;
     m_ws.timings->refine += wall * (1.0 - searchShare);
-    d.out.counters.rays += numActive;
-    IterationCounts counts{d.blk.fields().pairs, d.blk.fields().nextActive};
-    d.out.counters.candidatePairs += std::min<uint64_t>(counts.pairs, pairCapacity);
-    d.cur = 1 - d.cur;
-    return counts;
+    // The radii that searched queries; the active list they left is the
+    // last one resolve.comp wrote.
+    RadiiOutcome out;
+    const auto* log = reinterpret_cast<const sh::SearchLogEntry*>(d.blk.host + RTHDIST_CTR_SEARCH_LOG);
+    for (size_t i = 0; i < radii.size() && log[i].searched > 0; ++i) {
+        ++out.run;
+        out.stillOpen = log[i].goingOn;
+        out.lastPairs = log[i].pairs;
+        out.overflowed = log[i].pairs > pairCapacity;
+        d.out.counters.rays += log[i].searched;
+        d.out.counters.candidatePairs += std::min<uint64_t>(log[i].pairs, pairCapacity);
+    }
+    if (out.run == 0) throw std::runtime_error("candidate search: the device searched no query");
+    d.cur = out.run % 2 == 0 ? firstActive : 1 - firstActive;
+    return out;
 }
 
 void CandidateSearch::cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv,

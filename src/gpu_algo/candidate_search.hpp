@@ -2,10 +2,14 @@
 // radius R in a BLAS (refitted while the level stays, rebuilt when it
 // changes), one ray per active query (ray query or ray-tracing pipeline);
 // every reported cell within R becomes a (query, cell) pair for the
-// refinement. R grows until no query is active.
+// refinement. R grows until no query is active. The radii that share a
+// search level go in one submission (the BLAS refitted between them), the
+// count of queries each searches kept on the device (search_advance.comp).
 #pragma once
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "gpu_algo/direction.hpp"
 #include "gpu_algo/index_build.hpp"
@@ -18,27 +22,40 @@ namespace rthdist::gpu_algo {
 // Radii before a search is declared not converging.
 inline constexpr uint32_t kMaxIterations = 4096;
 
-// What one radius of the search reported.
-struct IterationCounts {
-    uint64_t pairs = 0;      // (query, cell) pairs the rays appended (some may not fit)
-    uint32_t stillOpen = 0;  // queries going on to the next radius (or retrying)
+// What the radii of one submission reported.
+struct RadiiOutcome {
+    uint32_t run = 0;         // radii that searched queries (the later ones had none left)
+    uint32_t stillOpen = 0;   // queries going on after the last of them (or retrying)
+    uint64_t lastPairs = 0;   // (query, cell) pairs the last of them appended
+    bool overflowed = false;  // ... more than the buffer held: its queries that lost pairs retry
 };
 
 class CandidateSearch {
 public:
-    CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, Refinement& refinement)
-        : m_ws(workspace), m_index(indexBuild), m_refine(refinement) {}
+    CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, Refinement& refinement);
 
     // Candidate search with a growing radius until no query is active.
     void runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options, double progressFrom,
                    double progressTo);
 
-    // One radius in one submission: the search (cmdSearch), then the
-    // refinement sized by the device from the pairs the rays appended
-    // (cmdRefine, indirect dispatch), then the resolution of every active
-    // query. The host reads the counts once, at the end.
-    IterationCounts iterate(DirectionRun& d, int level, bool sameLevel, double radius, Buffer& pairs,
-                            uint64_t pairCapacity, uint32_t numActive);
+    // The radii that follow `radius` (growth each time) at its search level,
+    // at most RTHDIST_SEARCH_LOG_MAX (and radiiPerSubmission) of them.
+    [[nodiscard]] std::vector<double> radiiAtLevel(const PointIndex& T, double radius, double growth) const;
+
+    // Radii of one level in one submission, each: the search (cmdSearch),
+    // the refinement sized by the device from the pairs the rays appended
+    // (cmdRefine, indirect dispatch), the resolution of every active query,
+    // then search_advance.comp, which logs the radius and hands the queries
+    // going on to the next (none after a pair-buffer overflow). numActive:
+    // the queries of the first radius (the later ones search at most as
+    // many). The host reads the log once, at the end.
+    RadiiOutcome runRadii(DirectionRun& d, int level, bool sameLevel, std::span<const double> radii,
+                          Buffer& pairs, uint64_t pairCapacity, uint32_t numActive);
+
+    // Radii per submission at most (1 to RTHDIST_SEARCH_LOG_MAX; the
+    // RTHDIST_SEARCH_RADII environment variable sets it for tests and
+    // benchmarks).
+    uint32_t radiiPerSubmission = RTHDIST_SEARCH_LOG_MAX;
 
     // Records the search of one radius: the level's boxes grown by the
     // radius, the BLAS refitted (same level) or rebuilt, one ray per active

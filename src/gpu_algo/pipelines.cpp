@@ -39,6 +39,7 @@
 #include "search.rgen.h"
 #include "search.rint.h"
 #include "search.rmiss.h"
+#include "search_advance.comp.h"
 #include "search_rq.comp.h"
 
 namespace rthdist::gpu {
@@ -82,6 +83,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_sample_gather_comp, "sample_gather"},
     {k_spv_batch_nearest_comp, "batch_nearest"},
     {k_spv_batch_witness_comp, "batch_witness"},
+    {k_spv_search_advance_comp, "search_advance"},
 }};
 
 }  // namespace

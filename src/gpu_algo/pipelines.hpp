@@ -42,6 +42,7 @@ enum class Kernel : uint32_t {
     kSampleGather,  // the bit count's sample of a device-input set (sample_gather.comp)
     kBatchNearest,  // computeBatch's small pairs: exact scans (batch_nearest.comp)
     kBatchWitness,  // and their witnesses (batch_witness.comp)
+    kSearchAdvance,  // between the radii of one submission (search_advance.comp)
     kCount
 };
 

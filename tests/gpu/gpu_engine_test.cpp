@@ -2,9 +2,14 @@
 // paper's candidate-set gap (DESIGN §3), pair-buffer overflow, engine reuse.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <optional>
 #include <random>
+#include <string>
+#include <utility>
 
 #include "common/brute_force.hpp"
 #include "common/oracle_cases.hpp"
@@ -114,6 +119,55 @@ TEST(GpuEngine, ReusedEngineStaysExactAcrossSizes) {
                     uniformCloud(s[0], seed, glm::vec3(0.0f)), uniformCloud(s[1], seed + 1, glm::vec3(0.3f)));
         seed += 2;
     }
+}
+
+// The radii of one search level run in one submission (the count of queries
+// each searches kept on the device) or one per submission
+// (RTHDIST_SEARCH_RADII=1): the same radii, so the same answers, witnesses
+// and per-point distances (not the same counters: how many queries die early
+// depends on when the running maximum rises, in either mode).
+TEST(GpuEngine, RadiiInOneSubmissionEqualOnePerSubmission) {
+    const char* before = std::getenv("RTHDIST_SEARCH_RADII");
+    const std::string saved = before ? before : "";
+    std::string whyNot;
+    setenv("RTHDIST_SEARCH_RADII", "1", 1);
+    std::optional<Engine> single = makeEngine(gpuOptions(), whyNot);
+    unsetenv("RTHDIST_SEARCH_RADII");
+    std::optional<Engine> fused = makeEngine(gpuOptions(), whyNot);
+    if (before) setenv("RTHDIST_SEARCH_RADII", saved.c_str(), 1);
+    if (!single || !fused) GTEST_SKIP() << "no device for this backend: " << whyNot;
+    uint32_t mostIterations = 0;
+    for (uint64_t seed = 31; seed < 38; ++seed) {
+        // The last: one bit per axis, far apart: the pair buffer overflows
+        // (PairBufferOverflowStaysExact) and the search resumes at that radius.
+        const bool overflow = seed == 37;
+        const float apart = overflow ? 2.5f : 0.1f * float(seed - 30);
+        OracleCase c{"radii-" + std::to_string(seed), seed,
+                     uniformCloud(overflow ? 12000 : 3000 + 500 * seed, seed, glm::vec3(0.0f)),
+                     uniformCloud(overflow ? 9000 : 5000, seed + 100, glm::vec3(apart, 0.05f, 0.0f))};
+        SCOPED_TRACE(c.name);
+        CallOptions call;
+        call.perPointDistances = seed % 2 == 0;
+        call.bits = overflow ? 1 : 0;
+        auto one = single->compute(c.a, c.b, call);
+        auto all = fused->compute(c.a, c.b, call);
+        ASSERT_TRUE(one.ok()) << one.error().message;
+        ASSERT_TRUE(all.ok()) << all.error().message;
+        expectMatchesOracle(c, *all);
+        EXPECT_EQ(all->hausdorff, one->hausdorff);
+        EXPECT_EQ(all->aNearest.distance, one->aNearest.distance);
+        EXPECT_EQ(all->bNearest.distance, one->bNearest.distance);
+        EXPECT_EQ(all->aNearest.nearest, one->aNearest.nearest);
+        EXPECT_EQ(all->bNearest.nearest, one->bNearest.nearest);
+        for (const auto& [x, y] : {std::pair{&all->aToB, &one->aToB}, std::pair{&all->bToA, &one->bToA}}) {
+            EXPECT_EQ(x->distance, y->distance);
+            EXPECT_EQ(x->queryIndex, y->queryIndex);
+            EXPECT_EQ(x->targetIndex, y->targetIndex);
+            mostIterations = std::max(mostIterations, x->counters.iterations);
+        }
+        EXPECT_EQ(all->validationMessages, 0u);
+    }
+    EXPECT_GE(mostIterations, 2u);  // radii shared a submission
 }
 
 TEST(GpuEngine, CountersDescribeTheWork) {

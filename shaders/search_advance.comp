@@ -1,0 +1,24 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Between two radii of the candidate search recorded in one submission: logs
+// the radius just run (queries searched, queries going on, pairs appended),
+// then sets up the next: it searches the queries going on (resolve.comp's
+// list), or none once the pair buffer overflowed (the host then resumes from
+// the logged radius with more room, as after a single radius).
+#include "common.glsl"
+layout(local_size_x = 1) in;
+layout(push_constant) uniform Push { SearchAdvancePush pc; };
+
+void main() {
+    uint64_t c = pc.counters;
+    uint searched = UintRef(c + RTHDIST_CTR_SEARCH_ACTIVE).v;
+    uint next = UintRef(c + RTHDIST_CTR_NEXT_ACTIVE).v;
+    uint64_t pairs = U64Ref(c + RTHDIST_CTR_PAIRS).v;
+    uint64_t entry = c + RTHDIST_CTR_SEARCH_LOG + uint64_t(pc.iteration) * 16ul;
+    UintRef(entry).v = searched;
+    UintRef(entry + 4ul).v = next;
+    U64Ref(entry + 8ul).v = pairs;
+    UintRef(c + RTHDIST_CTR_SEARCH_ACTIVE).v = pairs > uint64_t(pc.pairCapacity) ? 0u : next;
+    UintRef(c + RTHDIST_CTR_NEXT_ACTIVE).v = 0u;
+    U64Ref(c + RTHDIST_CTR_PAIRS).v = 0ul;
+}
