@@ -474,6 +474,7 @@ void Context::createCommandObjects() {
     qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
     qpi.queryCount = kTimestampSlots;
     m_timestamps = RTHDIST_VK_CREATE(UniqueQueryPool, vkCreateQueryPool, d, qpi);
+    m_traceSubmits = std::getenv("RTHDIST_SUBMIT_TRACE") != nullptr;
 }
 
 Context::~Context() {
@@ -517,6 +518,7 @@ VkCommandBuffer Context::begin() {
     vkCmdResetQueryPool(m_cmd, m_timestamps.get(), 0, kTimestampSlots);
     vkCmdWriteTimestamp(m_cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, m_timestamps.get(), 0);
     m_marks = 1;
+    if (m_traceSubmits) m_begun = std::chrono::steady_clock::now();
     return m_cmd;
 }
 
@@ -543,6 +545,7 @@ void Context::submitAndWait(VkCommandBuffer cmd) {
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cmd;
     const VkFence fence = m_fence.get();
+    if (m_traceSubmits) m_submitted = std::chrono::steady_clock::now();
     RTHDIST_VK_CHECK(vkQueueSubmit(m_queue, 1, &si, fence));
     VkResult r;
     do {
@@ -555,6 +558,18 @@ void Context::submitAndWait(VkCommandBuffer cmd) {
                               VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
     RTHDIST_VK_CHECK(r);
     m_lastGpuMs = gpuMsBetween(0, last);
+    if (m_traceSubmits) traceSubmit();
+}
+
+void Context::traceSubmit() {
+    using Ms = std::chrono::duration<double, std::milli>;
+    const auto now = std::chrono::steady_clock::now();
+    std::fprintf(
+        stderr,
+        "rthdist submit: host before %.3f ms, recording %.3f ms, submit+wait %.3f ms, device %.3f ms\n",
+        Ms(m_begun - m_lastDone).count(), Ms(m_submitted - m_begun).count(), Ms(now - m_submitted).count(),
+        m_lastGpuMs);
+    m_lastDone = now;
 }
 
 }  // namespace rthdist::gpu

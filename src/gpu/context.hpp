@@ -9,6 +9,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -165,7 +166,12 @@ private:
     UniqueFence m_fence;
     UniqueQueryPool m_timestamps;
     double m_lastGpuMs = 0.0;
-    uint32_t m_marks = 1;                              // timestamps written since begin()
+    uint32_t m_marks = 1;  // timestamps written since begin()
+    // RTHDIST_SUBMIT_TRACE=1: one stderr line per submission (host time
+    // recording it, waiting for it, its device time; a benchmark's tool).
+    bool m_traceSubmits = false;
+    void traceSubmit();
+    std::chrono::steady_clock::time_point m_begun, m_submitted, m_lastDone;
     std::array<uint64_t, kTimestampSlots> m_stamps{};  // of the last submission
     uint32_t m_timestampBits = 64;
     Backend m_backend = Backend::kRayQuery;

@@ -133,25 +133,34 @@ void DeviceIngest::ingest(std::span<PointIndex* const> sets, std::span<const Dev
         sets[k]->source = nullptr;
         cmdConvert(cmd, *sets[k], views[k], m_ws.blocks[k], origin);
     }
-    m_ws.barrier(cmd);
     std::array<size_t, 2> sampled{};
-    if (bits <= 0)
-        for (size_t k = 0; k < sets.size(); ++k) sampled[k] = cmdGatherSample(cmd, *sets[k], m_samples[k]);
+    if (bits <= 0) sampled = cmdGatherSamples(cmd, sets);
     m_ws.ctx.submitAndWait(cmd);
     m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
+    for (size_t k = 0; k < sets.size(); ++k) m_index.finishIngest(*sets[k], m_ws.blocks[k]);
+    chooseGrids(sets, sampled, bits);
+    m_ws.timings->index += msSince(t0);
+}
+
+std::array<size_t, 2> DeviceIngest::cmdGatherSamples(VkCommandBuffer cmd, std::span<PointIndex* const> sets) {
+    m_ws.barrier(cmd);
+    std::array<size_t, 2> sampled{};
+    for (size_t k = 0; k < sets.size(); ++k) sampled[k] = cmdGatherSample(cmd, *sets[k], m_samples[k]);
+    return sampled;
+}
+
+void DeviceIngest::chooseGrids(std::span<PointIndex* const> sets, const std::array<size_t, 2>& sampled,
+                               int bits) {
     for (size_t k = 0; k < sets.size(); ++k) {
         PointIndex& ix = *sets[k];
-        m_index.finishIngest(ix, m_ws.blocks[k]);
         int chosen = bits;
         if (bits <= 0) {
-            const size_t count = sampled[k];
-            std::vector<glm::vec3> sample(count);
-            std::memcpy(sample.data(), m_samples[k].mapped(), count * 12);
+            std::vector<glm::vec3> sample(sampled[k]);
+            std::memcpy(sample.data(), m_samples[k].mapped(), sampled[k] * 12);
             chosen = clampedBits(core::chooseBitsFromSample(sample, ix.n, ix.bounds), ix.n);
         }
         ix.grid = core::makeGrid(ix.bounds, chosen);
     }
-    m_ws.timings->index += msSince(t0);
 }
 
 }  // namespace rthdist::gpu_algo

@@ -47,6 +47,15 @@ public:
     void ingest(std::span<PointIndex* const> sets, std::span<const DeviceInput> views,
                 const glm::dvec3& origin, int bits, bool first);
 
+    // Records, after a barrier from the ingest, the bit count's sample of
+    // each ingested set (cmdGatherSample); returns their counts.
+    std::array<size_t, 2> cmdGatherSamples(VkCommandBuffer cmd, std::span<PointIndex* const> sets);
+    // Once that submission is done: each set's grid over its bounds, with
+    // `bits` or (bits <= 0) the bit count of its sample
+    // (core::chooseBitsFromSample: the count chooseBits finds on the same
+    // points).
+    void chooseGrids(std::span<PointIndex* const> sets, const std::array<size_t, 2>& sampled, int bits);
+
     // The first command of a call on device input: every earlier memory write
     // on the queue -> the shader and transfer reads of the call (the
     // synchronisation contract of vulkan_interop.hpp).

@@ -108,8 +108,9 @@ struct GpuHausdorff::State {
     }
 
     // One-shot H of two packed float host arrays through the ingest path:
-    // one submission uploads and ingests both, the host reads their bounds
-    // (the grid and the bit count need them), a second builds both indexes.
+    // one submission uploads and ingests both and gathers the bit count's
+    // samples, the host reads their bounds and samples (the grid and the bit
+    // count need them), a second builds both indexes.
     // Returns false, having done nothing else, when the sets need the exact
     // power-of-two scale (index_space.hpp), which the host path applies.
     bool ingestPair(DeviceSet& da, DeviceSet& db, std::span<const glm::vec3> a, std::span<const glm::vec3> b,
@@ -129,6 +130,9 @@ struct GpuHausdorff::State {
         const uint32_t uploaded = ws.ctx.cmdMark(cmd);
         ws.barrier(cmd);
         for (size_t k = 0; k < 2; ++k) index.cmdIngest(cmd, sets[k]->ix, ws.blocks[k]);
+        const std::array<PointIndex*, 2> indexes = {&da.ix, &db.ix};
+        std::array<size_t, 2> sampled{};
+        if (options.bits <= 0) sampled = deviceIngest.cmdGatherSamples(cmd, indexes);
         ws.ctx.submitAndWait(cmd);
         ws.imports.clear();  // the device has read the caller's arrays
         const double uploadMs = ws.ctx.gpuMsBetween(0, uploaded);
@@ -139,7 +143,7 @@ struct GpuHausdorff::State {
         const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
         if (exactScale(magnitude) != 1.0) return false;
         const auto t1 = Clock::now();
-        chooseIngestedGrids({&da.ix, &db.ix}, inputs, options.bits);
+        deviceIngest.chooseGrids(indexes, sampled, options.bits);
         ws.timings->index += msSince(t1);
         index.buildIndexes(std::array{&da.ix, &db.ix}, /*uploaded=*/true);
         return true;

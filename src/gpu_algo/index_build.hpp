@@ -21,12 +21,6 @@ namespace rthdist::gpu_algo {
 // count keeps it within a few entries per point.
 [[nodiscard]] int clampedBits(int bits, uint32_t n);
 
-// The bit counts and grids of two ingested sets, side by side: their bounds
-// come from the device, their bit counts from a strided sample of the
-// caller's arrays (chooseBits reads ~32k points in place, ~0.2-0.4 ms each).
-void chooseIngestedGrids(const std::array<PointIndex*, 2>& sets,
-                         const std::array<std::span<const glm::vec3>, 2>& pts, int bits);
-
 class IndexBuild {
 public:
     explicit IndexBuild(Workspace& workspace) : m_ws(workspace) {}

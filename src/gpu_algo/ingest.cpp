@@ -23,17 +23,6 @@ float fromOrderedBits(uint32_t u) {
 
 }  // namespace
 
-void chooseIngestedGrids(const std::array<PointIndex*, 2>& sets,
-                         const std::array<std::span<const glm::vec3>, 2>& pts, int bits) {
-    core::parallelChunks(2, 1, 2, [&](size_t begin, size_t end, int) {
-        for (size_t k = begin; k < end; ++k) {
-            PointIndex& ix = *sets[k];
-            const int chosen = bits > 0 ? bits : clampedBits(core::chooseBits(pts[k], ix.bounds), ix.n);
-            ix.grid = core::makeGrid(ix.bounds, chosen);
-        }
-    });
-}
-
 void IndexBuild::stageSource(PointIndex& ix, std::span<const glm::vec3> pts) {
     ix.n = uint32_t(pts.size());
     const size_t bytes = size_t(ix.n) * 12;
