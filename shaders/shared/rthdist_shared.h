@@ -45,6 +45,7 @@ struct vec3f {
 #define RTHDIST_CTR_INGEST 1152     // IngestSummary: ingest.comp, one set's bounds and first bad point
 #define RTHDIST_CTR_INGEST64 1184   // IngestSummary64: ingest_f64.comp, one device view's box in double
 #define RTHDIST_CTR_SEARCH_LOG 1280  // SearchLogEntry[RTHDIST_SEARCH_LOG_MAX]: the radii of one submission
+#define RTHDIST_CTR_PROBE 1536  // uint[RTHDIST_PROBE_LEVELS + 1]: probe_levels.comp, distinct cells per level
 #define RTHDIST_CTR_BYTES 2048
 // Radii of the candidate search recorded in one submission, at most.
 #define RTHDIST_SEARCH_LOG_MAX 16
@@ -389,6 +390,22 @@ struct ResolvePush {
     float lowerBound2;
 };
 
+// probe_levels.comp: the automatic bit count's probe on the device (the same
+// sample, keys and counts as core::chooseBitsFromSample on the host): the
+// sample's 10-bit probe cell keys, each level's distinct cells counted by
+// inserting the key's top 3k bits into a hash table of that level.
+#define RTHDIST_PROBE_LEVELS 8       // levels 1..8 (core::kMaxBits)
+#define RTHDIST_PROBE_SLOT_BITS 17   // slots per level's table: twice the largest sample
+struct ProbeLevelsPush {
+    uint64_t points;      // vec4 records of the ingested set
+    uint64_t tables;      // uint[RTHDIST_PROBE_LEVELS << RTHDIST_PROBE_SLOT_BITS], zeroed (0: empty)
+    uint64_t counts;      // uint[RTHDIST_PROBE_LEVELS + 1] (RTHDIST_CTR_PROBE), zeroed
+    uint64_t origin[3];   // double bits: the probe's origin (the box's low corner)
+    uint64_t perLength;   // double bits: probe cells per unit length
+    uint count;           // sampled records: record j * stride for j < count
+    uint stride;
+};
+
 // search_advance.comp: between two radii of one submission, the radius just
 // run is logged (entry `iteration` of RTHDIST_CTR_SEARCH_LOG) and the next
 // one set up: its queries are the ones going on, or none once the pair buffer
@@ -431,6 +448,9 @@ static_assert(offsetof(CounterFields, checkBad) == RTHDIST_CTR_CHECK_BAD);
 static_assert(offsetof(CounterFields, minEdge) == RTHDIST_CTR_MIN_EDGE);
 static_assert(offsetof(CounterFields, largeCells) == RTHDIST_CTR_LARGE_CELLS);
 static_assert(offsetof(CounterFields, searchActive) == RTHDIST_CTR_SEARCH_ACTIVE);
+static_assert(sizeof(ProbeLevelsPush) == 64 &&
+              RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_PROBE &&
+              RTHDIST_CTR_PROBE + (RTHDIST_PROBE_LEVELS + 1) * 4 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDIST_CTR_SEARCH_LOG &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);

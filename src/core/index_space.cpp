@@ -46,26 +46,36 @@ double exactScale(double maxAbs) {
 
 namespace {
 
-constexpr int kProbeBits = 10;  // the sample's keys: 10 bits per axis, 30 in all
 constexpr size_t kSampleSize = 32768;
 
 // The probe keys of the sample, in ascending order (LSD radix sort, three
-// passes of 10 bits: linear in the sample, where a comparison sort of 32k
-// keys cost ~1.5 ms per set on the host path).
-std::vector<uint32_t> sortedSampleKeys(std::span<const glm::vec3> sample, const GridSpec& probe) {
+// passes of 10 bits, the three digit counts taken in one pass: linear in the
+// sample, where a comparison sort of 32k keys cost ~1.5 ms per set on the
+// host path). A key's cell coordinates are (p - origin) * (cells / longest),
+// clamped: a product where a quotient cost ~3x the time, and the same keys
+// for every caller (the CPU backend, the host and device-ingest paths).
+std::vector<uint32_t> sortedSampleKeys(std::span<const glm::vec3> sample, const BitProbe& probe) {
+    constexpr uint32_t kDigits = 1u << kProbeBits;
+    const auto coord = [&](float p, double origin) {
+        const double c = (double(p) - origin) * probe.perLength;
+        if (!(c > 0.0)) return 0u;
+        return c >= double(kDigits) ? kDigits - 1 : uint32_t(c);
+    };
     std::vector<uint32_t> keys(sample.size()), tmp(sample.size());
+    std::vector<uint32_t> start(3 * (kDigits + 1), 0);
     for (size_t i = 0; i < sample.size(); ++i) {
         const glm::vec3& p = sample[i];
-        keys[i] = mortonEncode(cellCoord(p.x, probe.origin.x, probe.cellSize, probe.cellsPerAxis),
-                               cellCoord(p.y, probe.origin.y, probe.cellSize, probe.cellsPerAxis),
-                               cellCoord(p.z, probe.origin.z, probe.cellSize, probe.cellsPerAxis));
+        const uint32_t key =
+            mortonEncode(coord(p.x, probe.origin.x), coord(p.y, probe.origin.y), coord(p.z, probe.origin.z));
+        keys[i] = key;
+        for (uint32_t d = 0; d < 3; ++d)
+            ++start[d * (kDigits + 1) + ((key >> (d * kProbeBits)) & (kDigits - 1)) + 1];
     }
-    constexpr uint32_t kDigits = 1u << kProbeBits;
-    for (int shift = 0; shift < 3 * kProbeBits; shift += kProbeBits) {
-        std::vector<uint32_t> start(kDigits + 1, 0);
-        for (uint32_t key : keys) ++start[((key >> shift) & (kDigits - 1)) + 1];
-        for (uint32_t d = 0; d < kDigits; ++d) start[d + 1] += start[d];
-        for (uint32_t key : keys) tmp[start[(key >> shift) & (kDigits - 1)]++] = key;
+    for (uint32_t d = 0; d < 3; ++d) {
+        uint32_t* digitStart = start.data() + d * (kDigits + 1);
+        for (uint32_t v = 0; v < kDigits; ++v) digitStart[v + 1] += digitStart[v];
+        const uint32_t shift = d * kProbeBits;
+        for (uint32_t key : keys) tmp[digitStart[(key >> shift) & (kDigits - 1)]++] = key;
         keys.swap(tmp);
     }
     return keys;
@@ -75,7 +85,7 @@ std::vector<uint32_t> sortedSampleKeys(std::span<const glm::vec3> sample, const 
 // top 3k bits of a probe key) the sorted keys fall in. Two neighbours in the
 // order differ at level k exactly when their highest differing bit is at or
 // above the level's shift, so one pass over the neighbours counts every level.
-std::array<size_t, kMaxBits + 1> distinctCellsPerLevel(const std::vector<uint32_t>& sorted) {
+LevelCounts distinctCellsPerLevel(const std::vector<uint32_t>& sorted) {
     std::array<size_t, kMaxBits + 1> firstLevel{};  // neighbour pairs first differing at level k
     for (size_t i = 1; i < sorted.size(); ++i) {
         const uint32_t diff = sorted[i] ^ sorted[i - 1];
@@ -84,7 +94,7 @@ std::array<size_t, kMaxBits + 1> distinctCellsPerLevel(const std::vector<uint32_
         const int k = kProbeBits - high / 3;  // smallest k with 3 (kProbeBits - k) <= high
         if (k <= kMaxBits) ++firstLevel[size_t(std::max(k, 1))];
     }
-    std::array<size_t, kMaxBits + 1> distinct{};
+    LevelCounts distinct{};
     size_t running = sorted.empty() ? 0 : 1;
     for (int k = 1; k <= kMaxBits; ++k) {
         running += firstLevel[size_t(k)];
@@ -97,23 +107,30 @@ std::array<size_t, kMaxBits + 1> distinctCellsPerLevel(const std::vector<uint32_
 
 size_t sampleStride(size_t n) { return std::max<size_t>(1, n / kSampleSize); }
 
+bool bitProbeOf(const Bounds& bounds, size_t n, BitProbe& probe) {
+    if (n <= 1) return false;
+    const glm::dvec3 ext = bounds.hi - bounds.lo;
+    const double longest = std::max({ext.x, ext.y, ext.z});
+    if (!(longest > 0.0)) return false;
+    probe.origin = bounds.lo;
+    probe.perLength = 1.0 / (longest / double(1u << kProbeBits));
+    return true;
+}
+
 int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Bounds& bounds,
                          double targetPointsPerCell) {
-    if (n <= 1) return kMinBits;
-    GridSpec probe = makeGrid(bounds, kMaxBits);
-    probe.bits = kProbeBits;
-    probe.cellsPerAxis = 1u << kProbeBits;
-    glm::dvec3 ext = bounds.hi - bounds.lo;
-    double longest = std::max({ext.x, ext.y, ext.z});
-    if (!(longest > 0.0)) return kMinBits;
-    probe.cellSize = longest / double(probe.cellsPerAxis);
+    BitProbe probe;
+    if (!bitProbeOf(bounds, n, probe)) return kMinBits;
+    return chooseBitsFromCounts(distinctCellsPerLevel(sortedSampleKeys(sample, probe)), sample.size(), n,
+                                targetPointsPerCell);
+}
 
+int chooseBitsFromCounts(const LevelCounts& distinct, size_t sampledPoints, size_t n,
+                         double targetPointsPerCell) {
     // Its distinct-cell counts per level are trustworthy while the sample
     // still puts several points in each cell.
     const bool whole = sampleStride(n) == 1;
-    const std::vector<uint32_t> keys = sortedSampleKeys(sample, probe);
-    const std::array<size_t, kMaxBits + 1> distinct = distinctCellsPerLevel(keys);
-    const double sampled = double(keys.size());
+    const double sampled = double(sampledPoints);
     double estimate = 1.0;  // occupied cells at the previous level
     double growth = 8.0;
     int chosen = kMinBits;

@@ -9,6 +9,8 @@
 
 #include <glm/vec3.hpp>
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 
@@ -47,6 +49,23 @@ struct GridSpec {
 // j * sampleStride(n) of a set of n points): the same bit count as chooseBits
 // on the whole set (device input reads back only the sample).
 [[nodiscard]] int chooseBitsFromSample(std::span<const glm::vec3> sample, size_t n, const Bounds& bounds,
+                                       double targetPointsPerCell = kTargetPointsPerCell);
+
+// The rule in its two halves, for a probe counted elsewhere (the GPU
+// backend's probe_levels.comp). The probe: every sampled point's cell of
+// 2^kProbeBits per axis over the box's longest side, coordinate
+// (p - origin) * perLength in double, clamped; none when the rule needs no
+// sample (n <= 1 or a box of zero extent: kMinBits).
+inline constexpr int kProbeBits = 10;
+struct BitProbe {
+    glm::dvec3 origin{0.0};
+    double perLength = 0.0;
+};
+[[nodiscard]] bool bitProbeOf(const Bounds& bounds, size_t n, BitProbe& probe);
+// distinct[k], k = 1..kMaxBits: the probe cells of level k (a key's top 3k
+// bits) that the `sampled` points of the sample fall in.
+using LevelCounts = std::array<size_t, kMaxBits + 1>;
+[[nodiscard]] int chooseBitsFromCounts(const LevelCounts& distinct, size_t sampled, size_t n,
                                        double targetPointsPerCell = kTargetPointsPerCell);
 
 // The one scaling rule of both backends (squared distances are float there):

@@ -308,9 +308,17 @@ std::optional<Error> Context::createMessenger() {
 }
 
 // The device with exactly the extensions and features of `req` (plus the
-// optional host import), and its one compute queue.
-void Context::createDevice(const DeviceRequirements& req) {
+// optional host import, and shaderFloat64 where the device has it: the
+// automatic bit count's probe on the device), and its one compute queue.
+void Context::createDevice(const DeviceRequirements& required) {
     m_queueFamily = computeQueueFamily(m_physical);
+    DeviceRequirements req = required;
+    DeviceRequirements f64;
+    f64.apiVersion = VK_API_VERSION_1_0;
+    f64.features = {DeviceFeature::kShaderFloat64};
+    m_shaderFloat64 = unmetRequirements(m_physical, f64).empty();
+    if (m_shaderFloat64 && !req.needs(DeviceFeature::kShaderFloat64))
+        req.features.push_back(DeviceFeature::kShaderFloat64);
     // Optional: the device reads the caller's arrays in place (gpu/host_import.hpp).
     m_hostImport =
         wantsHostImport() && deviceHasExtension(m_physical, VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);

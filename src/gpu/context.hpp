@@ -78,7 +78,8 @@ public:
     [[nodiscard]] const std::string& deviceName() const { return m_name; }
     // The device is the embedder's (borrow): device input is possible.
     [[nodiscard]] bool borrowed() const { return m_borrowed; }
-    // shaderFloat64 is enabled on the device (double views of device input).
+    // shaderFloat64 is enabled on the device (double views of device input,
+    // the bit count's probe): on every device that has it.
     [[nodiscard]] bool shaderFloat64() const { return m_shaderFloat64; }
     [[nodiscard]] const RtFunctions& rt() const { return m_rt; }
     [[nodiscard]] const VkPhysicalDeviceRayTracingPipelinePropertiesKHR& rtProps() const { return m_rtProps; }

@@ -134,12 +134,66 @@ void DeviceIngest::ingest(std::span<PointIndex* const> sets, std::span<const Dev
         cmdConvert(cmd, *sets[k], views[k], m_ws.blocks[k], origin);
     }
     std::array<size_t, 2> sampled{};
-    if (bits <= 0) sampled = cmdGatherSamples(cmd, sets);
+    const bool probe = bits <= 0 && probesOnDevice();
+    if (bits <= 0 && !probe) sampled = cmdGatherSamples(cmd, sets);
     m_ws.ctx.submitAndWait(cmd);
     m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
     for (size_t k = 0; k < sets.size(); ++k) m_index.finishIngest(*sets[k], m_ws.blocks[k]);
-    chooseGrids(sets, sampled, bits);
+    if (probe)
+        chooseGridsByProbe(sets);
+    else
+        chooseGrids(sets, sampled, bits);
     m_ws.timings->index += msSince(t0);
+}
+
+void DeviceIngest::chooseGridsByProbe(std::span<PointIndex* const> sets) {
+    constexpr VkDeviceSize kTableBytes = (VkDeviceSize(RTHDIST_PROBE_LEVELS) << RTHDIST_PROBE_SLOT_BITS) * 4;
+    static_assert(RTHDIST_PROBE_LEVELS == core::kMaxBits && RTHDIST_PROBE_SLOT_BITS == 17);
+    std::array<core::BitProbe, 2> probes;
+    std::array<bool, 2> probed{};
+    std::array<uint32_t, 2> sampled{};
+    for (size_t k = 0; k < sets.size(); ++k)
+        probed[k] = core::bitProbeOf(sets[k]->bounds, sets[k]->n, probes[k]);
+    if (probed[0] || probed[1]) {
+        VkCommandBuffer cmd = m_ws.ctx.begin();
+        for (size_t k = 0; k < sets.size(); ++k) {
+            if (!probed[k]) continue;
+            Buffer& tables = m_ws.grow(m_probeTables[k], kTableBytes, sets[k]->name + ".probe");
+            vkCmdFillBuffer(cmd, tables.handle(), 0, kTableBytes, 0u);
+            std::memset(m_ws.blocks[k].host + RTHDIST_CTR_PROBE, 0, (RTHDIST_PROBE_LEVELS + 1) * 4);
+        }
+        m_ws.barrier(cmd);
+        for (size_t k = 0; k < sets.size(); ++k) {
+            if (!probed[k]) continue;
+            const PointIndex& ix = *sets[k];
+            const size_t stride = core::sampleStride(ix.n);
+            sampled[k] = uint32_t((size_t(ix.n) + stride - 1) / stride);
+            const core::BitProbe& p = probes[k];
+            const sh::ProbeLevelsPush push{
+                m_ws.grow(ix.scratch->points, VkDeviceSize(ix.n) * 16, ix.name + ".points").address(),
+                m_probeTables[k].address(),
+                m_ws.blocks[k].addr(RTHDIST_CTR_PROBE),
+                {std::bit_cast<uint64_t>(p.origin.x), std::bit_cast<uint64_t>(p.origin.y),
+                 std::bit_cast<uint64_t>(p.origin.z)},
+                std::bit_cast<uint64_t>(p.perLength),
+                sampled[k],
+                uint32_t(stride)};
+            m_ws.dispatch(cmd, Kernel::kProbeLevels, push, sampled[k]);
+        }
+        m_ws.ctx.submitAndWait(cmd);
+        m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
+    }
+    for (size_t k = 0; k < sets.size(); ++k) {
+        PointIndex& ix = *sets[k];
+        int chosen = core::kMinBits;
+        if (probed[k]) {
+            const auto* counts = reinterpret_cast<const uint32_t*>(m_ws.blocks[k].host + RTHDIST_CTR_PROBE);
+            core::LevelCounts distinct{};
+            for (int level = 1; level <= core::kMaxBits; ++level) distinct[size_t(level)] = counts[level];
+            chosen = core::chooseBitsFromCounts(distinct, sampled[k], ix.n);
+        }
+        ix.grid = core::makeGrid(ix.bounds, clampedBits(chosen, ix.n));
+    }
 }
 
 std::array<size_t, 2> DeviceIngest::cmdGatherSamples(VkCommandBuffer cmd, std::span<PointIndex* const> sets) {

@@ -56,6 +56,16 @@ public:
     // points).
     void chooseGrids(std::span<PointIndex* const> sets, const std::array<size_t, 2>& sampled, int bits);
 
+    // Whether the automatic bit count of ingested sets runs on the device
+    // (probe_levels.comp needs shaderFloat64); else the host counts it from
+    // the gathered samples (cmdGatherSamples, chooseGrids).
+    [[nodiscard]] bool probesOnDevice() const { return m_ws.ctx.shaderFloat64(); }
+    // Each ingested set's grid over its bounds with the automatic bit count,
+    // its probe counted on the device in one submission (the same sample,
+    // keys and counts as core::chooseBitsFromSample); the host reads the
+    // counts of each level and applies the rule (core::chooseBitsFromCounts).
+    void chooseGridsByProbe(std::span<PointIndex* const> sets);
+
     // The first command of a call on device input: every earlier memory write
     // on the queue -> the shader and transfer reads of the call (the
     // synchronisation contract of vulkan_interop.hpp).
@@ -71,7 +81,8 @@ private:
 
     Workspace& m_ws;
     IndexBuild& m_index;
-    std::array<Buffer, 2> m_samples;  // the sample of each set of a call (host-visible)
+    std::array<Buffer, 2> m_samples;      // the sample of each set of a call (host-visible)
+    std::array<Buffer, 2> m_probeTables;  // each set's hash tables of probe cells (device)
 };
 
 }  // namespace rthdist::gpu_algo

@@ -132,7 +132,8 @@ struct GpuHausdorff::State {
         for (size_t k = 0; k < 2; ++k) index.cmdIngest(cmd, sets[k]->ix, ws.blocks[k]);
         const std::array<PointIndex*, 2> indexes = {&da.ix, &db.ix};
         std::array<size_t, 2> sampled{};
-        if (options.bits <= 0) sampled = deviceIngest.cmdGatherSamples(cmd, indexes);
+        const bool probe = options.bits <= 0 && deviceIngest.probesOnDevice();
+        if (options.bits <= 0 && !probe) sampled = deviceIngest.cmdGatherSamples(cmd, indexes);
         ws.ctx.submitAndWait(cmd);
         ws.imports.clear();  // the device has read the caller's arrays
         const double uploadMs = ws.ctx.gpuMsBetween(0, uploaded);
@@ -143,7 +144,10 @@ struct GpuHausdorff::State {
         const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
         if (exactScale(magnitude) != 1.0) return false;
         const auto t1 = Clock::now();
-        deviceIngest.chooseGrids(indexes, sampled, options.bits);
+        if (probe)
+            deviceIngest.chooseGridsByProbe(indexes);
+        else
+            deviceIngest.chooseGrids(indexes, sampled, options.bits);
         ws.timings->index += msSince(t1);
         index.buildIndexes(std::array{&da.ix, &db.ix}, /*uploaded=*/true);
         return true;

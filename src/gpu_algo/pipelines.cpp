@@ -29,6 +29,7 @@
 #include "leaf_keys.comp.h"
 #include "leaf_scatter.comp.h"
 #include "leaf_slots.comp.h"
+#include "probe_levels.comp.h"
 #include "refine.comp.h"
 #include "refine_args.comp.h"
 #include "resolve.comp.h"
@@ -84,6 +85,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_batch_nearest_comp, "batch_nearest"},
     {k_spv_batch_witness_comp, "batch_witness"},
     {k_spv_search_advance_comp, "search_advance"},
+    {k_spv_probe_levels_comp, "probe_levels"},
 }};
 
 }  // namespace
@@ -136,7 +138,8 @@ void Pipelines::createComputePipelines(VkPipelineCache cache) {
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !m_rayQuery) continue;
         // Float64 SPIR-V is valid only on a device with shaderFloat64 enabled.
-        if (Kernel(k) == Kernel::kIngestF64 && !m_ctx.shaderFloat64()) continue;
+        if ((Kernel(k) == Kernel::kIngestF64 || Kernel(k) == Kernel::kProbeLevels) && !m_ctx.shaderFloat64())
+            continue;
         m_compute[k] = createComputePipeline(m_ctx, kComputeSpirv[k].code, m_layout.get(), cache,
                                              VK_PIPELINE_CREATE_DISPATCH_BASE_BIT, kComputeSpirv[k].name);
     }

@@ -36,13 +36,14 @@ enum class Kernel : uint32_t {
     kLeafScatter,
     kCellBounds,  // parallel tight boxes of large cells (cell_bounds*.comp)
     kCellBoundsFix,
-    kIngest,        // the caller's points into vec4 records, bounds, validation (ingest.comp)
-    kRefineArgs,    // refine.comp's indirect dispatch size (refine_args.comp)
-    kIngestF64,     // device input views read in double (ingest_f64.comp): only with shaderFloat64
-    kSampleGather,  // the bit count's sample of a device-input set (sample_gather.comp)
-    kBatchNearest,  // computeBatch's small pairs: exact scans (batch_nearest.comp)
-    kBatchWitness,  // and their witnesses (batch_witness.comp)
+    kIngest,         // the caller's points into vec4 records, bounds, validation (ingest.comp)
+    kRefineArgs,     // refine.comp's indirect dispatch size (refine_args.comp)
+    kIngestF64,      // device input views read in double (ingest_f64.comp): only with shaderFloat64
+    kSampleGather,   // the bit count's sample of a device-input set (sample_gather.comp)
+    kBatchNearest,   // computeBatch's small pairs: exact scans (batch_nearest.comp)
+    kBatchWitness,   // and their witnesses (batch_witness.comp)
     kSearchAdvance,  // between the radii of one submission (search_advance.comp)
+    kProbeLevels,    // the bit count's probe (probe_levels.comp): only with shaderFloat64
     kCount
 };
 

@@ -8,7 +8,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <random>
 #include <span>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "common/oracle_cases.hpp"
@@ -64,6 +67,51 @@ TEST(IngestPath, SameIndexAndAnswerAsTheHostPath) {
         ++compared;
     }
     EXPECT_GT(compared, 40);
+}
+
+// The automatic bit count of the device path (probe_levels.comp, where the
+// device has shaderFloat64; else a sample gathered for the host) equals the
+// host path's on sets that stress it: points on the probe's cell boundaries
+// (a lattice of binary fractions of the extent), every point a duplicate, a
+// plane, a line, a cluster with outliers, and sizes around the sample
+// stride's steps (every point sampled up to 65,535; every second from 65,536).
+TEST(IngestPath, DeviceBitCountEqualsTheHostCount) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const auto lattice = [](int side, float step, float offset) {
+        std::vector<glm::vec3> p;
+        for (int x = 0; x < side; ++x)
+            for (int y = 0; y < side; ++y)
+                for (int z = 0; z < side; ++z) p.emplace_back(offset + x * step, offset + y * step, z * step);
+        return p;
+    };
+    std::vector<std::pair<std::string, std::vector<glm::vec3>>> sets;
+    sets.emplace_back("lattice 1/1024", lattice(40, 1.0f / 1024.0f, 0.0f));
+    sets.emplace_back("lattice 1/64 shifted", lattice(33, 1.0f / 64.0f, 0.25f));
+    sets.emplace_back("duplicates", std::vector<glm::vec3>(5000, glm::vec3(0.5f, 0.25f, 2.0f)));
+    for (size_t n : {65535u, 65536u, 98303u}) {
+        std::vector<glm::vec3> p(n);
+        for (auto& v : p) v = {u(rng), u(rng), 0.0f};
+        sets.emplace_back("plane " + std::to_string(n), p);
+    }
+    std::vector<glm::vec3> line(20000), cluster(30000);
+    for (size_t i = 0; i < line.size(); ++i) line[i] = {float(i) / 16.0f, 3.0f, -1.0f};
+    for (auto& v : cluster) v = glm::vec3(u(rng), u(rng), u(rng)) * 1e-3f;
+    cluster[7] = glm::vec3(5.0f, 0.0f, 0.0f);
+    sets.emplace_back("line", line);
+    sets.emplace_back("cluster + outlier", cluster);
+    const std::vector<glm::vec3> queries = {{0.1f, 0.2f, 0.3f}, {2.0f, -1.0f, 0.5f}, {0.0f, 0.0f, 0.0f}};
+    for (const auto& [name, targets] : sets) {
+        SCOPED_TRACE(name);
+        auto device = engine->compute(queries, targets);
+        const Strided sq(queries), st(targets);
+        auto host = engine->compute(sq.view, st.view);
+        ASSERT_TRUE(device.ok()) << device.error().message;
+        ASSERT_TRUE(host.ok()) << host.error().message;
+        expectSameDirection(device->aToB, host->aToB);
+        EXPECT_GE(device->aToB.counters.bits, 1u);
+    }
 }
 
 // The device reads the caller's arrays in place (an import of their pages)
