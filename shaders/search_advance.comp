@@ -4,7 +4,8 @@
 // the radius just run (queries searched, queries going on, pairs appended),
 // then sets up the next: it searches the queries going on (resolve.comp's
 // list), or none once the pair buffer overflowed (the host then resumes from
-// the logged radius with more room, as after a single radius).
+// the logged radius with more room, as after a single radius), and writes
+// the dispatch sizes of its search and resolve.
 #include "common.glsl"
 layout(local_size_x = 1) in;
 layout(push_constant) uniform Push { SearchAdvancePush pc; };
@@ -18,7 +19,16 @@ void main() {
     UintRef(entry).v = searched;
     UintRef(entry + 4ul).v = next;
     U64Ref(entry + 8ul).v = pairs;
-    UintRef(c + RTHDIST_CTR_SEARCH_ACTIVE).v = pairs > uint64_t(pc.pairCapacity) ? 0u : next;
+    uint searchedNext = pairs > uint64_t(pc.pairCapacity) ? 0u : next;
+    UintRef(c + RTHDIST_CTR_SEARCH_ACTIVE).v = searchedNext;
+    // The next radius's dispatch sizes: groups of the search (ray queries)
+    // and of the resolve, and the rays of a trace.
+    uvec3 groups = uvec3((searchedNext + RTHDIST_WG - 1u) / RTHDIST_WG, 1u, 1u);
+    uvec3 rays = uvec3(searchedNext, 1u, 1u);
+    for (uint a = 0u; a < 3u; ++a) {
+        UintRef(c + RTHDIST_CTR_SEARCH_ARGS + 4ul * a).v = groups[a];
+        UintRef(c + RTHDIST_CTR_SEARCH_ARGS + 12ul + 4ul * a).v = rays[a];
+    }
     UintRef(c + RTHDIST_CTR_NEXT_ACTIVE).v = 0u;
     U64Ref(c + RTHDIST_CTR_PAIRS).v = 0ul;
 }

@@ -45,6 +45,7 @@ struct vec3f {
 #define RTHDIST_CTR_INGEST 1152     // IngestSummary: ingest.comp, one set's bounds and first bad point
 #define RTHDIST_CTR_INGEST64 1184   // IngestSummary64: ingest_f64.comp, one device view's box in double
 #define RTHDIST_CTR_SEARCH_LOG 1280  // SearchLogEntry[RTHDIST_SEARCH_LOG_MAX]: the radii of one submission
+#define RTHDIST_CTR_SEARCH_ARGS 1600  // uint[3] groups of the search and resolve, uint[3] rays (search_advance.comp)
 #define RTHDIST_CTR_PROBE 1536  // uint[RTHDIST_PROBE_LEVELS + 1]: probe_levels.comp, distinct cells per level
 #define RTHDIST_CTR_BYTES 2048
 // Radii of the candidate search recorded in one submission, at most.
@@ -450,7 +451,8 @@ static_assert(offsetof(CounterFields, largeCells) == RTHDIST_CTR_LARGE_CELLS);
 static_assert(offsetof(CounterFields, searchActive) == RTHDIST_CTR_SEARCH_ACTIVE);
 static_assert(sizeof(ProbeLevelsPush) == 64 &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_PROBE &&
-              RTHDIST_CTR_PROBE + (RTHDIST_PROBE_LEVELS + 1) * 4 <= RTHDIST_CTR_BYTES);
+              RTHDIST_CTR_PROBE + (RTHDIST_PROBE_LEVELS + 1) * 4 <= RTHDIST_CTR_SEARCH_ARGS &&
+              RTHDIST_CTR_SEARCH_ARGS + 24 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDIST_CTR_SEARCH_LOG &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);

@@ -319,6 +319,15 @@ void Context::createDevice(const DeviceRequirements& required) {
     m_shaderFloat64 = unmetRequirements(m_physical, f64).empty();
     if (m_shaderFloat64 && !req.needs(DeviceFeature::kShaderFloat64))
         req.features.push_back(DeviceFeature::kShaderFloat64);
+    // Optional too: ray traces sized by the device (the candidate search's
+    // radii of one submission launch only the queries still searched).
+    if (req.needs(DeviceFeature::kRayTracingPipeline)) {
+        DeviceRequirements indirect;
+        indirect.apiVersion = VK_API_VERSION_1_0;
+        indirect.features = {DeviceFeature::kTraceRaysIndirect};
+        if (unmetRequirements(m_physical, indirect).empty())
+            req.features.push_back(DeviceFeature::kTraceRaysIndirect);
+    }
     // Optional: the device reads the caller's arrays in place (gpu/host_import.hpp).
     m_hostImport =
         wantsHostImport() && deviceHasExtension(m_physical, VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
@@ -328,6 +337,9 @@ void Context::createDevice(const DeviceRequirements& required) {
     RTHDIST_VK_CHECK(createDeviceFor(m_physical, req, optional, m_queueFamily, &device));
     m_device = UniqueDevice(device, {});
     m_deviceHandle = device;
+    if (req.needs(DeviceFeature::kTraceRaysIndirect))
+        m_rt.cmdTraceRaysIndirect = reinterpret_cast<PFN_vkCmdTraceRaysIndirectKHR>(
+            vkGetDeviceProcAddr(device, "vkCmdTraceRaysIndirectKHR"));
     vkGetDeviceQueue(device, m_queueFamily, 0, &m_queue);
     loadLabelFunctions();
 }

@@ -37,6 +37,8 @@ struct RtFunctions {
     PFN_vkCreateRayTracingPipelinesKHR createRtPipelines = nullptr;
     PFN_vkGetRayTracingShaderGroupHandlesKHR getGroupHandles = nullptr;
     PFN_vkCmdTraceRaysKHR cmdTraceRays = nullptr;
+    // Where the device has rayTracingPipelineTraceRaysIndirect (optional).
+    PFN_vkCmdTraceRaysIndirectKHR cmdTraceRaysIndirect = nullptr;
 };
 
 // Every Vulkan physical device with what each backend it lacks (one

@@ -43,6 +43,9 @@ const FeatureEntry kFeatures[] = {
     {"shaderFloat64", Holder::kCore,
      offsetof(VkPhysicalDeviceFeatures2, features) + offsetof(VkPhysicalDeviceFeatures, shaderFloat64),
      nullptr},
+    {"rayTracingPipelineTraceRaysIndirect", Holder::kRtPipeline,
+     offsetof(VkPhysicalDeviceRayTracingPipelineFeaturesKHR, rayTracingPipelineTraceRaysIndirect),
+     VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME},
 };
 static_assert(std::size(kFeatures) == size_t(DeviceFeature::kCount));
 

@@ -33,6 +33,7 @@ enum class DeviceFeature : uint32_t {
     kRayQuery,                  // VK_KHR_ray_query
     kRayTracingPipeline,        // VK_KHR_ray_tracing_pipeline
     kShaderFloat64,             // VkPhysicalDeviceFeatures: double views of device input (ingest_f64.comp)
+    kTraceRaysIndirect,         // VK_KHR_ray_tracing_pipeline: traces sized by the device
     kCount
 };
 

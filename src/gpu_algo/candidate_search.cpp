@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 #include <utility>
 
@@ -93,6 +94,8 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
     counters.pairs = 0;
     counters.nextActive = 0;
     counters.searchActive = numActive;
+    const uint32_t firstSize[6] = {gpu::groupsFor(numActive, RTHDIST_WG), 1, 1, numActive, 1, 1};
+    std::memcpy(d.blk.host + RTHDIST_CTR_SEARCH_ARGS, firstSize, sizeof(firstSize));
     const int firstActive = d.cur;
     std::vector<std::pair<uint32_t, uint32_t>> marks;  // before and after each radius's search
     VkCommandBuffer cmd = m_ws.ctx.begin();
@@ -172,8 +175,17 @@ void CandidateSearch::cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const Poin
     sp.rayTMax = rayTMax;
     sp.skipScanned = sameLevel ? 1u : 0u;
     sp.slotBase = 0u;
-    if (m_ws.rayQuery)
+    // Sized by the device (search_advance.comp: the queries still searched)
+    // where one dispatch or trace holds them all; else numActive slots, the
+    // ones past the device's count returning at once.
+    const gpu::DeviceLimits& limits = m_ws.ctx.limits();
+    if (m_ws.rayQuery && gpu::groupsFor(numActive, RTHDIST_WG) <= limits.maxGroupsX)
+        m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kSearchRayQuery, &sp, sizeof(sp),
+                                           m_ws.hostSmall.handle(), d.blk.offset + RTHDIST_CTR_SEARCH_ARGS);
+    else if (m_ws.rayQuery)
         m_ws.dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
+    else if (m_ws.pipelines.tracesIndirect() && numActive <= limits.maxRayDispatch)
+        m_ws.pipelines.cmdTraceRaysIndirect(cmd, &sp, sizeof(sp), d.blk.addr(RTHDIST_CTR_SEARCH_ARGS + 12));
     else
         cmdTraceRaysSplit(cmd, sp);
 }

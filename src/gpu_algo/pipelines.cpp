@@ -245,13 +245,25 @@ void Pipelines::cmdDispatchIndirect(VkCommandBuffer cmd, Kernel kernel, const vo
     vkCmdDispatchIndirect(cmd, args, offset);
 }
 
-void Pipelines::cmdTraceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize, uint32_t width) const {
-    if (width == 0) return;
+void Pipelines::cmdBindRt(VkCommandBuffer cmd, const void* push, uint32_t pushSize) const {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, m_rtPipeline.get());
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, m_layout.get(), 0, 1, &m_set, 0,
                             nullptr);
     vkCmdPushConstants(cmd, m_layout.get(), m_stages, 0, pushSize, push);
+}
+
+void Pipelines::cmdTraceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize, uint32_t width) const {
+    if (width == 0) return;
+    cmdBindRt(cmd, push, pushSize);
     m_ctx.rt().cmdTraceRays(cmd, &m_raygen, &m_miss, &m_hit, &m_callable, width, 1, 1);
+}
+
+bool Pipelines::tracesIndirect() const { return m_ctx.rt().cmdTraceRaysIndirect != nullptr; }
+
+void Pipelines::cmdTraceRaysIndirect(VkCommandBuffer cmd, const void* push, uint32_t pushSize,
+                                     VkDeviceAddress args) const {
+    cmdBindRt(cmd, push, pushSize);
+    m_ctx.rt().cmdTraceRaysIndirect(cmd, &m_raygen, &m_miss, &m_hit, &m_callable, args);
 }
 
 }  // namespace rthdist::gpu

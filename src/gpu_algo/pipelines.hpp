@@ -66,6 +66,11 @@ public:
                              VkBuffer args, VkDeviceSize offset) const;
     // Ray-tracing pipeline: one ray-generation invocation per index in [0, width).
     void cmdTraceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize, uint32_t width) const;
+    // The same with (width, height, depth) read by the device at `args` (a
+    // VkTraceRaysIndirectCommandKHR): only where tracesIndirect().
+    void cmdTraceRaysIndirect(VkCommandBuffer cmd, const void* push, uint32_t pushSize,
+                              VkDeviceAddress args) const;
+    [[nodiscard]] bool tracesIndirect() const;
 
     [[nodiscard]] VkPipelineStageFlags shaderStages() const { return m_shaderStages; }
 
@@ -73,6 +78,7 @@ private:
     // Construction steps: set 0 (the TLAS) and the shared layout; the compute
     // kernels; the ray-tracing pipeline and its shader binding table.
     void createLayout();
+    void cmdBindRt(VkCommandBuffer cmd, const void* push, uint32_t pushSize) const;
     void createComputePipelines(VkPipelineCache cache);
     void createRtPipeline(VkPipelineCache cache);
     void createShaderBindingTable();

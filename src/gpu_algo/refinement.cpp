@@ -32,7 +32,13 @@ void Refinement::cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointInde
                        numActive,
                        r,
                        d.lowerBound2};
-    m_ws.dispatch(cmd, Kernel::kResolve, rs, numActive);
+    // As many groups as the device counted queries (search_advance.comp) where
+    // one dispatch holds numActive.
+    if (gpu::groupsFor(numActive, RTHDIST_WG) <= m_ws.ctx.limits().maxGroupsX)
+        m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kResolve, &rs, sizeof(rs), m_ws.hostSmall.handle(),
+                                           d.blk.offset + RTHDIST_CTR_SEARCH_ARGS);
+    else
+        m_ws.dispatch(cmd, Kernel::kResolve, rs, numActive);
 }
 
 }  // namespace rthdist::gpu_algo
