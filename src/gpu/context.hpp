@@ -117,6 +117,8 @@ public:
     // commands between them (e.g. the uploads of a submission).
     uint32_t cmdMark(VkCommandBuffer cmd);
     [[nodiscard]] double gpuMsBetween(uint32_t from, uint32_t to) const;
+    // RTHDIST_SUBMIT_TRACE is set: stages may add their own stderr lines.
+    [[nodiscard]] bool tracingSubmits() const { return m_traceSubmits; }
     static constexpr uint32_t kTimestampSlots = 40;
 
     void countValidationMessage() { ++m_validationMessages; }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
@@ -42,15 +43,22 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
         std::min(std::clamp<uint64_t>(pairBase * 4, 1u << 16, 1u << 22), m_ws.maxPairCapacity);
     Buffer* pairs = nullptr;
     int builtLevel = -1;  // level of the BLAS now built (-1: none yet)
+    // Radii per submission: 2, doubled while most queries go on (a radius
+    // recorded after the search ended costs a BLAS refit, ~a submission's
+    // overhead on an H100: docs/bench/prepared).
+    uint32_t chunk = 2;
     while (numActive > 0) {
         if (!pairs) {
             pairs = &m_ws.grow(m_ws.scratch.search.pairs, pairCapacity * 8, "pairs");
             pairCapacity = std::min<uint64_t>(pairs->size() / 8, m_ws.maxPairCapacity);
         }
         const int level = IndexBuild::searchLevelFor(T, radius);
-        const std::vector<double> radii = radiiAtLevel(T, radius, double(options.radiusGrowth));
+        const std::vector<double> radii = radiiAtLevel(T, radius, double(options.radiusGrowth), chunk);
         const RadiiOutcome out =
             runRadii(d, level, level == builtLevel, radii, *pairs, pairCapacity, numActive);
+        chunk = 2 * uint64_t(out.stillOpen) > numActive
+                    ? std::min<uint32_t>(2 * chunk, RTHDIST_SEARCH_LOG_MAX)
+                    : 2;
         builtLevel = level;
         d.out.counters.iterations += out.run;
         if (d.out.counters.iterations > kMaxIterations)
@@ -74,10 +82,11 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
     }
 }
 
-std::vector<double> CandidateSearch::radiiAtLevel(const PointIndex& T, double radius, double growth) const {
+std::vector<double> CandidateSearch::radiiAtLevel(const PointIndex& T, double radius, double growth,
+                                                  uint32_t most) const {
     const int level = IndexBuild::searchLevelFor(T, radius);
     std::vector<double> radii{radius};
-    while (radii.size() < radiiPerSubmission) {
+    while (radii.size() < std::min(most, radiiPerSubmission)) {
         const double next = radii.back() * growth;
         if (IndexBuild::searchLevelFor(T, next) != level) break;
         radii.push_back(next);
@@ -138,6 +147,13 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
         d.out.counters.candidatePairs += std::min<uint64_t>(log[i].pairs, pairCapacity);
     }
     if (out.run == 0) throw std::runtime_error("candidate search: the device searched no query");
+    if (m_ws.ctx.tracingSubmits())
+        for (size_t i = 0; i < radii.size(); ++i)
+            std::fprintf(
+                stderr,
+                "rthdist radius %zu/%zu level %d r %.6g: searched %u, going on %u, pairs %llu (room %llu)\n",
+                i + 1, radii.size(), level, radii[i], log[i].searched, log[i].goingOn,
+                static_cast<unsigned long long>(log[i].pairs), static_cast<unsigned long long>(pairCapacity));
     d.cur = out.run % 2 == 0 ? firstActive : 1 - firstActive;
     return out;
 }

@@ -39,8 +39,9 @@ public:
                    double progressTo);
 
     // The radii that follow `radius` (growth each time) at its search level,
-    // at most RTHDIST_SEARCH_LOG_MAX (and radiiPerSubmission) of them.
-    [[nodiscard]] std::vector<double> radiiAtLevel(const PointIndex& T, double radius, double growth) const;
+    // at most `most` (and radiiPerSubmission) of them.
+    [[nodiscard]] std::vector<double> radiiAtLevel(const PointIndex& T, double radius, double growth,
+                                                   uint32_t most) const;
 
     // Radii of one level in one submission, each: the search (cmdSearch),
     // the refinement sized by the device from the pairs the rays appended
