@@ -66,8 +66,8 @@ inline constexpr uint32_t kPad = 8;         // +inf entries after every SoA arra
 // empty boxes (lo = +inf, hi = -inf: infinitely far from every point).
 struct BoxLevel {
     static constexpr uint32_t kBlock = 6 * kFanout;  // floats per block
-    std::vector<float> boxes;
-    uint32_t count = 0;  // real boxes
+    core::UninitVector<float> boxes;  // kept between calls (uninit_vector.hpp), filled by resize
+    uint32_t count = 0;               // real boxes
 
     void resize(uint32_t n);  // n empty boxes
     void set(uint32_t j, const glm::vec3& lo, const glm::vec3& hi) {
@@ -102,9 +102,9 @@ struct TargetIndex {
     UninitVector<uint32_t> bucketOf;          // sorted position -> bucket
 
     // Occupied cells, ascending Morton key (grid.bits per axis).
-    std::vector<uint32_t> cellKey;
-    std::vector<uint32_t> cellFirst;        // cellCount + 1 offsets into the sorted points
-    std::vector<glm::vec3> cellLo, cellHi;  // tight boxes of the cells' points
+    core::UninitVector<uint32_t> cellKey;
+    core::UninitVector<uint32_t> cellFirst;        // cellCount + 1 offsets into the sorted points
+    core::UninitVector<glm::vec3> cellLo, cellHi;  // tight boxes of the cells' points
 
     // Buckets and the BVH: levels[0] holds the buckets, levels.back() one root.
     std::vector<uint32_t> bucketFirst;  // bucketCount + 1 offsets
