@@ -176,6 +176,10 @@ private:
     // recording it, waiting for it, its device time; a benchmark's tool).
     bool m_traceSubmits = false;
     void traceSubmit();
+    // How long submitAndWait polls its fence before it sleeps on it
+    // (RTHDIST_FENCE_SPIN_US; 0: never).
+    unsigned long m_spinMicros = 2000;
+    [[nodiscard]] VkResult waitBriefly(VkFence fence) const;
     std::chrono::steady_clock::time_point m_begun, m_submitted, m_lastDone;
     std::array<uint64_t, kTimestampSlots> m_stamps{};  // of the last submission
     uint32_t m_timestampBits = 64;
