@@ -3,6 +3,8 @@
 // histogram binning, normalization by the diagonal of the union's box).
 #include "rthdist/stats.hpp"
 
+#include "core/nearest_rank.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -29,10 +31,7 @@ double diagonalOf(std::span<const glm::vec3> points) {
 
 double percentileNearestRank(std::span<const double> sorted, double p) {
     if (sorted.empty()) return 0.0;
-    const double n = double(sorted.size());
-    double rank = std::ceil(p * n / 100.0);
-    rank = std::clamp(rank, 1.0, n);
-    return sorted[size_t(rank) - 1];
+    return sorted[core::nearestRankIndex(sorted.size(), p)];
 }
 
 DistanceStats distanceStats(std::span<const double> distances, const StatsOptions& options,

@@ -1,6 +1,8 @@
 // Selection instead of sorting (order_statistics.hpp).
 #include "masks/order_statistics.hpp"
 
+#include "core/nearest_rank.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -38,10 +40,7 @@ double percentilePlastimatch(std::vector<double>& values, double p) {
 
 double percentileNearestRank(std::vector<double>& values, double p) {
     if (values.empty()) return 0.0;
-    const double n = double(values.size());
-    double rank = std::ceil(p * n / 100.0);
-    rank = std::clamp(rank, 1.0, n);
-    return kthSmallest(values, size_t(rank) - 1);
+    return kthSmallest(values, core::nearestRankIndex(values.size(), p));
 }
 
 size_t countAtMost(const std::vector<double>& values, double limit) {
