@@ -499,7 +499,8 @@ void Context::createCommandObjects() {
     // from the device's own threads (2 cores: 39 -> 51 ms per call).
     VkPhysicalDeviceProperties props{};
     vkGetPhysicalDeviceProperties(m_physical, &props);
-    m_spinMicros = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : 2000;
+    m_cpuDevice = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    m_spinMicros = m_cpuDevice ? 0 : 2000;
     if (const char* spin = std::getenv("RTHDIST_FENCE_SPIN_US"))
         m_spinMicros = std::strtoul(spin, nullptr, 10);
 }

@@ -83,6 +83,8 @@ public:
     // shaderFloat64 is enabled on the device (double views of device input,
     // the bit count's probe): on every device that has it.
     [[nodiscard]] bool shaderFloat64() const { return m_shaderFloat64; }
+    // The device runs on the host's cores (VK_PHYSICAL_DEVICE_TYPE_CPU: lavapipe).
+    [[nodiscard]] bool cpuDevice() const { return m_cpuDevice; }
     [[nodiscard]] const RtFunctions& rt() const { return m_rt; }
     [[nodiscard]] const VkPhysicalDeviceRayTracingPipelinePropertiesKHR& rtProps() const { return m_rtProps; }
     [[nodiscard]] const VkPhysicalDeviceAccelerationStructurePropertiesKHR& asProps() const {
@@ -175,6 +177,7 @@ private:
     // RTHDIST_SUBMIT_TRACE=1: one stderr line per submission (host time
     // recording it, waiting for it, its device time; a benchmark's tool).
     bool m_traceSubmits = false;
+    bool m_cpuDevice = false;
     void traceSubmit();
     // How long submitAndWait polls its fence before it sleeps on it
     // (RTHDIST_FENCE_SPIN_US; 0: never).

@@ -46,9 +46,7 @@ struct SmallPairScan::Layout {
 };
 
 SmallPairScan::SmallPairScan(Workspace& ws) : m_ws(ws) {
-    VkPhysicalDeviceProperties props{};
-    vkGetPhysicalDeviceProperties(ws.ctx.physicalDevice(), &props);
-    m_maxWork = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? kMaxWorkCpuDevice : kMaxWorkGpu;
+    m_maxWork = ws.ctx.cpuDevice() ? kMaxWorkCpuDevice : kMaxWorkGpu;
     // Benchmarks compare both paths on one machine: RTHDIST_SMALL_PAIR_WORK
     // replaces the limit (0: every pair takes the RT path).
     if (const char* env = std::getenv("RTHDIST_SMALL_PAIR_WORK")) m_maxWork = std::strtoull(env, nullptr, 10);
