@@ -133,17 +133,24 @@ void DeviceIngest::ingest(std::span<PointIndex* const> sets, std::span<const Dev
         sets[k]->source = nullptr;
         cmdConvert(cmd, *sets[k], views[k], m_ws.blocks[k], origin);
     }
-    std::array<size_t, 2> sampled{};
-    const bool probe = bits <= 0 && probesOnDevice();
-    if (bits <= 0 && !probe) sampled = cmdGatherSamples(cmd, sets);
+    cmdBitCountSamples(cmd, sets, bits);
     m_ws.ctx.submitAndWait(cmd);
     m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
     for (size_t k = 0; k < sets.size(); ++k) m_index.finishIngest(*sets[k], m_ws.blocks[k]);
-    if (probe)
-        chooseGridsByProbe(sets);
-    else
-        chooseGrids(sets, sampled, bits);
+    chooseGrids(sets, bits);
     m_ws.timings->index += msSince(t0);
+}
+
+void DeviceIngest::cmdBitCountSamples(VkCommandBuffer cmd, std::span<PointIndex* const> sets, int bits) {
+    if (bits > 0 || probesOnDevice()) return;
+    m_ws.barrier(cmd);
+    for (size_t k = 0; k < sets.size(); ++k) m_sampled[k] = cmdGatherSample(cmd, *sets[k], m_samples[k]);
+}
+
+void DeviceIngest::chooseGrids(std::span<PointIndex* const> sets, int bits) {
+    if (bits <= 0 && probesOnDevice()) return chooseGridsByProbe(sets);
+    if (bits <= 0) return chooseGridsFromSamples(sets);
+    for (PointIndex* ix : sets) ix->grid = core::makeGrid(ix->bounds, bits);
 }
 
 void DeviceIngest::chooseGridsByProbe(std::span<PointIndex* const> sets) {
@@ -196,24 +203,13 @@ void DeviceIngest::chooseGridsByProbe(std::span<PointIndex* const> sets) {
     }
 }
 
-std::array<size_t, 2> DeviceIngest::cmdGatherSamples(VkCommandBuffer cmd, std::span<PointIndex* const> sets) {
-    m_ws.barrier(cmd);
-    std::array<size_t, 2> sampled{};
-    for (size_t k = 0; k < sets.size(); ++k) sampled[k] = cmdGatherSample(cmd, *sets[k], m_samples[k]);
-    return sampled;
-}
-
-void DeviceIngest::chooseGrids(std::span<PointIndex* const> sets, const std::array<size_t, 2>& sampled,
-                               int bits) {
+void DeviceIngest::chooseGridsFromSamples(std::span<PointIndex* const> sets) {
     for (size_t k = 0; k < sets.size(); ++k) {
         PointIndex& ix = *sets[k];
-        int chosen = bits;
-        if (bits <= 0) {
-            std::vector<glm::vec3> sample(sampled[k]);
-            std::memcpy(sample.data(), m_samples[k].mapped(), sampled[k] * 12);
-            chosen = clampedBits(core::chooseBitsFromSample(sample, ix.n, ix.bounds), ix.n);
-        }
-        ix.grid = core::makeGrid(ix.bounds, chosen);
+        std::vector<glm::vec3> sample(m_sampled[k]);
+        std::memcpy(sample.data(), m_samples[k].mapped(), m_sampled[k] * 12);
+        ix.grid =
+            core::makeGrid(ix.bounds, clampedBits(core::chooseBitsFromSample(sample, ix.n, ix.bounds), ix.n));
     }
 }
 

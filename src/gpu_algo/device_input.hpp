@@ -47,24 +47,19 @@ public:
     void ingest(std::span<PointIndex* const> sets, std::span<const DeviceInput> views,
                 const glm::dvec3& origin, int bits, bool first);
 
-    // Records, after a barrier from the ingest, the bit count's sample of
-    // each ingested set (cmdGatherSample); returns their counts.
-    std::array<size_t, 2> cmdGatherSamples(VkCommandBuffer cmd, std::span<PointIndex* const> sets);
-    // Once that submission is done: each set's grid over its bounds, with
-    // `bits` or (bits <= 0) the bit count of its sample
-    // (core::chooseBitsFromSample: the count chooseBits finds on the same
-    // points).
-    void chooseGrids(std::span<PointIndex* const> sets, const std::array<size_t, 2>& sampled, int bits);
-
-    // Whether the automatic bit count of ingested sets runs on the device
-    // (probe_levels.comp needs shaderFloat64); else the host counts it from
-    // the gathered samples (cmdGatherSamples, chooseGrids).
-    [[nodiscard]] bool probesOnDevice() const { return m_ws.ctx.shaderFloat64(); }
-    // Each ingested set's grid over its bounds with the automatic bit count,
-    // its probe counted on the device in one submission (the same sample,
-    // keys and counts as core::chooseBitsFromSample); the host reads the
-    // counts of each level and applies the rule (core::chooseBitsFromCounts).
-    void chooseGridsByProbe(std::span<PointIndex* const> sets);
+    // Records into the ingest's submission what the automatic bit count
+    // (bits <= 0) needs from it: on a device without shaderFloat64, after a
+    // barrier from the ingest, each set's sample (cmdGatherSample, kept for
+    // chooseGrids); nothing otherwise.
+    void cmdBitCountSamples(VkCommandBuffer cmd, std::span<PointIndex* const> sets, int bits);
+    // Once that submission is done and the bounds are read: each set's grid
+    // over its bounds with `bits`, or (bits <= 0) the automatic bit count,
+    // the count chooseBits finds on the same points: where the device has
+    // shaderFloat64 its probe is counted on the device in one more
+    // submission (probe_levels.comp) and the host applies the rule to the
+    // counts of each level (core::chooseBitsFromCounts); else the host counts
+    // the gathered sample (core::chooseBitsFromSample).
+    void chooseGrids(std::span<PointIndex* const> sets, int bits);
 
     // The first command of a call on device input: every earlier memory write
     // on the queue -> the shader and transfer reads of the call (the
@@ -78,10 +73,16 @@ private:
     // into `sample` (host-visible, 12 bytes per record, grown and kept), for
     // the bit count: one dispatch of sample_gather.comp. Returns the count.
     size_t cmdGatherSample(VkCommandBuffer cmd, PointIndex& ix, Buffer& sample);
+    // The automatic bit count runs on the device (probe_levels.comp needs shaderFloat64).
+    [[nodiscard]] bool probesOnDevice() const { return m_ws.ctx.shaderFloat64(); }
+    // chooseGrids' two automatic forms: the probe on the device, the gathered samples on the host.
+    void chooseGridsByProbe(std::span<PointIndex* const> sets);
+    void chooseGridsFromSamples(std::span<PointIndex* const> sets);
 
     Workspace& m_ws;
     IndexBuild& m_index;
     std::array<Buffer, 2> m_samples;      // the sample of each set of a call (host-visible)
+    std::array<size_t, 2> m_sampled{};    // ... and its count
     std::array<Buffer, 2> m_probeTables;  // each set's hash tables of probe cells (device)
 };
 

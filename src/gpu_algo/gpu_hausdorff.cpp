@@ -108,9 +108,11 @@ struct GpuHausdorff::State {
     }
 
     // One-shot H of two packed float host arrays through the ingest path:
-    // one submission uploads and ingests both and gathers the bit count's
-    // samples, the host reads their bounds and samples (the grid and the bit
-    // count need them), a second builds both indexes.
+    // one submission uploads and ingests both (and gathers the bit count's
+    // samples on a device without shaderFloat64), the host reads their
+    // bounds, chooses both grids (DeviceIngest::chooseGrids: one more
+    // submission for the probe of the automatic bit count), and a last
+    // submission builds both indexes.
     // Returns false, having done nothing else, when the sets need the exact
     // power-of-two scale (index_space.hpp), which the host path applies.
     bool ingestPair(DeviceSet& da, DeviceSet& db, std::span<const glm::vec3> a, std::span<const glm::vec3> b,
@@ -131,9 +133,7 @@ struct GpuHausdorff::State {
         ws.barrier(cmd);
         for (size_t k = 0; k < 2; ++k) index.cmdIngest(cmd, sets[k]->ix, ws.blocks[k]);
         const std::array<PointIndex*, 2> indexes = {&da.ix, &db.ix};
-        std::array<size_t, 2> sampled{};
-        const bool probe = options.bits <= 0 && deviceIngest.probesOnDevice();
-        if (options.bits <= 0 && !probe) sampled = deviceIngest.cmdGatherSamples(cmd, indexes);
+        deviceIngest.cmdBitCountSamples(cmd, indexes, options.bits);
         ws.ctx.submitAndWait(cmd);
         ws.imports.clear();  // the device has read the caller's arrays
         const double uploadMs = ws.ctx.gpuMsBetween(0, uploaded);
@@ -144,10 +144,7 @@ struct GpuHausdorff::State {
         const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
         if (exactScale(magnitude) != 1.0) return false;
         const auto t1 = Clock::now();
-        if (probe)
-            deviceIngest.chooseGridsByProbe(indexes);
-        else
-            deviceIngest.chooseGrids(indexes, sampled, options.bits);
+        deviceIngest.chooseGrids(indexes, options.bits);
         ws.timings->index += msSince(t1);
         index.buildIndexes(std::array{&da.ix, &db.ix}, /*uploaded=*/true);
         return true;
