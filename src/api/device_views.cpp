@@ -35,12 +35,9 @@ Result<VulkanDeviceSetup> vulkanDeviceSetup(VkPhysicalDevice pd, Backend backend
         return Error{ErrorCode::kNoDevice, std::string("the device cannot run backend ") +
                                                backendName(backend) + ": lacks " + lacks};
     }
-    gpu::DeviceRequirements f64;
-    f64.apiVersion = VK_API_VERSION_1_0;
-    f64.features = {gpu::DeviceFeature::kShaderFloat64};
     VulkanDeviceSetup setup;
     setup.backend = backend;
-    setup.shaderFloat64 = gpu::unmetRequirements(pd, f64).empty();
+    setup.shaderFloat64 = gpu::deviceHasFeature(pd, gpu::DeviceFeature::kShaderFloat64);
     if (setup.shaderFloat64) req.features.push_back(gpu::DeviceFeature::kShaderFloat64);
     gpu::describeForEmbedder(req, setup);
     setup.queueFamily = gpu::computeQueueFamily(pd);

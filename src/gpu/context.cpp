@@ -313,21 +313,14 @@ std::optional<Error> Context::createMessenger() {
 void Context::createDevice(const DeviceRequirements& required) {
     m_queueFamily = computeQueueFamily(m_physical);
     DeviceRequirements req = required;
-    DeviceRequirements f64;
-    f64.apiVersion = VK_API_VERSION_1_0;
-    f64.features = {DeviceFeature::kShaderFloat64};
-    m_shaderFloat64 = unmetRequirements(m_physical, f64).empty();
+    m_shaderFloat64 = deviceHasFeature(m_physical, DeviceFeature::kShaderFloat64);
     if (m_shaderFloat64 && !req.needs(DeviceFeature::kShaderFloat64))
         req.features.push_back(DeviceFeature::kShaderFloat64);
     // Optional too: ray traces sized by the device (the candidate search's
     // radii of one submission launch only the queries still searched).
-    if (req.needs(DeviceFeature::kRayTracingPipeline)) {
-        DeviceRequirements indirect;
-        indirect.apiVersion = VK_API_VERSION_1_0;
-        indirect.features = {DeviceFeature::kTraceRaysIndirect};
-        if (unmetRequirements(m_physical, indirect).empty())
-            req.features.push_back(DeviceFeature::kTraceRaysIndirect);
-    }
+    if (req.needs(DeviceFeature::kRayTracingPipeline) &&
+        deviceHasFeature(m_physical, DeviceFeature::kTraceRaysIndirect))
+        req.features.push_back(DeviceFeature::kTraceRaysIndirect);
     // Optional: the device reads the caller's arrays in place (gpu/host_import.hpp).
     m_hostImport =
         wantsHostImport() && deviceHasExtension(m_physical, VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);

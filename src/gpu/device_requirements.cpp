@@ -217,6 +217,13 @@ std::vector<std::string> unmetRequirements(VkPhysicalDevice pd, const DeviceRequ
     return unmet;
 }
 
+bool deviceHasFeature(VkPhysicalDevice pd, DeviceFeature feature) {
+    DeviceRequirements one;
+    one.apiVersion = VK_API_VERSION_1_0;
+    one.features = {feature};
+    return unmetRequirements(pd, one).empty();
+}
+
 VkResult createDeviceFor(VkPhysicalDevice pd, const DeviceRequirements& req,
                          std::span<const char* const> extraExtensions, uint32_t queueFamily,
                          VkDevice* device) {

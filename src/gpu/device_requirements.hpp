@@ -63,6 +63,9 @@ struct DeviceRequirements {
 // (device offers 1.2)", "extension VK_KHR_ray_query", "feature rayQuery",
 // "a compute queue with timestamps"); empty when it can.
 [[nodiscard]] std::vector<std::string> unmetRequirements(VkPhysicalDevice pd, const DeviceRequirements& req);
+// Whether the device has this one feature (an optional one: shaderFloat64,
+// rayTracingPipelineTraceRaysIndirect).
+[[nodiscard]] bool deviceHasFeature(VkPhysicalDevice pd, DeviceFeature feature);
 
 // Sets the flag of every feature of `req` in the embedder's feature
 // structures (rthdist/vulkan_interop.hpp), and lists the extensions and the
