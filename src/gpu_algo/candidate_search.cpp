@@ -194,13 +194,9 @@ void CandidateSearch::cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const Poin
     // Sized by the device (search_advance.comp: the queries still searched)
     // where one dispatch or trace holds them all; else numActive slots, the
     // ones past the device's count returning at once.
-    const gpu::DeviceLimits& limits = m_ws.ctx.limits();
-    if (m_ws.rayQuery && gpu::groupsFor(numActive, RTHDIST_WG) <= limits.maxGroupsX)
-        m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kSearchRayQuery, &sp, sizeof(sp),
-                                           m_ws.hostSmall.handle(), d.blk.offset + RTHDIST_CTR_SEARCH_ARGS);
-    else if (m_ws.rayQuery)
-        m_ws.dispatch(cmd, Kernel::kSearchRayQuery, sp, numActive);
-    else if (m_ws.pipelines.tracesIndirect() && numActive <= limits.maxRayDispatch)
+    if (m_ws.rayQuery)
+        m_ws.dispatchSearched(cmd, Kernel::kSearchRayQuery, sp, numActive, d.blk);
+    else if (m_ws.pipelines.tracesIndirect() && numActive <= m_ws.ctx.limits().maxRayDispatch)
         m_ws.pipelines.cmdTraceRaysIndirect(cmd, &sp, sizeof(sp), d.blk.addr(RTHDIST_CTR_SEARCH_ARGS + 12));
     else
         cmdTraceRaysSplit(cmd, sp);

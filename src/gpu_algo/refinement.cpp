@@ -32,13 +32,7 @@ void Refinement::cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointInde
                        numActive,
                        r,
                        d.lowerBound2};
-    // As many groups as the device counted queries (search_advance.comp) where
-    // one dispatch holds numActive.
-    if (gpu::groupsFor(numActive, RTHDIST_WG) <= m_ws.ctx.limits().maxGroupsX)
-        m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kResolve, &rs, sizeof(rs), m_ws.hostSmall.handle(),
-                                           d.blk.offset + RTHDIST_CTR_SEARCH_ARGS);
-    else
-        m_ws.dispatch(cmd, Kernel::kResolve, rs, numActive);
+    m_ws.dispatchSearched(cmd, Kernel::kResolve, rs, numActive, d.blk);
 }
 
 }  // namespace rthdist::gpu_algo

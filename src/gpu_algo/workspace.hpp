@@ -125,6 +125,21 @@ struct Workspace {
         pipelines.cmdDispatch(cmd, k, &push, sizeof(Push), gpu::groupsFor(items, groupSize));
     }
 
+    // One thread per query the radius in flight searches: the groups
+    // search_advance.comp (or the host, for a submission's first radius)
+    // wrote at `blk`'s RTHDIST_CTR_SEARCH_ARGS, where one dispatch holds
+    // `bound` queries; else `bound` threads, those past the device's count
+    // returning at once.
+    template <class Push>
+    void dispatchSearched(VkCommandBuffer cmd, Kernel k, const Push& push, uint32_t bound,
+                          const CounterBlock& blk) {
+        if (gpu::groupsFor(bound, RTHDIST_WG) <= ctx.limits().maxGroupsX)
+            pipelines.cmdDispatchIndirect(cmd, k, &push, sizeof(Push), hostSmall.handle(),
+                                          blk.offset + RTHDIST_CTR_SEARCH_ARGS);
+        else
+            dispatch(cmd, k, push, bound);
+    }
+
     // Exclusive scan of uint[n] at `data`, recursively over block sums:
     // `sums` holds each level's; `name` labels them.
     void cmdScan(VkCommandBuffer cmd, VkDeviceAddress data, uint32_t n, ScanScratch& sums, const char* name,
