@@ -292,6 +292,7 @@ def compare_masks(
     threads: int = 0,
     host_extraction: bool = False,
     validation: bool = False,
+    device_extraction: bool = False,
 ) -> Union[MaskResult, list[MaskResult]]: ...
 
 class MaskEngine:
@@ -302,6 +303,7 @@ class MaskEngine:
         device: Optional[int] = None,
         threads: int = 0,
         validation: bool = False,
+        device_extraction: bool = False,
     ) -> None: ...
     def prepare_reference(
         self,

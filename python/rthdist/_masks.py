@@ -270,8 +270,10 @@ class PreparedReference:
 
 
 class MaskEngine(DeviceOwner):
-    """The masks' engine kept between calls: the Vulkan device (and, on a GPU
-    backend, the boundary compute pass) opened once.
+    """The masks' engine kept between calls: the Vulkan device (and, with
+    device_extraction=True on a GPU backend, the boundary compute pass)
+    opened once. Boundary voxels are found on the host by default (measured
+    faster than the compute pass: docs/bench/masks).
 
         with rthdist.MaskEngine("ray-query") as engine:
             ref = rthdist.MaskVolume(nib.load("gt.nii.gz"))      # converted once
@@ -290,8 +292,9 @@ class MaskEngine(DeviceOwner):
     block releases the device.
     """
 
-    def __init__(self, backend="auto", *, device=None, threads=0, validation=False):
-        self._engine = _rthdist._MaskEngine(str(backend), device, int(threads), bool(validation))
+    def __init__(self, backend="auto", *, device=None, threads=0, validation=False, device_extraction=False):
+        self._engine = _rthdist._MaskEngine(str(backend), device, int(threads), bool(validation),
+                                            bool(device_extraction))
 
     def prepare_reference(self, reference, *, spacing=None, affine=None, convention="rthdist",
                           connectivity=None, label=None, labels=None, host_extraction=False):
@@ -349,7 +352,7 @@ class MaskEngine(DeviceOwner):
 
 def compare_masks(a, b, *, spacing=None, affine=None, convention="rthdist", percentiles=(95,),
                   connectivity=None, tolerance=1.0, label=None, labels=None, backend="auto", device=None,
-                  threads=0, host_extraction=False, validation=False):
+                  threads=0, host_extraction=False, validation=False, device_extraction=False):
     """HD, HD-p, ASSD/MSD and surface Dice between two segmentation masks.
 
     a, b: 3-D label arrays (axes i, j, k; bool, integer or integral float
@@ -368,7 +371,9 @@ def compare_masks(a, b, *, spacing=None, affine=None, convention="rthdist", perc
     label: compare label N in both; labels: "all" (every label present in
         either, one result each) or a list; default every non-zero voxel.
     backend, device, threads, validation: as rthdist.hausdorff;
-    host_extraction: boundary voxels on the host even on a GPU backend.
+    device_extraction: GPU backends: boundary voxels by a compute shader
+        (default: on the host, measured faster);
+    host_extraction: with device_extraction, on the host all the same.
 
     Returns a MaskResult, or a list of them (label-major, as the CLI's rows)
     when several conventions or labels="all"/a list are asked. A temporary
@@ -386,7 +391,8 @@ def compare_masks(a, b, *, spacing=None, affine=None, convention="rthdist", perc
             return x.engine.compare(a, b, spacing=spacing, affine=affine, convention=convention,
                                     percentiles=percentiles, connectivity=connectivity, tolerance=tolerance,
                                     label=label, labels=labels, host_extraction=host_extraction)
-    with MaskEngine(backend, device=device, threads=threads, validation=validation) as engine:
+    with MaskEngine(backend, device=device, threads=threads, validation=validation,
+                    device_extraction=device_extraction) as engine:
         return engine.compare(a, b, spacing=spacing, affine=affine, convention=convention,
                               percentiles=percentiles, connectivity=connectivity, tolerance=tolerance,
                               label=label, labels=labels, host_extraction=host_extraction)

@@ -248,12 +248,13 @@ std::vector<Selection> selectionsOf(const py::object& labels, const masks::Volum
 // The masks' Engine (and boundary pass) for Python, until close().
 class PyMaskEngine {
 public:
-    PyMaskEngine(const std::string& backend, std::optional<int> device, int threads, bool validation) {
+    PyMaskEngine(const std::string& backend, std::optional<int> device, int threads, bool validation,
+                 bool devicePass) {
         const Options options = engineOptions(backend, device, threads, validation);
         std::optional<Result<masks::MaskEngine>> engine;
         {
             py::gil_scoped_release release;
-            engine.emplace(masks::makeMaskEngine(options));
+            engine.emplace(masks::makeMaskEngine(options, devicePass));
         }
         m_engine.emplace(valueOrRaise(std::move(*engine)));
         m_threads = threads;
@@ -511,8 +512,8 @@ void bindMasks(py::module_& m) {
 
     py::class_<PyMaskEngine>(m, "_MaskEngine",
                              "The masks' Engine and boundary pass kept between calls (rthdist.MaskEngine).")
-        .def(py::init<const std::string&, std::optional<int>, int, bool>(), py::arg("backend"),
-             py::arg("device"), py::arg("threads"), py::arg("validation"))
+        .def(py::init<const std::string&, std::optional<int>, int, bool, bool>(), py::arg("backend"),
+             py::arg("device"), py::arg("threads"), py::arg("validation"), py::arg("device_extraction"))
         .def("compare", &PyMaskEngine::compare, py::arg("a"), py::arg("b"), py::arg("labels"),
              py::arg("conventions"), py::arg("percentiles"), py::arg("connectivity"), py::arg("tolerance"),
              py::arg("host_extraction"))

@@ -46,8 +46,8 @@ Result<std::array<Direction, 2>> bothDirections(Engine& engine, const Volume& a,
                                                 MaskResult& timed) {
     auto t0 = Clock::now();
     const detail::VoxelMetric metric(a, world);
-    const std::vector<glm::vec3> pa = metric.searchPoints(ba, threads);
-    const std::vector<glm::vec3> pb = metric.searchPoints(bb, threads);
+    const detail::SearchPoints pa = metric.searchPoints(ba, threads);
+    const detail::SearchPoints pb = metric.searchPoints(bb, threads);
     timed.extractMs += msSince(t0);
     t0 = Clock::now();
     Result<HausdorffResult> r = engine.compute(PointView(pa), PointView(pb), detail::perPointCall(false));
@@ -183,13 +183,13 @@ const char* emptyStatusName(EmptyStatus s) {
     return "?";
 }
 
-Result<MaskEngine> makeMaskEngine(Options options) {
+Result<MaskEngine> makeMaskEngine(Options options, bool devicePass) {
     options.perPointDistances = true;
     options.directedOnly = true;
     Result<Engine> engine = Engine::create(options);
     if (!engine) return engine.error();
     MaskEngine m{std::move(*engine), nullptr};
-    if (m.engine.backend() != Backend::kCpu) {
+    if (devicePass && m.engine.backend() != Backend::kCpu) {
         auto pass = masks_gpu::BoundaryPass::create(options.deviceIndex, options.validation);
         if (!pass) return pass.error();
         m.boundaryPass = std::move(*pass);

@@ -81,7 +81,7 @@ Result<std::vector<std::pair<double, double>>> searched(
     auto t0 = Clock::now();
     std::vector<uint64_t> queries(rest.size());
     for (size_t i = 0; i < rest.size(); ++i) queries[i] = x.corners[rest[i]];
-    const std::vector<glm::vec3> q = metric.searchPoints(queries, threads);
+    const SearchPoints q = metric.searchPoints(queries, threads);
     timing.extractMs += msSince(t0);
     t0 = Clock::now();
     Result<HausdorffResult> r = nearestOf(q);
@@ -135,13 +135,12 @@ Result<SurfelDirection> directed(const VoxelMetric& metric, const Volume& v, con
 // One-shot searches against Y's surfels.
 NearestCall oneShot(Engine& engine, const VoxelMetric& metric, const Surfels& y, int threads,
                     Timing& timing) {
-    return
-        [&engine, &metric, &y, threads, &timing](const std::vector<glm::vec3>& q) -> Result<HausdorffResult> {
-            auto t0 = Clock::now();
-            const std::vector<glm::vec3> t = metric.searchPoints(y.corners, threads);
-            timing.extractMs += msSince(t0);
-            return engine.compute(PointView(q), PointView(t), perPointCall(true));
-        };
+    return [&engine, &metric, &y, threads, &timing](std::span<const glm::vec3> q) -> Result<HausdorffResult> {
+        auto t0 = Clock::now();
+        const SearchPoints t = metric.searchPoints(y.corners, threads);
+        timing.extractMs += msSince(t0);
+        return engine.compute(PointView(q), PointView(t), perPointCall(true));
+    };
 }
 
 // Area of the direction's surfels within `tolerance` (a prefix of the sorted distances).

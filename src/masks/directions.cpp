@@ -39,14 +39,14 @@ void emptyValues(Convention c, EmptyStatus s, MaskResult& r) {
 }
 
 // HD, ASSD, MSD, surface overlaps and surface Dice from both directions.
-void summarise(Direction& da, Direction& db, double tolerance, MaskResult& r) {
+void summarise(Direction& da, Direction& db, double tolerance, int threads, MaskResult& r) {
     r.hd = std::max(da.out.hd, db.out.hd);
     const double nAll = double(da.out.points + db.out.points);
     r.assd = (da.sum + db.sum) / nAll;
     r.msd = 0.5 * (da.out.mean + db.out.mean);
     uint64_t within = 0;
     for (Direction* d : {&da, &db}) {
-        const uint64_t w = countAtMost(d->distances, tolerance);
+        const uint64_t w = countAtMost(d->distances, tolerance, threads);
         d->out.surfaceOverlap = double(w) / double(d->out.points);
         within += w;
     }
@@ -59,28 +59,28 @@ struct PercentilePair {
     double a = 0.0, b = 0.0, combined = 0.0;
 };
 
-PercentilePair percentilesOf(Convention c, Direction& da, Direction& db, std::vector<double>& pooled,
-                             double p) {
+PercentilePair percentilesOf(Convention c, Direction& da, Direction& db, std::span<double> pooled, double p,
+                             int threads) {
     PercentilePair v;
     switch (c) {
         case Convention::kRthdist:
-            v.a = percentileNearestRank(da.distances, p);
-            v.b = percentileNearestRank(db.distances, p);
+            v.a = percentileNearestRank(da.distances, p, threads);
+            v.b = percentileNearestRank(db.distances, p, threads);
             v.combined = std::max(v.a, v.b);
             break;
         case Convention::kMonai:
-            v.a = percentileLinear(da.distances, p);
-            v.b = percentileLinear(db.distances, p);
+            v.a = percentileLinear(da.distances, p, threads);
+            v.b = percentileLinear(db.distances, p, threads);
             v.combined = std::max(v.a, v.b);
             break;
         case Convention::kMedpy:
-            v.a = percentileLinear(da.distances, p);
-            v.b = percentileLinear(db.distances, p);
-            v.combined = percentileLinear(pooled, p);
+            v.a = percentileLinear(da.distances, p, threads);
+            v.b = percentileLinear(db.distances, p, threads);
+            v.combined = percentileLinear(pooled, p, threads);
             break;
         case Convention::kPlastimatch:
-            v.a = percentilePlastimatch(da.distances, p);
-            v.b = percentilePlastimatch(db.distances, p);
+            v.a = percentilePlastimatch(da.distances, p, threads);
+            v.b = percentilePlastimatch(db.distances, p, threads);
             v.combined = 0.5 * (v.a + v.b);
             break;
         case Convention::kItk:
@@ -91,15 +91,15 @@ PercentilePair percentilesOf(Convention c, Direction& da, Direction& db, std::ve
 
 // Every requested HD-p, per direction and combined (not for itk).
 void addPercentiles(Convention c, const std::vector<double>& percentiles, Direction& da, Direction& db,
-                    MaskResult& r) {
-    std::vector<double> pooled;
+                    int threads, MaskResult& r) {
+    core::UninitVector<double> pooled;
     if (c == Convention::kMedpy) {
         pooled.reserve(da.distances.size() + db.distances.size());
         pooled.assign(da.distances.begin(), da.distances.end());
         pooled.insert(pooled.end(), db.distances.begin(), db.distances.end());
     }
     for (double p : percentiles) {
-        const PercentilePair v = percentilesOf(c, da, db, pooled, p);
+        const PercentilePair v = percentilesOf(c, da, db, pooled, p, threads);
         da.out.percentiles.push_back(v.a);
         db.out.percentiles.push_back(v.b);
         r.hdPercentile.push_back(v.combined);
@@ -145,11 +145,15 @@ Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric,
     RecomputedDirection r = recompute(metric, v.dims, queries, targets, nearest.nearest, threads);
     Direction d;
     d.out.points = queries.size() + zeros;
-    d.distances.reserve(size_t(d.out.points));
-    d.distances.assign(size_t(zeros), 0.0);
-    d.distances.insert(d.distances.end(), r.distances.begin(), r.distances.end());
-    d.sum = r.sum;
     d.out.hd = r.distances[r.witness];
+    if (zeros == 0) {
+        d.distances = std::move(r.distances);
+    } else {
+        d.distances.reserve(size_t(d.out.points));
+        d.distances.assign(size_t(zeros), 0.0);
+        d.distances.insert(d.distances.end(), r.distances.begin(), r.distances.end());
+    }
+    d.sum = r.sum;
     d.out.voxel = voxelOf(queries[r.witness], v.dims);
     d.out.nearestVoxel = voxelOf(targets[nearest.nearest[r.witness]], v.dims);
     finishDirection(v, d);
@@ -158,9 +162,9 @@ Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric,
 
 NearestCall oneShotCall(Engine& engine, const VoxelMetric& metric, const std::vector<uint64_t>& targets,
                         int threads, MaskResult& timed) {
-    return [&engine, &metric, &targets, threads, &timed](const std::vector<glm::vec3>& q) {
+    return [&engine, &metric, &targets, threads, &timed](std::span<const glm::vec3> q) {
         const auto t0 = Clock::now();
-        const std::vector<glm::vec3> t = metric.searchPoints(targets, threads);
+        const SearchPoints t = metric.searchPoints(targets, threads);
         timed.extractMs += msSince(t0);
         return engine.compute(PointView(q), PointView(t), perPointCall(true));
     };
@@ -179,7 +183,7 @@ Result<Direction> directed(const VoxelMetric& metric, const Volume& v, const std
         return d;
     }
     auto t0 = Clock::now();
-    const std::vector<glm::vec3> q = metric.searchPoints(queries, threads);
+    const SearchPoints q = metric.searchPoints(queries, threads);
     timed.extractMs += msSince(t0);
     t0 = Clock::now();
     Result<HausdorffResult> r = nearest(q);
@@ -205,12 +209,12 @@ void setEmpty(uint64_t na, uint64_t nb, size_t percentiles, MaskResult& r) {
 }
 
 void combine(const MaskOptions& options, Direction& ab, Direction& ba, MaskResult& r) {
-    summarise(ab, ba, options.tolerance, r);
+    summarise(ab, ba, options.tolerance, options.threads, r);
     if (options.convention == Convention::kItk) {
         r.assd = r.surfaceDice = ab.out.surfaceOverlap = ba.out.surfaceOverlap =
             std::numeric_limits<double>::quiet_NaN();
     } else {
-        addPercentiles(options.convention, options.percentiles, ab, ba, r);
+        addPercentiles(options.convention, options.percentiles, ab, ba, options.threads, r);
     }
     r.aToB = std::move(ab.out);
     r.bToA = std::move(ba.out);

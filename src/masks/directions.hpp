@@ -16,8 +16,10 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <vector>
 
+#include "core/uninit_vector.hpp"
 #include "masks/masks.hpp"
 #include "masks/voxel_metric.hpp"
 
@@ -27,7 +29,7 @@ using Clock = std::chrono::steady_clock;
 [[nodiscard]] double msSince(Clock::time_point t);
 
 struct Direction {
-    std::vector<double> distances;  // all of X's distances, in no particular order (zeros included)
+    core::UninitVector<double> distances;  // all of X's distances, in no particular order (zeros included)
     DirectedMask out;
     double sum = 0.0;
 };
@@ -52,7 +54,7 @@ void addTimings(Timings& sum, const Timings& t);
 
 // The engine's per-point search of float query points against one target
 // set it already holds (or is given with the call).
-using NearestCall = std::function<Result<HausdorffResult>(const std::vector<glm::vec3>& queries)>;
+using NearestCall = std::function<Result<HausdorffResult>(std::span<const glm::vec3> queries)>;
 
 // A one-shot call against `targets` (voxels, put in `metric`'s frame at each
 // call; `timed.extractMs` gains that); the arguments must outlive it.

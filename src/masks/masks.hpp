@@ -175,7 +175,8 @@ struct MaskOptions {
     double tolerance = 1.0;                 // surface Dice tolerance, in mm (>= 0)
     int threads = 0;                        // boundary extraction; 0 = all hardware threads
     // Extract boundaries on the host even when the MaskEngine has a device
-    // pass (benchmarks and tests compare the two; the voxels are the same).
+    // pass (makeMaskEngine's devicePass; tests compare the two: the voxels
+    // are the same).
     bool hostExtraction = false;
 };
 
@@ -221,16 +222,21 @@ struct MaskResult {
     DirectedMask aToB, bToA;
     double extractMs = 0.0, distanceMs = 0.0, totalMs = 0.0;
     Timings engine;  // the engine calls' stages, summed over the calls (distanceMs is their wall time)
-    // Where the boundary voxels were found: "device" (the compute pass) or
-    // "host" (the CPU backend, itk's foreground, deepmind's surfels, a box
-    // too large for the pass, or MaskOptions::hostExtraction).
+    // Where the boundary voxels were found: "device" (the compute pass of a
+    // MaskEngine made with devicePass) or "host" (the default, itk's
+    // foreground, deepmind's surfels, a box too large for the pass, or
+    // MaskOptions::hostExtraction).
     std::string extraction = "host";
 };
 
-// The engine of compareMasks and, on a GPU backend, the boundary pass
-// (masks_gpu/boundary_pass.hpp) opened on the same device index: boundary
-// voxels are then found by a compute shader, the points' distances by the
-// engine. Not thread-safe (one per thread), as Engine.
+// The engine of compareMasks and, when asked for on a GPU backend, the
+// boundary pass (masks_gpu/boundary_pass.hpp) opened on the same device
+// index: boundary voxels are then found by a compute shader, the points'
+// distances by the engine. Without it the host finds them (row_bits.hpp:
+// one read of each label, then word arithmetic), which measured faster on
+// the H100 machine (docs/bench/masks): the pass needs the same host read to
+// find and stage the labels' box, then an upload and a read-back. Not
+// thread-safe (one per thread), as Engine.
 struct MaskEngine {
     Engine engine;
     std::shared_ptr<masks_gpu::BoundaryPass> boundaryPass;  // null: extraction on the host
@@ -244,8 +250,9 @@ struct MaskEngine {
                                               const Volume& b, LabelSelect selectB,
                                               const MaskOptions& options);
 
-// The Engine of `options` (backend, device, threads, validation) and, when
-// it runs a GPU backend, the boundary pass on options.deviceIndex.
-[[nodiscard]] Result<MaskEngine> makeMaskEngine(Options options);
+// The Engine of `options` (backend, device, threads, validation) and, with
+// devicePass on a GPU backend, the boundary pass on options.deviceIndex
+// (a second Vulkan device of its own).
+[[nodiscard]] Result<MaskEngine> makeMaskEngine(Options options, bool devicePass = false);
 
 }  // namespace rthdist::masks

@@ -1,50 +1,136 @@
 // Selection instead of sorting (order_statistics.hpp).
 #include "masks/order_statistics.hpp"
 
-#include "core/nearest_rank.hpp"
-
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <iterator>
 #include <limits>
+#include <utility>
+#include <vector>
+
+#include "core/nearest_rank.hpp"
+#include "core/parallel.hpp"
 
 namespace rthdist::masks::detail {
+namespace {
 
-double kthSmallest(std::vector<double>& values, size_t k) {
-    const auto at = values.begin() + std::ptrdiff_t(k);
-    std::nth_element(values.begin(), at, values.end());
-    return *at;
+constexpr size_t kParallelFrom = size_t(1) << 15;
+constexpr size_t kChunk = size_t(1) << 13;
+constexpr size_t kBuckets = 4096;
+
+// The least and greatest of `values`, one parallel pass.
+std::pair<double, double> rangeOf(std::span<const double> values, int threads) {
+    const size_t chunks = (values.size() + kChunk - 1) / kChunk;
+    std::vector<double> lows(chunks), highs(chunks);
+    core::parallelChunks(values.size(), kChunk, threads, [&](size_t b, size_t e, int) {
+        double lo = values[b], hi = values[b];
+        for (size_t i = b; i < e; ++i) {
+            lo = values[i] < lo ? values[i] : lo;
+            hi = values[i] > hi ? values[i] : hi;
+        }
+        lows[b / kChunk] = lo;
+        highs[b / kChunk] = hi;
+    });
+    return {*std::min_element(lows.begin(), lows.end()), *std::max_element(highs.begin(), highs.end())};
 }
 
-double percentileLinear(std::vector<double>& values, double p) {
+// The k-th and (k+1)-th smallest of `values` (at least kParallelFrom of
+// them; the k-th twice when k is the last) on `threads` threads: the range
+// [min, max] cut into kBuckets equal buckets (the bucket of a value never
+// decreases as the value grows), a histogram, and selection among the
+// values of the buckets that hold ranks k and k + 1. Three parallel passes.
+std::pair<double, double> bucketSelect(std::span<const double> values, size_t k, int threads) {
+    const size_t n = values.size(), chunks = (n + kChunk - 1) / kChunk;
+    const auto [lo, hi] = rangeOf(values, threads);
+    if (!(hi > lo)) return {lo, lo};  // all equal
+    const double scale = double(kBuckets) / (hi - lo);
+    const auto bucketOf = [lo, scale](double v) { return std::min(kBuckets - 1, size_t((v - lo) * scale)); };
+    std::vector<uint32_t> histograms(chunks * kBuckets, 0);
+    core::parallelChunks(n, kChunk, threads, [&](size_t b, size_t e, int) {
+        uint32_t* h = histograms.data() + (b / kChunk) * kBuckets;
+        for (size_t i = b; i < e; ++i) ++h[bucketOf(values[i])];
+    });
+    std::vector<uint64_t> total(kBuckets, 0);
+    for (size_t c = 0; c < chunks; ++c)
+        for (size_t j = 0; j < kBuckets; ++j) total[j] += histograms[c * kBuckets + j];
+    // first: the bucket holding rank k (below: the values before it); last:
+    // the one holding rank k + 1 (the same or a later one).
+    const size_t next = std::min(k + 1, n - 1);
+    size_t below = 0, first = 0;
+    while (k >= below + total[first]) below += total[first++];
+    size_t last = first, upTo = below + total[first];
+    while (next >= upTo) upTo += total[++last];
+    std::vector<std::vector<double>> inside(chunks);
+    core::parallelChunks(n, kChunk, threads, [&](size_t b, size_t e, int) {
+        std::vector<double>& in = inside[b / kChunk];
+        for (size_t i = b; i < e; ++i) {
+            const size_t bucket = bucketOf(values[i]);
+            if (bucket >= first && bucket <= last) in.push_back(values[i]);
+        }
+    });
+    std::vector<double> gathered;
+    for (const auto& in : inside) gathered.insert(gathered.end(), in.begin(), in.end());
+    const auto at = gathered.begin() + std::ptrdiff_t(k - below);
+    std::nth_element(gathered.begin(), at, gathered.end());
+    const double kth = *at;
+    return {kth, next == k ? kth : *std::min_element(at + 1, gathered.end())};
+}
+
+// The k-th and (k+1)-th smallest of non-empty `values` (the k-th twice when
+// k is the last).
+std::pair<double, double> kthAndNext(std::span<double> values, size_t k, int threads) {
+    const size_t n = values.size();
+    if (n >= kParallelFrom && core::resolveThreads(threads, n / kChunk) > 1)
+        return bucketSelect(values, k, threads);
+    const auto at = values.begin() + std::ptrdiff_t(k);
+    std::nth_element(values.begin(), at, values.end());
+    // After selecting k, the (k + 1)-th smallest is the least of what follows it.
+    return {*at, k + 1 < n ? *std::min_element(at + 1, values.end()) : *at};
+}
+
+}  // namespace
+
+double kthSmallest(std::span<double> values, size_t k, int threads) {
+    return kthAndNext(values, k, threads).first;
+}
+
+double percentileLinear(std::span<double> values, double p, int threads) {
     const size_t n = values.size();
     if (n == 0) return std::numeric_limits<double>::quiet_NaN();
     const double rank = (p / 100.0) * double(n - 1);
     const double lo = std::floor(rank);
-    const size_t i = std::min(size_t(lo), n - 1), j = std::min(i + 1, n - 1);
+    const size_t i = std::min(size_t(lo), n - 1);
     const double t = rank - lo;
-    const double a = kthSmallest(values, i);
-    // After selecting i, the (i + 1)-th smallest is the least of what follows it.
-    const double b = j == i ? a : *std::min_element(values.begin() + std::ptrdiff_t(j), values.end());
+    const auto [a, b] = kthAndNext(values, i, threads);
     const double diff = b - a;
     return t >= 0.5 ? b - diff * (1.0 - t) : a + diff * t;
 }
 
-double percentilePlastimatch(std::vector<double>& values, double p) {
+double percentilePlastimatch(std::span<double> values, double p, int threads) {
     const size_t n = values.size();
     if (n == 0) return 0.0;
     double k = std::floor((p / 100.0) * double(n) - 1.0);
     k = std::clamp(k, 0.0, double(n - 1));
-    return kthSmallest(values, size_t(k));
+    return kthSmallest(values, size_t(k), threads);
 }
 
-double percentileNearestRank(std::vector<double>& values, double p) {
+double percentileNearestRank(std::span<double> values, double p, int threads) {
     if (values.empty()) return 0.0;
-    return kthSmallest(values, core::nearestRankIndex(values.size(), p));
+    return kthSmallest(values, core::nearestRankIndex(values.size(), p), threads);
 }
 
-size_t countAtMost(const std::vector<double>& values, double limit) {
-    return size_t(std::count_if(values.begin(), values.end(), [limit](double v) { return v <= limit; }));
+size_t countAtMost(std::span<const double> values, double limit, int threads) {
+    const size_t chunks = (values.size() + kChunk - 1) / kChunk;
+    std::vector<size_t> counts(chunks, 0);
+    core::parallelChunks(values.size(), kChunk, threads, [&](size_t b, size_t e, int) {
+        size_t c = 0;
+        for (size_t i = b; i < e; ++i) c += values[i] <= limit;
+        counts[b / kChunk] = c;
+    });
+    size_t total = 0;
+    for (size_t c : counts) total += c;
+    return total;
 }
 
 }  // namespace rthdist::masks::detail

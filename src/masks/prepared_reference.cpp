@@ -85,13 +85,13 @@ std::optional<Error> checkPreparedFor(const State& s, const MaskOptions& options
 // Prepares `points` (voxels or corners of the reference) in the search frame.
 Result<PreparedSet> prepareSet(Engine& engine, const detail::VoxelMetric& metric,
                                const std::vector<uint64_t>& points, int threads) {
-    const std::vector<glm::vec3> p = metric.searchPoints(points, threads);
+    const detail::SearchPoints p = metric.searchPoints(points, threads);
     return engine.prepare(PointView(p));
 }
 
 // Searches float queries against the reference's prepared set.
 detail::NearestCall againstReference(Engine& engine, const PreparedSet& reference) {
-    return [&engine, &reference](const std::vector<glm::vec3>& q) -> Result<HausdorffResult> {
+    return [&engine, &reference](std::span<const glm::vec3> q) -> Result<HausdorffResult> {
         Result<PreparedSet> queries = engine.prepare(PointView(q));
         if (!queries) return queries.error();
         return engine.compute(*queries, reference, detail::perPointCall(true));
@@ -116,7 +116,7 @@ Result<std::array<Direction, 2>> boundaryDirections(Engine& engine, const State&
                                                     MaskResult& r) {
     auto t0 = Clock::now();
     const detail::VoxelMetric metric = metricOf(s);
-    const std::vector<glm::vec3> pb = metric.searchPoints(eb.boundary, threads);
+    const detail::SearchPoints pb = metric.searchPoints(eb.boundary, threads);
     r.extractMs += msSince(t0);
     t0 = Clock::now();
     Result<PreparedSet> prediction = engine.prepare(PointView(pb));

@@ -39,11 +39,13 @@ VoxelMetric VoxelMetric::corners(const Volume& v) {
                        glm::dvec3(0.5 * double(v.dims[0]), 0.5 * double(v.dims[1]), 0.5 * double(v.dims[2])));
 }
 
-std::vector<glm::vec3> VoxelMetric::searchPoints(const std::vector<uint64_t>& voxels, int threads) const {
-    std::vector<glm::vec3> out(voxels.size());
+SearchPoints VoxelMetric::searchPoints(const std::vector<uint64_t>& voxels, int threads) const {
+    SearchPoints out;
+    out.resize(voxels.size());
+    const VoxelDecoder decode(m_dims);
     core::parallelChunks(voxels.size(), kChunk, threads, [&](size_t b, size_t e, int) {
         for (size_t i = b; i < e; ++i)
-            out[i] = glm::vec3(m_linear * (asVector(voxelOf(voxels[i], m_dims)) - m_centre));
+            out[i] = glm::vec3(m_linear * (asVector(decode(voxels[i])) - m_centre));
     });
     return out;
 }
@@ -58,13 +60,27 @@ RecomputedDirection recompute(const VoxelMetric& metric, Dims dims, const std::v
                               int threads) {
     RecomputedDirection r;
     r.distances.resize(queries.size());
+    // Each chunk's sum and witness (largest, smallest index among ties),
+    // combined in chunk order: the same for any thread count.
+    const size_t chunks = (queries.size() + kChunk - 1) / kChunk;
+    std::vector<double> sums(chunks, 0.0);
+    std::vector<size_t> witnesses(chunks, 0);
+    const VoxelDecoder decode(dims);
     core::parallelChunks(queries.size(), kChunk, threads, [&](size_t b, size_t e, int) {
-        for (size_t i = b; i < e; ++i)
-            r.distances[i] = metric.distance(voxelOf(queries[i], dims), voxelOf(targets[nearest[i]], dims));
+        double sum = 0.0;
+        size_t witness = b;
+        for (size_t i = b; i < e; ++i) {
+            const double d = metric.distance(decode(queries[i]), decode(targets[nearest[i]]));
+            r.distances[i] = d;
+            sum += d;
+            if (d > r.distances[witness]) witness = i;
+        }
+        sums[b / kChunk] = sum;
+        witnesses[b / kChunk] = witness;
     });
-    for (size_t i = 0; i < r.distances.size(); ++i) {
-        r.sum += r.distances[i];
-        if (r.distances[i] > r.distances[r.witness]) r.witness = i;
+    for (size_t c = 0; c < chunks; ++c) {
+        r.sum += sums[c];
+        if (r.distances[witnesses[c]] > r.distances[r.witness]) r.witness = witnesses[c];
     }
     return r;
 }

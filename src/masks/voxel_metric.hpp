@@ -20,10 +20,14 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/uninit_vector.hpp"
 #include "masks/boundary.hpp"
 #include "masks/masks.hpp"
 
 namespace rthdist::masks::detail {
+
+// Float search coordinates of voxels (kept between calls: core::UninitVector).
+using SearchPoints = core::UninitVector<glm::vec3>;
 
 class VoxelMetric {
 public:
@@ -36,7 +40,7 @@ public:
     [[nodiscard]] static VoxelMetric corners(const Volume& v);
 
     // Float coordinates of `voxels` (linear indices) in the search frame.
-    [[nodiscard]] std::vector<glm::vec3> searchPoints(const std::vector<uint64_t>& voxels, int threads) const;
+    [[nodiscard]] SearchPoints searchPoints(const std::vector<uint64_t>& voxels, int threads) const;
     // |linear (p - q)| in double.
     [[nodiscard]] double distance(std::array<int64_t, 3> p, std::array<int64_t, 3> q) const;
 
@@ -52,9 +56,9 @@ private:
 // (nearest[i]: index into targets), recomputed in double; the largest of
 // them (smallest query index among ties) is the direction's witness.
 struct RecomputedDirection {
-    std::vector<double> distances;  // in query order
-    double sum = 0.0;               // summed in query order
-    size_t witness = 0;             // query index of the largest distance
+    core::UninitVector<double> distances;  // in query order
+    double sum = 0.0;                      // summed in chunks of 2^13 queries, in query order
+    size_t witness = 0;                    // query index of the largest distance
 };
 [[nodiscard]] RecomputedDirection recompute(const VoxelMetric& metric, Dims dims,
                                             const std::vector<uint64_t>& queries,

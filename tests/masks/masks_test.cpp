@@ -142,37 +142,59 @@ TEST(MasksLoad, NpyCAndFortranOrder) {
     }
 }
 
+// The host extraction (packed rows, row_bits.hpp) against a voxel-by-voxel
+// brute force: rows shorter than a word, of whole words and across words,
+// 8- and 32-bit labels, a label value, any non-zero, a value the 8-bit type
+// cannot hold, every connectivity.
 TEST(MasksBoundary, MatchesBruteForce) {
-    const detail::Dims dims{9, 8, 7};
     std::mt19937 rng(13);
-    Volume v = makeVolume(dims, glm::dvec3(1.0));
-    for (auto& l : v.labels) l = (rng() % 100) < 60 ? 3 : 0;
-    std::vector<uint8_t> mask(v.labels.size());
-    for (size_t i = 0; i < mask.size(); ++i) mask[i] = v.labels[i] == 3;
-    for (int conn : {6, 18, 26}) {
-        const detail::Extraction e = detail::extractBoundary(v, LabelSelect{3, false}, conn, 2);
-        EXPECT_EQ(e.count, uint64_t(std::count(mask.begin(), mask.end(), 1)));
-        const std::vector<uint64_t>& got = e.boundary;
-        std::vector<uint64_t> want;
-        for (int64_t k = 0; k < 7; ++k)
-            for (int64_t j = 0; j < 8; ++j)
-                for (int64_t i = 0; i < 9; ++i) {
-                    const size_t at = size_t(i + 9 * (j + 8 * k));
-                    if (!mask[at]) continue;
-                    bool edge = false;
-                    for (int dz = -1; dz <= 1; ++dz)
-                        for (int dy = -1; dy <= 1; ++dy)
-                            for (int dx = -1; dx <= 1; ++dx) {
-                                const int l1 = std::abs(dx) + std::abs(dy) + std::abs(dz);
-                                if (l1 == 0 || l1 > (conn == 6 ? 1 : conn == 18 ? 2 : 3)) continue;
-                                const int64_t x = i + dx, y = j + dy, z = k + dz;
-                                if (x < 0 || y < 0 || z < 0 || x >= 9 || y >= 8 || z >= 7 ||
-                                    !mask[size_t(x + 9 * (y + 8 * z))])
-                                    edge = true;
-                            }
-                    if (edge) want.push_back(at);
+    for (const detail::Dims dims :
+         {detail::Dims{9, 8, 7}, detail::Dims{64, 5, 4}, detail::Dims{130, 6, 5}, detail::Dims{70, 1, 3}}) {
+        for (bool eightBit : {false, true}) {
+            Volume v = makeVolume(dims, glm::dvec3(1.0));
+            for (auto& l : v.labels) l = (rng() % 100) < 60 ? 3 : int32_t(rng() % 3);
+            if (eightBit) {
+                v.labels8.assign(v.labels.begin(), v.labels.end());
+                v.labels.clear();
+            }
+            for (LabelSelect select :
+                 {LabelSelect{3, false}, LabelSelect{1, true}, LabelSelect{259, false}}) {
+                std::vector<uint8_t> mask(size_t(v.voxelCount()));
+                for (size_t i = 0; i < mask.size(); ++i) {
+                    const int32_t l = eightBit ? int32_t(v.labels8[i]) : v.labels[i];
+                    mask[i] = select.anyNonZero ? l != 0 : l == select.value;
                 }
-        EXPECT_EQ(got, want) << "connectivity " << conn;
+                for (int conn : {6, 18, 26}) {
+                    const detail::Extraction e = detail::extractBoundary(v, select, conn, 2);
+                    const std::string what =
+                        "dims " + std::to_string(dims[0]) + " 8-bit " + std::to_string(eightBit) + " label " +
+                        std::to_string(select.value) + " connectivity " + std::to_string(conn);
+                    EXPECT_EQ(e.count, uint64_t(std::count(mask.begin(), mask.end(), 1))) << what;
+                    std::vector<uint64_t> want;
+                    for (int64_t k = 0; k < dims[2]; ++k)
+                        for (int64_t j = 0; j < dims[1]; ++j)
+                            for (int64_t i = 0; i < dims[0]; ++i) {
+                                const size_t at = size_t(i + dims[0] * (j + dims[1] * k));
+                                if (!mask[at]) continue;
+                                bool edge = false;
+                                for (int dz = -1; dz <= 1; ++dz)
+                                    for (int dy = -1; dy <= 1; ++dy)
+                                        for (int dx = -1; dx <= 1; ++dx) {
+                                            const int l1 = std::abs(dx) + std::abs(dy) + std::abs(dz);
+                                            if (l1 == 0 || l1 > (conn == 6 ? 1 : conn == 18 ? 2 : 3))
+                                                continue;
+                                            const int64_t x = i + dx, y = j + dy, z = k + dz;
+                                            if (x < 0 || y < 0 || z < 0 || x >= dims[0] || y >= dims[1] ||
+                                                z >= dims[2] ||
+                                                !mask[size_t(x + dims[0] * (y + dims[1] * z))])
+                                                edge = true;
+                                        }
+                                if (edge) want.push_back(at);
+                            }
+                    EXPECT_EQ(e.boundary, want) << what;
+                }
+            }
+        }
     }
 }
 
@@ -272,41 +294,44 @@ TEST(MasksCompare, InvalidOptions) {
     EXPECT_EQ(compareMasks(*engine, v, {}, v, {}, mo).error().code, ErrorCode::kInvalidArgument);
 }
 
-// Every convention on the backend under test equals the CPU backend's values.
+// Every convention on the backend under test equals the CPU backend's
+// values, with the host's extraction (the default) and with the compute pass.
 TEST(MasksBackend, AllConventionsMatchCpu) {
-    Options o;
-    o.backend = backendUnderTest();
-    Result<MaskEngine> engine = makeMaskEngine(o);
-    ASSERT_TRUE(engine.ok()) << engine.error().message;
-    Options oc;
-    oc.backend = Backend::kCpu;
-    Result<MaskEngine> cpu = makeMaskEngine(oc);
-    ASSERT_TRUE(cpu.ok());
-    Volume a = makeVolume({30, 28, 10}, glm::dvec3(0.5, 0.7, 3.0));
-    Volume b = a;
-    ball(a, glm::dvec3(14, 13, 5), 6.0, 1);
-    ball(b, glm::dvec3(16, 12, 4.5), 7.0, 1);
-    a.labels[size_t(1 + 30 * (1 + 28 * 1))] = 1;  // an outlier voxel
-    const double diag = glm::length(glm::dvec3(29 * 0.5, 27 * 0.7, 9 * 3.0));
-    for (Convention c : kAllConventions) {
-        MaskOptions mo;
-        mo.convention = c;
-        mo.percentiles = {95.0, 50.0};
-        Result<MaskResult> r = compareMasks(*engine, a, {}, b, {}, mo);
-        Result<MaskResult> w = compareMasks(*cpu, a, {}, b, {}, mo);
-        ASSERT_TRUE(r.ok() && w.ok()) << conventionName(c);
-        EXPECT_NEAR(r->hd, w->hd, 1e-6 * diag) << conventionName(c);
-        EXPECT_NEAR(r->msd, w->msd, 1e-6 * diag) << conventionName(c);
-        ASSERT_EQ(r->hdPercentile.size(), w->hdPercentile.size());
-        for (size_t i = 0; i < r->hdPercentile.size(); ++i)
-            EXPECT_NEAR(r->hdPercentile[i], w->hdPercentile[i], 1e-6 * diag) << conventionName(c);
-        EXPECT_EQ(r->aToB.points, w->aToB.points);
-        EXPECT_GT(r->hd, 6.0);  // the outlier voxel (about 8 mm from b)
-        // A GPU backend finds boundary voxels with its compute pass (not
-        // deepmind's surfels); the CPU backend on the host.
-        const bool devicePass = o.backend != Backend::kCpu && c != Convention::kDeepmind;
-        EXPECT_EQ(r->extraction, devicePass ? "device" : "host") << conventionName(c);
-        EXPECT_EQ(w->extraction, "host") << conventionName(c);
+    for (bool devicePass : {false, true}) {
+        Options o;
+        o.backend = backendUnderTest();
+        Result<MaskEngine> engine = makeMaskEngine(o, devicePass);
+        ASSERT_TRUE(engine.ok()) << engine.error().message;
+        Options oc;
+        oc.backend = Backend::kCpu;
+        Result<MaskEngine> cpu = makeMaskEngine(oc);
+        ASSERT_TRUE(cpu.ok());
+        Volume a = makeVolume({30, 28, 10}, glm::dvec3(0.5, 0.7, 3.0));
+        Volume b = a;
+        ball(a, glm::dvec3(14, 13, 5), 6.0, 1);
+        ball(b, glm::dvec3(16, 12, 4.5), 7.0, 1);
+        a.labels[size_t(1 + 30 * (1 + 28 * 1))] = 1;  // an outlier voxel
+        const double diag = glm::length(glm::dvec3(29 * 0.5, 27 * 0.7, 9 * 3.0));
+        for (Convention c : kAllConventions) {
+            MaskOptions mo;
+            mo.convention = c;
+            mo.percentiles = {95.0, 50.0};
+            Result<MaskResult> r = compareMasks(*engine, a, {}, b, {}, mo);
+            Result<MaskResult> w = compareMasks(*cpu, a, {}, b, {}, mo);
+            ASSERT_TRUE(r.ok() && w.ok()) << conventionName(c);
+            EXPECT_NEAR(r->hd, w->hd, 1e-6 * diag) << conventionName(c);
+            EXPECT_NEAR(r->msd, w->msd, 1e-6 * diag) << conventionName(c);
+            ASSERT_EQ(r->hdPercentile.size(), w->hdPercentile.size());
+            for (size_t i = 0; i < r->hdPercentile.size(); ++i)
+                EXPECT_NEAR(r->hdPercentile[i], w->hdPercentile[i], 1e-6 * diag) << conventionName(c);
+            EXPECT_EQ(r->aToB.points, w->aToB.points);
+            EXPECT_GT(r->hd, 6.0);  // the outlier voxel (about 8 mm from b)
+            // A GPU backend with the pass finds boundary voxels with it (not
+            // deepmind's surfels); the CPU backend on the host.
+            const bool onDevice = devicePass && o.backend != Backend::kCpu && c != Convention::kDeepmind;
+            EXPECT_EQ(r->extraction, onDevice ? "device" : "host") << conventionName(c);
+            EXPECT_EQ(w->extraction, "host") << conventionName(c);
+        }
     }
 }
 

@@ -199,11 +199,12 @@ def run_cli(cli, backend, a_path, b_path, extra):
     return json.loads(p.stdout)
 
 
-def check_host_extraction(name, cli, backend, a_path, b_path, extra, out):
-    """--host-extraction --repeat 2 gives every row of `out` unchanged (the device
-    pass and the host find the same voxels, in the same order), says where each
-    extraction ran, and lists both runs' times."""
-    again = run_cli(cli, backend, a_path, b_path, extra + ["--host-extraction", "--repeat", "2"])
+def check_device_extraction(name, cli, backend, a_path, b_path, extra, out):
+    """--device-extraction --repeat 2 gives every row of `out` (the default: the
+    host's extraction) unchanged (the compute pass and the host find the same
+    voxels, in the same order), says where each extraction ran, and lists both
+    runs' times."""
+    again = run_cli(cli, backend, a_path, b_path, extra + ["--device-extraction", "--repeat", "2"])
     if again is None:
         return
     timing_keys = {"timings_ms", "engine_ms", "extraction", "repeat_total_ms"}
@@ -211,17 +212,19 @@ def check_host_extraction(name, cli, backend, a_path, b_path, extra, out):
         tag = f"{name} label {row['label']} {row['convention']}"
         if {k: v for k, v in row.items() if k not in timing_keys} != \
                 {k: v for k, v in other.items() if k not in timing_keys}:
-            FAILURES.append(f"{tag}: --host-extraction changed the row")
-        if other.get("extraction") != "host" or len(other.get("repeat_total_ms", [])) != 2:
-            FAILURES.append(f"{tag}: --host-extraction --repeat 2 reported {other.get('extraction')}, "
-                            f"{other.get('repeat_total_ms')}")
-        # GPU backends run the device pass for every convention but deepmind
-        # (surfels), also when it finds a mask empty.
+            FAILURES.append(f"{tag}: --device-extraction changed the row")
+        # With --device-extraction, GPU backends run the compute pass for
+        # every convention but deepmind (surfels), also when it finds a mask
+        # empty; without it, the host extracts.
         device = backend != "cpu" and row["convention"] != "deepmind"
-        if row.get("extraction") != ("device" if device else "host"):
-            FAILURES.append(f"{tag}: extraction {row.get('extraction')} on {backend}")
+        if other.get("extraction") != ("device" if device else "host") or \
+                len(other.get("repeat_total_ms", [])) != 2:
+            FAILURES.append(f"{tag}: --device-extraction --repeat 2 reported {other.get('extraction')}, "
+                            f"{other.get('repeat_total_ms')} on {backend}")
+        if row.get("extraction") != "host":
+            FAILURES.append(f"{tag}: extraction {row.get('extraction')} on {backend} by default")
     if len(out["results"]) != len(again["results"]):
-        FAILURES.append(f"{name}: --host-extraction gave {len(again['results'])} rows, not {len(out['results'])}")
+        FAILURES.append(f"{name}: --device-extraction gave {len(again['results'])} rows, not {len(out['results'])}")
 
 
 def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_volumes=None, npy=False,
@@ -252,7 +255,7 @@ def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_vol
     out = run_cli(cli, backend, a_path, b_path, extra)
     if out is None:
         return
-    check_host_extraction(f"[{backend}] {name}", cli, backend, a_path, b_path, extra, out)
+    check_device_extraction(f"[{backend}] {name}", cli, backend, a_path, b_path, extra, out)
     eps = 1e-6 * diagonal(a.shape, affine)
     for row in out["results"]:
         conv = row["convention"]

@@ -43,27 +43,57 @@ TEST(OrderStatistics, SelectionEqualsTheSortedRule) {
             std::sort(sorted.begin(), sorted.end());
             for (double p : ps) {
                 std::vector<double> work = values;
-                EXPECT_EQ(percentileLinear(work, p), sortedLinear(sorted, p)) << n << " p" << p;
+                EXPECT_EQ(percentileLinear(work, p, 2), sortedLinear(sorted, p)) << n << " p" << p;
                 work = values;
-                EXPECT_EQ(percentilePlastimatch(work, p), sortedPlastimatch(sorted, p)) << n << " p" << p;
+                EXPECT_EQ(percentilePlastimatch(work, p, 2), sortedPlastimatch(sorted, p)) << n << " p" << p;
                 work = values;
-                EXPECT_EQ(percentileNearestRank(work, p), sortedNearestRank(sorted, p)) << n << " p" << p;
+                EXPECT_EQ(percentileNearestRank(work, p, 2), sortedNearestRank(sorted, p)) << n << " p" << p;
                 // Reused without restoring the order (several percentiles in a row).
-                EXPECT_EQ(percentileLinear(work, p), sortedLinear(sorted, p)) << n << " p" << p;
+                EXPECT_EQ(percentileLinear(work, p, 2), sortedLinear(sorted, p)) << n << " p" << p;
             }
             for (double limit : {-1.0, 0.0, 1.0, std::sqrt(2.0), 10.0})
-                EXPECT_EQ(countAtMost(values, limit),
+                EXPECT_EQ(countAtMost(values, limit, 2),
                           size_t(std::upper_bound(sorted.begin(), sorted.end(), limit) - sorted.begin()));
+        }
+    }
+}
+
+// From 2^15 values on, the bracketed parallel selection: lattice distances
+// with many ties, a spread of distinct values, and a heavy tail (the few far
+// outliers of a noisy mask), against the sorted rule on every percentile.
+TEST(OrderStatistics, ParallelSelectionEqualsTheSortedRule) {
+    std::mt19937 rng(11);
+    const std::vector<double> ps{0.0, 0.001, 5.0, 50.0, 90.0, 95.0, 99.0, 99.99, 100.0};
+    for (size_t n : {size_t(1) << 15, size_t(100003), size_t(400000)}) {
+        for (int shape = 0; shape < 3; ++shape) {
+            std::vector<double> values(n);
+            for (double& v : values) {
+                const uint32_t r = rng();
+                v = shape == 0   ? std::sqrt(double(r % 40))
+                    : shape == 1 ? double(r) / 4096.0
+                                 : (r % 1000 == 0 ? 100.0 + double(r % 997) : std::sqrt(double(r % 9)));
+            }
+            std::vector<double> sorted = values;
+            std::sort(sorted.begin(), sorted.end());
+            for (double p : ps) {
+                std::vector<double> work = values;
+                EXPECT_EQ(percentileLinear(work, p, 2), sortedLinear(sorted, p))
+                    << n << " shape " << shape << " p" << p;
+                EXPECT_EQ(percentilePlastimatch(work, p, 2), sortedPlastimatch(sorted, p)) << n << " p" << p;
+                EXPECT_EQ(percentileNearestRank(work, p, 2), sortedNearestRank(sorted, p)) << n << " p" << p;
+            }
+            EXPECT_EQ(countAtMost(values, 2.0, 2),
+                      size_t(std::upper_bound(sorted.begin(), sorted.end(), 2.0) - sorted.begin()));
         }
     }
 }
 
 TEST(OrderStatistics, EmptyValuesFollowTheConventions) {
     std::vector<double> none;
-    EXPECT_TRUE(std::isnan(percentileLinear(none, 95.0)));
-    EXPECT_EQ(percentilePlastimatch(none, 95.0), 0.0);
-    EXPECT_EQ(percentileNearestRank(none, 95.0), 0.0);
-    EXPECT_EQ(countAtMost(none, 1.0), 0u);
+    EXPECT_TRUE(std::isnan(percentileLinear(none, 95.0, 2)));
+    EXPECT_EQ(percentilePlastimatch(none, 95.0, 2), 0.0);
+    EXPECT_EQ(percentileNearestRank(none, 95.0, 2), 0.0);
+    EXPECT_EQ(countAtMost(none, 1.0, 2), 0u);
 }
 
 }  // namespace

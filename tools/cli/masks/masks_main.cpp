@@ -5,7 +5,7 @@
 //   rthdist-masks A B [B2 ...] [--label N | --labels all] [--convention NAME|all]
 //                 [--percentile P]... [--connectivity 6|18|26] [--tolerance MM]
 //                 [--spacing X,Y,Z | --affine 12 numbers] [--backend B] [--device N]
-//                 [--threads N] [--host-extraction] [--repeat N]
+//                 [--threads N] [--device-extraction [--host-extraction]] [--repeat N]
 //                 [--unprepared] [--json | --csv]
 //
 // With more than one B, A is a reference compared with each B in turn
@@ -58,9 +58,10 @@ struct MasksArgs {
     std::optional<glm::dmat4> affine;  // --affine: voxel-to-world of .npy inputs
     Options options;
     bool json = false, csv = false, help = false, version = false;
-    bool hostExtraction = false;  // --host-extraction
-    bool unprepared = false;      // --unprepared: several Bs without a prepared reference
-    int repeat = 1;               // --repeat N: each comparison N times (benchmarks)
+    bool deviceExtraction = false;  // --device-extraction: the boundary pass on a GPU backend
+    bool hostExtraction = false;    // --host-extraction: the host all the same (tests compare)
+    bool unprepared = false;        // --unprepared: several Bs without a prepared reference
+    int repeat = 1;                 // --repeat N: each comparison N times (benchmarks)
 };
 
 const char* kUsage =
@@ -81,8 +82,9 @@ const char* kUsage =
     "  --affine R00,R01,R02,T0,R10,...,T2  voxel-to-world of .npy inputs: 3x4, row-major\n"
     "  --backend B          auto, cpu, ray-query, rt-pipeline (default auto)\n"
     "  --device N           Vulkan device index;  --threads N  CPU threads (0 = all)\n"
-    "  --host-extraction    find boundary voxels on the host even with a GPU backend\n"
-    "                       (default there: a compute shader)\n"
+    "  --device-extraction  GPU backends: find boundary voxels with a compute shader\n"
+    "                       (default: on the host, which measured faster)\n"
+    "  --host-extraction    with --device-extraction: the host all the same (tests)\n"
     "  --repeat N           run each comparison N times in this process (benchmarks: JSON\n"
     "                       lists every run's time; the numbers are the last run's)\n"
     "  --unprepared         several Bs: extract and index A again for each (benchmarks;\n"
@@ -227,7 +229,7 @@ Result<MasksArgs> parse(std::span<const std::string> argv) {
     for (auto [name, target] :
          {std::pair{"--help", &a.help}, std::pair{"--version", &a.version}, std::pair{"--json", &a.json},
           std::pair{"--csv", &a.csv}, std::pair{"--host-extraction", &a.hostExtraction},
-          std::pair{"--unprepared", &a.unprepared}}) {
+          std::pair{"--device-extraction", &a.deviceExtraction}, std::pair{"--unprepared", &a.unprepared}}) {
         line.flag(name, [target = target](bool) { *target = true; });
     }
     addMeasureOptions(line, a, conventionSet);
@@ -561,7 +563,7 @@ int run(int argc, char** argv) {
         if (!b) return fail(exitCodeFor(b.error().code), b.error().message);
         first = std::move(*b);
     }
-    Result<masks::MaskEngine> engine = masks::makeMaskEngine(args.options);
+    Result<masks::MaskEngine> engine = masks::makeMaskEngine(args.options, args.deviceExtraction);
     if (!engine) return fail(exitCodeFor(engine.error().code), engine.error().message);
     Report report;
     report.a = &*a;

@@ -1,0 +1,130 @@
+// Packed rows and their boundary words (row_bits.hpp).
+#include "masks/row_bits.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstdlib>
+
+#include "core/parallel.hpp"
+#include "masks/selected.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace rthdist::masks::detail {
+namespace {
+
+constexpr size_t kRowsPerChunk = 256;
+
+// Bits of `n` <= 64 labels from `p` (bit i: label i selected).
+template <class T>
+uint64_t packScalar(const Selected<T>& sel, int64_t at, int64_t n) {
+    uint64_t word = 0;
+    for (int64_t i = 0; i < n; ++i) word |= uint64_t(sel(at + i)) << i;
+    return word;
+}
+
+// 64 8-bit labels at once: four 16-byte compares.
+uint64_t pack64(const Selected<uint8_t>& sel, int64_t at) {
+#if defined(__SSE2__)
+    const __m128i key = _mm_set1_epi8(static_cast<char>(sel.any ? 0 : sel.value));
+    uint64_t word = 0;
+    for (int k = 0; k < 4; ++k) {
+        const __m128i labels = _mm_loadu_si128(reinterpret_cast<const __m128i*>(sel.data + at + 16 * k));
+        uint32_t equal = uint32_t(_mm_movemask_epi8(_mm_cmpeq_epi8(labels, key)));
+        if (sel.any) equal = ~equal & 0xffffu;
+        word |= uint64_t(equal) << (16 * k);
+    }
+    return word;
+#else
+    return packScalar(sel, at, 64);
+#endif
+}
+
+template <class T>
+uint64_t pack64(const Selected<T>& sel, int64_t at) {
+    return packScalar(sel, at, 64);
+}
+
+// One row of labels starting at voxel `at` into `words` (nx voxels).
+template <class T>
+void packRow(const Selected<T>& sel, int64_t at, int64_t nx, uint64_t* words) {
+    if (sel.none) {
+        std::fill(words, words + (nx + 63) / 64, uint64_t(0));
+        return;
+    }
+    int64_t x = 0;
+    for (; x + 64 <= nx; x += 64) *words++ = pack64(sel, at + x);
+    if (x < nx) *words = packScalar(sel, at + x, nx - x);
+}
+
+// Word w of "selected with both x neighbours selected" for a packed row of W words.
+uint64_t withXNeighbours(const uint64_t* r, int64_t w, int64_t W) {
+    const uint64_t left = (r[w] << 1) | (w > 0 ? r[w - 1] >> 63 : 0);       // bit x: x - 1 selected
+    const uint64_t right = (r[w] >> 1) | (w + 1 < W ? r[w + 1] << 63 : 0);  // bit x: x + 1 selected
+    return r[w] & left & right;
+}
+
+}  // namespace
+
+RowBits::RowBits(const Volume& v, LabelSelect select, int threads)
+    : m_dims(v.dims), m_rowWords((v.dims[0] + 63) / 64) {
+    const int64_t nx = m_dims[0];
+    const size_t rows = size_t(m_dims[1] * m_dims[2]);
+    m_words.resize(rows * size_t(m_rowWords));
+    std::vector<uint64_t> chunkCounts((rows + kRowsPerChunk - 1) / kRowsPerChunk, 0);
+    withLabels(v, [&](const auto* labels) {
+        const Selected sel(labels, select);
+        core::parallelChunks(rows, kRowsPerChunk, threads, [&](size_t b, size_t e, int) {
+            uint64_t count = 0;
+            for (size_t r = b; r < e; ++r) {
+                uint64_t* words = m_words.data() + r * size_t(m_rowWords);
+                packRow(sel, int64_t(r) * nx, nx, words);
+                for (int64_t w = 0; w < m_rowWords; ++w) count += uint64_t(std::popcount(words[w]));
+            }
+            chunkCounts[b / kRowsPerChunk] = count;
+        });
+    });
+    for (uint64_t c : chunkCounts) m_count += c;
+}
+
+void RowBits::appendBoundaryOfRow(int64_t y, int64_t z, int connectivity, std::vector<uint64_t>& out) const {
+    const int64_t W = m_rowWords, ny = m_dims[1], nz = m_dims[2];
+    const uint64_t* centre = row(y, z);
+    if (std::all_of(centre, centre + W, [](uint64_t w) { return w == 0; })) return;
+    // The neighbour rows (dy, dz) of the connectivity (|dy| + |dz| <= maxL1)
+    // and whether their x neighbours count too (|dy| + |dz| + 1 <= maxL1).
+    // A row outside the volume is background: every selected voxel of this
+    // row is then a boundary voxel.
+    const int maxL1 = connectivity == 6 ? 1 : connectivity == 18 ? 2 : 3;
+    const uint64_t* rows[8];
+    bool shifted[8];
+    int count = 0;
+    bool outside = false;
+    for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy) {
+            const int l1 = std::abs(dy) + std::abs(dz);
+            if (l1 == 0 || l1 > maxL1) continue;
+            const int64_t ny2 = y + dy, nz2 = z + dz;
+            if (ny2 < 0 || nz2 < 0 || ny2 >= ny || nz2 >= nz) {
+                outside = true;
+                continue;
+            }
+            rows[count] = row(ny2, nz2);
+            shifted[count++] = l1 + 1 <= maxL1;
+        }
+    const uint64_t first = uint64_t((z * ny + y) * m_dims[0]);
+    for (int64_t w = 0; w < W; ++w) {
+        uint64_t interior = 0;
+        if (!outside) {
+            interior = withXNeighbours(centre, w, W);
+            for (int k = 0; k < count && interior != 0; ++k)
+                interior &= shifted[k] ? withXNeighbours(rows[k], w, W) : rows[k][w];
+        }
+        for (uint64_t b = centre[w] & ~interior; b != 0; b &= b - 1)
+            out.push_back(first + uint64_t(w) * 64 + uint64_t(std::countr_zero(b)));
+    }
+}
+
+}  // namespace rthdist::masks::detail

@@ -1,0 +1,50 @@
+// A mask's selection packed one bit per voxel, row by row: what the host
+// extraction (boundary.cpp) tests neighbours on. The label volume is read
+// once, by rows on every thread (64 labels to a word; 16 8-bit labels per
+// SSE2 compare where the target has it), then a row's boundary is word
+// arithmetic on it and on its up to eight neighbour rows, and an empty row
+// costs a test of its words. (Packing and testing slab by slab instead, with
+// three slices in cache, measured slower on the H100 machine's 16 cores:
+// docs/bench/masks.) Internal to rthdist_masks.
+//
+// Layout: row (y, z) is the words [((z * ny) + y) * W, + W), W = ceil(nx /
+// 64); voxel x of the row is bit x % 64 of word x / 64; the bits past nx are
+// zero (outside the volume counts as background).
+// Memory: ny * nz * W words (a 512 x 512 x 300 volume: 9.8 MB), from
+// core::UninitVector (kept for the next extraction of the same size).
+// Threading: built on `threads` threads; const methods may be called from
+// any number of threads.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/uninit_vector.hpp"
+#include "masks/boundary.hpp"
+#include "masks/masks.hpp"
+
+namespace rthdist::masks::detail {
+
+class RowBits {
+public:
+    // The voxels of `v` that `select` picks.
+    RowBits(const Volume& v, LabelSelect select, int threads);
+
+    [[nodiscard]] uint64_t selectedCount() const { return m_count; }
+
+    // Appends the boundary voxels of row (y, z) under connectivity 6, 18 or
+    // 26 (boundary.hpp's definition) to `out` as linear indices, ascending.
+    void appendBoundaryOfRow(int64_t y, int64_t z, int connectivity, std::vector<uint64_t>& out) const;
+
+private:
+    [[nodiscard]] const uint64_t* row(int64_t y, int64_t z) const {
+        return m_words.data() + size_t((z * m_dims[1] + y) * m_rowWords);
+    }
+
+    Dims m_dims{0, 0, 0};
+    int64_t m_rowWords = 0;
+    core::UninitVector<uint64_t> m_words;
+    uint64_t m_count = 0;
+};
+
+}  // namespace rthdist::masks::detail
