@@ -20,6 +20,7 @@ CandidateSearch::CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, R
     if (const char* env = std::getenv("RTHDIST_SEARCH_RADII"))
         radiiPerSubmission =
             uint32_t(std::clamp<unsigned long>(std::strtoul(env, nullptr, 10), 1, RTHDIST_SEARCH_LOG_MAX));
+    if (const char* env = std::getenv("RTHDIST_SEARCH_TAIL")) squaredTailGrowth = std::strcmp(env, "0") != 0;
 }
 
 void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options,
@@ -47,19 +48,25 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
     // recorded after the search ended costs a BLAS refit, ~a submission's
     // overhead on an H100: docs/bench/prepared).
     uint32_t chunk = 2;
+    // The radius's growth per step: options.radiusGrowth, squared for a tail
+    // of far queries (tailStep below).
+    const double growth = double(options.radiusGrowth);
+    double step = growth;
+    const uint32_t searched = numActive;
     while (numActive > 0) {
         if (!pairs) {
             pairs = &m_ws.grow(m_ws.scratch.search.pairs, pairCapacity * 8, "pairs");
             pairCapacity = std::min<uint64_t>(pairs->size() / 8, m_ws.maxPairCapacity);
         }
         const int level = IndexBuild::searchLevelFor(T, radius);
-        const std::vector<double> radii = radiiAtLevel(T, radius, double(options.radiusGrowth), chunk);
+        const std::vector<double> radii = radiiAtLevel(T, radius, step, chunk);
         const RadiiOutcome out =
             runRadii(d, level, level == builtLevel, radii, *pairs, pairCapacity, numActive);
         chunk = 2 * uint64_t(out.stillOpen) > numActive
                     ? std::min<uint32_t>(2 * chunk, RTHDIST_SEARCH_LOG_MAX)
                     : 2;
         builtLevel = level;
+        step = squaredTailGrowth ? tailStep(growth, searched, numActive, out.stillOpen) : growth;
         d.out.counters.iterations += out.run;
         if (d.out.counters.iterations > kMaxIterations)
             throw std::runtime_error("candidate search did not converge");
@@ -72,7 +79,7 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
                                             double(std::max<uint64_t>(1, d.out.counters.survivingQueries)))));
         radius = radii[out.run - 1];
         if (!out.overflowed) {
-            radius *= double(options.radiusGrowth);
+            radius *= step;
         } else if (pairCapacity < m_ws.maxPairCapacity) {
             // Some queries lost pairs: redo them at the same radius with room.
             pairCapacity =
@@ -80,6 +87,12 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
             pairs = nullptr;
         }
     }
+}
+
+double CandidateSearch::tailStep(double growth, uint32_t searched, uint32_t before, uint32_t after) {
+    const bool fewLeft = uint64_t(after) * 8 <= searched;
+    const bool mostGoOn = 2 * uint64_t(after) > before;
+    return fewLeft && mostGoOn ? growth * growth : growth;
 }
 
 std::vector<double> CandidateSearch::radiiAtLevel(const PointIndex& T, double radius, double growth,

@@ -38,6 +38,18 @@ public:
     void runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options, double progressFrom,
                    double progressTo);
 
+    // The growth of the next radii after a submission that left `after` of
+    // its `before` queries going on (`searched`: the direction's queries
+    // that entered the search): `growth`, or growth^2 for a tail of far
+    // queries (at most an eighth of `searched` left, and most of those of
+    // the submission going on). Such a tail is a noisy mask's isolated
+    // voxels, up to 300 mm from the other mask against a first radius of
+    // 12 mm: each radius costs a BLAS refit and a trace pass whatever the
+    // number of queries (~0.5 ms on an H100), so they reach their distance
+    // in about half the radii. The radii never decide a result (every
+    // query's nearest cell is refined exactly, whatever the radius).
+    [[nodiscard]] static double tailStep(double growth, uint32_t searched, uint32_t before, uint32_t after);
+
     // The radii that follow `radius` (growth each time) at its search level,
     // at most `most` (and radiiPerSubmission) of them.
     [[nodiscard]] std::vector<double> radiiAtLevel(const PointIndex& T, double radius, double growth,
@@ -57,6 +69,9 @@ public:
     // RTHDIST_SEARCH_RADII environment variable sets it for tests and
     // benchmarks).
     uint32_t radiiPerSubmission = RTHDIST_SEARCH_LOG_MAX;
+    // tailStep's squared growth (RTHDIST_SEARCH_TAIL=0 turns it off, for
+    // tests and benchmarks).
+    bool squaredTailGrowth = true;
 
     // Records the search of one radius: the level's boxes grown by the
     // radius, the BLAS refitted (same level) or rebuilt, one ray per active

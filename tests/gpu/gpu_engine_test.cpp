@@ -170,6 +170,42 @@ TEST(GpuEngine, RadiiInOneSubmissionEqualOnePerSubmission) {
     EXPECT_GE(mostIterations, 2u);  // radii shared a submission
 }
 
+// A dense cloud with a few isolated points far from the other set (a noisy
+// mask's outliers): their search is the tail whose radius grows by the
+// square of the growth (CandidateSearch::tailStep). Per-point distances and
+// witnesses equal those with the plain growth (RTHDIST_SEARCH_TAIL=0) and
+// the brute force; the tail takes fewer radius iterations.
+TEST(GpuEngine, FarTailGrowsFasterAndStaysExact) {
+    const char* before = std::getenv("RTHDIST_SEARCH_TAIL");
+    const std::string saved = before ? before : "";
+    std::string whyNot;
+    setenv("RTHDIST_SEARCH_TAIL", "0", 1);
+    std::optional<Engine> plain = makeEngine(gpuOptions(), whyNot);
+    unsetenv("RTHDIST_SEARCH_TAIL");
+    std::optional<Engine> tail = makeEngine(gpuOptions(), whyNot);
+    if (before) setenv("RTHDIST_SEARCH_TAIL", saved.c_str(), 1);
+    if (!plain || !tail) GTEST_SKIP() << "no device for this backend: " << whyNot;
+    std::vector<glm::vec3> a = uniformCloud(6000, 41, glm::vec3(0.0f));
+    const std::vector<glm::vec3> far = uniformCloud(60, 42, glm::vec3(-40.0f), 80.0f);
+    a.insert(a.end(), far.begin(), far.end());
+    const std::vector<glm::vec3> b = uniformCloud(5000, 43, glm::vec3(0.3f, 0.0f, 0.0f));
+    CallOptions call;
+    call.perPointDistances = true;
+    auto p = plain->compute(a, b, call);
+    auto t = tail->compute(a, b, call);
+    ASSERT_TRUE(p.ok()) << p.error().message;
+    ASSERT_TRUE(t.ok()) << t.error().message;
+    const std::vector<double> want = oracle::bruteForceNearest(a, b);
+    EXPECT_EQ(t->aNearest.distance, want);
+    EXPECT_EQ(t->aNearest.distance, p->aNearest.distance);
+    EXPECT_EQ(t->aNearest.nearest, p->aNearest.nearest);
+    EXPECT_EQ(t->bNearest.distance, p->bNearest.distance);
+    EXPECT_EQ(t->hausdorff, p->hausdorff);
+    EXPECT_EQ(t->aToB.queryIndex, p->aToB.queryIndex);
+    EXPECT_LT(t->aToB.counters.iterations, p->aToB.counters.iterations);
+    EXPECT_EQ(t->validationMessages, 0u);
+}
+
 TEST(GpuEngine, CountersDescribeTheWork) {
     RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
     auto a = uniformCloud(8000, 21, glm::vec3(0.0f));
