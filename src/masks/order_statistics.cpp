@@ -35,6 +35,15 @@ std::pair<double, double> rangeOf(std::span<const double> values, int threads) {
     return {*std::min_element(lows.begin(), lows.end()), *std::max_element(highs.begin(), highs.end())};
 }
 
+// The k-th and (k+1)-th smallest of non-empty `values` (the k-th twice when
+// k is the last) by nth_element: the values are reordered.
+std::pair<double, double> nthAndNext(std::span<double> values, size_t k) {
+    const auto at = values.begin() + std::ptrdiff_t(k);
+    std::nth_element(values.begin(), at, values.end());
+    // After selecting k, the (k + 1)-th smallest is the least of what follows it.
+    return {*at, k + 1 < values.size() ? *std::min_element(at + 1, values.end()) : *at};
+}
+
 // The k-th and (k+1)-th smallest of `values` (at least kParallelFrom of
 // them; the k-th twice when k is the last) on `threads` threads: the range
 // [min, max] cut into kBuckets equal buckets (the bucket of a value never
@@ -45,6 +54,10 @@ std::pair<double, double> bucketSelect(std::span<const double> values, size_t k,
     const auto [lo, hi] = rangeOf(values, threads);
     if (!(hi > lo)) return {lo, lo};  // all equal
     const double scale = double(kBuckets) / (hi - lo);
+    if (!std::isfinite(scale)) {  // a range of subnormal width
+        std::vector<double> copy(values.begin(), values.end());
+        return nthAndNext(copy, k);
+    }
     const auto bucketOf = [lo, scale](double v) { return std::min(kBuckets - 1, size_t((v - lo) * scale)); };
     std::vector<uint32_t> histograms(chunks * kBuckets, 0);
     core::parallelChunks(n, kChunk, threads, [&](size_t b, size_t e, int) {
@@ -71,10 +84,8 @@ std::pair<double, double> bucketSelect(std::span<const double> values, size_t k,
     });
     std::vector<double> gathered;
     for (const auto& in : inside) gathered.insert(gathered.end(), in.begin(), in.end());
-    const auto at = gathered.begin() + std::ptrdiff_t(k - below);
-    std::nth_element(gathered.begin(), at, gathered.end());
-    const double kth = *at;
-    return {kth, next == k ? kth : *std::min_element(at + 1, gathered.end())};
+    // The values of ranks below .. upTo - 1: k and (unless k is the last) k + 1.
+    return nthAndNext(gathered, k - below);
 }
 
 // The k-th and (k+1)-th smallest of non-empty `values` (the k-th twice when
@@ -83,10 +94,7 @@ std::pair<double, double> kthAndNext(std::span<double> values, size_t k, int thr
     const size_t n = values.size();
     if (n >= kParallelFrom && core::resolveThreads(threads, n / kChunk) > 1)
         return bucketSelect(values, k, threads);
-    const auto at = values.begin() + std::ptrdiff_t(k);
-    std::nth_element(values.begin(), at, values.end());
-    // After selecting k, the (k + 1)-th smallest is the least of what follows it.
-    return {*at, k + 1 < n ? *std::min_element(at + 1, values.end()) : *at};
+    return nthAndNext(values, k);
 }
 
 }  // namespace

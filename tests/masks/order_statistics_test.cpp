@@ -65,13 +65,14 @@ TEST(OrderStatistics, ParallelSelectionEqualsTheSortedRule) {
     std::mt19937 rng(11);
     const std::vector<double> ps{0.0, 0.001, 5.0, 50.0, 90.0, 95.0, 99.0, 99.99, 100.0};
     for (size_t n : {size_t(1) << 15, size_t(100003), size_t(400000)}) {
-        for (int shape = 0; shape < 3; ++shape) {
+        for (int shape = 0; shape < 4; ++shape) {
             std::vector<double> values(n);
             for (double& v : values) {
                 const uint32_t r = rng();
                 v = shape == 0   ? std::sqrt(double(r % 40))
                     : shape == 1 ? double(r) / 4096.0
-                                 : (r % 1000 == 0 ? 100.0 + double(r % 997) : std::sqrt(double(r % 9)));
+                    : shape == 2 ? (r % 1000 == 0 ? 100.0 + double(r % 997) : std::sqrt(double(r % 9)))
+                                 : (r % 7 == 0 ? 4.9e-324 * double(r % 5) : 0.0);  // a subnormal range
             }
             std::vector<double> sorted = values;
             std::sort(sorted.begin(), sorted.end());
