@@ -55,8 +55,9 @@
 // arithmetic, sqrt(((di sx)^2 + (dj sy)^2) + (dk sz)^2), and sums areas in
 // NumPy's order (area_weighted.hpp), so its area-weighted percentiles pick
 // the index DeepMind's own run picks, rounding included.
-// Threading: extraction uses options.threads (0 = all); the Engine passed in is
-// not thread-safe (one per thread). Functions are otherwise reentrant.
+// Threading: extraction, the recomputed distances and the percentiles use
+// options.threads (0 = all); the Engine passed in is not thread-safe (one per
+// thread). Functions are otherwise reentrant.
 // Limits: volumes up to 2^31 - 1 selected points per mask (engine limit);
 // labels are int32 values (wider or non-integral values -> kBadInput).
 #pragma once
@@ -173,7 +174,7 @@ struct MaskOptions {
     int connectivity = 0;
     std::vector<double> percentiles{95.0};  // each in [0, 100]
     double tolerance = 1.0;                 // surface Dice tolerance, in mm (>= 0)
-    int threads = 0;                        // boundary extraction; 0 = all hardware threads
+    int threads = 0;                        // extraction, distances, percentiles; 0 = all hardware threads
     // Extract boundaries on the host even when the MaskEngine has a device
     // pass (makeMaskEngine's devicePass; tests compare the two: the voxels
     // are the same).
