@@ -8,55 +8,15 @@
 #include "core/parallel.hpp"
 #include "masks/selected.hpp"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 namespace rthdist::masks::detail {
 namespace {
 
 constexpr size_t kRowsPerChunk = 256;
 
-// Bits of `n` <= 64 labels from `p` (bit i: label i selected).
-template <class T>
-uint64_t packScalar(const Selected<T>& sel, int64_t at, int64_t n) {
-    uint64_t word = 0;
-    for (int64_t i = 0; i < n; ++i) word |= uint64_t(sel(at + i)) << i;
-    return word;
-}
-
-// 64 8-bit labels at once: four 16-byte compares.
-uint64_t pack64(const Selected<uint8_t>& sel, int64_t at) {
-#if defined(__SSE2__)
-    const __m128i key = _mm_set1_epi8(static_cast<char>(sel.any ? 0 : sel.value));
-    uint64_t word = 0;
-    for (int k = 0; k < 4; ++k) {
-        const __m128i labels = _mm_loadu_si128(reinterpret_cast<const __m128i*>(sel.data + at + 16 * k));
-        uint32_t equal = uint32_t(_mm_movemask_epi8(_mm_cmpeq_epi8(labels, key)));
-        if (sel.any) equal = ~equal & 0xffffu;
-        word |= uint64_t(equal) << (16 * k);
-    }
-    return word;
-#else
-    return packScalar(sel, at, 64);
-#endif
-}
-
-template <class T>
-uint64_t pack64(const Selected<T>& sel, int64_t at) {
-    return packScalar(sel, at, 64);
-}
-
 // One row of labels starting at voxel `at` into `words` (nx voxels).
 template <class T>
 void packRow(const Selected<T>& sel, int64_t at, int64_t nx, uint64_t* words) {
-    if (sel.none) {
-        std::fill(words, words + (nx + 63) / 64, uint64_t(0));
-        return;
-    }
-    int64_t x = 0;
-    for (; x + 64 <= nx; x += 64) *words++ = pack64(sel, at + x);
-    if (x < nx) *words = packScalar(sel, at + x, nx - x);
+    for (int64_t x = 0; x < nx; x += 64) *words++ = sel.word(at + x, std::min<int64_t>(64, nx - x));
 }
 
 // Word w of "selected with both x neighbours selected" for a packed row of W words.

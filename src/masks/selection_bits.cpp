@@ -23,12 +23,8 @@ SelectionBits::SelectionBits(const Volume& v, LabelSelect select, int threads)
     withLabels(v, [&](const auto* labels) {
         const Selected sel(labels, select);
         core::parallelChunks(m_words.size(), kWordsPerChunk, threads, [&](size_t wb, size_t we, int) {
-            for (size_t w = wb; w < we; ++w) {
-                uint64_t word = 0;
-                const uint64_t end = std::min<uint64_t>(n, (w + 1) * 64);
-                for (uint64_t i = w * 64; i < end; ++i) word |= uint64_t(sel(int64_t(i))) << (i & 63);
-                m_words[w] = word;
-            }
+            for (size_t w = wb; w < we; ++w)
+                m_words[w] = sel.word(int64_t(w * 64), int64_t(std::min<uint64_t>(64, n - w * 64)));
         });
     });
 }
