@@ -26,6 +26,22 @@ std::vector<glm::vec3> uniformCloud(size_t n, uint64_t seed, glm::vec3 offset, f
     return p;
 }
 
+// Two engines of gpuOptions(): the first made with environment variable
+// `name` set to `value`, the second without it; the variable is restored.
+// Either is empty (whyNot says why) when no device runs the backend.
+std::pair<std::optional<Engine>, std::optional<Engine>> enginesWithAndWithout(const char* name,
+                                                                              const char* value,
+                                                                              std::string& whyNot) {
+    const char* before = std::getenv(name);
+    const std::string saved = before ? before : "";
+    setenv(name, value, 1);
+    std::optional<Engine> with = makeEngine(gpuOptions(), whyNot);
+    unsetenv(name);
+    std::optional<Engine> without = makeEngine(gpuOptions(), whyNot);
+    if (before) setenv(name, saved.c_str(), 1);
+    return {std::move(with), std::move(without)};
+}
+
 void expectExact(Engine& engine, const std::string& name, uint64_t seed, std::vector<glm::vec3> a,
                  std::vector<glm::vec3> b) {
     OracleCase c{name, seed, std::move(a), std::move(b)};
@@ -127,14 +143,8 @@ TEST(GpuEngine, ReusedEngineStaysExactAcrossSizes) {
 // and per-point distances (not the same counters: how many queries die early
 // depends on when the running maximum rises, in either mode).
 TEST(GpuEngine, RadiiInOneSubmissionEqualOnePerSubmission) {
-    const char* before = std::getenv("RTHDIST_SEARCH_RADII");
-    const std::string saved = before ? before : "";
     std::string whyNot;
-    setenv("RTHDIST_SEARCH_RADII", "1", 1);
-    std::optional<Engine> single = makeEngine(gpuOptions(), whyNot);
-    unsetenv("RTHDIST_SEARCH_RADII");
-    std::optional<Engine> fused = makeEngine(gpuOptions(), whyNot);
-    if (before) setenv("RTHDIST_SEARCH_RADII", saved.c_str(), 1);
+    auto [single, fused] = enginesWithAndWithout("RTHDIST_SEARCH_RADII", "1", whyNot);
     if (!single || !fused) GTEST_SKIP() << "no device for this backend: " << whyNot;
     uint32_t mostIterations = 0;
     for (uint64_t seed = 31; seed < 38; ++seed) {
@@ -176,14 +186,8 @@ TEST(GpuEngine, RadiiInOneSubmissionEqualOnePerSubmission) {
 // witnesses equal those with the plain growth (RTHDIST_SEARCH_TAIL=0) and
 // the brute force; the tail takes fewer radius iterations.
 TEST(GpuEngine, FarTailGrowsFasterAndStaysExact) {
-    const char* before = std::getenv("RTHDIST_SEARCH_TAIL");
-    const std::string saved = before ? before : "";
     std::string whyNot;
-    setenv("RTHDIST_SEARCH_TAIL", "0", 1);
-    std::optional<Engine> plain = makeEngine(gpuOptions(), whyNot);
-    unsetenv("RTHDIST_SEARCH_TAIL");
-    std::optional<Engine> tail = makeEngine(gpuOptions(), whyNot);
-    if (before) setenv("RTHDIST_SEARCH_TAIL", saved.c_str(), 1);
+    auto [plain, tail] = enginesWithAndWithout("RTHDIST_SEARCH_TAIL", "0", whyNot);
     if (!plain || !tail) GTEST_SKIP() << "no device for this backend: " << whyNot;
     std::vector<glm::vec3> a = uniformCloud(6000, 41, glm::vec3(0.0f));
     const std::vector<glm::vec3> far = uniformCloud(60, 42, glm::vec3(-40.0f), 80.0f);
