@@ -271,6 +271,14 @@ public:
                                                                     std::span<const PairRef> pairs,
                                                                     const CallOptions& call = {});
 
+    // Hands back a result that is no longer needed: its per-point arrays
+    // (aNearest, bNearest) become the next per-point call's on a GPU
+    // backend, filled in place (no allocation, no zero-fill: ~1 ms per 5 x
+    // 10^5 queries on a 16-core host). Optional; arrays of any size may be
+    // given (the next call resizes them); the CPU backend drops them. Like
+    // compute, one caller at a time.
+    void recycle(HausdorffResult&& spent);
+
     [[nodiscard]] const std::string& deviceName() const;
     [[nodiscard]] Backend backend() const;
     // The pipeline cache file (empty: none, e.g. the CPU backend) and

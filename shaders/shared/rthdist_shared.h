@@ -300,6 +300,8 @@ struct CheckPush {
     uint afterCull;       // check_queries recorded behind the cull: nothing to do when queries
                           // survived (RTHDIST_CTR_ACTIVE > 0): they are checked after the search
     uint pad0;
+    uint64_t nearestOut;  // check_queries, per-point calls: uint[n], each query's nearest target
+                          // at the query's original index (0: not written)
 };
 
 // refine.comp: exact scan of the candidate pairs' cells.
@@ -456,6 +458,7 @@ static_assert(sizeof(ProbeLevelsPush) == 64 &&
 static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDIST_CTR_SEARCH_LOG &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
+static_assert(sizeof(CheckPush) == 96 && offsetof(CheckPush, nearestOut) == 88);
 static_assert(sizeof(IngestDevicePush) == 64 && offsetof(IngestDevicePush, n) == 48);
 static_assert(sizeof(BatchDirection) == RTHDIST_BATCH_DIRECTION_BYTES);
 static_assert(sizeof(IngestSummary64) == 56 && offsetof(IngestSummary64, firstBad) == 48);

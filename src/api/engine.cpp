@@ -434,6 +434,11 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOpti
     return computeViews(*m_impl, a, b, *checked, call, t0);
 }
 
+void Engine::recycle(HausdorffResult&& spent) {
+    if (m_impl->device->gpu)
+        m_impl->device->gpu->recyclePerPoint(std::move(spent.aNearest), std::move(spent.bNearest));
+}
+
 Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& options) {
     if (auto err = validateBits(options.bits)) return *err;
     if (auto err = validatePreparedSize(points)) return *err;

@@ -67,7 +67,8 @@ struct GpuHausdorff::State {
           smallPairs(ws) {}
 
     Workspace ws;
-    PerPoint spare;  // recyclePerPoint: the next per-point result's h(A,B) arrays
+    PerPoint spare;   // recyclePerPoint: the next per-point result's h(A,B) arrays
+    PerPoint spareB;  // and its h(B,A) arrays
     IndexBuild index;
     QueryCheck check;
     NeighbourhoodPass cull;
@@ -262,8 +263,11 @@ struct GpuHausdorff::State {
     // [from, 1] of the call.
     void runPair(DeviceSet& a, DeviceSet& b, const CallOptions& options, HausdorffResult& res, double from) {
         const bool pp = options.perPointDistances;
-        if (pp) res.aNearest = std::move(spare);  // filled whole: read-back writes every entry
-        spare = PerPoint{};
+        if (pp) {  // filled whole: the read-back writes every entry
+            res.aNearest = std::move(spare);
+            if (!options.directedOnly) res.bNearest = std::move(spareB);
+        }
+        spare = spareB = PerPoint{};
         const double mid = options.directedOnly ? 1.0 : from + 0.5 * (1.0 - from);
         DirectionRun ab{a.ix, b.ix, a.pts, b.pts, ws.blocks[0], pp ? &res.aNearest : nullptr};
         DirectionRun ba{b.ix, a.ix, b.pts, a.pts, ws.blocks[1], pp ? &res.bNearest : nullptr};
@@ -370,7 +374,10 @@ void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
     m_state->ws.maxPairCapacity = std::max<uint64_t>(1, pairs);
 }
 
-void GpuHausdorff::recyclePerPoint(PerPoint&& spare) { m_state->spare = std::move(spare); }
+void GpuHausdorff::recyclePerPoint(PerPoint&& a, PerPoint&& b) {
+    m_state->spare = std::move(a);
+    m_state->spareB = std::move(b);
+}
 
 void GpuHausdorff::releaseScratch() {
     Workspace& ws = m_state->ws;
@@ -378,7 +385,7 @@ void GpuHausdorff::releaseScratch() {
     ws.tlasBound = false;
     ws.scratch = Scratch{};
     ws.oneShot = {};
-    m_state->spare = PerPoint{};
+    m_state->spare = m_state->spareB = PerPoint{};
 }
 
 Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, const std::string& cacheDir,

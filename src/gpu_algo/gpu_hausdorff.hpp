@@ -131,8 +131,9 @@ public:
     // Takes back the per-point arrays of an earlier result (out-of-core tile
     // calls, one after another): the next per-point call fills them in place
     // of fresh ones, whose zero-fill on one thread and first-touch page
-    // faults cost about as much as the read-back itself (10^8 queries).
-    void recyclePerPoint(PerPoint&& spare);
+    // faults cost about as much as the read-back itself (10^8 queries);
+    // `b` serves the next h(B,A) (Engine::recycle).
+    void recyclePerPoint(PerPoint&& a, PerPoint&& b = PerPoint{});
 
     struct State;
 

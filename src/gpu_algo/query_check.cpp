@@ -28,8 +28,17 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, boo
                      d.perPoint ? 1u : 0u,
                      m_ws.hostSmall.address() + witnessAt,
                      afterCull ? 1u : 0u,
-                     0u};
+                     0u,
+                     d.nearest != nullptr ? d.nearest->address() : 0};
     m_ws.dispatch(cmd, Kernel::kCheckQueries, cp, d.Q.n);
+    if (d.nearest != nullptr) {
+        // Per-point: the whole direction's nearest targets come back with
+        // the check (a check behind the cull that found survivors copies
+        // what the check after the search overwrites).
+        m_ws.barrier(cmd);
+        const VkBufferCopy all{0, 0, VkDeviceSize(d.Q.n) * 4};
+        vkCmdCopyBuffer(cmd, d.nearest->handle(), d.nearestHost->handle(), 1, &all);
+    }
     std::vector<VkBufferCopy> sortedCopies, stateCopies;
     for (size_t k = 0; k < d.checkSlots.size(); ++k) {
         const VkDeviceSize at = readback + VkDeviceSize(k) * 32;
@@ -98,41 +107,28 @@ Directed QueryCheck::finishDirection(DirectionRun& d, const SampledQuery& witnes
     out.queryPoint = d.qPts.original(qi);
     out.targetPoint = d.tPts.original(ti);
     out.distance = glm::length(out.queryPoint - out.targetPoint);
-    if (d.perPoint) readPerPoint(d.Q, *d.state, d.qPts.all(), d.tPts.all(), *d.perPoint);
+    if (d.perPoint) readPerPoint(d, *d.perPoint);
     return out;
 }
 
-void QueryCheck::readPerPoint(const PointIndex& Q, const Buffer& state, std::span<const glm::vec3> qPts,
-                              std::span<const glm::vec3> tPts, PerPoint& out) {
-    const VkDeviceSize stateBytes = VkDeviceSize(Q.n) * sizeof(sh::QueryState);
-    const VkDeviceSize pointBytes = VkDeviceSize(Q.n) * 16;
-    Buffer& host =
-        m_ws.grow(m_ws.scratch.search.readback, stateBytes + pointBytes, "readback", MemoryKind::kReadback);
-    VkCommandBuffer cmd = m_ws.ctx.begin();
-    VkBufferCopy c1{0, 0, stateBytes};
-    vkCmdCopyBuffer(cmd, state.handle(), host.handle(), 1, &c1);
-    VkBufferCopy c2{0, stateBytes, pointBytes};
-    vkCmdCopyBuffer(cmd, Q.sorted->handle(), host.handle(), 1, &c2);
-    m_ws.ctx.submitAndWait(cmd);
-    const auto* states = static_cast<const sh::QueryState*>(host.mapped());
-    const auto* sorted = reinterpret_cast<const float*>(static_cast<const char*>(host.mapped()) + stateBytes);
-    // Every entry is written below (the sorted queries are a permutation),
-    // so arrays recycled from an earlier call are not cleared first.
-    out.distance.resize(Q.n);
-    out.nearest.resize(Q.n);
-    // Cached host memory (MemoryKind::kReadback) read on every host thread:
-    // 32 bytes per query (per-point calls of out-of-core tiles read back
-    // 10^8 queries). Chunks of 2^13 queries: a mask's 10^5 boundary voxels
-    // take every thread (2^16 gave them two: 1 ms of a 5 ms call on an H100).
+void QueryCheck::readPerPoint(const DirectionRun& d, PerPoint& out) {
+    const std::span<const glm::vec3> qPts = d.qPts.all(), tPts = d.tPts.all();
+    const auto* nearest = static_cast<const uint32_t*>(d.nearestHost->mapped());
+    // Arrays recycled from an earlier call (Engine::recycle) are not
+    // cleared first: every entry is written below.
+    out.distance.resize(d.Q.n);
+    out.nearest.resize(d.Q.n);
+    // Cached host memory (MemoryKind::kReadback) read on every host thread,
+    // in the queries' own order. Chunks of 2^13 queries: a mask's 10^5
+    // boundary voxels take every thread.
     constexpr size_t kPerPointChunk = size_t(1) << 13;
     std::atomic<uint64_t> firstBad{UINT64_MAX};
-    core::parallelChunks(Q.n, kPerPointChunk, m_ws.threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) {
-            const uint32_t qi = std::bit_cast<uint32_t>(sorted[4 * i + 3]);
-            const uint32_t ti = uint32_t(states[i].best & 0xffffffffu);
-            if (qi >= qPts.size() || ti >= tPts.size() || states[i].status != RTHDIST_EXACT) {
+    core::parallelChunks(d.Q.n, kPerPointChunk, m_ws.threads, [&](size_t begin, size_t end, int) {
+        for (size_t qi = begin; qi < end; ++qi) {
+            const uint32_t ti = nearest[qi];
+            if (ti >= tPts.size()) {
                 uint64_t seen = firstBad.load();
-                while (i < seen && !firstBad.compare_exchange_weak(seen, i)) {
+                while (qi < seen && !firstBad.compare_exchange_weak(seen, qi)) {
                 }
                 return;
             }
@@ -142,7 +138,7 @@ void QueryCheck::readPerPoint(const PointIndex& Q, const Buffer& state, std::spa
     });
     if (firstBad.load() != UINT64_MAX)
         throw std::runtime_error("per-point read-back: query " + std::to_string(firstBad.load()) +
-                                 " has no exact NN");
+                                 " has no nearest point of " + d.T.name);
 }
 
 }  // namespace rthdist::gpu_algo

@@ -22,7 +22,8 @@ public:
     // block's read-back area. Recorded right after the cull, it is the
     // direction's check when no query survives the cull (no extra
     // submission); otherwise (afterCull: the shader then returns at once) it
-    // is recorded again after the search.
+    // is recorded again after the search. Per-point calls: the check also
+    // writes each query's nearest target and copies them all to the host.
     void cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, bool afterCull);
 
     // The self-check's verdict once its submission completed: every query
@@ -35,9 +36,10 @@ public:
     // distances).
     Directed finishDirection(DirectionRun& d, const SampledQuery& witness);
 
-    // Every query is EXACT after a per-point run: its state holds its NN.
-    void readPerPoint(const PointIndex& Q, const Buffer& state, std::span<const glm::vec3> qPts,
-                      std::span<const glm::vec3> tPts, PerPoint& out);
+    // Every query is EXACT after a per-point run (the check counted any
+    // other): the nearest targets its self-check copied to the host, with
+    // their distances in double.
+    void readPerPoint(const DirectionRun& d, PerPoint& out);
 
 private:
     // The sampled records' query and target points, for the host to compare

@@ -42,10 +42,14 @@ struct LevelScratch {
     ScanScratch scan;
 };
 
-// One direction's query states and active lists (ping-pong).
+// One direction's query states and active lists (ping-pong); per-point
+// calls: each query's nearest target, written by the self-check, and its
+// host copy.
 struct DirectionBuffers {
     Buffer state;
     std::array<Buffer, 2> active;
+    Buffer nearest;
+    Buffer nearestHost;
 };
 
 // The candidate search, refinement and per-point read-back.
@@ -53,7 +57,6 @@ struct SearchScratch {
     Buffer pairs;       // (query, cell) pairs the rays append
     Buffer aabbs;       // the search cells' grown boxes (BLAS input)
     Buffer refineArgs;  // the refinement's indirect dispatch
-    Buffer readback;    // host: per-point states and points
     Buffer fetched;     // host: the self-check's points of device input (SetPoints::cmdCopy)
 };
 

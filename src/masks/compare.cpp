@@ -57,6 +57,7 @@ Result<std::array<Direction, 2>> bothDirections(Engine& engine, const Volume& a,
     if (!ab) return ab.error();
     Result<Direction> bA = detail::directionOf(b, metric, bb, r->bNearest, ba, 0, threads);
     if (!bA) return bA.error();
+    engine.recycle(std::move(*r));  // its arrays serve the next comparison
     timed.distanceMs += msSince(t0);
     return std::array<Direction, 2>{std::move(*ab), std::move(*bA)};
 }

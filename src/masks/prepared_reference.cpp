@@ -129,6 +129,7 @@ Result<std::array<Direction, 2>> boundaryDirections(Engine& engine, const State&
     if (!ab) return ab.error();
     Result<Direction> bA = detail::directionOf(b, metric, eb.boundary, h->bNearest, ba, 0, threads);
     if (!bA) return bA.error();
+    engine.recycle(std::move(*h));  // its arrays serve the next comparison
     r.distanceMs += msSince(t0);
     return std::array<Direction, 2>{std::move(*ab), std::move(*bA)};
 }

@@ -11,6 +11,8 @@
 #include <string>
 #include <utility>
 
+#include <glm/geometric.hpp>
+
 #include "common/brute_force.hpp"
 #include "common/oracle_cases.hpp"
 #include "gpu_test_support.hpp"
@@ -208,6 +210,56 @@ TEST(GpuEngine, FarTailGrowsFasterAndStaysExact) {
     EXPECT_EQ(t->aToB.queryIndex, p->aToB.queryIndex);
     EXPECT_LT(t->aToB.counters.iterations, p->aToB.counters.iterations);
     EXPECT_EQ(t->validationMessages, 0u);
+}
+
+// Per-point arrays handed back (Engine::recycle), of other sizes and
+// holding stale values, are filled whole by the next call: the same
+// distances and nearest points as fresh arrays and the brute force, for a
+// pair the neighbourhood pass settles whole (its check behind the cull
+// copies the nearest points) and for pairs that search.
+TEST(GpuEngine, RecycledPerPointArraysAreFilledWhole) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    CallOptions call;
+    call.perPointDistances = true;
+    const std::vector<glm::vec3> same = uniformCloud(2500, 51, glm::vec3(0.0f));
+    const std::vector<std::pair<std::vector<glm::vec3>, std::vector<glm::vec3>>> pairs = {
+        {same, same},
+        {uniformCloud(3000, 52, glm::vec3(0.0f)), uniformCloud(4000, 53, glm::vec3(0.6f, 0.0f, 0.0f))},
+        {uniformCloud(5000, 54, glm::vec3(0.0f)), uniformCloud(2000, 55, glm::vec3(0.0f, 2.0f, 0.0f))},
+    };
+    uint32_t searched = 0, settledByCull = 0;
+    for (size_t k = 0; k < pairs.size(); ++k) {
+        SCOPED_TRACE(k);
+        const auto& [a, b] = pairs[k];
+        auto fresh = engine->compute(a, b, call);
+        ASSERT_TRUE(fresh.ok()) << fresh.error().message;
+        // Stale arrays: a's larger and out of range, b's smaller.
+        HausdorffResult spent;
+        spent.aNearest.distance.assign(a.size() + 77, -1.0);
+        spent.aNearest.nearest.assign(a.size() + 77, UINT32_MAX);
+        spent.bNearest.distance.assign(b.size() / 3, -1.0);
+        spent.bNearest.nearest.assign(b.size() / 3, UINT32_MAX);
+        engine->recycle(std::move(spent));
+        auto again = engine->compute(a, b, call);
+        ASSERT_TRUE(again.ok()) << again.error().message;
+        EXPECT_EQ(again->aNearest.distance, oracle::bruteForceNearest(a, b));
+        EXPECT_EQ(again->bNearest.distance, oracle::bruteForceNearest(b, a));
+        EXPECT_EQ(again->aNearest.distance, fresh->aNearest.distance);
+        EXPECT_EQ(again->aNearest.nearest, fresh->aNearest.nearest);
+        EXPECT_EQ(again->bNearest.distance, fresh->bNearest.distance);
+        EXPECT_EQ(again->bNearest.nearest, fresh->bNearest.nearest);
+        for (size_t i = 0; i < a.size(); ++i)
+            ASSERT_EQ(again->aNearest.distance[i],
+                      glm::length(glm::dvec3(a[i]) - glm::dvec3(b[again->aNearest.nearest[i]])))
+                << i;
+        // The result's arrays go back again: the next pair reuses them.
+        for (const Directed* d : {&again->aToB, &again->bToA})
+            (d->counters.survivingQueries > 0 ? searched : settledByCull) += 1;
+        engine->recycle(std::move(*again));
+        EXPECT_EQ(fresh->validationMessages, 0u);
+    }
+    EXPECT_GE(searched, 1u);
+    EXPECT_GE(settledByCull, 1u);
 }
 
 TEST(GpuEngine, CountersDescribeTheWork) {
