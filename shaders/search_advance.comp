@@ -5,7 +5,9 @@
 // then sets up the next: it searches the queries going on (resolve.comp's
 // list), or none once the pair buffer overflowed (the host then resumes from
 // the logged radius with more room, as after a single radius), and writes
-// the dispatch sizes of its search and resolve.
+// the dispatch sizes of its search and resolve. The queries going on after
+// the last radius that searched any are the count the host goes on with;
+// the self-check recorded behind the radii runs when it is 0.
 #include "common.glsl"
 layout(local_size_x = 1) in;
 layout(push_constant) uniform Push { SearchAdvancePush pc; };
@@ -19,6 +21,7 @@ void main() {
     UintRef(entry).v = searched;
     UintRef(entry + 4ul).v = next;
     U64Ref(entry + 8ul).v = pairs;
+    if (searched > 0u) UintRef(c + RTHDIST_CTR_SEARCH_OPEN).v = next;
     uint searchedNext = pairs > uint64_t(pc.pairCapacity) ? 0u : next;
     UintRef(c + RTHDIST_CTR_SEARCH_ACTIVE).v = searchedNext;
     // The next radius's dispatch sizes: groups of the search (ray queries)

@@ -41,6 +41,8 @@ struct vec3f {
 #define RTHDIST_CTR_MIN_EDGE 48     // float bits: leaf_slots, the narrowest sub-cell edge of a split
 #define RTHDIST_CTR_LARGE_CELLS 52  // uint: cell_build, 1 when a cell needs the parallel box
 #define RTHDIST_CTR_SEARCH_ACTIVE 56  // uint: queries the radius in flight searches (search_advance.comp)
+#define RTHDIST_CTR_SEARCH_OPEN 60    // uint: queries going on after the last radius that searched
+                                      // (search_advance.comp; the host's "still open")
 #define RTHDIST_CTR_READBACK 64     // host read-back area after the counters
 #define RTHDIST_CTR_INGEST 1152     // IngestSummary: ingest.comp, one set's bounds and first bad point
 #define RTHDIST_CTR_INGEST64 1184   // IngestSummary64: ingest_f64.comp, one device view's box in double
@@ -286,6 +288,14 @@ struct SearchPush {
                        // maxRayDispatchInvocationCount); 0 for the ray-query dispatch
 };
 
+// What a check_queries dispatch was recorded behind. Behind the cull, or
+// behind a submission of candidate-search radii, it has nothing to do while
+// queries are still open (RTHDIST_CTR_ACTIVE after the cull,
+// RTHDIST_CTR_SEARCH_OPEN after radii): a later submission checks them.
+#define RTHDIST_CHECK_FINAL 0u
+#define RTHDIST_CHECK_BEHIND_CULL 1u
+#define RTHDIST_CHECK_BEHIND_SEARCH 2u
+
 // check_index.comp / check_queries.comp: the self-check (every record visited
 // once, violations counted at RTHDIST_CTR_CHECK_BAD).
 struct CheckPush {
@@ -297,8 +307,7 @@ struct CheckPush {
     uint n;
     uint perPoint;        // check_queries: 1 = every query must be EXACT
     uint64_t witnessOut;  // check_queries: the witness query's sorted record and state (32 bytes)
-    uint afterCull;       // check_queries recorded behind the cull: nothing to do when queries
-                          // survived (RTHDIST_CTR_ACTIVE > 0): they are checked after the search
+    uint behind;          // check_queries: RTHDIST_CHECK_* below, what it was recorded behind
     uint pad0;
     uint64_t nearestOut;  // check_queries, per-point calls: uint[n], each query's nearest target
                           // at the query's original index (0: not written)
@@ -439,6 +448,7 @@ struct CounterFields {
     uint minEdge;  // float bits
     uint largeCells;
     uint searchActive;
+    uint searchOpen;
 };
 static_assert(offsetof(CounterFields, active) == RTHDIST_CTR_ACTIVE);
 static_assert(offsetof(CounterFields, maxCount) == RTHDIST_CTR_MAX_COUNT);
@@ -451,6 +461,7 @@ static_assert(offsetof(CounterFields, checkBad) == RTHDIST_CTR_CHECK_BAD);
 static_assert(offsetof(CounterFields, minEdge) == RTHDIST_CTR_MIN_EDGE);
 static_assert(offsetof(CounterFields, largeCells) == RTHDIST_CTR_LARGE_CELLS);
 static_assert(offsetof(CounterFields, searchActive) == RTHDIST_CTR_SEARCH_ACTIVE);
+static_assert(offsetof(CounterFields, searchOpen) == RTHDIST_CTR_SEARCH_OPEN);
 static_assert(sizeof(ProbeLevelsPush) == 64 &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_PROBE &&
               RTHDIST_CTR_PROBE + (RTHDIST_PROBE_LEVELS + 1) * 4 <= RTHDIST_CTR_SEARCH_ARGS &&

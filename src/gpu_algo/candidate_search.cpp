@@ -15,8 +15,9 @@ namespace rthdist::gpu_algo {
 // Two timestamps per radius of a submission, and the submission's own two.
 static_assert(2 * RTHDIST_SEARCH_LOG_MAX + 2 < gpu::Context::kTimestampSlots);
 
-CandidateSearch::CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, Refinement& refinement)
-    : m_ws(workspace), m_index(indexBuild), m_refine(refinement) {
+CandidateSearch::CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, Refinement& refinement,
+                                 QueryCheck& check)
+    : m_ws(workspace), m_index(indexBuild), m_refine(refinement), m_check(check) {
     if (const char* env = std::getenv("RTHDIST_SEARCH_RADII"))
         radiiPerSubmission =
             uint32_t(std::clamp<unsigned long>(std::strtoul(env, nullptr, 10), 1, RTHDIST_SEARCH_LOG_MAX));
@@ -137,6 +138,10 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
         if (i + 1 < radii.size()) m_ws.ctx.cmdMark(cmd);
         d.cur = 1 - d.cur;
     }
+    // The self-check, done by the device only if these radii settled the
+    // last query (one submission fewer than a check of its own).
+    m_ws.barrier(cmd);
+    m_check.cmdCheckQueries(cmd, d, RTHDIST_CHECK_BEHIND_SEARCH);
     m_ws.ctx.submitAndWait(cmd);
     double searchGpu = 0.0;
     for (const auto& [from, to] : marks) searchGpu += m_ws.ctx.gpuMsBetween(from, to);

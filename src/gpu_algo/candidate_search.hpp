@@ -13,6 +13,7 @@
 
 #include "gpu_algo/direction.hpp"
 #include "gpu_algo/index_build.hpp"
+#include "gpu_algo/query_check.hpp"
 #include "gpu_algo/refinement.hpp"
 #include "gpu_algo/workspace.hpp"
 #include "rthdist/rthdist.hpp"
@@ -32,9 +33,11 @@ struct RadiiOutcome {
 
 class CandidateSearch {
 public:
-    CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, Refinement& refinement);
+    CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, Refinement& refinement, QueryCheck& check);
 
-    // Candidate search with a growing radius until no query is active.
+    // Candidate search with a growing radius until no query is active; the
+    // submission that settles the last query also ran the direction's
+    // self-check (QueryCheck::finishCheck reads it).
     void runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options, double progressFrom,
                    double progressTo);
 
@@ -61,7 +64,8 @@ public:
     // then search_advance.comp, which logs the radius and hands the queries
     // going on to the next (none after a pair-buffer overflow). numActive:
     // the queries of the first radius (the later ones search at most as
-    // many). The host reads the log once, at the end.
+    // many). The host reads the log once, at the end. The direction's
+    // self-check follows the radii (it returns at once while queries go on).
     RadiiOutcome runRadii(DirectionRun& d, int level, bool sameLevel, std::span<const double> radii,
                           Buffer& pairs, uint64_t pairCapacity, uint32_t numActive);
 
@@ -87,6 +91,7 @@ private:
     Workspace& m_ws;
     IndexBuild& m_index;
     Refinement& m_refine;
+    QueryCheck& m_check;
 };
 
 }  // namespace rthdist::gpu_algo

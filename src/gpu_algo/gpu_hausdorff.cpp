@@ -62,7 +62,7 @@ struct GpuHausdorff::State {
           check(ws),
           cull(ws, check),
           refine(ws),
-          search(ws, index, refine),
+          search(ws, index, refine, check),
           deviceIngest(ws, index),
           smallPairs(ws) {}
 
@@ -77,15 +77,12 @@ struct GpuHausdorff::State {
     DeviceIngest deviceIngest;
     SmallPairScan smallPairs;
 
-    // The search of a direction that has survivors, then its self-check
-    // (one more submission); returns the checked witness.
+    // The search of a direction that has survivors, whose last submission
+    // ran its self-check; returns the checked witness.
     SampledQuery searchAndCheck(DirectionRun& d, uint32_t survivors, const CallOptions& options,
                                 double progressFrom, double progressTo) {
         search.runSearch(d, survivors, options, progressFrom, progressTo);
         const auto t0 = Clock::now();
-        VkCommandBuffer cmd = ws.ctx.begin();
-        check.cmdCheckQueries(cmd, d, false);
-        ws.ctx.submitAndWait(cmd);
         SampledQuery witness = check.finishCheck(d);
         ws.timings->check += msSince(t0);
         return witness;

@@ -57,6 +57,7 @@ void NeighbourhoodPass::cmdCull(VkCommandBuffer cmd, DirectionRun& d) {
     sh::CounterFields& c = d.blk.fields();
     c.active = c.maxCount = c.nextActive = c.cells = 0;
     c.maxPacked = c.pairs = 0;
+    c.searchOpen = 0;
     sh::CullPush cull{d.Q.sorted->address(),
                       d.T.sorted->address(),
                       d.T.dense->address(),
@@ -83,7 +84,7 @@ std::array<uint32_t, 2> NeighbourhoodPass::runCulls(std::span<DirectionRun* cons
     for (DirectionRun* d : dirs) cmdCull(cmd, *d);
     m_ws.barrier(cmd);
     const uint32_t culled = m_ws.ctx.cmdMark(cmd);
-    for (DirectionRun* d : dirs) m_check.cmdCheckQueries(cmd, *d, true);
+    for (DirectionRun* d : dirs) m_check.cmdCheckQueries(cmd, *d, RTHDIST_CHECK_BEHIND_CULL);
     m_ws.ctx.submitAndWait(cmd);
     m_ws.timings->gpuCull += m_ws.ctx.gpuMsBetween(0, culled);
     std::array<uint32_t, 2> survivors{};

@@ -14,7 +14,7 @@
 
 namespace rthdist::gpu_algo {
 
-void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, bool afterCull) {
+void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, uint32_t behind) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "query check");
     d.blk.fields().checkBad = 0;
     const VkDeviceSize readback = d.blk.offset + RTHDIST_CTR_READBACK;
@@ -27,14 +27,14 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, boo
                      d.Q.n,
                      d.perPoint ? 1u : 0u,
                      m_ws.hostSmall.address() + witnessAt,
-                     afterCull ? 1u : 0u,
+                     behind,
                      0u,
                      d.nearest != nullptr ? d.nearest->address() : 0};
     m_ws.dispatch(cmd, Kernel::kCheckQueries, cp, d.Q.n);
     if (d.nearest != nullptr) {
         // Per-point: the whole direction's nearest targets come back with
-        // the check (a check behind the cull that found survivors copies
-        // what the check after the search overwrites).
+        // the check (a check that found queries still open copies what a
+        // later one overwrites).
         m_ws.barrier(cmd);
         const VkBufferCopy all{0, 0, VkDeviceSize(d.Q.n) * 4};
         vkCmdCopyBuffer(cmd, d.nearest->handle(), d.nearestHost->handle(), 1, &all);

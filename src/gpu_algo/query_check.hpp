@@ -19,12 +19,13 @@ public:
     // Records the self-check of a direction (check_queries.comp: every query
     // settled below the final maximum, the witness's records copied by the
     // shader) and the copies of the sampled queries' records into the
-    // block's read-back area. Recorded right after the cull, it is the
-    // direction's check when no query survives the cull (no extra
-    // submission); otherwise (afterCull: the shader then returns at once) it
-    // is recorded again after the search. Per-point calls: the check also
-    // writes each query's nearest target and copies them all to the host.
-    void cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, bool afterCull);
+    // block's read-back area. It is recorded behind the cull and behind each
+    // submission of search radii (`behind`: RTHDIST_CHECK_BEHIND_*), so the
+    // submission that settles the last query also checks them (no
+    // submission of its own); while queries are open the shader returns at
+    // once. Per-point calls: the check also writes each query's nearest
+    // target and copies them all to the host.
+    void cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, uint32_t behind);
 
     // The self-check's verdict once its submission completed: every query
     // settled, the sampled records and the witness's agree with the host's
