@@ -16,9 +16,7 @@ layout(push_constant) uniform Push { CheckPush pc; };
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i >= pc.n) return;
-    if (pc.behind == RTHDIST_CHECK_BEHIND_CULL && UintRef(pc.counters + RTHDIST_CTR_ACTIVE).v != 0u) return;
-    if (pc.behind == RTHDIST_CHECK_BEHIND_SEARCH && UintRef(pc.counters + RTHDIST_CTR_SEARCH_OPEN).v != 0u) return;
+    if (i >= pc.n || (pc.afterCull != 0u && UintRef(pc.counters + RTHDIST_CTR_ACTIVE).v != 0u)) return;
     QueryState st = stateAt(pc.state, i).v;
     uint64_t packed = U64Ref(pc.counters + RTHDIST_CTR_MAX_PACKED).v;
     if (i == 0u) {

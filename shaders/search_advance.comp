@@ -7,7 +7,8 @@
 // the logged radius with more room, as after a single radius), and writes
 // the dispatch sizes of its search and resolve. The queries going on after
 // the last radius that searched any are the count the host goes on with;
-// the self-check recorded behind the radii runs when it is 0.
+// the self-check recorded behind the radii (an indirect dispatch) gets its
+// groups only when that count is 0, else none.
 #include "common.glsl"
 layout(local_size_x = 1) in;
 layout(push_constant) uniform Push { SearchAdvancePush pc; };
@@ -21,7 +22,11 @@ void main() {
     UintRef(entry).v = searched;
     UintRef(entry + 4ul).v = next;
     U64Ref(entry + 8ul).v = pairs;
-    if (searched > 0u) UintRef(c + RTHDIST_CTR_SEARCH_OPEN).v = next;
+    uint open = searched > 0u ? next : UintRef(c + RTHDIST_CTR_SEARCH_OPEN).v;
+    UintRef(c + RTHDIST_CTR_SEARCH_OPEN).v = open;
+    UintRef(c + RTHDIST_CTR_CHECK_ARGS).v = open == 0u ? pc.checkGroups : 0u;
+    UintRef(c + RTHDIST_CTR_CHECK_ARGS + 4ul).v = 1u;
+    UintRef(c + RTHDIST_CTR_CHECK_ARGS + 8ul).v = 1u;
     uint searchedNext = pairs > uint64_t(pc.pairCapacity) ? 0u : next;
     UintRef(c + RTHDIST_CTR_SEARCH_ACTIVE).v = searchedNext;
     // The next radius's dispatch sizes: groups of the search (ray queries)

@@ -111,10 +111,10 @@ struct Timings {
     double cull = 0.0;    // neighbourhood pass: exact NN in the 3x3x3 cell block
     double search = 0.0;  // stage 2: BLAS builds + ray traversal (candidate pairs)
     double refine = 0.0;  // stage 3: exact scan of candidate cells, classification
-    double check = 0.0;   // GPU backends: the host's side of the per-query self-check (its
-                          // device work is recorded behind the cull or the search's last
-                          // radii) and the per-point read-back; the index self-check runs
-                          // inside `index`. 0 on the CPU backend
+    double check = 0.0;   // GPU backends: the per-query self-check (recorded behind the cull,
+                          // or behind the search's last radii unless per-point, else a
+                          // submission per direction) and the per-point read-back; the index
+                          // self-check runs inside `index`. 0 on the CPU backend
     double total = 0.0;   // the whole compute() call, device setup excluded
     // Device time per stage from Vulkan timestamp queries (GPU backends only;
     // 0 on the CPU backend). The wall-clock fields above include submission,

@@ -48,6 +48,7 @@ struct vec3f {
 #define RTHDIST_CTR_INGEST64 1184   // IngestSummary64: ingest_f64.comp, one device view's box in double
 #define RTHDIST_CTR_SEARCH_LOG 1280  // SearchLogEntry[RTHDIST_SEARCH_LOG_MAX]: the radii of one submission
 #define RTHDIST_CTR_SEARCH_ARGS 1600  // uint[3] groups of the search and resolve, uint[3] rays (search_advance.comp)
+#define RTHDIST_CTR_CHECK_ARGS 1624  // uint[3] groups of the self-check behind search radii (search_advance.comp)
 #define RTHDIST_CTR_PROBE 1536  // uint[RTHDIST_PROBE_LEVELS + 1]: probe_levels.comp, distinct cells per level
 #define RTHDIST_CTR_BYTES 2048
 // Radii of the candidate search recorded in one submission, at most.
@@ -288,14 +289,6 @@ struct SearchPush {
                        // maxRayDispatchInvocationCount); 0 for the ray-query dispatch
 };
 
-// What a check_queries dispatch was recorded behind. Behind the cull, or
-// behind a submission of candidate-search radii, it has nothing to do while
-// queries are still open (RTHDIST_CTR_ACTIVE after the cull,
-// RTHDIST_CTR_SEARCH_OPEN after radii): a later submission checks them.
-#define RTHDIST_CHECK_FINAL 0u
-#define RTHDIST_CHECK_BEHIND_CULL 1u
-#define RTHDIST_CHECK_BEHIND_SEARCH 2u
-
 // check_index.comp / check_queries.comp: the self-check (every record visited
 // once, violations counted at RTHDIST_CTR_CHECK_BAD).
 struct CheckPush {
@@ -307,7 +300,8 @@ struct CheckPush {
     uint n;
     uint perPoint;        // check_queries: 1 = every query must be EXACT
     uint64_t witnessOut;  // check_queries: the witness query's sorted record and state (32 bytes)
-    uint behind;          // check_queries: RTHDIST_CHECK_* below, what it was recorded behind
+    uint afterCull;       // check_queries recorded behind the cull: nothing to do when queries
+                          // survived (RTHDIST_CTR_ACTIVE > 0): they are checked after the search
     uint pad0;
     uint64_t nearestOut;  // check_queries, per-point calls: uint[n], each query's nearest target
                           // at the query's original index (0: not written)
@@ -431,6 +425,8 @@ struct SearchAdvancePush {
     uint64_t counters;  // the counter block
     uint iteration;     // the log entry of the radius just run
     uint pairCapacity;
+    uint checkGroups;   // groups of the self-check behind the radii (0: none recorded)
+    uint pad0;
 };
 
 #ifdef __cplusplus
@@ -465,7 +461,8 @@ static_assert(offsetof(CounterFields, searchOpen) == RTHDIST_CTR_SEARCH_OPEN);
 static_assert(sizeof(ProbeLevelsPush) == 64 &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_PROBE &&
               RTHDIST_CTR_PROBE + (RTHDIST_PROBE_LEVELS + 1) * 4 <= RTHDIST_CTR_SEARCH_ARGS &&
-              RTHDIST_CTR_SEARCH_ARGS + 24 <= RTHDIST_CTR_BYTES);
+              RTHDIST_CTR_SEARCH_ARGS + 24 <= RTHDIST_CTR_CHECK_ARGS &&
+              RTHDIST_CTR_CHECK_ARGS + 12 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDIST_CTR_SEARCH_LOG &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);

@@ -120,6 +120,8 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
     const uint32_t firstSize[6] = {gpu::groupsFor(numActive, RTHDIST_WG), 1, 1, numActive, 1, 1};
     std::memcpy(d.blk.host + RTHDIST_CTR_SEARCH_ARGS, firstSize, sizeof(firstSize));
     const int firstActive = d.cur;
+    const bool folded = m_check.foldsIntoSearch(d);
+    const uint32_t checkGroups = folded ? gpu::groupsFor(d.Q.n, RTHDIST_WG) : 0u;
     std::vector<std::pair<uint32_t, uint32_t>> marks;  // before and after each radius's search
     VkCommandBuffer cmd = m_ws.ctx.begin();
     for (size_t i = 0; i < radii.size(); ++i) {
@@ -133,15 +135,18 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
         m_ws.barrier(cmd);
         m_refine.cmdRefine(cmd, d, lv, level > 0, float(radii[i]), pairs, pairCapacity, numActive);
         m_ws.barrier(cmd);
-        const sh::SearchAdvancePush ap{d.blk.device, uint32_t(i), uint32_t(pairCapacity)};
+        const sh::SearchAdvancePush ap{d.blk.device, uint32_t(i), uint32_t(pairCapacity), checkGroups, 0u};
         m_ws.pipelines.cmdDispatch(cmd, Kernel::kSearchAdvance, &ap, sizeof(ap), 1);
         if (i + 1 < radii.size()) m_ws.ctx.cmdMark(cmd);
         d.cur = 1 - d.cur;
     }
-    // The self-check, done by the device only if these radii settled the
-    // last query (one submission fewer than a check of its own).
-    m_ws.barrier(cmd);
-    m_check.cmdCheckQueries(cmd, d, RTHDIST_CHECK_BEHIND_SEARCH);
+    // The self-check, given groups by search_advance.comp only if these
+    // radii settled the last query (one submission fewer than a check of
+    // its own).
+    if (folded) {
+        m_ws.barrier(cmd);
+        m_check.cmdCheckQueries(cmd, d, CheckAt::kBehindSearch);
+    }
     m_ws.ctx.submitAndWait(cmd);
     double searchGpu = 0.0;
     for (const auto& [from, to] : marks) searchGpu += m_ws.ctx.gpuMsBetween(from, to);

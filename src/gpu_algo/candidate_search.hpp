@@ -35,9 +35,9 @@ class CandidateSearch {
 public:
     CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, Refinement& refinement, QueryCheck& check);
 
-    // Candidate search with a growing radius until no query is active; the
-    // submission that settles the last query also ran the direction's
-    // self-check (QueryCheck::finishCheck reads it).
+    // Candidate search with a growing radius until no query is active; where
+    // the check folds into the search (QueryCheck::foldsIntoSearch), the
+    // submission that settles the last query also ran it.
     void runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options, double progressFrom,
                    double progressTo);
 
@@ -65,7 +65,8 @@ public:
     // going on to the next (none after a pair-buffer overflow). numActive:
     // the queries of the first radius (the later ones search at most as
     // many). The host reads the log once, at the end. The direction's
-    // self-check follows the radii (it returns at once while queries go on).
+    // self-check follows the radii where it folds into the search (groups
+    // only once no query goes on).
     RadiiOutcome runRadii(DirectionRun& d, int level, bool sameLevel, std::span<const double> radii,
                           Buffer& pairs, uint64_t pairCapacity, uint32_t numActive);
 

@@ -77,12 +77,18 @@ struct GpuHausdorff::State {
     DeviceIngest deviceIngest;
     SmallPairScan smallPairs;
 
-    // The search of a direction that has survivors, whose last submission
-    // ran its self-check; returns the checked witness.
+    // The search of a direction that has survivors, then its self-check
+    // (in the search's last submission where it folds into it, else one
+    // more); returns the checked witness.
     SampledQuery searchAndCheck(DirectionRun& d, uint32_t survivors, const CallOptions& options,
                                 double progressFrom, double progressTo) {
         search.runSearch(d, survivors, options, progressFrom, progressTo);
         const auto t0 = Clock::now();
+        if (!check.foldsIntoSearch(d)) {
+            VkCommandBuffer cmd = ws.ctx.begin();
+            check.cmdCheckQueries(cmd, d, CheckAt::kFinal);
+            ws.ctx.submitAndWait(cmd);
+        }
         SampledQuery witness = check.finishCheck(d);
         ws.timings->check += msSince(t0);
         return witness;

@@ -84,7 +84,7 @@ std::array<uint32_t, 2> NeighbourhoodPass::runCulls(std::span<DirectionRun* cons
     for (DirectionRun* d : dirs) cmdCull(cmd, *d);
     m_ws.barrier(cmd);
     const uint32_t culled = m_ws.ctx.cmdMark(cmd);
-    for (DirectionRun* d : dirs) m_check.cmdCheckQueries(cmd, *d, RTHDIST_CHECK_BEHIND_CULL);
+    for (DirectionRun* d : dirs) m_check.cmdCheckQueries(cmd, *d, CheckAt::kBehindCull);
     m_ws.ctx.submitAndWait(cmd);
     m_ws.timings->gpuCull += m_ws.ctx.gpuMsBetween(0, culled);
     std::array<uint32_t, 2> survivors{};

@@ -14,7 +14,11 @@
 
 namespace rthdist::gpu_algo {
 
-void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, uint32_t behind) {
+bool QueryCheck::foldsIntoSearch(const DirectionRun& d) const {
+    return d.perPoint == nullptr && gpu::groupsFor(d.Q.n, RTHDIST_WG) <= m_ws.ctx.limits().maxGroupsX;
+}
+
+void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, CheckAt at) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "query check");
     d.blk.fields().checkBad = 0;
     const VkDeviceSize readback = d.blk.offset + RTHDIST_CTR_READBACK;
@@ -27,14 +31,18 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, uin
                      d.Q.n,
                      d.perPoint ? 1u : 0u,
                      m_ws.hostSmall.address() + witnessAt,
-                     behind,
+                     at == CheckAt::kBehindCull ? 1u : 0u,
                      0u,
                      d.nearest != nullptr ? d.nearest->address() : 0};
-    m_ws.dispatch(cmd, Kernel::kCheckQueries, cp, d.Q.n);
+    if (at == CheckAt::kBehindSearch)  // groups written by search_advance.comp: none while queries go on
+        m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kCheckQueries, &cp, sizeof(cp),
+                                           m_ws.hostSmall.handle(), d.blk.offset + RTHDIST_CTR_CHECK_ARGS);
+    else
+        m_ws.dispatch(cmd, Kernel::kCheckQueries, cp, d.Q.n);
     if (d.nearest != nullptr) {
         // Per-point: the whole direction's nearest targets come back with
-        // the check (a check that found queries still open copies what a
-        // later one overwrites).
+        // the check (a check behind the cull that found survivors copies
+        // what the check after the search overwrites).
         m_ws.barrier(cmd);
         const VkBufferCopy all{0, 0, VkDeviceSize(d.Q.n) * 4};
         vkCmdCopyBuffer(cmd, d.nearest->handle(), d.nearestHost->handle(), 1, &all);

@@ -12,6 +12,12 @@
 
 namespace rthdist::gpu_algo {
 
+// Where a direction's self-check is recorded: behind the cull (it returns
+// at once when queries survived it), behind each submission of search radii
+// (dispatched indirectly: groups only once no query goes on), or in a
+// submission of its own after the search.
+enum class CheckAt { kBehindCull, kBehindSearch, kFinal };
+
 class QueryCheck {
 public:
     explicit QueryCheck(Workspace& workspace) : m_ws(workspace) {}
@@ -19,13 +25,17 @@ public:
     // Records the self-check of a direction (check_queries.comp: every query
     // settled below the final maximum, the witness's records copied by the
     // shader) and the copies of the sampled queries' records into the
-    // block's read-back area. It is recorded behind the cull and behind each
-    // submission of search radii (`behind`: RTHDIST_CHECK_BEHIND_*), so the
-    // submission that settles the last query also checks them (no
-    // submission of its own); while queries are open the shader returns at
-    // once. Per-point calls: the check also writes each query's nearest
-    // target and copies them all to the host.
-    void cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, uint32_t behind);
+    // block's read-back area, at `at`: the submission that settles a
+    // direction's last query (the cull's, or the search's when the check
+    // folds into it) also checks it. Per-point calls: the check also writes
+    // each query's nearest target and copies them all to the host.
+    void cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, CheckAt at);
+
+    // Whether d's check is recorded behind its search radii (kBehindSearch)
+    // rather than in a submission of its own: not in per-point calls, whose
+    // copy of every query's nearest point would cross the bus after each
+    // submission of radii, nor past one dispatch's groups.
+    [[nodiscard]] bool foldsIntoSearch(const DirectionRun& d) const;
 
     // The self-check's verdict once its submission completed: every query
     // settled, the sampled records and the witness's agree with the host's
