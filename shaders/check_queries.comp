@@ -6,8 +6,9 @@
 // squared distance is at most the final maximum. With per-point distances
 // every query must be EXACT. A query never visited, or one whose distance was
 // lost, breaks this. Thread 0 also copies the witness's records (the query
-// slot in the low half of the maximum) for the host, so the check needs no
-// round trip to learn that slot first. In a per-point call every thread writes
+// slot in the low half of the maximum) and the first threads those of the
+// sampled slots, for the host, so the check needs no round trip to learn
+// that slot first and no copy commands. In a per-point call every thread writes
 // its query's nearest target at the query's original index (nearestOut),
 // which the host reads back whole: 4 bytes a query, in the input's order.
 #include "common.glsl"
@@ -19,6 +20,14 @@ void main() {
     if (i >= pc.n || (pc.afterCull != 0u && UintRef(pc.counters + RTHDIST_CTR_ACTIVE).v != 0u)) return;
     QueryState st = stateAt(pc.state, i).v;
     uint64_t packed = U64Ref(pc.counters + RTHDIST_CTR_MAX_PACKED).v;
+    if (i < pc.samples) {  // the sampled records, before the witness's
+        uint slot = pc.n <= RTHDIST_CHECK_SAMPLES
+                        ? i
+                        : uint(uint64_t(pc.n - 1u) * uint64_t(i) / uint64_t(RTHDIST_CHECK_SAMPLES - 1u));
+        uint64_t at = pc.witnessOut - uint64_t(pc.samples - i) * 32ul;
+        Vec4Ref(at).v = vec4At(pc.sorted, slot).v;
+        StateRef(at + 16ul).v = stateAt(pc.state, slot).v;
+    }
     if (i == 0u) {
         uint slot = min(uint(packed & 0xffffffffu), pc.n - 1u);
         vec4At(pc.witnessOut, 0u).v = vec4At(pc.sorted, slot).v;

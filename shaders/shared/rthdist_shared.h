@@ -289,6 +289,10 @@ struct SearchPush {
                        // maxRayDispatchInvocationCount); 0 for the ray-query dispatch
 };
 
+// Query slots the self-check samples: all of n <= RTHDIST_CHECK_SAMPLES,
+// else slot k = (n - 1) * k / (RTHDIST_CHECK_SAMPLES - 1) (sampleSlots).
+#define RTHDIST_CHECK_SAMPLES 32u
+
 // check_index.comp / check_queries.comp: the self-check (every record visited
 // once, violations counted at RTHDIST_CTR_CHECK_BAD).
 struct CheckPush {
@@ -302,7 +306,8 @@ struct CheckPush {
     uint64_t witnessOut;  // check_queries: the witness query's sorted record and state (32 bytes)
     uint afterCull;       // check_queries recorded behind the cull: nothing to do when queries
                           // survived (RTHDIST_CTR_ACTIVE > 0): they are checked after the search
-    uint pad0;
+    uint samples;         // check_queries: sampled records written before the witness's (32
+                          // bytes each, slots by the rule of RTHDIST_CHECK_SAMPLES)
     uint64_t nearestOut;  // check_queries, per-point calls: uint[n], each query's nearest target
                           // at the query's original index (0: not written)
 };

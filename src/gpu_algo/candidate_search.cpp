@@ -143,8 +143,10 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
     // The self-check, given groups by search_advance.comp only if these
     // radii settled the last query (one submission fewer than a check of
     // its own).
-    if (folded) {
-        m_ws.barrier(cmd);
+    if (folded) {  // its groups are indirect arguments search_advance.comp wrote
+        gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                         VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
         m_check.cmdCheckQueries(cmd, d, CheckAt::kBehindSearch);
     }
     m_ws.ctx.submitAndWait(cmd);

@@ -32,7 +32,7 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, Che
                      d.perPoint ? 1u : 0u,
                      m_ws.hostSmall.address() + witnessAt,
                      at == CheckAt::kBehindCull ? 1u : 0u,
-                     0u,
+                     uint32_t(d.checkSlots.size()),
                      d.nearest != nullptr ? d.nearest->address() : 0};
     if (at == CheckAt::kBehindSearch)  // groups written by search_advance.comp: none while queries go on
         m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kCheckQueries, &cp, sizeof(cp),
@@ -47,16 +47,6 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, Che
         const VkBufferCopy all{0, 0, VkDeviceSize(d.Q.n) * 4};
         vkCmdCopyBuffer(cmd, d.nearest->handle(), d.nearestHost->handle(), 1, &all);
     }
-    std::vector<VkBufferCopy> sortedCopies, stateCopies;
-    for (size_t k = 0; k < d.checkSlots.size(); ++k) {
-        const VkDeviceSize at = readback + VkDeviceSize(k) * 32;
-        sortedCopies.push_back({VkDeviceSize(d.checkSlots[k]) * 16, at, 16});
-        stateCopies.push_back({VkDeviceSize(d.checkSlots[k]) * sizeof(sh::QueryState), at + 16, 16});
-    }
-    vkCmdCopyBuffer(cmd, d.Q.sorted->handle(), m_ws.hostSmall.handle(), uint32_t(sortedCopies.size()),
-                    sortedCopies.data());
-    vkCmdCopyBuffer(cmd, d.state->handle(), m_ws.hostSmall.handle(), uint32_t(stateCopies.size()),
-                    stateCopies.data());
 }
 
 void QueryCheck::fetchSampled(const DirectionRun& d, std::span<const SampledQuery> sampled) {

@@ -37,7 +37,7 @@ inline constexpr uint64_t kMaxPairCapacity = uint64_t(1) << 26;  // 512 MiB of p
 // past the device's largest buffer).
 inline constexpr VkDeviceSize kMaxSlack = VkDeviceSize(64) << 20;
 // Query slots whose device records the self-check compares with the host.
-inline constexpr uint32_t kCheckSamples = 32;
+inline constexpr uint32_t kCheckSamples = RTHDIST_CHECK_SAMPLES;
 
 // One block of the host-visible counters (offsets RTHDIST_CTR_* of
 // rthdist_shared.h, the read-back area after them). The shaders find a
