@@ -43,13 +43,12 @@ struct LevelScratch {
 };
 
 // One direction's query states and active lists (ping-pong); per-point
-// calls: each query's nearest target, written by the self-check, and its
-// host copy.
+// calls: each query's nearest target, written into host memory by the
+// self-check.
 struct DirectionBuffers {
     Buffer state;
     std::array<Buffer, 2> active;
-    Buffer nearest;
-    Buffer nearestHost;
+    Buffer nearest;  // host: uvec2 per query slot (original index, nearest target)
 };
 
 // The candidate search, refinement and per-point read-back.
