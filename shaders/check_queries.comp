@@ -9,8 +9,8 @@
 // slot in the low half of the maximum) and the first threads those of the
 // sampled slots, for the host, so the check needs no round trip to learn
 // that slot first and no copy commands. In a per-point call every thread writes
-// its query's original index and nearest target into host memory
-// (nearestOut, 8 bytes a query, in slot order).
+// its query's nearest target at the query's original index (nearestOut),
+// which the host reads back whole: 4 bytes a query, in the input's order.
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CheckPush pc; };
@@ -33,8 +33,8 @@ void main() {
         vec4At(pc.witnessOut, 0u).v = vec4At(pc.sorted, slot).v;
         StateRef(pc.witnessOut + 16ul).v = stateAt(pc.state, slot).v;
     }
-    if (pc.nearestOut != 0ul)  // slot order: consecutive threads write consecutive bytes
-        uvec2At(pc.nearestOut, i).v = uvec2(floatBitsToUint(vec4At(pc.sorted, i).v.w), uint(st.best & 0xffffffffu));
+    if (pc.nearestOut != 0ul)
+        uintAt(pc.nearestOut, floatBitsToUint(vec4At(pc.sorted, i).v.w)).v = uint(st.best & 0xffffffffu);
     float maxD2 = packedDist2(packed);
     bool settled = st.status == RTHDIST_EXACT || (st.status == RTHDIST_DEAD && pc.perPoint == 0u);
     if (!settled || !(packedDist2(st.best) <= maxD2))

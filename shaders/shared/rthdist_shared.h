@@ -308,8 +308,8 @@ struct CheckPush {
                           // survived (RTHDIST_CTR_ACTIVE > 0): they are checked after the search
     uint samples;         // check_queries: sampled records written before the witness's (32
                           // bytes each, slots by the rule of RTHDIST_CHECK_SAMPLES)
-    uint64_t nearestOut;  // check_queries, per-point calls: uvec2[n] in host memory, slot i's
-                          // (original query index, nearest target) (0: not written)
+    uint64_t nearestOut;  // check_queries, per-point calls: uint[n], each query's nearest target
+                          // at the query's original index (0: not written)
 };
 
 // refine.comp: exact scan of the candidate pairs' cells.

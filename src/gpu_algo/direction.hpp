@@ -33,7 +33,8 @@ struct DirectionRun {
     Buffer* state = nullptr;                 // QueryState per query slot
     Buffer* active[2] = {nullptr, nullptr};  // active slots, ping-pong
     int cur = 0;                             // active[cur] holds this iteration's slots
-    Buffer* nearest = nullptr;               // per-point: (query, nearest target) per slot (host)
+    Buffer* nearest = nullptr;               // per-point: uint nearest target per query (device)
+    Buffer* nearestHost = nullptr;           // per-point: `nearest` copied by each self-check
     std::vector<uint32_t> checkSlots;        // the self-check's sampled query slots
     [[nodiscard]] std::string name() const { return Q.name + "->" + T.name; }
 };

@@ -43,9 +43,12 @@ void NeighbourhoodPass::startDirection(DirectionRun& d, size_t direction) {
     d.state = &m_ws.grow(memory.state, VkDeviceSize(d.Q.n) * sizeof(sh::QueryState), d.name() + ".state");
     d.active[0] = &m_ws.grow(memory.active[0], VkDeviceSize(d.Q.n) * 4, d.name() + ".active0");
     d.active[1] = &m_ws.grow(memory.active[1], VkDeviceSize(d.Q.n) * 4, d.name() + ".active1");
-    if (d.perPoint)
-        d.nearest =
-            &m_ws.grow(memory.nearest, VkDeviceSize(d.Q.n) * 8, d.name() + ".nearest", MemoryKind::kReadback);
+    if (d.perPoint) {
+        const VkDeviceSize bytes = VkDeviceSize(d.Q.n) * 4;
+        d.nearest = &m_ws.grow(memory.nearest, bytes, d.name() + ".nearest");
+        d.nearestHost =
+            &m_ws.grow(memory.nearestHost, bytes, d.name() + ".nearestHost", MemoryKind::kReadback);
+    }
     d.checkSlots = sampleSlots(d.Q.n, kCheckSamples);
 }
 

@@ -15,7 +15,7 @@
 namespace rthdist::gpu_algo {
 
 bool QueryCheck::foldsIntoSearch(const DirectionRun& d) const {
-    return gpu::groupsFor(d.Q.n, RTHDIST_WG) <= m_ws.ctx.limits().maxGroupsX;
+    return d.perPoint == nullptr && gpu::groupsFor(d.Q.n, RTHDIST_WG) <= m_ws.ctx.limits().maxGroupsX;
 }
 
 void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, CheckAt at) {
@@ -39,6 +39,14 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, Che
                                            m_ws.hostSmall.handle(), d.blk.offset + RTHDIST_CTR_CHECK_ARGS);
     else
         m_ws.dispatch(cmd, Kernel::kCheckQueries, cp, d.Q.n);
+    if (d.nearest != nullptr) {
+        // Per-point: the whole direction's nearest targets come back with
+        // the check (a check behind the cull that found survivors copies
+        // what the check after the search overwrites).
+        m_ws.barrier(cmd);
+        const VkBufferCopy all{0, 0, VkDeviceSize(d.Q.n) * 4};
+        vkCmdCopyBuffer(cmd, d.nearest->handle(), d.nearestHost->handle(), 1, &all);
+    }
 }
 
 void QueryCheck::fetchSampled(const DirectionRun& d, std::span<const SampledQuery> sampled) {
@@ -103,39 +111,32 @@ Directed QueryCheck::finishDirection(DirectionRun& d, const SampledQuery& witnes
 
 void QueryCheck::readPerPoint(const DirectionRun& d, PerPoint& out) {
     const std::span<const glm::vec3> qPts = d.qPts.all(), tPts = d.tPts.all();
-    const auto* pairs = static_cast<const uint32_t*>(d.nearest->mapped());  // (query, target) per slot
+    const auto* nearest = static_cast<const uint32_t*>(d.nearestHost->mapped());
     // Arrays recycled from an earlier call (Engine::recycle) are not
-    // cleared first: every entry is written below, the slots holding each
-    // query once (their indices must sum to n(n - 1)/2, as the index
-    // self-check's do).
+    // cleared first: every entry is written below.
     out.distance.resize(d.Q.n);
     out.nearest.resize(d.Q.n);
-    // Cached host memory (MemoryKind::kReadback) read on every host thread.
-    // Chunks of 2^13 queries: a mask's 10^5 boundary voxels take every thread.
+    // Cached host memory (MemoryKind::kReadback) read on every host thread,
+    // in the queries' own order. Chunks of 2^13 queries: a mask's 10^5
+    // boundary voxels take every thread.
     constexpr size_t kPerPointChunk = size_t(1) << 13;
-    std::atomic<uint64_t> firstBad{UINT64_MAX}, indexSum{0};
+    std::atomic<uint64_t> firstBad{UINT64_MAX};
     core::parallelChunks(d.Q.n, kPerPointChunk, m_ws.threads, [&](size_t begin, size_t end, int) {
-        uint64_t sum = 0;
-        for (size_t i = begin; i < end; ++i) {
-            const uint32_t qi = pairs[2 * i], ti = pairs[2 * i + 1];
-            sum += qi;
-            if (qi >= qPts.size() || ti >= tPts.size()) {
+        for (size_t qi = begin; qi < end; ++qi) {
+            const uint32_t ti = nearest[qi];
+            if (ti >= tPts.size()) {
                 uint64_t seen = firstBad.load();
-                while (i < seen && !firstBad.compare_exchange_weak(seen, i)) {
+                while (qi < seen && !firstBad.compare_exchange_weak(seen, qi)) {
                 }
                 return;
             }
             out.nearest[qi] = ti;
             out.distance[qi] = glm::length(glm::dvec3(qPts[qi]) - glm::dvec3(tPts[ti]));
         }
-        indexSum.fetch_add(sum, std::memory_order_relaxed);
     });
     if (firstBad.load() != UINT64_MAX)
-        throw SelfCheckError(d.name() + ": per-point read-back: query slot " +
-                             std::to_string(firstBad.load()) + " names no query and nearest point");
-    const uint64_t n = d.Q.n, wanted = n % 2 == 0 ? (n / 2) * (n - 1) : n * ((n - 1) / 2);
-    if (indexSum.load() != wanted)
-        throw SelfCheckError(d.name() + ": per-point read-back: the query slots do not hold each query once");
+        throw std::runtime_error("per-point read-back: query " + std::to_string(firstBad.load()) +
+                                 " has no nearest point of " + d.T.name);
 }
 
 }  // namespace rthdist::gpu_algo

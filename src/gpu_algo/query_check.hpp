@@ -28,11 +28,13 @@ public:
     // block's read-back area, at `at`: the submission that settles a
     // direction's last query (the cull's, or the search's when the check
     // folds into it) also checks it. Per-point calls: the check also writes
-    // each query's nearest target into host memory.
+    // each query's nearest target and copies them all to the host.
     void cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, CheckAt at);
 
     // Whether d's check is recorded behind its search radii (kBehindSearch)
-    // rather than in a submission of its own: not past one dispatch's groups.
+    // rather than in a submission of its own: not in per-point calls, whose
+    // copy of every query's nearest point would cross the bus after each
+    // submission of radii, nor past one dispatch's groups.
     [[nodiscard]] bool foldsIntoSearch(const DirectionRun& d) const;
 
     // The self-check's verdict once its submission completed: every query
@@ -46,7 +48,7 @@ public:
     Directed finishDirection(DirectionRun& d, const SampledQuery& witness);
 
     // Every query is EXACT after a per-point run (the check counted any
-    // other): the nearest targets its self-check wrote to the host, with
+    // other): the nearest targets its self-check copied to the host, with
     // their distances in double.
     void readPerPoint(const DirectionRun& d, PerPoint& out);
 

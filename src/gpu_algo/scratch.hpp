@@ -43,12 +43,13 @@ struct LevelScratch {
 };
 
 // One direction's query states and active lists (ping-pong); per-point
-// calls: each query's nearest target, written into host memory by the
-// self-check.
+// calls: each query's nearest target, written by the self-check, and its
+// host copy.
 struct DirectionBuffers {
     Buffer state;
     std::array<Buffer, 2> active;
-    Buffer nearest;  // host: uvec2 per query slot (original index, nearest target)
+    Buffer nearest;
+    Buffer nearestHost;
 };
 
 // The candidate search, refinement and per-point read-back.
