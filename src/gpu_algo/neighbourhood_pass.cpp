@@ -75,6 +75,10 @@ void NeighbourhoodPass::cmdCull(VkCommandBuffer cmd, DirectionRun& d) {
         d.state->address(), d.active[0]->address(), d.blk.device, d.blk.addr(RTHDIST_CTR_MAX_PACKED), d.Q.n,
         d.lowerBound2};
     m_ws.dispatch(cmd, Kernel::kCompact, comp, d.Q.n);
+    // Per-point: no query's nearest target yet. The checks write every
+    // query's; one the device never wrote reads back out of range, which
+    // readPerPoint refuses (never a stale value of an earlier call).
+    if (d.nearest != nullptr) vkCmdFillBuffer(cmd, d.nearest->handle(), 0, VkDeviceSize(d.Q.n) * 4, ~0u);
 }
 
 std::array<uint32_t, 2> NeighbourhoodPass::runCulls(std::span<DirectionRun* const> dirs) {
