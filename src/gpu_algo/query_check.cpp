@@ -15,7 +15,7 @@
 namespace rthdist::gpu_algo {
 
 bool QueryCheck::foldsIntoSearch(const DirectionRun& d) const {
-    return d.perPoint == nullptr && gpu::groupsFor(d.Q.n, RTHDIST_WG) <= m_ws.ctx.limits().maxGroupsX;
+    return d.perPoint == nullptr && m_ws.oneDispatchHolds(d.Q.n);
 }
 
 void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, CheckAt at) {

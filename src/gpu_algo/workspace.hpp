@@ -125,6 +125,12 @@ struct Workspace {
         pipelines.cmdDispatch(cmd, k, &push, sizeof(Push), gpu::groupsFor(items, groupSize));
     }
 
+    // Whether one dispatch of RTHDIST_WG-thread groups holds `items` threads
+    // (an indirect dispatch has no split into several).
+    [[nodiscard]] bool oneDispatchHolds(uint32_t items) const {
+        return gpu::groupsFor(items, RTHDIST_WG) <= ctx.limits().maxGroupsX;
+    }
+
     // One thread per query the radius in flight searches: the groups
     // search_advance.comp (or the host, for a submission's first radius)
     // wrote at `blk`'s RTHDIST_CTR_SEARCH_ARGS, where one dispatch holds
@@ -133,7 +139,7 @@ struct Workspace {
     template <class Push>
     void dispatchSearched(VkCommandBuffer cmd, Kernel k, const Push& push, uint32_t bound,
                           const CounterBlock& blk) {
-        if (gpu::groupsFor(bound, RTHDIST_WG) <= ctx.limits().maxGroupsX)
+        if (oneDispatchHolds(bound))
             pipelines.cmdDispatchIndirect(cmd, k, &push, sizeof(Push), hostSmall.handle(),
                                           blk.offset + RTHDIST_CTR_SEARCH_ARGS);
         else
