@@ -1,9 +1,10 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // Stage 3: exact minimum over the points of each candidate (query, search
-// cell) pair, breaking off once a point is strictly closer than the running
-// maximum. One thread per pair (grid-stride).
+// cell) pair (scan_cells.glsl), breaking off once a point is strictly closer
+// than the running maximum. One thread per pair (grid-stride).
 #include "common.glsl"
+#include "scan_cells.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { RefinePush pc; };
 
@@ -23,34 +24,10 @@ void refinePair(uint p) {
         f0 = uintAt(pc.fineFirst, pair.y).v;
         f1 = pair.y + 1u < pc.numSearchCells ? uintAt(pc.fineFirst, pair.y + 1u).v : pc.numFineCells;
     }
-    uint64_t fine = pc.fineCells;
-    uint64_t targets = pc.targets;
     float best = uintBitsToFloat(0x7f800000u);
     uint bestT = 0;
     bool dead = false;
-    // A point at distance 0 ends the scan: nothing can be closer (with
-    // duplicates, the reported target is one of the query's copies).
-    for (uint f = f0; f < f1 && !dead && best > 0.0; ++f) {
-        Cell c = cellAt(fine, f).v;
-        if (boxDist2(q, c.lo, c.hi) > min(bound, best)) continue;
-        // Copies of one point: the first stands for all (no per-copy work).
-        uint end = all(equal(c.lo, c.hi)) ? c.first + 1u : c.first + c.count;
-        for (uint t = c.first; t < end; ++t) {
-            vec4 tv = vec4At(targets, t).v;
-            float d2 = dist2(q, tv.xyz);
-            uint t_ = floatBitsToUint(tv.w);
-            // Ties go to the smallest target index, as in the CPU backend.
-            if (d2 < best || (d2 == best && t_ < bestT)) {
-                best = d2;
-                bestT = t_;
-                if (best < thr) {
-                    dead = true;
-                    break;
-                }
-                if (best == 0.0) break;
-            }
-        }
-    }
+    scanFineCells(q, f0, f1, bound, thr, pc.fineCells, pc.targets, best, bestT, dead);
     if (best == uintBitsToFloat(0x7f800000u)) return;
     atomicMin(stateAt(state, qi).v.best, packDistIndex(best, bestT));
 }

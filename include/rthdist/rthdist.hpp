@@ -87,6 +87,8 @@ struct Counters {
     uint32_t iterations = 0;             // candidate-search radius iterations
     uint64_t rays = 0;                   // rays cast over all iterations
     uint64_t candidatePairs = 0;         // (query, cell) pairs refined
+    uint64_t tailScanned = 0;            // GPU backends: queries of the search's far tail that
+                                         // scanned whole cells of a coarse level instead of more radii
     // Out-of-core (EngineOptions::memoryBudget): the calls this direction
     // took, queryChunks x targetTiles; 1 x 1 when it fit one call.
     uint32_t queryChunks = 1;

@@ -32,6 +32,7 @@ py::dict counters(const Counters& c) {
     d["iterations"] = c.iterations;
     d["rays"] = c.rays;
     d["candidate_pairs"] = c.candidatePairs;
+    d["tail_scanned"] = c.tailScanned;
     d["query_chunks"] = c.queryChunks;
     d["target_tiles"] = c.targetTiles;
     return d;

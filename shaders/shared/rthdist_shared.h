@@ -30,25 +30,28 @@ struct vec3f {
 // A host-visible counter block (byte offsets; one per index build or
 // direction in flight, zeroed by the host before the submissions that count
 // into it; RTHDIST_CTR_BYTES apart).
-#define RTHDIST_CTR_ACTIVE 0        // uint: compact.comp, queries entering the search
-#define RTHDIST_CTR_MAX_COUNT 4     // uint: cell_build, points of the largest cell that can split
-#define RTHDIST_CTR_NEXT_ACTIVE 8   // uint: resolve.comp, queries going on
-#define RTHDIST_CTR_CELLS 12        // uint: cell_build/coarsen, cells written
-#define RTHDIST_CTR_MAX_PACKED 16   // uint64: (bits of h^2 << 32) | query slot
-#define RTHDIST_CTR_PAIRS 24        // uint64: candidate pairs appended (64-bit: cannot wrap)
-#define RTHDIST_CTR_CHECK_SUM 32    // uint64: self-check, sum of original indices
-#define RTHDIST_CTR_CHECK_BAD 40    // uint64: self-check, records that broke an invariant
-#define RTHDIST_CTR_MIN_EDGE 48     // float bits: leaf_slots, the narrowest sub-cell edge of a split
-#define RTHDIST_CTR_LARGE_CELLS 52  // uint: cell_build, 1 when a cell needs the parallel box
+#define RTHDIST_CTR_ACTIVE 0          // uint: compact.comp, queries entering the search
+#define RTHDIST_CTR_MAX_COUNT 4       // uint: cell_build, points of the largest cell that can split
+#define RTHDIST_CTR_NEXT_ACTIVE 8     // uint: resolve.comp, queries going on
+#define RTHDIST_CTR_CELLS 12          // uint: cell_build/coarsen, cells written
+#define RTHDIST_CTR_MAX_PACKED 16     // uint64: (bits of h^2 << 32) | query slot
+#define RTHDIST_CTR_PAIRS 24          // uint64: candidate pairs appended (64-bit: cannot wrap)
+#define RTHDIST_CTR_CHECK_SUM 32      // uint64: self-check, sum of original indices
+#define RTHDIST_CTR_CHECK_BAD 40      // uint64: self-check, records that broke an invariant
+#define RTHDIST_CTR_MIN_EDGE 48       // float bits: leaf_slots, the narrowest sub-cell edge of a split
+#define RTHDIST_CTR_LARGE_CELLS 52    // uint: cell_build, 1 when a cell needs the parallel box
 #define RTHDIST_CTR_SEARCH_ACTIVE 56  // uint: queries the radius in flight searches (search_advance.comp)
-#define RTHDIST_CTR_SEARCH_OPEN 60    // uint: queries going on after the last radius that searched
-                                      // (search_advance.comp; the host's "still open")
-#define RTHDIST_CTR_READBACK 64     // host read-back area after the counters
-#define RTHDIST_CTR_INGEST 1152     // IngestSummary: ingest.comp, one set's bounds and first bad point
-#define RTHDIST_CTR_INGEST64 1184   // IngestSummary64: ingest_f64.comp, one device view's box in double
+#define RTHDIST_CTR_SEARCH_OPEN \
+    60                               // uint: queries going on after the last radius that searched
+                                     // (search_advance.comp; the host's "still open")
+#define RTHDIST_CTR_READBACK 64      // host read-back area after the counters
+#define RTHDIST_CTR_INGEST 1152      // IngestSummary: ingest.comp, one set's bounds and first bad point
+#define RTHDIST_CTR_INGEST64 1184    // IngestSummary64: ingest_f64.comp, one device view's box in double
 #define RTHDIST_CTR_SEARCH_LOG 1280  // SearchLogEntry[RTHDIST_SEARCH_LOG_MAX]: the radii of one submission
-#define RTHDIST_CTR_SEARCH_ARGS 1600  // uint[3] groups of the search and resolve, uint[3] rays (search_advance.comp)
-#define RTHDIST_CTR_CHECK_ARGS 1624  // uint[3] groups of the self-check behind search radii (search_advance.comp)
+#define RTHDIST_CTR_SEARCH_ARGS \
+    1600  // uint[3] groups of the search and resolve, uint[3] rays (search_advance.comp)
+#define RTHDIST_CTR_CHECK_ARGS \
+    1624                        // uint[3] groups of the self-check behind search radii (search_advance.comp)
 #define RTHDIST_CTR_PROBE 1536  // uint[RTHDIST_PROBE_LEVELS + 1]: probe_levels.comp, distinct cells per level
 #define RTHDIST_CTR_BYTES 2048
 // Radii of the candidate search recorded in one submission, at most.
@@ -331,6 +334,24 @@ struct RefinePush {
     uint numFineCells;
 };
 
+// tail_scan.comp: every open query of a direction scans every search cell
+// of one level (the candidate search's far tail), one thread per query.
+struct TailScanPush {
+    uint64_t queries;
+    uint64_t targets;
+    uint64_t cells;  // the level's search cells
+    uint64_t state;
+    uint64_t activeList;  // the open queries' slots
+    uint64_t maxPacked;
+    uint64_t fineCells;  // level-0 cells: a search cell is scanned through them
+    uint64_t fineFirst;  // uint per search cell: its first level-0 cell; 0 when the
+                         // search cells are the level-0 cells themselves
+    uint numActive;
+    float lowerBound2;
+    uint numSearchCells;
+    uint numFineCells;
+};
+
 // sample_gather.comp: records j * stride (j < count) of `points` (vec4) into
 // `gathered` (float[3 count]), the bit count's sample of a device-input set.
 struct SampleGatherPush {
@@ -405,15 +426,15 @@ struct ResolvePush {
 // sample, keys and counts as core::chooseBitsFromSample on the host): the
 // sample's 10-bit probe cell keys, each level's distinct cells counted by
 // inserting the key's top 3k bits into a hash table of that level.
-#define RTHDIST_PROBE_LEVELS 8       // levels 1..8 (core::kMaxBits)
-#define RTHDIST_PROBE_SLOT_BITS 17   // slots per level's table: twice the largest sample
+#define RTHDIST_PROBE_LEVELS 8      // levels 1..8 (core::kMaxBits)
+#define RTHDIST_PROBE_SLOT_BITS 17  // slots per level's table: twice the largest sample
 struct ProbeLevelsPush {
-    uint64_t points;      // vec4 records of the ingested set
-    uint64_t tables;      // uint[RTHDIST_PROBE_LEVELS << RTHDIST_PROBE_SLOT_BITS], zeroed (0: empty)
-    uint64_t counts;      // uint[RTHDIST_PROBE_LEVELS + 1] (RTHDIST_CTR_PROBE), zeroed
-    uint64_t origin[3];   // double bits: the probe's origin (the box's low corner)
-    uint64_t perLength;   // double bits: probe cells per unit length
-    uint count;           // sampled records: record j * stride for j < count
+    uint64_t points;     // vec4 records of the ingested set
+    uint64_t tables;     // uint[RTHDIST_PROBE_LEVELS << RTHDIST_PROBE_SLOT_BITS], zeroed (0: empty)
+    uint64_t counts;     // uint[RTHDIST_PROBE_LEVELS + 1] (RTHDIST_CTR_PROBE), zeroed
+    uint64_t origin[3];  // double bits: the probe's origin (the box's low corner)
+    uint64_t perLength;  // double bits: probe cells per unit length
+    uint count;          // sampled records: record j * stride for j < count
     uint stride;
 };
 
@@ -430,7 +451,7 @@ struct SearchAdvancePush {
     uint64_t counters;  // the counter block
     uint iteration;     // the log entry of the radius just run
     uint pairCapacity;
-    uint checkGroups;   // groups of the self-check behind the radii (0: none recorded)
+    uint checkGroups;  // groups of the self-check behind the radii (0: none recorded)
     uint pad0;
 };
 
@@ -471,6 +492,7 @@ static_assert(sizeof(ProbeLevelsPush) == 64 &&
 static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDIST_CTR_SEARCH_LOG &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
+static_assert(sizeof(TailScanPush) == 80);
 static_assert(sizeof(CheckPush) == 96 && offsetof(CheckPush, nearestOut) == 88);
 static_assert(sizeof(IngestDevicePush) == 64 && offsetof(IngestDevicePush, n) == 48);
 static_assert(sizeof(BatchDirection) == RTHDIST_BATCH_DIRECTION_BYTES);

@@ -57,6 +57,7 @@ void addCounters(Counters& into, const Counters& c, bool countTargets) {
     into.iterations = std::max(into.iterations, c.iterations);
     into.rays += c.rays;
     into.candidatePairs += c.candidatePairs;
+    into.tailScanned += c.tailScanned;
 }
 
 // The squared distance of a pair as the backends compare pairs: in float, on

@@ -22,11 +22,14 @@ CandidateSearch::CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, R
         radiiPerSubmission =
             uint32_t(std::clamp<unsigned long>(std::strtoul(env, nullptr, 10), 1, RTHDIST_SEARCH_LOG_MAX));
     if (const char* env = std::getenv("RTHDIST_SEARCH_TAIL")) squaredTailGrowth = std::strcmp(env, "0") != 0;
+    tailScanWork = m_ws.ctx.cpuDevice() ? kTailScanWorkCpuDevice : kTailScanWorkGpu;
+    if (const char* env = std::getenv("RTHDIST_TAIL_SCAN_WORK"))
+        tailScanWork = std::strtoull(env, nullptr, 10);
 }
 
 void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options,
                                 double progressFrom, double progressTo) {
-    const PointIndex& T = d.T;
+    PointIndex& T = d.T;
     // Small first radius, grown geometrically: measured against starting
     // at the threshold's root, which makes every ray visit far more boxes
     // (docs/bench/gpu.md, growth sweep).
@@ -54,11 +57,21 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
     const double growth = double(options.radiusGrowth);
     double step = growth;
     const uint32_t searched = numActive;
+    bool traced = false;  // a submission of radii has run
     while (numActive > 0) {
         if (!pairs) {
             pairs = &m_ws.grow(m_ws.scratch.search.pairs, pairCapacity * 8, "pairs");
             pairCapacity = std::min<uint64_t>(pairs->size() / 8, m_ws.maxPairCapacity);
         }
+        if (const int tail = traced ? tailScanLevel(T, numActive, searched) : -1; tail >= 0) {
+            const RadiiOutcome out = runRadii(d, tail, false, {}, *pairs, pairCapacity, numActive, true);
+            if (out.stillOpen != 0)
+                throw std::runtime_error("candidate search: the tail scan left queries open");
+            d.out.counters.iterations += out.run;
+            d.out.counters.tailScanned += numActive;
+            break;
+        }
+        traced = true;
         const int level = IndexBuild::searchLevelFor(T, radius);
         const std::vector<double> radii = radiiAtLevel(T, radius, step, chunk);
         const RadiiOutcome out =
@@ -90,6 +103,15 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
     }
 }
 
+int CandidateSearch::tailScanLevel(PointIndex& T, uint32_t open, uint32_t searched) {
+    if (tailScanWork == 0 || uint64_t(open) * 4 > searched || !m_ws.oneDispatchHolds(open)) return -1;
+    const int last = std::max(1, T.grid.bits - 1);
+    int level = std::max(1, int(T.levels.size()));
+    uint32_t cells = m_index.levelCells(T, level).count;  // may build it (a submission)
+    while (cells > kTailScanCells && level < last) cells = m_index.levelCells(T, ++level).count;
+    return uint64_t(open) * cells <= tailScanWork ? level : -1;
+}
+
 double CandidateSearch::tailStep(double growth, uint32_t searched, uint32_t before, uint32_t after) {
     const bool fewLeft = uint64_t(after) * 8 <= searched;
     const bool mostGoOn = 2 * uint64_t(after) > before;
@@ -110,7 +132,7 @@ std::vector<double> CandidateSearch::radiiAtLevel(const PointIndex& T, double ra
 
 RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLevel,
                                        std::span<const double> radii, Buffer& pairs, uint64_t pairCapacity,
-                                       uint32_t numActive) {
+                                       uint32_t numActive, bool wholeLevel) {
     const PointIndex::Level lv = m_index.levelCells(d.T, level);  // may build the level (a submission)
     const auto t0 = Clock::now();
     sh::CounterFields& counters = d.blk.fields();
@@ -123,21 +145,26 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
     const bool folded = m_check.foldsIntoSearch(d);
     const uint32_t checkGroups = folded ? gpu::groupsFor(d.Q.n, RTHDIST_WG) : 0u;
     std::vector<std::pair<uint32_t, uint32_t>> marks;  // before and after each radius's search
+    const size_t steps = wholeLevel ? 1 : radii.size();
     VkCommandBuffer cmd = m_ws.ctx.begin();
-    for (size_t i = 0; i < radii.size(); ++i) {
+    for (size_t i = 0; i < steps; ++i) {
         if (i > 0)  // everything of the radius before, before anything of this one
             gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                              VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                              VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
-        const uint32_t before = i == 0 ? 0 : marks.back().second + 1;
-        cmdSearch(cmd, d, lv, sameLevel || i > 0, radii[i], pairs, pairCapacity, numActive);
-        marks.emplace_back(before, m_ws.ctx.cmdMark(cmd));
-        m_ws.barrier(cmd);
-        m_refine.cmdRefine(cmd, d, lv, level > 0, float(radii[i]), pairs, pairCapacity, numActive);
+        if (wholeLevel) {  // no rays: its device time counts as refinement
+            m_refine.cmdTailScan(cmd, d, lv, level > 0, numActive);
+        } else {
+            const uint32_t before = i == 0 ? 0 : marks.back().second + 1;
+            cmdSearch(cmd, d, lv, sameLevel || i > 0, radii[i], pairs, pairCapacity, numActive);
+            marks.emplace_back(before, m_ws.ctx.cmdMark(cmd));
+            m_ws.barrier(cmd);
+            m_refine.cmdRefine(cmd, d, lv, level > 0, float(radii[i]), pairs, pairCapacity, numActive);
+        }
         m_ws.barrier(cmd);
         const sh::SearchAdvancePush ap{d.blk.device, uint32_t(i), uint32_t(pairCapacity), checkGroups, 0u};
         m_ws.pipelines.cmdDispatch(cmd, Kernel::kSearchAdvance, &ap, sizeof(ap), 1);
-        if (i + 1 < radii.size()) m_ws.ctx.cmdMark(cmd);
+        if (i + 1 < steps) m_ws.ctx.cmdMark(cmd);
         d.cur = 1 - d.cur;
     }
     // The self-check, given groups by search_advance.comp only if these
@@ -163,7 +190,7 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
     // last one resolve.comp wrote.
     RadiiOutcome out;
     const auto* log = reinterpret_cast<const sh::SearchLogEntry*>(d.blk.host + RTHDIST_CTR_SEARCH_LOG);
-    for (size_t i = 0; i < radii.size() && log[i].searched > 0; ++i) {
+    for (size_t i = 0; i < steps && log[i].searched > 0; ++i) {
         ++out.run;
         out.stillOpen = log[i].goingOn;
         out.lastPairs = log[i].pairs;
@@ -172,12 +199,15 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
         d.out.counters.candidatePairs += std::min<uint64_t>(log[i].pairs, pairCapacity);
     }
     if (out.run == 0) throw std::runtime_error("candidate search: the device searched no query");
-    if (m_ws.ctx.tracingSubmits())
-        for (size_t i = 0; i < radii.size(); ++i)
+    if (m_ws.ctx.tracingSubmits() && wholeLevel)
+        std::fprintf(stderr, "rthdist tail scan level %d (%u cells): searched %u, going on %u\n", level,
+                     lv.count, log[0].searched, log[0].goingOn);
+    else if (m_ws.ctx.tracingSubmits())
+        for (size_t i = 0; i < steps; ++i)
             std::fprintf(
                 stderr,
                 "rthdist radius %zu/%zu level %d r %.6g: searched %u, going on %u, pairs %llu (room %llu)\n",
-                i + 1, radii.size(), level, radii[i], log[i].searched, log[i].goingOn,
+                i + 1, steps, level, radii[i], log[i].searched, log[i].goingOn,
                 static_cast<unsigned long long>(log[i].pairs), static_cast<unsigned long long>(pairCapacity));
     d.cur = out.run % 2 == 0 ? firstActive : 1 - firstActive;
     return out;

@@ -5,6 +5,8 @@
 // refinement. R grows until no query is active. The radii that share a
 // search level go in one submission (the BLAS refitted between them), the
 // count of queries each searches kept on the device (search_advance.comp).
+// A far tail of few open queries skips the rays: they scan every cell of a
+// coarse level instead (tailScanLevel, Refinement::cmdTailScan).
 #pragma once
 
 #include <cstdint>
@@ -22,6 +24,14 @@ namespace rthdist::gpu_algo {
 
 // Radii before a search is declared not converging.
 inline constexpr uint32_t kMaxIterations = 4096;
+
+// The far tail's scan (CandidateSearch::tailScanLevel): at most this many
+// (open query, search cell) tests, on a GPU and on a CPU device (lavapipe),
+// and the level scanned the first with at most kTailScanCells cells (each
+// query's thread walks all of them).
+inline constexpr uint64_t kTailScanWorkGpu = uint64_t(1) << 28;
+inline constexpr uint64_t kTailScanWorkCpuDevice = uint64_t(1) << 24;
+inline constexpr uint32_t kTailScanCells = 4096;
 
 // What the radii of one submission reported.
 struct RadiiOutcome {
@@ -53,6 +63,19 @@ public:
     // query's nearest cell is refined exactly, whatever the radius).
     [[nodiscard]] static double tailStep(double growth, uint32_t searched, uint32_t before, uint32_t after);
 
+    // Whether the `open` queries left of the direction's `searched` are a
+    // far tail that scans whole cells instead of tracing more radii, and at
+    // which level (-1: trace on). A tail: at most a quarter of the searched
+    // queries left, and `open` x the level's cells at most tailScanWork
+    // (each query then costs a walk over the level's cells, against a BLAS
+    // refit and a trace pass for every radius, ~0.5 ms on an H100 whatever
+    // the number of queries, that a noisy mask's isolated voxels, up to
+    // 300 mm from the other mask, take 5 of). The level: the first from
+    // the coarsest built with at most kTailScanCells cells, building coarser
+    // ones (a submission each) up to the grid's last. The result is exact
+    // either way.
+    [[nodiscard]] int tailScanLevel(PointIndex& T, uint32_t open, uint32_t searched);
+
     // The radii that follow `radius` (growth each time) at its search level,
     // at most `most` (and radiiPerSubmission) of them.
     [[nodiscard]] std::vector<double> radiiAtLevel(const PointIndex& T, double radius, double growth,
@@ -66,9 +89,11 @@ public:
     // the queries of the first radius (the later ones search at most as
     // many). The host reads the log once, at the end. The direction's
     // self-check follows the radii where it folds into the search (groups
-    // only once no query goes on).
+    // only once no query goes on). `wholeLevel`: one step, the far tail's
+    // scan of every cell of `level` (radii unused), after which no query
+    // goes on.
     RadiiOutcome runRadii(DirectionRun& d, int level, bool sameLevel, std::span<const double> radii,
-                          Buffer& pairs, uint64_t pairCapacity, uint32_t numActive);
+                          Buffer& pairs, uint64_t pairCapacity, uint32_t numActive, bool wholeLevel = false);
 
     // Radii per submission at most (1 to RTHDIST_SEARCH_LOG_MAX; the
     // RTHDIST_SEARCH_RADII environment variable sets it for tests and
@@ -77,6 +102,10 @@ public:
     // tailStep's squared growth (RTHDIST_SEARCH_TAIL=0 turns it off, for
     // tests and benchmarks).
     bool squaredTailGrowth = true;
+    // tailScanLevel's work limit: kTailScanWorkGpu, or kTailScanWorkCpuDevice
+    // on a CPU device; the RTHDIST_TAIL_SCAN_WORK environment variable sets
+    // it for tests and benchmarks (0: never).
+    uint64_t tailScanWork = kTailScanWorkGpu;
 
     // Records the search of one radius: the level's boxes grown by the
     // radius, the BLAS refitted (same level) or rebuilt, one ray per active

@@ -42,6 +42,7 @@
 #include "search.rmiss.h"
 #include "search_advance.comp.h"
 #include "search_rq.comp.h"
+#include "tail_scan.comp.h"
 
 namespace rthdist::gpu {
 
@@ -86,6 +87,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_batch_witness_comp, "batch_witness"},
     {k_spv_search_advance_comp, "search_advance"},
     {k_spv_probe_levels_comp, "probe_levels"},
+    {k_spv_tail_scan_comp, "tail_scan"},
 }};
 
 }  // namespace

@@ -44,6 +44,7 @@ enum class Kernel : uint32_t {
     kBatchWitness,   // and their witnesses (batch_witness.comp)
     kSearchAdvance,  // between the radii of one submission (search_advance.comp)
     kProbeLevels,    // the bit count's probe (probe_levels.comp): only with shaderFloat64
+    kTailScan,       // the candidate search's far tail: whole levels scanned (tail_scan.comp)
     kCount
 };
 

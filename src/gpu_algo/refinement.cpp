@@ -1,6 +1,7 @@
 #include "gpu_algo/refinement.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace rthdist::gpu_algo {
 
@@ -31,6 +32,35 @@ void Refinement::cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointInde
                        d.blk.addr(RTHDIST_CTR_MAX_PACKED),
                        numActive,
                        r,
+                       d.lowerBound2};
+    m_ws.dispatchSearched(cmd, Kernel::kResolve, rs, numActive, d.blk);
+}
+
+void Refinement::cmdTailScan(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse,
+                             uint32_t numActive) {
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "tail scan");
+    const sh::TailScanPush tp{d.Q.sorted->address(),
+                              d.T.sorted->address(),
+                              lv.cells->address(),
+                              d.state->address(),
+                              d.active[d.cur]->address(),
+                              d.blk.addr(RTHDIST_CTR_MAX_PACKED),
+                              d.T.cells->address(),
+                              coarse ? lv.fineFirst->address() : 0,
+                              numActive,
+                              d.lowerBound2,
+                              lv.count,
+                              d.T.numCells};
+    m_ws.dispatch(cmd, Kernel::kTailScan, tp, numActive);
+    m_ws.barrier(cmd);
+    const float everything = std::numeric_limits<float>::infinity();
+    sh::ResolvePush rs{d.state->address(),
+                       d.active[d.cur]->address(),
+                       d.active[1 - d.cur]->address(),
+                       d.blk.device,
+                       d.blk.addr(RTHDIST_CTR_MAX_PACKED),
+                       numActive,
+                       everything,
                        d.lowerBound2};
     m_ws.dispatchSearched(cmd, Kernel::kResolve, rs, numActive, d.blk);
 }

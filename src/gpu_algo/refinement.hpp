@@ -2,6 +2,8 @@
 // resolve.comp): the exact scan of the (query, cell) pairs the rays
 // appended, sized by the device (indirect dispatch), with the early break;
 // then every active query resolved: exact, dead, or on to the next radius.
+// The search's far tail skips the rays: every open query scans all cells of
+// one level (tail_scan.comp) and is then settled.
 #pragma once
 
 #include "gpu_algo/direction.hpp"
@@ -19,6 +21,13 @@ public:
     // the other active buffer.
     void cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse, float r,
                    Buffer& pairs, uint64_t pairCapacity, uint32_t numActive);
+
+    // Records the far tail's scan: each of the numActive open queries scans
+    // every cell of level `lv` (coarse: through its level-0 cells), then all
+    // are resolved at radius +inf (exact or dead; none goes on). numActive
+    // must fit one dispatch (Workspace::oneDispatchHolds).
+    void cmdTailScan(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse,
+                     uint32_t numActive);
 
 private:
     Workspace& m_ws;

@@ -59,9 +59,10 @@ Extraction extractBoundary(const Volume& v, LabelSelect select, int connectivity
     Extraction e;
     e.count = bits.selectedCount();
     if (e.count == 0) return e;
-    e.boundary = perSlice(v.dims[2], threads, [&](int64_t z, std::vector<uint64_t>& out) {
-        for (int64_t y = 0; y < v.dims[1]; ++y) bits.appendBoundaryOfRow(y, z, connectivity, out);
-    });
+    e.boundary = perSlice<core::UninitVector<uint64_t>>(
+        v.dims[2], threads, [&](int64_t z, std::vector<uint64_t>& out) {
+            for (int64_t y = 0; y < v.dims[1]; ++y) bits.appendBoundaryOfRow(y, z, connectivity, out);
+        });
     return e;
 }
 

@@ -14,6 +14,8 @@
 #include <optional>
 #include <vector>
 
+#include "core/uninit_vector.hpp"
+
 #include "masks/masks.hpp"
 
 namespace rthdist::masks::detail {
@@ -21,8 +23,8 @@ namespace rthdist::masks::detail {
 using Dims = std::array<int64_t, 3>;
 
 struct Extraction {
-    uint64_t count = 0;              // selected voxels
-    std::vector<uint64_t> boundary;  // ascending linear indices of the boundary voxels
+    uint64_t count = 0;                     // selected voxels
+    core::UninitVector<uint64_t> boundary;  // ascending linear indices of the boundary voxels
 };
 
 // One pass over the volume: the selected voxels' count and boundary.

@@ -40,10 +40,9 @@ using detail::msSince;
 // uploaded and indexed once), every boundary voxel a query (a voxel on both
 // boundaries comes back at distance 0). Both sets take A's grid (B's equals
 // it: checkSameGrid); `timed` gains the extraction, distance and engine times.
-Result<std::array<Direction, 2>> bothDirections(Engine& engine, const Volume& a,
-                                                const std::vector<uint64_t>& ba, const Volume& b,
-                                                const std::vector<uint64_t>& bb, bool world, int threads,
-                                                MaskResult& timed) {
+Result<std::array<Direction, 2>> bothDirections(Engine& engine, const Volume& a, std::span<const uint64_t> ba,
+                                                const Volume& b, std::span<const uint64_t> bb, bool world,
+                                                int threads, MaskResult& timed) {
     auto t0 = Clock::now();
     const detail::VoxelMetric metric(a, world);
     const detail::SearchPoints pa = metric.searchPoints(ba, threads);

@@ -137,9 +137,9 @@ void addTimings(Timings& sum, const Timings& t) {
     sum.total += t.total;
 }
 
-Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric,
-                              const std::vector<uint64_t>& queries, const PerPoint& nearest,
-                              const std::vector<uint64_t>& targets, uint64_t zeros, int threads) {
+Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric, std::span<const uint64_t> queries,
+                              const PerPoint& nearest, std::span<const uint64_t> targets, uint64_t zeros,
+                              int threads) {
     if (queries.empty() || nearest.nearest.size() != queries.size())
         return Error{ErrorCode::kInternal, "masks: the engine returned no per-point nearest points"};
     RecomputedDirection r = recompute(metric, v.dims, queries, targets, nearest.nearest, threads);
@@ -160,9 +160,9 @@ Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric,
     return d;
 }
 
-NearestCall oneShotCall(Engine& engine, const VoxelMetric& metric, const std::vector<uint64_t>& targets,
+NearestCall oneShotCall(Engine& engine, const VoxelMetric& metric, std::span<const uint64_t> targets,
                         int threads, MaskResult& timed) {
-    return [&engine, &metric, &targets, threads, &timed](std::span<const glm::vec3> q) {
+    return [&engine, &metric, targets, threads, &timed](std::span<const glm::vec3> q) {
         const auto t0 = Clock::now();
         const SearchPoints t = metric.searchPoints(targets, threads);
         timed.extractMs += msSince(t0);
@@ -170,8 +170,8 @@ NearestCall oneShotCall(Engine& engine, const VoxelMetric& metric, const std::ve
     };
 }
 
-Result<Direction> directed(const VoxelMetric& metric, const Volume& v, const std::vector<uint64_t>& queries,
-                           uint64_t zeros, uint64_t zeroWitness, const std::vector<uint64_t>& targets,
+Result<Direction> directed(const VoxelMetric& metric, const Volume& v, std::span<const uint64_t> queries,
+                           uint64_t zeros, uint64_t zeroWitness, std::span<const uint64_t> targets,
                            const NearestCall& nearest, int threads, MaskResult& timed) {
     Result<Direction> d = Direction{};
     if (queries.empty()) {

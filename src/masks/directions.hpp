@@ -48,9 +48,8 @@ void addTimings(Timings& sum, const Timings& t);
 // plus `zeros` more of X's voxels at distance 0 that were not sent. Distances
 // in `metric`, witness points on X's grid `v`; the mean and points filled.
 [[nodiscard]] Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric,
-                                            const std::vector<uint64_t>& queries, const PerPoint& nearest,
-                                            const std::vector<uint64_t>& targets, uint64_t zeros,
-                                            int threads);
+                                            std::span<const uint64_t> queries, const PerPoint& nearest,
+                                            std::span<const uint64_t> targets, uint64_t zeros, int threads);
 
 // The engine's per-point search of float query points against one target
 // set it already holds (or is given with the call).
@@ -59,15 +58,15 @@ using NearestCall = std::function<Result<HausdorffResult>(std::span<const glm::v
 // A one-shot call against `targets` (voxels, put in `metric`'s frame at each
 // call; `timed.extractMs` gains that); the arguments must outlive it.
 [[nodiscard]] NearestCall oneShotCall(Engine& engine, const VoxelMetric& metric,
-                                      const std::vector<uint64_t>& targets, int threads, MaskResult& timed);
+                                      std::span<const uint64_t> targets, int threads, MaskResult& timed);
 
 // One direction of itk: `queries` (X's voxels outside Y), `zeros` more of
 // X's voxels at distance 0 (zeroWitness: one of them), `targets` (Y's
 // boundary voxels, searched by `nearest`); X's grid `v`. `timed` gains the
 // extraction, distance and engine times.
 [[nodiscard]] Result<Direction> directed(const VoxelMetric& metric, const Volume& v,
-                                         const std::vector<uint64_t>& queries, uint64_t zeros,
-                                         uint64_t zeroWitness, const std::vector<uint64_t>& targets,
+                                         std::span<const uint64_t> queries, uint64_t zeros,
+                                         uint64_t zeroWitness, std::span<const uint64_t> targets,
                                          const NearestCall& nearest, int threads, MaskResult& timed);
 
 // The convention's empty status and values for masks with na and nb points

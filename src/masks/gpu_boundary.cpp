@@ -68,7 +68,8 @@ void stageRows(const uint8_t* labels, size_t voxelBytes, Dims dims, const RowBox
 }
 
 // Linear volume indices of the set bits, ascending (box order is volume order).
-std::vector<uint64_t> decodeBits(std::span<const uint32_t> bits, Dims dims, const RowBox& rows, int threads) {
+core::UninitVector<uint64_t> decodeBits(std::span<const uint32_t> bits, Dims dims, const RowBox& rows,
+                                        int threads) {
     const uint64_t nx = uint64_t(dims[0]), sliceVoxels = nx * uint64_t(rows.y1 - rows.y0 + 1);
     const size_t slices = size_t(rows.z1 - rows.z0 + 1);
     std::vector<std::vector<uint64_t>> out(slices);
@@ -88,7 +89,7 @@ std::vector<uint64_t> decodeBits(std::span<const uint32_t> bits, Dims dims, cons
     });
     size_t total = 0;
     for (const auto& s : out) total += s.size();
-    std::vector<uint64_t> joined;
+    core::UninitVector<uint64_t> joined;
     joined.reserve(total);
     for (const auto& s : out) joined.insert(joined.end(), s.begin(), s.end());
     return joined;

@@ -84,7 +84,7 @@ std::optional<Error> checkPreparedFor(const State& s, const MaskOptions& options
 
 // Prepares `points` (voxels or corners of the reference) in the search frame.
 Result<PreparedSet> prepareSet(Engine& engine, const detail::VoxelMetric& metric,
-                               const std::vector<uint64_t>& points, int threads) {
+                               std::span<const uint64_t> points, int threads) {
     const detail::SearchPoints p = metric.searchPoints(points, threads);
     return engine.prepare(PointView(p));
 }
@@ -124,7 +124,7 @@ Result<std::array<Direction, 2>> boundaryDirections(Engine& engine, const State&
     Result<HausdorffResult> h = engine.compute(*s.set, *prediction, detail::perPointCall(false));
     if (!h) return h.error();
     detail::addTimings(r.engine, h->timings);
-    const std::vector<uint64_t>& ba = s.extracted.boundary;
+    const std::span<const uint64_t> ba = s.extracted.boundary;
     Result<Direction> ab = detail::directionOf(s.grid, metric, ba, h->aNearest, eb.boundary, 0, threads);
     if (!ab) return ab.error();
     Result<Direction> bA = detail::directionOf(b, metric, eb.boundary, h->bNearest, ba, 0, threads);

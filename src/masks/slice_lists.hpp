@@ -14,21 +14,27 @@
 namespace rthdist::masks::detail {
 
 // fn(z, out) for every slice z in [0, slices), each with its own list (one
-// slice per work item, any thread); the lists joined in slice order.
-template <class Fn>
-std::vector<uint64_t> perSlice(int64_t slices, int threads, Fn&& fn) {
+// slice per work item, any thread); the lists joined in slice order into an
+// `Out` (a std::vector, or a core::UninitVector, which the join's threads
+// touch first instead of one thread zeroing it: 0.5 ms of a noisy mask's
+// 376k boundary voxels on an H100 host), each list copied to its place and
+// freed by the thread that copies it.
+template <class Out = std::vector<uint64_t>, class Fn>
+Out perSlice(int64_t slices, int threads, Fn&& fn) {
     std::vector<std::vector<uint64_t>> lists(size_t(std::max<int64_t>(slices, 0)));
     core::parallelChunks(lists.size(), 1, threads, [&](size_t zb, size_t ze, int) {
         for (size_t z = zb; z < ze; ++z) fn(int64_t(z), lists[z]);
     });
-    size_t total = 0;
-    for (const auto& l : lists) total += l.size();
-    std::vector<uint64_t> out;
-    out.reserve(total);
-    for (auto& l : lists) {
-        out.insert(out.end(), l.begin(), l.end());
-        std::vector<uint64_t>().swap(l);
-    }
+    std::vector<size_t> at(lists.size() + 1, 0);
+    for (size_t z = 0; z < lists.size(); ++z) at[z + 1] = at[z] + lists[z].size();
+    Out out;
+    out.resize(at.back());
+    core::parallelChunks(lists.size(), 1, threads, [&](size_t zb, size_t ze, int) {
+        for (size_t z = zb; z < ze; ++z) {
+            std::copy(lists[z].begin(), lists[z].end(), out.begin() + ptrdiff_t(at[z]));
+            std::vector<uint64_t>().swap(lists[z]);
+        }
+    });
     return out;
 }
 

@@ -39,7 +39,7 @@ VoxelMetric VoxelMetric::corners(const Volume& v) {
                        glm::dvec3(0.5 * double(v.dims[0]), 0.5 * double(v.dims[1]), 0.5 * double(v.dims[2])));
 }
 
-SearchPoints VoxelMetric::searchPoints(const std::vector<uint64_t>& voxels, int threads) const {
+SearchPoints VoxelMetric::searchPoints(std::span<const uint64_t> voxels, int threads) const {
     SearchPoints out;
     out.resize(voxels.size());
     const VoxelDecoder decode(m_dims);
@@ -55,8 +55,8 @@ double VoxelMetric::distance(std::array<int64_t, 3> p, std::array<int64_t, 3> q)
     return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
 }
 
-RecomputedDirection recompute(const VoxelMetric& metric, Dims dims, const std::vector<uint64_t>& queries,
-                              const std::vector<uint64_t>& targets, const std::vector<uint32_t>& nearest,
+RecomputedDirection recompute(const VoxelMetric& metric, Dims dims, std::span<const uint64_t> queries,
+                              std::span<const uint64_t> targets, const std::vector<uint32_t>& nearest,
                               int threads) {
     RecomputedDirection r;
     r.distances.resize(queries.size());

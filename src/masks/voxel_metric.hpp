@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/uninit_vector.hpp"
@@ -40,7 +41,7 @@ public:
     [[nodiscard]] static VoxelMetric corners(const Volume& v);
 
     // Float coordinates of `voxels` (linear indices) in the search frame.
-    [[nodiscard]] SearchPoints searchPoints(const std::vector<uint64_t>& voxels, int threads) const;
+    [[nodiscard]] SearchPoints searchPoints(std::span<const uint64_t> voxels, int threads) const;
     // |linear (p - q)| in double.
     [[nodiscard]] double distance(std::array<int64_t, 3> p, std::array<int64_t, 3> q) const;
 
@@ -61,8 +62,8 @@ struct RecomputedDirection {
     size_t witness = 0;                    // query index of the largest distance
 };
 [[nodiscard]] RecomputedDirection recompute(const VoxelMetric& metric, Dims dims,
-                                            const std::vector<uint64_t>& queries,
-                                            const std::vector<uint64_t>& targets,
+                                            std::span<const uint64_t> queries,
+                                            std::span<const uint64_t> targets,
                                             const std::vector<uint32_t>& nearest, int threads);
 
 }  // namespace rthdist::masks::detail

@@ -35,10 +35,10 @@ mpi::Candidate winnerOf(MPI_Comm comm, const mpi::Candidate& mine) {
 
 // Sums the counters over ranks; bits and iterations are the maximum.
 Counters reduceCounters(MPI_Comm comm, const Counters& c) {
-    uint64_t sums[6] = {c.occupiedCells,    c.queries, c.culledByNeighbourhood,
-                        c.survivingQueries, c.rays,    c.candidatePairs};
+    uint64_t sums[7] = {c.occupiedCells,  c.queries,    c.culledByNeighbourhood, c.survivingQueries, c.rays,
+                        c.candidatePairs, c.tailScanned};
     uint32_t maxima[2] = {c.bits, c.iterations};
-    MPI_Allreduce(MPI_IN_PLACE, sums, 6, MPI_UINT64_T, MPI_SUM, comm);
+    MPI_Allreduce(MPI_IN_PLACE, sums, 7, MPI_UINT64_T, MPI_SUM, comm);
     MPI_Allreduce(MPI_IN_PLACE, maxima, 2, MPI_UINT32_T, MPI_MAX, comm);
     Counters out;
     out.occupiedCells = sums[0];
@@ -47,6 +47,7 @@ Counters reduceCounters(MPI_Comm comm, const Counters& c) {
     out.survivingQueries = sums[3];
     out.rays = sums[4];
     out.candidatePairs = sums[5];
+    out.tailScanned = sums[6];
     out.bits = maxima[0];
     out.iterations = maxima[1];
     return out;

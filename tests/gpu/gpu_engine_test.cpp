@@ -44,6 +44,28 @@ std::pair<std::optional<Engine>, std::optional<Engine>> enginesWithAndWithout(co
     return {std::move(with), std::move(without)};
 }
 
+// Sets an environment variable for its lifetime, then restores it.
+class ScopedEnv {
+public:
+    ScopedEnv(const char* name, const char* value) : m_name(name) {
+        const char* before = std::getenv(name);
+        if (before) m_saved = before;
+        setenv(name, value, 1);
+    }
+    ~ScopedEnv() {
+        if (m_saved)
+            setenv(m_name, m_saved->c_str(), 1);
+        else
+            unsetenv(m_name);
+    }
+    ScopedEnv(const ScopedEnv&) = delete;
+    ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+private:
+    const char* m_name;
+    std::optional<std::string> m_saved;
+};
+
 void expectExact(Engine& engine, const std::string& name, uint64_t seed, std::vector<glm::vec3> a,
                  std::vector<glm::vec3> b) {
     OracleCase c{name, seed, std::move(a), std::move(b)};
@@ -188,6 +210,7 @@ TEST(GpuEngine, RadiiInOneSubmissionEqualOnePerSubmission) {
 // witnesses equal those with the plain growth (RTHDIST_SEARCH_TAIL=0) and
 // the brute force; the tail takes fewer radius iterations.
 TEST(GpuEngine, FarTailGrowsFasterAndStaysExact) {
+    const ScopedEnv radiiOnly("RTHDIST_TAIL_SCAN_WORK", "0");  // the tail traced, not scanned
     std::string whyNot;
     auto [plain, tail] = enginesWithAndWithout("RTHDIST_SEARCH_TAIL", "0", whyNot);
     if (!plain || !tail) GTEST_SKIP() << "no device for this backend: " << whyNot;
@@ -210,6 +233,54 @@ TEST(GpuEngine, FarTailGrowsFasterAndStaysExact) {
     EXPECT_EQ(t->aToB.queryIndex, p->aToB.queryIndex);
     EXPECT_LT(t->aToB.counters.iterations, p->aToB.counters.iterations);
     EXPECT_EQ(t->validationMessages, 0u);
+}
+
+// The search's far tail scans every cell of a coarse level instead of
+// tracing more radii (CandidateSearch::tailScanLevel): the same distances as
+// the brute force and the same results as the radii alone, for far outliers
+// per point and for H alone (where the running maximum kills queries), with
+// every target doubled (copies), and with one bit per axis (the pair buffer
+// overflows before the tail).
+TEST(GpuEngine, TailScanEqualsRadiiAndBruteForce) {
+    std::string whyNot;
+    auto [radiiOnly, tail] = enginesWithAndWithout("RTHDIST_TAIL_SCAN_WORK", "0", whyNot);
+    if (!radiiOnly || !tail) GTEST_SKIP() << "no device for this backend: " << whyNot;
+    uint64_t scanned = 0;
+    for (uint64_t seed = 61; seed < 66; ++seed) {
+        const bool overflow = seed == 65;  // as in RadiiInOneSubmissionEqualOnePerSubmission
+        OracleCase c{
+            "tail-" + std::to_string(seed), seed,
+            uniformCloud(overflow ? 12000 : 4000, seed, glm::vec3(0.0f)),
+            uniformCloud(overflow ? 9000 : 3000, seed + 20, glm::vec3(overflow ? 2.5f : 0.2f, 0.05f, 0.0f))};
+        SCOPED_TRACE(c.name);
+        const std::vector<glm::vec3> far = uniformCloud(80, seed + 10, glm::vec3(-30.0f), 60.0f);
+        c.a.insert(c.a.end(), far.begin(), far.end());
+        if (seed == 63) {
+            const std::vector<glm::vec3> copies = c.b;
+            c.b.insert(c.b.end(), copies.begin(), copies.end());
+        }
+        CallOptions call;
+        call.perPointDistances = seed % 2 == 0;
+        call.bits = overflow ? 1 : 0;
+        auto r = radiiOnly->compute(c.a, c.b, call);
+        auto t = tail->compute(c.a, c.b, call);
+        ASSERT_TRUE(r.ok()) << r.error().message;
+        ASSERT_TRUE(t.ok()) << t.error().message;
+        EXPECT_EQ(r->aToB.counters.tailScanned + r->bToA.counters.tailScanned, 0u);
+        scanned += t->aToB.counters.tailScanned + t->bToA.counters.tailScanned;
+        expectMatchesOracle(c, *t);
+        EXPECT_EQ(t->hausdorff, r->hausdorff);
+        EXPECT_EQ(t->aToB.distance, r->aToB.distance);
+        EXPECT_EQ(t->bToA.distance, r->bToA.distance);
+        if (call.perPointDistances) {
+            EXPECT_EQ(t->aNearest.distance, oracle::bruteForceNearest(c.a, c.b));
+            EXPECT_EQ(t->bNearest.distance, oracle::bruteForceNearest(c.b, c.a));
+            EXPECT_EQ(t->aNearest.nearest, r->aNearest.nearest);
+            EXPECT_EQ(t->bNearest.nearest, r->bNearest.nearest);
+        }
+        EXPECT_EQ(t->validationMessages, 0u);
+    }
+    EXPECT_GT(scanned, 0u);
 }
 
 // Per-point arrays handed back (Engine::recycle), of other sizes and

@@ -191,7 +191,7 @@ TEST(MasksBoundary, MatchesBruteForce) {
                                         }
                                 if (edge) want.push_back(at);
                             }
-                    EXPECT_EQ(e.boundary, want) << what;
+                    EXPECT_EQ(std::vector<uint64_t>(e.boundary.begin(), e.boundary.end()), want) << what;
                 }
             }
         }

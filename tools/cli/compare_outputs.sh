@@ -93,7 +93,7 @@ mask() {
         s/, [0-9.]+ ms\)$/, MASKED ms)/mg;
         s/,[0-9.e+-]+$/,MASKED/mg if /^label,convention/;
         s/\b(culled|surviving|candidate pairs) [0-9]+/$1 N/g;
-        s/("(?:culled_by_neighbourhood|surviving_queries|candidate_pairs|surviving|pairs)": ?)[0-9]+/$1N/g;
+        s/("(?:culled_by_neighbourhood|surviving_queries|candidate_pairs|tail_scanned|surviving|pairs)": ?)[0-9]+/$1N/g;
     '
 }
 case_() {  # case_ BINARY ARGS...: runs one invocation and records it

@@ -53,6 +53,7 @@ Json countersJson(const Counters& c) {
             {"iterations", c.iterations},
             {"rays", c.rays},
             {"candidate_pairs", c.candidatePairs},
+            {"tail_scanned", c.tailScanned},
             {"query_chunks", c.queryChunks},
             {"target_tiles", c.targetTiles}};
 }
@@ -81,6 +82,7 @@ std::string countersText(const Counters& c) {
             (unsigned long long)c.queries, (unsigned long long)c.culledByNeighbourhood,
             (unsigned long long)c.survivingQueries, c.iterations, (unsigned long long)c.rays,
             (unsigned long long)c.candidatePairs, (unsigned long long)c.occupiedCells);
+    if (c.tailScanned > 0) appendf(s, ", tail scanned %llu", (unsigned long long)c.tailScanned);
     if (c.queryChunks > 1 || c.targetTiles > 1)
         appendf(s, ", out of core in %u query chunks x %u target tiles", c.queryChunks, c.targetTiles);
     return s;
