@@ -10,6 +10,17 @@
 // is strictly closer than thr (the query is dead: it cannot raise h) or at
 // distance 0 (nothing can be closer).
 
+// Squared distance from q to the farthest corner of the box [lo, hi]: no
+// point of the box has a larger dist2, in float too (each component's
+// difference is at most the larger corner difference, rounding is
+// monotone, and the sum is formed as dist2 forms it), so the box holds a
+// point within it.
+float boxFarDist2(vec3 q, vec3 lo, vec3 hi) {
+    precise vec3 d = max(abs(q - lo), abs(q - hi));
+    precise float r = d.x * d.x + d.y * d.y + d.z * d.z;
+    return r;
+}
+
 // The points of one level-0 cell.
 void scanCellPoints(vec3 q, Cell c, uint64_t targets, float thr, inout float best, inout uint bestT,
                     inout bool dead) {

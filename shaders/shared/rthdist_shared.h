@@ -20,6 +20,7 @@ struct vec3f {
 
 // Workgroup size of every 1-D compute dispatch.
 #define RTHDIST_WG 128
+#define RTHDIST_TAIL_WG 64  // tail_scan.comp: threads per open query
 // Elements per scan block: one workgroup of RTHDIST_SCAN_WG threads, each
 // scanning RTHDIST_SCAN_PER_THREAD consecutive elements serially (few
 // barriers: they dominate on lavapipe).
@@ -335,7 +336,8 @@ struct RefinePush {
 };
 
 // tail_scan.comp: every open query of a direction scans every search cell
-// of one level (the candidate search's far tail), one thread per query.
+// of one level (the candidate search's far tail), one workgroup of
+// RTHDIST_TAIL_WG threads per query (numActive groups).
 struct TailScanPush {
     uint64_t queries;
     uint64_t targets;

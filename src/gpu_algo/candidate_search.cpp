@@ -104,7 +104,7 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
 }
 
 int CandidateSearch::tailScanLevel(PointIndex& T, uint32_t open, uint32_t searched) {
-    if (tailScanWork == 0 || uint64_t(open) * 4 > searched || !m_ws.oneDispatchHolds(open)) return -1;
+    if (tailScanWork == 0 || uint64_t(open) * 4 > searched || open > m_ws.ctx.limits().maxGroupsX) return -1;
     const int last = std::max(1, T.grid.bits - 1);
     int level = std::max(1, int(T.levels.size()));
     uint32_t cells = m_index.levelCells(T, level).count;  // may build it (a submission)

@@ -66,8 +66,9 @@ public:
     // Whether the `open` queries left of the direction's `searched` are a
     // far tail that scans whole cells instead of tracing more radii, and at
     // which level (-1: trace on). A tail: at most a quarter of the searched
-    // queries left, and `open` x the level's cells at most tailScanWork
-    // (each query then costs a walk over the level's cells, against a BLAS
+    // queries left (at most the device's maxGroupsX: a workgroup each), and
+    // `open` x the level's cells at most tailScanWork (each query then
+    // costs a walk over the level's cells, against a BLAS
     // refit and a trace pass for every radius, ~0.5 ms on an H100 whatever
     // the number of queries, that a noisy mask's isolated voxels, up to
     // 300 mm from the other mask, take 5 of). The level: the first from

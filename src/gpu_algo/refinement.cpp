@@ -51,7 +51,7 @@ void Refinement::cmdTailScan(VkCommandBuffer cmd, DirectionRun& d, const PointIn
                               d.lowerBound2,
                               lv.count,
                               d.T.numCells};
-    m_ws.dispatch(cmd, Kernel::kTailScan, tp, numActive);
+    m_ws.pipelines.cmdDispatch(cmd, Kernel::kTailScan, &tp, sizeof(tp), numActive);  // a group per query
     m_ws.barrier(cmd);
     const float everything = std::numeric_limits<float>::infinity();
     sh::ResolvePush rs{d.state->address(),

@@ -24,8 +24,8 @@ public:
 
     // Records the far tail's scan: each of the numActive open queries scans
     // every cell of level `lv` (coarse: through its level-0 cells), then all
-    // are resolved at radius +inf (exact or dead; none goes on). numActive
-    // must fit one dispatch (Workspace::oneDispatchHolds).
+    // are resolved at radius +inf (exact or dead; none goes on). One
+    // workgroup per query: numActive at most the device's maxGroupsX.
     void cmdTailScan(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse,
                      uint32_t numActive);
 
