@@ -7,13 +7,22 @@
 // the caller's callable. A worker only takes work while idle, never while
 // waiting inside a nested call, so waits form no cycle. In a fork() child
 // every call runs on its caller alone.
+//
+// Waiting spins before it sleeps: an idle worker polls for a posted call,
+// and a caller for its helpers' last chunk, for up to spinTime() before blocking
+// on a condition variable. A masks comparison runs ~20 parallel loops back
+// to back, and waking a sleeping thread through the kernel costs tens of
+// microseconds on a virtual machine's vCPUs (each loop paid it on the H100
+// machine's 16 cores: docs/bench/masks).
 #include "core/thread_pool.hpp"
 
 #include <pthread.h>
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
+#include <cstdlib>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -23,6 +32,38 @@
 
 namespace rthdist::core {
 namespace {
+
+// How long a waiting thread polls before it sleeps: 200 us, or the
+// RTHDIST_POOL_SPIN_US environment variable's value read at the first call
+// (0: never polls; benchmarks compare both).
+std::chrono::microseconds spinTime() {
+    static const std::chrono::microseconds spin = [] {
+        const char* env = std::getenv("RTHDIST_POOL_SPIN_US");
+        return std::chrono::microseconds(env != nullptr ? std::strtol(env, nullptr, 10) : 200);
+    }();
+    return spin;
+}
+
+void cpuRelax() {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#elif defined(__aarch64__)
+    asm volatile("yield");
+#endif
+}
+
+// Polls `ready` until it holds or spinTime() has passed; whether it held.
+template <class Ready>
+bool spinFor(Ready&& ready) {
+    const std::chrono::microseconds spin = spinTime();
+    if (spin.count() <= 0) return ready();
+    const auto until = std::chrono::steady_clock::now() + spin;
+    for (unsigned i = 0;; ++i) {
+        if (ready()) return true;
+        cpuRelax();
+        if ((i & 63u) == 63u && std::chrono::steady_clock::now() >= until) return false;
+    }
+}
 
 class ChunkJob {
 public:
@@ -50,11 +91,15 @@ public:
         if (ran == 0) return;
         std::lock_guard lock(m_mutex);
         m_done += ran;
-        if (m_done == m_chunks) m_finished.notify_all();
+        if (m_done == m_chunks) {
+            m_allDone.store(true, std::memory_order_release);
+            m_finished.notify_all();
+        }
     }
 
     // Waits for the chunks other workers have claimed and not finished yet.
     void waitAll() {
+        if (spinFor([this] { return m_allDone.load(std::memory_order_acquire); })) return;
         std::unique_lock lock(m_mutex);
         m_finished.wait(lock, [this] { return m_done == m_chunks; });
     }
@@ -66,7 +111,8 @@ private:
     std::atomic<int> m_nextThread{1};
     std::mutex m_mutex;
     std::condition_variable m_finished;
-    size_t m_done = 0;  // guarded by m_mutex
+    size_t m_done = 0;                   // guarded by m_mutex
+    std::atomic<bool> m_allDone{false};  // m_done == m_chunks, for spinFor
 };
 
 // A posted call and how many helpers it still asks for.
@@ -84,6 +130,7 @@ public:
             std::lock_guard lock(m_mutex);
             if (m_stopping || m_forkedChild) return false;
             m_queue.push_back({job, helpers});
+            m_queued.store(m_queue.size(), std::memory_order_relaxed);
             m_wanted += helpers;
             m_limit = std::max(m_limit, helpers);
             // Idle workers first; new ones only while the posted calls want
@@ -109,6 +156,7 @@ public:
         if (it == m_queue.end()) return;
         m_wanted -= it->helpers;
         m_queue.erase(it);
+        m_queued.store(m_queue.size(), std::memory_order_relaxed);
     }
 
     size_t workerCount() {
@@ -128,8 +176,10 @@ public:
         {
             std::lock_guard lock(m_mutex);
             m_stopping = true;
+            m_stopFlag.store(true, std::memory_order_relaxed);
             if (m_forkedChild) return;  // the handles name the parent's threads
             m_queue.clear();
+            m_queued.store(0, std::memory_order_relaxed);
             m_wanted = 0;
             workers.swap(m_workers);
         }
@@ -171,6 +221,14 @@ private:
     void workerLoop() {
         std::unique_lock lock(m_mutex);
         for (;;) {
+            if (m_queue.empty() && !m_stopping) {  // the next call may come at once
+                lock.unlock();
+                spinFor([this] {
+                    return m_queued.load(std::memory_order_relaxed) != 0 ||
+                           m_stopFlag.load(std::memory_order_relaxed);
+                });
+                lock.lock();
+            }
             ++m_idle;
             m_wake.wait(lock, [this] { return m_stopping || !m_queue.empty(); });
             --m_idle;
@@ -178,7 +236,10 @@ private:
             Posting& front = m_queue.front();
             std::shared_ptr<ChunkJob> job = front.job;
             --m_wanted;
-            if (--front.helpers == 0) m_queue.pop_front();
+            if (--front.helpers == 0) {
+                m_queue.pop_front();
+                m_queued.store(m_queue.size(), std::memory_order_relaxed);
+            }
             ++m_busy;
             lock.unlock();
             job->help();
@@ -190,7 +251,9 @@ private:
 
     std::mutex m_mutex;
     std::condition_variable m_wake;
-    std::deque<Posting> m_queue;  // calls still asking for helpers
+    std::deque<Posting> m_queue;          // calls still asking for helpers
+    std::atomic<size_t> m_queued{0};      // m_queue.size(), polled by spinning workers
+    std::atomic<bool> m_stopFlag{false};  // m_stopping, polled by spinning workers
     std::vector<std::thread> m_workers;
     size_t m_busy = 0;    // workers inside a call
     size_t m_idle = 0;    // workers waiting for work
