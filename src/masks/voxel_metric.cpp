@@ -26,10 +26,20 @@ VoxelMetric::VoxelMetric(const Volume& v, bool world)
         const glm::dvec3 s = v.spacing();
         m_linear = glm::dmat3(s.x, 0.0, 0.0, 0.0, s.y, 0.0, 0.0, 0.0, s.z);
     }
+    noteDiagonal();
 }
 
 VoxelMetric::VoxelMetric(Dims dims, const glm::dmat3& linear, glm::dvec3 centre)
-    : m_dims(dims), m_linear(linear), m_centre(centre) {}
+    : m_dims(dims), m_linear(linear), m_centre(centre) {
+    noteDiagonal();
+}
+
+void VoxelMetric::noteDiagonal() {
+    const glm::dmat3& m = m_linear;
+    m_diagonal = m[0][1] == 0.0 && m[0][2] == 0.0 && m[1][0] == 0.0 && m[1][2] == 0.0 && m[2][0] == 0.0 &&
+                 m[2][1] == 0.0;
+    m_scale = glm::dvec3(m[0][0], m[1][1], m[2][2]);
+}
 
 VoxelMetric VoxelMetric::corners(const Volume& v) {
     const glm::dvec3 s = v.spacing();
@@ -43,16 +53,17 @@ SearchPoints VoxelMetric::searchPoints(std::span<const uint64_t> voxels, int thr
     SearchPoints out;
     out.resize(voxels.size());
     const VoxelDecoder decode(m_dims);
+    // The diagonal map as distance() applies it: the same coordinates.
     core::parallelChunks(voxels.size(), kChunk, threads, [&](size_t b, size_t e, int) {
-        for (size_t i = b; i < e; ++i)
-            out[i] = glm::vec3(m_linear * (asVector(decode(voxels[i])) - m_centre));
+        if (m_diagonal) {
+            for (size_t i = b; i < e; ++i)
+                out[i] = glm::vec3(m_scale * (asVector(decode(voxels[i])) - m_centre));
+        } else {
+            for (size_t i = b; i < e; ++i)
+                out[i] = glm::vec3(m_linear * (asVector(decode(voxels[i])) - m_centre));
+        }
     });
     return out;
-}
-
-double VoxelMetric::distance(std::array<int64_t, 3> p, std::array<int64_t, 3> q) const {
-    const glm::dvec3 d = m_linear * glm::dvec3(double(p[0] - q[0]), double(p[1] - q[1]), double(p[2] - q[2]));
-    return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
 }
 
 RecomputedDirection recompute(const VoxelMetric& metric, Dims dims, std::span<const uint64_t> queries,
