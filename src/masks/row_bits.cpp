@@ -41,7 +41,10 @@ RowBits::RowBits(const Volume& v, LabelSelect select, int threads)
             for (size_t r = b; r < e; ++r) {
                 uint64_t* words = m_words.data() + r * size_t(m_rowWords);
                 packRow(sel, int64_t(r) * nx, nx, words);
-                for (int64_t w = 0; w < m_rowWords; ++w) count += uint64_t(std::popcount(words[w]));
+                // Most words of a mask volume are empty; std::popcount is a
+                // library call on the baseline x86-64 target (no POPCNT).
+                for (int64_t w = 0; w < m_rowWords; ++w)
+                    if (words[w] != 0) count += uint64_t(std::popcount(words[w]));
             }
             chunkCounts[b / kRowsPerChunk] = count;
         });
