@@ -62,25 +62,28 @@ struct PercentilePair {
 PercentilePair percentilesOf(Convention c, Direction& da, Direction& db, std::span<double> pooled, double p,
                              int threads) {
     PercentilePair v;
+    const ValueRange ra{{da.least, da.out.hd}}, rb{{db.least, db.out.hd}};
     switch (c) {
         case Convention::kRthdist:
-            v.a = percentileNearestRank(da.distances, p, threads);
-            v.b = percentileNearestRank(db.distances, p, threads);
+            v.a = percentileNearestRank(da.distances, p, threads, ra);
+            v.b = percentileNearestRank(db.distances, p, threads, rb);
             v.combined = std::max(v.a, v.b);
             break;
         case Convention::kMonai:
-            v.a = percentileLinear(da.distances, p, threads);
-            v.b = percentileLinear(db.distances, p, threads);
+            v.a = percentileLinear(da.distances, p, threads, ra);
+            v.b = percentileLinear(db.distances, p, threads, rb);
             v.combined = std::max(v.a, v.b);
             break;
         case Convention::kMedpy:
-            v.a = percentileLinear(da.distances, p, threads);
-            v.b = percentileLinear(db.distances, p, threads);
-            v.combined = percentileLinear(pooled, p, threads);
+            v.a = percentileLinear(da.distances, p, threads, ra);
+            v.b = percentileLinear(db.distances, p, threads, rb);
+            v.combined =
+                percentileLinear(pooled, p, threads,
+                                 ValueRange{{std::min(da.least, db.least), std::max(da.out.hd, db.out.hd)}});
             break;
         case Convention::kPlastimatch:
-            v.a = percentilePlastimatch(da.distances, p, threads);
-            v.b = percentilePlastimatch(db.distances, p, threads);
+            v.a = percentilePlastimatch(da.distances, p, threads, ra);
+            v.b = percentilePlastimatch(db.distances, p, threads, rb);
             v.combined = 0.5 * (v.a + v.b);
             break;
         case Convention::kItk:
@@ -154,6 +157,7 @@ Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric, std::s
         d.distances.insert(d.distances.end(), r.distances.begin(), r.distances.end());
     }
     d.sum = r.sum;
+    d.least = zeros == 0 ? r.least : 0.0;
     d.out.voxel = voxelOf(queries[r.witness], v.dims);
     d.out.nearestVoxel = voxelOf(targets[nearest.nearest[r.witness]], v.dims);
     finishDirection(v, d);

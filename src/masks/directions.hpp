@@ -32,6 +32,7 @@ struct Direction {
     core::UninitVector<double> distances;  // all of X's distances, in no particular order (zeros included)
     DirectedMask out;
     double sum = 0.0;
+    double least = 0.0;  // the smallest of `distances` (out.hd the greatest): their range for the percentiles
 };
 
 // The connectivity convention c measures boundaries with (`requested`: MaskOptions::connectivity).

@@ -48,10 +48,12 @@ std::pair<double, double> nthAndNext(std::span<double> values, size_t k) {
 // them; the k-th twice when k is the last) on `threads` threads: the range
 // [min, max] cut into kBuckets equal buckets (the bucket of a value never
 // decreases as the value grows), a histogram, and selection among the
-// values of the buckets that hold ranks k and k + 1. Three parallel passes.
-std::pair<double, double> bucketSelect(std::span<const double> values, size_t k, int threads) {
+// values of the buckets that hold ranks k and k + 1. Three parallel passes
+// (two when the range is known); a histogram per thread.
+std::pair<double, double> bucketSelect(std::span<const double> values, size_t k, int threads,
+                                       ValueRange range) {
     const size_t n = values.size(), chunks = (n + kChunk - 1) / kChunk;
-    const auto [lo, hi] = rangeOf(values, threads);
+    const auto [lo, hi] = range ? *range : rangeOf(values, threads);
     if (!(hi > lo)) return {lo, lo};  // all equal
     const double scale = double(kBuckets) / (hi - lo);
     if (!std::isfinite(scale)) {  // a range of subnormal width
@@ -59,14 +61,15 @@ std::pair<double, double> bucketSelect(std::span<const double> values, size_t k,
         return nthAndNext(copy, k);
     }
     const auto bucketOf = [lo, scale](double v) { return std::min(kBuckets - 1, size_t((v - lo) * scale)); };
-    std::vector<uint32_t> histograms(chunks * kBuckets, 0);
-    core::parallelChunks(n, kChunk, threads, [&](size_t b, size_t e, int) {
-        uint32_t* h = histograms.data() + (b / kChunk) * kBuckets;
+    const int workers = core::resolveThreads(threads, chunks);
+    std::vector<uint64_t> histograms(size_t(workers) * kBuckets, 0);
+    core::parallelChunks(n, kChunk, workers, [&](size_t b, size_t e, int t) {
+        uint64_t* h = histograms.data() + size_t(t) * kBuckets;
         for (size_t i = b; i < e; ++i) ++h[bucketOf(values[i])];
     });
     std::vector<uint64_t> total(kBuckets, 0);
-    for (size_t c = 0; c < chunks; ++c)
-        for (size_t j = 0; j < kBuckets; ++j) total[j] += histograms[c * kBuckets + j];
+    for (int t = 0; t < workers; ++t)
+        for (size_t j = 0; j < kBuckets; ++j) total[j] += histograms[size_t(t) * kBuckets + j];
     // first: the bucket holding rank k (below: the values before it); last:
     // the one holding rank k + 1 (the same or a later one).
     const size_t next = std::min(k + 1, n - 1);
@@ -90,42 +93,42 @@ std::pair<double, double> bucketSelect(std::span<const double> values, size_t k,
 
 // The k-th and (k+1)-th smallest of non-empty `values` (the k-th twice when
 // k is the last).
-std::pair<double, double> kthAndNext(std::span<double> values, size_t k, int threads) {
+std::pair<double, double> kthAndNext(std::span<double> values, size_t k, int threads, ValueRange range) {
     const size_t n = values.size();
     if (n >= kParallelFrom && core::resolveThreads(threads, n / kChunk) > 1)
-        return bucketSelect(values, k, threads);
+        return bucketSelect(values, k, threads, range);
     return nthAndNext(values, k);
 }
 
 }  // namespace
 
-double kthSmallest(std::span<double> values, size_t k, int threads) {
-    return kthAndNext(values, k, threads).first;
+double kthSmallest(std::span<double> values, size_t k, int threads, ValueRange range) {
+    return kthAndNext(values, k, threads, range).first;
 }
 
-double percentileLinear(std::span<double> values, double p, int threads) {
+double percentileLinear(std::span<double> values, double p, int threads, ValueRange range) {
     const size_t n = values.size();
     if (n == 0) return std::numeric_limits<double>::quiet_NaN();
     const double rank = (p / 100.0) * double(n - 1);
     const double lo = std::floor(rank);
     const size_t i = std::min(size_t(lo), n - 1);
     const double t = rank - lo;
-    const auto [a, b] = kthAndNext(values, i, threads);
+    const auto [a, b] = kthAndNext(values, i, threads, range);
     const double diff = b - a;
     return t >= 0.5 ? b - diff * (1.0 - t) : a + diff * t;
 }
 
-double percentilePlastimatch(std::span<double> values, double p, int threads) {
+double percentilePlastimatch(std::span<double> values, double p, int threads, ValueRange range) {
     const size_t n = values.size();
     if (n == 0) return 0.0;
     double k = std::floor((p / 100.0) * double(n) - 1.0);
     k = std::clamp(k, 0.0, double(n - 1));
-    return kthSmallest(values, size_t(k), threads);
+    return kthSmallest(values, size_t(k), threads, range);
 }
 
-double percentileNearestRank(std::span<double> values, double p, int threads) {
+double percentileNearestRank(std::span<double> values, double p, int threads, ValueRange range) {
     if (values.empty()) return 0.0;
-    return kthSmallest(values, core::nearestRankIndex(values.size(), p), threads);
+    return kthSmallest(values, core::nearestRankIndex(values.size(), p), threads, range);
 }
 
 size_t countAtMost(std::span<const double> values, double limit, int threads) {

@@ -7,29 +7,38 @@
 // histogram of 4096 equal buckets over it, and the values of the bucket
 // that holds the rank, and nth_element runs on those (the values are left as
 // they are).
-// `threads`: 0 = all hardware threads. Values must not be NaN.
+// `threads`: 0 = all hardware threads. Values must not be NaN. `range`, when
+// given, must be the exact least and greatest of the values (a direction
+// knows them from its recomputed distances): the parallel passes then skip
+// finding it.
 // Internal to rthdist_masks.
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <span>
+#include <utility>
 
 namespace rthdist::masks::detail {
 
+using ValueRange = std::optional<std::pair<double, double>>;  // least, greatest
+
 // The k-th smallest (0-based) of non-empty `values`.
-[[nodiscard]] double kthSmallest(std::span<double> values, size_t k, int threads);
+[[nodiscard]] double kthSmallest(std::span<double> values, size_t k, int threads, ValueRange range = {});
 
 // Linear interpolation between order statistics (numpy.percentile's and
 // torch.quantile's default): rank q (n - 1), lerp written as numpy writes it.
 // NaN when empty.
-[[nodiscard]] double percentileLinear(std::span<double> values, double p, int threads);
+[[nodiscard]] double percentileLinear(std::span<double> values, double p, int threads, ValueRange range = {});
 
 // plastimatch: the k-th smallest (0-based), k = floor(f n - 1) clamped to [0, n-1]; 0 when empty.
-[[nodiscard]] double percentilePlastimatch(std::span<double> values, double p, int threads);
+[[nodiscard]] double percentilePlastimatch(std::span<double> values, double p, int threads,
+                                           ValueRange range = {});
 
 // Nearest rank (rthdist/stats.hpp percentileNearestRank): the ceil(p n / 100)-th
 // smallest, rank clamped to [1, n]; 0 when empty.
-[[nodiscard]] double percentileNearestRank(std::span<double> values, double p, int threads);
+[[nodiscard]] double percentileNearestRank(std::span<double> values, double p, int threads,
+                                           ValueRange range = {});
 
 // How many values are <= limit.
 [[nodiscard]] size_t countAtMost(std::span<const double> values, double limit, int threads);

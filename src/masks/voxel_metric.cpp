@@ -1,7 +1,9 @@
 // The search frame and the recomputed distances (voxel_metric.hpp).
 #include "masks/voxel_metric.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/parallel.hpp"
 
@@ -76,19 +78,24 @@ RecomputedDirection recompute(const VoxelMetric& metric, Dims dims, std::span<co
     const size_t chunks = (queries.size() + kChunk - 1) / kChunk;
     std::vector<double> sums(chunks, 0.0);
     std::vector<size_t> witnesses(chunks, 0);
+    std::vector<double> leasts(chunks, 0.0);
     const VoxelDecoder decode(dims);
     core::parallelChunks(queries.size(), kChunk, threads, [&](size_t b, size_t e, int) {
         double sum = 0.0;
         size_t witness = b;
+        double least = std::numeric_limits<double>::infinity();
         for (size_t i = b; i < e; ++i) {
             const double d = metric.distance(decode(queries[i]), decode(targets[nearest[i]]));
             r.distances[i] = d;
             sum += d;
             if (d > r.distances[witness]) witness = i;
+            least = d < least ? d : least;
         }
         sums[b / kChunk] = sum;
         witnesses[b / kChunk] = witness;
+        leasts[b / kChunk] = least;
     });
+    r.least = chunks > 0 ? *std::min_element(leasts.begin(), leasts.end()) : 0.0;
     for (size_t c = 0; c < chunks; ++c) {
         r.sum += sums[c];
         if (r.distances[witnesses[c]] > r.distances[r.witness]) r.witness = witnesses[c];

@@ -72,6 +72,7 @@ struct RecomputedDirection {
     core::UninitVector<double> distances;  // in query order
     double sum = 0.0;                      // summed in chunks of 2^13 queries, in query order
     size_t witness = 0;                    // query index of the largest distance
+    double least = 0.0;                    // the smallest distance
 };
 [[nodiscard]] RecomputedDirection recompute(const VoxelMetric& metric, Dims dims,
                                             std::span<const uint64_t> queries,
