@@ -60,7 +60,8 @@ TEST(OrderStatistics, SelectionEqualsTheSortedRule) {
 
 // From 2^15 values on, the bracketed parallel selection: lattice distances
 // with many ties, a spread of distinct values, and a heavy tail (the few far
-// outliers of a noisy mask), against the sorted rule on every percentile.
+// outliers of a noisy mask), against the sorted rule on every percentile,
+// with the range found by the selection and given by the caller.
 TEST(OrderStatistics, ParallelSelectionEqualsTheSortedRule) {
     std::mt19937 rng(11);
     const std::vector<double> ps{0.0, 0.001, 5.0, 50.0, 90.0, 95.0, 99.0, 99.99, 100.0};
@@ -76,12 +77,19 @@ TEST(OrderStatistics, ParallelSelectionEqualsTheSortedRule) {
             }
             std::vector<double> sorted = values;
             std::sort(sorted.begin(), sorted.end());
+            // The range given (as a direction knows it) or found: the same values.
+            const ValueRange range{{sorted.front(), sorted.back()}};
             for (double p : ps) {
                 std::vector<double> work = values;
                 EXPECT_EQ(percentileLinear(work, p, 2), sortedLinear(sorted, p))
                     << n << " shape " << shape << " p" << p;
                 EXPECT_EQ(percentilePlastimatch(work, p, 2), sortedPlastimatch(sorted, p)) << n << " p" << p;
                 EXPECT_EQ(percentileNearestRank(work, p, 2), sortedNearestRank(sorted, p)) << n << " p" << p;
+                EXPECT_EQ(percentileLinear(work, p, 2, range), sortedLinear(sorted, p)) << n << " p" << p;
+                EXPECT_EQ(percentilePlastimatch(work, p, 2, range), sortedPlastimatch(sorted, p))
+                    << n << " p" << p;
+                EXPECT_EQ(percentileNearestRank(work, p, 2, range), sortedNearestRank(sorted, p))
+                    << n << " p" << p;
             }
             EXPECT_EQ(countAtMost(values, 2.0, 2),
                       size_t(std::upper_bound(sorted.begin(), sorted.end(), 2.0) - sorted.begin()));
