@@ -25,6 +25,9 @@ CandidateSearch::CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, R
     tailScanWork = m_ws.ctx.cpuDevice() ? kTailScanWorkCpuDevice : kTailScanWorkGpu;
     if (const char* env = std::getenv("RTHDIST_TAIL_SCAN_WORK"))
         tailScanWork = std::strtoull(env, nullptr, 10);
+    tailScanStartWork = kTailScanStartWorkGpu;
+    if (const char* env = std::getenv("RTHDIST_TAIL_SCAN_START"))
+        tailScanStartWork = std::strtoull(env, nullptr, 10);
 }
 
 void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options,
@@ -63,7 +66,9 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
             pairs = &m_ws.grow(m_ws.scratch.search.pairs, pairCapacity * 8, "pairs");
             pairCapacity = std::min<uint64_t>(pairs->size() / 8, m_ws.maxPairCapacity);
         }
-        if (const int tail = traced ? tailScanLevel(T, numActive, searched) : -1; tail >= 0) {
+        const int tail = traced ? tailScanLevel(T, numActive, searched, tailScanWork)
+                                : tailScanLevel(T, numActive, d.Q.n, tailScanStartWork);
+        if (tail >= 0) {
             const RadiiOutcome out = runRadii(d, tail, false, {}, *pairs, pairCapacity, numActive, true);
             if (out.stillOpen != 0)
                 throw std::runtime_error("candidate search: the tail scan left queries open");
@@ -103,13 +108,13 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
     }
 }
 
-int CandidateSearch::tailScanLevel(PointIndex& T, uint32_t open, uint32_t searched) {
-    if (tailScanWork == 0 || uint64_t(open) * 4 > searched || open > m_ws.ctx.limits().maxGroupsX) return -1;
+int CandidateSearch::tailScanLevel(PointIndex& T, uint32_t open, uint64_t from, uint64_t work) {
+    if (work == 0 || uint64_t(open) * 4 > from || open > m_ws.ctx.limits().maxGroupsX) return -1;
     const int last = std::max(1, T.grid.bits - 1);
     int level = std::max(1, int(T.levels.size()));
     uint32_t cells = m_index.levelCells(T, level).count;  // may build it (a submission)
     while (cells > kTailScanCells && level < last) cells = m_index.levelCells(T, ++level).count;
-    return uint64_t(open) * cells <= tailScanWork ? level : -1;
+    return uint64_t(open) * cells <= work ? level : -1;
 }
 
 double CandidateSearch::tailStep(double growth, uint32_t searched, uint32_t before, uint32_t after) {

@@ -31,6 +31,13 @@ inline constexpr uint32_t kMaxIterations = 4096;
 // query's thread walks all of them).
 inline constexpr uint64_t kTailScanWorkGpu = uint64_t(1) << 28;
 inline constexpr uint64_t kTailScanWorkCpuDevice = uint64_t(1) << 24;
+// Before any radius (the queries the neighbourhood pass left): off by
+// default. Measured on an H100 with 2^25 tests (docs/bench/prepared,
+// 2026-11-27): prepared Dragon translated 0.3 4.1-4.4 -> 1.05-1.07 ms and
+// surface-5M 2.6-2.7 -> 1.9 ms, but translated 0.7 5.4-5.6 -> 7.2-7.4 ms
+// (its survivors far enough that each walks much of the level) and no
+// change on the masks: no rule found yet that picks only the wins.
+inline constexpr uint64_t kTailScanStartWorkGpu = 0;
 inline constexpr uint32_t kTailScanCells = 4096;
 
 // What the radii of one submission reported.
@@ -63,19 +70,20 @@ public:
     // query's nearest cell is refined exactly, whatever the radius).
     [[nodiscard]] static double tailStep(double growth, uint32_t searched, uint32_t before, uint32_t after);
 
-    // Whether the `open` queries left of the direction's `searched` are a
-    // far tail that scans whole cells instead of tracing more radii, and at
-    // which level (-1: trace on). A tail: at most a quarter of the searched
-    // queries left (at most the device's maxGroupsX: a workgroup each), and
-    // `open` x the level's cells at most tailScanWork (each query then
-    // costs a walk over the level's cells, against a BLAS
+    // Whether the `open` queries left of `from` (the direction's searched
+    // queries after radii, all its queries before the first) are a tail
+    // that scans whole cells instead of tracing (more) radii, and at which
+    // level (-1: trace). A tail: at most a quarter of `from` left (at most
+    // the device's maxGroupsX: a workgroup each), and `open` x the level's
+    // cells at most `work` (tailScanWork after radii, tailScanStartWork
+    // before; each query then costs a walk over the level's cells, against a BLAS
     // refit and a trace pass for every radius, ~0.5 ms on an H100 whatever
     // the number of queries, that a noisy mask's isolated voxels, up to
     // 300 mm from the other mask, take 5 of). The level: the first from
     // the coarsest built with at most kTailScanCells cells, building coarser
     // ones (a submission each) up to the grid's last. The result is exact
     // either way.
-    [[nodiscard]] int tailScanLevel(PointIndex& T, uint32_t open, uint32_t searched);
+    [[nodiscard]] int tailScanLevel(PointIndex& T, uint32_t open, uint64_t from, uint64_t work);
 
     // The radii that follow `radius` (growth each time) at its search level,
     // at most `most` (and radiiPerSubmission) of them.
@@ -107,6 +115,10 @@ public:
     // on a CPU device; the RTHDIST_TAIL_SCAN_WORK environment variable sets
     // it for tests and benchmarks (0: never).
     uint64_t tailScanWork = kTailScanWorkGpu;
+    // Before any radius: kTailScanStartWorkGpu (0: never), also on a CPU
+    // device; the RTHDIST_TAIL_SCAN_START environment variable sets it
+    // (tests, benchmarks).
+    uint64_t tailScanStartWork = kTailScanStartWorkGpu;
 
     // Records the search of one radius: the level's boxes grown by the
     // radius, the BLAS refitted (same level) or rebuilt, one ray per active

@@ -211,6 +211,7 @@ TEST(GpuEngine, RadiiInOneSubmissionEqualOnePerSubmission) {
 // the brute force; the tail takes fewer radius iterations.
 TEST(GpuEngine, FarTailGrowsFasterAndStaysExact) {
     const ScopedEnv radiiOnly("RTHDIST_TAIL_SCAN_WORK", "0");  // the tail traced, not scanned
+    const ScopedEnv noStart("RTHDIST_TAIL_SCAN_START", "0");
     std::string whyNot;
     auto [plain, tail] = enginesWithAndWithout("RTHDIST_SEARCH_TAIL", "0", whyNot);
     if (!plain || !tail) GTEST_SKIP() << "no device for this backend: " << whyNot;
@@ -240,12 +241,25 @@ TEST(GpuEngine, FarTailGrowsFasterAndStaysExact) {
 // the brute force and the same results as the radii alone, for far outliers
 // per point and for H alone (where the running maximum kills queries), with
 // every target doubled (copies), and with one bit per axis (the pair buffer
-// overflows before the tail).
+// overflows before the tail); and with the scan taking the queries the
+// neighbourhood pass left before any radius (RTHDIST_TAIL_SCAN_START, off by
+// default).
 TEST(GpuEngine, TailScanEqualsRadiiAndBruteForce) {
     std::string whyNot;
-    auto [radiiOnly, tail] = enginesWithAndWithout("RTHDIST_TAIL_SCAN_WORK", "0", whyNot);
-    if (!radiiOnly || !tail) GTEST_SKIP() << "no device for this backend: " << whyNot;
+    std::optional<Engine> radiiOnly, tail, fromStart;
+    {
+        const ScopedEnv noTail("RTHDIST_TAIL_SCAN_WORK", "0");
+        const ScopedEnv noStart("RTHDIST_TAIL_SCAN_START", "0");
+        radiiOnly = makeEngine(gpuOptions(), whyNot);
+    }
+    tail = makeEngine(gpuOptions(), whyNot);
+    {
+        const ScopedEnv start("RTHDIST_TAIL_SCAN_START", "4294967296");
+        fromStart = makeEngine(gpuOptions(), whyNot);
+    }
+    if (!radiiOnly || !tail || !fromStart) GTEST_SKIP() << "no device for this backend: " << whyNot;
     uint64_t scanned = 0;
+    uint32_t scannedWhole = 0;  // directions whose whole search was one scan
     for (uint64_t seed = 61; seed < 66; ++seed) {
         const bool overflow = seed == 65;  // as in RadiiInOneSubmissionEqualOnePerSubmission
         OracleCase c{
@@ -263,24 +277,30 @@ TEST(GpuEngine, TailScanEqualsRadiiAndBruteForce) {
         call.perPointDistances = seed % 2 == 0;
         call.bits = overflow ? 1 : 0;
         auto r = radiiOnly->compute(c.a, c.b, call);
-        auto t = tail->compute(c.a, c.b, call);
         ASSERT_TRUE(r.ok()) << r.error().message;
-        ASSERT_TRUE(t.ok()) << t.error().message;
         EXPECT_EQ(r->aToB.counters.tailScanned + r->bToA.counters.tailScanned, 0u);
-        scanned += t->aToB.counters.tailScanned + t->bToA.counters.tailScanned;
-        expectMatchesOracle(c, *t);
-        EXPECT_EQ(t->hausdorff, r->hausdorff);
-        EXPECT_EQ(t->aToB.distance, r->aToB.distance);
-        EXPECT_EQ(t->bToA.distance, r->bToA.distance);
-        if (call.perPointDistances) {
-            EXPECT_EQ(t->aNearest.distance, oracle::bruteForceNearest(c.a, c.b));
-            EXPECT_EQ(t->bNearest.distance, oracle::bruteForceNearest(c.b, c.a));
-            EXPECT_EQ(t->aNearest.nearest, r->aNearest.nearest);
-            EXPECT_EQ(t->bNearest.nearest, r->bNearest.nearest);
+        for (Engine* e : {&*tail, &*fromStart}) {
+            auto t = e->compute(c.a, c.b, call);
+            ASSERT_TRUE(t.ok()) << t.error().message;
+            scanned += t->aToB.counters.tailScanned + t->bToA.counters.tailScanned;
+            for (const Directed* d : {&t->aToB, &t->bToA})
+                scannedWhole += d->counters.iterations == 1 && d->counters.tailScanned > 0 &&
+                                d->counters.tailScanned == d->counters.survivingQueries;
+            expectMatchesOracle(c, *t);
+            EXPECT_EQ(t->hausdorff, r->hausdorff);
+            EXPECT_EQ(t->aToB.distance, r->aToB.distance);
+            EXPECT_EQ(t->bToA.distance, r->bToA.distance);
+            if (call.perPointDistances) {
+                EXPECT_EQ(t->aNearest.distance, oracle::bruteForceNearest(c.a, c.b));
+                EXPECT_EQ(t->bNearest.distance, oracle::bruteForceNearest(c.b, c.a));
+                EXPECT_EQ(t->aNearest.nearest, r->aNearest.nearest);
+                EXPECT_EQ(t->bNearest.nearest, r->bNearest.nearest);
+            }
+            EXPECT_EQ(t->validationMessages, 0u);
         }
-        EXPECT_EQ(t->validationMessages, 0u);
     }
     EXPECT_GT(scanned, 0u);
+    EXPECT_GT(scannedWhole, 0u);
 }
 
 // Per-point arrays handed back (Engine::recycle), of other sizes and
