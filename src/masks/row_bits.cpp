@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <bit>
 #include <cstdlib>
+#include <type_traits>
 
 #include "core/parallel.hpp"
+#include "masks/byte_rows.hpp"
 #include "masks/selected.hpp"
 
 namespace rthdist::masks::detail {
@@ -36,8 +38,19 @@ RowBits::RowBits(const Volume& v, LabelSelect select, int threads)
     std::vector<uint64_t> chunkCounts((rows + kRowsPerChunk - 1) / kRowsPerChunk, 0);
     withLabels(v, [&](const auto* labels) {
         const Selected sel(labels, select);
+        using Label = std::remove_cv_t<std::remove_pointer_t<decltype(labels)>>;
         core::parallelChunks(rows, kRowsPerChunk, threads, [&](size_t b, size_t e, int) {
             uint64_t count = 0;
+            if constexpr (std::is_same_v<Label, uint8_t>) {
+                if (!sel.none) {  // 8-bit labels: byte_rows.hpp (AVX2 where the CPU has it)
+                    const ByteSelect bytes{sel.any, sel.value};
+                    for (size_t r = b; r < e; ++r)
+                        count += packByteRow(labels + int64_t(r) * nx, nx, bytes,
+                                             m_words.data() + r * size_t(m_rowWords));
+                    chunkCounts[b / kRowsPerChunk] = count;
+                    return;
+                }
+            }
             for (size_t r = b; r < e; ++r) {
                 uint64_t* words = m_words.data() + r * size_t(m_rowWords);
                 packRow(sel, int64_t(r) * nx, nx, words);

@@ -1,7 +1,7 @@
 // A mask's selection packed one bit per voxel, row by row: what the host
 // extraction (boundary.cpp) tests neighbours on. The label volume is read
-// once, by rows on every thread (64 labels to a word; 16 8-bit labels per
-// SSE2 compare where the target has it), then a row's boundary is word
+// once, by rows on every thread (64 labels to a word; 8-bit labels through
+// byte_rows.hpp, 32 per AVX2 compare where the CPU has it), then a row's boundary is word
 // arithmetic on it and on its up to eight neighbour rows, and an empty row
 // costs a test of its words. (Packing and testing slab by slab instead, with
 // three slices in cache, measured slower on the H100 machine's 16 cores:

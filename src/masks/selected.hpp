@@ -6,10 +6,7 @@
 #include <limits>
 #include <type_traits>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
+#include "masks/byte_rows.hpp"
 #include "masks/masks.hpp"
 
 namespace rthdist::masks::detail {
@@ -32,16 +29,12 @@ struct Selected {
     }
     bool operator()(int64_t i) const { return any ? data[i] != 0 : (!none && data[i] == value); }
     // Bit i set when voxel at + i is selected, for the n <= 64 voxels from
-    // `at` (64 8-bit labels: four 16-byte SSE2 compares where the target
-    // has them). The packing of the host extraction (row_bits.hpp) and of a
-    // prepared itk reference (selection_bits.hpp).
+    // `at` (8-bit labels: byte_rows.hpp's SSE2 compares). The packing of the
+    // host extraction (row_bits.hpp) and of a prepared itk reference
+    // (selection_bits.hpp).
     uint64_t word(int64_t at, int64_t n = 64) const {
         if (none) return 0;
-#if defined(__SSE2__)
-        if constexpr (std::is_same_v<T, uint8_t>) {
-            if (n == 64) return word64(at);
-        }
-#endif
+        if constexpr (std::is_same_v<T, uint8_t>) return byteWord(data + at, n, ByteSelect{any, value});
         uint64_t bits = 0;
         for (int64_t i = 0; i < n; ++i) bits |= uint64_t((*this)(at + i)) << i;
         return bits;
@@ -57,21 +50,6 @@ struct Selected {
         }
         return c;
     }
-
-private:
-#if defined(__SSE2__)
-    uint64_t word64(int64_t at) const {
-        const __m128i key = _mm_set1_epi8(static_cast<char>(any ? 0 : value));
-        uint64_t bits = 0;
-        for (int k = 0; k < 4; ++k) {
-            const __m128i labels = _mm_loadu_si128(reinterpret_cast<const __m128i*>(data + at + 16 * k));
-            uint32_t equal = uint32_t(_mm_movemask_epi8(_mm_cmpeq_epi8(labels, key)));
-            if (any) equal = ~equal & 0xffffu;
-            bits |= uint64_t(equal) << (16 * k);
-        }
-        return bits;
-    }
-#endif
 };
 
 // Calls fn(labels) with the stored array's typed pointer.
