@@ -61,7 +61,7 @@ Extraction extractBoundary(const Volume& v, LabelSelect select, int connectivity
     if (e.count == 0) return e;
     e.boundary = perSlice<core::UninitVector<uint64_t>>(
         v.dims[2], threads, [&](int64_t z, std::vector<uint64_t>& out) {
-            for (int64_t y = 0; y < v.dims[1]; ++y) bits.appendBoundaryOfRow(y, z, connectivity, out);
+            bits.forRowsInUse(z, [&](int64_t y) { bits.appendBoundaryOfRow(y, z, connectivity, out); });
         });
     return e;
 }

@@ -35,29 +35,36 @@ RowBits::RowBits(const Volume& v, LabelSelect select, int threads)
     const int64_t nx = m_dims[0];
     const size_t rows = size_t(m_dims[1] * m_dims[2]);
     m_words.resize(rows * size_t(m_rowWords));
+    // A chunk's rows are whole words of m_rowsInUse (kRowsPerChunk % 64 == 0):
+    // each word has one writer.
+    static_assert(kRowsPerChunk % 64 == 0);
+    m_rowsInUse.resize((rows + 63) / 64);
     std::vector<uint64_t> chunkCounts((rows + kRowsPerChunk - 1) / kRowsPerChunk, 0);
     withLabels(v, [&](const auto* labels) {
         const Selected sel(labels, select);
         using Label = std::remove_cv_t<std::remove_pointer_t<decltype(labels)>>;
         core::parallelChunks(rows, kRowsPerChunk, threads, [&](size_t b, size_t e, int) {
             uint64_t count = 0;
-            if constexpr (std::is_same_v<Label, uint8_t>) {
-                if (!sel.none) {  // 8-bit labels: byte_rows.hpp (AVX2 where the CPU has it)
-                    const ByteSelect bytes{sel.any, sel.value};
-                    for (size_t r = b; r < e; ++r)
-                        count += packByteRow(labels + int64_t(r) * nx, nx, bytes,
-                                             m_words.data() + r * size_t(m_rowWords));
-                    chunkCounts[b / kRowsPerChunk] = count;
-                    return;
-                }
-            }
+            for (size_t w = b / 64; w < (e + 63) / 64; ++w) m_rowsInUse[w] = 0;
             for (size_t r = b; r < e; ++r) {
                 uint64_t* words = m_words.data() + r * size_t(m_rowWords);
-                packRow(sel, int64_t(r) * nx, nx, words);
-                // Most words of a mask volume are empty; std::popcount is a
-                // library call on the baseline x86-64 target (no POPCNT).
-                for (int64_t w = 0; w < m_rowWords; ++w)
-                    if (words[w] != 0) count += uint64_t(std::popcount(words[w]));
+                uint64_t inRow = 0;
+                if constexpr (std::is_same_v<Label, uint8_t>) {
+                    // 8-bit labels: byte_rows.hpp (AVX2 where the CPU has it).
+                    if (!sel.none)
+                        inRow =
+                            packByteRow(labels + int64_t(r) * nx, nx, ByteSelect{sel.any, sel.value}, words);
+                    else
+                        std::fill(words, words + m_rowWords, uint64_t(0));
+                } else {
+                    packRow(sel, int64_t(r) * nx, nx, words);
+                    // Most words of a mask volume are empty; std::popcount is a
+                    // library call on the baseline x86-64 target (no POPCNT).
+                    for (int64_t w = 0; w < m_rowWords; ++w)
+                        if (words[w] != 0) inRow += uint64_t(std::popcount(words[w]));
+                }
+                if (inRow != 0) m_rowsInUse[r / 64] |= uint64_t(1) << (r % 64);
+                count += inRow;
             }
             chunkCounts[b / kRowsPerChunk] = count;
         });

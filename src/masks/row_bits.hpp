@@ -16,6 +16,7 @@
 // any number of threads.
 #pragma once
 
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -36,6 +37,24 @@ public:
     // 26 (boundary.hpp's definition) to `out` as linear indices, ascending.
     void appendBoundaryOfRow(int64_t y, int64_t z, int connectivity, std::vector<uint64_t>& out) const;
 
+    // fn(y) for every row y of slice z that holds a selected voxel, in
+    // ascending y (the others hold no boundary voxel): the boundary pass
+    // reads only those rows and their neighbours (a mask's slices are mostly
+    // background: the organ pair's 153,600 rows per volume cost 0.6-0.9 ms
+    // to visit on the H100 machine).
+    template <class Fn>
+    void forRowsInUse(int64_t z, Fn&& fn) const {
+        const int64_t ny = m_dims[1];
+        const int64_t first = z * ny, end = first + ny;
+        for (int64_t r = first; r < end;) {
+            const int64_t word = r / 64, bit = r % 64;
+            uint64_t bits = m_rowsInUse[size_t(word)] >> bit;
+            if (end - r < 64 - bit) bits &= (uint64_t(1) << (end - r)) - 1;
+            for (; bits != 0; bits &= bits - 1) fn(r + std::countr_zero(bits) - first);
+            r += 64 - bit;
+        }
+    }
+
 private:
     [[nodiscard]] const uint64_t* row(int64_t y, int64_t z) const {
         return m_words.data() + size_t((z * m_dims[1] + y) * m_rowWords);
@@ -44,6 +63,7 @@ private:
     Dims m_dims{0, 0, 0};
     int64_t m_rowWords = 0;
     core::UninitVector<uint64_t> m_words;
+    core::UninitVector<uint64_t> m_rowsInUse;  // bit r: row r (z * ny + y) holds a selected voxel
     uint64_t m_count = 0;
 };
 
