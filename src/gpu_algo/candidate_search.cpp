@@ -200,7 +200,7 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
         out.stillOpen = log[i].goingOn;
         out.lastPairs = log[i].pairs;
         out.overflowed = log[i].pairs > pairCapacity;
-        d.out.counters.rays += log[i].searched;
+        if (!wholeLevel) d.out.counters.rays += log[i].searched;  // the tail scan casts none
         d.out.counters.candidatePairs += std::min<uint64_t>(log[i].pairs, pairCapacity);
     }
     if (out.run == 0) throw std::runtime_error("candidate search: the device searched no query");
