@@ -79,11 +79,12 @@ std::pair<double, double> bucketSelect(std::span<const double> values, size_t k,
     while (next >= upTo) upTo += total[++last];
     std::vector<std::vector<double>> inside(chunks);
     core::parallelChunks(n, kChunk, threads, [&](size_t b, size_t e, int) {
-        std::vector<double>& in = inside[b / kChunk];
+        std::vector<double> in;  // the thread's own (perSlice's note on shared lines)
         for (size_t i = b; i < e; ++i) {
             const size_t bucket = bucketOf(values[i]);
             if (bucket >= first && bucket <= last) in.push_back(values[i]);
         }
+        inside[b / kChunk] = std::move(in);
     });
     std::vector<double> gathered;
     for (const auto& in : inside) gathered.insert(gathered.end(), in.begin(), in.end());

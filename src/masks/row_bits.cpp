@@ -45,7 +45,7 @@ RowBits::RowBits(const Volume& v, LabelSelect select, int threads)
         using Label = std::remove_cv_t<std::remove_pointer_t<decltype(labels)>>;
         core::parallelChunks(rows, kRowsPerChunk, threads, [&](size_t b, size_t e, int) {
             uint64_t count = 0;
-            for (size_t w = b / 64; w < (e + 63) / 64; ++w) m_rowsInUse[w] = 0;
+            uint64_t inUse[kRowsPerChunk / 64] = {};  // written to m_rowsInUse once, below
             for (size_t r = b; r < e; ++r) {
                 uint64_t* words = m_words.data() + r * size_t(m_rowWords);
                 uint64_t inRow = 0;
@@ -63,9 +63,10 @@ RowBits::RowBits(const Volume& v, LabelSelect select, int threads)
                     for (int64_t w = 0; w < m_rowWords; ++w)
                         if (words[w] != 0) inRow += uint64_t(std::popcount(words[w]));
                 }
-                if (inRow != 0) m_rowsInUse[r / 64] |= uint64_t(1) << (r % 64);
+                if (inRow != 0) inUse[(r - b) / 64] |= uint64_t(1) << (r % 64);
                 count += inRow;
             }
+            for (size_t w = b / 64; w < (e + 63) / 64; ++w) m_rowsInUse[w] = inUse[w - b / 64];
             chunkCounts[b / kRowsPerChunk] = count;
         });
     });
