@@ -11,6 +11,7 @@ namespace rthdist::masks::detail {
 namespace {
 
 constexpr size_t kChunk = size_t(1) << 13;
+constexpr size_t kPrefetchAhead = 16;  // queries (2 cores: the distances of the noisy pair 2.3-2.5 -> 2.1 ms)
 
 glm::dvec3 asVector(std::array<int64_t, 3> ijk) {
     return glm::dvec3(double(ijk[0]), double(ijk[1]), double(ijk[2]));
@@ -85,6 +86,9 @@ RecomputedDirection recompute(const VoxelMetric& metric, Dims dims, std::span<co
         size_t witness = b;
         double least = std::numeric_limits<double>::infinity();
         for (size_t i = b; i < e; ++i) {
+            // The targets are read in the engine's order, not theirs: fetch a
+            // few queries ahead.
+            if (i + kPrefetchAhead < e) __builtin_prefetch(&targets[nearest[i + kPrefetchAhead]]);
             const double d = metric.distance(decode(queries[i]), decode(targets[nearest[i]]));
             r.distances[i] = d;
             sum += d;
