@@ -11,6 +11,7 @@
 
 #include "core/nearest_rank.hpp"
 #include "core/parallel.hpp"
+#include "core/uninit_vector.hpp"
 
 namespace rthdist::masks::detail {
 namespace {
@@ -62,14 +63,23 @@ std::pair<double, double> bucketSelect(std::span<const double> values, size_t k,
     }
     const auto bucketOf = [lo, scale](double v) { return std::min(kBuckets - 1, size_t((v - lo) * scale)); };
     const int workers = core::resolveThreads(threads, chunks);
-    std::vector<uint64_t> histograms(size_t(workers) * kBuckets, 0);
+    // Each thread zeroes its own histogram at its first chunk (kept blocks:
+    // core::UninitVector, no fresh pages per call).
+    core::UninitVector<uint64_t> histograms;
+    histograms.resize(size_t(workers) * kBuckets);
+    std::vector<char> used(size_t(workers), 0);  // entry t: thread t's only
     core::parallelChunks(n, kChunk, workers, [&](size_t b, size_t e, int t) {
         uint64_t* h = histograms.data() + size_t(t) * kBuckets;
+        if (!used[size_t(t)]) {
+            std::fill(h, h + kBuckets, uint64_t(0));
+            used[size_t(t)] = 1;
+        }
         for (size_t i = b; i < e; ++i) ++h[bucketOf(values[i])];
     });
     std::vector<uint64_t> total(kBuckets, 0);
     for (int t = 0; t < workers; ++t)
-        for (size_t j = 0; j < kBuckets; ++j) total[j] += histograms[size_t(t) * kBuckets + j];
+        if (used[size_t(t)])
+            for (size_t j = 0; j < kBuckets; ++j) total[j] += histograms[size_t(t) * kBuckets + j];
     // first: the bucket holding rank k (below: the values before it); last:
     // the one holding rank k + 1 (the same or a later one).
     const size_t next = std::min(k + 1, n - 1);
