@@ -54,7 +54,9 @@ struct EngineOptions {
     bool validation = false;
     // Host threads: the CPU backend's, and the GPU backends' passes over the
     // points (checks, bounds, copies); 0 = all hardware threads. The work
-    // runs on one persistent worker pool per process (core/thread_pool).
+    // runs on one persistent worker pool per process (core/thread_pool),
+    // whose waiting threads poll for up to 200 us before they sleep
+    // (RTHDIST_POOL_SPIN_US sets it; 0: never).
     int threads = 0;
     // GPU backends: the directory of the pipeline cache file, which spares a
     // new process the pipeline compilation on the same device and driver.
