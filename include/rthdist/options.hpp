@@ -93,6 +93,13 @@ struct CallOptions {
     // (HausdorffResult::aNearest / bNearest). Every query then needs its own
     // NN, so the early break against the running maximum is off: slower.
     bool perPointDistances = false;
+    // With perPointDistances: fill only PerPoint::nearest, leaving
+    // PerPoint::distance empty, for callers that recompute each distance in
+    // a metric of their own (the segmentation masks do, from voxel
+    // indices). On the GPU backends it spares the host's pass over every
+    // query's pair; the CPU backend computes the distances for its witness
+    // and drops them. Ignored without perPointDistances.
+    bool perPointNearestOnly = false;
     // Called from the calling thread between stages and iterations with a
     // stage name ("index", "cull", "search", "refine") and the fraction of
     // the whole call done so far (0..1); a pair scanned whole (small pairs on

@@ -274,8 +274,15 @@ Device& laneDevice(const Engine::Impl& impl, size_t lane) {
     return lane == 0 ? *impl.device : *impl.moreDevices[lane - 1];
 }
 
-// What every call's result carries besides the backend's figures.
-void finishResult(Engine::Impl& impl, HausdorffResult& r, std::chrono::steady_clock::time_point t0) {
+// What every call's result carries besides the backend's figures; a
+// nearest-only per-point call's distances dropped (the backends that
+// computed them anyway: CallOptions::perPointNearestOnly).
+void finishResult(Engine::Impl& impl, HausdorffResult& r, const CallOptions& call,
+                  std::chrono::steady_clock::time_point t0) {
+    if (call.perPointDistances && call.perPointNearestOnly) {
+        r.aNearest.distance.clear();
+        r.bNearest.distance.clear();
+    }
     r.timings.setup = impl.setupMs;
     impl.setupMs = 0.0;  // only the first call pays for creation
     r.timings.total = msSince(t0);
@@ -380,7 +387,7 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
     if (copied) core::restoreOriginal(*r, a, b, impl.options.threads);
     r->origin = origin;
-    finishResult(impl, *r, t0);
+    finishResult(impl, *r, call, t0);
     return r;
 }
 
@@ -413,7 +420,7 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
     Result<HausdorffResult> r = impl.device->gpu->computePacked(asVec3(a), asVec3(b), call);
     if (!r) return r;
     r->origin = glm::dvec3(0.0);
-    finishResult(impl, *r, t0);
+    finishResult(impl, *r, call, t0);
     return r;
 }
 
@@ -498,7 +505,7 @@ std::vector<Result<HausdorffResult>> scanSmallPairs(Engine::Impl& impl, std::spa
         if (!a.originals.empty() || !b.originals.empty())
             core::restoreOriginal(*out[i], a.input(), b.input(), impl.options.threads);
         out[i]->origin = a.origin;
-        finishResult(impl, *out[i], t0);
+        finishResult(impl, *out[i], call, t0);
         out[i]->timings.total = share;
     }
     return out;
@@ -533,7 +540,7 @@ Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet&
     if (!ia.originals.empty() || !ib.originals.empty())
         core::restoreOriginal(*r, ia.input(), ib.input(), m_impl->options.threads);
     r->origin = ia.origin;
-    finishResult(*m_impl, *r, t0);
+    finishResult(*m_impl, *r, call, t0);
     return r;
 }
 
@@ -631,7 +638,7 @@ Result<HausdorffResult> Engine::compute(const DevicePointView& a, const DevicePo
                                                   "(device input is not split into pieces)"};
     Result<HausdorffResult> r = m_impl->device->gpu->computeDevice(*da, *db, call);
     if (!r) return r;
-    finishResult(*m_impl, *r, t0);
+    finishResult(*m_impl, *r, call, t0);
     return r;
 }
 

@@ -115,6 +115,7 @@ CallOptions pieceOptions(const CallOptions& call, bool perPoint, double from, do
     CallOptions piece = call;
     piece.directedOnly = true;
     piece.perPointDistances = perPoint;
+    piece.perPointNearestOnly = false;  // the pieces are merged by their distances
     if (call.progress) {
         piece.progress = [progress = call.progress, from, width](const char* stage, double f) {
             progress(stage, from + width * f);

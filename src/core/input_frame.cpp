@@ -164,6 +164,7 @@ void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b,
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
     }
     auto perPoint = [threads](PerPoint& pp, const PointView& q, const PointView& t) {
+        if (pp.distance.empty()) return;  // nearest only
         const int workers = core::resolveThreads(threads, pp.nearest.size() / kChunk + 1);
         core::parallelChunks(pp.nearest.size(), kChunk, workers, [&](size_t begin, size_t end, int) {
             for (size_t i = begin; i < end; ++i) pp.distance[i] = glm::length(q.at(i) - t.at(pp.nearest[i]));

@@ -83,7 +83,9 @@ private:
 };
 
 // Replaces a backend's witnesses and per-point distances (float coordinates
-// after the shift) by those of the original coordinates, in double.
+// after the shift) by those of the original coordinates, in double. A
+// per-point array without distances (CallOptions::perPointNearestOnly)
+// stays without them.
 void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b, int threads = 0);
 
 }  // namespace rthdist::core

@@ -26,6 +26,7 @@ struct DirectionRun {
     SetPoints& tPts;
     const CounterBlock& blk;
     PerPoint* perPoint = nullptr;
+    bool perPointDistances = true;  // false: perPoint's nearest only (CallOptions::perPointNearestOnly)
     Directed out;
     double lowerBound2Exact = 0.0;  // the boxes' bound (double), for the witness check
     float lowerBound2 = 0.0f;       // < 0: per-point (no early break)

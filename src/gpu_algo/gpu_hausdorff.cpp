@@ -274,6 +274,7 @@ struct GpuHausdorff::State {
         const double mid = options.directedOnly ? 1.0 : from + 0.5 * (1.0 - from);
         DirectionRun ab{a.ix, b.ix, a.pts, b.pts, ws.blocks[0], pp ? &res.aNearest : nullptr};
         DirectionRun ba{b.ix, a.ix, b.pts, a.pts, ws.blocks[1], pp ? &res.bNearest : nullptr};
+        ab.perPointDistances = ba.perPointDistances = !options.perPointNearestOnly;
         cull.startDirection(ab, 0);
         if (!options.directedOnly) cull.startDirection(ba, 1);
         // Both culls (and their checks) in one submission; a direction with

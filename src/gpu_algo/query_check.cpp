@@ -114,8 +114,9 @@ void QueryCheck::readPerPoint(const DirectionRun& d, PerPoint& out) {
     const auto* nearest = static_cast<const uint32_t*>(d.nearestHost->mapped());
     // Arrays recycled from an earlier call (Engine::recycle) are not
     // cleared first: every entry is written below.
-    out.distance.resize(d.Q.n);
+    out.distance.resize(d.perPointDistances ? d.Q.n : 0);
     out.nearest.resize(d.Q.n);
+    const bool distances = d.perPointDistances;
     // Cached host memory (MemoryKind::kReadback) read on every host thread,
     // in the queries' own order. Chunks of 2^13 queries: a mask's 10^5
     // boundary voxels take every thread.
@@ -131,7 +132,7 @@ void QueryCheck::readPerPoint(const DirectionRun& d, PerPoint& out) {
                 return;
             }
             out.nearest[qi] = ti;
-            out.distance[qi] = glm::length(glm::dvec3(qPts[qi]) - glm::dvec3(tPts[ti]));
+            if (distances) out.distance[qi] = glm::length(glm::dvec3(qPts[qi]) - glm::dvec3(tPts[ti]));
         }
     });
     if (firstBad.load() != UINT64_MAX)

@@ -49,7 +49,8 @@ public:
 
     // Every query is EXACT after a per-point run (the check counted any
     // other): the nearest targets its self-check copied to the host, with
-    // their distances in double.
+    // their distances in double unless d.perPointDistances is off (then
+    // `out.distance` is left empty).
     void readPerPoint(const DirectionRun& d, PerPoint& out);
 
 private:

@@ -1,5 +1,6 @@
 // The options of every engine call of compareMasks: each query's exact
-// nearest distance (per-point), one direction or both. Set per call, so any
+// nearest point (per-point, nearest only: the masks recompute each
+// distance in double from the voxels), one direction or both. Set per call, so any
 // Engine serves (its own call defaults are not used). Internal to rthdist_masks.
 #pragma once
 
@@ -10,6 +11,7 @@ namespace rthdist::masks::detail {
 [[nodiscard]] inline CallOptions perPointCall(bool directedOnly) {
     CallOptions call;
     call.perPointDistances = true;
+    call.perPointNearestOnly = true;  // the distances are recomputed from the voxels
     call.directedOnly = directedOnly;
     return call;
 }

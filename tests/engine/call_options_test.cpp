@@ -58,6 +58,63 @@ TEST(CallOptions, ChangeBetweenCallsOfOneEngine) {
     }
 }
 
+// Per-point nearest only (CallOptions::perPointNearestOnly): the same
+// nearest points, H and witnesses as the call with distances and
+// PerPoint::distance empty — one-shot, after a recycled result whose arrays
+// held distances, prepared, and on double input far from the origin (the
+// witnesses restored in double).
+TEST(CallOptions, PerPointNearestOnlyKeepsTheNearestPoints) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    const OracleCase c{"nearest-only", 23, randomCloud(4000, 23),
+                       randomCloud(3000, 24, glm::vec3(0.3f, 0.1f, 0.0f))};
+    CallOptions full;
+    full.perPointDistances = true;
+    CallOptions only = full;
+    only.perPointNearestOnly = true;
+    auto expectSame = [](const HausdorffResult& o, const HausdorffResult& f) {
+        EXPECT_TRUE(o.aNearest.distance.empty());
+        EXPECT_TRUE(o.bNearest.distance.empty());
+        EXPECT_EQ(o.aNearest.nearest, f.aNearest.nearest);
+        EXPECT_EQ(o.bNearest.nearest, f.bNearest.nearest);
+        EXPECT_EQ(o.hausdorff, f.hausdorff);
+        EXPECT_EQ(o.aToB.queryIndex, f.aToB.queryIndex);
+        EXPECT_EQ(o.bToA.targetIndex, f.bToA.targetIndex);
+    };
+    auto f = engine->compute(c.a, c.b, full);
+    ASSERT_TRUE(f.ok()) << f.error().message;
+    EXPECT_EQ(f->aNearest.distance, oracle::bruteForceNearest(c.a, c.b));
+    auto o = engine->compute(c.a, c.b, only);
+    ASSERT_TRUE(o.ok()) << o.error().message;
+    expectSame(*o, *f);
+    {
+        SCOPED_TRACE("recycled");
+        HausdorffResult spent = *f;  // arrays of the right sizes, distances filled
+        engine->recycle(std::move(spent));
+        auto again = engine->compute(c.a, c.b, only);
+        ASSERT_TRUE(again.ok()) << again.error().message;
+        expectSame(*again, *f);
+    }
+    {
+        SCOPED_TRACE("prepared");
+        auto pa = engine->prepare(c.a);
+        auto pb = engine->prepare(c.b);
+        ASSERT_TRUE(pa && pb);
+        auto p = engine->compute(*pa, *pb, only);
+        ASSERT_TRUE(p.ok()) << p.error().message;
+        expectSame(*p, *f);
+    }
+    {
+        SCOPED_TRACE("double input far from the origin");
+        std::vector<glm::dvec3> da, db;
+        for (const glm::vec3& v : c.a) da.push_back(glm::dvec3(v) + glm::dvec3(5.0e5, -2.0e5, 1.0e3));
+        for (const glm::vec3& v : c.b) db.push_back(glm::dvec3(v) + glm::dvec3(5.0e5, -2.0e5, 1.0e3));
+        auto fd = engine->compute(PointView(da), PointView(db), full);
+        auto od = engine->compute(PointView(da), PointView(db), only);
+        ASSERT_TRUE(fd.ok() && od.ok());
+        expectSame(*od, *fd);
+    }
+}
+
 TEST(CallOptions, InvalidCallOptionsAreErrorValues) {
     RTHDIST_REQUIRE_TEST_ENGINE(engine);
     const auto a = randomCloud(100, 1), b = randomCloud(100, 2);

@@ -97,6 +97,15 @@ TEST(OutOfCore, PerPointAndDirectedUnderAForcedBudget) {
         EXPECT_EQ(got->bNearest.distance.empty(), directed);
         EXPECT_GT(got->aToB.counters.targetTiles, 1u);
         EXPECT_GT(got->aToB.counters.queryChunks, 1u);
+        // Nearest only: the pieces still merge by their distances, the
+        // result drops them.
+        CallOptions nearestOnly = call;
+        nearestOnly.perPointNearestOnly = true;
+        auto only = split.compute(c.a, c.b, nearestOnly);
+        ASSERT_TRUE(only.ok()) << only.error().message;
+        EXPECT_TRUE(only->aNearest.distance.empty());
+        EXPECT_EQ(only->aNearest.nearest, got->aNearest.nearest);
+        EXPECT_EQ(only->hausdorff, got->hausdorff);
     }
 }
 
