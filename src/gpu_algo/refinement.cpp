@@ -25,15 +25,7 @@ void Refinement::cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointInde
     rp.numFineCells = d.T.numCells;
     m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kRefine, &rp, sizeof(rp), args.handle(), 0);
     m_ws.barrier(cmd);
-    sh::ResolvePush rs{d.state->address(),
-                       d.active[d.cur]->address(),
-                       d.active[1 - d.cur]->address(),
-                       d.blk.device,
-                       d.blk.addr(RTHDIST_CTR_MAX_PACKED),
-                       numActive,
-                       r,
-                       d.lowerBound2};
-    m_ws.dispatchSearched(cmd, Kernel::kResolve, rs, numActive, d.blk);
+    cmdResolve(cmd, d, numActive, r);
 }
 
 void Refinement::cmdTailScan(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse,
@@ -53,15 +45,18 @@ void Refinement::cmdTailScan(VkCommandBuffer cmd, DirectionRun& d, const PointIn
                               d.T.numCells};
     m_ws.pipelines.cmdDispatch(cmd, Kernel::kTailScan, &tp, sizeof(tp), numActive);  // a group per query
     m_ws.barrier(cmd);
-    const float everything = std::numeric_limits<float>::infinity();
-    sh::ResolvePush rs{d.state->address(),
-                       d.active[d.cur]->address(),
-                       d.active[1 - d.cur]->address(),
-                       d.blk.device,
-                       d.blk.addr(RTHDIST_CTR_MAX_PACKED),
-                       numActive,
-                       everything,
-                       d.lowerBound2};
+    cmdResolve(cmd, d, numActive, std::numeric_limits<float>::infinity());  // everything was scanned
+}
+
+void Refinement::cmdResolve(VkCommandBuffer cmd, DirectionRun& d, uint32_t numActive, float radius) {
+    const sh::ResolvePush rs{d.state->address(),
+                             d.active[d.cur]->address(),
+                             d.active[1 - d.cur]->address(),
+                             d.blk.device,
+                             d.blk.addr(RTHDIST_CTR_MAX_PACKED),
+                             numActive,
+                             radius,
+                             d.lowerBound2};
     m_ws.dispatchSearched(cmd, Kernel::kResolve, rs, numActive, d.blk);
 }
 

@@ -30,6 +30,10 @@ public:
                      uint32_t numActive);
 
 private:
+    // Every active query resolved at `radius` (resolve.comp): exact, dead,
+    // or into the other active buffer for the next radius.
+    void cmdResolve(VkCommandBuffer cmd, DirectionRun& d, uint32_t numActive, float radius);
+
     Workspace& m_ws;
 };
 
