@@ -15,6 +15,7 @@
 
 #include "common/brute_force.hpp"
 #include "common/oracle_cases.hpp"
+#include "common/scoped_env.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {
@@ -34,37 +35,17 @@ std::vector<glm::vec3> uniformCloud(size_t n, uint64_t seed, glm::vec3 offset, f
 std::pair<std::optional<Engine>, std::optional<Engine>> enginesWithAndWithout(const char* name,
                                                                               const char* value,
                                                                               std::string& whyNot) {
-    const char* before = std::getenv(name);
-    const std::string saved = before ? before : "";
-    setenv(name, value, 1);
-    std::optional<Engine> with = makeEngine(gpuOptions(), whyNot);
-    unsetenv(name);
-    std::optional<Engine> without = makeEngine(gpuOptions(), whyNot);
-    if (before) setenv(name, saved.c_str(), 1);
+    std::optional<Engine> with, without;
+    {
+        const ScopedEnv set(name, value);
+        with = makeEngine(gpuOptions(), whyNot);
+    }
+    {
+        const ScopedEnv unset(name, nullptr);
+        without = makeEngine(gpuOptions(), whyNot);
+    }
     return {std::move(with), std::move(without)};
 }
-
-// Sets an environment variable for its lifetime, then restores it.
-class ScopedEnv {
-public:
-    ScopedEnv(const char* name, const char* value) : m_name(name) {
-        const char* before = std::getenv(name);
-        if (before) m_saved = before;
-        setenv(name, value, 1);
-    }
-    ~ScopedEnv() {
-        if (m_saved)
-            setenv(m_name, m_saved->c_str(), 1);
-        else
-            unsetenv(m_name);
-    }
-    ScopedEnv(const ScopedEnv&) = delete;
-    ScopedEnv& operator=(const ScopedEnv&) = delete;
-
-private:
-    const char* m_name;
-    std::optional<std::string> m_saved;
-};
 
 void expectExact(Engine& engine, const std::string& name, uint64_t seed, std::vector<glm::vec3> a,
                  std::vector<glm::vec3> b) {

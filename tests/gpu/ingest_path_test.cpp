@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "common/oracle_cases.hpp"
+#include "common/scoped_env.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {
@@ -120,9 +121,8 @@ TEST(IngestPath, DeviceBitCountEqualsTheHostCount) {
 TEST(IngestPath, ImportedOrCopiedArraysStartingAnywhere) {
     const std::vector<OracleCase> cases = makeOracleCases();
     for (const char* import : {"1", "0"}) {
-        setenv("RTHDIST_HOST_IMPORT", import, 1);
+        const ScopedEnv imports("RTHDIST_HOST_IMPORT", import);  // read when the device is made
         RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
-        unsetenv("RTHDIST_HOST_IMPORT");
         for (size_t k = 5; k < cases.size(); k += 41) {
             const OracleCase& c = cases[k];
             SCOPED_TRACE(c.name + (import[0] == '1' ? " imported" : " copied"));
