@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -100,6 +101,21 @@ struct CallOptions {
     // query's pair; the CPU backend computes the distances for its witness
     // and drops them. Ignored without perPointDistances.
     bool perPointNearestOnly = false;
+    // With perPointDistances and perPointNearestOnly (else the call is
+    // refused, kInvalidArgument): called once per computed direction
+    // (0: A's points -> B, 1: B's -> A) with that direction's
+    // PerPoint::nearest — the very array the result returns — as soon as it
+    // is final, so that a caller's own work on one direction overlaps the
+    // search of the other. Engine::compute calls only; computeBatch ignores
+    // it. On the GPU backends the direction with more query points is then
+    // searched first and handed to a thread of the call's own while the
+    // device searches the other one; every other path (the CPU backend,
+    // pairs split into pieces, small pairs scanned whole) calls it from the
+    // calling thread once the result is complete. Either way compute()
+    // returns (a result or an error) only after every call of it has
+    // returned. Must not throw and must not call back into the Engine; it
+    // may run the library's host threads (it shares their pool).
+    std::function<void(int direction, std::span<const uint32_t> nearest)> perPointReady;
     // Called from the calling thread between stages and iterations with a
     // stage name ("index", "cull", "search", "refine") and the fraction of
     // the whole call done so far (0..1); a pair scanned whole (small pairs on

@@ -49,6 +49,10 @@ std::optional<Error> validateCallOptions(const CallOptions& o) {
     if (!(o.radiusGrowth > 1.0f) || !std::isfinite(o.radiusGrowth)) {
         return Error{ErrorCode::kInvalidArgument, "radiusGrowth must be a finite number > 1"};
     }
+    if (o.perPointReady && !(o.perPointDistances && o.perPointNearestOnly))
+        return Error{ErrorCode::kInvalidArgument,
+                     "perPointReady hands back per-point nearest points: it needs perPointDistances and "
+                     "perPointNearestOnly"};
     return std::nullopt;
 }
 
@@ -274,6 +278,15 @@ Device& laneDevice(const Engine::Impl& impl, size_t lane) {
     return lane == 0 ? *impl.device : *impl.moreDevices[lane - 1];
 }
 
+// CallOptions::perPointReady for each direction of a complete result that
+// the backend did not hand back early itself (GpuHausdorff::handedBack).
+void handBackTheRest(const Engine::Impl& impl, const HausdorffResult& r, const CallOptions& call) {
+    if (!call.perPointReady) return;
+    const uint32_t done = impl.device->gpu ? impl.device->gpu->handedBack() : 0u;
+    if ((done & 1u) == 0) call.perPointReady(0, r.aNearest.nearest);
+    if (!r.directedOnly && (done & 2u) == 0) call.perPointReady(1, r.bNearest.nearest);
+}
+
 // What every call's result carries besides the backend's figures; a
 // nearest-only per-point call's distances dropped (the backends that
 // computed them anyway: CallOptions::perPointNearestOnly).
@@ -283,6 +296,7 @@ void finishResult(Engine::Impl& impl, HausdorffResult& r, const CallOptions& cal
         r.aNearest.distance.clear();
         r.bNearest.distance.clear();
     }
+    handBackTheRest(impl, r, call);
     r.timings.setup = impl.setupMs;
     impl.setupMs = 0.0;  // only the first call pays for creation
     r.timings.total = msSince(t0);
@@ -347,6 +361,8 @@ Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm:
     if (api::fitsOneCall(budget, a.size(), b.size())) {
         Result<HausdorffResult> r = runBackend(impl, 0, a, b, scale, call);
         if (r || r.error().code != ErrorCode::kOutOfMemory || !automatic) return r;
+        // A direction already handed back (perPointReady) is not handed back again from pieces.
+        if (impl.device->gpu && impl.device->gpu->handedBack() != 0) return r;
     }
     const std::function<void()> release = [&impl] {
         for (size_t lane = 0; lane < laneCount(impl); ++lane)
@@ -546,8 +562,10 @@ Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet&
 
 std::vector<Result<HausdorffResult>> Engine::computeBatch(std::span<const PreparedSet> sets,
                                                           std::span<const PairRef> pairs,
-                                                          const CallOptions& call) {
+                                                          const CallOptions& given) {
     std::vector<std::optional<Result<HausdorffResult>>> out(pairs.size());
+    CallOptions call = given;
+    call.perPointReady = nullptr;  // compute() calls only (CallOptions::perPointReady)
     const bool cancelled = call.cancel != nullptr && call.cancel->load();
     const bool callValid = !validateCallOptions(call).has_value();
     std::vector<size_t> scanned;

@@ -116,6 +116,7 @@ CallOptions pieceOptions(const CallOptions& call, bool perPoint, double from, do
     piece.directedOnly = true;
     piece.perPointDistances = perPoint;
     piece.perPointNearestOnly = false;  // the pieces are merged by their distances
+    piece.perPointReady = nullptr;      // the merged result is handed back (engine.cpp)
     if (call.progress) {
         piece.progress = [progress = call.progress, from, width](const char* stage, double f) {
             progress(stage, from + width * f);

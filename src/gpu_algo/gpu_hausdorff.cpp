@@ -5,6 +5,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -69,6 +70,9 @@ struct GpuHausdorff::State {
     Workspace ws;
     PerPoint spare;   // recyclePerPoint: the next per-point result's h(A,B) arrays
     PerPoint spareB;  // and its h(B,A) arrays
+    // Bit k: this call (or the call that failed last) has called
+    // CallOptions::perPointReady for direction k (GpuHausdorff::handedBack).
+    uint32_t handedBack = 0;
     IndexBuild index;
     QueryCheck check;
     NeighbourhoodPass cull;
@@ -285,19 +289,43 @@ struct GpuHausdorff::State {
         else
             survivors = cull.runCulls(std::array{&ab, &ba});
         reportProgress(options, "cull", from + 0.2 * (1.0 - from));
-        const auto directed = [&](DirectionRun& d, uint32_t n, double lo, double hi) {
-            const SampledQuery witness = n > 0 ? searchAndCheck(d, n, options, lo, hi) : check.finishCheck(d);
-            const auto t0 = Clock::now();
-            Directed out = check.finishDirection(d, witness);
-            ws.timings->check += msSince(t0);
-            return out;
+        struct Step {
+            DirectionRun* run;
+            uint32_t survivors;
+            Directed* out;
+            const PerPoint* perPoint;
+            int direction;
         };
-        res.aToB = directed(ab, survivors[0], from, mid);
-        res.hausdorff = res.aToB.distance;
-        if (!options.directedOnly) {
-            res.bToA = directed(ba, survivors[1], mid, 1.0);
-            res.hausdorff = std::max(res.hausdorff, res.bToA.distance);
+        std::array<Step, 2> steps{Step{&ab, survivors[0], &res.aToB, &res.aNearest, 0},
+                                  Step{&ba, survivors[1], &res.bToA, &res.bNearest, 1}};
+        const size_t count = options.directedOnly ? 1 : 2;
+        const bool handBack = pp && options.perPointReady != nullptr;
+        // Handed back: the direction with more queries first, its caller's
+        // work (proportional to them) then overlaps the other's search.
+        if (handBack && count == 2 && ba.Q.n > ab.Q.n) std::swap(steps[0], steps[1]);
+        std::jthread handing;  // the first direction's perPointReady; joined before the next call of it
+        for (size_t i = 0; i < count; ++i) {
+            const Step& s = steps[i];
+            const double lo = i == 0 ? from : mid, hi = i + 1 == count ? 1.0 : mid;
+            const SampledQuery witness = s.survivors > 0
+                                             ? searchAndCheck(*s.run, s.survivors, options, lo, hi)
+                                             : check.finishCheck(*s.run);
+            const auto t0 = Clock::now();
+            *s.out = check.finishDirection(*s.run, witness);
+            ws.timings->check += msSince(t0);
+            if (!handBack) continue;
+            handedBack |= 1u << s.direction;
+            const std::span<const uint32_t> nearest = s.perPoint->nearest;
+            if (i + 1 < count) {
+                handing =
+                    std::jthread([&options, k = s.direction, nearest] { options.perPointReady(k, nearest); });
+            } else {
+                if (handing.joinable()) handing.join();
+                options.perPointReady(s.direction, nearest);
+            }
         }
+        res.hausdorff =
+            options.directedOnly ? res.aToB.distance : std::max(res.aToB.distance, res.bToA.distance);
         // Witnesses and per-point distances from the unscaled inputs, in double.
         if (a.scale != 1.0) core::restoreOriginal(res, PointView(a.input), PointView(b.input), ws.threads);
     }
@@ -343,6 +371,7 @@ struct GpuHausdorff::State {
     template <class Work>
     std::optional<Error> guarded(Timings& into, Work&& work) {
         ws.timings = &into;
+        handedBack = 0;
         std::optional<Error> err;
         try {
             work();
@@ -390,7 +419,10 @@ void GpuHausdorff::releaseScratch() {
     ws.scratch = Scratch{};
     ws.oneShot = {};
     m_state->spare = m_state->spareB = PerPoint{};
+    m_state->handedBack = 0;
 }
+
+uint32_t GpuHausdorff::handedBack() const { return m_state->handedBack; }
 
 Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, const std::string& cacheDir,
                                                            int threads) {

@@ -128,6 +128,11 @@ public:
     // one-shot calls (the next call allocates them again). Out-of-core calls
     // free one direction's before the other's. Prepared sets keep theirs.
     void releaseScratch();
+    // Bit k set: the last call (compute of any kind, also one that failed)
+    // called CallOptions::perPointReady for direction k itself — early, from
+    // runPair, while the other direction was searched. 0 after
+    // releaseScratch. The API calls it for the directions left, at the end.
+    [[nodiscard]] uint32_t handedBack() const;
     // Takes back the per-point arrays of an earlier result (out-of-core tile
     // calls, one after another): the next per-point call fills them in place
     // of fresh ones, whose zero-fill on one thread and first-touch page

@@ -38,27 +38,23 @@ using detail::msSince;
 
 // Boundary conventions: both directions in one engine call (each set
 // uploaded and indexed once), every boundary voxel a query (a voxel on both
-// boundaries comes back at distance 0). Both sets take A's grid (B's equals
-// it: checkSameGrid); `timed` gains the extraction, distance and engine times.
+// boundaries comes back at distance 0), each direction's numbers computed as
+// the engine hands it back (directionsOfOneCall). Both sets take A's grid
+// (B's equals it: checkSameGrid); `timed` gains the extraction, distance and
+// engine times.
 Result<std::array<Direction, 2>> bothDirections(Engine& engine, const Volume& a, std::span<const uint64_t> ba,
-                                                const Volume& b, std::span<const uint64_t> bb, bool world,
-                                                int threads, MaskResult& timed) {
-    auto t0 = Clock::now();
-    const detail::VoxelMetric metric(a, world);
-    const detail::SearchPoints pa = metric.searchPoints(ba, threads);
-    const detail::SearchPoints pb = metric.searchPoints(bb, threads);
+                                                const Volume& b, std::span<const uint64_t> bb,
+                                                const MaskOptions& options, MaskResult& timed) {
+    const auto t0 = Clock::now();
+    const detail::VoxelMetric metric(a, options.convention == Convention::kRthdist);
+    const detail::SearchPoints pa = metric.searchPoints(ba, options.threads);
+    const detail::SearchPoints pb = metric.searchPoints(bb, options.threads);
     timed.extractMs += msSince(t0);
-    t0 = Clock::now();
-    Result<HausdorffResult> r = engine.compute(PointView(pa), PointView(pb), detail::perPointCall(false));
-    if (!r) return r.error();
-    detail::addTimings(timed.engine, r->timings);
-    Result<Direction> ab = detail::directionOf(a, metric, ba, r->aNearest, bb, 0, threads);
-    if (!ab) return ab.error();
-    Result<Direction> bA = detail::directionOf(b, metric, bb, r->bNearest, ba, 0, threads);
-    if (!bA) return bA.error();
-    engine.recycle(std::move(*r));  // its arrays serve the next comparison
-    timed.distanceMs += msSince(t0);
-    return std::array<Direction, 2>{std::move(*ab), std::move(*bA)};
+    const detail::PairCall call = [&](const CallOptions& c) {
+        return engine.compute(PointView(pa), PointView(pb), c);
+    };
+    return detail::directionsOfOneCall(engine, call, metric,
+                                       {detail::Side{&a, ba, bb}, detail::Side{&b, bb, ba}}, options, timed);
 }
 
 // The checks of compareMasks that every convention shares.
@@ -228,7 +224,7 @@ Result<MaskResult> compareMasks(MaskEngine& maskEngine, const Volume& a, LabelSe
     }
     Result<std::array<Direction, 2>> both =
         itk ? itkDirections(engine, a, selectA, *ea, b, selectB, *eb, threads, r)
-            : bothDirections(engine, a, ea->boundary, b, eb->boundary, c == Convention::kRthdist, threads, r);
+            : bothDirections(engine, a, ea->boundary, b, eb->boundary, options, r);
     if (!both) return both.error();
     detail::combine(options, (*both)[0], (*both)[1], r);
     r.totalMs = msSince(start);

@@ -38,74 +38,48 @@ void emptyValues(Convention c, EmptyStatus s, MaskResult& r) {
     }
 }
 
-// HD, ASSD, MSD, surface overlaps and surface Dice from both directions.
-void summarise(Direction& da, Direction& db, double tolerance, int threads, MaskResult& r) {
+// This direction's HD-p under convention c (none for itk and deepmind).
+double directedPercentile(Convention c, Direction& d, double p, int threads) {
+    const ValueRange range{{d.least, d.out.hd}};
+    switch (c) {
+        case Convention::kRthdist: return percentileNearestRank(d.distances, p, threads, range);
+        case Convention::kMonai:
+        case Convention::kMedpy: return percentileLinear(d.distances, p, threads, range);
+        case Convention::kPlastimatch: return percentilePlastimatch(d.distances, p, threads, range);
+        case Convention::kItk:
+        case Convention::kDeepmind: break;
+    }
+    return 0.0;
+}
+
+// HD, ASSD, MSD and surface Dice from both numbered directions.
+void summarise(const Direction& da, const Direction& db, MaskResult& r) {
     r.hd = std::max(da.out.hd, db.out.hd);
     const double nAll = double(da.out.points + db.out.points);
     r.assd = (da.sum + db.sum) / nAll;
     r.msd = 0.5 * (da.out.mean + db.out.mean);
-    uint64_t within = 0;
-    for (Direction* d : {&da, &db}) {
-        const uint64_t w = countAtMost(d->distances, tolerance, threads);
-        d->out.surfaceOverlap = double(w) / double(d->out.points);
-        within += w;
-    }
-    r.surfaceDice = double(within) / nAll;
+    r.surfaceDice = double(da.withinTolerance + db.withinTolerance) / nAll;
 }
 
-// Percentile p of each direction and their combination, in convention c
-// (pooled: both directions' distances merged, medpy only).
-struct PercentilePair {
-    double a = 0.0, b = 0.0, combined = 0.0;
-};
-
-PercentilePair percentilesOf(Convention c, Direction& da, Direction& db, std::span<double> pooled, double p,
-                             int threads) {
-    PercentilePair v;
-    const ValueRange ra{{da.least, da.out.hd}}, rb{{db.least, db.out.hd}};
-    switch (c) {
-        case Convention::kRthdist:
-            v.a = percentileNearestRank(da.distances, p, threads, ra);
-            v.b = percentileNearestRank(db.distances, p, threads, rb);
-            v.combined = std::max(v.a, v.b);
-            break;
-        case Convention::kMonai:
-            v.a = percentileLinear(da.distances, p, threads, ra);
-            v.b = percentileLinear(db.distances, p, threads, rb);
-            v.combined = std::max(v.a, v.b);
-            break;
-        case Convention::kMedpy:
-            v.a = percentileLinear(da.distances, p, threads, ra);
-            v.b = percentileLinear(db.distances, p, threads, rb);
-            v.combined =
-                percentileLinear(pooled, p, threads,
-                                 ValueRange{{std::min(da.least, db.least), std::max(da.out.hd, db.out.hd)}});
-            break;
-        case Convention::kPlastimatch:
-            v.a = percentilePlastimatch(da.distances, p, threads, ra);
-            v.b = percentilePlastimatch(db.distances, p, threads, rb);
-            v.combined = 0.5 * (v.a + v.b);
-            break;
-        case Convention::kItk:
-        case Convention::kDeepmind: break;
-    }
-    return v;
-}
-
-// Every requested HD-p, per direction and combined (not for itk).
+// Every requested HD-p combined from the directions' own (directionNumbers)
+// in convention c: the larger, the mean, or (medpy) the linear percentile of
+// both directions' distances pooled.
 void addPercentiles(Convention c, const std::vector<double>& percentiles, Direction& da, Direction& db,
                     int threads, MaskResult& r) {
+    if (c == Convention::kItk || c == Convention::kDeepmind) return;
     core::UninitVector<double> pooled;
     if (c == Convention::kMedpy) {
         pooled.reserve(da.distances.size() + db.distances.size());
         pooled.assign(da.distances.begin(), da.distances.end());
         pooled.insert(pooled.end(), db.distances.begin(), db.distances.end());
     }
-    for (double p : percentiles) {
-        const PercentilePair v = percentilesOf(c, da, db, pooled, p, threads);
-        da.out.percentiles.push_back(v.a);
-        db.out.percentiles.push_back(v.b);
-        r.hdPercentile.push_back(v.combined);
+    const ValueRange both{{std::min(da.least, db.least), std::max(da.out.hd, db.out.hd)}};
+    for (size_t i = 0; i < percentiles.size(); ++i) {
+        const double a = da.out.percentiles[i], b = db.out.percentiles[i];
+        r.hdPercentile.push_back(c == Convention::kMedpy
+                                     ? percentileLinear(pooled, percentiles[i], threads, both)
+                                 : c == Convention::kPlastimatch ? 0.5 * (a + b)
+                                                                 : std::max(a, b));
     }
 }
 
@@ -141,11 +115,11 @@ void addTimings(Timings& sum, const Timings& t) {
 }
 
 Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric, std::span<const uint64_t> queries,
-                              const PerPoint& nearest, std::span<const uint64_t> targets, uint64_t zeros,
-                              int threads) {
-    if (queries.empty() || nearest.nearest.size() != queries.size())
+                              std::span<const uint32_t> nearest, std::span<const uint64_t> targets,
+                              uint64_t zeros, int threads) {
+    if (queries.empty() || nearest.size() != queries.size())
         return Error{ErrorCode::kInternal, "masks: the engine returned no per-point nearest points"};
-    RecomputedDirection r = recompute(metric, v.dims, queries, targets, nearest.nearest, threads);
+    RecomputedDirection r = recompute(metric, v.dims, queries, targets, nearest, threads);
     Direction d;
     d.out.points = queries.size() + zeros;
     d.out.hd = r.distances[r.witness];
@@ -159,9 +133,54 @@ Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric, std::s
     d.sum = r.sum;
     d.least = zeros == 0 ? r.least : 0.0;
     d.out.voxel = voxelOf(queries[r.witness], v.dims);
-    d.out.nearestVoxel = voxelOf(targets[nearest.nearest[r.witness]], v.dims);
+    d.out.nearestVoxel = voxelOf(targets[nearest[r.witness]], v.dims);
     finishDirection(v, d);
     return d;
+}
+
+void directionNumbers(const MaskOptions& options, Direction& d) {
+    d.withinTolerance = countAtMost(d.distances, options.tolerance, options.threads);
+    d.out.surfaceOverlap = double(d.withinTolerance) / double(d.out.points);
+    d.out.percentiles.clear();
+    if (options.convention != Convention::kItk)
+        for (double p : options.percentiles)
+            d.out.percentiles.push_back(directedPercentile(options.convention, d, p, options.threads));
+    d.numbered = true;
+}
+
+Result<std::array<Direction, 2>> directionsOfOneCall(Engine& engine, const PairCall& call,
+                                                     const VoxelMetric& metric,
+                                                     const std::array<Side, 2>& sides,
+                                                     const MaskOptions& options, MaskResult& timed) {
+    const auto t0 = Clock::now();
+    std::array<std::optional<Result<Direction>>, 2> done;
+    CallOptions handed = perPointCall(false);
+    // On a thread of the engine's while it searches the other direction
+    // (CallOptions::perPointReady); nothing may throw out of it.
+    handed.perPointReady = [&](int k, std::span<const uint32_t> nearest) {
+        const Side& s = sides[size_t(k)];
+        try {
+            Result<Direction> d =
+                directionOf(*s.grid, metric, s.queries, nearest, s.targets, 0, options.threads);
+            if (d) directionNumbers(options, *d);
+            done[size_t(k)] = std::move(d);
+        } catch (const std::bad_alloc&) {
+            done[size_t(k)] =
+                Error{ErrorCode::kOutOfMemory, "masks: out of host memory for a direction's distances"};
+        }
+    };
+    Result<HausdorffResult> r = call(handed);
+    if (!r) return r.error();
+    addTimings(timed.engine, r->timings);
+    std::array<Direction, 2> out;
+    for (size_t k = 0; k < 2; ++k) {
+        if (!done[k]) return Error{ErrorCode::kInternal, "masks: the engine handed no nearest points back"};
+        if (!*done[k]) return done[k]->error();
+        out[k] = std::move(**done[k]);
+    }
+    engine.recycle(std::move(*r));  // its arrays serve the next comparison
+    timed.distanceMs += msSince(t0);
+    return out;
 }
 
 NearestCall oneShotCall(Engine& engine, const VoxelMetric& metric, std::span<const uint64_t> targets,
@@ -193,7 +212,7 @@ Result<Direction> directed(const VoxelMetric& metric, const Volume& v, std::span
     Result<HausdorffResult> r = nearest(q);
     if (!r) return r.error();
     addTimings(timed.engine, r->timings);
-    d = directionOf(v, metric, queries, r->aNearest, targets, zeros, threads);
+    d = directionOf(v, metric, queries, r->aNearest.nearest, targets, zeros, threads);
     timed.distanceMs += msSince(t0);
     return d;
 }
@@ -213,13 +232,14 @@ void setEmpty(uint64_t na, uint64_t nb, size_t percentiles, MaskResult& r) {
 }
 
 void combine(const MaskOptions& options, Direction& ab, Direction& ba, MaskResult& r) {
-    summarise(ab, ba, options.tolerance, options.threads, r);
-    if (options.convention == Convention::kItk) {
+    for (Direction* d : {&ab, &ba})
+        if (!d->numbered) directionNumbers(options, *d);
+    summarise(ab, ba, r);
+    if (options.convention == Convention::kItk)
         r.assd = r.surfaceDice = ab.out.surfaceOverlap = ba.out.surfaceOverlap =
             std::numeric_limits<double>::quiet_NaN();
-    } else {
+    else
         addPercentiles(options.convention, options.percentiles, ab, ba, options.threads, r);
-    }
     r.aToB = std::move(ab.out);
     r.bToA = std::move(ba.out);
 }

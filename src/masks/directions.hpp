@@ -33,6 +33,10 @@ struct Direction {
     DirectedMask out;
     double sum = 0.0;
     double least = 0.0;  // the smallest of `distances` (out.hd the greatest): their range for the percentiles
+    // directionNumbers: the distances within the tolerance (out.surfaceOverlap
+    // their fraction) and out.percentiles filled.
+    uint64_t withinTolerance = 0;
+    bool numbered = false;
 };
 
 // The connectivity convention c measures boundaries with (`requested`: MaskOptions::connectivity).
@@ -49,8 +53,36 @@ void addTimings(Timings& sum, const Timings& t);
 // plus `zeros` more of X's voxels at distance 0 that were not sent. Distances
 // in `metric`, witness points on X's grid `v`; the mean and points filled.
 [[nodiscard]] Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric,
-                                            std::span<const uint64_t> queries, const PerPoint& nearest,
+                                            std::span<const uint64_t> queries,
+                                            std::span<const uint32_t> nearest,
                                             std::span<const uint64_t> targets, uint64_t zeros, int threads);
+
+// A direction's own numbers under `options`: its distances within the
+// tolerance and its HD-p of the convention (not for itk), per percentile
+// asked for. `d.distances` is reordered (selection).
+void directionNumbers(const MaskOptions& options, Direction& d);
+
+// One side of a boundary comparison: X's grid, X's voxels (the engine's
+// queries) and Y's (its targets).
+struct Side {
+    const Volume* grid = nullptr;
+    std::span<const uint64_t> queries, targets;
+};
+
+// Runs the engine's call over both sides' points (A's queries first) with the call options given.
+using PairCall = std::function<Result<HausdorffResult>(const CallOptions& call)>;
+
+// Both directions of one engine call (`call`, on `engine`; its result
+// recycled), each with its distances and numbers (directionNumbers) computed
+// as soon as the engine hands its nearest points back
+// (CallOptions::perPointReady): on a GPU backend the first one while the
+// device searches the other. `timed` gains the engine's timings and the
+// whole as distanceMs.
+[[nodiscard]] Result<std::array<Direction, 2>> directionsOfOneCall(Engine& engine, const PairCall& call,
+                                                                   const VoxelMetric& metric,
+                                                                   const std::array<Side, 2>& sides,
+                                                                   const MaskOptions& options,
+                                                                   MaskResult& timed);
 
 // The engine's per-point search of float query points against one target
 // set it already holds (or is given with the call).
@@ -75,7 +107,8 @@ using NearestCall = std::function<Result<HausdorffResult>(std::span<const glm::v
 void setEmpty(uint64_t na, uint64_t nb, size_t percentiles, MaskResult& r);
 
 // HD, ASSD, MSD, surface overlaps and Dice and (but for itk) the HD-p of
-// options.convention from both directions, moved into r.aToB and r.bToA.
+// options.convention from both directions (numbered here unless they are),
+// moved into r.aToB and r.bToA.
 void combine(const MaskOptions& options, Direction& ab, Direction& ba, MaskResult& r);
 
 }  // namespace rthdist::masks::detail

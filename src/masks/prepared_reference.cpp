@@ -112,26 +112,21 @@ Result<detail::Extraction> extractOne(MaskEngine& engine, const Volume& v, Label
 // rthdist, monai, medpy, plastimatch: the prediction's boundary prepared,
 // both directions in one call on the two prepared sets.
 Result<std::array<Direction, 2>> boundaryDirections(Engine& engine, const State& s, const Volume& b,
-                                                    const detail::Extraction& eb, int threads,
+                                                    const detail::Extraction& eb, const MaskOptions& options,
                                                     MaskResult& r) {
-    auto t0 = Clock::now();
+    const auto t0 = Clock::now();
     const detail::VoxelMetric metric = metricOf(s);
-    const detail::SearchPoints pb = metric.searchPoints(eb.boundary, threads);
+    const detail::SearchPoints pb = metric.searchPoints(eb.boundary, options.threads);
     r.extractMs += msSince(t0);
-    t0 = Clock::now();
-    Result<PreparedSet> prediction = engine.prepare(PointView(pb));
-    if (!prediction) return prediction.error();
-    Result<HausdorffResult> h = engine.compute(*s.set, *prediction, detail::perPointCall(false));
-    if (!h) return h.error();
-    detail::addTimings(r.engine, h->timings);
+    const detail::PairCall call = [&](const CallOptions& c) -> Result<HausdorffResult> {
+        Result<PreparedSet> prediction = engine.prepare(PointView(pb));
+        if (!prediction) return prediction.error();
+        return engine.compute(*s.set, *prediction, c);
+    };
     const std::span<const uint64_t> ba = s.extracted.boundary;
-    Result<Direction> ab = detail::directionOf(s.grid, metric, ba, h->aNearest, eb.boundary, 0, threads);
-    if (!ab) return ab.error();
-    Result<Direction> bA = detail::directionOf(b, metric, eb.boundary, h->bNearest, ba, 0, threads);
-    if (!bA) return bA.error();
-    engine.recycle(std::move(*h));  // its arrays serve the next comparison
-    r.distanceMs += msSince(t0);
-    return std::array<Direction, 2>{std::move(*ab), std::move(*bA)};
+    return detail::directionsOfOneCall(
+        engine, call, metric, {detail::Side{&s.grid, ba, eb.boundary}, detail::Side{&b, eb.boundary, ba}},
+        options, r);
 }
 
 // itk: the reference's voxels outside the prediction query the prediction's
@@ -176,7 +171,7 @@ Result<MaskResult> compareVoxels(MaskEngine& engine, const State& s, const Volum
     }
     Result<std::array<Direction, 2>> both =
         itk ? itkDirections(engine.engine, s, b, sb, *eb, options.threads, r)
-            : boundaryDirections(engine.engine, s, b, *eb, options.threads, r);
+            : boundaryDirections(engine.engine, s, b, *eb, options, r);
     if (!both) return both.error();
     detail::combine(options, (*both)[0], (*both)[1], r);
     r.totalMs = msSince(start);

@@ -70,7 +70,7 @@ SearchPoints VoxelMetric::searchPoints(std::span<const uint64_t> voxels, int thr
 }
 
 RecomputedDirection recompute(const VoxelMetric& metric, Dims dims, std::span<const uint64_t> queries,
-                              std::span<const uint64_t> targets, const std::vector<uint32_t>& nearest,
+                              std::span<const uint64_t> targets, std::span<const uint32_t> nearest,
                               int threads) {
     RecomputedDirection r;
     r.distances.resize(queries.size());

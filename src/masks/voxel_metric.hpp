@@ -77,6 +77,6 @@ struct RecomputedDirection {
 [[nodiscard]] RecomputedDirection recompute(const VoxelMetric& metric, Dims dims,
                                             std::span<const uint64_t> queries,
                                             std::span<const uint64_t> targets,
-                                            const std::vector<uint32_t>& nearest, int threads);
+                                            std::span<const uint32_t> nearest, int threads);
 
 }  // namespace rthdist::masks::detail

@@ -26,6 +26,7 @@ CallOptions directedCall(const CallOptions& call) {
     CallOptions directed = call;
     directed.directedOnly = true;
     directed.perPointDistances = false;
+    directed.perPointReady = nullptr;
     directed.progress = nullptr;
     return directed;
 }

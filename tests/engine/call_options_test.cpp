@@ -2,13 +2,17 @@
 // cancellation, on the backend under test.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <span>
 #include <string>
 
 #include <unistd.h>
 
+#include "api/out_of_core.hpp"
 #include "common/brute_force.hpp"
 #include "common/oracle_cases.hpp"
 #include "engine/engine_test_support.hpp"
@@ -113,6 +117,117 @@ TEST(CallOptions, PerPointNearestOnlyKeepsTheNearestPoints) {
         ASSERT_TRUE(fd.ok() && od.ok());
         expectSame(*od, *fd);
     }
+}
+
+// CallOptions::perPointReady: each computed direction handed back exactly
+// once, with the very array the result returns and its final values, before
+// compute() returns, the result the same as without it — one-shot with A
+// smaller and larger than B (a GPU hands the larger back first, while it
+// searches the other), directed only, prepared, double input, a pair split
+// into pieces (out-of-core); refused without perPointNearestOnly; ignored by
+// computeBatch.
+TEST(CallOptions, PerPointReadyHandsEachDirectionBackOnce) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    EngineOptions budgetOptions = engineUnderTest();
+    budgetOptions.memoryBudget = 1500 * api::kBytesPerPoint;
+    auto pieces = Engine::create(budgetOptions);
+    ASSERT_TRUE(pieces.ok()) << pieces.error().message;
+    const std::vector<glm::vec3> small = randomCloud(2000, 25);
+    const std::vector<glm::vec3> large = randomCloud(5000, 26, glm::vec3(0.2f, 0.0f, 0.1f));
+    struct Handed {
+        int calls = 0;
+        const uint32_t* data = nullptr;
+        std::vector<uint32_t> values;
+    };
+    using Run = std::function<Result<HausdorffResult>(const CallOptions&)>;
+    auto expectHandedBack = [](const Run& run, bool directed) {
+        CallOptions plain;
+        plain.perPointDistances = plain.perPointNearestOnly = true;
+        plain.directedOnly = directed;
+        std::array<Handed, 2> handed;
+        int other = 0;
+        CallOptions call = plain;
+        call.perPointReady = [&](int k, std::span<const uint32_t> nearest) {
+            if (k != 0 && k != 1) {
+                ++other;
+                return;
+            }
+            Handed& h = handed[size_t(k)];
+            ++h.calls;
+            h.data = nearest.data();
+            h.values.assign(nearest.begin(), nearest.end());
+        };
+        auto with = run(call);
+        auto without = run(plain);
+        ASSERT_TRUE(with.ok()) << with.error().message;
+        ASSERT_TRUE(without.ok()) << without.error().message;
+        EXPECT_EQ(other, 0);
+        EXPECT_EQ(handed[0].calls, 1);
+        EXPECT_EQ(handed[1].calls, directed ? 0 : 1);
+        const std::array<const PerPoint*, 2> got = {&with->aNearest, &without->aNearest};
+        const std::array<const PerPoint*, 2> gotB = {&with->bNearest, &without->bNearest};
+        for (size_t k = 0; k < (directed ? 1u : 2u); ++k) {
+            const PerPoint& w = k == 0 ? *got[0] : *gotB[0];
+            const PerPoint& wo = k == 0 ? *got[1] : *gotB[1];
+            EXPECT_EQ(handed[k].data, w.nearest.data()) << "direction " << k;
+            EXPECT_EQ(handed[k].values, w.nearest) << "direction " << k;
+            EXPECT_EQ(w.nearest, wo.nearest) << "direction " << k;
+        }
+        EXPECT_EQ(with->hausdorff, without->hausdorff);
+    };
+    for (bool directed : {false, true}) {
+        for (bool smallFirst : {true, false}) {
+            const std::vector<glm::vec3>& a = smallFirst ? small : large;
+            const std::vector<glm::vec3>& b = smallFirst ? large : small;
+            SCOPED_TRACE(std::string(directed ? "directed" : "both") +
+                         (smallFirst ? ", A smaller" : ", A larger"));
+            {
+                SCOPED_TRACE("one-shot");
+                expectHandedBack([&](const CallOptions& c) { return engine->compute(a, b, c); }, directed);
+            }
+            {
+                SCOPED_TRACE("prepared");
+                auto pa = engine->prepare(a);
+                auto pb = engine->prepare(b);
+                ASSERT_TRUE(pa && pb);
+                expectHandedBack([&](const CallOptions& c) { return engine->compute(*pa, *pb, c); },
+                                 directed);
+            }
+            {
+                SCOPED_TRACE("double input far from the origin");
+                std::vector<glm::dvec3> da, db;
+                for (const glm::vec3& v : a) da.push_back(glm::dvec3(v) + glm::dvec3(5.0e5, -2.0e5, 1.0e3));
+                for (const glm::vec3& v : b) db.push_back(glm::dvec3(v) + glm::dvec3(5.0e5, -2.0e5, 1.0e3));
+                expectHandedBack(
+                    [&](const CallOptions& c) { return engine->compute(PointView(da), PointView(db), c); },
+                    directed);
+            }
+            {
+                SCOPED_TRACE("in pieces");
+                expectHandedBack([&](const CallOptions& c) { return pieces->compute(a, b, c); }, directed);
+            }
+        }
+    }
+    CallOptions withDistances;
+    withDistances.perPointDistances = true;
+    withDistances.perPointReady = [](int, std::span<const uint32_t>) {};
+    auto refused = engine->compute(small, large, withDistances);
+    ASSERT_FALSE(refused.ok());
+    EXPECT_EQ(refused.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(refused.error().message.find("perPointNearestOnly"), std::string::npos)
+        << refused.error().message;
+    auto ps = engine->prepare(small);
+    auto pl = engine->prepare(large);
+    ASSERT_TRUE(ps && pl);
+    const std::array<PreparedSet, 2> sets = {*ps, *pl};
+    const std::array<PairRef, 2> pairs = {PairRef{0, 1}, PairRef{1, 0}};
+    CallOptions batch;
+    batch.perPointDistances = batch.perPointNearestOnly = true;
+    int batchCalls = 0;
+    batch.perPointReady = [&](int, std::span<const uint32_t>) { ++batchCalls; };
+    for (const Result<HausdorffResult>& r : engine->computeBatch(sets, pairs, batch))
+        EXPECT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(batchCalls, 0);
 }
 
 TEST(CallOptions, InvalidCallOptionsAreErrorValues) {
