@@ -45,19 +45,32 @@ struct Extraction {
 }
 
 // voxelOf for many voxels of one grid (the per-voxel loops of the distance
-// stage): each division by a dimension is a multiplication by its reciprocal
-// in double, corrected by one step. Exact for linear indices below 2^50
-// (the product's error stays below one); past that, voxelOf's divisions.
+// stage), without a division instruction. Linear indices and dimensions
+// below 2^32 (a 512 x 512 x 300 volume's): each quotient is the high word of
+// one 64 x 64-bit product, n / d = (c n) >> 64 with c = ceil(2^64 / d),
+// exact for every n, d < 2^32, d >= 2 (Lemire, Kaser & Kurz, "Faster
+// remainder by direct computation", 2019; a dimension of 1 divides by
+// nothing). Larger ones, below 2^50: a multiplication by the reciprocal in
+// double, corrected by one step (the product's error stays below one); past
+// that, voxelOf's divisions.
 class VoxelDecoder {
 public:
     explicit VoxelDecoder(Dims dims)
         : m_nx(uint64_t(dims[0])),
           m_ny(uint64_t(dims[1])),
+          m_cx(reciprocal64(m_nx)),
+          m_cy(reciprocal64(m_ny)),
           m_invX(1.0 / double(dims[0])),
           m_invY(1.0 / double(dims[1])),
+          m_small(m_nx < kWordLimit && m_ny < kWordLimit),
           m_dims(dims) {}
 
     [[nodiscard]] std::array<int64_t, 3> operator()(uint64_t linear) const {
+        if (m_small && linear < kWordLimit) {
+            const uint64_t row = m_nx == 1 ? linear : highWord(m_cx, linear);
+            const uint64_t z = m_ny == 1 ? row : highWord(m_cy, row);
+            return {int64_t(linear - row * m_nx), int64_t(row - z * m_ny), int64_t(z)};
+        }
         if (linear >= kExactBelow) return voxelOf(linear, m_dims);
         const uint64_t row = quotient(linear, m_nx, m_invX);
         const uint64_t z = quotient(row, m_ny, m_invY);
@@ -65,8 +78,14 @@ public:
     }
 
 private:
+    static constexpr uint64_t kWordLimit = uint64_t(1) << 32;
     static constexpr uint64_t kExactBelow = uint64_t(1) << 50;
 
+    // ceil(2^64 / d) for 2 <= d < 2^32 (0 otherwise: not used).
+    static uint64_t reciprocal64(uint64_t d) { return d >= 2 && d < kWordLimit ? ~uint64_t(0) / d + 1 : 0; }
+    static uint64_t highWord(uint64_t c, uint64_t n) {
+        return uint64_t((static_cast<unsigned __int128>(c) * n) >> 64);
+    }
     static uint64_t quotient(uint64_t n, uint64_t d, double inverse) {
         uint64_t q = uint64_t(double(n) * inverse);
         if (q * d > n) {
@@ -78,7 +97,9 @@ private:
     }
 
     uint64_t m_nx, m_ny;
+    uint64_t m_cx, m_cy;
     double m_invX, m_invY;
+    bool m_small;
     Dims m_dims;
 };
 
