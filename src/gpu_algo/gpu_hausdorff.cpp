@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <exception>
 #include <optional>
 #include <span>
 #include <string>
@@ -293,7 +294,7 @@ struct GpuHausdorff::State {
             DirectionRun* run;
             uint32_t survivors;
             Directed* out;
-            const PerPoint* perPoint;
+            PerPoint* perPoint;
             int direction;
         };
         std::array<Step, 2> steps{Step{&ab, survivors[0], &res.aToB, &res.aNearest, 0},
@@ -303,7 +304,11 @@ struct GpuHausdorff::State {
         // Handed back: the direction with more queries first, its caller's
         // work (proportional to them) then overlaps the other's search.
         if (handBack && count == 2 && ba.Q.n > ab.Q.n) std::swap(steps[0], steps[1]);
-        std::jthread handing;  // the first direction's perPointReady; joined before the next call of it
+        // The first direction's read-back and perPointReady, on a thread of
+        // its own while the device searches the second; joined before the
+        // next call of it (what it throws rethrown then).
+        std::exception_ptr handingFailed;
+        std::jthread handing;
         for (size_t i = 0; i < count; ++i) {
             const Step& s = steps[i];
             const double lo = i == 0 ? from : mid, hi = i + 1 == count ? 1.0 : mid;
@@ -313,17 +318,28 @@ struct GpuHausdorff::State {
             const auto t0 = Clock::now();
             *s.out = check.finishDirection(*s.run, witness);
             ws.timings->check += msSince(t0);
-            if (!handBack) continue;
-            handedBack |= 1u << s.direction;
-            const std::span<const uint32_t> nearest = s.perPoint->nearest;
-            if (i + 1 < count) {
-                handing =
-                    std::jthread([&options, k = s.direction, nearest] { options.perPointReady(k, nearest); });
-            } else {
-                if (handing.joinable()) handing.join();
-                options.perPointReady(s.direction, nearest);
+            if (handBack && i + 1 < count) {
+                handedBack |= 1u << s.direction;
+                handing = std::jthread([this, &options, &handingFailed, s] {
+                    try {
+                        check.readPerPoint(*s.run, *s.perPoint);
+                    } catch (...) {
+                        handingFailed = std::current_exception();
+                        return;
+                    }
+                    options.perPointReady(s.direction, s.perPoint->nearest);
+                });
+                continue;
             }
+            if (pp) check.readPerPoint(*s.run, *s.perPoint);
+            if (!handBack) continue;
+            if (handing.joinable()) handing.join();
+            if (handingFailed) std::rethrow_exception(handingFailed);
+            handedBack |= 1u << s.direction;
+            options.perPointReady(s.direction, s.perPoint->nearest);
         }
+        if (handing.joinable()) handing.join();
+        if (handingFailed) std::rethrow_exception(handingFailed);
         res.hausdorff =
             options.directedOnly ? res.aToB.distance : std::max(res.aToB.distance, res.bToA.distance);
         // Witnesses and per-point distances from the unscaled inputs, in double.

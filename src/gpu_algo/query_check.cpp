@@ -105,7 +105,6 @@ Directed QueryCheck::finishDirection(DirectionRun& d, const SampledQuery& witnes
     out.queryPoint = d.qPts.original(qi);
     out.targetPoint = d.tPts.original(ti);
     out.distance = glm::length(out.queryPoint - out.targetPoint);
-    if (d.perPoint) readPerPoint(d, *d.perPoint);
     return out;
 }
 

@@ -43,14 +43,16 @@ public:
     // the maximum).
     SampledQuery finishCheck(const DirectionRun& d);
 
-    // The direction's result from its checked witness (and its per-point
-    // distances).
+    // The direction's result from its checked witness (its per-point
+    // output: readPerPoint).
     Directed finishDirection(DirectionRun& d, const SampledQuery& witness);
 
     // Every query is EXACT after a per-point run (the check counted any
     // other): the nearest targets its self-check copied to the host, with
     // their distances in double unless d.perPointDistances is off (then
-    // `out.distance` is left empty).
+    // `out.distance` is left empty). Reads only d's own read-back buffer and
+    // the host's points: may run on another thread while the other
+    // direction is searched.
     void readPerPoint(const DirectionRun& d, PerPoint& out);
 
 private:
