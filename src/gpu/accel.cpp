@@ -21,14 +21,13 @@ struct BuildDesc {
         VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
     uint32_t primitives = 0;
 
-    BuildDesc() {
-        info.geometryCount = 1;
-        info.pGeometries = &geometry;
-    }
+    BuildDesc() = default;
     BuildDesc(const BuildDesc&) = delete;
     BuildDesc& operator=(const BuildDesc&) = delete;
 
     void querySizes(const Context& ctx) {
+        info.geometryCount = 1;
+        info.pGeometries = &geometry;
         ctx.rt().getBuildSizes(ctx.device(), VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info,
                                &primitives, &sizes);
     }
@@ -102,21 +101,9 @@ void AccelStructures::writeInstance() {
     std::memcpy(m_instances.mapped(), &inst, sizeof(inst));
 }
 
-VkAccelerationStructureBuildSizesInfoKHR AccelStructures::blasSizes(uint32_t count) {
-    for (const auto& [kept, sizes] : m_blasSizes)
-        if (kept == count) return sizes;
-    BuildDesc blas;
-    describeBlas(blas, 0, count);  // the sizes depend on the count and flags, not on the boxes' address
-    blas.querySizes(m_ctx);
-    if (m_blasSizes.size() == kKeptSizes) m_blasSizes.erase(m_blasSizes.begin());
-    m_blasSizes.emplace_back(count, blas.sizes);
-    return blas.sizes;
-}
-
 void AccelStructures::release() {
     m_tlas.reset();
     m_blas.reset();
-    m_blasSize = 0;
     m_blasBuffer.reset();
     m_tlasBuffer.reset();
     m_scratch.reset();
@@ -130,26 +117,14 @@ bool AccelStructures::cmdBuild(VkCommandBuffer cmd, VkDeviceAddress aabbs, uint3
     const bool doUpdate = update && m_blas && count == m_count;
     BuildDesc blas, tlas;
     describeBlas(blas, aabbs, count);
-    blas.sizes = blasSizes(count);
+    blas.querySizes(m_ctx);
     describeTlas(tlas);
-    if (m_tlasSizes.accelerationStructureSize == 0) {  // one instance: the same sizes every time
-        tlas.querySizes(m_ctx);
-        m_tlasSizes = tlas.sizes;
-    }
-    tlas.sizes = m_tlasSizes;
+    tlas.querySizes(m_ctx);
 
-    bool newBlas = false;
     if (!doUpdate) {
-        // A built BLAS object large enough for this count is built into again
-        // (a structure may be larger than its build needs): no new object, and
-        // the TLAS instance keeps its address.
-        if (!m_blas || m_blasSize < blas.sizes.accelerationStructureSize) {
-            m_blas.reset();  // before its storage may be reallocated
-            m_blas = createIn(m_blasBuffer, blas.sizes.accelerationStructureSize,
-                              VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR);
-            m_blasSize = blas.sizes.accelerationStructureSize;
-            newBlas = true;
-        }
+        m_blas.reset();  // before its storage may be reallocated
+        m_blas = createIn(m_blasBuffer, blas.sizes.accelerationStructureSize,
+                          VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR);
         m_count = count;
     }
     // One scratch buffer serves both builds, one after the other.
@@ -169,7 +144,7 @@ bool AccelStructures::cmdBuild(VkCommandBuffer cmd, VkDeviceAddress aabbs, uint3
         VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
         VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR);
 
-    if (newBlas || !m_instances) writeInstance();
+    writeInstance();
     tlas.geometry.geometry.instances.data.deviceAddress = m_instances.address();
     const bool rebound = !m_tlas;
     if (!m_tlas)

@@ -5,10 +5,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include <cstddef>
 #include <cstdint>
-#include <utility>
-#include <vector>
 
 #include "gpu/buffer.hpp"
 #include "gpu/unique_handle.hpp"
@@ -41,22 +38,11 @@ private:
     VkDeviceAddress scratchFor(VkDeviceSize bytes);
     // The TLAS's one instance: the BLAS, identity transform.
     void writeInstance();
-    // The build sizes of a BLAS of `count` boxes: the driver's answer, kept
-    // for the last kKeptSizes counts (a search alternates between the levels
-    // of two sets and refits at the same count; the query cost ~a tenth of a
-    // submission's recording on an H100).
-    VkAccelerationStructureBuildSizesInfoKHR blasSizes(uint32_t count);
-
-    static constexpr size_t kKeptSizes = 8;
 
     Context& m_ctx;
     Buffer m_blasBuffer, m_tlasBuffer, m_scratch, m_instances;
-    UniqueAccel m_blas, m_tlas;   // declared after their storage: destroyed before it
-    VkDeviceSize m_blasSize = 0;  // the size m_blas was created with (>= what its builds need)
-    uint32_t m_count = 0;         // boxes of the last BLAS build (an update needs the same)
-    std::vector<std::pair<uint32_t, VkAccelerationStructureBuildSizesInfoKHR>> m_blasSizes;
-    VkAccelerationStructureBuildSizesInfoKHR m_tlasSizes{
-        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};  // queried at the first build
+    UniqueAccel m_blas, m_tlas;  // declared after their storage: destroyed before it
+    uint32_t m_count = 0;
 };
 
 }  // namespace rthdist::gpu
