@@ -315,7 +315,7 @@ struct GpuHausdorff::State {
             const SampledQuery witness = s.survivors > 0
                                              ? searchAndCheck(*s.run, s.survivors, options, lo, hi)
                                              : check.finishCheck(*s.run);
-            const auto t0 = Clock::now();
+            auto t0 = Clock::now();
             *s.out = check.finishDirection(*s.run, witness);
             ws.timings->check += msSince(t0);
             if (handBack && i + 1 < count) {
@@ -331,7 +331,9 @@ struct GpuHausdorff::State {
                 });
                 continue;
             }
+            t0 = Clock::now();
             if (pp) check.readPerPoint(*s.run, *s.perPoint);
+            ws.timings->check += msSince(t0);  // a handed-back first direction's runs beside the search
             if (!handBack) continue;
             if (handing.joinable()) handing.join();
             if (handingFailed) std::rethrow_exception(handingFailed);
