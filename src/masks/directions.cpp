@@ -116,10 +116,10 @@ void addTimings(Timings& sum, const Timings& t) {
 
 Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric, std::span<const uint64_t> queries,
                               std::span<const uint32_t> nearest, std::span<const uint64_t> targets,
-                              uint64_t zeros, int threads) {
+                              uint64_t zeros, double tolerance, int threads) {
     if (queries.empty() || nearest.size() != queries.size())
         return Error{ErrorCode::kInternal, "masks: the engine returned no per-point nearest points"};
-    RecomputedDirection r = recompute(metric, v.dims, queries, targets, nearest, threads);
+    RecomputedDirection r = recompute(metric, v.dims, queries, targets, nearest, tolerance, threads);
     Direction d;
     d.out.points = queries.size() + zeros;
     d.out.hd = r.distances[r.witness];
@@ -132,6 +132,8 @@ Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric, std::s
     }
     d.sum = r.sum;
     d.least = zeros == 0 ? r.least : 0.0;
+    d.withinTolerance = r.atMost + zeros;  // zeros are within any tolerance (>= 0)
+    d.countedAt = tolerance;
     d.out.voxel = voxelOf(queries[r.witness], v.dims);
     d.out.nearestVoxel = voxelOf(targets[nearest[r.witness]], v.dims);
     finishDirection(v, d);
@@ -139,7 +141,10 @@ Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric, std::s
 }
 
 void directionNumbers(const MaskOptions& options, Direction& d) {
-    d.withinTolerance = countAtMost(d.distances, options.tolerance, options.threads);
+    if (d.countedAt != options.tolerance) {
+        d.withinTolerance = countAtMost(d.distances, options.tolerance, options.threads);
+        d.countedAt = options.tolerance;
+    }
     d.out.surfaceOverlap = double(d.withinTolerance) / double(d.out.points);
     d.out.percentiles.clear();
     if (options.convention != Convention::kItk)
@@ -160,8 +165,8 @@ Result<std::array<Direction, 2>> directionsOfOneCall(Engine& engine, const PairC
     handed.perPointReady = [&](int k, std::span<const uint32_t> nearest) {
         const Side& s = sides[size_t(k)];
         try {
-            Result<Direction> d =
-                directionOf(*s.grid, metric, s.queries, nearest, s.targets, 0, options.threads);
+            Result<Direction> d = directionOf(*s.grid, metric, s.queries, nearest, s.targets, 0,
+                                              options.tolerance, options.threads);
             if (d) directionNumbers(options, *d);
             done[size_t(k)] = std::move(d);
         } catch (const std::bad_alloc&) {
@@ -212,7 +217,7 @@ Result<Direction> directed(const VoxelMetric& metric, const Volume& v, std::span
     Result<HausdorffResult> r = nearest(q);
     if (!r) return r.error();
     addTimings(timed.engine, r->timings);
-    d = directionOf(v, metric, queries, r->aNearest.nearest, targets, zeros, threads);
+    d = directionOf(v, metric, queries, r->aNearest.nearest, targets, zeros, 0.0, threads);
     timed.distanceMs += msSince(t0);
     return d;
 }

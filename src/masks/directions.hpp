@@ -33,9 +33,11 @@ struct Direction {
     DirectedMask out;
     double sum = 0.0;
     double least = 0.0;  // the smallest of `distances` (out.hd the greatest): their range for the percentiles
-    // directionNumbers: the distances within the tolerance (out.surfaceOverlap
-    // their fraction) and out.percentiles filled.
+    // The distances within `countedAt` (directionOf counts them at the
+    // tolerance it is given; directionNumbers recounts at another).
     uint64_t withinTolerance = 0;
+    double countedAt = -1.0;
+    // directionNumbers: out.surfaceOverlap and out.percentiles filled.
     bool numbered = false;
 };
 
@@ -51,15 +53,18 @@ void addTimings(Timings& sum, const Timings& t);
 // X's side of an engine call: `queries` (X's voxels sent, in the call's
 // order), `nearest` the engine's per-point output (indices into `targets`),
 // plus `zeros` more of X's voxels at distance 0 that were not sent. Distances
-// in `metric`, witness points on X's grid `v`; the mean and points filled.
+// in `metric`, witness points on X's grid `v`; the mean, points and the
+// distances within `tolerance` (>= 0) filled.
 [[nodiscard]] Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric,
                                             std::span<const uint64_t> queries,
                                             std::span<const uint32_t> nearest,
-                                            std::span<const uint64_t> targets, uint64_t zeros, int threads);
+                                            std::span<const uint64_t> targets, uint64_t zeros,
+                                            double tolerance, int threads);
 
-// A direction's own numbers under `options`: its distances within the
-// tolerance and its HD-p of the convention (not for itk), per percentile
-// asked for. `d.distances` is reordered (selection).
+// A direction's own numbers under `options`: the fraction of its distances
+// within the tolerance (counted again unless directionOf counted at it) and
+// its HD-p of the convention (not for itk), per percentile asked for.
+// `d.distances` is reordered (selection).
 void directionNumbers(const MaskOptions& options, Direction& d);
 
 // One side of a boundary comparison: X's grid, X's voxels (the engine's

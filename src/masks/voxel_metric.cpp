@@ -71,7 +71,7 @@ SearchPoints VoxelMetric::searchPoints(std::span<const uint64_t> voxels, int thr
 
 RecomputedDirection recompute(const VoxelMetric& metric, Dims dims, std::span<const uint64_t> queries,
                               std::span<const uint64_t> targets, std::span<const uint32_t> nearest,
-                              int threads) {
+                              double tolerance, int threads) {
     RecomputedDirection r;
     r.distances.resize(queries.size());
     // Each chunk's sum and witness (largest, smallest index among ties),
@@ -80,11 +80,13 @@ RecomputedDirection recompute(const VoxelMetric& metric, Dims dims, std::span<co
     std::vector<double> sums(chunks, 0.0);
     std::vector<size_t> witnesses(chunks, 0);
     std::vector<double> leasts(chunks, 0.0);
+    std::vector<uint64_t> atMost(chunks, 0);
     const VoxelDecoder decode(dims);
     core::parallelChunks(queries.size(), kChunk, threads, [&](size_t b, size_t e, int) {
         double sum = 0.0;
         size_t witness = b;
         double least = std::numeric_limits<double>::infinity();
+        uint64_t within = 0;
         for (size_t i = b; i < e; ++i) {
             // The targets are read in the engine's order, not theirs: fetch a
             // few queries ahead.
@@ -94,14 +96,17 @@ RecomputedDirection recompute(const VoxelMetric& metric, Dims dims, std::span<co
             sum += d;
             if (d > r.distances[witness]) witness = i;
             least = d < least ? d : least;
+            within += d <= tolerance;
         }
         sums[b / kChunk] = sum;
         witnesses[b / kChunk] = witness;
         leasts[b / kChunk] = least;
+        atMost[b / kChunk] = within;
     });
     r.least = chunks > 0 ? *std::min_element(leasts.begin(), leasts.end()) : 0.0;
     for (size_t c = 0; c < chunks; ++c) {
         r.sum += sums[c];
+        r.atMost += atMost[c];
         if (r.distances[witnesses[c]] > r.distances[r.witness]) r.witness = witnesses[c];
     }
     return r;

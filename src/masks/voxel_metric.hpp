@@ -67,16 +67,18 @@ private:
 
 // Every query's distance to the target the engine found for it
 // (nearest[i]: index into targets), recomputed in double; the largest of
-// them (smallest query index among ties) is the direction's witness.
+// them (smallest query index among ties) is the direction's witness; how
+// many are within `tolerance` is counted in the same pass.
 struct RecomputedDirection {
     core::UninitVector<double> distances;  // in query order
     double sum = 0.0;                      // summed in chunks of 2^13 queries, in query order
     size_t witness = 0;                    // query index of the largest distance
     double least = 0.0;                    // the smallest distance
+    uint64_t atMost = 0;                   // distances <= the `tolerance` given
 };
 [[nodiscard]] RecomputedDirection recompute(const VoxelMetric& metric, Dims dims,
                                             std::span<const uint64_t> queries,
                                             std::span<const uint64_t> targets,
-                                            std::span<const uint32_t> nearest, int threads);
+                                            std::span<const uint32_t> nearest, double tolerance, int threads);
 
 }  // namespace rthdist::masks::detail
