@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "core/parallel.hpp"
 #include "core/timings.hpp"
 #include "masks/order_statistics.hpp"
 #include "masks/per_point_call.hpp"
@@ -162,12 +163,18 @@ Result<std::array<Direction, 2>> directionsOfOneCall(Engine& engine, const PairC
     CallOptions handed = perPointCall(false);
     // On a thread of the engine's while it searches the other direction
     // (CallOptions::perPointReady); nothing may throw out of it.
+    // The first direction's work runs beside the engine's thread (on a GPU,
+    // polling its fences): one host thread fewer for it.
+    MaskOptions first = options;
+    first.threads = std::max(1, core::resolveThreads(options.threads) - 1);
+    int calls = 0;  // perPointReady's calls never overlap
     handed.perPointReady = [&](int k, std::span<const uint32_t> nearest) {
         const Side& s = sides[size_t(k)];
+        const MaskOptions& use = calls++ == 0 ? first : options;
         try {
-            Result<Direction> d = directionOf(*s.grid, metric, s.queries, nearest, s.targets, 0,
-                                              options.tolerance, options.threads);
-            if (d) directionNumbers(options, *d);
+            Result<Direction> d =
+                directionOf(*s.grid, metric, s.queries, nearest, s.targets, 0, use.tolerance, use.threads);
+            if (d) directionNumbers(use, *d);
             done[size_t(k)] = std::move(d);
         } catch (const std::bad_alloc&) {
             done[size_t(k)] =
