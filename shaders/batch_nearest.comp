@@ -70,6 +70,6 @@ void main() {
         if (anyAlive == 0u) break;
     }
     if (!alive) return;
-    atomicMax(u64At(maxAddr, 0u).v, packDistIndex(best, qIndex));
+    raiseMax(maxAddr, packDistIndex(best, qIndex));
     uintAt(d.nearest, qIndex).v = bestIndex;
 }

@@ -82,6 +82,15 @@ uint64_t packDistIndex(float d2, uint index) {
 }
 float packedDist2(uint64_t p) { return uintBitsToFloat(uint(p >> 32)); }
 
+// atomicMax of the running maximum at maxPacked, skipped when a plain read
+// already shows one at least as large: the maximum only grows, so a stale
+// read costs only the atomic, and the threads that settle a query below
+// the maximum (most of them) do not queue on the one address (the plain
+// read deadThreshold relies on too).
+void raiseMax(uint64_t maxPacked, uint64_t packed) {
+    if (packed > U64Ref(maxPacked).v) atomicMax(U64Ref(maxPacked).v, packed);
+}
+
 // The threshold below which a query cannot raise h: the larger of the exact
 // running maximum (has a witness) and the witness-less lower bound.
 // A negative lowerBound2 turns the early break off (per-point distances).

@@ -103,7 +103,7 @@ void main() {
         st.status = RTHDIST_DEAD;
     } else if (best == 0.0 || (complete && dOut > 0.0 && best <= dOut * dOut)) {
         st.status = RTHDIST_EXACT;
-        atomicMax(u64At(maxPacked, 0).v, packDistIndex(best, qi));
+        raiseMax(maxPacked, packDistIndex(best, qi));
     } else {
         st.status = RTHDIST_OPEN;
     }

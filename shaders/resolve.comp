@@ -23,7 +23,7 @@ void main() {
     }
     if (st.status != RTHDIST_RETRY && best <= pc.radius * pc.radius) {
         stateAt(state, qi).v.status = RTHDIST_EXACT;
-        atomicMax(u64At(maxPacked, 0).v, packDistIndex(best, qi));
+        raiseMax(maxPacked, packDistIndex(best, qi));
         return;
     }
     if (st.status != RTHDIST_RETRY) stateAt(state, qi).v.rLo = pc.radius;
