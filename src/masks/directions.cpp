@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <thread>
 
 #include "core/parallel.hpp"
 #include "core/timings.hpp"
@@ -163,14 +164,16 @@ Result<std::array<Direction, 2>> directionsOfOneCall(Engine& engine, const PairC
     CallOptions handed = perPointCall(false);
     // On a thread of the engine's while it searches the other direction
     // (CallOptions::perPointReady); nothing may throw out of it.
-    // The first direction's work runs beside the engine's thread (on a GPU,
-    // polling its fences): one host thread fewer for it.
-    MaskOptions first = options;
-    first.threads = std::max(1, core::resolveThreads(options.threads) - 1);
-    int calls = 0;  // perPointReady's calls never overlap
+    // A direction handed back on another thread than this one runs beside
+    // the engine's (on a GPU, polling its fences while it searches the
+    // other direction): one host thread fewer for it. On this thread (the
+    // CPU backend's hand-backs, a GPU's last) the engine is idle.
+    MaskOptions beside = options;
+    beside.threads = std::max(1, core::resolveThreads(options.threads) - 1);
+    const std::thread::id caller = std::this_thread::get_id();
     handed.perPointReady = [&](int k, std::span<const uint32_t> nearest) {
         const Side& s = sides[size_t(k)];
-        const MaskOptions& use = calls++ == 0 ? first : options;
+        const MaskOptions& use = std::this_thread::get_id() != caller ? beside : options;
         try {
             Result<Direction> d =
                 directionOf(*s.grid, metric, s.queries, nearest, s.targets, 0, use.tolerance, use.threads);
