@@ -2,11 +2,9 @@
 
 #include <algorithm>
 #include <array>
-#include <exception>
 #include <optional>
 #include <span>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -20,6 +18,7 @@
 #include "gpu_algo/direction.hpp"
 #include "gpu_algo/index_build.hpp"
 #include "gpu_algo/neighbourhood_pass.hpp"
+#include "gpu_algo/per_point_hand_back.hpp"
 #include "gpu_algo/point_index.hpp"
 #include "gpu_algo/query_check.hpp"
 #include "gpu_algo/refinement.hpp"
@@ -304,11 +303,7 @@ struct GpuHausdorff::State {
         // Handed back: the direction with more queries first, its caller's
         // work (proportional to them) then overlaps the other's search.
         if (handBack && count == 2 && ba.Q.n > ab.Q.n) std::swap(steps[0], steps[1]);
-        // The first direction's read-back and perPointReady, on a thread of
-        // its own while the device searches the second; joined before the
-        // next call of it (what it throws rethrown then).
-        std::exception_ptr handingFailed;
-        std::jthread handing;
+        PerPointHandBack handing(options, check, handedBack);
         for (size_t i = 0; i < count; ++i) {
             const Step& s = steps[i];
             const double lo = i == 0 ? from : mid, hi = i + 1 == count ? 1.0 : mid;
@@ -318,30 +313,16 @@ struct GpuHausdorff::State {
             auto t0 = Clock::now();
             *s.out = check.finishDirection(*s.run, witness);
             ws.timings->check += msSince(t0);
-            if (handBack && i + 1 < count) {
-                handedBack |= 1u << s.direction;
-                handing = std::jthread([this, &options, &handingFailed, s] {
-                    try {
-                        check.readPerPoint(*s.run, *s.perPoint);
-                    } catch (...) {
-                        handingFailed = std::current_exception();
-                        return;
-                    }
-                    options.perPointReady(s.direction, s.perPoint->nearest);
-                });
+            if (handBack && i + 1 < count) {  // read back beside the next direction's search: not timed
+                handing.handBeside(*s.run, *s.perPoint, s.direction);
                 continue;
             }
             t0 = Clock::now();
             if (pp) check.readPerPoint(*s.run, *s.perPoint);
-            ws.timings->check += msSince(t0);  // a handed-back first direction's runs beside the search
-            if (!handBack) continue;
-            if (handing.joinable()) handing.join();
-            if (handingFailed) std::rethrow_exception(handingFailed);
-            handedBack |= 1u << s.direction;
-            options.perPointReady(s.direction, s.perPoint->nearest);
+            ws.timings->check += msSince(t0);
+            if (handBack) handing.handHere(*s.perPoint, s.direction);
         }
-        if (handing.joinable()) handing.join();
-        if (handingFailed) std::rethrow_exception(handingFailed);
+        handing.join();
         res.hausdorff =
             options.directedOnly ? res.aToB.distance : std::max(res.aToB.distance, res.bToA.distance);
         // Witnesses and per-point distances from the unscaled inputs, in double.
