@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <string>
 #include <thread>
 
 #include "core/parallel.hpp"
@@ -182,6 +183,9 @@ Result<std::array<Direction, 2>> directionsOfOneCall(Engine& engine, const PairC
         } catch (const std::bad_alloc&) {
             done[size_t(k)] =
                 Error{ErrorCode::kOutOfMemory, "masks: out of host memory for a direction's distances"};
+        } catch (const std::exception& e) {  // on the engine's thread nothing may escape (std::terminate)
+            done[size_t(k)] =
+                Error{ErrorCode::kInternal, std::string("masks: a direction's distances: ") + e.what()};
         }
     };
     Result<HausdorffResult> r = call(handed);
