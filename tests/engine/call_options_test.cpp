@@ -9,6 +9,7 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <thread>
 
 #include <unistd.h>
 
@@ -138,6 +139,7 @@ TEST(CallOptions, PerPointReadyHandsEachDirectionBackOnce) {
         int calls = 0;
         const uint32_t* data = nullptr;
         std::vector<uint32_t> values;
+        bool besideCaller = false;  // called on another thread than compute()'s
     };
     using Run = std::function<Result<HausdorffResult>(const CallOptions&)>;
     auto expectHandedBack = [](const Run& run, bool directed) {
@@ -147,6 +149,7 @@ TEST(CallOptions, PerPointReadyHandsEachDirectionBackOnce) {
         std::array<Handed, 2> handed;
         int other = 0;
         CallOptions call = plain;
+        const std::thread::id caller = std::this_thread::get_id();
         call.perPointReady = [&](int k, std::span<const uint32_t> nearest) {
             if (k != 0 && k != 1) {
                 ++other;
@@ -156,6 +159,7 @@ TEST(CallOptions, PerPointReadyHandsEachDirectionBackOnce) {
             ++h.calls;
             h.data = nearest.data();
             h.values.assign(nearest.begin(), nearest.end());
+            h.besideCaller = std::this_thread::get_id() != caller;
         };
         auto with = run(call);
         auto without = run(plain);
@@ -174,6 +178,15 @@ TEST(CallOptions, PerPointReadyHandsEachDirectionBackOnce) {
             EXPECT_EQ(w.nearest, wo.nearest) << "direction " << k;
         }
         EXPECT_EQ(with->hausdorff, without->hausdorff);
+        // Off the caller's thread: only on a GPU backend, only the first of
+        // two directions, the one with more queries (A's on a tie).
+        EXPECT_FALSE(handed[0].besideCaller && handed[1].besideCaller);
+        if (with->backend == Backend::kCpu || directed) {
+            EXPECT_FALSE(handed[0].besideCaller || handed[1].besideCaller);
+        } else {
+            const bool bLarger = with->bNearest.nearest.size() > with->aNearest.nearest.size();
+            EXPECT_FALSE(handed[bLarger ? 0 : 1].besideCaller) << "the larger direction is handed back first";
+        }
     };
     for (bool directed : {false, true}) {
         for (bool smallFirst : {true, false}) {
