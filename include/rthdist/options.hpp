@@ -113,8 +113,11 @@ struct CallOptions {
     // pairs split into pieces, small pairs scanned whole) calls it from the
     // calling thread once the result is complete. Either way compute()
     // returns (a result or an error) only after every call of it has
-    // returned. Must not throw and must not call back into the Engine; it
-    // may run the library's host threads (it shares their pool).
+    // returned; a call that fails may have handed back some directions or
+    // none (and one that ran out of device memory after handing a direction
+    // back returns kOutOfMemory instead of retrying in pieces). Must not
+    // throw and must not call back into the Engine; it may run the
+    // library's host threads (it shares their pool).
     std::function<void(int direction, std::span<const uint32_t> nearest)> perPointReady;
     // Called from the calling thread between stages and iterations with a
     // stage name ("index", "cull", "search", "refine") and the fraction of
