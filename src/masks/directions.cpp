@@ -163,12 +163,12 @@ Result<std::array<Direction, 2>> directionsOfOneCall(Engine& engine, const PairC
     const auto t0 = Clock::now();
     std::array<std::optional<Result<Direction>>, 2> done;
     CallOptions handed = perPointCall(false);
-    // On a thread of the engine's while it searches the other direction
-    // (CallOptions::perPointReady); nothing may throw out of it.
-    // A direction handed back on another thread than this one runs beside
-    // the engine's (on a GPU, polling its fences while it searches the
-    // other direction): one host thread fewer for it. On this thread (the
-    // CPU backend's hand-backs, a GPU's last) the engine is idle.
+    // Each direction's work as the engine hands it back
+    // (CallOptions::perPointReady; nothing may throw out of it). One handed
+    // back on another thread than this one runs beside the engine's (on a
+    // GPU, polling its fences while it searches the other direction): one
+    // host thread fewer for it. On this thread (the CPU backend's
+    // hand-backs, a GPU's last) the engine is idle.
     MaskOptions beside = options;
     beside.threads = std::max(1, core::resolveThreads(options.threads) - 1);
     const std::thread::id caller = std::this_thread::get_id();
