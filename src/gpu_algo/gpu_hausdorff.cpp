@@ -293,11 +293,10 @@ struct GpuHausdorff::State {
             DirectionRun* run;
             uint32_t survivors;
             Directed* out;
-            PerPoint* perPoint;
             int direction;
         };
-        std::array<Step, 2> steps{Step{&ab, survivors[0], &res.aToB, &res.aNearest, 0},
-                                  Step{&ba, survivors[1], &res.bToA, &res.bNearest, 1}};
+        std::array<Step, 2> steps{Step{&ab, survivors[0], &res.aToB, 0},
+                                  Step{&ba, survivors[1], &res.bToA, 1}};
         const size_t count = options.directedOnly ? 1 : 2;
         const bool handBack = pp && options.perPointReady != nullptr;
         // Handed back: the direction with more queries first, its caller's
@@ -314,13 +313,13 @@ struct GpuHausdorff::State {
             *s.out = check.finishDirection(*s.run, witness);
             ws.timings->check += msSince(t0);
             if (handBack && i + 1 < count) {  // read back beside the next direction's search: not timed
-                handing.handBeside(*s.run, *s.perPoint, s.direction);
+                handing.handBeside(*s.run, *s.run->perPoint, s.direction);
                 continue;
             }
             t0 = Clock::now();
-            if (pp) check.readPerPoint(*s.run, *s.perPoint);
+            if (pp) check.readPerPoint(*s.run, *s.run->perPoint);
             ws.timings->check += msSince(t0);
-            if (handBack) handing.handHere(*s.perPoint, s.direction);
+            if (handBack) handing.handHere(*s.run->perPoint, s.direction);
         }
         handing.join();
         res.hausdorff =
