@@ -144,16 +144,16 @@ Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric, std::s
 }
 
 void directionNumbers(const MaskOptions& options, Direction& d) {
+    d.numbered = true;
+    d.out.percentiles.clear();
+    if (options.convention == Convention::kItk) return;  // neither: combine reports NaN
     if (d.countedAt != options.tolerance) {
         d.withinTolerance = countAtMost(d.distances, options.tolerance, options.threads);
         d.countedAt = options.tolerance;
     }
     d.out.surfaceOverlap = double(d.withinTolerance) / double(d.out.points);
-    d.out.percentiles.clear();
-    if (options.convention != Convention::kItk)
-        for (double p : options.percentiles)
-            d.out.percentiles.push_back(directedPercentile(options.convention, d, p, options.threads));
-    d.numbered = true;
+    for (double p : options.percentiles)
+        d.out.percentiles.push_back(directedPercentile(options.convention, d, p, options.threads));
 }
 
 Result<std::array<Direction, 2>> directionsOfOneCall(Engine& engine, const PairCall& call,

@@ -61,10 +61,11 @@ void addTimings(Timings& sum, const Timings& t);
                                             std::span<const uint64_t> targets, uint64_t zeros,
                                             double tolerance, int threads);
 
-// A direction's own numbers under `options`: the fraction of its distances
-// within the tolerance (counted again unless directionOf counted at it) and
-// its HD-p of the convention (not for itk), per percentile asked for.
-// `d.distances` is reordered (selection).
+// A direction's own numbers under `options` (none for itk, whose surface
+// overlap and HD-p are not defined): the fraction of its distances within
+// the tolerance (counted again unless directionOf counted at it) and its
+// HD-p of the convention, per percentile asked for. `d.distances` is
+// reordered (selection).
 void directionNumbers(const MaskOptions& options, Direction& d);
 
 // One side of a boundary comparison: X's grid, X's voxels (the engine's
