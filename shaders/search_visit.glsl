@@ -19,7 +19,10 @@ bool visitCell(uint slot, uint qi, vec3 q, float rLo, float thr, uint cellIndex,
     Cell c = cellAt(pc.cells, cellIndex).v;
     float d2 = boxDist2(q, c.lo, c.hi);
     if (d2 > pc.radius * pc.radius) return false;
-    if (pc.skipScanned != 0u && d2 <= rLo * rLo) return false;
+    // rLo = 0: nothing of this level was scanned yet (a query that lost pairs
+    // at its first radius, or at the first radius of a new level): even the
+    // cells q lies in (d2 = 0) must be visited.
+    if (pc.skipScanned != 0u && rLo > 0.0 && d2 <= rLo * rLo) return false;
     if (d2 > bestLocal) return false;
     vec4 rep = vec4At(pc.targets, c.first).v;
     float r2 = dist2(q, rep.xyz);

@@ -422,6 +422,7 @@ struct ResolvePush {
     uint numActive;  // slots dispatched: at least RTHDIST_CTR_SEARCH_ACTIVE, the ones resolved
     float radius;
     float lowerBound2;
+    uint sameLevel;  // 1: the radius before searched this level (a RETRY query keeps its rLo), else 0
 };
 
 // probe_levels.comp: the automatic bit count's probe on the device (the same

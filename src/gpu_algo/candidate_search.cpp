@@ -164,7 +164,8 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
             cmdSearch(cmd, d, lv, sameLevel || i > 0, radii[i], pairs, pairCapacity, numActive);
             marks.emplace_back(before, m_ws.ctx.cmdMark(cmd));
             m_ws.barrier(cmd);
-            m_refine.cmdRefine(cmd, d, lv, level > 0, float(radii[i]), pairs, pairCapacity, numActive);
+            m_refine.cmdRefine(cmd, d, lv, level > 0, float(radii[i]), sameLevel || i > 0, pairs,
+                               pairCapacity, numActive);
         }
         m_ws.barrier(cmd);
         const sh::SearchAdvancePush ap{d.blk.device, uint32_t(i), uint32_t(pairCapacity), checkGroups, 0u};

@@ -6,7 +6,8 @@
 namespace rthdist::gpu_algo {
 
 void Refinement::cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse,
-                           float r, Buffer& pairs, uint64_t pairCapacity, uint32_t numActive) {
+                           float r, bool sameLevel, Buffer& pairs, uint64_t pairCapacity,
+                           uint32_t numActive) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "refinement");
     Buffer& args = m_ws.grow(m_ws.scratch.search.refineArgs, 16, "refineArgs");
     sh::RefineArgsPush ap{d.blk.device, args.address(), uint32_t(pairCapacity),
@@ -25,7 +26,7 @@ void Refinement::cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointInde
     rp.numFineCells = d.T.numCells;
     m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kRefine, &rp, sizeof(rp), args.handle(), 0);
     m_ws.barrier(cmd);
-    cmdResolve(cmd, d, numActive, r);
+    cmdResolve(cmd, d, numActive, r, sameLevel);
 }
 
 void Refinement::cmdTailScan(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse,
@@ -45,10 +46,12 @@ void Refinement::cmdTailScan(VkCommandBuffer cmd, DirectionRun& d, const PointIn
                               d.T.numCells};
     m_ws.pipelines.cmdDispatch(cmd, Kernel::kTailScan, &tp, sizeof(tp), numActive);  // a group per query
     m_ws.barrier(cmd);
-    cmdResolve(cmd, d, numActive, std::numeric_limits<float>::infinity());  // everything was scanned
+    // Everything was scanned (no query lost pairs here: the scan appends none).
+    cmdResolve(cmd, d, numActive, std::numeric_limits<float>::infinity(), true);
 }
 
-void Refinement::cmdResolve(VkCommandBuffer cmd, DirectionRun& d, uint32_t numActive, float radius) {
+void Refinement::cmdResolve(VkCommandBuffer cmd, DirectionRun& d, uint32_t numActive, float radius,
+                            bool sameLevel) {
     const sh::ResolvePush rs{d.state->address(),
                              d.active[d.cur]->address(),
                              d.active[1 - d.cur]->address(),
@@ -56,7 +59,8 @@ void Refinement::cmdResolve(VkCommandBuffer cmd, DirectionRun& d, uint32_t numAc
                              d.blk.addr(RTHDIST_CTR_MAX_PACKED),
                              numActive,
                              radius,
-                             d.lowerBound2};
+                             d.lowerBound2,
+                             sameLevel ? 1u : 0u};
     m_ws.dispatchSearched(cmd, Kernel::kResolve, rs, numActive, d.blk);
 }
 

@@ -18,9 +18,10 @@ public:
     // Records the refinement of one radius: the pairs that fit are scanned
     // exactly (as many groups as the device counted pairs for), then every
     // active query is resolved (exact, dead, or on to the next radius) into
-    // the other active buffer.
+    // the other active buffer. sameLevel: the radius before searched this
+    // level too (the search skipped the cells within each query's rLo).
     void cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse, float r,
-                   Buffer& pairs, uint64_t pairCapacity, uint32_t numActive);
+                   bool sameLevel, Buffer& pairs, uint64_t pairCapacity, uint32_t numActive);
 
     // Records the far tail's scan: each of the numActive open queries scans
     // every cell of level `lv` (coarse: through its level-0 cells), then all
@@ -31,8 +32,9 @@ public:
 
 private:
     // Every active query resolved at `radius` (resolve.comp): exact, dead,
-    // or into the other active buffer for the next radius.
-    void cmdResolve(VkCommandBuffer cmd, DirectionRun& d, uint32_t numActive, float radius);
+    // or into the other active buffer for the next radius (a query that lost
+    // pairs keeps its rLo only when sameLevel, resolve.comp).
+    void cmdResolve(VkCommandBuffer cmd, DirectionRun& d, uint32_t numActive, float radius, bool sameLevel);
 
     Workspace& m_ws;
 };

@@ -6,12 +6,17 @@
 // with the limit named when a buffer or a BLAS is past the device's limit.
 #include <gtest/gtest.h>
 
+#include <glm/glm.hpp>
+
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include "address_probe.comp.h"
+#include "common/density_cases.hpp"
 #include "common/oracle_cases.hpp"
+#include "common/rng.hpp"
 #include "gpu/buffer.hpp"
 #include "gpu/context.hpp"
 #include "gpu_algo/gpu_hausdorff.hpp"
@@ -118,6 +123,49 @@ TEST(LargeSizes, ExactWhenEverySplitIsForcedSmall) {
         ++run;
     }
     EXPECT_GT(run, 30);
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// Issue 32 (wrong H at 300M x 400M and on a 20M crowded sphere): a query
+// whose pairs did not fit the pair buffer at its first radius, or at the first
+// radius of a new search level, was searched again with the cells it lies in
+// skipped (rLo = 0 read as "the cells at distance 0 were scanned", and an rLo
+// of the level before kept). Only a split index (crowded cells, which the
+// neighbourhood pass leaves to the search) and a full pair buffer show it: at
+// scale the buffer's first size (2^22 pairs) overflows at the first radius.
+// Here the buffer is forced small on crowded inputs: density cases and a
+// small noisy sphere in a unit box whose corners belong to both sets (20k
+// points a set; before the fix its H came out 16 % too large).
+TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0);
+    ASSERT_TRUE(engine) << engine.error().message;
+    std::vector<OracleCase> cases;
+    for (const OracleCase& c : makeDensityCases())
+        if (c.a.size() + c.b.size() <= 25000 && c.a.size() > 1000 && c.b.size() > 1000) cases.push_back(c);
+    auto sphere = [](uint64_t seed, int n) {
+        Rng rng(seed);
+        std::vector<glm::vec3> p{{0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}};
+        while (int(p.size()) < n) {
+            const glm::dvec3 noise(rng.gauss(), rng.gauss(), rng.gauss());
+            p.emplace_back(glm::dvec3(0.5) + 0.005 * rng.direction() + 2e-6 * noise);
+        }
+        return p;
+    };
+    cases.push_back(OracleCase{"crowded_sphere_in_unit_box", 32, sphere(3201, 20000), sphere(3202, 20000)});
+    for (uint64_t capacity : {uint64_t(64), uint64_t(2000)}) {
+        (*engine)->setMaxPairCapacity(capacity);
+        for (const OracleCase& c : cases) {
+            SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed) + " pairs " + std::to_string(capacity));
+            auto r = (*engine)->compute(c.a, c.b, Options{});
+            ASSERT_TRUE(r) << r.error().message;
+            std::printf("  %-28s pairs %5llu: H %.9g\n", c.name.c_str(),
+                        static_cast<unsigned long long>(capacity), r->hausdorff);
+            expectMatchesOracle(c, *r);
+            // Crowded cells: the neighbourhood pass leaves most of the sphere's queries to the search.
+            if (c.seed == 32) EXPECT_LT(r->aToB.counters.culledByNeighbourhood * 2, r->aToB.counters.queries);
+        }
+    }
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
