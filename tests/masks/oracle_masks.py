@@ -258,9 +258,9 @@ def check_device_extraction(name, cli, backend, a_path, b_path, extra, out):
 
 
 def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_volumes=None, npy=False,
-               npy_affine=False):
+               npy_affine=False, more_percentiles=()):
     """Writes the pair (label volumes or binary masks), runs every convention, compares."""
-    percentiles = [95.0, 50.0, 100.0]
+    percentiles = [95.0, 50.0, 100.0] + [float(p) for p in more_percentiles]
     va = label_volumes[0] if label_volumes else a.astype(np.uint8)
     vb = label_volumes[1] if label_volumes else b.astype(np.uint8)
     if npy:
@@ -280,6 +280,8 @@ def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_vol
         affine = nib.load(a_path).affine
         extra = []
     extra += ["--connectivity", str(conn), "--tolerance", repr(tol)]
+    for p in more_percentiles:
+        extra += ["--percentile", repr(float(p))]
     if label_volumes:
         extra += ["--labels", "all"]
     out = run_cli(cli, backend, a_path, b_path, extra)
@@ -374,6 +376,20 @@ def synthetic_cases(cli, backend, tmp, quick):
     thin_b = np.zeros(shape, bool)
     thin_b[8:30, 10:26, 7] = True  # a one-voxel plate
     check_case("thin_structures", cli, backend, tmp, thin_a, thin_b, aniso)
+    # MONAI's float32: slabs 3 voxels apart at 0.8 mm are 2.4000000000000004
+    # mm apart in double, 2.4f in float32 (inside a 2.4 mm tolerance); a cube
+    # and the cube plus a voxel 24 mm away: the HD-99.9 rank 0.999 * 488 in
+    # float32, and p = 0 (MONAI: the maximum; the others: the least).
+    slab_a, slab_b = np.zeros((20, 20, 20), bool), np.zeros((20, 20, 20), bool)
+    slab_a[:, :, 5:12] = True
+    slab_b[:, :, 8:15] = True
+    check_case("slabs_0.8mm_tol2.4", cli, backend, tmp, slab_a, slab_b, np.diag([0.8, 0.8, 0.8, 1.0]), tol=2.4,
+               more_percentiles=(0, 99.9))
+    cube = np.zeros((40, 16, 16), bool)
+    cube[2:12, 2:12, 2:12] = True
+    island = cube.copy()
+    island[35, 7, 7] = True
+    check_case("cube_island", cli, backend, tmp, island, cube, np.eye(4), more_percentiles=(0, 99.9))
     one_a = np.zeros(shape, bool)
     one_a[3, 4, 5] = True
     one_b = np.zeros(shape, bool)
