@@ -133,6 +133,36 @@ py::dict engineMs(const Timings& e) {
     return d;
 }
 
+py::list percentileTexts(const std::vector<double>& p, const std::vector<std::string>& texts) {
+    py::list out;
+    for (size_t i = 0; i < texts.size() && i < p.size(); ++i)
+        out.append(py::dict(py::arg("p") = p[i], py::arg("value") = texts[i]));
+    return out;
+}
+
+py::dict emptyDirectedDict(const masks::EmptyDirected& d, const std::vector<double>& p) {
+    py::dict out;
+    out["hd"] = d.hd;
+    out["mean"] = d.mean;
+    out["surface_overlap"] = d.surfaceOverlap;
+    out["percentiles"] = percentileTexts(p, d.percentiles);
+    return out;
+}
+
+// emptyJson of tools/cli/masks/masks_main.cpp.
+py::dict emptyDict(const MaskResult& r) {
+    const masks::EmptyValues& e = r.emptyValues;
+    py::dict out;
+    out["hd"] = e.hd;
+    out["hd_percentile"] = percentileTexts(r.percentiles, e.hdPercentile);
+    out["assd"] = e.assd;
+    out["msd"] = e.msd;
+    out["surface_dice"] = e.surfaceDice;
+    out["a_to_b"] = emptyDirectedDict(e.aToB, r.percentiles);
+    out["b_to_a"] = emptyDirectedDict(e.bToA, r.percentiles);
+    return out;
+}
+
 // rowJson of tools/cli/masks/masks_main.cpp (same keys, same order).
 py::dict rowDict(const std::string& label, const MaskResult& r) {
     const bool ok = r.empty == masks::EmptyStatus::kNone;
@@ -146,17 +176,7 @@ py::dict rowDict(const std::string& label, const MaskResult& r) {
                         : r.convention == Convention::kItk    ? "voxels"
                                                               : "boundary_voxels";
     out["status"] = masks::emptyStatusName(r.empty);
-    if (!ok) {
-        py::dict value;
-        value["hd"] = r.emptyHd;
-        value["hd_percentile"] = r.emptyHdPercentile;
-        if (!r.emptySurfaceDice.empty()) {
-            value["surface_dice"] = r.emptySurfaceDice;
-            value["a_to_b_mean"] = r.emptyMeanAToB;
-            value["b_to_a_mean"] = r.emptyMeanBToA;
-        }
-        out["convention_value"] = value;
-    }
+    if (!ok) out["convention_value"] = emptyDict(r);
     out["hd"] = number(r.hd);
     out["hd_percentile"] = percentileRows(r.percentiles, r.hdPercentile);
     out["assd"] = number(r.assd);
@@ -207,7 +227,7 @@ struct PyPrepared {
 // empty sides exchanged (the numbers of both directions are symmetric).
 MaskResult swapped(MaskResult r) {
     std::swap(r.aToB, r.bToA);
-    std::swap(r.emptyMeanAToB, r.emptyMeanBToA);
+    std::swap(r.emptyValues.aToB, r.emptyValues.bToA);
     if (r.empty == masks::EmptyStatus::kAEmpty) {
         r.empty = masks::EmptyStatus::kBEmpty;
     } else if (r.empty == masks::EmptyStatus::kBEmpty) {

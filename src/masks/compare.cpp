@@ -218,7 +218,8 @@ Result<MaskResult> compareMasks(MaskEngine& maskEngine, const Volume& a, LabelSe
     const detail::Extraction* eb = &(*extracted)[1];
     r.extractMs = msSince(t0);
     if (ea->count == 0 || eb->count == 0) {
-        detail::setEmpty(ea->count, eb->count, itk ? 0 : options.percentiles.size(), r);
+        detail::setEmpty(itk ? ea->count : ea->boundary.size(), itk ? eb->count : eb->boundary.size(),
+                         options.percentiles, r);
         r.totalMs = msSince(start);
         return r;
     }

@@ -150,23 +150,6 @@ double areaWithin(const SurfelDirection& d, double tolerance) {
     return numpySum(std::span<const double>(d.areas).first(n));
 }
 
-MaskResult emptyResult(uint64_t na, uint64_t nb, size_t percentiles) {
-    MaskResult r;
-    const bool both = na == 0 && nb == 0;
-    r.empty = both ? EmptyStatus::kBothEmpty : na == 0 ? EmptyStatus::kAEmpty : EmptyStatus::kBEmpty;
-    r.emptyHd = r.emptyHdPercentile = "inf";
-    r.emptySurfaceDice = both ? "nan" : "0";
-    // A side without surfels averages nothing (0/0); the other side's distances are all inf.
-    r.emptyMeanAToB = na == 0 ? "nan" : "inf";
-    r.emptyMeanBToA = nb == 0 ? "nan" : "inf";
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    r.hd = r.assd = r.msd = r.surfaceDice = nan;
-    r.hdPercentile.assign(percentiles, nan);
-    r.aToB.hd = r.bToA.hd = r.aToB.mean = r.bToA.mean = nan;
-    r.aToB.surfaceOverlap = r.bToA.surfaceOverlap = nan;
-    return r;
-}
-
 // The numbers of both directions, area-weighted.
 MaskResult summary(const MaskOptions& options, SurfelDirection& ab, SurfelDirection& ba, const Timing& timing,
                    Clock::time_point start) {
@@ -210,12 +193,11 @@ Result<MaskResult> compareSurfels(Engine& engine, const Volume& a, const Surfels
     Timing timing;
     timing.extractMs = extractMs;
     if (sa.selected == 0 || sb.selected == 0) {
-        MaskResult r = emptyResult(sa.selected, sb.selected, options.percentiles.size());
+        MaskResult r;
         r.convention = Convention::kDeepmind;
         r.connectivity = 0;
         r.percentiles = options.percentiles;
-        r.aToB.points = sa.corners.size();
-        r.bToA.points = sb.corners.size();
+        setEmpty(sa.corners.size(), sb.corners.size(), options.percentiles, r);
         r.extractMs = timing.extractMs;
         r.totalMs = msSince(start);
         return r;

@@ -3,6 +3,8 @@
 #include "masks/directions.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
 #include <limits>
 #include <string>
 #include <thread>
@@ -26,27 +28,16 @@ void finishDirection(const Volume& v, Direction& d) {
     d.out.mean = d.out.points ? d.sum / double(d.out.points) : 0.0;
 }
 
-void emptyValues(Convention c, EmptyStatus s, MaskResult& r) {
-    const bool both = s == EmptyStatus::kBothEmpty;
-    switch (c) {
-        case Convention::kRthdist: r.emptyHd = r.emptyHdPercentile = "undefined"; break;
-        case Convention::kMonai:
-            r.emptyHd = both ? "nan" : "inf";
-            r.emptyHdPercentile = "nan";
-            break;
-        case Convention::kMedpy: r.emptyHd = r.emptyHdPercentile = "error"; break;
-        case Convention::kPlastimatch: r.emptyHd = r.emptyHdPercentile = both ? "0" : "undefined"; break;
-        case Convention::kItk: r.emptyHd = r.emptyHdPercentile = "undefined"; break;
-        case Convention::kDeepmind: break;  // deepmind.cpp
-    }
-}
-
-// This direction's HD-p under convention c (none for itk and deepmind).
-double directedPercentile(Convention c, Direction& d, double p, int threads) {
+// This direction's HD-p under the options' convention (none for itk and deepmind).
+double directedPercentile(const MaskOptions& options, Direction& d, double p) {
     const ValueRange range{{d.least, d.out.hd}};
-    switch (c) {
+    const int threads = options.threads;
+    switch (options.convention) {
         case Convention::kRthdist: return percentileNearestRank(d.distances, p, threads, range);
         case Convention::kMonai:
+            if (p == 0.0) return d.out.hd;  // MONAI: `if not percentile: return max`
+            return options.monaiFloat32 ? percentileTorchFloat32(d.distances, p, threads, range)
+                                        : percentileLinear(d.distances, p, threads, range);
         case Convention::kMedpy: return percentileLinear(d.distances, p, threads, range);
         case Convention::kPlastimatch: return percentilePlastimatch(d.distances, p, threads, range);
         case Convention::kItk:
@@ -147,13 +138,13 @@ void directionNumbers(const MaskOptions& options, Direction& d) {
     d.numbered = true;
     d.out.percentiles.clear();
     if (options.convention == Convention::kItk) return;  // neither: combine reports NaN
-    if (d.countedAt != options.tolerance) {
-        d.withinTolerance = countAtMost(d.distances, options.tolerance, options.threads);
-        d.countedAt = options.tolerance;
+    const double limit = toleranceLimit(options);
+    if (d.countedAt != limit) {
+        d.withinTolerance = countAtMost(d.distances, limit, options.threads);
+        d.countedAt = limit;
     }
     d.out.surfaceOverlap = double(d.withinTolerance) / double(d.out.points);
-    for (double p : options.percentiles)
-        d.out.percentiles.push_back(directedPercentile(options.convention, d, p, options.threads));
+    for (double p : options.percentiles) d.out.percentiles.push_back(directedPercentile(options, d, p));
 }
 
 Result<std::array<Direction, 2>> directionsOfOneCall(Engine& engine, const PairCall& call,
@@ -176,8 +167,8 @@ Result<std::array<Direction, 2>> directionsOfOneCall(Engine& engine, const PairC
         const Side& s = sides[size_t(k)];
         const MaskOptions& use = std::this_thread::get_id() != caller ? beside : options;
         try {
-            Result<Direction> d =
-                directionOf(*s.grid, metric, s.queries, nearest, s.targets, 0, use.tolerance, use.threads);
+            Result<Direction> d = directionOf(*s.grid, metric, s.queries, nearest, s.targets, 0,
+                                              toleranceLimit(use), use.threads);
             if (d) directionNumbers(use, *d);
             done[size_t(k)] = std::move(d);
         } catch (const std::bad_alloc&) {
@@ -236,18 +227,34 @@ Result<Direction> directed(const VoxelMetric& metric, const Volume& v, std::span
     return d;
 }
 
-// A mask without points (na or nb is 0): which one, the convention's empty
-// values, and NaN for every number.
-void setEmpty(uint64_t na, uint64_t nb, size_t percentiles, MaskResult& r) {
+void setEmpty(uint64_t na, uint64_t nb, const std::vector<double>& percentiles, MaskResult& r) {
     r.empty = na == 0 && nb == 0 ? EmptyStatus::kBothEmpty
               : na == 0          ? EmptyStatus::kAEmpty
                                  : EmptyStatus::kBEmpty;
-    emptyValues(r.convention, r.empty, r);
+    const bool itk = r.convention == Convention::kItk;
+    r.emptyValues = emptyValues(r.convention, r.empty, itk ? std::vector<double>{} : percentiles);
     const double nan = std::numeric_limits<double>::quiet_NaN();
     r.hd = r.assd = r.msd = r.surfaceDice = nan;
-    r.hdPercentile.assign(percentiles, nan);
-    r.aToB.hd = r.bToA.hd = r.aToB.mean = r.bToA.mean = nan;
-    r.aToB.surfaceOverlap = r.bToA.surfaceOverlap = nan;
+    r.hdPercentile.assign(itk ? 0 : percentiles.size(), nan);
+    for (DirectedMask* d : {&r.aToB, &r.bToA}) {
+        d->hd = d->mean = d->surfaceOverlap = nan;
+        d->percentiles.assign(itk ? 0 : percentiles.size(), nan);
+    }
+    r.aToB.points = na;
+    r.bToA.points = nb;
+}
+
+double toleranceLimit(const MaskOptions& options) {
+    const double t = options.tolerance;
+    if (options.convention != Convention::kMonai || !options.monaiFloat32) return t;
+    // float(d) <= f for every d below the midpoint m of f and the next float
+    // up; at m itself when rounding to even picks f.
+    const float f = float(t);
+    const float up = std::nextafter(f, std::numeric_limits<float>::infinity());
+    if (!std::isfinite(f) || !std::isfinite(up)) return std::numeric_limits<double>::infinity();
+    const double m = 0.5 * (double(f) + double(up));  // exact: two adjacent floats
+    const bool even = (std::bit_cast<uint32_t>(f) & 1u) == 0;
+    return even ? m : std::nextafter(m, -std::numeric_limits<double>::infinity());
 }
 
 void combine(const MaskOptions& options, Direction& ab, Direction& ba, MaskResult& r) {

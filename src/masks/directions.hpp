@@ -108,9 +108,16 @@ using NearestCall = std::function<Result<HausdorffResult>(std::span<const glm::v
                                          uint64_t zeroWitness, std::span<const uint64_t> targets,
                                          const NearestCall& nearest, int threads, MaskResult& timed);
 
-// The convention's empty status and values for masks with na and nb points
-// (one of them 0), NaN in every number.
-void setEmpty(uint64_t na, uint64_t nb, size_t percentiles, MaskResult& r);
+// The empty status and the convention's values (emptyValues) for masks with
+// na and nb points (one of them 0; r.convention set): NaN in every number,
+// both sides' points.
+void setEmpty(uint64_t na, uint64_t nb, const std::vector<double>& percentiles, MaskResult& r);
+
+// The largest distance counted within options.tolerance: the tolerance, or
+// for monai with monaiFloat32 the largest double d with float(d) <=
+// float(tolerance) (MONAI compares float32 distances with the threshold
+// rounded to float32).
+[[nodiscard]] double toleranceLimit(const MaskOptions& options);
 
 // HD, ASSD, MSD, surface overlaps and Dice and (but for itk) the HD-p of
 // options.convention from both directions (numbered here unless they are),

@@ -17,7 +17,9 @@
 //               (rthdist/stats.hpp percentileNearestRank); empty -> status, no value.
 //   monai       boundary = mask XOR erosion (6-connected cross); spacing only;
 //               HD-p = max of the two directed linear percentiles
-//               (torch.quantile); empty: both -> NaN, one -> HD inf, HD-p NaN.
+//               (torch.quantile: rank and weight in float32; p = 0 -> the
+//               maximum); surface Dice counts float(d) <= float(tolerance)
+//               (MaskOptions::monaiFloat32); empty: emptyValues.
 //   medpy       boundary as monai (connectivity 6 by default); HD-p = linear
 //               percentile of the POOLED distances of both directions;
 //               HD = max; empty -> undefined (MedPy raises).
@@ -175,6 +177,13 @@ struct MaskOptions {
     std::vector<double> percentiles{95.0};  // each in [0, 100]
     double tolerance = 1.0;                 // surface Dice tolerance, in mm (>= 0)
     int threads = 0;                        // extraction, distances, percentiles; 0 = all hardware threads
+    // monai only: MONAI's float32 arithmetic (its distances are float32
+    // tensors): a distance d is within the tolerance when float(d) <=
+    // float(tolerance), and torch.quantile's rank p/100 (n - 1) and weight are
+    // float32 (rank, weight and the two order statistics as torch takes them;
+    // the interpolation in double). false: the same rules in double (d <= tolerance,
+    // numpy's rank). Either way p = 0 is the maximum (MONAI's `if not percentile`).
+    bool monaiFloat32 = true;
     // Extract boundaries on the host even when the MaskEngine has a device
     // pass (makeMaskEngine's devicePass; tests compare the two: the voxels
     // are the same).
@@ -184,9 +193,41 @@ struct MaskOptions {
 enum class EmptyStatus { kNone, kBothEmpty, kAEmpty, kBEmpty };
 [[nodiscard]] const char* emptyStatusName(EmptyStatus s);  // "ok", "both_empty", "a_empty", "b_empty"
 
+// What a convention's own tool reports for a row with an empty mask, one
+// text per number of MaskResult: "nan", "inf", "0", "undefined" (the tool
+// defines no such value) or "error" (the tool raises). emptyValues() below
+// has each convention's rules.
+struct EmptyDirected {
+    std::string hd, mean, surfaceOverlap;
+    std::vector<std::string> percentiles;  // per MaskOptions::percentiles
+};
+struct EmptyValues {
+    std::string hd, assd, msd, surfaceDice;
+    std::vector<std::string> hdPercentile;  // per MaskOptions::percentiles
+    EmptyDirected aToB, bToA;
+};
+
+// The values convention c reports when A or B (or both) is empty, for the
+// requested percentiles (none for itk):
+//   rthdist, itk  "undefined" everywhere.
+//   monai (d388d1c)  both: "nan" everywhere. One: every distance of both
+//                 directions is inf (get_surface_distance), so HD, the
+//                 directed HDs and means, ASSD and MSD "inf"; HD-p "nan"
+//                 (torch.quantile interpolates inf - inf) except p = 0
+//                 ("inf": the maximum); surface Dice and overlaps "0".
+//   medpy         "error" everywhere (RuntimeError: no binary object).
+//   plastimatch   both: "0" (its statistics stay 0) but surface Dice and
+//                 overlaps "undefined"; one: "undefined".
+//   deepmind (1f805ce)  HD, HD-p and every directed HD-p "inf"; a side
+//                 without surfels: mean and overlap "nan" (0/0), the other
+//                 side's "inf" and "0"; surface Dice "0" (one) or "nan"
+//                 (both); ASSD "inf" (one) or "nan"; MSD "nan".
+[[nodiscard]] EmptyValues emptyValues(Convention c, EmptyStatus s, const std::vector<double>& percentiles);
+
 // One direction X -> Y.
 struct DirectedMask {
-    uint64_t points = 0;  // X's points under the convention (boundary voxels, all voxels or surfels)
+    uint64_t points = 0;  // X's points under the convention (boundary voxels, all voxels or surfels);
+                          // also with an empty mask (0 for the empty side only)
     double hd = 0.0;      // max over X of the nearest distance to Y
     double mean = 0.0;    // deepmind: area-weighted
     std::vector<double> percentiles;  // this direction's percentile per MaskOptions::percentiles
@@ -207,11 +248,9 @@ struct MaskResult {
     Convention convention = Convention::kRthdist;
     int connectivity = 6;  // 0 for itk (all voxels) and deepmind (surfels)
     EmptyStatus empty = EmptyStatus::kNone;
-    // With empty != kNone: no number below is valid; what the convention
-    // itself would report, as text ("nan", "inf", "0", "undefined").
-    std::string emptyHd, emptyHdPercentile;
-    // deepmind only (else ""): its surface Dice and directed means.
-    std::string emptySurfaceDice, emptyMeanAToB, emptyMeanBToA;
+    // With empty != kNone: no number below is valid (NaN) but the points
+    // of both sides; `emptyValues` says what the convention itself reports.
+    EmptyValues emptyValues;
     double hd = 0.0;
     std::vector<double> percentiles;   // the requested p values
     std::vector<double> hdPercentile;  // combined per the convention (empty for itk)

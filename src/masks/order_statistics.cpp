@@ -129,6 +129,22 @@ double percentileLinear(std::span<double> values, double p, int threads, ValueRa
     return t >= 0.5 ? b - diff * (1.0 - t) : a + diff * t;
 }
 
+double percentileTorchFloat32(std::span<double> values, double p, int threads, ValueRange range) {
+    const size_t n = values.size();
+    if (n == 0) return std::numeric_limits<double>::quiet_NaN();
+    const float q = float(p / 100.0);
+    const float rank = q * float(n - 1);  // one float32 product, as torch's q * last_index
+    // torch indexes with the truncated rank and its ceiling; a rank that
+    // float(n - 1) rounded past the last index (n > 2^24) is clamped.
+    const size_t below = std::min(size_t(rank), n - 1);
+    const size_t above = std::min(size_t(std::ceil(rank)), n - 1);
+    const float weight = rank - float(below);
+    const auto [a, next] = kthAndNext(values, below, threads, range);
+    const double b = above == below ? a : next;
+    const double w = double(weight);
+    return w < 0.5 ? a + w * (b - a) : b - (b - a) * (1.0 - w);
+}
+
 double percentilePlastimatch(std::span<double> values, double p, int threads, ValueRange range) {
     const size_t n = values.size();
     if (n == 0) return 0.0;

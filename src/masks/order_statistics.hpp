@@ -31,6 +31,16 @@ using ValueRange = std::optional<std::pair<double, double>>;  // least, greatest
 // NaN when empty.
 [[nodiscard]] double percentileLinear(std::span<double> values, double p, int threads, ValueRange range = {});
 
+// torch.quantile(t, p / 100) of a float32 tensor t (MONAI's HD-p): the rank
+// q (n - 1) computed in float32 as torch computes it (q = float(p / 100),
+// n - 1 rounded to float, their product rounded), truncated to the lower
+// index, its float32 fraction the weight of the next order statistic,
+// torch's lerp (w < 0.5: a + w (b - a), else b - (b - a)(1 - w)) evaluated in
+// double. Ranks and weights are torch's; the values are the double
+// distances (MONAI's are their float32 roundings). NaN when empty.
+[[nodiscard]] double percentileTorchFloat32(std::span<double> values, double p, int threads,
+                                            ValueRange range = {});
+
 // plastimatch: the k-th smallest (0-based), k = floor(f n - 1) clamped to [0, n-1]; 0 when empty.
 [[nodiscard]] double percentilePlastimatch(std::span<double> values, double p, int threads,
                                            ValueRange range = {});

@@ -165,7 +165,8 @@ Result<MaskResult> compareVoxels(MaskEngine& engine, const State& s, const Volum
     if (!eb) return eb.error();
     r.extractMs = msSince(t0);
     if (s.extracted.count == 0 || eb->count == 0) {
-        detail::setEmpty(s.extracted.count, eb->count, itk ? 0 : options.percentiles.size(), r);
+        detail::setEmpty(itk ? s.extracted.count : s.extracted.boundary.size(),
+                         itk ? eb->count : eb->boundary.size(), options.percentiles, r);
         r.totalMs = msSince(start);
         return r;
     }

@@ -238,15 +238,15 @@ TEST(DeepmindBackend, EmptyMasksReportInf) {
     Result<MaskResult> both = compareMasks(*engine, empty, {}, empty, {}, mo);
     ASSERT_TRUE(both.ok());
     EXPECT_EQ(both->empty, EmptyStatus::kBothEmpty);
-    EXPECT_EQ(both->emptyHd, "inf");
-    EXPECT_EQ(both->emptySurfaceDice, "nan");
+    EXPECT_EQ(both->emptyValues.hd, "inf");
+    EXPECT_EQ(both->emptyValues.surfaceDice, "nan");
     Result<MaskResult> bEmpty = compareMasks(*engine, one, {}, empty, {}, mo);
     ASSERT_TRUE(bEmpty.ok());
     EXPECT_EQ(bEmpty->empty, EmptyStatus::kBEmpty);
-    EXPECT_EQ(bEmpty->emptyHdPercentile, "inf");
-    EXPECT_EQ(bEmpty->emptySurfaceDice, "0");
-    EXPECT_EQ(bEmpty->emptyMeanAToB, "inf");
-    EXPECT_EQ(bEmpty->emptyMeanBToA, "nan");
+    EXPECT_EQ(bEmpty->emptyValues.hdPercentile.at(0), "inf");
+    EXPECT_EQ(bEmpty->emptyValues.surfaceDice, "0");
+    EXPECT_EQ(bEmpty->emptyValues.aToB.mean, "inf");
+    EXPECT_EQ(bEmpty->emptyValues.bToA.mean, "nan");
     EXPECT_TRUE(std::isnan(bEmpty->hd));  // never a number folded into a mean
 }
 

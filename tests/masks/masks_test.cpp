@@ -348,11 +348,11 @@ TEST(MasksBackend, EmptyMasksHaveAStatus) {
     Result<MaskResult> both = compareMasks(*engine, empty, {}, empty, {}, mo);
     ASSERT_TRUE(both.ok());
     EXPECT_EQ(both->empty, EmptyStatus::kBothEmpty);
-    EXPECT_EQ(both->emptyHd, "nan");
+    EXPECT_EQ(both->emptyValues.hd, "nan");
     Result<MaskResult> one = compareMasks(*engine, full, {}, empty, {}, mo);
     ASSERT_TRUE(one.ok());
     EXPECT_EQ(one->empty, EmptyStatus::kBEmpty);
-    EXPECT_EQ(one->emptyHd, "inf");
+    EXPECT_EQ(one->emptyValues.hd, "inf");
     EXPECT_TRUE(std::isnan(one->hd));  // never a number folded into a mean
     // One voxel each: HD is their distance.
     Volume v1 = empty, v2 = empty;

@@ -150,9 +150,20 @@ def expected(mask_a, mask_b, spacing, percentiles, tol):
         with np.errstate(invalid="ignore", divide="ignore"):
             dice = (np.sum(aa[da <= tol]) + np.sum(ab[db <= tol])) / (np.sum(aa) + np.sum(ab))
             mean_a, mean_b = np.sum(da * aa) / np.sum(aa), np.sum(db * ab) / np.sum(ab)
+            assd = (np.sum(da * aa) + np.sum(db * ab)) / (np.sum(aa) + np.sum(ab))
+            over_a = np.sum(aa[da <= tol]) / np.sum(aa)
+            over_b = np.sum(ab[db <= tol]) / np.sum(ab)
         hd = max(robust_directed(da, aa, 100), robust_directed(db, ab, 100))
-        return {"status": status, "text": {"hd": f"{hd:g}", "hd_percentile": f"{hd:g}", "surface_dice": f"{dice:g}",
-                                           "a_to_b_mean": f"{mean_a:g}", "b_to_a_mean": f"{mean_b:g}"}}
+
+        def directed(d, a, mean, overlap):
+            return {"hd": f"{robust_directed(d, a, 100):g}", "mean": f"{mean:g}", "surface_overlap": f"{overlap:g}",
+                    "percentiles": [{"p": p, "value": f"{robust_directed(d, a, p):g}"} for p in percentiles]}
+        hp = [{"p": p, "value": f"{max(robust_directed(da, aa, p), robust_directed(db, ab, p)):g}"}
+              for p in percentiles]
+        return {"status": status, "a_points": len(da), "b_points": len(db),
+                "text": {"hd": f"{hd:g}", "hd_percentile": hp, "assd": f"{assd:g}",
+                         "msd": f"{0.5 * (mean_a + mean_b):g}", "surface_dice": f"{dice:g}",
+                         "a_to_b": directed(da, aa, mean_a, over_a), "b_to_a": directed(db, ab, mean_b, over_b)}}
     out = {"status": "ok", "a_points": len(da), "b_points": len(db), "a_area": np.sum(aa), "b_area": np.sum(ab),
            "a_hd": robust_directed(da, aa, 100), "b_hd": robust_directed(db, ab, 100)}
     out["hd"] = max(out["a_hd"], out["b_hd"])

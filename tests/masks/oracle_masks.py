@@ -64,6 +64,21 @@ def nearest_rank(s, p):
     return s[r - 1]
 
 
+def torch_quantile(s, p):
+    """MONAI's HD-p: the maximum for p = 0, else torch.quantile of a float32
+    tensor (sorted s): rank float32(p / 100) * float32(n - 1) in float32,
+    truncated; its float32 fraction the weight (interpolated here in double)."""
+    if p == 0:
+        return s[-1]
+    n = len(s)
+    rank = np.float32(p / 100.0) * np.float32(n - 1)
+    lo = min(int(rank), n - 1)
+    hi = min(int(np.ceil(rank)), n - 1)
+    w = float(rank - np.float32(lo))
+    a, b = s[lo], s[hi]
+    return a + w * (b - a) if w < 0.5 else b - (b - a) * (1.0 - w)
+
+
 def plastimatch_pct(s, p):
     k = int(min(max(math.floor(p / 100.0 * len(s) - 1.0), 0), len(s) - 1))
     return s[k]
@@ -74,7 +89,11 @@ def oracle(conv, a, b, affine, percentiles, conn, tol):
     sp = spacing_of(affine)
     na, nb = int(a.sum()), int(b.sum())
     if na == 0 or nb == 0:
-        return {"status": "both_empty" if na == nb else ("a_empty" if na == 0 else "b_empty")}
+        # Both sides' points all the same: voxels (itk) or boundary voxels.
+        c = 6 if conv not in ("rthdist", "medpy") else conn
+        pa, pb = (na, nb) if conv == "itk" else (int(boundary(a, c).sum()), int(boundary(b, c).sum()))
+        return {"status": "both_empty" if na == nb else ("a_empty" if na == 0 else "b_empty"),
+                "a_points": pa, "b_points": pb}
     if conv == "itk":
         da, db = edt_directed(a, b, sp), edt_directed(b, a, sp)
     else:
@@ -87,7 +106,17 @@ def oracle(conv, a, b, affine, percentiles, conn, tol):
     sa, sb = np.sort(da), np.sort(db)
     out = {"status": "ok", "hd": max(sa[-1], sb[-1]), "a_hd": sa[-1], "b_hd": sb[-1],
            "a_points": len(sa), "b_points": len(sb), "msd": 0.5 * (sa.mean() + sb.mean())}
-    if conv != "itk":
+    if conv == "monai":
+        # MONAI's distances are float32: d counts when float32(d) <= float32(tol), exactly.
+        t32 = np.float32(tol)
+        ca, cb = np.count_nonzero(sa.astype(np.float32) <= t32), np.count_nonzero(sb.astype(np.float32) <= t32)
+        out["assd"] = (sa.sum() + sb.sum()) / (len(sa) + len(sb))
+        out["surface_dice"] = (ca + cb) / (len(sa) + len(sb))
+        out["surface_dice_range"] = (out["surface_dice"], out["surface_dice"])
+        out["a_overlap_range"] = (ca / len(sa),) * 2
+        out["b_overlap_range"] = (cb / len(sb),) * 2
+        out["hd_percentile"] = [max(torch_quantile(sa, p), torch_quantile(sb, p)) for p in percentiles]
+    elif conv != "itk":
         out["assd"] = (sa.sum() + sb.sum()) / (len(sa) + len(sb))
         out["surface_dice"] = (np.count_nonzero(sa <= tol) + np.count_nonzero(sb <= tol)) / (len(sa) + len(sb))
         # Distances within rounding of the tolerance may fall either side (an
@@ -102,8 +131,6 @@ def oracle(conv, a, b, affine, percentiles, conn, tol):
         for p in percentiles:
             if conv == "rthdist":
                 hp.append(max(nearest_rank(sa, p), nearest_rank(sb, p)))
-            elif conv == "monai":
-                hp.append(max(np.percentile(sa, p), np.percentile(sb, p)))
             elif conv == "medpy":
                 hp.append(np.percentile(np.concatenate([sa, sb]), p))
             else:
@@ -164,6 +191,9 @@ def check_deepmind(tag, row, xa, xb, affine, percentiles, tol, eps, offset=(0, 0
     if want["status"] != "ok":
         if row["convention_value"] != want["text"] or row["hd"] is not None:
             FAILURES.append(f"{tag}: empty values {row['convention_value']} / hd {row['hd']}, expected {want['text']}")
+        if row["a_to_b"]["points"] != want["a_points"] or row["b_to_a"]["points"] != want["b_points"]:
+            FAILURES.append(f"{tag}: points {row['a_to_b']['points']}/{row['b_to_a']['points']}, "
+                            f"expected {want['a_points']}/{want['b_points']}")
         return
     for key in ("hd", "msd", "assd"):
         close(f"{tag} {key}", row[key], want[key], eps)
@@ -228,9 +258,9 @@ def check_device_extraction(name, cli, backend, a_path, b_path, extra, out):
 
 
 def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_volumes=None, npy=False,
-               npy_affine=False):
+               npy_affine=False, more_percentiles=()):
     """Writes the pair (label volumes or binary masks), runs every convention, compares."""
-    percentiles = [95.0, 50.0, 100.0]
+    percentiles = [95.0, 50.0, 100.0] + [float(p) for p in more_percentiles]
     va = label_volumes[0] if label_volumes else a.astype(np.uint8)
     vb = label_volumes[1] if label_volumes else b.astype(np.uint8)
     if npy:
@@ -250,6 +280,8 @@ def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_vol
         affine = nib.load(a_path).affine
         extra = []
     extra += ["--connectivity", str(conn), "--tolerance", repr(tol)]
+    for p in more_percentiles:
+        extra += ["--percentile", repr(float(p))]
     if label_volumes:
         extra += ["--labels", "all"]
     out = run_cli(cli, backend, a_path, b_path, extra)
@@ -278,6 +310,9 @@ def check_case(name, cli, backend, tmp, a, b, affine, conn=6, tol=1.0, label_vol
             expect = both if want["status"] == "both_empty" else one
             if row["convention_value"]["hd"] != expect or row["hd"] is not None:
                 FAILURES.append(f"{tag}: empty value {row['convention_value']} / hd {row['hd']}, expected {expect}")
+            if row["a_to_b"]["points"] != want["a_points"] or row["b_to_a"]["points"] != want["b_points"]:
+                FAILURES.append(f"{tag}: points {row['a_to_b']['points']}/{row['b_to_a']['points']}, "
+                                f"expected {want['a_points']}/{want['b_points']}")
             continue
         close(tag + " hd", row["hd"], want["hd"], eps)
         close(tag + " a_to_b hd", row["a_to_b"]["hd"], want["a_hd"], eps)
@@ -341,6 +376,20 @@ def synthetic_cases(cli, backend, tmp, quick):
     thin_b = np.zeros(shape, bool)
     thin_b[8:30, 10:26, 7] = True  # a one-voxel plate
     check_case("thin_structures", cli, backend, tmp, thin_a, thin_b, aniso)
+    # MONAI's float32: slabs 3 voxels apart at 0.8 mm are 2.4000000000000004
+    # mm apart in double, 2.4f in float32 (inside a 2.4 mm tolerance); a cube
+    # and the cube plus a voxel 24 mm away: the HD-99.9 rank 0.999 * 488 in
+    # float32, and p = 0 (MONAI: the maximum; the others: the least).
+    slab_a, slab_b = np.zeros((20, 20, 20), bool), np.zeros((20, 20, 20), bool)
+    slab_a[:, :, 5:12] = True
+    slab_b[:, :, 8:15] = True
+    check_case("slabs_0.8mm_tol2.4", cli, backend, tmp, slab_a, slab_b, np.diag([0.8, 0.8, 0.8, 1.0]), tol=2.4,
+               more_percentiles=(0, 99.9))
+    cube = np.zeros((40, 16, 16), bool)
+    cube[2:12, 2:12, 2:12] = True
+    island = cube.copy()
+    island[35, 7, 7] = True
+    check_case("cube_island", cli, backend, tmp, island, cube, np.eye(4), more_percentiles=(0, 99.9))
     one_a = np.zeros(shape, bool)
     one_a[3, 4, 5] = True
     one_b = np.zeros(shape, bool)

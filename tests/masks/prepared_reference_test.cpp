@@ -146,11 +146,18 @@ void expectSameValues(const MaskResult& x, const MaskResult& y, const std::strin
     EXPECT_EQ(x.convention, y.convention) << what;
     EXPECT_EQ(x.connectivity, y.connectivity) << what;
     EXPECT_EQ(x.empty, y.empty) << what;
-    EXPECT_EQ(x.emptyHd, y.emptyHd) << what;
-    EXPECT_EQ(x.emptyHdPercentile, y.emptyHdPercentile) << what;
-    EXPECT_EQ(x.emptySurfaceDice, y.emptySurfaceDice) << what;
-    EXPECT_EQ(x.emptyMeanAToB, y.emptyMeanAToB) << what;
-    EXPECT_EQ(x.emptyMeanBToA, y.emptyMeanBToA) << what;
+    const EmptyValues &ex = x.emptyValues, &ey = y.emptyValues;
+    EXPECT_EQ(ex.hd, ey.hd) << what;
+    EXPECT_EQ(ex.hdPercentile, ey.hdPercentile) << what;
+    EXPECT_EQ(ex.assd, ey.assd) << what;
+    EXPECT_EQ(ex.msd, ey.msd) << what;
+    EXPECT_EQ(ex.surfaceDice, ey.surfaceDice) << what;
+    for (auto [dx, dy] : {std::pair{&ex.aToB, &ey.aToB}, std::pair{&ex.bToA, &ey.bToA}}) {
+        EXPECT_EQ(dx->hd, dy->hd) << what;
+        EXPECT_EQ(dx->mean, dy->mean) << what;
+        EXPECT_EQ(dx->surfaceOverlap, dy->surfaceOverlap) << what;
+        EXPECT_EQ(dx->percentiles, dy->percentiles) << what;
+    }
     EXPECT_TRUE(same(x.hd, y.hd)) << what << ": hd " << x.hd << " vs " << y.hd;
     EXPECT_EQ(x.percentiles, y.percentiles) << what;
     ASSERT_EQ(x.hdPercentile.size(), y.hdPercentile.size()) << what;

@@ -230,10 +230,20 @@ def test_empty_masks_are_a_status(which, tmp_path, pair):
         if r.convention != "itk":  # itk has no percentile
             assert r.hd95 is None
         assert r.a_to_b.hd is None and r.a_to_b.voxel is None
-        assert r.convention_value["hd"] and r.convention_value["hd_percentile"]
+        v = r.convention_value
+        assert v["hd"] and v["assd"] and v["surface_dice"] and v["a_to_b"]["mean"] and v["b_to_a"]["mean"]
+        assert len(v["hd_percentile"]) == (0 if r.convention == "itk" else 1)
+        # Both sides' points, also the non-empty one.
+        assert (r.a_to_b.points > 0) == (which == "b_empty") and (r.b_to_a.points > 0) == (which == "a_empty")
         assert which in repr(r)
     monai = got[rthdist.CONVENTIONS.index("monai")]
     assert monai.convention_value["hd"] == ("nan" if which == "both_empty" else "inf")
+    one = which != "both_empty"
+    assert monai.convention_value["hd_percentile"] == [{"p": 95.0, "value": "nan"}]
+    assert monai.convention_value["surface_dice"] == ("0" if one else "nan")
+    assert monai.convention_value["a_to_b"]["hd"] == ("inf" if one else "nan")
+    deepmind = got[rthdist.CONVENTIONS.index("deepmind")]
+    assert deepmind.convention_value["a_to_b"]["surface_overlap"] == ("0" if which == "b_empty" else "nan")
 
 
 def test_bad_inputs_raise_value_errors(pair):

@@ -4,6 +4,7 @@
 //
 //   rthdist-masks A B [B2 ...] [--label N | --labels all] [--convention NAME|all]
 //                 [--percentile P]... [--connectivity 6|18|26] [--tolerance MM]
+//                 [--monai-precision float32|double]
 //                 [--spacing X,Y,Z | --affine 12 numbers] [--backend B] [--device N]
 //                 [--threads N] [--device-extraction [--host-extraction]] [--repeat N]
 //                 [--unprepared] [--json | --csv]
@@ -54,6 +55,7 @@ struct MasksArgs {
     std::vector<double> percentiles;
     int connectivity = 0;
     double tolerance = 1.0;
+    bool monaiFloat32 = true;  // --monai-precision float32 (default) | double
     glm::dvec3 spacing{1.0};
     std::optional<glm::dmat4> affine;  // --affine: voxel-to-world of .npy inputs
     Options options;
@@ -78,6 +80,9 @@ const char* kUsage =
     "  --connectivity C     boundary connectivity 6, 18 or 26 (default 6; itk uses all voxels,\n"
     "                       deepmind surfels)\n"
     "  --tolerance MM       surface Dice tolerance in mm (default 1)\n"
+    "  --monai-precision float32|double  monai: compare distances with the tolerance and\n"
+    "                       compute torch.quantile's rank in float32 as MONAI does (default),\n"
+    "                       or in double\n"
     "  --spacing X,Y,Z      voxel spacing of .npy inputs along axes 0,1,2 (default 1,1,1)\n"
     "  --affine R00,R01,R02,T0,R10,...,T2  voxel-to-world of .npy inputs: 3x4, row-major\n"
     "  --backend B          auto, cpu, ray-query, rt-pipeline (default auto)\n"
@@ -193,6 +198,11 @@ void addMeasureOptions(CommandLine& line, MasksArgs& a, bool& conventionSet) {
         if (!t || *t < 0) reject("--tolerance expects a number >= 0, got '" + v + "'");
         a.tolerance = *t;
     });
+    value("--monai-precision", [&a](const std::string& v) {
+        if (v != "float32" && v != "double")
+            reject("--monai-precision expects float32 or double, got '" + v + "'");
+        a.monaiFloat32 = v == "float32";
+    });
     value("--spacing", [&a](const std::string& v) { a.spacing = parseSpacing(v); });
     value("--affine", [&a](const std::string& v) { a.affine = parseAffine(v); });
     value("--backend", [&a](const std::string& v) {
@@ -296,6 +306,32 @@ Json directedJson(const masks::DirectedMask& d, const MaskResult& r, bool ok) {
     return out;
 }
 
+Json percentileTexts(const std::vector<double>& p, const std::vector<std::string>& texts) {
+    Json out = Json::array();
+    for (size_t i = 0; i < texts.size() && i < p.size(); ++i)
+        out.push_back({{"p", p[i]}, {"value", texts[i]}});
+    return out;
+}
+
+Json emptyDirectedJson(const masks::EmptyDirected& d, const std::vector<double>& p) {
+    return {{"hd", d.hd},
+            {"mean", d.mean},
+            {"surface_overlap", d.surfaceOverlap},
+            {"percentiles", percentileTexts(p, d.percentiles)}};
+}
+
+// What the convention's tool reports for a row with an empty mask, as text.
+Json emptyJson(const MaskResult& r) {
+    const masks::EmptyValues& e = r.emptyValues;
+    return {{"hd", e.hd},
+            {"hd_percentile", percentileTexts(r.percentiles, e.hdPercentile)},
+            {"assd", e.assd},
+            {"msd", e.msd},
+            {"surface_dice", e.surfaceDice},
+            {"a_to_b", emptyDirectedJson(e.aToB, r.percentiles)},
+            {"b_to_a", emptyDirectedJson(e.bToA, r.percentiles)}};
+}
+
 Json rowJson(const Row& row) {
     const MaskResult& r = row.r;
     const bool ok = r.empty == masks::EmptyStatus::kNone;
@@ -310,14 +346,7 @@ Json rowJson(const Row& row) {
                                    : r.convention == Convention::kItk    ? "voxels"
                                                                          : "boundary_voxels"},
                     {"status", masks::emptyStatusName(r.empty)}});
-    if (!ok) {
-        out["convention_value"] = {{"hd", r.emptyHd}, {"hd_percentile", r.emptyHdPercentile}};
-        if (!r.emptySurfaceDice.empty()) {
-            out["convention_value"]["surface_dice"] = r.emptySurfaceDice;
-            out["convention_value"]["a_to_b_mean"] = r.emptyMeanAToB;
-            out["convention_value"]["b_to_a_mean"] = r.emptyMeanBToA;
-        }
-    }
+    if (!ok) out["convention_value"] = emptyJson(r);
     Json hdPercentile = Json::array();
     for (size_t i = 0; i < r.hdPercentile.size(); ++i)
         hdPercentile.push_back({{"p", r.percentiles[i]}, {"value", r.hdPercentile[i]}});
@@ -383,6 +412,7 @@ std::string jsonReport(const MasksArgs& args, const Report& report, const Engine
     j.update(Json{{"backend", backendName(engine.backend())},
                   {"device", engine.deviceName()},
                   {"tolerance_mm", args.tolerance},
+                  {"monai_precision", args.monaiFloat32 ? "float32" : "double"},
                   {"results", std::move(results)}});
     return jsonText(j) + "\n";
 }
@@ -417,8 +447,16 @@ std::string textReport(const MasksArgs& args, const Engine& engine, const std::v
                       masks::conventionName(r.convention));
         out += line;
         if (r.empty != masks::EmptyStatus::kNone) {
-            out += std::string(masks::emptyStatusName(r.empty)) + ": the convention reports HD " + r.emptyHd +
-                   ", HD-p " + r.emptyHdPercentile + "\n";
+            const masks::EmptyValues& e = r.emptyValues;
+            out += std::string(masks::emptyStatusName(r.empty)) + ": the convention reports HD " + e.hd;
+            for (size_t i = 0; i < e.hdPercentile.size(); ++i) {
+                std::snprintf(line, sizeof line, "  HD%g ", args.percentiles[i]);
+                out += line + e.hdPercentile[i];
+            }
+            out += "  ASSD " + e.assd + "  MSD " + e.msd + "  SurfDice " + e.surfaceDice;
+            std::snprintf(line, sizeof line, "  (%llu / %llu points)\n", (unsigned long long)r.aToB.points,
+                          (unsigned long long)r.bToA.points);
+            out += line;
             continue;
         }
         std::snprintf(line, sizeof line, "HD %.6f", r.hd);
@@ -476,6 +514,7 @@ masks::MaskOptions maskOptions(const MasksArgs& args, Convention c) {
     mo.connectivity = args.connectivity;
     mo.percentiles = args.percentiles;
     mo.tolerance = args.tolerance;
+    mo.monaiFloat32 = args.monaiFloat32;
     mo.threads = args.options.threads;
     mo.hostExtraction = args.hostExtraction;
     return mo;
