@@ -73,8 +73,15 @@ std::optional<Error> readLabels(const NextRaw& next, const std::array<int64_t, 3
                                 Volume& v) {
     const uint64_t n = uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
     const bool bytes8 = type.npyKind == "u1" && !how.scale;
-    if (bytes8) {
+    // Fortran order fills the volume front to back: reserved, and grown a
+    // piece at a time, so that a stream that ends early (a .nii.gz whose
+    // header promises more than it holds) has not touched the whole volume.
+    if (bytes8 && fortran) {
+        v.labels8.reserve(n);
+    } else if (bytes8) {
         v.labels8.resize(n);
+    } else if (fortran) {
+        v.labels.reserve(n);
     } else {
         v.labels.resize(n);
     }
@@ -92,6 +99,11 @@ std::optional<Error> readLabels(const NextRaw& next, const std::array<int64_t, 3
             const uint64_t count = std::min(kPieceVoxels, n - at);
             const Result<const char*> raw = next(size_t(count * type.bytes));
             if (!raw) return raw.error();
+            if (bytes8) {
+                v.labels8.resize(at + count);
+            } else {
+                v.labels.resize(at + count);
+            }
             void* out = bytes8 ? static_cast<void*>(v.labels8.data() + at) : v.labels.data() + at;
             if (auto e = convert(*raw, count, at, out)) return e;
         }

@@ -19,7 +19,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 seconds=${RTHDIST_FUZZ_SECONDS:-60}
 build=${RTHDIST_FUZZ_BUILD:-$root/build-fuzz}
 jobs=${RTHDIST_FUZZ_JOBS:-2}
-all_targets=(ply xyz obj gltf glb stl off pcd las gz cli_args)
+all_targets=(ply xyz obj gltf glb stl off pcd las gz nifti npy cli_args)
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=("${all_targets[@]}")
 
