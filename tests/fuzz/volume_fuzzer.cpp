@@ -50,9 +50,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::string path = "/proc/self/fd/" + std::to_string(fd);
     masks::VolumeLimits limits;
     limits.maxVolumeBytes = kFuzzVolumeBytes;
-    const Result<masks::Volume> v = kFormat == "nifti"
-                                        ? masks::loadNifti(path, limits)
-                                        : masks::loadNpy(path, glm::dvec3(0.5, 1.0, 2.0), std::nullopt, limits);
+    const Result<masks::Volume> v =
+        kFormat == "nifti" ? masks::loadNifti(path, limits)
+                           : masks::loadNpy(path, glm::dvec3(0.5, 1.0, 2.0), std::nullopt, limits);
     if (!v) {
         if (v.error().code != ErrorCode::kBadInput) std::abort();
         if (v.error().message.compare(0, path.size(), path) != 0) std::abort();  // names the file
