@@ -59,9 +59,9 @@ Result<std::array<Direction, 2>> bothDirections(Engine& engine, const Volume& a,
 
 // The checks of compareMasks that every convention shares.
 std::optional<Error> checkInputs(const Volume& a, const Volume& b, const MaskOptions& options) {
+    if (auto e = checkVolume(a)) return e;
+    if (auto e = checkVolume(b)) return e;
     if (auto e = checkSameGrid(a, b)) return e;
-    if (a.storedVoxels() != a.voxelCount() || b.storedVoxels() != b.voxelCount())
-        return Error{ErrorCode::kInvalidArgument, "masks: label array size differs from the dimensions"};
     return detail::checkOptions(options);
 }
 

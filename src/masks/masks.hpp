@@ -106,25 +106,63 @@ struct Volume {
     [[nodiscard]] glm::dvec3 spacing() const;
 };
 
-// Reads a NIfTI-1 or NIfTI-2 file (.nii, .nii.gz) through libnifti2
-// (nifti.cpp: in target rthdist_masks, not rthdist_masks_core). The
+// What one volume file may make the loaders hold. maxVolumeBytes bounds a
+// volume's voxel data both as stored in the file (inflated, for .nii.gz)
+// and as held in memory (1 byte a voxel for bool/uint8 without scaling, 4
+// for every other type); a file past it is kBadInput naming the file, its
+// size and the limit, before anything is allocated or inflated (the CLI's
+// --max-volume-mib raises it). The voxels are held once: read (inflated) in
+// pieces straight into the Volume's labels.
+inline constexpr uint64_t kDefaultMaxVolumeBytes = uint64_t{2} << 30;  // 2 GiB
+struct VolumeLimits {
+    uint64_t maxVolumeBytes = kDefaultMaxVolumeBytes;
+};
+
+// The geometry every volume must have (loaders, arrays, compareMasks and
+// prepareReference check it): each voxel axis (a column norm of the
+// affine's 3x3 part) at least kMinSpacing and at most kMaxCoordinate, the
+// grid's corners within kMaxCoordinate of 0 in world and in spacing
+// coordinates, the affine finite (a NaN origin is refused), last row
+// 0 0 0 1, not singular. Within these the distances are exact; beyond them
+// the engine's arithmetic is not (the engine works in float after centring:
+// spacings below ~1.4e-45 and extents beyond ~3e38 gave wrong values).
+inline constexpr double kMinSpacing = 1e-30;
+inline constexpr double kMaxCoordinate = 1e30;
+
+// Reads a NIfTI-1 or NIfTI-2 file (.nii, .nii.gz; nifti.cpp, in target
+// rthdist_masks, not rthdist_masks_core) with rthdist's own reader: the
+// header is validated field by field (README "Segmentation masks": dim,
+// datatype, pixdim, vox_offset, scl_slope/scl_inter, qform/sform codes,
+// quatern_b/c/d, qoffset, srow) before any value is used, then the voxels
+// are read (inflated) in pieces into the Volume, within `limits`. The
 // transform is the sform when sform_code > 0, else the qform when
 // qform_code > 0, else diag(pixdim[1..3]) with origin 0. scl_slope/scl_inter
-// are applied when the slope is finite and non-zero. A 4-D file must have
-// one volume. Errors (kBadInput) name the file.
-[[nodiscard]] Result<Volume> loadNifti(const std::string& path);
+// are applied when the slope is finite and non-zero (as nibabel). A 4-D to
+// 7-D file must have one volume. Only regular files are read (a FIFO or a
+// device is refused before a byte is read). Errors (kBadInput) name the
+// file and the field.
+[[nodiscard]] Result<Volume> loadNifti(const std::string& path, const VolumeLimits& limits = {});
 
-// Reads a NumPy .npy file (3-D; bool, int8..int64, uint8..uint64, float32,
-// float64; C or Fortran order). Array axes 0, 1, 2 are i, j, k; the voxel
-// spacing along them is `spacing` (origin 0) unless `affine` (a 4x4 whose
-// last row is 0 0 0 1) is given.
+// Reads a NumPy .npy file (format 1.0, 2.0 or 3.0, read as NumPy's format
+// specification says: npy_header.hpp; 3-D; bool, int8..int64,
+// uint8..uint64, float32, float64, either byte order; C or Fortran order).
+// Array axes 0, 1, 2 are i, j, k; the voxel spacing along them is `spacing`
+// (origin 0) unless `affine` (a 4x4 whose last row is 0 0 0 1) is given.
+// Regular files only; errors (kBadInput) name the file and the field.
 [[nodiscard]] Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing,
-                                     const std::optional<glm::dmat4>& affine = std::nullopt);
+                                     const std::optional<glm::dmat4>& affine = std::nullopt,
+                                     const VolumeLimits& limits = {});
 
 // Loads by extension: .nii / .nii.gz through loadNifti, .npy through loadNpy
 // (rthdist_masks, as loadNifti).
 [[nodiscard]] Result<Volume> loadVolume(const std::string& path, glm::dvec3 spacing = glm::dvec3(1.0),
-                                        const std::optional<glm::dmat4>& affine = std::nullopt);
+                                        const std::optional<glm::dmat4>& affine = std::nullopt,
+                                        const VolumeLimits& limits = {});
+
+// kInvalidArgument naming v.path when v breaks the geometry rules above
+// (kMinSpacing, kMaxCoordinate, a finite affine) or its labels do not
+// match its dims.
+[[nodiscard]] std::optional<Error> checkVolume(const Volume& v);
 
 // A 3-D label array in memory (a NumPy array): C order ((i, j, k) at
 // (i * n1 + j) * n2 + k) or, when `fortran`, i fastest; scalars of NumPy

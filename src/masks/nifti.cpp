@@ -1,18 +1,21 @@
-// NIfTI-1/2 label volumes through libnifti2 (Debian libnifti2-dev), and
-// loadVolume (by extension). Apart from volume.cpp so that what reads arrays
-// (the Python module) does not link libnifti2.
-#include <nifti2_io.h>
-#include <glm/matrix.hpp>
+// NIfTI-1/2 label volumes (.nii, .nii.gz) read by rthdist itself: the
+// header validated field by field (nifti_header.hpp), then the voxels
+// inflated (zlib; a plain .nii is read through the same gzread) a piece at
+// a time straight into the Volume, never more than the header declares and
+// the limit allows; and loadVolume (by extension). Apart from volume.cpp so
+// that what reads arrays (the Python module) does not link zlib's reader.
+#include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
-#include <cmath>
-#include <fstream>
 #include <memory>
 #include <string_view>
-#include <utility>
+#include <vector>
 
 #include "masks/label_types.hpp"
 #include "masks/masks.hpp"
+#include "masks/nifti_header.hpp"
+#include "masks/volume_file.hpp"
 
 namespace rthdist::masks {
 namespace {
@@ -23,100 +26,100 @@ bool endsWith(const std::string& s, std::string_view suffix) {
     return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-glm::dmat4 fromNifti(const nifti_dmat44& m) {
-    glm::dmat4 g(1.0);
-    for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c) g[c][r] = m.m[r][c];
-    return g;
-}
-
-struct NiftiFree {
-    void operator()(nifti_image* p) const { nifti_image_free(p); }
+struct GzClose {
+    void operator()(gzFile_s* g) const { gzclose(g); }
 };
 
-// The label type of a NIfTI datatype (label_types.hpp), null when not a label type.
-const detail::LabelType* niftiLabelType(int datatype) {
-    constexpr std::pair<int, std::string_view> kKinds[] = {
-        {DT_UINT8, "u1"}, {DT_INT8, "i1"},   {DT_UINT16, "u2"}, {DT_INT16, "i2"},   {DT_UINT32, "u4"},
-        {DT_INT32, "i4"}, {DT_UINT64, "u8"}, {DT_INT64, "i8"},  {DT_FLOAT32, "f4"}, {DT_FLOAT64, "f8"},
-    };
-    for (const auto& [type, kind] : kKinds)
-        if (type == datatype) return detail::labelType(kind);
-    return nullptr;
-}
+// A gzip (or plain: zlib reads it through) stream over the file's descriptor.
+class Inflated {
+public:
+    Inflated(gzFile g, const std::string& path) : m_g(g), m_path(path) {}
 
-// The voxel-to-world transform of a NIfTI image: its sform, else its qform,
-// else diag(pixdim[1..3]); finite and not singular.
-std::optional<Error> setNiftiTransform(const nifti_image& nim, const std::string& path, Volume& v) {
-    if (nim.sform_code > 0) {
-        v.voxelToWorld = fromNifti(nim.sto_xyz);
-        v.transform = "sform";
-    } else if (nim.qform_code > 0) {
-        v.voxelToWorld = fromNifti(nim.qto_xyz);
-        v.transform = "qform";
-    } else {
-        const double dx = std::fabs(nim.dx), dy = std::fabs(nim.dy), dz = std::fabs(nim.dz);
-        if (!(dx > 0 && dy > 0 && dz > 0 && std::isfinite(dx) && std::isfinite(dy) && std::isfinite(dz)))
-            return badInput(path, "no sform/qform and pixdim[1..3] are not positive: no voxel size");
-        v.voxelToWorld = detail::diagonalAffine({dx, dy, dz});
-        v.transform = "pixdim";
+    // Exactly n bytes into out, else the reason (corrupt stream, file ends early).
+    std::optional<Error> read(void* out, size_t n, const std::string& what) {
+        size_t got = 0;
+        while (got < n) {
+            const unsigned piece = unsigned(std::min<size_t>(n - got, size_t(1) << 30));
+            const int r = gzread(m_g.get(), static_cast<char*>(out) + got, piece);
+            if (r < 0) {
+                int code = 0;
+                const char* why = gzerror(m_g.get(), &code);
+                return badInput(m_path, what + ": the gzip stream is corrupt (zlib: " +
+                                            std::string(why ? why : "?") + ")");
+            }
+            if (r == 0) break;
+            got += size_t(r);
+        }
+        if (got != n)
+            return badInput(m_path, what + " is truncated (" + std::to_string(got) + " of " +
+                                        std::to_string(n) + " bytes; the " +
+                                        (direct() ? "file" : "inflated stream") + " ends early)");
+        return std::nullopt;
     }
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r)
-            if (!std::isfinite(v.voxelToWorld[c][r]))
-                return badInput(path, v.transform + " has a non-finite entry");
-    if (std::fabs(glm::determinant(glm::dmat3(v.voxelToWorld))) == 0.0)
-        return badInput(path, v.transform + " is singular (a voxel axis of length 0)");
-    return std::nullopt;
-}
+    bool direct() { return gzdirect(m_g.get()) != 0; }
+
+private:
+    std::unique_ptr<gzFile_s, GzClose> m_g;
+    const std::string& m_path;
+};
 
 }  // namespace
 
-Result<Volume> loadNifti(const std::string& path) {
-    {
-        std::ifstream probe(path, std::ios::binary);
-        if (!probe) return badInput(path, "cannot open the file");
+Result<Volume> loadNifti(const std::string& path, const VolumeLimits& limits) {
+    Result<detail::VolumeFile> file = detail::VolumeFile::open(path);
+    if (!file) return file.error();
+    const int fd = ::dup(file->fd());
+    if (fd < 0) return badInput(path, "cannot read the file (dup failed)");
+    gzFile g = gzdopen(fd, "rb");
+    if (g == nullptr) {
+        ::close(fd);
+        return badInput(path, "cannot read the file (gzdopen failed)");
     }
-    nifti_set_debug_level(0);
-    std::unique_ptr<nifti_image, NiftiFree> nim(nifti_image_read(path.c_str(), 1));
-    if (!nim) return badInput(path, "not a readable NIfTI-1/NIfTI-2 file (libnifti2 rejected it)");
-    if (!nim->data) return badInput(path, "NIfTI file without voxel data");
-    const int64_t nx = nim->nx, ny = std::max<int64_t>(nim->ny, 1), nz = std::max<int64_t>(nim->nz, 1);
-    if (nim->ndim > 3) {
-        for (int d = 4; d <= nim->ndim && d <= 7; ++d)
-            if (nim->dim[d] > 1)
-                return badInput(path, "a " + std::to_string(nim->ndim) +
-                                          "-D image with more than one volume (dim[" + std::to_string(d) +
-                                          "] = " + std::to_string(nim->dim[d]) + "); masks are 3-D");
+    gzbuffer(g, 1u << 17);
+    Inflated in(g, path);
+    std::string header(4, '\0');
+    if (auto e = in.read(header.data(), 4, "the NIfTI header")) return *e;
+    const Result<size_t> size = detail::niftiHeaderBytes(header, path);
+    if (!size) return size.error();
+    header.resize(*size);
+    if (auto e = in.read(header.data() + 4, *size - 4, "the NIfTI header")) return *e;
+    const Result<detail::NiftiHeader> h = detail::parseNiftiHeader(header, path);
+    if (!h) return h.error();
+    const bool bytes8 = h->type->npyKind == "u1" && !h->how.scale;
+    if (auto e = detail::checkVolumeBytes(path, h->voxels, h->type->bytes, bytes8 ? 1 : 4, h->typeName,
+                                          limits.maxVolumeBytes))
+        return *e;
+    const uint64_t dataBytes = h->voxels * h->type->bytes;
+    if (in.direct() && h->voxOffset + dataBytes > file->size())
+        return badInput(path, "NIfTI data is truncated: vox_offset " + std::to_string(h->voxOffset) + " + " +
+                                  std::to_string(h->voxels) + " voxels of " + h->typeName + " need " +
+                                  std::to_string(h->voxOffset + dataBytes) + " bytes, the file has " +
+                                  std::to_string(file->size()));
+    // Extensions (up to vox_offset) are skipped.
+    std::vector<char> buffer(size_t(std::min<uint64_t>(h->voxOffset - *size, uint64_t(1) << 20)));
+    for (uint64_t skip = h->voxOffset - *size; skip > 0;) {
+        const size_t piece = size_t(std::min<uint64_t>(skip, buffer.size()));
+        if (auto e = in.read(buffer.data(), piece, "the NIfTI extensions before vox_offset")) return *e;
+        skip -= piece;
     }
-    if (nx < 1 || uint64_t(nx) * uint64_t(ny) * uint64_t(nz) != uint64_t(nim->nvox))
-        return badInput(path, "inconsistent dimensions");
     Volume v;
     v.path = path;
-    v.dims = {nx, ny, nz};
-    if (auto e = setNiftiTransform(*nim, path, v)) return *e;
-    const double slope = nim->scl_slope, inter = nim->scl_inter;
-    const bool scale =
-        std::isfinite(slope) && slope != 0.0 && std::isfinite(inter) && (slope != 1.0 || inter != 0.0);
-    const size_t n = size_t(nim->nvox);
-    if (nim->datatype == DT_UINT8 && !scale) {
-        const uint8_t* raw = static_cast<const uint8_t*>(nim->data);
-        v.labels8.assign(raw, raw + n);
-        return v;
-    }
-    const detail::LabelType* type = niftiLabelType(nim->datatype);
-    if (type == nullptr) {
-        return badInput(path, std::string("voxel type ") + nifti_datatype_string(nim->datatype) +
-                                  " is not a label type (integers or float32/float64)");
-    }
-    if (auto e = type->toLabels(nim->data, n, scale, slope, inter, path, v.labels)) return *e;
+    v.dims = h->dims;
+    v.voxelToWorld = h->voxelToWorld;
+    v.transform = h->transform;
+    auto next = [&in, &buffer](size_t bytes) -> Result<const char*> {
+        buffer.resize(bytes);
+        if (auto e = in.read(buffer.data(), bytes, "the NIfTI voxel data")) return *e;
+        return static_cast<const char*>(buffer.data());
+    };
+    if (auto e = detail::readVolumeLabels(next, v.dims, true, *h->type, h->how, path, v)) return *e;
     return v;
 }
 
 Result<Volume> loadVolume(const std::string& path, glm::dvec3 spacing,
-                          const std::optional<glm::dmat4>& affine) {
-    if (endsWith(path, ".npy")) return loadNpy(path, spacing, affine);
-    if (endsWith(path, ".nii") || endsWith(path, ".nii.gz")) return loadNifti(path);
+                          const std::optional<glm::dmat4>& affine, const VolumeLimits& limits) {
+    if (endsWith(path, ".npy")) return loadNpy(path, spacing, affine, limits);
+    if (endsWith(path, ".nii") || endsWith(path, ".nii.gz")) return loadNifti(path, limits);
     return badInput(path, "unknown volume format (expected .nii, .nii.gz or .npy)");
 }
 

@@ -235,8 +235,7 @@ const std::string& PreparedReference::extraction() const { return m_state->extra
 Result<PreparedReference> prepareReference(MaskEngine& engine, const Volume& reference, LabelSelect select,
                                            const MaskOptions& options) {
     const auto start = Clock::now();
-    if (reference.storedVoxels() != reference.voxelCount())
-        return Error{ErrorCode::kInvalidArgument, "masks: label array size differs from the dimensions"};
+    if (auto e = checkVolume(reference)) return *e;
     if (auto e = detail::checkOptions(options)) return *e;
     auto s = std::make_shared<State>();
     s->grid.path = reference.path;
@@ -257,9 +256,8 @@ Result<MaskResult> compareMasks(MaskEngine& engine, const PreparedReference& ref
                                 const Volume& prediction, LabelSelect select, const MaskOptions& options) {
     const auto start = Clock::now();
     const State& s = *reference.m_state;
+    if (auto e = checkVolume(prediction)) return *e;
     if (auto e = checkSameGrid(s.grid, prediction)) return *e;
-    if (prediction.storedVoxels() != prediction.voxelCount())
-        return Error{ErrorCode::kInvalidArgument, "masks: label array size differs from the dimensions"};
     if (auto e = detail::checkOptions(options)) return *e;
     if (auto e = checkPreparedFor(s, options)) return *e;
     if (options.convention != Convention::kDeepmind)

@@ -1,6 +1,6 @@
-// Label volumes: NumPy .npy read here (format 1.0-3.0: magic, version,
-// little-endian header length, a Python dict literal, then the raw array),
-// label arrays in memory, grid comparison. NIfTI: nifti.cpp.
+// Label volumes: NumPy .npy read here (the header by npy_header.hpp, the
+// array in pieces straight into the volume), label arrays in memory, the
+// geometry checks, grid comparison. NIfTI: nifti.cpp.
 #include <glm/matrix.hpp>
 
 #include <algorithm>
@@ -8,8 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <iterator>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <set>
@@ -18,11 +17,15 @@
 #include "core/parallel.hpp"
 #include "masks/label_types.hpp"
 #include "masks/masks.hpp"
+#include "masks/npy_header.hpp"
+#include "masks/volume_file.hpp"
 
 namespace rthdist::masks {
 
 using detail::badInput;
+using detail::LabelScale;
 using detail::LabelType;
+using detail::VolumeFile;
 
 glm::dvec3 Volume::spacing() const {
     return {glm::length(glm::dvec3(voxelToWorld[0])), glm::length(glm::dvec3(voxelToWorld[1])),
@@ -31,177 +34,194 @@ glm::dvec3 Volume::spacing() const {
 
 namespace {
 
-// The value text of `key` in the .npy header dict ("'descr': '<u1', ...").
-std::optional<std::string> dictValue(const std::string& header, const std::string& key) {
-    const size_t k = header.find("'" + key + "'");
-    if (k == std::string::npos) return std::nullopt;
-    size_t at = header.find(':', k);
-    if (at == std::string::npos) return std::nullopt;
-    ++at;
-    while (at < header.size() && header[at] == ' ') ++at;
-    size_t end = at;
-    if (at < header.size() && header[at] == '(') {
-        end = header.find(')', at);
-        if (end == std::string::npos) return std::nullopt;
-        return header.substr(at, end - at + 1);
-    }
-    if (at < header.size() && header[at] == '\'') {
-        end = header.find('\'', at + 1);
-        if (end == std::string::npos) return std::nullopt;
-        return header.substr(at + 1, end - at - 1);
-    }
-    while (end < header.size() && header[end] != ',' && header[end] != '}') ++end;
-    return header.substr(at, end - at);
-}
+// Voxels per piece of a file read (and of a C-order array converted): the
+// raw piece and its int32 labels are all the reader holds besides the volume.
+constexpr uint64_t kPieceVoxels = uint64_t{1} << 22;
 
-// The axes of a .npy shape tuple ("(4, 5, 6)").
-Result<std::vector<int64_t>> parseShape(const std::string& shape, const std::string& path) {
-    std::vector<int64_t> dims;
-    const std::string s = shape.substr(1, shape.size() - 2);
-    size_t at = 0;
-    while (at < s.size()) {
-        while (at < s.size() && (s[at] == ' ' || s[at] == ',')) ++at;
-        if (at >= s.size()) break;
-        size_t end = at;
-        while (end < s.size() && std::isdigit(static_cast<unsigned char>(s[end]))) ++end;
-        if (end == at) return badInput(path, ".npy shape '" + shape + "' is malformed");
-        dims.push_back(std::stoll(s.substr(at, end - at)));
-        at = end;
-    }
-    return dims;
-}
+// Where the raw scalars come from, in file order: `next(bytes)` points at
+// the next `bytes` bytes (a file read into a piece buffer, or an array in
+// memory), valid until the next call.
+using NextRaw = std::function<Result<const char*>(size_t bytes)>;
 
-// What a .npy header says of its 3-D array.
-struct NpyHeader {
-    size_t dataAt = 0;  // the array's first byte
-    std::string descr;  // dtype, with its byte order ("<u1")
-    bool fortran = false;
-    std::array<int64_t, 3> dims{0, 0, 0};
-};
-
-Result<NpyHeader> parseNpyHeader(const std::vector<char>& bytes, const std::string& path) {
-    if (bytes.size() < 10 || std::memcmp(bytes.data(), "\x93NUMPY", 6) != 0)
-        return badInput(path, "not a .npy file");
-    const int major = uint8_t(bytes[6]);
-    size_t headerLen = 0, headerAt = 0;
-    if (major == 1) {
-        headerLen = uint8_t(bytes[8]) | (size_t(uint8_t(bytes[9])) << 8);
-        headerAt = 10;
-    } else if (major == 2 || major == 3) {
-        if (bytes.size() < 12) return badInput(path, "truncated .npy header");
-        for (int i = 0; i < 4; ++i) headerLen |= size_t(uint8_t(bytes[8 + i])) << (8 * i);
-        headerAt = 12;
-    } else {
-        return badInput(path, ".npy format version " + std::to_string(major) + " is not supported");
-    }
-    if (bytes.size() < headerAt + headerLen) return badInput(path, "truncated .npy header");
-    const std::string header(bytes.data() + headerAt, headerLen);
-    const auto descr = dictValue(header, "descr");
-    const auto order = dictValue(header, "fortran_order");
-    const auto shape = dictValue(header, "shape");
-    if (!descr || !order || !shape) return badInput(path, ".npy header without descr/fortran_order/shape");
-    const Result<std::vector<int64_t>> dims = parseShape(*shape, path);
-    if (!dims) return dims.error();
-    if (dims->size() != 3)
-        return badInput(path, ".npy array has " + std::to_string(dims->size()) + " axes; masks are 3-D");
-    return NpyHeader{headerAt + headerLen,
-                     *descr,
-                     order->find("True") != std::string::npos,
-                     {(*dims)[0], (*dims)[1], (*dims)[2]}};
-}
-
-// The label type of a .npy dtype: little-endian, or one byte in any order.
-Result<const LabelType*> npyType(const std::string& d, const std::string& path) {
-    if (d.size() < 3) return badInput(path, ".npy dtype '" + d + "' is not supported");
-    if (d[0] == '>' && d.substr(1) != "u1" && d.substr(1) != "i1" && d.substr(1) != "b1")
-        return badInput(path, "big-endian .npy arrays are not supported (dtype '" + d + "')");
-    const LabelType* type = detail::labelType(std::string_view(d).substr(1));
-    if (type == nullptr) return badInput(path, ".npy dtype '" + d + "' is not a label type");
-    return type;
-}
-
-// A C-order array ((i, j, k) at (i * n1 + j) * n2 + k) stored i fastest:
-// for each j an (i, k) transpose, in square tiles (a tile's rows of both
-// arrays stay in cache; the naive loop wrote one cache line per voxel), the
-// j planes spread over every hardware thread.
+// Planes i0..i1 of a C-order array ((i, j, k) at (i * n1 + j) * n2 + k,
+// `in` starting at plane i0) into `out`, i fastest: for each j an (i, k)
+// transpose, in square tiles (a tile's rows of both arrays stay in cache),
+// the j planes spread over every hardware thread.
 template <class T>
-void fromCOrder(const T* in, const std::array<int64_t, 3>& dims, T* out) {
+void planesFromCOrder(const T* in, int64_t i0, int64_t i1, const std::array<int64_t, 3>& dims, T* out) {
     constexpr int64_t kTile = 64;
     const int64_t n0 = dims[0], n1 = dims[1], n2 = dims[2];
     core::parallelChunks(size_t(n1), 1, 0, [&](size_t jb, size_t je, int) {
         for (int64_t j = int64_t(jb); j < int64_t(je); ++j)
-            for (int64_t i0 = 0; i0 < n0; i0 += kTile)
+            for (int64_t it = i0; it < i1; it += kTile)
                 for (int64_t k0 = 0; k0 < n2; k0 += kTile) {
-                    const int64_t i1 = std::min(n0, i0 + kTile), k1 = std::min(n2, k0 + kTile);
+                    const int64_t ie = std::min(i1, it + kTile), k1 = std::min(n2, k0 + kTile);
                     for (int64_t k = k0; k < k1; ++k) {
                         T* row = out + size_t(n0 * (j + n1 * k));
-                        for (int64_t i = i0; i < i1; ++i) row[i] = in[size_t((i * n1 + j) * n2 + k)];
+                        for (int64_t i = it; i < ie; ++i) row[i] = in[size_t(((i - i0) * n1 + j) * n2 + k)];
                     }
                 }
     });
 }
 
-// The labels of a 3-D array at `raw` (C order, or Fortran when `fortran`)
-// into v, i fastest: bool and uint8 as bytes (labels8), the other types
-// converted to int32.
-std::optional<Error> readLabels(const char* raw, const std::array<int64_t, 3>& dims, bool fortran,
-                                const LabelType& type, const std::string& path, Volume& v) {
+// The labels of a 3-D array of `type` read through `next` (C order, or
+// Fortran when `fortran`) into v, i fastest, in pieces: bool and uint8 as
+// bytes (labels8) straight into the volume, the other types converted to
+// int32 a piece at a time. Nothing but the volume and one piece is held.
+std::optional<Error> readLabels(const NextRaw& next, const std::array<int64_t, 3>& dims, bool fortran,
+                                const LabelType& type, const LabelScale& how, const std::string& path,
+                                Volume& v) {
     const uint64_t n = uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
-    if (type.npyKind == "u1") {
-        const uint8_t* b8 = reinterpret_cast<const uint8_t*>(raw);
+    const bool bytes8 = type.npyKind == "u1" && !how.scale;
+    // Fortran order fills the volume front to back: reserved, and grown a
+    // piece at a time, so that a stream that ends early (a .nii.gz whose
+    // header promises more than it holds) has not touched the whole volume.
+    if (bytes8 && fortran) {
+        v.labels8.reserve(n);
+    } else if (bytes8) {
         v.labels8.resize(n);
-        if (fortran) {
-            std::copy(b8, b8 + n, v.labels8.begin());
-        } else {
-            fromCOrder(b8, dims, v.labels8.data());
+    } else if (fortran) {
+        v.labels.reserve(n);
+    } else {
+        v.labels.resize(n);
+    }
+    std::vector<int32_t> piece;
+    // `count` raw scalars (file order, first at file index `first`) as labels at `out`.
+    auto convert = [&](const char* raw, uint64_t count, uint64_t first, void* out) -> std::optional<Error> {
+        if (bytes8) {
+            std::memcpy(out, raw, size_t(count));
+            return std::nullopt;
+        }
+        return type.toLabels(raw, size_t(count), how, path, first, static_cast<int32_t*>(out));
+    };
+    if (fortran) {  // the file's order is the volume's
+        for (uint64_t at = 0; at < n; at += kPieceVoxels) {
+            const uint64_t count = std::min(kPieceVoxels, n - at);
+            const Result<const char*> raw = next(size_t(count * type.bytes));
+            if (!raw) return raw.error();
+            if (bytes8) {
+                v.labels8.resize(at + count);
+            } else {
+                v.labels.resize(at + count);
+            }
+            void* out = bytes8 ? static_cast<void*>(v.labels8.data() + at) : v.labels.data() + at;
+            if (auto e = convert(*raw, count, at, out)) return e;
         }
         return std::nullopt;
     }
-    std::vector<int32_t> flat;
-    if (auto e = type.toLabels(raw, n, false, 1, 0, path, flat)) return e;
-    if (fortran) {
-        v.labels = std::move(flat);  // already i fastest
-    } else {
-        v.labels.resize(n);
-        fromCOrder(flat.data(), dims, v.labels.data());
+    const int64_t n0 = dims[0], n1 = dims[1], n2 = dims[2];
+    const uint64_t plane = uint64_t(n1) * uint64_t(n2);
+    if (plane <= kPieceVoxels) {  // whole i planes a piece, transposed in tiles
+        const int64_t planes = int64_t(std::max<uint64_t>(1, kPieceVoxels / plane));
+        std::vector<uint8_t> piece8;
+        for (int64_t i0 = 0; i0 < n0; i0 += planes) {
+            const int64_t i1 = std::min(n0, i0 + planes);
+            const uint64_t count = uint64_t(i1 - i0) * plane;
+            const Result<const char*> raw = next(size_t(count * type.bytes));
+            if (!raw) return raw.error();
+            if (bytes8) {
+                planesFromCOrder(reinterpret_cast<const uint8_t*>(*raw), i0, i1, dims, v.labels8.data());
+            } else {
+                piece.resize(count);
+                if (auto e = convert(*raw, count, uint64_t(i0) * plane, piece.data())) return e;
+                planesFromCOrder(piece.data(), i0, i1, dims, v.labels.data());
+            }
+        }
+        return std::nullopt;
+    }
+    // Planes larger than a piece: rows of k scattered with stride n0 * n1.
+    for (int64_t i = 0; i < n0; ++i) {
+        for (uint64_t q = 0; q < plane; q += kPieceVoxels) {
+            const uint64_t count = std::min(kPieceVoxels, plane - q);
+            const Result<const char*> raw = next(size_t(count * type.bytes));
+            if (!raw) return raw.error();
+            const int32_t* labels = nullptr;
+            if (!bytes8) {
+                piece.resize(count);
+                if (auto e = convert(*raw, count, uint64_t(i) * plane + q, piece.data())) return e;
+                labels = piece.data();
+            }
+            int64_t j = int64_t(q / uint64_t(n2)), k = int64_t(q % uint64_t(n2));
+            for (uint64_t e = 0; e < count; ++e) {
+                const size_t at = size_t(i + n0 * (j + n1 * k));
+                if (bytes8) {
+                    v.labels8[at] = uint8_t((*raw)[e]);
+                } else {
+                    v.labels[at] = labels[e];
+                }
+                if (++k == n2) {
+                    k = 0;
+                    ++j;
+                }
+            }
+        }
     }
     return std::nullopt;
 }
 
-// The .npy file's array (after its header) into v.
-std::optional<Error> readNpyLabels(const std::vector<char>& bytes, const NpyHeader& h, const LabelType& type,
-                                   const std::string& path, Volume& v) {
-    const uint64_t n = uint64_t(h.dims[0]) * uint64_t(h.dims[1]) * uint64_t(h.dims[2]);
-    if (bytes.size() - h.dataAt < n * type.bytes)
-        return badInput(path, ".npy data is truncated (" + std::to_string(bytes.size() - h.dataAt) +
-                                  " bytes for " + std::to_string(n) + " voxels of " +
-                                  std::to_string(type.bytes) + " bytes)");
-    return readLabels(bytes.data() + h.dataAt, h.dims, h.fortran, type, path, v);
+// `next` over a file: reads each piece into one buffer.
+NextRaw fileReader(VolumeFile& file, std::vector<char>& buffer, const std::string& what) {
+    return [&file, &buffer, what](size_t bytes) -> Result<const char*> {
+        buffer.resize(bytes);
+        if (auto e = file.readExact(buffer.data(), bytes, what)) return *e;
+        return static_cast<const char*>(buffer.data());
+    };
 }
 
 }  // namespace
 
-Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing, const std::optional<glm::dmat4>& affine) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return badInput(path, "cannot open the file");
-    const std::vector<char> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    const Result<NpyHeader> header = parseNpyHeader(bytes, path);
-    if (!header) return header.error();
-    const Result<const LabelType*> type = npyType(header->descr, path);
-    if (!type) return type.error();
+namespace detail {
+
+std::optional<Error> readVolumeLabels(const std::function<Result<const char*>(size_t)>& next,
+                                      const std::array<int64_t, 3>& dims, bool fortran, const LabelType& type,
+                                      const LabelScale& how, const std::string& path, Volume& v) {
+    return readLabels(next, dims, fortran, type, how, path, v);
+}
+
+}  // namespace detail
+
+Result<Volume> loadNpy(const std::string& path, glm::dvec3 spacing, const std::optional<glm::dmat4>& affine,
+                       const VolumeLimits& limits) {
+    Result<VolumeFile> file = VolumeFile::open(path);
+    if (!file) return file.error();
+    std::string head(detail::kNpyMaxPreamble, '\0');
+    const Result<size_t> got = file->readSome(head.data(), head.size());
+    if (!got) return got.error();
+    head.resize(*got);
+    const Result<uint64_t> end = detail::npyHeaderEnd(head, path);
+    if (!end) return end.error();
+    if (*end > head.size()) {
+        const size_t have = head.size();
+        head.resize(size_t(*end));
+        const Result<size_t> more = file->readSome(head.data() + have, head.size() - have);
+        if (!more) return more.error();
+        head.resize(have + *more);
+    }
+    const Result<detail::NpyHeader> h = detail::parseNpyHeader(head, file->size(), path);
+    if (!h) return h.error();
+    const size_t held = h->type->npyKind == "u1" ? 1 : 4;
+    if (auto e = detail::checkVolumeBytes(path, h->voxels, h->type->bytes, held, "'" + h->descr + "'",
+                                          limits.maxVolumeBytes))
+        return *e;
     Volume v;
     v.path = path;
-    v.dims = header->dims;
-    if (auto e = readNpyLabels(bytes, *header, **type, path, v)) return *e;
+    v.dims = h->dims;
     if (affine) {
         v.voxelToWorld = *affine;
         v.transform = "affine";
     } else {
-        if (!(spacing.x > 0 && spacing.y > 0 && spacing.z > 0))
-            return Error{ErrorCode::kInvalidArgument, path + ": spacing must be positive"};
         v.voxelToWorld = detail::diagonalAffine(spacing);
         v.transform = "spacing";
     }
+    if (auto e = detail::checkGrid(v.dims, v.voxelToWorld, path, affine ? "the affine" : "the spacing",
+                                   ErrorCode::kBadInput))
+        return *e;
+    std::vector<char> buffer;
+    LabelScale how;
+    how.swap = h->swap;
+    if (auto e =
+            readLabels(fileReader(*file, buffer, ".npy data"), h->dims, h->fortran, *h->type, how, path, v))
+        return *e;
     return v;
 }
 
@@ -213,24 +233,36 @@ Result<Volume> volumeFromArray(const LabelArray& array, const glm::dmat4& voxelT
     for (int64_t d : array.dims)
         if (d < 1) return badInput(name, "a label array needs at least one voxel along each axis");
     if (array.data == nullptr) return Error{ErrorCode::kInvalidArgument, name + ": no array data"};
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r)
-            if (!std::isfinite(voxelToWorld[c][r]))
-                return Error{ErrorCode::kInvalidArgument, name + ": the affine has a non-finite entry"};
-    if (voxelToWorld[0][3] != 0.0 || voxelToWorld[1][3] != 0.0 || voxelToWorld[2][3] != 0.0 ||
-        voxelToWorld[3][3] != 1.0)
-        return Error{ErrorCode::kInvalidArgument, name + ": the affine's last row must be 0 0 0 1"};
-    if (glm::determinant(glm::dmat3(voxelToWorld)) == 0.0)
-        return Error{ErrorCode::kInvalidArgument,
-                     name + ": the affine is singular (a voxel axis of length 0)"};
+    if (auto e = detail::checkGrid(array.dims, voxelToWorld, name, "the affine", ErrorCode::kInvalidArgument))
+        return *e;
     Volume v;
     v.path = name;
     v.dims = array.dims;
     v.voxelToWorld = voxelToWorld;
     v.transform = transform;
-    if (auto e = readLabels(static_cast<const char*>(array.data), array.dims, array.fortran, *type, name, v))
-        return *e;
+    const char* at = static_cast<const char*>(array.data);
+    const NextRaw next = [&at](size_t bytes) -> Result<const char*> {
+        const char* p = at;
+        at += bytes;
+        return p;
+    };
+    if (auto e = readLabels(next, array.dims, array.fortran, *type, LabelScale{}, name, v)) return *e;
     return v;
+}
+
+std::optional<Error> checkVolume(const Volume& v) {
+    for (int64_t d : v.dims)
+        if (d < 1)
+            return Error{ErrorCode::kInvalidArgument,
+                         v.path + ": a volume needs at least one voxel along each axis"};
+    uint64_t n = 1;
+    for (int64_t d : v.dims)
+        if (__builtin_mul_overflow(n, uint64_t(d), &n))
+            return Error{ErrorCode::kInvalidArgument, v.path + ": the voxel count overflows 64 bits"};
+    if (v.storedVoxels() != n)
+        return Error{ErrorCode::kInvalidArgument, v.path + ": label array size differs from the dimensions"};
+    return detail::checkGrid(v.dims, v.voxelToWorld, v.path, "the voxel-to-world affine",
+                             ErrorCode::kInvalidArgument);
 }
 
 std::optional<Error> checkSameGrid(const Volume& a, const Volume& b) {

@@ -7,7 +7,7 @@
 # left in build-fuzz/artifacts/<target>/.
 #
 #   tools/fuzz/run.sh                         # every target, 60 s each
-#   RTHDIST_FUZZ_SECONDS=45 tools/fuzz/run.sh # CI: 11 targets in about 10 min
+#   RTHDIST_FUZZ_SECONDS=45 tools/fuzz/run.sh # 13 targets in about 11 min (CI: 30 s each)
 #   tools/fuzz/run.sh ply gltf                # some targets
 #
 # Environment: RTHDIST_FUZZ_SECONDS, RTHDIST_FUZZ_BUILD (build dir),
@@ -19,7 +19,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 seconds=${RTHDIST_FUZZ_SECONDS:-60}
 build=${RTHDIST_FUZZ_BUILD:-$root/build-fuzz}
 jobs=${RTHDIST_FUZZ_JOBS:-2}
-all_targets=(ply xyz obj gltf glb stl off pcd las gz cli_args)
+all_targets=(ply xyz obj gltf glb stl off pcd las gz nifti npy cli_args)
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=("${all_targets[@]}")
 

@@ -5,7 +5,8 @@
 //   rthdist-masks A B [B2 ...] [--label N | --labels all] [--convention NAME|all]
 //                 [--percentile P]... [--connectivity 6|18|26] [--tolerance MM]
 //                 [--monai-precision float32|double]
-//                 [--spacing X,Y,Z | --affine 12 numbers] [--backend B] [--device N]
+//                 [--spacing X,Y,Z | --affine 12 numbers] [--max-volume-mib N]
+//                 [--backend B] [--device N]
 //                 [--threads N] [--device-extraction [--host-extraction]] [--repeat N]
 //                 [--unprepared] [--json | --csv]
 //
@@ -58,6 +59,7 @@ struct MasksArgs {
     bool monaiFloat32 = true;  // --monai-precision float32 (default) | double
     glm::dvec3 spacing{1.0};
     std::optional<glm::dmat4> affine;  // --affine: voxel-to-world of .npy inputs
+    masks::VolumeLimits limits;        // --max-volume-mib
     Options options;
     bool json = false, csv = false, help = false, version = false;
     bool deviceExtraction = false;  // --device-extraction: the boundary pass on a GPU backend
@@ -85,6 +87,9 @@ const char* kUsage =
     "                       or in double\n"
     "  --spacing X,Y,Z      voxel spacing of .npy inputs along axes 0,1,2 (default 1,1,1)\n"
     "  --affine R00,R01,R02,T0,R10,...,T2  voxel-to-world of .npy inputs: 3x4, row-major\n"
+    "  --max-volume-mib N   the most voxel data one volume may have, in MiB, as stored\n"
+    "                       (inflated) and as held (1 byte a voxel for uint8/bool, else 4);\n"
+    "                       default 2048; a larger file is refused (exit 3) before reading\n"
     "  --backend B          auto, cpu, ray-query, rt-pipeline (default auto)\n"
     "  --device N           Vulkan device index;  --threads N  CPU threads (0 = all)\n"
     "  --device-extraction  GPU backends: find boundary voxels with a compute shader\n"
@@ -214,6 +219,10 @@ void addMeasureOptions(CommandLine& line, MasksArgs& a, bool& conventionSet) {
     });
     value("--threads", [&a](const std::string& v) {
         a.options.threads = int(integerIn(v, 0, 1024, "--threads expects [0, 1024]"));
+    });
+    value("--max-volume-mib", [&a](const std::string& v) {
+        a.limits.maxVolumeBytes =
+            uint64_t(integerIn(v, 1, int64_t(1) << 30, "--max-volume-mib expects [1, 2^30] MiB")) << 20;
     });
     value("--repeat", [&a](const std::string& v) {
         a.repeat = int(integerIn(v, 1, 1000, "--repeat expects [1, 1000]"));
@@ -554,7 +563,7 @@ Result<Row> compareRow(const MasksArgs& args, masks::MaskEngine& engine, const m
 
 // B read and checked against A's grid.
 Result<masks::Volume> loadB(const MasksArgs& args, const masks::Volume& a, const std::string& path) {
-    Result<masks::Volume> b = masks::loadVolume(path, args.spacing, args.affine);
+    Result<masks::Volume> b = masks::loadVolume(path, args.spacing, args.affine, args.limits);
     if (!b) return b;
     if (auto e = masks::checkSameGrid(a, *b)) return *e;
     return b;
@@ -594,7 +603,7 @@ int run(int argc, char** argv) {
     if (args.help) return std::fputs(kUsage, stdout) >= 0 ? kExitOk : kExitInternal;
     if (args.version) return std::printf("rthdist-masks %s\n", versionString()) > 0 ? kExitOk : kExitInternal;
 
-    Result<masks::Volume> a = masks::loadVolume(args.pathA, args.spacing, args.affine);
+    Result<masks::Volume> a = masks::loadVolume(args.pathA, args.spacing, args.affine, args.limits);
     if (!a) return fail(exitCodeFor(a.error().code), a.error().message);
     std::optional<masks::Volume> first;  // both files read and checked before the engine starts
     if (args.pathsB.size() == 1) {
