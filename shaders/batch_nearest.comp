@@ -64,7 +64,11 @@ void main() {
             threshold = pc.earlyBreak != 0u ? packedDist2(atomicOr(u64At(maxAddr, 0u).v, 0ul)) : -1.0;
         }
         barrier();
-        if (alive && best <= threshold) alive = false;
+        if (alive && best <= threshold) {
+            alive = false;
+            // The killing target: a real one within the maximum (the certificate's band).
+            uintAt(d.nearest, qIndex).v = bestIndex;
+        }
         if (alive) anyAlive = 1u;
         barrier();
         if (anyAlive == 0u) break;

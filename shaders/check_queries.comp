@@ -11,6 +11,7 @@
 // that slot first and no copy commands. In a per-point call every thread writes
 // its query's nearest target at the query's original index (nearestOut),
 // which the host reads back whole: 4 bytes a query, in the input's order.
+// Every query near the maximum is appended to the certificate's band.
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CheckPush pc; };
@@ -39,4 +40,16 @@ void main() {
     bool settled = st.status == RTHDIST_EXACT || (st.status == RTHDIST_DEAD && pc.perPoint == 0u);
     if (!settled || !(packedDist2(st.best) <= maxD2))
         atomicAdd(U64Ref(pc.counters + RTHDIST_CTR_CHECK_BAD).v, 1ul);
+    // The certificate's band (core/certificate.hpp): every query whose best
+    // lies within 2e of the maximum, with its best target. The threshold is
+    // rounded down (a relative 2^-20 on the maximum and on the square), so it
+    // is never above (hf - 2e)^2 in real numbers.
+    if (pc.bandOut != 0ul) {
+        float lo = max(sqrt(maxD2) * (1.0 - 1.0 / 1048576.0) - 2.0 * pc.bandSlack, 0.0);
+        if (packedDist2(st.best) >= lo * lo * (1.0 - 1.0 / 1048576.0)) {
+            uint k = atomicAdd(UintRef(pc.bandOut).v, 1u);
+            if (k < pc.bandCapacity)
+                uvec2At(pc.bandOut + 8ul, k).v = uvec2(floatBitsToUint(vec4At(pc.sorted, i).v.w), uint(st.best & 0xffffffffu));
+        }
+    }
 }

@@ -69,6 +69,9 @@
 #include "rthdist/result.hpp"
 
 namespace rthdist {
+namespace detail {
+struct ProofMaterial;  // core/certificate.hpp
+}
 
 // Every point's nearest neighbour in the other set (perPointDistances).
 struct PerPoint {
@@ -95,6 +98,26 @@ struct Counters {
     uint32_t targetTiles = 1;
 };
 
+// The proof of one directed value (README "Exactness"; docs/design.md, "The
+// certificate"). The float search leaves every query settled with a real
+// nearest-so-far target; the queries whose float value lies within the
+// rounding slack e of the float maximum (the band: usually the witness alone)
+// get their nearest target by a brute force in double over the WHOLE target
+// set (on the device, or on the host for the CPU backend); when the largest of
+// those exact distances reaches the float maximum minus e, no other query can
+// exceed it, so it is h(Q,T) exactly in double, and its pair is the witness.
+// e = 2^-20 * m, m the largest |coordinate| searched (after the frame's origin
+// and power-of-two scale), covers every float rounding of the search.
+struct Certificate {
+    bool confirmed = false;   // the argument held for this answer: distance is exact in double
+    bool recomputed = false;  // the first answer's proof failed; the direction was recomputed on
+                              // the CPU backend (an independent search), whose proof held
+    uint64_t query = 0;       // the witness query (= Directed::queryIndex)
+    uint64_t nearest = 0;     // its nearest target by the brute force in double (= targetIndex)
+    double distance = 0.0;    // their distance in double (= Directed::distance)
+    uint64_t band = 0;        // queries settled again in double
+};
+
 // One directed distance h(Q,T) with its witness.
 struct Directed {
     double distance = 0.0;       // recomputed in double from the pair
@@ -103,21 +126,24 @@ struct Directed {
     glm::dvec3 queryPoint{0.0};  // the input's coordinates (double; exact for float input)
     glm::dvec3 targetPoint{0.0};
     Counters counters;
+    Certificate certificate;
 };
 
 // Wall-clock milliseconds per stage, summed over both directions.
 struct Timings {
-    double setup = 0.0;   // device/pipeline creation (0 when an Engine is reused)
-    double upload = 0.0;  // host -> device copies
-    double index = 0.0;   // stage 1: bounding box, cell keys, sort, run-length encode
-    double cull = 0.0;    // neighbourhood pass: exact NN in the 3x3x3 cell block
-    double search = 0.0;  // stage 2: BLAS builds + ray traversal (candidate pairs)
-    double refine = 0.0;  // stage 3: exact scan of candidate cells, classification
-    double check = 0.0;   // GPU backends: the per-query self-check (recorded behind the cull,
-                          // or behind the search's last radii unless per-point, else a
-                          // submission per direction) and the per-point read-back; the index
-                          // self-check runs inside `index`. 0 on the CPU backend
-    double total = 0.0;   // the whole compute() call, device setup excluded
+    double setup = 0.0;        // device/pipeline creation (0 when an Engine is reused)
+    double upload = 0.0;       // host -> device copies
+    double index = 0.0;        // stage 1: bounding box, cell keys, sort, run-length encode
+    double cull = 0.0;         // neighbourhood pass: exact NN in the 3x3x3 cell block
+    double search = 0.0;       // stage 2: BLAS builds + ray traversal (candidate pairs)
+    double refine = 0.0;       // stage 3: exact scan of candidate cells, classification
+    double check = 0.0;        // GPU backends: the per-query self-check (recorded behind the cull,
+                               // or behind the search's last radii unless per-point, else a
+                               // submission per direction) and the per-point read-back; the index
+                               // self-check runs inside `index`. 0 on the CPU backend
+    double certificate = 0.0;  // the certificate's brute force and proof in double (wall;
+                               // also inside `check`/`total`)
+    double total = 0.0;        // the whole compute() call, device setup excluded
     // Device time per stage from Vulkan timestamp queries (GPU backends only;
     // 0 on the CPU backend). The wall-clock fields above include submission,
     // waiting and the host work between the stages' submissions.
@@ -128,6 +154,9 @@ struct Timings {
     // Device time of the host -> device transfers (the copy commands alone;
     // their bytes over this time is the link speed the call reached).
     double gpuUpload = 0.0;
+    // Device time of the certificate's brute force (cert_scan.comp; the band
+    // itself is appended by the self-check, inside gpuSearch or gpuCull).
+    double gpuCertificate = 0.0;
 };
 
 struct HausdorffResult {
@@ -144,6 +173,10 @@ struct HausdorffResult {
     glm::dvec3 origin{0.0};
     Timings timings;
     uint64_t validationMessages = 0;  // with Options::validation
+    // The band the backend left for the certificate (its queries and their
+    // candidate targets), which the Engine settles in double from the
+    // caller's coordinates; opaque, empty in a returned result.
+    std::shared_ptr<const detail::ProofMaterial> proofMaterial;
 };
 
 // A Vulkan physical device and what rthdist can do with it.

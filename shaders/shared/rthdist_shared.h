@@ -234,6 +234,7 @@ struct CullPush {
                         // block does not cover whole search cells)
     uint scanMax;       // a cell of more points is not scanned (only its first point):
                         // the query then cannot be settled by this pass
+    uint mutant;        // tests only (core/search_mutant.hpp): 1 = skip the query's own cell
 };
 
 // coarsen.comp: search cells of level j (edge s * 2^j) from those of level
@@ -314,6 +315,23 @@ struct CheckPush {
                           // bytes each, slots by the rule of RTHDIST_CHECK_SAMPLES)
     uint64_t nearestOut;  // check_queries, per-point calls: uint[n], each query's nearest target
                           // at the query's original index (0: not written)
+    uint64_t bandOut;     // check_queries: the certificate's band (core/certificate.hpp): uint count,
+                          // uint pad, then uvec2 (query, best target) original indices (0: none)
+    uint bandCapacity;    // entries bandOut holds (the count goes on past it: overflow)
+    float bandSlack;      // e of the certificate, search units (rounded up)
+};
+
+// cert_scan.comp: the certificate's brute force over every target of a
+// direction for up to RTHDIST_CERT_ENTRIES band queries at once.
+#define RTHDIST_CERT_ENTRIES 64
+struct CertScanPush {
+    uint64_t targets;  // vec4[n] the target set's points (w = original index)
+    uint64_t entries;  // vec4[entryCount]: a band query (search units) and its squared bound
+    uint64_t found;    // uint count, uint pad, then uvec2 (entry, target original index)
+    uint n;
+    uint entryCount;
+    uint capacity;  // candidates `found` holds (the count goes on past it: overflow)
+    uint pad;
 };
 
 // refine.comp: exact scan of the candidate pairs' cells.
@@ -333,6 +351,7 @@ struct RefinePush {
     float lowerBound2;
     uint numSearchCells;
     uint numFineCells;
+    uint mutant;  // tests only (core/search_mutant.hpp): 1 = drop every third pair
 };
 
 // tail_scan.comp: every open query of a direction scans every search cell
@@ -496,7 +515,8 @@ static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDI
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
 static_assert(sizeof(TailScanPush) == 80);
-static_assert(sizeof(CheckPush) == 96 && offsetof(CheckPush, nearestOut) == 88);
+static_assert(sizeof(CheckPush) == 112 && offsetof(CheckPush, nearestOut) == 88);
+static_assert(sizeof(CertScanPush) == 40);
 static_assert(sizeof(IngestDevicePush) == 64 && offsetof(IngestDevicePush, n) == 48);
 static_assert(sizeof(BatchDirection) == RTHDIST_BATCH_DIRECTION_BYTES);
 static_assert(sizeof(IngestSummary64) == 56 && offsetof(IngestSummary64, firstBad) == 48);

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "api/certify.hpp"
 #include "api/device_views.hpp"
 #include "api/out_of_core.hpp"
 #include "core/index_space.hpp"
@@ -403,6 +404,7 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
     if (copied) core::restoreOriginal(*r, a, b, impl.options.threads);
     r->origin = origin;
+    if (auto err = api::settleCertificates(*r, a, b, impl.options.threads)) return *err;
     finishResult(impl, *r, call, t0);
     return r;
 }
@@ -436,6 +438,7 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
     Result<HausdorffResult> r = impl.device->gpu->computePacked(asVec3(a), asVec3(b), call);
     if (!r) return r;
     r->origin = glm::dvec3(0.0);
+    if (auto err = api::settleCertificates(*r, a, b, impl.options.threads)) return *err;
     finishResult(impl, *r, call, t0);
     return r;
 }
@@ -521,6 +524,10 @@ std::vector<Result<HausdorffResult>> scanSmallPairs(Engine::Impl& impl, std::spa
         if (!a.originals.empty() || !b.originals.empty())
             core::restoreOriginal(*out[i], a.input(), b.input(), impl.options.threads);
         out[i]->origin = a.origin;
+        if (auto err = api::settleCertificates(*out[i], a.input(), b.input(), impl.options.threads)) {
+            out[i] = *err;
+            continue;
+        }
         finishResult(impl, *out[i], call, t0);
         out[i]->timings.total = share;
     }
@@ -556,6 +563,12 @@ Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet&
     if (!ia.originals.empty() || !ib.originals.empty())
         core::restoreOriginal(*r, ia.input(), ib.input(), m_impl->options.threads);
     r->origin = ia.origin;
+    // Sets prepared from device views keep no host copy: their proof is the device's own.
+    const bool onHost = !ia.onDevice && !ib.onDevice;
+    if (auto err =
+            api::settleCertificates(*r, onHost ? ia.input() : PointView{}, onHost ? ib.input() : PointView{},
+                                    m_impl->options.threads, onHost))
+        return *err;
     finishResult(*m_impl, *r, call, t0);
     return r;
 }
@@ -656,6 +669,9 @@ Result<HausdorffResult> Engine::compute(const DevicePointView& a, const DevicePo
                                                   "(device input is not split into pieces)"};
     Result<HausdorffResult> r = m_impl->device->gpu->computeDevice(*da, *db, call);
     if (!r) return r;
+    // The host cannot read device views: the device's own proof stands, or the call fails.
+    if (auto err = api::settleCertificates(*r, PointView{}, PointView{}, m_impl->options.threads, false))
+        return *err;
     finishResult(*m_impl, *r, call, t0);
     return r;
 }

@@ -1,5 +1,7 @@
 #include "core/input_frame.hpp"
 
+#include "core/certificate.hpp"
+
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
@@ -152,10 +154,11 @@ FloatSet::FloatSet(const PointView& points, const glm::dvec3& origin, int thread
 }
 
 void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b, int threads) {
+    proveFromViews(r, a, b, threads);  // the certificate from these coordinates
     auto restore = [](Directed& d, const PointView& q, const PointView& t) {
         d.queryPoint = q.at(d.queryIndex);
         d.targetPoint = t.at(d.targetIndex);
-        d.distance = glm::length(d.queryPoint - d.targetPoint);
+        d.distance = exactDistance(d.queryPoint, d.targetPoint);
     };
     restore(r.aToB, a, b);
     r.hausdorff = r.aToB.distance;
@@ -167,7 +170,7 @@ void restoreOriginal(HausdorffResult& r, const PointView& a, const PointView& b,
         if (pp.distance.empty()) return;  // nearest only
         const int workers = core::resolveThreads(threads, pp.nearest.size() / kChunk + 1);
         core::parallelChunks(pp.nearest.size(), kChunk, workers, [&](size_t begin, size_t end, int) {
-            for (size_t i = begin; i < end; ++i) pp.distance[i] = glm::length(q.at(i) - t.at(pp.nearest[i]));
+            for (size_t i = begin; i < end; ++i) pp.distance[i] = exactDistance(q.at(i), t.at(pp.nearest[i]));
         });
     };
     perPoint(r.aNearest, a, b);

@@ -20,6 +20,8 @@ inline void addStageTimings(Timings& into, const Timings& t) {
     into.gpuSearch += t.gpuSearch;
     into.gpuRefine += t.gpuRefine;
     into.gpuUpload += t.gpuUpload;
+    into.certificate += t.certificate;
+    into.gpuCertificate += t.gpuCertificate;
 }
 
 }  // namespace rthdist::core

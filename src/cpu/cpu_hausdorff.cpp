@@ -50,7 +50,9 @@
 #include <optional>
 #include <vector>
 
+#include "core/certificate.hpp"
 #include "core/parallel.hpp"
+#include "core/search_mutant.hpp"
 #include "cpu/target_index.hpp"
 
 namespace rthdist::cpu {
@@ -244,6 +246,8 @@ bool searchTree(const TargetIndex& t, const Query& q, float kill, Best& best, Se
                 if (children[k].d2 > best.d2 * (1.0f + kPruneSlack)) break;
                 ++stats.bucketsScanned;
                 const uint32_t bucket = children[k].node;
+                // Tests only (core/search_mutant.hpp): a search that misses candidates.
+                if (bucket % 3 == 1 && core::searchMutant().load(std::memory_order_relaxed)) continue;
                 scanRange(t, t.bucketFirst[bucket], t.bucketFirst[bucket + 1], q, best);
                 if (best.d2 < kill) return true;
                 if (best.d2 == 0.0f) return false;
@@ -274,6 +278,8 @@ struct Winner {
 
 struct DirectedOutput {
     Directed directed;
+    core::DirectionBand
+        band;  // the certificate's band (core/certificate.hpp), for a proof from the originals
     // A query whose search found no target (impossible for finite, scaled
     // input; kept as an internal error rather than a read past the arrays).
     bool lostQuery = false;
@@ -364,6 +370,7 @@ struct Direction {
     const TargetIndex& t;
     double scale;
     int threads;
+    core::Bounds qBounds, tBounds;  // both sets' boxes, scaled
 
     [[nodiscard]] size_t queryCount() const { return queries.size(); }
     [[nodiscard]] Query query(size_t i) const { return {splat(qx[i]), splat(qy[i]), splat(qz[i])}; }
@@ -502,6 +509,39 @@ inline Best nearestOf(const Direction& d, size_t i, Seeds& seeds, CellCache& cel
     return best;
 }
 
+// The certificate's slack e for a direction (core/certificate.hpp): 2^-20 of
+// the largest |coordinate| of both sets (scaled, as searched).
+double slackOf(const Direction& d) {
+    const core::Bounds& q = d.qBounds;
+    const core::Bounds& t = d.tBounds;
+    double m = 0.0;
+    for (const core::Bounds* b : {&q, &t})
+        for (int k = 0; k < 3; ++k) m = std::max({m, std::abs(b->lo[k]), std::abs(b->hi[k])});
+    return core::searchSlack(m);
+}
+
+core::DirectionBand bandOf(const Direction& d, std::vector<core::BandQuery> queries, double hf) {
+    core::DirectionBand band;
+    band.present = true;
+    band.queries = std::move(queries);
+    band.hf = hf;
+    band.slack = slackOf(d);
+    band.scale = d.scale;
+    return band;
+}
+
+// The certificate from the float sets the backend searched (their own
+// coordinates; HausdorffResult::proofMaterial keeps the band for a proof
+// from the caller's): out.directed takes the proof's witness when it holds.
+void proveDirection(const Direction& d, DirectedOutput& out) {
+    const core::PointAt query = [&d](uint64_t i) { return glm::dvec3(d.queries[i]); };
+    const core::PointAt target = [&d](uint64_t i) { return glm::dvec3(d.targets[i]); };
+    const core::DirectedProof proof = core::proveDirection(
+        out.band, query, target, core::hostBruteForce(query, target, d.targets.size(), d.threads));
+    core::applyProof(out.directed, proof, query, target);
+    if (!proof.proven) out.band.failure = proof.failure;
+}
+
 // Every query's exact float nearest neighbour. A query equal to the previous
 // one takes its nearest target. Fills `nearest` (input order) with the target
 // index and the double distance recomputed from the pair.
@@ -563,7 +603,20 @@ void perPointDirection(const Direction& d, PerPoint& perPoint, Progress& progres
     r.distance = perPoint.distance[win];
     r.counters = passCounters(d, stats);
     r.counters.survivingQueries = d.queryCount();
+    // The band from the double distances of the float nearest pairs (each
+    // within e / s of the query's exact nearest distance): those within 2e of
+    // the largest, whose search-unit value stands for the float maximum.
+    const double slack = slackOf(d), top = perPoint.distance[win] * d.scale;
+    std::vector<core::BandQuery> band;
+    for (size_t i = 0; i < d.queryCount(); ++i)
+        if (perPoint.distance[i] * d.scale >= top - 2.0 * slack) band.push_back({i, perPoint.nearest[i]});
+    out.band = bandOf(d, std::move(band), top);
     out.refineMs = msSince(start);
+    proveDirection(d, out);
+    if (out.directed.certificate.confirmed) {  // the witness's entry as proven
+        perPoint.nearest[out.directed.queryIndex] = uint32_t(out.directed.targetIndex);
+        perPoint.distance[out.directed.queryIndex] = out.directed.distance;
+    }
     progress.report("refine", 1.0);
 }
 
@@ -626,7 +679,11 @@ inline bool killedBySeeds(const Direction& d, size_t i, const Query& q, float k,
     if (seeds.bucket != kNone) {
         const float dx = d.qx[i] - t.x[seeds.pos], dy = d.qy[i] - t.y[seeds.pos],
                     dz = d.qz[i] - t.z[seeds.pos];
-        if (dx * dx + dy * dy + dz * dz < k) return true;
+        const float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < k) {
+            best = {d2, t.original[seeds.pos], seeds.pos};  // the killing point (the certificate's band)
+            return true;
+        }
         ++stat.bucketsScanned;
         scanRange(t, t.bucketFirst[seeds.bucket], t.bucketFirst[seeds.bucket + 1], q, best);
         if (best.d2 < k) {
@@ -643,21 +700,33 @@ inline bool killedBySeeds(const Direction& d, size_t i, const Query& q, float k,
     return false;
 }
 
+// Every query's best pair when the pass ends (a real target: its nearest,
+// or the point that killed it), by position in the queries' order: the
+// certificate's band is read from it.
+struct QueryBests {
+    float* d2;
+    uint32_t* target;  // input index
+};
+
 // Query i of the early-break pass: culled (a copy of the previous query, or
 // killed by a seed), killed in the BVH search, or searched to the end, when
 // it is offered as the witness and raises the kill threshold.
 inline void searchQuery(const Direction& d, size_t i, bool first, std::atomic<uint32_t>& kill, Seeds& seeds,
-                        ChunkTally& tally, SearchStats& stat) {
+                        ChunkTally& tally, SearchStats& stat, const QueryBests& bests) {
     const float k = std::bit_cast<float>(kill.load(std::memory_order_relaxed));
     if (!first && seeds.bucket != kNone && d.sameAsPrevious(i)) {
         // A copy of the previous query (smaller input index, same nearest
         // distance) was killed or offered already.
+        bests.d2[i] = bests.d2[i - 1];
+        bests.target[i] = bests.target[i - 1];
         ++tally.culled;
         return;
     }
     const Query q = d.query(i);
     Best best;
     if (killedBySeeds(d, i, q, k, seeds, best, stat)) {
+        bests.d2[i] = best.d2;
+        bests.target[i] = best.target;
         ++tally.culled;
         return;
     }
@@ -669,6 +738,8 @@ inline void searchQuery(const Direction& d, size_t i, bool first, std::atomic<ui
         return;
     }
     seeds.follow(d.t, best);
+    bests.d2[i] = best.d2;
+    bests.target[i] = best.target;
     if (dead) return;
     tally.winner.offer(best.d2, uint32_t(d.qKeyed[i]), best.target);
     atomicMax(kill, best.d2);
@@ -676,14 +747,14 @@ inline void searchQuery(const Direction& d, size_t i, bool first, std::atomic<ui
 
 // The pass over all queries, in chunks of consecutive queries; `kill` only grows.
 void searchPass(const Direction& d, std::atomic<uint32_t>& kill, PassTally& tally, Progress& progress,
-                std::atomic<bool>& lost) {
+                std::atomic<bool>& lost, const QueryBests& bests) {
     const size_t nq = d.queryCount();
     parallelChunks(nq, kQueryChunk, d.threads, [&](size_t begin, size_t end, int w) {
         if (progress.cancelled()) return;
         ChunkTally chunk{tally.winners[size_t(w)]};
         SearchStats stat;
         Seeds seeds{kNone, kNone, d.firstCell(begin)};
-        for (size_t i = begin; i < end; ++i) searchQuery(d, i, i == begin, kill, seeds, chunk, stat);
+        for (size_t i = begin; i < end; ++i) searchQuery(d, i, i == begin, kill, seeds, chunk, stat, bests);
         if (chunk.lost) lost.store(true, std::memory_order_relaxed);
         tally.winners[size_t(w)] = chunk.winner;
         tally.stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
@@ -726,7 +797,9 @@ void earlyBreakDirection(const Direction& d, double boxBound2, Progress& progres
 
     start = Clock::now();
     std::atomic<bool> lost{false};
-    searchPass(d, kill, tally, progress, lost);
+    std::vector<float> bestD2(d.queryCount());
+    std::vector<uint32_t> bestTarget(d.queryCount());
+    searchPass(d, kill, tally, progress, lost, QueryBests{bestD2.data(), bestTarget.data()});
     out.searchMs = msSince(start);
     out.lostQuery = lost.load();
     out.cancelled = progress.cancelled();
@@ -735,7 +808,17 @@ void earlyBreakDirection(const Direction& d, double boxBound2, Progress& progres
 
     start = Clock::now();
     out.directed = witnessOf(d, tally);
+    if (out.lostQuery) return;
+    // The band: every query whose best lies within 2e of the maximum.
+    float hf2 = -1.0f;
+    for (const Winner& w : tally.winners) hf2 = std::max(hf2, w.d2);
+    std::vector<core::BandQuery> band;
+    const double threshold2 = core::bandThreshold2(hf2, slackOf(d));
+    for (size_t i = 0; i < d.queryCount(); ++i)
+        if (double(bestD2[i]) >= threshold2) band.push_back({uint32_t(d.qKeyed[i]), bestTarget[i]});
+    out.band = bandOf(d, std::move(band), std::sqrt(double(hf2)));
     out.refineMs = msSince(start);
+    proveDirection(d, out);
     progress.report("refine", 1.0);
 }
 
@@ -747,8 +830,9 @@ DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet
     const TargetIndex& t = targetSet.targetIndex(threads);
     const SetOrder& qOrder = querySet.order;
     const QueryKeys keys = keyQueries(qOrder, t.grid, targetSet.order.bounds, threads);
-    const Direction d{querySet.points, targetSet.points, qOrder.x, qOrder.y,       qOrder.z,
-                      qOrder.keyed,    keys.key,         t,        querySet.scale, threads};
+    const Direction d{querySet.points, targetSet.points, qOrder.x,      qOrder.y,
+                      qOrder.z,        qOrder.keyed,     keys.key,      t,
+                      querySet.scale,  threads,          qOrder.bounds, targetSet.order.bounds};
     out.indexMs = msSince(start);
     progress.report("index", kIndexDone);
     if (perPoint != nullptr) {
@@ -767,7 +851,8 @@ double chooseScale(std::span<const glm::vec3> a, std::span<const glm::vec3> b, i
 // One direction into `r` (its witness, per-point array and stage times), or
 // why it has no result.
 std::optional<Error> runDirection(const CpuSet& q, const CpuSet& t, int threads, Progress& progress,
-                                  PerPoint* perPoint, Directed& into, Timings& timings) {
+                                  PerPoint* perPoint, Directed& into, core::DirectionBand& band,
+                                  Timings& timings) {
     const DirectedOutput o = directedHausdorff(q, t, threads, perPoint, progress);
     timings.index += o.indexMs;
     timings.cull += o.cullMs;
@@ -776,6 +861,7 @@ std::optional<Error> runDirection(const CpuSet& q, const CpuSet& t, int threads,
     if (o.cancelled) return Error{ErrorCode::kCancelled, "the call was cancelled (CallOptions::cancel)"};
     if (o.lostQuery) return Error{ErrorCode::kInternal, "CPU backend: a query found no target"};
     into = o.directed;
+    band = o.band;
     return std::nullopt;
 }
 
@@ -816,15 +902,19 @@ Result<HausdorffResult> cpuHausdorff(const CpuSet& a, const CpuSet& b, const Cal
     const int threads = resolveThreads(threadCount);
     const bool perPoint = options.perPointDistances;
     Progress first(options, 0.0, options.directedOnly ? 1.0 : 0.5);
-    if (auto e = runDirection(a, b, threads, first, perPoint ? &r.aNearest : nullptr, r.aToB, r.timings))
+    auto material = std::make_shared<detail::ProofMaterial>();
+    if (auto e = runDirection(a, b, threads, first, perPoint ? &r.aNearest : nullptr, r.aToB, material->aToB,
+                              r.timings))
         return *e;
     r.hausdorff = r.aToB.distance;
     if (!options.directedOnly) {
         Progress second(options, 0.5, 0.5);
-        if (auto e = runDirection(b, a, threads, second, perPoint ? &r.bNearest : nullptr, r.bToA, r.timings))
+        if (auto e = runDirection(b, a, threads, second, perPoint ? &r.bNearest : nullptr, r.bToA,
+                                  material->bToA, r.timings))
             return *e;
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
     }
+    r.proofMaterial = std::move(material);
     r.timings.total = msSince(start);
     return r;
 }

@@ -37,6 +37,8 @@ struct DirectionRun {
     Buffer* nearest = nullptr;               // per-point: uint nearest target per query (device)
     Buffer* nearestHost = nullptr;           // per-point: `nearest` copied by each self-check
     std::vector<uint32_t> checkSlots;        // the self-check's sampled query slots
+    Buffer* band = nullptr;                  // host: the certificate's band (certificate_pass.hpp)
+    double slack = 0.0;                      // the certificate's e, search units
     [[nodiscard]] std::string name() const { return Q.name + "->" + T.name; }
 };
 

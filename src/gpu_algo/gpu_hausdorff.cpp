@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -12,8 +13,10 @@
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
 #include "core/parallel.hpp"
+#include "core/search_mutant.hpp"
 #include "gpu/device_limits.hpp"
 #include "gpu_algo/candidate_search.hpp"
+#include "gpu_algo/certificate_pass.hpp"
 #include "gpu_algo/device_input.hpp"
 #include "gpu_algo/direction.hpp"
 #include "gpu_algo/index_build.hpp"
@@ -64,6 +67,7 @@ struct GpuHausdorff::State {
           cull(ws, check),
           refine(ws),
           search(ws, index, refine, check),
+          certificate(ws, check),
           deviceIngest(ws, index),
           smallPairs(ws) {}
 
@@ -78,6 +82,7 @@ struct GpuHausdorff::State {
     NeighbourhoodPass cull;
     Refinement refine;
     CandidateSearch search;
+    CertificatePass certificate;
     DeviceIngest deviceIngest;
     SmallPairScan smallPairs;
 
@@ -280,7 +285,12 @@ struct GpuHausdorff::State {
         DirectionRun ba{b.ix, a.ix, b.pts, a.pts, ws.blocks[1], pp ? &res.bNearest : nullptr};
         ab.perPointDistances = ba.perPointDistances = !options.perPointNearestOnly;
         cull.startDirection(ab, 0);
-        if (!options.directedOnly) cull.startDirection(ba, 1);
+        certificate.startDirection(ab, 0);
+        if (!options.directedOnly) {
+            cull.startDirection(ba, 1);
+            certificate.startDirection(ba, 1);
+        }
+        auto material = std::make_shared<detail::ProofMaterial>();
         // Both culls (and their checks) in one submission; a direction with
         // survivors searches, then checks again.
         std::array<uint32_t, 2> survivors{};
@@ -311,6 +321,11 @@ struct GpuHausdorff::State {
                                              : check.finishCheck(*s.run);
             auto t0 = Clock::now();
             *s.out = check.finishDirection(*s.run, witness);
+            const auto tc = Clock::now();
+            core::DirectionBand& band = s.direction == 0 ? material->aToB : material->bToA;
+            band = certificate.prove(*s.run, *s.out);
+            band.scale = a.scale;  // the caller's units to the search's (both sets share it)
+            ws.timings->certificate += msSince(tc);
             ws.timings->check += msSince(t0);
             if (handBack && i + 1 < count) {  // read back beside the next direction's search: not timed
                 handing.handBeside(*s.run, *s.run->perPoint, s.direction);
@@ -324,6 +339,7 @@ struct GpuHausdorff::State {
         handing.join();
         res.hausdorff =
             options.directedOnly ? res.aToB.distance : std::max(res.aToB.distance, res.bToA.distance);
+        res.proofMaterial = std::move(material);
         // Witnesses and per-point distances from the unscaled inputs, in double.
         if (a.scale != 1.0) core::restoreOriginal(res, PointView(a.input), PointView(b.input), ws.threads);
     }
@@ -369,6 +385,7 @@ struct GpuHausdorff::State {
     template <class Work>
     std::optional<Error> guarded(Timings& into, Work&& work) {
         ws.timings = &into;
+        ws.mutant = core::searchMutant().load();
         handedBack = 0;
         std::optional<Error> err;
         try {

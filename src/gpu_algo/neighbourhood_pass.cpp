@@ -67,8 +67,9 @@ void NeighbourhoodPass::cmdCull(VkCommandBuffer cmd, DirectionRun& d) {
                       d.Q.n,
                       d.lowerBound2,
                       d.epsilon,
-                      0u,             // search cells are coarser than the block's cells
-                      kCrowdedCell};  // past it: split leaves, or copies of one point
+                      0u,            // search cells are coarser than the block's cells
+                      kCrowdedCell,  // past it: split leaves, or copies of one point
+                      m_ws.mutant ? 1u : 0u};
     m_ws.dispatch(cmd, Kernel::kCull, cull, d.Q.n);
     m_ws.barrier(cmd);
     sh::CompactPush comp{

@@ -18,6 +18,7 @@
 #include "cell_build.comp.h"
 #include "cell_heads.comp.h"
 #include "cell_keys.comp.h"
+#include "cert_scan.comp.h"
 #include "check_index.comp.h"
 #include "check_queries.comp.h"
 #include "coarsen.comp.h"
@@ -88,6 +89,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_search_advance_comp, "search_advance"},
     {k_spv_probe_levels_comp, "probe_levels"},
     {k_spv_tail_scan_comp, "tail_scan"},
+    {k_spv_cert_scan_comp, "cert_scan"},
 }};
 
 }  // namespace

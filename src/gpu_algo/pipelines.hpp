@@ -45,6 +45,7 @@ enum class Kernel : uint32_t {
     kSearchAdvance,  // between the radii of one submission (search_advance.comp)
     kProbeLevels,    // the bit count's probe (probe_levels.comp): only with shaderFloat64
     kTailScan,       // the candidate search's far tail: whole levels scanned (tail_scan.comp)
+    kCertScan,       // the certificate's brute force over a direction's targets (cert_scan.comp)
     kCount
 };
 

@@ -1,6 +1,7 @@
 #include "gpu_algo/query_check.hpp"
 
 #include "core/parallel.hpp"
+#include "gpu_algo/certificate_pass.hpp"
 
 #include <atomic>
 #include <bit>
@@ -33,7 +34,10 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, Che
                      m_ws.hostSmall.address() + witnessAt,
                      at == CheckAt::kBehindCull ? 1u : 0u,
                      uint32_t(d.checkSlots.size()),
-                     d.nearest != nullptr ? d.nearest->address() : 0};
+                     d.nearest != nullptr ? d.nearest->address() : 0,
+                     d.band != nullptr ? d.band->address() : 0,
+                     kBandCapacity,
+                     float(d.slack * (1.0 + 0x1.0p-20))};
     if (at == CheckAt::kBehindSearch)  // groups written by search_advance.comp: none while queries go on
         m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kCheckQueries, &cp, sizeof(cp),
                                            m_ws.hostSmall.handle(), d.blk.offset + RTHDIST_CTR_CHECK_ARGS);
@@ -55,6 +59,11 @@ void QueryCheck::fetchSampled(const DirectionRun& d, std::span<const SampledQuer
         queries.push_back(std::bit_cast<uint32_t>(s.sorted[3]));
         targets.push_back(uint32_t(s.state.best & 0xffffffffu));
     }
+    fetchPoints(d, queries, targets);
+}
+
+void QueryCheck::fetchPoints(const DirectionRun& d, std::span<const uint32_t> queries,
+                             std::span<const uint32_t> targets) {
     // Both sets' missing points in one submission, into the workspace's kept
     // host buffer (a buffer and a submission per set and check cost ~3 ms
     // per call on an H100).

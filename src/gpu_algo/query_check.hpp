@@ -55,6 +55,13 @@ public:
     // direction is searched.
     void readPerPoint(const DirectionRun& d, PerPoint& out);
 
+    // Device input: copies the query points `queries` and target points
+    // `targets` (input indices) from the embedder's buffers to the host in
+    // one submission, so that d.qPts / d.tPts.original() can read them; host
+    // arrays: nothing to do.
+    void fetchPoints(const DirectionRun& d, std::span<const uint32_t> queries,
+                     std::span<const uint32_t> targets);
+
 private:
     // The sampled records' query and target points, for the host to compare
     // (device input: copied from the embedder's buffers, a few dozen points).

@@ -24,6 +24,7 @@ void Refinement::cmdRefine(VkCommandBuffer cmd, DirectionRun& d, const PointInde
     rp.lowerBound2 = d.lowerBound2;
     rp.numSearchCells = lv.count;
     rp.numFineCells = d.T.numCells;
+    rp.mutant = m_ws.mutant ? 1u : 0u;
     m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kRefine, &rp, sizeof(rp), args.handle(), 0);
     m_ws.barrier(cmd);
     cmdResolve(cmd, d, numActive, r, sameLevel);

@@ -50,6 +50,14 @@ struct DirectionBuffers {
     std::array<Buffer, 2> active;
     Buffer nearest;
     Buffer nearestHost;
+    Buffer band;  // host: the certificate's band (check_queries.comp)
+};
+
+// The certificate's brute force (certificate_pass.hpp): its band queries and
+// the candidates it found, both in host memory.
+struct CertificateScratch {
+    Buffer entries;
+    Buffer candidates;
 };
 
 // The candidate search, refinement and per-point read-back.
@@ -78,6 +86,7 @@ struct Scratch {
     LevelScratch levels;
     std::array<DirectionBuffers, 2> directions;  // A->B, B->A
     SearchScratch search;
+    CertificateScratch certificate;
     BatchScratch batch;
 };
 

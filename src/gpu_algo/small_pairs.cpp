@@ -99,7 +99,9 @@ SmallPairScan::Layout SmallPairScan::layOut(std::span<const SmallPair> pairs, bo
     upload(s.chunks, l.chunks.data(), l.chunks.size() * 4, "batch.chunks");
     m_ws.grow(s.maxPacked, VkDeviceSize(dirs) * 8, "batch.maxPacked");
     m_ws.grow(s.witnesses, VkDeviceSize(dirs) * 16, "batch.witnesses", MemoryKind::kReadback);
-    if (perPoint) m_ws.grow(s.perPoint, l.queries * 4, "batch.perPoint", MemoryKind::kReadback);
+    // Every query's nearest (or killing) target comes back: per-point output,
+    // and the certificate's band (finishPair).
+    m_ws.grow(s.perPoint, l.queries * 4, "batch.perPoint", MemoryKind::kReadback);
     return l;
 }
 
@@ -122,16 +124,17 @@ void SmallPairScan::record(VkCommandBuffer cmd, const Layout& l, bool perPoint) 
     m_ws.barrier(cmd);
     const sh::BatchWitnessPush w{s.directions.address(), s.maxPacked.address(), s.witnesses.address(), dirs};
     m_ws.dispatch(cmd, Kernel::kBatchWitness, w, dirs);
-    if (perPoint) {
-        const VkBufferCopy all{0, 0, l.queries * 4};
-        vkCmdCopyBuffer(cmd, s.nearest.handle(), s.perPoint.handle(), 1, &all);
-    }
+    const VkBufferCopy all{0, 0, l.queries * 4};
+    vkCmdCopyBuffer(cmd, s.nearest.handle(), s.perPoint.handle(), 1, &all);
+    gpu::cmdHostReadBarrier(cmd);
 }
 
 std::string SmallPairScan::finishPair(const SmallPair& pair, size_t first, const Layout& l, bool perPoint,
                                       HausdorffResult& out) const {
     const BatchScratch& s = m_ws.scratch.batch;
     const auto* witnesses = static_cast<const uint32_t*>(s.witnesses.mapped());
+    auto material = std::make_shared<detail::ProofMaterial>();
+    out.proofMaterial = material;  // filled below
     for (size_t k = 0; k < l.perPair; ++k) {
         const bool ab = k == 0;
         const ScanSet& q = ab ? pair.a : pair.b;
@@ -153,16 +156,41 @@ std::string SmallPairScan::finishPair(const SmallPair& pair, size_t first, const
         d.counters.bits = uint32_t(t.bits);
         d.counters.occupiedCells = t.cells;
         d.counters.queries = nq;
+        const uint32_t* nearest = static_cast<const uint32_t*>(s.perPoint.mapped()) + l.nearestAt[first + k];
+        if (std::any_of(nearest, nearest + nq, [&](uint32_t i) { return i >= nt; }))
+            return name + ": a query's nearest index lies past the target set's " + std::to_string(nt) +
+                   " points";
+        (ab ? material->aToB : material->bToA) = bandOf(q, t, nearest, std::bit_cast<float>(w[2]));
         if (!perPoint) continue;
         PerPoint& pp = ab ? out.aNearest : out.bNearest;
-        const uint32_t* nearest = static_cast<const uint32_t*>(s.perPoint.mapped()) + l.nearestAt[first + k];
         pp.nearest.assign(nearest, nearest + nq);
-        if (std::any_of(pp.nearest.begin(), pp.nearest.end(), [&](uint32_t i) { return i >= nt; }))
-            return name + ": a per-point nearest index lies past the target set's " + std::to_string(nt) +
-                   " points";
         pp.distance.resize(nq);
     }
     return "";
+}
+
+core::DirectionBand SmallPairScan::bandOf(const ScanSet& q, const ScanSet& t, const uint32_t* nearest,
+                                          float maxD2) {
+    // The certificate's band (core/certificate.hpp) from every query's
+    // nearest or killing target (batch_nearest.comp writes both): the
+    // queries whose pair, in double over the searched points, lies within
+    // 2e of the float maximum. Outside it a query's pair is nearer than
+    // hf - 2e there, hence than hf - e in the caller's coordinates.
+    core::DirectionBand band;
+    band.present = true;
+    band.hf = std::sqrt(double(maxD2));
+    double m = 0.0;
+    for (const ScanSet* s : {&q, &t})
+        for (const glm::vec3& p : s->points)
+            m = std::max({m, std::abs(double(p.x)), std::abs(double(p.y)), std::abs(double(p.z))});
+    band.slack = core::searchSlack(m * std::max(q.pointsScale, t.pointsScale));
+    band.scale = q.inputScale;
+    for (size_t i = 0; i < q.points.size(); ++i) {
+        const double u = core::exactDistance(glm::dvec3(q.points[i]) * q.pointsScale,
+                                             glm::dvec3(t.points[nearest[i]]) * t.pointsScale);
+        if (u >= band.hf - 2.0 * band.slack) band.queries.push_back({i, nearest[i]});
+    }
+    return band;
 }
 
 SmallPairScan::Outcome SmallPairScan::submit(std::span<const SmallPair> pairs, const Layout& l,
@@ -235,7 +263,8 @@ SmallPairScan::Outcome SmallPairScan::runHostArrays(std::span<const glm::vec3> a
         }
     }
     const VkDeviceAddress records = m_ws.grow(s.records, bytes, "batch.records").address();
-    const SmallPair pair{ScanSet{records, 1.0f, a, scale}, ScanSet{records + a.size() * 16, 1.0f, b, scale}};
+    const SmallPair pair{ScanSet{records, 1.0f, a, scale, 0, 0, scale},
+                         ScanSet{records + a.size() * 16, 1.0f, b, scale, 0, 0, scale}};
     const Layout l = layOut(std::span(&pair, 1), options.directedOnly, options.perPointDistances);
     const double staging = msSince(t0);
     uint32_t copied = 0;
@@ -253,8 +282,8 @@ SmallPairScan::Outcome SmallPairScan::runHostArrays(std::span<const glm::vec3> a
 }
 
 ScanSet scanSetOf(const DeviceSet& set, double scale) {
-    return ScanSet{set.ix.sorted->address(), float(scale),   set.points, scale,
-                   set.ix.grid.bits,         set.ix.numCells};
+    return ScanSet{set.ix.sorted->address(), float(scale),    set.points,       scale,
+                   set.ix.grid.bits,         set.ix.numCells, set.scale * scale};
 }
 
 }  // namespace rthdist::gpu_algo

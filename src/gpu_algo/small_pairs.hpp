@@ -25,6 +25,8 @@
 // Threading: one caller at a time (the Workspace's).
 #pragma once
 
+#include "core/certificate.hpp"
+
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -47,6 +49,7 @@ struct ScanSet {
     double pointsScale = 1.0;
     int bits = 0;
     uint64_t cells = 0;
+    double inputScale = 1.0;  // searched units (points * pointsScale) per unit of the caller's input
 };
 
 // A prepared set (its cell-sorted records) as a scan's side.
@@ -97,6 +100,10 @@ private:
     // Pair i's result from the read-back witnesses (and per-point indices).
     [[nodiscard]] std::string finishPair(const SmallPair& pair, size_t first, const Layout& layout,
                                          bool perPoint, HausdorffResult& out) const;
+    // One direction's band for the certificate, from every query's nearest
+    // (or killing) target and the float maximum.
+    [[nodiscard]] static core::DirectionBand bandOf(const ScanSet& q, const ScanSet& t,
+                                                    const uint32_t* nearest, float maxD2);
 
     Workspace& m_ws;
     uint64_t m_maxWork;

@@ -26,6 +26,7 @@ CliRun runMpi(int np, const std::vector<std::string>& args) {
 // The JSON minus what legitimately differs between one process and N ranks.
 nlohmann::json comparable(nlohmann::json j, bool spatial) {
     j.erase("timings_ms");
+    j.erase("gpu_ms");  // device times (rthdist-mpi reports none)
     for (const char* d : {"a_to_b", "b_to_a"}) {
         if (j["counters"][d].is_object()) j["counters"][d] = {{"queries", j["counters"][d]["queries"]}};
     }

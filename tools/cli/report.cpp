@@ -68,10 +68,23 @@ Json directedJson(const Directed& d, const std::string& q, const std::string& t)
 }
 
 // "hausdorff", "a_to_b", "b_to_a" (null with --directed) into `out`.
+// The proof of one directed value (rthdist.hpp, Certificate).
+Json certificateJson(const Certificate& c) {
+    Json j = {{"confirmed", c.confirmed},
+              {"query", c.query},
+              {"nearest", c.nearest},
+              {"distance", c.distance},
+              {"band", c.band}};
+    if (c.recomputed) j["recomputed"] = true;
+    return j;
+}
+
 void addDirectedResult(Json& out, const HausdorffResult& r) {
     out["hausdorff"] = r.hausdorff;
     out["a_to_b"] = directedJson(r.aToB, "a", "b");
     out["b_to_a"] = r.directedOnly ? Json() : directedJson(r.bToA, "b", "a");
+    out["certificate"] = {{"a_to_b", certificateJson(r.aToB.certificate)},
+                          {"b_to_a", r.directedOnly ? Json() : certificateJson(r.bToA.certificate)}};
 }
 
 std::string countersText(const Counters& c) {
@@ -152,10 +165,13 @@ std::string jsonReport(const RunReport& report) {
               {"bits_requested", args.options.bits},
               {"directed", r.directedOnly}};
     addDirectedResult(j, r);
-    j["timings_ms"] = {{"load", report.loadMs}, {"setup", t.setup}, {"upload", t.upload},
-                       {"index", t.index},      {"cull", t.cull},   {"search", t.search},
-                       {"refine", t.refine},    {"check", t.check}, {"total", t.total},
-                       {"wall", report.wallMs}};
+    j["timings_ms"] = {{"load", report.loadMs}, {"setup", t.setup},     {"upload", t.upload},
+                       {"index", t.index},      {"cull", t.cull},       {"search", t.search},
+                       {"refine", t.refine},    {"check", t.check},     {"certificate", t.certificate},
+                       {"total", t.total},      {"wall", report.wallMs}};
+    if (r.backend != Backend::kCpu)  // device time per stage (timestamp queries)
+        j["gpu_ms"] = {{"upload", t.gpuUpload}, {"index", t.gpuIndex},   {"cull", t.gpuCull},
+                       {"search", t.gpuSearch}, {"refine", t.gpuRefine}, {"certificate", t.gpuCertificate}};
     j["counters"] = {{"a_to_b", countersJson(r.aToB.counters)},
                      {"b_to_a", r.directedOnly ? Json() : countersJson(r.bToA.counters)}};
     j["validation"] = args.options.validation;

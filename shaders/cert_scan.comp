@@ -1,0 +1,28 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// The certificate's brute force (core/certificate.hpp): every target of the
+// direction against up to RTHDIST_CERT_ENTRIES band queries, each with its
+// squared bound (search units); every target within a query's bound is
+// appended as a candidate, which the host settles in double. One read of the
+// targets, whatever the number of queries; a grid-stride loop.
+#include "common.glsl"
+layout(local_size_x = RTHDIST_WG) in;
+layout(push_constant) uniform Push { CertScanPush pc; };
+
+shared vec4 entries[RTHDIST_CERT_ENTRIES];
+
+void main() {
+    const uint count = min(pc.entryCount, uint(RTHDIST_CERT_ENTRIES));
+    for (uint k = gl_LocalInvocationID.x; k < count; k += RTHDIST_WG) entries[k] = vec4At(pc.entries, k).v;
+    barrier();
+    const uint step = gl_NumWorkGroups.x * RTHDIST_WG;
+    for (uint t = gl_GlobalInvocationID.x; t < pc.n; t += step) {
+        const vec4 p = vec4At(pc.targets, t).v;
+        for (uint k = 0u; k < count; ++k) {
+            if (dist2(entries[k].xyz, p.xyz) <= entries[k].w) {
+                const uint j = atomicAdd(UintRef(pc.found).v, 1u);
+                if (j < pc.capacity) uvec2At(pc.found + 8ul, j).v = uvec2(k, floatBitsToUint(p.w));
+            }
+        }
+    }
+}

@@ -1,0 +1,167 @@
+#include "core/certificate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+
+#include "core/parallel.hpp"
+
+namespace rthdist::core {
+namespace {
+
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return buf;
+}
+
+}  // namespace
+
+double bandThreshold2(double hf2, double slack) {
+    const double lo = std::max(std::sqrt(std::max(hf2, 0.0)) - 2.0 * slack, 0.0);
+    return lo * lo * (1.0 - kSlackPerMagnitude);
+}
+
+BruteForce hostBruteForce(const PointAt& query, const PointAt& target, uint64_t n, int threads) {
+    return [query, target, n, threads](std::span<BandNearest> band) {
+        if (band.empty()) return true;
+        std::vector<glm::dvec3> q(band.size());
+        for (size_t k = 0; k < band.size(); ++k) q[k] = query(band[k].query);
+        std::mutex merge;
+        constexpr size_t kChunk = size_t(1) << 15;
+        const int workers = resolveThreads(threads, n / kChunk + 1);
+        parallelChunks(n, kChunk, workers, [&](size_t begin, size_t end, int) {
+            std::vector<BandNearest> local(band.size());
+            for (size_t t = begin; t < end; ++t) {
+                const glm::dvec3 p = target(t);
+                for (size_t k = 0; k < q.size(); ++k) local[k].offer(t, exactDistance(q[k], p));
+            }
+            const std::lock_guard<std::mutex> lock(merge);
+            for (size_t k = 0; k < band.size(); ++k) band[k].offer(local[k].target, local[k].distance);
+        });
+        return true;
+    };
+}
+
+DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, const PointAt& target,
+                             const BruteForce& bruteForce) {
+    DirectedProof p;
+    p.band = band.queries.size();
+    if (!band.failure.empty()) {
+        p.failure = band.failure;
+        return p;
+    }
+    if (band.queries.empty()) {
+        p.failure = "the band is empty (the search's maximum has no query)";
+        return p;
+    }
+    // U per band query, then in falling order (ties: the smaller query index).
+    struct Entry {
+        double upper;
+        uint64_t query, best;
+    };
+    std::vector<Entry> order;
+    order.reserve(band.queries.size());
+    for (const BandQuery& b : band.queries)
+        order.push_back({exactDistance(query(b.query), target(b.best)), b.query, b.best});
+    std::sort(order.begin(), order.end(), [](const Entry& x, const Entry& y) {
+        return x.upper > y.upper || (x.upper == y.upper && x.query < y.query);
+    });
+    std::vector<std::pair<uint64_t, const std::vector<uint64_t>*>> known;
+    for (const auto& [q, list] : band.candidates) known.emplace_back(q, &list);
+    std::sort(known.begin(), known.end());
+    auto candidatesOf = [&](uint64_t q) -> const std::vector<uint64_t>* {
+        auto it = std::lower_bound(known.begin(), known.end(),
+                                   std::make_pair(q, (const std::vector<uint64_t>*)nullptr));
+        return it != known.end() && it->first == q ? it->second : nullptr;
+    };
+    BandNearest win;
+    bool have = false;
+    auto take = [&](const BandNearest& b) {
+        if (!have || b.distance > win.distance || (b.distance == win.distance && b.query < win.query))
+            win = b;
+        have = true;
+    };
+    size_t i = 0;
+    while (i < order.size()) {
+        // A query whose bound does not exceed the largest exact distance so
+        // far cannot raise it (nor win a tie: its index is larger, or it ties
+        // a value already reached); neither can any after it.
+        if (have && !(order[i].upper > win.distance)) break;
+        if (const std::vector<uint64_t>* list = candidatesOf(order[i].query)) {
+            BandNearest b{order[i].query};
+            const glm::dvec3 q = query(order[i].query);
+            b.offer(order[i].best, order[i].upper);
+            for (uint64_t t : *list) b.offer(t, exactDistance(q, target(t)));
+            ++p.bruteForced;
+            take(b);
+            ++i;
+            continue;
+        }
+        std::vector<BandNearest> batch;
+        for (size_t j = i; j < order.size() && batch.size() < kBruteForceBatch; ++j) {
+            if (have && !(order[j].upper > win.distance)) break;
+            if (candidatesOf(order[j].query) != nullptr) break;
+            BandNearest b{order[j].query};
+            b.offer(order[j].best, order[j].upper);  // the bound a device brute force needs
+            batch.push_back(b);
+        }
+        if (!bruteForce || !bruteForce(batch)) {
+            p.failure = "band query " + std::to_string(order[i].query) +
+                        " needs a brute force in double that this route cannot run";
+            return p;
+        }
+        p.bruteForced += batch.size();
+        for (const BandNearest& b : batch) {
+            if (b.target == std::numeric_limits<uint64_t>::max()) {
+                p.failure = "band query " + std::to_string(b.query) + " found no target in its brute force";
+                return p;
+            }
+            take(b);
+        }
+        i += batch.size();
+    }
+    p.query = win.query;
+    p.target = win.target;
+    p.distance = win.distance;
+    // Outside the band every query is nearer than (hf - e) / s.
+    if (!(win.distance * band.scale >= band.hf - band.slack)) {
+        p.failure = "the search's maximum " + number(band.hf / band.scale) +
+                    " is not reached in double: the largest nearest distance of the band is " +
+                    number(win.distance) + " (query " + std::to_string(win.query) + ")";
+        return p;
+    }
+    p.proven = true;
+    return p;
+}
+
+void applyProof(Directed& d, const DirectedProof& proof, const PointAt& query, const PointAt& target) {
+    d.certificate = Certificate{};
+    d.certificate.band = proof.band;
+    if (!proof.proven) return;
+    d.queryIndex = proof.query;
+    d.targetIndex = proof.target;
+    d.queryPoint = query(proof.query);
+    d.targetPoint = target(proof.target);
+    d.distance = proof.distance;
+    d.certificate.confirmed = true;
+    d.certificate.query = proof.query;
+    d.certificate.nearest = proof.target;
+    d.certificate.distance = proof.distance;
+}
+
+void proveFromViews(HausdorffResult& r, const PointView& a, const PointView& b, int threads) {
+    if (!r.proofMaterial) return;
+    auto one = [threads](Directed& d, const DirectionBand& band, const PointView& q, const PointView& t) {
+        if (!band.present) return;
+        const PointAt query = [&q](uint64_t i) { return q.at(i); };
+        const PointAt target = [&t](uint64_t i) { return t.at(i); };
+        applyProof(d, proveDirection(band, query, target, hostBruteForce(query, target, t.size(), threads)),
+                   query, target);
+    };
+    one(r.aToB, r.proofMaterial->aToB, a, b);
+    if (!r.directedOnly) one(r.bToA, r.proofMaterial->bToA, b, a);
+}
+
+}  // namespace rthdist::core
