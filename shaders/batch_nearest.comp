@@ -7,7 +7,7 @@
 // finds a target as near as the running maximum early. Exact: a query stops
 // only with a target at most as far as the maximum, which a finished query
 // (its witness, whose nearest target is written) has as its exact nearest
-// distance, so it cannot raise h (DESIGN §3); a query that finishes has its
+// distance, so it cannot raise h (design.md §3); a query that finishes has its
 // exact nearest distance (ties: the smallest input index).
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;

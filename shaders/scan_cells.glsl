@@ -2,7 +2,7 @@
 // (query, search cell) pair) and tail_scan.comp (every search cell of a
 // level). Include after common.glsl.
 //
-// Exactness (DESIGN §3): a cell whose box is farther than min(bound, best)
+// Exactness (design.md §3): a cell whose box is farther than min(bound, best)
 // is skipped (float rounding is monotone, so no point in it is nearer than
 // its box; equal distances are kept for the tie rule); copies of one point
 // (a cell whose box is one position) scan only their first; ties go to the

@@ -2,7 +2,7 @@
 // pipeline searches, so the two paths cannot diverge. Expects `pc` to be a
 // SearchPush. Returns true when the query is dead (stop its traversal).
 //
-// Invariant (DESIGN §3): every cell whose tight box lies within `radius` of q
+// Invariant (design.md §3): every cell whose tight box lies within `radius` of q
 // is reported by the traversal (boxes are grown by radius + epsilon); cells
 // within rLo were scanned in the previous iteration and are skipped when it
 // used the same cells (skipScanned); the others

@@ -137,7 +137,7 @@ struct PrepareOptions {
     // Bit count of the set's index (0 = from the data).
     int bits = 0;
     // Frame of a double set whose coordinates are not all float32 values
-    // (DESIGN §8): it is searched as p - origin rounded to float. Unset: the
+    // (design.md §8): it is searched as p - origin rounded to float. Unset: the
     // centre of its own box. Two prepared sets reuse their indexes together
     // only when they share a frame: give the sets that will meet one origin
     // (say reference.origin()). Float sets (and double sets of float values)

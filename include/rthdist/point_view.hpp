@@ -8,7 +8,7 @@
 // float, 24 for double) and a multiple of the scalar size; the view must stay
 // valid for the duration of the call that reads it.
 //
-// Precision: double views keep their precision (DESIGN §8): the engine
+// Precision: double views keep their precision (design.md §8): the engine
 // searches in float32 after shifting both sets by one origin chosen in
 // double, and reports witnesses and distances from the original doubles.
 #pragma once

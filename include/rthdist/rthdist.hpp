@@ -6,19 +6,31 @@
 //   h(A,B) = max_{a in A} min_{b in B} |a - b|,  H(A,B) = max(h(A,B), h(B,A)).
 //   The value is EXACT for the input as the caller gave it (float or double,
 //   point_view.hpp): it equals the brute force computed in double over those
-//   coordinates within 1e-6 of the diagonal D of the union's bounding box
-//   (the extent, not the magnitude of the coordinates), and the reported
-//   index pair realizes it. Final distances and witness points come from the
-//   original coordinates, in double.
+//   coordinates, sqrt(dx^2 + dy^2 + dz^2) (ties aside: among equal values
+//   the witness may be another realizing pair), and the reported index pair
+//   realizes it. Final distances and witness points come from the original
+//   coordinates, in double. Each directed value carries its proof
+//   (Directed::certificate, below): the search runs in float32; the queries
+//   whose float value lies within the rounding slack e of the float maximum
+//   are settled again in double by a brute force over the whole target set.
+//   Precondition of the proof: every query ended settled with a real target
+//   (the self-check below); a proof that fails makes the Engine recompute
+//   the direction on the CPU backend (Certificate::recomputed), and kInternal
+//   only if that proof fails too.
 //
-// Precision (DESIGN §8): when an input is double, both sets are shifted by
+// Precision (design.md §8): when an input is double, both sets are shifted by
 //   one origin o chosen in double (the centre of the union's bounding box,
 //   HausdorffResult::origin) and the search runs on p - o rounded to float32.
-//   Each coordinate then moves by at most 2^-24 * D / 2, so every distance by
-//   at most eps = sqrt(3) * 2^-24 * D (about 1e-7 D) and the float search
-//   finds, for every query, a neighbour within 2 eps of its true nearest
-//   neighbour: the reported h is within 2 eps (< 1e-6 D) of the double truth,
-//   realized by a real pair, for coordinates of any magnitude (UTM, ECEF).
+//   Each coordinate then moves by at most 2^-24 * m (m the largest |p - o|),
+//   so every float distance lies within e = 2^-20 m of the exact one (the
+//   rounding, the float arithmetic and a margin: core/certificate.hpp). The
+//   certificate settles in double every query within 2e of the float
+//   maximum, so the reported h is the double truth for coordinates of any
+//   magnitude (UTM, ECEF). The band is small on ordinary data: a query
+//   enters it only when its nearest distance lies within 2e (~1e-6 of the
+//   extent) of h; a maximum below e over more than 2^18 queries (e.g. a set
+//   against a copy of itself in a double frame) is settled by the CPU
+//   backend's recomputation instead.
 //   Inputs whose every coordinate is a float32 value (float views, and double
 //   views holding float values, e.g. text written from floats) are searched
 //   as they are (o = 0). Squared distances that would overflow or vanish in float

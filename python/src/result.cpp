@@ -38,6 +38,19 @@ py::dict counters(const Counters& c) {
     return d;
 }
 
+// The proof of one directed value (rthdist.hpp, Certificate): the CLI's
+// certificate.a_to_b / b_to_a keys.
+py::dict certificate(const Certificate& c) {
+    py::dict d;
+    d["confirmed"] = c.confirmed;
+    d["query"] = c.query;
+    d["nearest"] = c.nearest;
+    d["distance"] = c.distance;
+    d["band"] = c.band;
+    d["recomputed"] = c.recomputed;
+    return d;
+}
+
 py::dict timings(const Timings& t) {
     py::dict d;
     d["setup"] = t.setup;
@@ -52,6 +65,8 @@ py::dict timings(const Timings& t) {
     d["gpu_cull"] = t.gpuCull;
     d["gpu_search"] = t.gpuSearch;
     d["gpu_refine"] = t.gpuRefine;
+    d["certificate"] = t.certificate;
+    d["gpu_certificate"] = t.gpuCertificate;
     return d;
 }
 
@@ -250,6 +265,10 @@ void bindResult(py::module_& m) {
             "(query_point, target_point)")
         .def_property_readonly(
             "counters", [](const Directed& d) { return counters(d.counters); }, "what the search did (dict)")
+        .def_property_readonly(
+            "certificate", [](const Directed& d) { return certificate(d.certificate); },
+            "the proof that distance is exact in double (dict: confirmed, query, nearest, distance, band, "
+            "recomputed)")
         .def("__float__", [](const Directed& d) { return d.distance; })
         .def("__repr__", &directedRepr);
 
@@ -292,6 +311,16 @@ void bindResult(py::module_& m) {
                 return d;
             },
             "per direction: bits, occupied_cells, queries, culled_by_neighbourhood, ... (the CLI's keys)")
+        .def_property_readonly(
+            "certificate",
+            [](const PyResult& r) {
+                py::dict d;
+                d["a_to_b"] = certificate(r.result.aToB.certificate);
+                d["b_to_a"] = r.result.directedOnly ? py::object(py::none())
+                                                    : py::object(certificate(r.result.bToA.certificate));
+                return d;
+            },
+            "per direction: the proof that the value is exact in double (the CLI's certificate keys)")
         .def_property_readonly(
             "validation_messages", [](const PyResult& r) { return r.result.validationMessages; },
             "validation-layer messages (validation=True only)")

@@ -1,5 +1,6 @@
 #include "api/out_of_core.hpp"
 
+#include "core/certificate.hpp"
 #include "core/index_space.hpp"
 #include "core/parallel.hpp"
 #include "core/timings.hpp"
@@ -36,7 +37,27 @@ struct DirectionState {
     PerPoint perPoint;
     Counters counters;
     Timings timings;
+    // The certificate's band (core/certificate.hpp): the union of the
+    // pieces' bands (query indices into the whole set). A query outside it
+    // is nearer than its piece's hf - e, which the proof must reach: the
+    // largest such bound over the pieces is `reach` (search units).
+    core::DirectionBand band;
+    double reach = 0.0;
 };
+
+// A piece's band into the direction's (its queries offset by q0).
+void mergeBand(DirectionState& s, const core::DirectionBand& piece, uint64_t q0) {
+    core::DirectionBand& band = s.band;
+    if (!piece.present) {
+        band.failure = "a piece's call kept no band";
+        return;
+    }
+    if (!piece.failure.empty()) band.failure = piece.failure;
+    for (const core::BandQuery& b : piece.queries) band.queries.push_back({b.query + q0, b.best});
+    for (const auto& [q, list] : piece.candidates) band.candidates.emplace_back(q + q0, list);
+    s.reach = std::max(s.reach, piece.hf - piece.slack);
+    band.slack = std::max(band.slack, piece.slack);
+}
 
 // A direction's state shared by its lanes (one per device: chunks run in
 // parallel): the witness, counters and timings under the mutex; per-point
@@ -44,6 +65,7 @@ struct DirectionState {
 struct SharedDirection {
     std::mutex mutex;
     DirectionState state;
+    double slack = 0.0;          // the certificate's e for the whole direction (search units)
     std::optional<Error> error;  // the first failure; the other lanes stop at their next chunk
     std::atomic<bool> failed{false};
 };
@@ -94,7 +116,7 @@ void addCall(SharedDirection& shared, const HausdorffResult& r, bool countTarget
 }
 
 // The early break of a chunk starting at query index q0 against the witness
-// of the chunks finished so far (DESIGN §3): a query whose best pair is
+// of the chunks finished so far (design.md §3): a query whose best pair is
 // nearer than the witness's cannot be the maximum; one at the same distance
 // cannot win the tie when the witness's query index is smaller (an earlier
 // chunk). Per-point output: nothing is dropped.
@@ -342,6 +364,13 @@ std::optional<Error> chunkAgainstAll(Span qc, uint64_t q0, Span t, double scale,
     addCall(shared, *r, q0 == 0);
     const Directed& w = r->aToB;
     offerWitness(shared, w, searchDist2(qc[w.queryIndex], t[w.targetIndex], scale), q0);
+    {
+        const std::lock_guard lock(shared.mutex);
+        if (r->proofMaterial)
+            mergeBand(shared.state, r->proofMaterial->aToB, q0);
+        else
+            shared.state.band.failure = "a piece's call kept no band";
+    }
     if (piece.perPointDistances) {
         std::copy(r->aNearest.distance.begin(), r->aNearest.distance.end(),
                   shared.state.perPoint.distance.begin() + ptrdiff_t(q0));
@@ -387,6 +416,19 @@ std::optional<Error> chunkAgainstTiles(Span qc, uint64_t q0, Span t, const std::
     d.queryPoint = glm::dvec3(qc[w]);
     d.targetPoint = glm::dvec3(t[x.nearest[w]]);
     offerWitness(shared, d, x.d2[w], q0);
+    {
+        // The chunk's band from every query's best pair over the tiles (a
+        // real pair, searched as one call compares pairs).
+        core::DirectionBand band;
+        band.present = true;
+        band.hf = std::sqrt(double(x.d2[w]));
+        band.slack = shared.slack;
+        const double lo2 = core::bandThreshold2(double(x.d2[w]), band.slack);
+        for (size_t i = 0; i < qc.size(); ++i)
+            if (double(x.d2[i]) >= lo2) band.queries.push_back({i, x.nearest[i]});
+        const std::lock_guard lock(shared.mutex);
+        mergeBand(shared.state, band, q0);
+    }
     if (call.perPointDistances) {
         PerPoint& pp = shared.state.perPoint;
         std::copy(x.distance.begin(), x.distance.end(), pp.distance.begin() + ptrdiff_t(q0));
@@ -459,6 +501,9 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
     queue.chunkSize = split.queryChunk;
     queue.chunks = (q.size() + split.queryChunk - 1) / split.queryChunk;
     SharedDirection shared;
+    shared.slack = core::searchSlack(
+        std::max(core::largestMagnitude(q, threads), core::largestMagnitude(t, threads)) * scale);
+    shared.state.band.present = true;
     if (call.perPointDistances) {
         shared.state.perPoint.distance.resize(q.size());
         shared.state.perPoint.nearest.resize(q.size());
@@ -480,6 +525,8 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
     s.counters.queryChunks = uint32_t(queue.chunks);
     s.counters.targetTiles = uint32_t(std::max<size_t>(1, tiles.size()));
     s.witness.counters = s.counters;
+    s.band.hf = s.reach + s.band.slack;  // the proof's bound: hf - slack = the largest piece's reach
+    s.band.scale = scale;
     return s;
 }
 
@@ -540,6 +587,8 @@ Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const Call
     if (!ab) return ab.error();
     HausdorffResult r;
     r.directedOnly = call.directedOnly;
+    auto material = std::make_shared<detail::ProofMaterial>();
+    material->aToB = ab->band;
     r.aToB = ab->witness;
     r.aNearest = std::move(ab->perPoint);
     r.hausdorff = r.aToB.distance;
@@ -553,7 +602,13 @@ Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const Call
         r.bNearest = std::move(ba->perPoint);
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
         core::addStageTimings(r.timings, ba->timings);
+        material->bToA = ba->band;
     }
+    // The certificate of the whole from the pieces' bands, on the float sets
+    // the pieces searched (core::restoreOriginal proves it again from the
+    // caller's coordinates when they differ).
+    r.proofMaterial = std::move(material);
+    core::proveFromViews(r, PointView(a), PointView(b), threads);
     return r;
 }
 

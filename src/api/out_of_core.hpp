@@ -1,5 +1,5 @@
 // Out-of-core: a pair of sets larger than the memory budget of one call is
-// computed as a sequence of smaller calls (DESIGN §9), each of which fits.
+// computed as a sequence of smaller calls (design.md §9), each of which fits.
 //
 // Exactness. h(Q,T) = max over q of min over t of |q - t|.
 //   - Queries are split into chunks Q_1..Q_m of consecutive input indices:
@@ -17,7 +17,7 @@
 //     the tile can be nearer, nor tie with a smaller index, because the box
 //     distance is computed as pairs are and rounding is monotone. Tiles go
 //     nearest the chunk first, so best pairs shrink early.
-//   - Early break across chunks (DESIGN §3): without per-point output, a
+//   - Early break across chunks (design.md §3): without per-point output, a
 //     query whose best pair is no farther than the running maximum M of the
 //     earlier chunks is sent to no further tile: its nearest distance is at
 //     most M and its index is larger than theirs, so it can neither exceed M

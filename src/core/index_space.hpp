@@ -2,7 +2,7 @@
 // target bounding volume, cell edge s = L / 2^k with L the longest side.
 // Shared by the GPU and CPU backends so both assign cells by the same rules.
 //
-// Rules (DESIGN §2): cell of t = floor((t - o) / s), clamped to [0, 2^k - 1]
+// Rules (design.md §2): cell of t = floor((t - o) / s), clamped to [0, 2^k - 1]
 // per axis; o and s are computed in double on the host. When every target is
 // the same point (L = 0) s is 1, so nothing divides by zero.
 #pragma once
@@ -40,7 +40,7 @@ struct GridSpec {
 [[nodiscard]] GridSpec makeGrid(const Bounds& targetBounds, int bits);
 
 // Picks k so that occupied cells hold about kTargetPointsPerCell points, from
-// a strided sample's occupancy extrapolated to the full set (DESIGN §5).
+// a strided sample's occupancy extrapolated to the full set (design.md §5).
 [[nodiscard]] int chooseBits(std::span<const glm::vec3> targets, const Bounds& bounds,
                              double targetPointsPerCell = kTargetPointsPerCell);
 // chooseBits samples every sampleStride(n)-th point (about 32k of them).
@@ -74,7 +74,7 @@ using LevelCounts = std::array<size_t, kMaxBits + 1>;
 // float and none overflows); else the power of two 2^-e with maxAbs in
 // [2^(e-1), 2^e), which brings maxAbs into [0.5, 1). Applied in double and
 // rounded to float, every scaled coordinate is exact or flushes to zero only
-// below 2^-126 * maxAbs-scale, far inside DESIGN §1's tolerance. Finite for
+// below 2^-126 * maxAbs-scale, far inside design.md §1's tolerance. Finite for
 // every finite maxAbs, subnormals included; 1 for maxAbs = 0.
 [[nodiscard]] double exactScale(double maxAbs);
 

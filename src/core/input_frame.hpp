@@ -1,5 +1,5 @@
 // From the caller's point views to the float32 sets the backends search, and
-// back (DESIGN §8): one pass per set checks every coordinate and takes the
+// back (design.md §8): one pass per set checks every coordinate and takes the
 // bounding box in double; when an input is double the origin is the centre
 // of the union's box and both sets are shifted by it and rounded to float
 // (the error bound is in rthdist.hpp); packed float inputs are searched in

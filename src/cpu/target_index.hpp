@@ -21,7 +21,7 @@
 // with +inf so that the 8-wide scans may read past a bucket's end (extra
 // lanes are real targets or +inf, never wrong).
 //
-// Why a search over it is exact (DESIGN §3 restated for this structure):
+// Why a search over it is exact (design.md §3 restated for this structure):
 // every stored target lies in the bucket that holds its sorted position, every
 // bucket's box is the float min/max of its points, and every node's box the
 // min/max of its children's, so the float distance from a query to a node's

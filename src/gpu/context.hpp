@@ -90,7 +90,7 @@ public:
     [[nodiscard]] const VkPhysicalDeviceAccelerationStructurePropertiesKHR& asProps() const {
         return m_asProps;
     }
-    // Size limits of the device (DESIGN §9); setLimits replaces them (tests
+    // Size limits of the device (design.md §9); setLimits replaces them (tests
     // shrink them to cross every split boundary with small inputs; a larger
     // value than the device's would be unsafe).
     [[nodiscard]] const DeviceLimits& limits() const { return m_limits; }

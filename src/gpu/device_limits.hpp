@@ -1,4 +1,4 @@
-// The device limits that bound the size of a problem (DESIGN §9), read once
+// The device limits that bound the size of a problem (design.md §9), read once
 // per device. Every buffer, dispatch and trace of an Engine is checked
 // against them before it is recorded: a size past a limit is refused with
 // the limit named, never truncated. Tests shrink them (Context::setLimits)

@@ -1,5 +1,5 @@
 // The GPU form of RT-HDIST (Kim, Lee, Kim 2025) on Vulkan, with the exactness
-// fixes of DESIGN.md §3-4:
+// fixes of design.md §3-4:
 //   1. index space (compute): cell keys, counting sort over a dense key table,
 //      run-length encode into occupied cells with tight boxes;
 //   2. neighbourhood pass (compute): exact NN inside the 3x3x3 cell block,

@@ -1,5 +1,5 @@
 // A point set sorted into the cells of its own grid on the device (the index
-// space of RT-HDIST, DESIGN §2), and the set a prepared call or a one-shot
+// space of RT-HDIST, design.md §2), and the set a prepared call or a one-shot
 // call holds: its index, the buffers it owns, the float points behind it.
 // Data only; IndexBuild (index_build.hpp) fills them.
 #pragma once

@@ -1,4 +1,4 @@
-// The self-check of a direction on the device (check_query.comp, DESIGN §6):
+// The self-check of a direction on the device (check_query.comp, design.md §6):
 // every query settled below the final maximum, sampled query records and
 // the witness's compared with the host's copy of the points; the checked
 // witness becomes the direction's result, with its per-point distances.

@@ -3,7 +3,7 @@
 // (batch_nearest.comp, batch_witness.comp). For sets of a few thousand points
 // the RT path's fixed cost (a cull, a self-check and per-radius submissions
 // per pair, one pair after another) is far above the scan's, which is the
-// brute force of DESIGN §4's sample with the early break of §3:
+// brute force of design.md §4's sample with the early break of §3:
 //   1. seed: RTHDIST_WG sample queries per direction scan all targets; the
 //      largest of their exact nearest distances is the first lower bound of h;
 //   2. scan: every query scans the targets (a spread order, RTHDIST_WG at a

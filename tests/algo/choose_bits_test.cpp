@@ -20,7 +20,7 @@
 namespace rthdist::core {
 namespace {
 
-// The rule of DESIGN §5 written out directly (a set per level, no tricks).
+// The rule of design.md §5 written out directly (a set per level, no tricks).
 int referenceBits(const std::vector<glm::vec3>& pts, const Bounds& b, double perCell = kTargetPointsPerCell) {
     const size_t n = pts.size();
     if (n <= 1) return kMinBits;

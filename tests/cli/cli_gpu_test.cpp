@@ -38,20 +38,6 @@ Points translated(Points p, float dx) {
     return p;
 }
 
-// Diagonal of the bounding box: the contract's tolerance is 1e-6 of the larger one.
-double bboxDiagonal(const Points& points) {
-    std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-    for (const auto& p : points) {
-        for (int k = 0; k < 3; ++k) {
-            lo[k] = std::min(lo[k], double(p[k]));
-            hi[k] = std::max(hi[k], double(p[k]));
-        }
-    }
-    double s = 0.0;
-    for (int k = 0; k < 3; ++k) s += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    return std::sqrt(s);
-}
-
 std::string xyzText(const Points& points) {
     std::string out;
     char line[128];
@@ -115,7 +101,7 @@ TEST_P(CliGpu, SmallFixturesExact) {
         {a, translated(a, 1.0f)},  // translated by half the extent
         {a, translated(b, 1e4f)},  // far apart: distance >> extent
         {{{0, 0, 0}, {1, 0, 0}}, {{0, 0, 0}}},
-        {{{0.5f, 0, 0}}, {{1.99f, 0, 0}, {-0.1f, 0, 0}}},  // DESIGN §3 corner counterexample
+        {{{0.5f, 0, 0}}, {{1.99f, 0, 0}, {-0.1f, 0, 0}}},  // design.md §3 corner counterexample
     };
     for (size_t i = 0; i < cases.size(); ++i) {
         SCOPED_TRACE("case " + std::to_string(i));
@@ -127,10 +113,8 @@ TEST_P(CliGpu, SmallFixturesExact) {
         // input.
         const double hab = directedBrute(cases[i].first, cases[i].second);
         const double hba = directedBrute(cases[i].second, cases[i].first);
-        // Float comparisons of near-tied squared distances may pick another pair: the
-        // contract allows 1e-6 of the larger bounding-box diagonal.
-        const double tol =
-            1e-6 * std::max(bboxDiagonal(cases[i].first), bboxDiagonal(cases[i].second)) + 1e-12;
+        // Exact in double (issue 32): the same value as the brute force in double.
+        const double tol = 0.0;
         EXPECT_NEAR(j["a_to_b"]["distance"].get<double>(), hab, tol);
         EXPECT_NEAR(j["b_to_a"]["distance"].get<double>(), hba, tol);
         EXPECT_NEAR(j["hausdorff"].get<double>(), std::max(hab, hba), tol);

@@ -1,4 +1,4 @@
-// The double-precision oracle (issue 10, DESIGN §8): georeferenced point sets
+// The double-precision oracle (issue 10, design.md §8): georeferenced point sets
 // whose coordinates are far larger than their extent (UTM eastings and
 // northings, Earth-centred coordinates), with centimetre or millimetre
 // detail, compared with a brute force in double over the doubles as given.

@@ -176,7 +176,7 @@ std::vector<OracleCase> makeOracleCases() {
         b = segment(r, sizeAt(i + 4), d * 1.0, d * 5.0);
     });
     f.family("counterexample_1d", 15, [](Rng& r, size_t i, Points& a, Points& b) {
-        // DESIGN §3: q = 0.5, t1 = 1.99, t2 = -0.1 (NN 0.6, corner test gives 1.49).
+        // design.md §3: q = 0.5, t1 = 1.99, t2 = -0.1 (NN 0.6, corner test gives 1.49).
         const double scale = std::pow(10.0, double(int(i % 5) - 2));
         if (i < 10) {
             const glm::dvec3 d = kAxes[i % 5];

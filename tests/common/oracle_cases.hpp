@@ -1,5 +1,5 @@
 // Oracle test cases shared by every backend's tests: fixed-seed point sets
-// covering the shapes of DESIGN §3 and §6, and the comparison of a
+// covering the shapes of design.md §3 and §6, and the comparison of a
 // HausdorffResult against the double brute force (cpu/brute_force.hpp).
 #pragma once
 
@@ -25,7 +25,7 @@ struct OracleCase {
 // uniform, gaussian blobs, sphere shells, planes, overlapping, partially
 // overlapping, nested, far apart (>> extent and 1e6 cell widths), translated
 // copies, subsets, duplicates, one point, all identical, coplanar, collinear,
-// the 1-D counterexample of DESIGN §3 (embedded and 3-D), large offsets
+// the 1-D counterexample of design.md §3 (embedded and 3-D), large offsets
 // (~1e7, small extent), integer lattices with exact ties, clustered and
 // heavy-tailed clouds, and a few large clouds.
 [[nodiscard]] std::vector<OracleCase> makeOracleCases();
@@ -33,7 +33,7 @@ struct OracleCase {
 // Allowed |reported - brute force| of a PER-POINT distance (the directed
 // values are exact in double: expectMatchesOracle allows nothing), for a
 // Hausdorff value h of a and b:
-//   1e-6 * (the larger bounding-box diagonal)      DESIGN §1 "exact"
+//   1e-6 * (the larger bounding-box diagonal)      design.md §1 "exact"
 // + 8 * 2^-24 * h                                  float rounding allowance
 // The second term covers backends that compare squared distances in float:
 // each float squared distance carries a relative error of a few 2^-24, so a

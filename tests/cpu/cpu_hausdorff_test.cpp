@@ -1,5 +1,5 @@
 // cpuHausdorff against the brute-force oracle: the shared oracle cases, the
-// degenerate inputs of DESIGN §6 as named tests, directedOnly, and thread-count
+// degenerate inputs of design.md §6 as named tests, directedOnly, and thread-count
 // independence.
 #include <gtest/gtest.h>
 
@@ -124,7 +124,7 @@ TEST(CpuHausdorff, Coplanar) {
     expectMatchesOracle(c, run(c.a, c.b));
 }
 
-// DESIGN §3: the corner-representative test reports 1.49; the truth is 0.6.
+// design.md §3: the corner-representative test reports 1.49; the truth is 0.6.
 TEST(CpuHausdorff, CounterExample1D) {
     for (int axis = 0; axis < 3; ++axis) {
         glm::vec3 q(0.0f), t1(0.0f), t2(0.0f);

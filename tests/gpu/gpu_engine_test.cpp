@@ -1,5 +1,5 @@
-// Named GPU tests: errors as values, degenerate shapes (DESIGN §6), the
-// paper's candidate-set gap (DESIGN §3), pair-buffer overflow, engine reuse.
+// Named GPU tests: errors as values, degenerate shapes (design.md §6), the
+// paper's candidate-set gap (design.md §3), pair-buffer overflow, engine reuse.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -94,7 +94,7 @@ TEST(GpuEngine, IdenticalSetsGiveZero) {
 }
 
 TEST(GpuEngine, PaperCornerTestCounterexample) {
-    // DESIGN §3: cell edge 1, q = 0.5, t1 = 1.99 (near corner), t2 = -0.1;
+    // design.md §3: cell edge 1, q = 0.5, t1 = 1.99 (near corner), t2 = -0.1;
     // the true NN is t2 at 0.6. Padding points fix the grid to unit cells.
     RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
     std::vector<glm::vec3> a{{0.5f, 0, 0}};

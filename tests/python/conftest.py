@@ -54,6 +54,13 @@ def check_result(r, a, b, directed=False):
     assert abs(np.linalg.norm(a64[qi] - b64[ti]) - r.a_to_b.distance) <= tol
     np.testing.assert_array_equal(r.a_to_b.query_point, a64[qi])
     np.testing.assert_array_equal(r.a_to_b.target_point, b64[ti])
+    # The certificate (issue 32): confirmed, and its witness is the result's.
+    for d in (r.a_to_b,) if directed else (r.a_to_b, r.b_to_a):
+        c = d.certificate
+        assert c["confirmed"], c
+        assert (c["query"], c["nearest"]) == d.indices
+        assert c["distance"] == d.distance
+    assert r.certificate["a_to_b"] == r.a_to_b.certificate
     if directed:
         assert r.b_to_a is None
         assert abs(r.distance - hab) <= tol

@@ -240,7 +240,7 @@ def machine_info(bench):
 
 
 def agree(row):
-    """rthdist cpu vs cKDTree (and ray-query) within DESIGN §1's tolerance (1e-6 of the diagonal)."""
+    """rthdist cpu vs cKDTree (and ray-query) within design.md §1's tolerance (1e-6 of the diagonal)."""
     tools = row["tools"]
     cpu = tools.get("rthdist-cpu")
     if not cpu or cpu["status"] != "ok":

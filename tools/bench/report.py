@@ -292,7 +292,7 @@ def markdown(res, pngs):
     L.append("")
 
     # ---- agreement
-    L.append("## Agreement (DESIGN §1: within 1e-6 of the larger bbox diagonal)")
+    L.append("## Agreement (design.md §1: within 1e-6 of the larger bbox diagonal)")
     L.append("")
     L.append("Every tool's h(A,B), h(B,A) and H are compared with rthdist cpu's. PCL prints its values with 6 "
              "decimals (`%f` of a float32), so its allowance adds 5e-7 + float32 rounding.")
@@ -493,7 +493,7 @@ def summary(res):
                 LABEL[t], len(faster), len(ok), ", ".join(faster) or "none"))
     nbad = sum(1 for e in ents for r in e["rows"] if r.get("agree") is False)
     nchk = sum(1 for e in ents for r in e["rows"] if "agree" in r)
-    L.append("- Values: %d of %d finished (tool, scenario) results agree with rthdist cpu within DESIGN §1's "
+    L.append("- Values: %d of %d finished (tool, scenario) results agree with rthdist cpu within design.md §1's "
              "tolerance%s." % (nchk - nbad, nchk, "" if not nbad else " (see Agreement for the others)"))
     L.append("")
     return L
