@@ -8,8 +8,11 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "core/index_space.hpp"
+#include "core/input_frame.hpp"
+#include "core/input_limits.hpp"
 #include "mpi/collectives.hpp"
 #include "rthdist/mpi.hpp"
 
@@ -118,7 +121,26 @@ Result<GlobalSets> makeGlobalSets(MPI_Comm comm, PointView localA, PointView loc
     MPI_Allreduce(MPI_IN_PLACE, hi, 3, MPI_DOUBLE, MPI_MAX, comm);
     MPI_Allreduce(MPI_IN_PLACE, &floatExact, 1, MPI_INT, MPI_LAND, comm);
     const glm::dvec3 boxLo(lo[0], lo[1], lo[2]), boxHi(hi[0], hi[1], hi[2]);
-    sets.origin = floatExact ? glm::dvec3(0.0) : 0.5 * (boxLo + boxHi);
+    const core::SetSummary unionBox{core::Bounds{boxLo, boxHi}, floatExact != 0};
+    sets.origin = core::searchOrigin(unionBox, unionBox);  // 0 for float data, else the centre
+
+    // The float search's limits (core/input_limits.hpp), as one process checks them.
+    if (!floatExact || sets.origin != glm::dvec3(0.0)) {
+        local = guarded([&]() -> std::optional<Error> {
+            const std::pair<const GlobalSet*, const SliceSummary*> slices[] = {{&sets.a, &sa},
+                                                                               {&sets.b, &sb}};
+            for (const auto& [set, summary] : slices) {
+                if (set->local.count == 0) continue;
+                if (auto e = core::checkShiftedRange(set->local, core::Bounds{summary->lo, summary->hi},
+                                                     sets.origin, set == &sets.a ? "A" : "B", set->offset()))
+                    return e;
+            }
+            return std::nullopt;
+        });
+        if (auto error = agreeOnError(comm, local)) return *error;
+        if (auto error = core::checkShiftedExtent(core::Bounds{boxLo, boxHi}, sets.origin, "A and B"))
+            return *error;  // the same on every rank: from the agreed box
+    }
     double magnitude = std::max(sliceMagnitude(sets.a, sets.origin), sliceMagnitude(sets.b, sets.origin));
     MPI_Allreduce(MPI_IN_PLACE, &magnitude, 1, MPI_DOUBLE, MPI_MAX, comm);
     sets.scale = core::exactScale(magnitude);

@@ -111,7 +111,7 @@ int run(const std::vector<std::string>& argv) {
     options.progress = [&meter](const char* stage, double fraction) { meter.update(stage, fraction); };
     Result<HausdorffResult> result = hausdorff(a->view(), b->view(), options);
     meter.finish();
-    if (!result) return failWith(result.error());
+    if (!result) return failWith(withFileNames(result.error(), args.pathA, args.pathB));
 
     std::optional<HausdorffStats> stats;
     if (args.perPoint) {
