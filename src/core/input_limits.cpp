@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 namespace rthdist::core {
 
@@ -41,23 +42,37 @@ std::optional<Error> checkShiftedRange(const PointView& points, const Bounds& bo
                                        const char* name, uint64_t firstIndex) {
     const glm::dvec3 far = farthest(box, origin);
     if (far.x <= kMaxShifted && far.y <= kMaxShifted && far.z <= kMaxShifted) return std::nullopt;
-    // Past the limit: the first point past it names the place (a second pass, on this path only).
+    // Past the limit (a second pass, on this path only): the point farthest
+    // from the origin names the place; on a tie (both ends of an axis are as
+    // far from the centre) the one of larger magnitude, a stray at 1e308
+    // rather than the points near 0 it is far from; then the first.
+    size_t worst = 0;
+    int axis = -1;
+    std::pair<double, double> worstReach{-1.0, -1.0};
     for (size_t i = 0; i < points.count; ++i) {
         const glm::dvec3 p = points.at(i);
         for (int k = 0; k < 3; ++k) {
-            if (std::abs(p[k] - origin[k]) <= kMaxShifted) continue;
-            return Error{ErrorCode::kBadInput,
-                         std::string("point set ") + name + ": point " + std::to_string(firstIndex + i) +
-                             " has " + axisName(k) + " = " + number(p[k]) + ", " +
-                             number(std::abs(p[k] - origin[k])) + " from the search origin (" + axisName(k) +
-                             " = " + number(origin[k]) + "): past " + number(kMaxShifted) +
-                             " (float32's largest value), the most the float search takes after the "
-                             "shift; bring the sets closer together or scale them down"};
+            const double d = std::abs(p[k] - origin[k]);
+            if (d <= kMaxShifted) continue;
+            const std::pair<double, double> reach{std::isnan(d) ? INFINITY : d, std::abs(p[k])};
+            if (reach > worstReach) {
+                worstReach = reach;
+                worst = i;
+                axis = k;
+            }
         }
     }
-    return Error{ErrorCode::kBadInput, std::string("point set ") + name + ": coordinates past " +
-                                           number(kMaxShifted) +
-                                           " from the search origin (float32's largest value)"};
+    if (axis < 0)
+        return Error{ErrorCode::kBadInput, std::string("point set ") + name + ": coordinates past " +
+                                               number(kMaxShifted) + " from the search origin"};
+    const double v = points.at(worst)[axis];
+    return Error{ErrorCode::kBadInput,
+                 std::string("point set ") + name + ": point " + std::to_string(firstIndex + worst) +
+                     " has " + axisName(axis) + " = " + number(v) + ", " +
+                     number(std::abs(v - origin[axis])) + " from the search origin (" + axisName(axis) +
+                     " = " + number(origin[axis]) + "): past " + number(kMaxShifted) +
+                     " (float32's largest value), the most the float search takes after the shift; bring "
+                     "the sets closer together or scale them down"};
 }
 
 std::optional<Error> checkShiftedExtent(const Bounds& box, const glm::dvec3& origin, const char* names) {
@@ -75,8 +90,22 @@ std::optional<Error> checkPairFrame(const PointView& a, const Bounds& boxA, bool
                                     const PointView& b, const Bounds& boxB, bool floatExactB,
                                     const glm::dvec3& origin) {
     if (floatExactA && floatExactB && origin == glm::dvec3(0.0)) return std::nullopt;
-    if (auto e = checkShiftedRange(a, boxA, origin, "A")) return e;
-    if (auto e = checkShiftedRange(b, boxB, origin, "B")) return e;
+    // The set that reaches farther first; on a tie (the centre is as far from
+    // both ends of an axis) the one of larger coordinates: a stray at 1e308,
+    // rather than the points near 0 it is far from.
+    auto reach = [&origin](const Bounds& box) {
+        const glm::dvec3 f = farthest(box, origin);
+        const glm::dvec3 m = glm::max(glm::abs(box.lo), glm::abs(box.hi));
+        double magnitude = 0.0;
+        for (int k = 0; k < 3; ++k)
+            if (!(f[k] <= kMaxShifted)) magnitude = std::max(magnitude, m[k]);
+        return std::pair{std::max({f.x, f.y, f.z}), magnitude};
+    };
+    const bool bFirst = reach(boxB) > reach(boxA);
+    if (auto e = bFirst ? checkShiftedRange(b, boxB, origin, "B") : checkShiftedRange(a, boxA, origin, "A"))
+        return e;
+    if (auto e = bFirst ? checkShiftedRange(a, boxA, origin, "A") : checkShiftedRange(b, boxB, origin, "B"))
+        return e;
     const Bounds both{glm::min(boxA.lo, boxB.lo), glm::max(boxA.hi, boxB.hi)};
     return checkShiftedExtent(both, origin, "A and B");
 }
