@@ -86,10 +86,7 @@ std::optional<Error> checkShiftedExtent(const Bounds& box, const glm::dvec3& ori
                      "scale the sets up (H scales with them)"};
 }
 
-std::optional<Error> checkPairFrame(const PointView& a, const Bounds& boxA, bool floatExactA,
-                                    const PointView& b, const Bounds& boxB, bool floatExactB,
-                                    const glm::dvec3& origin) {
-    if (floatExactA && floatExactB && origin == glm::dvec3(0.0)) return std::nullopt;
+bool checkBFirst(const Bounds& boxA, const Bounds& boxB, const glm::dvec3& origin) {
     // The set that reaches farther first; on a tie (the centre is as far from
     // both ends of an axis) the one of larger coordinates: a stray at 1e308,
     // rather than the points near 0 it is far from.
@@ -101,7 +98,14 @@ std::optional<Error> checkPairFrame(const PointView& a, const Bounds& boxA, bool
             if (!(f[k] <= kMaxShifted)) magnitude = std::max(magnitude, m[k]);
         return std::pair{std::max({f.x, f.y, f.z}), magnitude};
     };
-    const bool bFirst = reach(boxB) > reach(boxA);
+    return reach(boxB) > reach(boxA);
+}
+
+std::optional<Error> checkPairFrame(const PointView& a, const Bounds& boxA, bool floatExactA,
+                                    const PointView& b, const Bounds& boxB, bool floatExactB,
+                                    const glm::dvec3& origin) {
+    if (floatExactA && floatExactB && origin == glm::dvec3(0.0)) return std::nullopt;
+    const bool bFirst = checkBFirst(boxA, boxB, origin);
     if (auto e = bFirst ? checkShiftedRange(b, boxB, origin, "B") : checkShiftedRange(a, boxA, origin, "A"))
         return e;
     if (auto e = bFirst ? checkShiftedRange(a, boxA, origin, "A") : checkShiftedRange(b, boxB, origin, "B"))

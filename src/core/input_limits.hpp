@@ -48,8 +48,13 @@ inline constexpr double kMinShifted = 1.1754943508222875e-38;  // FLT_MIN = 2^-1
 [[nodiscard]] std::optional<Error> checkShiftedExtent(const Bounds& box, const glm::dvec3& origin,
                                                       const char* names);
 
-// Both rules for a pair in one frame; nothing when neither set is shifted
-// (both float values, origin 0).
+// Whether the upper rule checks B before A: the set that reaches farther
+// from the origin, on a tie the one of larger coordinates (a stray at 1e308
+// rather than the points near 0 it is far from).
+[[nodiscard]] bool checkBFirst(const Bounds& boxA, const Bounds& boxB, const glm::dvec3& origin);
+
+// Both rules for a pair in one frame (the upper one in checkBFirst's order); nothing when neither set is
+// shifted (both float values, origin 0).
 [[nodiscard]] std::optional<Error> checkPairFrame(const PointView& a, const Bounds& boxA, bool floatExactA,
                                                   const PointView& b, const Bounds& boxB, bool floatExactB,
                                                   const glm::dvec3& origin);

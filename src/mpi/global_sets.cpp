@@ -8,7 +8,6 @@
 #include <limits>
 #include <optional>
 #include <string>
-#include <utility>
 
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
@@ -124,20 +123,32 @@ Result<GlobalSets> makeGlobalSets(MPI_Comm comm, PointView localA, PointView loc
     const core::SetSummary unionBox{core::Bounds{boxLo, boxHi}, floatExact != 0};
     sets.origin = core::searchOrigin(unionBox, unionBox);  // 0 for float data, else the centre
 
-    // The float search's limits (core/input_limits.hpp), as one process checks them.
+    // The float search's limits (core/input_limits.hpp), as one process checks
+    // them: the sets in checkBFirst's order of their global boxes; within a
+    // set, the lowest failing rank's slice names the point.
     if (!floatExact || sets.origin != glm::dvec3(0.0)) {
-        local = guarded([&]() -> std::optional<Error> {
-            const std::pair<const GlobalSet*, const SliceSummary*> slices[] = {{&sets.a, &sa},
-                                                                               {&sets.b, &sb}};
-            for (const auto& [set, summary] : slices) {
-                if (set->local.count == 0) continue;
-                if (auto e = core::checkShiftedRange(set->local, core::Bounds{summary->lo, summary->hi},
-                                                     sets.origin, set == &sets.a ? "A" : "B", set->offset()))
-                    return e;
-            }
-            return std::nullopt;
-        });
-        if (auto error = agreeOnError(comm, local)) return *error;
+        double boxes[12];  // A's lo, B's lo, -A's hi, -B's hi: one MIN reduction
+        for (int k = 0; k < 3; ++k) {
+            boxes[k] = sa.lo[k];
+            boxes[3 + k] = sb.lo[k];
+            boxes[6 + k] = -sa.hi[k];
+            boxes[9 + k] = -sb.hi[k];
+        }
+        MPI_Allreduce(MPI_IN_PLACE, boxes, 12, MPI_DOUBLE, MPI_MIN, comm);
+        const core::Bounds boxA{glm::dvec3(boxes[0], boxes[1], boxes[2]),
+                                -glm::dvec3(boxes[6], boxes[7], boxes[8])};
+        const core::Bounds boxB{glm::dvec3(boxes[3], boxes[4], boxes[5]),
+                                -glm::dvec3(boxes[9], boxes[10], boxes[11])};
+        const bool bFirst = core::checkBFirst(boxA, boxB, sets.origin);
+        for (const GlobalSet* set : {bFirst ? &sets.b : &sets.a, bFirst ? &sets.a : &sets.b}) {
+            const SliceSummary& summary = set == &sets.a ? sa : sb;
+            local = guarded([&]() -> std::optional<Error> {
+                if (set->local.count == 0) return std::nullopt;
+                return core::checkShiftedRange(set->local, core::Bounds{summary.lo, summary.hi}, sets.origin,
+                                               set == &sets.a ? "A" : "B", set->offset());
+            });
+            if (auto error = agreeOnError(comm, local)) return *error;
+        }
         if (auto error = core::checkShiftedExtent(core::Bounds{boxLo, boxHi}, sets.origin, "A and B"))
             return *error;  // the same on every rank: from the agreed box
     }
