@@ -31,6 +31,10 @@ namespace {
 
 std::optional<Error> validateEngineOptions(const EngineOptions& o) {
     if (o.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
+    if (o.devices.size() > kMaxEngineDevices)
+        return Error{ErrorCode::kInvalidArgument,
+                     "devices lists " + std::to_string(o.devices.size()) + " devices; at most " +
+                         std::to_string(kMaxEngineDevices) + " (kMaxEngineDevices)"};
     for (int d : o.devices) {
         if (d < 0) return Error{ErrorCode::kInvalidArgument, "devices must be device indices >= 0"};
     }

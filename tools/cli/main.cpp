@@ -92,6 +92,7 @@ int run(const std::vector<std::string>& argv) {
     Options options = args.options;
     if (args.allDevices) {
         options.devices = everyRtDevice(options.backend);
+        if (options.devices.size() > kMaxEngineDevices) options.devices.resize(kMaxEngineDevices);
         if (options.devices.empty())
             return fail(kExitNoDevice, "--devices all: no device with hardware ray tracing for the " +
                                            std::string(backendName(options.backend)) + " backend");
