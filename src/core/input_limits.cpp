@@ -38,30 +38,33 @@ std::optional<Error> checkOrigin(const glm::dvec3& origin, const char* what) {
     return std::nullopt;
 }
 
-std::optional<Error> checkShiftedRange(const PointView& points, const Bounds& box, const glm::dvec3& origin,
-                                       const char* name, uint64_t firstIndex) {
-    const glm::dvec3 far = farthest(box, origin);
-    if (far.x <= kMaxShifted && far.y <= kMaxShifted && far.z <= kMaxShifted) return std::nullopt;
-    // Past the limit (a second pass, on this path only): the point farthest
-    // from the origin names the place; on a tie (both ends of an axis are as
-    // far from the centre) the one of larger magnitude, a stray at 1e308
-    // rather than the points near 0 it is far from; then the first.
-    size_t worst = 0;
-    int axis = -1;
-    std::pair<double, double> worstReach{-1.0, -1.0};
+ShiftedReach farthestShifted(const PointView& points, const glm::dvec3& origin) {
+    ShiftedReach best;
     for (size_t i = 0; i < points.count; ++i) {
         const glm::dvec3 p = points.at(i);
         for (int k = 0; k < 3; ++k) {
             const double d = std::abs(p[k] - origin[k]);
             if (d <= kMaxShifted) continue;
             const std::pair<double, double> reach{std::isnan(d) ? INFINITY : d, std::abs(p[k])};
-            if (reach > worstReach) {
-                worstReach = reach;
-                worst = i;
-                axis = k;
+            if (reach > std::pair{best.distance, best.magnitude}) {
+                best.distance = reach.first;
+                best.magnitude = reach.second;
+                best.index = i;
+                best.axis = k;
             }
         }
     }
+    return best;
+}
+
+std::optional<Error> checkShiftedRange(const PointView& points, const Bounds& box, const glm::dvec3& origin,
+                                       const char* name, uint64_t firstIndex) {
+    const glm::dvec3 far = farthest(box, origin);
+    if (far.x <= kMaxShifted && far.y <= kMaxShifted && far.z <= kMaxShifted) return std::nullopt;
+    // Past the limit (a second pass, on this path only): farthestShifted names the place.
+    const ShiftedReach worstPoint = farthestShifted(points, origin);
+    const size_t worst = worstPoint.index;
+    const int axis = worstPoint.axis;
     if (axis < 0)
         return Error{ErrorCode::kBadInput, std::string("point set ") + name + ": coordinates past " +
                                                number(kMaxShifted) + " from the search origin"};

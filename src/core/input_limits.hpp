@@ -21,6 +21,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 
@@ -36,8 +37,20 @@ inline constexpr double kMinShifted = 1.1754943508222875e-38;  // FLT_MIN = 2^-1
 // A caller's origin (PrepareOptions::origin): finite, or kInvalidArgument.
 [[nodiscard]] std::optional<Error> checkOrigin(const glm::dvec3& origin, const char* what);
 
+// The point of `points` past kMaxShifted from `origin` that names an error:
+// the farthest from it, on a tie the one of larger magnitude (a stray at
+// 1e308 rather than the points near 0 it is far from), then the first;
+// axis -1 when none is past the limit.
+struct ShiftedReach {
+    double distance = -1.0;
+    double magnitude = -1.0;
+    size_t index = 0;
+    int axis = -1;
+};
+[[nodiscard]] ShiftedReach farthestShifted(const PointView& points, const glm::dvec3& origin);
+
 // The upper rule for one set of box `box` searched as p - origin: the error
-// names the first point past kMaxShifted (its index plus `firstIndex`, the
+// names farthestShifted's point (its index plus `firstIndex`, the
 // set's offset in a larger one) and its axis.
 [[nodiscard]] std::optional<Error> checkShiftedRange(const PointView& points, const Bounds& box,
                                                      const glm::dvec3& origin, const char* name,

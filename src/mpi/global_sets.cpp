@@ -8,6 +8,8 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
@@ -141,9 +143,28 @@ Result<GlobalSets> makeGlobalSets(MPI_Comm comm, PointView localA, PointView loc
                                 -glm::dvec3(boxes[9], boxes[10], boxes[11])};
         const bool bFirst = core::checkBFirst(boxA, boxB, sets.origin);
         for (const GlobalSet* set : {bFirst ? &sets.b : &sets.a, bFirst ? &sets.a : &sets.b}) {
+            // The rank holding the farthest point (farthestShifted's order, the
+            // lowest rank on a tie) names it, as one process would.
             const SliceSummary& summary = set == &sets.a ? sa : sb;
+            core::ShiftedReach reach;
             local = guarded([&]() -> std::optional<Error> {
-                if (set->local.count == 0) return std::nullopt;
+                if (set->local.count > 0) reach = core::farthestShifted(set->local, sets.origin);
+                return std::nullopt;
+            });
+            if (auto error = agreeOnError(comm, local)) return *error;
+            std::vector<double> reaches(2 * size_t(set->offsets.size() - 1));
+            const double mine[2] = {reach.distance, reach.magnitude};
+            MPI_Allgather(mine, 2, MPI_DOUBLE, reaches.data(), 2, MPI_DOUBLE, comm);
+            int chosen = -1;
+            for (int r = 0; 2 * size_t(r) < reaches.size(); ++r) {
+                const std::pair<double, double> key{reaches[2 * size_t(r)], reaches[2 * size_t(r) + 1]};
+                if (key.first >= 0.0 && (chosen < 0 || key > std::pair{reaches[2 * size_t(chosen)],
+                                                                       reaches[2 * size_t(chosen) + 1]}))
+                    chosen = r;
+            }
+            if (chosen < 0) continue;
+            local = guarded([&]() -> std::optional<Error> {
+                if (chosen != set->rank) return std::nullopt;
                 return core::checkShiftedRange(set->local, core::Bounds{summary.lo, summary.hi}, sets.origin,
                                                set == &sets.a ? "A" : "B", set->offset());
             });
