@@ -33,6 +33,11 @@ enum class Backend {
 [[nodiscard]] RTHDIST_API bool parseBackend(const std::string& text, Backend& out);
 
 // Fixed for the life of an Engine (its device and pipelines).
+// The most entries of EngineOptions::devices: each opens a Vulkan device
+// (about 20 MB of host memory and 50-80 ms on lavapipe), so the list is
+// bounded; 16 covers the largest single hosts (16 GPUs).
+inline constexpr size_t kMaxEngineDevices = 16;
+
 struct EngineOptions {
     Backend backend = Backend::kAuto;
     // Vulkan physical device index as listed by listDevices(); -1 = the first
@@ -47,8 +52,11 @@ struct EngineOptions {
     // result (README, "Several GPUs"). A pair that fits one call runs on the
     // first device (splitting it costs more than it gains: each device would
     // index every target), as do prepared sets and batches. Empty:
-    // deviceIndex alone. An index given twice opens that device twice (tests
-    // on a one-device machine; no speedup). Every device must run the backend.
+    // deviceIndex alone. At most kMaxEngineDevices entries (more ->
+    // kInvalidArgument before any device is opened). An index given twice
+    // opens that device twice (tests on a one-device machine; no speedup);
+    // the CLI's --devices refuses a repeated index. Every device must run the
+    // backend.
     std::vector<int> devices;
     // Enable VK_LAYER_KHRONOS_validation and count every message it emits
     // (Result::validationMessages). For tests; slow.

@@ -138,7 +138,8 @@ std::unique_ptr<PyResult> hausdorffOnce(const py::array& a, const py::array& b, 
     std::optional<Result<HausdorffResult>> r;
     {
         py::gil_scoped_release release;
-        r.emplace(hausdorff(va, vb, options));
+        const PointCopy ca(va), cb(vb);  // another thread's writes cannot reach the call (points.hpp)
+        r.emplace(hausdorff(ca.view(), cb.view(), options));
     }
     monitor.raisePending();
     return wrap(valueOrRaise(std::move(*r)), a, b, perPoint);
@@ -190,12 +191,13 @@ public:
         {
             py::gil_scoped_release release;
             std::lock_guard<std::mutex> lock(m_mutex);
+            const PointCopy ca(va), cb(vb);  // of the arrays only (a prepared set has its own copy)
             if (!m_engine) {
                 r.emplace(Error{ErrorCode::kInvalidArgument, "this Engine is closed"});
             } else if (pa == nullptr && pb == nullptr) {
-                r.emplace(m_engine->compute(va, vb, call));
+                r.emplace(m_engine->compute(ca.view(), cb.view(), call));
             } else {
-                r.emplace(computePrepared(pa, va, pb, vb, call));
+                r.emplace(computePrepared(pa, ca.view(), pb, cb.view(), call));
             }
         }
         monitor.raisePending();
@@ -213,10 +215,11 @@ public:
         {
             py::gil_scoped_release release;
             std::lock_guard<std::mutex> lock(m_mutex);
+            const PointCopy copy(view);  // the set keeps copies of its own; this one is checked first
             if (!m_engine) {
                 r.emplace(Error{ErrorCode::kInvalidArgument, "this Engine is closed"});
             } else {
-                r.emplace(m_engine->prepare(view, options));
+                r.emplace(m_engine->prepare(copy.view(), options));
             }
         }
         return std::make_unique<PyPrepared>(PyPrepared{valueOrRaise(std::move(*r)), this, points});

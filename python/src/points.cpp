@@ -1,5 +1,7 @@
 #include "points.hpp"
 
+#include <cstring>
+#include <memory>
 #include <string>
 
 namespace py = pybind11;
@@ -40,6 +42,21 @@ PointView viewOf(const py::array& array, const char* name) {
     view.strideBytes = size_t(stride);
     view.scalar = scalar;
     return view;
+}
+
+PointCopy::PointCopy(const PointView& view) : m_view(view) {
+    const size_t point = 3 * scalarBytes(view.scalar);
+    if (view.count == 0 || view.data == nullptr) return;  // the library names what is wrong
+    m_bytes = std::make_unique_for_overwrite<std::byte[]>(view.count * point);
+    const auto* from = static_cast<const std::byte*>(view.data);
+    if (view.strideBytes == point) {
+        std::memcpy(m_bytes.get(), from, view.count * point);
+    } else {
+        for (size_t i = 0; i < view.count; ++i)
+            std::memcpy(m_bytes.get() + i * point, from + i * view.strideBytes, point);
+    }
+    m_view.data = m_bytes.get();
+    m_view.strideBytes = point;
 }
 
 }  // namespace rthdist::python

@@ -18,6 +18,7 @@
 #include "api/out_of_core.hpp"
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
+#include "core/input_limits.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 #include "gpu/context.hpp"
 #include "gpu/pipeline_cache.hpp"
@@ -31,6 +32,10 @@ namespace {
 
 std::optional<Error> validateEngineOptions(const EngineOptions& o) {
     if (o.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
+    if (o.devices.size() > kMaxEngineDevices)
+        return Error{ErrorCode::kInvalidArgument,
+                     "devices lists " + std::to_string(o.devices.size()) + " devices; at most " +
+                         std::to_string(kMaxEngineDevices) + " (kMaxEngineDevices)"};
     for (int d : o.devices) {
         if (d < 0) return Error{ErrorCode::kInvalidArgument, "devices must be device indices >= 0"};
     }
@@ -396,6 +401,9 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
                                      std::chrono::steady_clock::time_point t0) {
     if (auto err = validateCallOptions(call)) return *err;
     const glm::dvec3 origin = core::searchOrigin(checked.a, checked.b);
+    if (auto err = core::checkPairFrame(a, checked.a.box, checked.a.floatExact, b, checked.b.box,
+                                        checked.b.floatExact, origin))
+        return *err;
     const core::FloatSet fa(a, origin, impl.options.threads), fb(b, origin, impl.options.threads);
     const double scale = core::exactScale(
         std::max(core::searchMagnitude(checked.a, origin), core::searchMagnitude(checked.b, origin)));
@@ -468,6 +476,8 @@ void Engine::recycle(HausdorffResult&& spent) {
 Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& options) {
     if (auto err = validateBits(options.bits)) return *err;
     if (auto err = validatePreparedSize(points)) return *err;
+    if (options.origin)
+        if (auto err = core::checkOrigin(*options.origin, "PrepareOptions::origin")) return *err;
     Result<core::SetSummary> summary = core::summarizeSet(points, "to prepare", m_impl->options.threads);
     if (!summary) return summary.error();
     auto set = std::make_shared<PreparedSet::Impl>();
@@ -475,6 +485,10 @@ Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& opti
     set->summary = *summary;
     set->count = points.count;
     set->origin = core::preparedOrigin(*summary, options.origin);
+    if (!summary->floatExact || set->origin != glm::dvec3(0.0)) {
+        if (auto err = core::checkShiftedRange(points, summary->box, set->origin, "to prepare")) return *err;
+        if (auto err = core::checkShiftedExtent(summary->box, set->origin, "to prepare")) return *err;
+    }
     set->floats = core::roundedCopy(points, set->origin, m_impl->options.threads);
     if (!summary->floatExact) {
         set->originals.resize(points.count);
@@ -679,6 +693,8 @@ Result<HausdorffResult> Engine::compute(const DevicePointView& a, const DevicePo
 Result<PreparedSet> Engine::prepare(const DevicePointView& points, const PrepareOptions& options) {
     if (auto err = deviceInputEngine(*m_impl)) return *err;
     if (auto err = validateBits(options.bits)) return *err;
+    if (options.origin)
+        if (auto err = core::checkOrigin(*options.origin, "PrepareOptions::origin")) return *err;
     Result<gpu_algo::DeviceInput> view =
         api::checkDeviceView(points, "to prepare", m_impl->device->context->device());
     if (!view) return view.error();

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numeric>
 #include <string>
 
 #include "core/parallel.hpp"
@@ -62,6 +63,12 @@ ChunkSummary summarizeChunk(const char* base, size_t stride, size_t begin, size_
     return s;
 }
 
+// (lo + hi) / 2 per axis without overflow near the double range
+// (std::midpoint: the same value as 0.5 * (lo + hi) wherever that is finite).
+glm::dvec3 boxCentre(const glm::dvec3& lo, const glm::dvec3& hi) {
+    return glm::dvec3(std::midpoint(lo.x, hi.x), std::midpoint(lo.y, hi.y), std::midpoint(lo.z, hi.z));
+}
+
 void merge(ChunkSummary& into, const ChunkSummary& part) {
     into.firstBad = std::min(into.firstBad, part.firstBad);
     into.floatExact = into.floatExact && part.floatExact;
@@ -108,12 +115,12 @@ Result<SetSummary> summarizeSet(const PointView& points, const char* name, int t
 
 glm::dvec3 searchOrigin(const SetSummary& a, const SetSummary& b) {
     if (a.floatExact && b.floatExact) return glm::dvec3(0.0);
-    return 0.5 * (glm::min(a.box.lo, b.box.lo) + glm::max(a.box.hi, b.box.hi));
+    return boxCentre(glm::min(a.box.lo, b.box.lo), glm::max(a.box.hi, b.box.hi));
 }
 
 glm::dvec3 preparedOrigin(const SetSummary& set, const std::optional<glm::dvec3>& wanted) {
     if (set.floatExact) return glm::dvec3(0.0);
-    return wanted ? *wanted : 0.5 * (set.box.lo + set.box.hi);
+    return wanted ? *wanted : boxCentre(set.box.lo, set.box.hi);
 }
 
 bool frameKeepsBound(const SetSummary& a, const SetSummary& b, const glm::dvec3& origin) {

@@ -4,10 +4,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <vector>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include "gpu/vk_check.hpp"
 
@@ -38,20 +41,52 @@ std::string headerMismatch(const std::vector<char>& data, const VkPhysicalDevice
     return "";
 }
 
+// Why `dir` must not hold the cache, or "" when it may: a directory that
+// another user can write (its owner when that is not us, its group or
+// others) unless it is sticky and ours (there nobody else can replace or
+// remove our files). A missing directory is fine (save() creates it, 0700).
+std::string unsafeDirectory(const std::string& dir) {
+    struct stat st {};
+    if (::stat(dir.c_str(), &st) != 0) return "";
+    if (!S_ISDIR(st.st_mode)) return dir + " is not a directory";
+    const bool ours = st.st_uid == ::geteuid();
+    const bool othersWrite =
+        (!ours && (st.st_mode & S_IWUSR) != 0) || (st.st_mode & (S_IWGRP | S_IWOTH)) != 0;
+    if (othersWrite && !(ours && (st.st_mode & S_ISVTX) != 0))
+        return dir +
+               " can be written by other users and is not a sticky directory of this user's "
+               "(chmod go-w it, or set RTHDIST_CACHE_DIR)";
+    return "";
+}
+
+// The file's bytes: a regular file of this user's, opened without following
+// a symlink (one planted in a shared directory is ignored, not read).
 std::vector<char> readFile(const std::string& path, std::string& status) {
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(path, ec);
-    if (ec) return {};  // no file yet: status stays "none"
-    if (size > PipelineCache::kMaxFileBytes) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) {
+        if (errno != ENOENT) status = errno == ELOOP ? "ignored: a symbolic link" : "ignored: unreadable";
+        return {};  // no file yet: status stays "none"
+    }
+    std::vector<char> data;
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_uid != ::geteuid()) {
+        status = "ignored: not a regular file of this user's";
+    } else if (uint64_t(st.st_size) > PipelineCache::kMaxFileBytes) {
         status = "ignored: larger than 64 MiB";
-        return {};
+    } else {
+        data.resize(size_t(st.st_size));
+        size_t done = 0;
+        while (done < data.size()) {
+            const ssize_t n = ::read(fd, data.data() + done, data.size() - done);
+            if (n <= 0) break;
+            done += size_t(n);
+        }
+        if (done != data.size()) {
+            status = "ignored: unreadable";
+            data.clear();
+        }
     }
-    std::vector<char> data(size);
-    std::ifstream in(path, std::ios::binary);
-    if (!in.read(data.data(), std::streamsize(size))) {
-        status = "ignored: unreadable";
-        return {};
-    }
+    ::close(fd);
     return data;
 }
 
@@ -72,7 +107,12 @@ PipelineCache::PipelineCache(VkDevice device, VkPhysicalDevice physical, const s
     if (!dir.empty()) {
         m_path = dir + "/pipelines-" + std::to_string(props.vendorID) + "-" + std::to_string(props.deviceID) +
                  "-" + hex(props.pipelineCacheUUID, VK_UUID_SIZE) + ".bin";
-        data = readFile(m_path, m_status);
+        if (const std::string why = unsafeDirectory(dir); !why.empty()) {
+            m_status = "ignored: " + why;
+            m_path.clear();  // neither read nor written
+        } else {
+            data = readFile(m_path, m_status);
+        }
         if (!data.empty()) {
             const std::string why = headerMismatch(data, props);
             if (why.empty()) {
@@ -97,18 +137,26 @@ void PipelineCache::save() {
     if (m_status == "loaded" && size <= m_loadedBytes) return;  // nothing new
     std::vector<char> data(size);
     if (vkGetPipelineCacheData(m_device, m_cache.get(), &size, data.data()) != VK_SUCCESS) return;
+    // The directory: created 0700 where missing, and checked again (it may
+    // have changed since the constructor).
+    const std::filesystem::path dir = std::filesystem::path(m_path).parent_path();
     std::error_code ec;
-    std::filesystem::create_directories(std::filesystem::path(m_path).parent_path(), ec);
-    const std::string tmp = m_path + ".tmp" + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out.write(data.data(), std::streamsize(size))) {
-            std::filesystem::remove(tmp, ec);
-            return;
-        }
+    std::filesystem::create_directories(dir.parent_path(), ec);
+    if (::mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) return;
+    if (!unsafeDirectory(dir.string()).empty()) return;
+    // A temporary file of an unpredictable name, created here (O_EXCL, 0600:
+    // mkstemp), renamed over the old file: a symlink planted under any name
+    // is never opened for writing, and a reader sees the old file or the new.
+    std::string tmp = m_path + ".tmp-XXXXXX";
+    const int fd = ::mkstemp(tmp.data());
+    if (fd < 0) return;
+    size_t done = 0;
+    while (done < size) {
+        const ssize_t n = ::write(fd, data.data() + done, size - done);
+        if (n <= 0) break;
+        done += size_t(n);
     }
-    std::filesystem::rename(tmp, m_path, ec);
-    if (ec) std::filesystem::remove(tmp, ec);
+    if (::close(fd) != 0 || done != size || ::rename(tmp.c_str(), m_path.c_str()) != 0) ::unlink(tmp.c_str());
 }
 
 }  // namespace rthdist::gpu

@@ -6,9 +6,15 @@
 // header (VkPipelineCacheHeaderVersionOne) is checked against the device
 // before the driver sees the data; a file that is short, larger than
 // kMaxFileBytes, or written for another device or driver is ignored (and
-// replaced on save). Writes go to a temporary file renamed over the old one,
-// so concurrent processes never read half a file. Any I/O failure only means
-// an empty cache: it is reported by loadStatus(), never as an error.
+// replaced on save). Writes go to a temporary file of an unpredictable name
+// created exclusively (mkstemp, 0600) in the same directory and renamed over
+// the old one, so concurrent processes never read half a file and a symlink
+// planted under any name is never written through; the file is read only
+// when it is a regular file of this user's, opened without following a
+// symlink. A directory that another user can write (not sticky and ours) is
+// neither read nor written ("ignored: ..."); a missing one is created 0700.
+// Any I/O failure only means an empty cache: it is reported by loadStatus(),
+// never as an error.
 // Threading: one owner; Vulkan synchronizes the cache's use by pipeline
 // creation internally.
 #pragma once

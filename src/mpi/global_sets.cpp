@@ -8,8 +8,12 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/index_space.hpp"
+#include "core/input_frame.hpp"
+#include "core/input_limits.hpp"
 #include "mpi/collectives.hpp"
 #include "rthdist/mpi.hpp"
 
@@ -118,7 +122,57 @@ Result<GlobalSets> makeGlobalSets(MPI_Comm comm, PointView localA, PointView loc
     MPI_Allreduce(MPI_IN_PLACE, hi, 3, MPI_DOUBLE, MPI_MAX, comm);
     MPI_Allreduce(MPI_IN_PLACE, &floatExact, 1, MPI_INT, MPI_LAND, comm);
     const glm::dvec3 boxLo(lo[0], lo[1], lo[2]), boxHi(hi[0], hi[1], hi[2]);
-    sets.origin = floatExact ? glm::dvec3(0.0) : 0.5 * (boxLo + boxHi);
+    const core::SetSummary unionBox{core::Bounds{boxLo, boxHi}, floatExact != 0};
+    sets.origin = core::searchOrigin(unionBox, unionBox);  // 0 for float data, else the centre
+
+    // The float search's limits (core/input_limits.hpp), as one process checks
+    // them: the sets in checkBFirst's order of their global boxes; within a
+    // set, the lowest failing rank's slice names the point.
+    if (!floatExact || sets.origin != glm::dvec3(0.0)) {
+        double boxes[12];  // A's lo, B's lo, -A's hi, -B's hi: one MIN reduction
+        for (int k = 0; k < 3; ++k) {
+            boxes[k] = sa.lo[k];
+            boxes[3 + k] = sb.lo[k];
+            boxes[6 + k] = -sa.hi[k];
+            boxes[9 + k] = -sb.hi[k];
+        }
+        MPI_Allreduce(MPI_IN_PLACE, boxes, 12, MPI_DOUBLE, MPI_MIN, comm);
+        const core::Bounds boxA{glm::dvec3(boxes[0], boxes[1], boxes[2]),
+                                -glm::dvec3(boxes[6], boxes[7], boxes[8])};
+        const core::Bounds boxB{glm::dvec3(boxes[3], boxes[4], boxes[5]),
+                                -glm::dvec3(boxes[9], boxes[10], boxes[11])};
+        const bool bFirst = core::checkBFirst(boxA, boxB, sets.origin);
+        for (const GlobalSet* set : {bFirst ? &sets.b : &sets.a, bFirst ? &sets.a : &sets.b}) {
+            // The rank holding the farthest point (farthestShifted's order, the
+            // lowest rank on a tie) names it, as one process would.
+            const SliceSummary& summary = set == &sets.a ? sa : sb;
+            core::ShiftedReach reach;
+            local = guarded([&]() -> std::optional<Error> {
+                if (set->local.count > 0) reach = core::farthestShifted(set->local, sets.origin);
+                return std::nullopt;
+            });
+            if (auto error = agreeOnError(comm, local)) return *error;
+            std::vector<double> reaches(2 * size_t(set->offsets.size() - 1));
+            const double mine[2] = {reach.distance, reach.magnitude};
+            MPI_Allgather(mine, 2, MPI_DOUBLE, reaches.data(), 2, MPI_DOUBLE, comm);
+            int chosen = -1;
+            for (int r = 0; 2 * size_t(r) < reaches.size(); ++r) {
+                const std::pair<double, double> key{reaches[2 * size_t(r)], reaches[2 * size_t(r) + 1]};
+                if (key.first >= 0.0 && (chosen < 0 || key > std::pair{reaches[2 * size_t(chosen)],
+                                                                       reaches[2 * size_t(chosen) + 1]}))
+                    chosen = r;
+            }
+            if (chosen < 0) continue;
+            local = guarded([&]() -> std::optional<Error> {
+                if (chosen != set->rank) return std::nullopt;
+                return core::checkShiftedRange(set->local, core::Bounds{summary.lo, summary.hi}, sets.origin,
+                                               set == &sets.a ? "A" : "B", set->offset());
+            });
+            if (auto error = agreeOnError(comm, local)) return *error;
+        }
+        if (auto error = core::checkShiftedExtent(core::Bounds{boxLo, boxHi}, sets.origin, "A and B"))
+            return *error;  // the same on every rank: from the agreed box
+    }
     double magnitude = std::max(sliceMagnitude(sets.a, sets.origin), sliceMagnitude(sets.b, sets.origin));
     MPI_Allreduce(MPI_IN_PLACE, &magnitude, 1, MPI_DOUBLE, MPI_MAX, comm);
     sets.scale = core::exactScale(magnitude);

@@ -114,9 +114,43 @@ bool parseTargetMode(const char* text, TargetMode& out) {
     return false;
 }
 
+namespace {
+
+// The options that steer the collectives (how many directions, which mode)
+// or the values (bits, radius growth) are the same on every rank: a rank
+// with others would enter other collectives (a hang) or compute another H.
+// kInvalidArgument on every rank, naming the first option that differs.
+std::optional<Error> optionsDiffer(MPI_Comm comm, const CallOptions& call, const MpiOptions& mpi) {
+    float growth = call.radiusGrowth;
+    uint32_t growthBits = 0;
+    std::memcpy(&growthBits, &growth, sizeof(growthBits));
+    const std::pair<const char*, int64_t> fields[] = {
+        {"CallOptions::directedOnly", call.directedOnly ? 1 : 0},
+        {"CallOptions::perPointDistances", call.perPointDistances ? 1 : 0},
+        {"CallOptions::bits", call.bits},
+        {"CallOptions::radiusGrowth", int64_t(growthBits)},
+        {"MpiOptions::mode", int64_t(mpi.mode)},
+        {"MpiOptions::replicateLimitBytes", int64_t(mpi.replicateLimitBytes)}};
+    constexpr int kFields = int(sizeof(fields) / sizeof(fields[0]));
+    int64_t lo[kFields], hi[kFields];
+    for (int k = 0; k < kFields; ++k) lo[k] = hi[k] = fields[k].second;
+    MPI_Allreduce(MPI_IN_PLACE, lo, kFields, MPI_INT64_T, MPI_MIN, comm);
+    MPI_Allreduce(MPI_IN_PLACE, hi, kFields, MPI_INT64_T, MPI_MAX, comm);
+    for (int k = 0; k < kFields; ++k) {
+        if (lo[k] != hi[k])
+            return Error{ErrorCode::kInvalidArgument,
+                         std::string("hausdorffMpi: the ranks passed different ") + fields[k].first +
+                             "; every rank must pass the same options"};
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
 Result<HausdorffResult> hausdorffMpi(MPI_Comm comm, Engine& engine, PointView localA, PointView localB,
                                      const CallOptions& call, const MpiOptions& mpi) {
     const Clock::time_point start = Clock::now();
+    if (auto error = optionsDiffer(comm, call, mpi)) return *error;  // the same on every rank
     std::optional<Error> local;
     if (call.perPointDistances)
         local = Error{ErrorCode::kInvalidArgument, "hausdorffMpi does not compute per-point distances"};

@@ -257,5 +257,75 @@ TEST(CliPrecision, DoublePlyAtUtmMatchesTheDoubleBruteForce) {
     EXPECT_GT(std::abs(hausdorffOf(rounded) - truth), 100 * tolerance) << "float32 UTM should miss the truth";
 }
 
+// ---- coordinates past the float search's limits (issue 36) -------------------------
+
+// Exit 3 naming the file and every word of `words`, on every backend; never a
+// signal, never a distance.
+void expectLimitExit3(const std::vector<std::string>& files, const std::vector<std::string>& words) {
+    for (const std::string backend : {"cpu", "ray-query", "rt-pipeline"}) {
+        SCOPED_TRACE(backend);
+        std::vector<std::string> args = {"--backend", backend, "--json"};
+        args.insert(args.end(), files.begin(), files.end());
+        const CliRun run = runCli(args);
+        if (backend != "cpu" && run.exitCode == 4) GTEST_SKIP() << "no device for " << backend << "\n" << run;
+        EXPECT_EQ(run.exitCode, 3) << run;
+        EXPECT_TRUE(run.out.empty()) << run;
+        for (const std::string& w : words) EXPECT_NE(run.err.find(w), std::string::npos) << w << "\n" << run;
+    }
+}
+
+TEST(CliInputLimits, XyzPastFloatRangeIsExit3) {
+    TempDir dir;
+    const std::string big = dir.write("big.xyz", "1e308 0 0\n0.1 0 0\n");
+    const std::string small = dir.write("small.xyz", "0 0 0\n1 0 0\n");
+    expectLimitExit3({big, small}, {"point set A (" + big + ")", "point 0", "x = 1e+308", "3.40282347e+38"});
+    expectLimitExit3({big, big}, {big, "x = 1e+308", "float32's largest value"});
+    // A few strays among many points: refused before any search.
+    std::string many;
+    for (int i = 0; i < 2000; ++i) many += std::to_string(i % 37) + " " + std::to_string(i % 11) + " 0.5\n";
+    const std::string strays = dir.write("strays.xyz", many + "-1e308 0 0\n0 1e308 0\n");
+    expectLimitExit3({small, strays}, {"point set B (" + strays + ")", "point 2000", "x = -1e+308"});
+}
+
+TEST(CliInputLimits, XyzBelowFloatNormalsIsExit3) {
+    TempDir dir;
+    const std::string tiny = dir.write("tiny.xyz", "1e-160 0 0\n0 2e-160 0\n");
+    const std::string zero = dir.write("zero.xyz", "0 0 0\n");
+    expectLimitExit3({tiny, zero},
+                     {"point sets A and B (" + tiny + ", " + zero + ")", "1e-160", "1.17549435e-38"});
+}
+
+TEST(CliInputLimits, LasScaleOrOffsetPastFloatRangeIsExit3) {
+    TempDir dir;
+    LasSpec s;
+    s.points = {{{1, 2, 3}}, {{4, 5, 6}}};
+    s.scale = {1e300, 0.01, 0.01};
+    const std::string scaled = dir.write("scale.las", lasBytes(s));
+    ASSERT_EQ(std::filesystem::file_size(scaled), 267u);
+    expectLimitExit3({scaled, scaled}, {"point set A (" + scaled + ")", "x = 4e+300", "3.40282347e+38"});
+    s.scale = {0.01, 0.01, 0.01};
+    s.offset = {0.0, 1e308, 0.0};
+    const std::string offset = dir.write("offset.las", lasBytes(s));
+    expectLimitExit3({kSampleA, offset}, {"point set B (" + offset + ")", "y = 1e+308", "3.40282347e+38"});
+}
+
+// Far from the origin but close together: exact, whatever the magnitude.
+TEST(CliInputLimits, LasFarButSmallIsExact) {
+    TempDir dir;
+    LasSpec s;
+    s.offset = {1e300, 0.0, -1e307};  // y varies: 1e300 + 1 is 1e300 in double
+    s.points = {{{0, 0, 0}}, {{0, 100, 0}}};
+    const std::string a = dir.write("a.las", lasBytes(s));
+    s.points = {{{0, 500, 0}}};
+    const std::string b = dir.write("b.las", lasBytes(s));
+    for (const std::string backend : {"cpu", "ray-query", "rt-pipeline"}) {
+        SCOPED_TRACE(backend);
+        const CliRun run = runCli({"--backend", backend, "--json", a, b});
+        if (backend != "cpu" && run.exitCode == 4) GTEST_SKIP() << "no device for " << backend << "\n" << run;
+        ASSERT_EQ(run.exitCode, 0) << run;
+        EXPECT_EQ(hausdorffOf(run), 5.0) << run;
+    }
+}
+
 }  // namespace
 }  // namespace rthdist::cli_test

@@ -7,10 +7,12 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <span>
 #include <string>
 #include <thread>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "api/out_of_core.hpp"
@@ -336,6 +338,78 @@ TEST(PipelineCache, WrittenReadAndRepaired) {
     fs::remove_all(dir);
     exactWith(off, "none");
     EXPECT_FALSE(fs::exists(dir));
+}
+
+// A planted symlink in the cache directory (issue 36): neither the old
+// predictable temporary name (<file>.tmp<pid>) nor the file's own name is
+// written through; a symlink at the file's name is not read, and is replaced
+// by a regular file.
+TEST(PipelineCache, PlantedSymlinksAreNeitherFollowedNorRead) {
+    if (engineUnderTest().backend == Backend::kCpu) return;  // no pipeline cache
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("rthdist-cache-links-" + std::to_string(::getpid()));
+    const fs::path victim = dir.string() + "-victim";
+    fs::remove_all(dir);
+    ASSERT_EQ(::mkdir(dir.c_str(), 0700), 0);
+    std::ofstream(victim) << "precious";
+    EngineOptions o = engineUnderTest();
+    o.pipelineCacheDir = dir.string();
+    auto engineStatus = [&o](std::string& path) {
+        std::string whyNot;
+        auto engine = makeEngine(o, whyNot);
+        EXPECT_TRUE(engine) << whyNot;
+        path = engine ? engine->pipelineCachePath() : "";
+        return engine ? engine->pipelineCacheStatus() : whyNot;
+    };
+    std::string file;
+    EXPECT_EQ(engineStatus(file), "none");
+    ASSERT_TRUE(fs::is_regular_file(file));
+    fs::remove(file);
+    fs::create_symlink(victim, file + ".tmp" + std::to_string(::getpid()));
+    EXPECT_EQ(engineStatus(file), "none");
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(file)));
+    fs::remove(file);
+    fs::create_symlink(victim, file);
+    EXPECT_EQ(engineStatus(file).rfind("ignored: a symbolic link", 0), 0u);
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(file))) << "replaced by the new cache";
+    std::ifstream in(victim);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "precious");
+    size_t files = 0;
+    for (const auto& e : fs::directory_iterator(dir))
+        files += e.path().string().find(".tmp-") == std::string::npos;
+    EXPECT_EQ(files, 2u) << "the cache and the planted .tmp<pid> link, no temporary left";
+    fs::remove_all(dir);
+    fs::remove(victim);
+}
+
+// A cache directory that another user can write is refused (nothing read or
+// written) unless it is sticky and this user's.
+TEST(PipelineCache, DirectoryOthersCanWriteIsRefused) {
+    if (engineUnderTest().backend == Backend::kCpu) return;  // no pipeline cache
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("rthdist-cache-mode-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    ASSERT_EQ(::mkdir(dir.c_str(), 0700), 0);
+    EngineOptions o = engineUnderTest();
+    o.pipelineCacheDir = dir.string();
+    for (const mode_t mode : {mode_t(0777), mode_t(0770), mode_t(0722), mode_t(01777), mode_t(0755)}) {
+        SCOPED_TRACE("mode " + std::to_string(mode));
+        ASSERT_EQ(::chmod(dir.c_str(), mode), 0);
+        std::string whyNot;
+        auto engine = makeEngine(o, whyNot);
+        ASSERT_TRUE(engine) << whyNot;
+        const bool refused = (mode & 022) != 0 && (mode & 01000) == 0;
+        if (refused) {
+            EXPECT_NE(engine->pipelineCacheStatus().find("can be written by other users"), std::string::npos)
+                << engine->pipelineCacheStatus();
+            EXPECT_EQ(engine->pipelineCachePath(), "");
+            EXPECT_TRUE(fs::is_empty(dir));
+        } else {
+            EXPECT_TRUE(fs::is_regular_file(engine->pipelineCachePath())) << engine->pipelineCacheStatus();
+        }
+        for (const auto& e : fs::directory_iterator(dir)) fs::remove(e.path());
+    }
+    fs::remove_all(dir);
 }
 
 }  // namespace

@@ -135,6 +135,12 @@ TEST(SeveralDevicesOptions, RefusedWhereTheyCannotRun) {
     auto negative = Engine::create(o);
     ASSERT_FALSE(negative);
     EXPECT_EQ(negative.error().code, ErrorCode::kInvalidArgument);
+    // The list is bounded (issue 36: 2,000 entries opened the device 2,000 times).
+    o.devices.assign(kMaxEngineDevices + 1, 0);
+    auto many = Engine::create(o);
+    ASSERT_FALSE(many);
+    EXPECT_EQ(many.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(many.error().message.find("at most 16"), std::string::npos) << many.error().message;
 }
 
 }  // namespace

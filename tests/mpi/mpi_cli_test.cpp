@@ -5,6 +5,9 @@
 // lines; the same exit codes and "rthdist: " messages. N = 1, 2, 3.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <utility>
+
 #include "cli/cli_runner.hpp"
 
 namespace rthdist::cli_test {
@@ -169,6 +172,111 @@ TEST(MpiCli, UnsupportedOptionsAreUsageErrors) {
     EXPECT_EQ(bad.exitCode, 2) << bad;
     EXPECT_NE(bad.err.find("unknown MPI mode 'halo'"), std::string::npos) << bad;
 }
+
+// ---- ranks that disagree, inputs past the float search's limits (issue 36) ----------
+
+// mpirun with one rank group per entry of `groups` ({ranks, working directory,
+// arguments}: MPMD, `a : b`), bounded by `timeout` so that a hang fails the
+// test (exit 124) instead of stalling it.
+struct RankGroup {
+    int ranks = 1;
+    std::string dir;
+    std::vector<std::string> args;
+};
+
+CliRun runGroups(const std::vector<RankGroup>& groups) {
+    std::vector<std::string> argv = {"timeout",        "-s", "KILL", "120", kMpirun, "--allow-run-as-root",
+                                     "--oversubscribe"};
+    for (size_t g = 0; g < groups.size(); ++g) {
+        if (g > 0) argv.push_back(":");
+        argv.insert(argv.end(), {"-np", std::to_string(groups[g].ranks), "-wdir", groups[g].dir, kMpiCli});
+        argv.insert(argv.end(), groups[g].args.begin(), groups[g].args.end());
+    }
+    return runArgv(argv);
+}
+
+class MpiAgreement : public testing::TestWithParam<std::string> {};
+
+// The same relative path names other contents on the last rank(s): exit 3 on
+// every rank naming the file and the ranks, never an H (it was 0 with an H of
+// neither input). Before any engine: one backend.
+TEST(MpiAgreementCpu, DifferentFileContentsAreExit3) {
+    const TempDir dir;
+    std::filesystem::create_directories(dir.path() / "one");
+    std::filesystem::create_directories(dir.path() / "two");
+    const std::string one = (dir.path() / "one").string(), two = (dir.path() / "two").string();
+    dir.write("one/b.xyz", "0 0 0\n1 0 0\n2 0 0\n");
+    dir.write("two/b.xyz", "0 0 0\n1 0 0\n2 0 7\n");  // same count, other values
+    dir.write("one/c.xyz", "0 0 0\n1 0 0\n");
+    dir.write("two/c.xyz", "0 0 0\n1 0 0\n2 0 0\n");  // another count
+    for (int np : {2, 3}) {
+        for (const std::string file : {"b.xyz", "c.xyz"}) {
+            SCOPED_TRACE("np " + std::to_string(np) + " " + file);
+            const std::vector<std::string> args = {"--backend", "cpu", "--json", kSampleA, file};
+            const CliRun run = runGroups({{np - 1, one, args}, {1, two, args}});
+            EXPECT_EQ(run.exitCode, 3) << run;
+            EXPECT_TRUE(run.out.empty()) << run;
+            EXPECT_NE(run.err.find("rthdist: " + file + ": the ranks read different contents: rank 0 read "),
+                      std::string::npos)
+                << run;
+            EXPECT_NE(run.err.find("rank " + std::to_string(np - 1) + " read "), std::string::npos) << run;
+        }
+    }
+}
+
+// An option on one rank only (the last): exit 2 on every rank, never a hang.
+// Before any engine: one backend.
+TEST(MpiAgreementCpu, OptionOnOneRankIsExit2) {
+    const TempDir dir;
+    const std::string cwd = dir.path().string();
+    const std::vector<std::string> args = {"--backend", "cpu", kSampleA, kSampleB};
+    for (int np : {2, 3}) {
+        for (const std::string extra : {"--json", "--help"}) {
+            SCOPED_TRACE("np " + std::to_string(np) + " " + extra);
+            std::vector<std::string> more = args;
+            more.push_back(extra);
+            const CliRun run = runGroups({{np - 1, cwd, args}, {1, cwd, more}});
+            EXPECT_EQ(run.exitCode, 2) << run;
+            EXPECT_TRUE(run.out.empty()) << run;
+            EXPECT_NE(run.err.find("rthdist: rank " + std::to_string(np - 1) +
+                                   " was started with other arguments than rank 0"),
+                      std::string::npos)
+                << run;
+        }
+    }
+}
+
+// Coordinates past the float search's limits: exit 3 naming the file and the
+// limit, as rthdist (core/input_limits.hpp), on every rank count.
+TEST_P(MpiAgreement, InputLimitsAsRthdist) {
+    const TempDir dir;
+    const std::string big = dir.write("big.xyz", "1e308 0 0\n0.1 0 0\n");
+    const std::string small = dir.write("small.xyz", "0 0 0\n1 0 0\n2 0 0\n");
+    const std::string tiny = dir.write("tiny.xyz", "1e-160 0 0\n0 2e-160 0\n");
+    const std::string zero = dir.write("zero.xyz", "0 0 0\n");
+    for (int np : {2, 3}) {
+        SCOPED_TRACE("np " + std::to_string(np));
+        for (const auto& [files, words] :
+             {std::pair{std::vector{big, small},
+                        std::vector<std::string>{"rthdist: point set A (" + big + ")", "x = 1e+308",
+                                                 "3.40282347e+38"}},
+              std::pair{std::vector{tiny, zero},
+                        std::vector<std::string>{"rthdist: point sets A and B (" + tiny + ", " + zero + ")",
+                                                 "1.17549435e-38"}}}) {
+            const CliRun run =
+                runGroups({{np, dir.path().string(), {"--backend", GetParam(), files[0], files[1]}}});
+            EXPECT_EQ(run.exitCode, 3) << run;
+            EXPECT_TRUE(run.out.empty()) << run;
+            for (const std::string& w : words)
+                EXPECT_NE(run.err.find(w), std::string::npos) << w << "\n" << run;
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, MpiAgreement, testing::Values("cpu", "ray-query"),
+                         [](const testing::TestParamInfo<std::string>& info) {
+                             return info.param == "cpu" ? std::string("Cpu") : std::string("RayQuery");
+                         });
 
 }  // namespace
 }  // namespace rthdist::cli_test

@@ -86,5 +86,42 @@ TEST(MpiErrors, AfterAnErrorTheNextCallWorks) {
     EXPECT_EQ(r->bToA.targetIndex, 6u);
 }
 
+// Options that differ between ranks (issue 36: an option on one rank only
+// hung the job): kInvalidArgument on every rank, naming the option.
+TEST(MpiErrors, OptionsThatDifferBetweenRanksFailEveryRank) {
+    const std::vector<glm::vec3> a = line(12), b = line(9, 1.0f);
+    int rank = 0, size = 1;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    if (size < 2) return;  // one rank: nothing can differ
+    Options o = cpu();
+    o.directedOnly = rank == size - 1;
+    Result<HausdorffResult> r = hausdorffMpi(MPI_COMM_WORLD, sliceView(a), sliceView(b), o);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(r.error().message.find("CallOptions::directedOnly"), std::string::npos) << r.error().message;
+    expectAgreed(r.error());
+    MpiOptions mode;
+    mode.mode = rank == 0 ? TargetMode::kSpatial : TargetMode::kReplicated;
+    r = hausdorffMpi(MPI_COMM_WORLD, sliceView(a), sliceView(b), cpu(), mode);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().message.find("MpiOptions::mode"), std::string::npos) << r.error().message;
+    expectAgreed(r.error());
+}
+
+// Coordinates past the float search's limits, on any rank: kBadInput on
+// every rank, as one process refuses them (core/input_limits.hpp).
+TEST(MpiErrors, InputLimitsFailEveryRank) {
+    std::vector<glm::dvec3> a = {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, {3.0, 0.0, 0.0}};
+    const std::vector<glm::dvec3> b = {{0.5, 0.0, 0.0}, {1.5, 0.0, 0.0}, {2.5, 0.0, 0.0}};
+    a[3].x = 1e308;  // the last rank's slice
+    Result<HausdorffResult> r = hausdorffMpi(MPI_COMM_WORLD, sliceView(a), sliceView(b), cpu());
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().code, ErrorCode::kBadInput);
+    EXPECT_NE(r.error().message.find("point set A: point 3 has x = 1e+308"), std::string::npos)
+        << r.error().message;
+    expectAgreed(r.error());
+}
+
 }  // namespace
 }  // namespace rthdist::mpi_test

@@ -1,8 +1,10 @@
 #include "cli/args.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <functional>
 #include <optional>
@@ -105,7 +107,8 @@ Options:
   --device N          Vulkan device index from --list-devices, 0..1023
                       (default: first usable)
   --devices LIST      several GPUs: comma-separated device indices (e.g. 0,1),
-                      or all (every hardware RT device); a pair past the
+                      each once, at most 16, or all (every hardware RT
+                      device, the first 16); a pair past the
                       memory budget spreads its pieces over them (the result
                       is one device's); a pair that fits runs on the first
   --bits K            index-space bit count 0..8, 0 = choose from the data (default 0)
@@ -216,6 +219,16 @@ void addComputeOptions(CommandLine& line, CliArgs& out) {
             outOfRange(
                 "--devices", v,
                 "all, or comma-separated device indices in " + rangeText(0, kMaxDeviceIndex) + " (e.g. 0,1)");
+        // Each device once (every entry opens a device), at most kMaxEngineDevices of them.
+        if (devices->size() > kMaxEngineDevices)
+            reject("option '--devices' lists " + std::to_string(devices->size()) + " devices; at most " +
+                   std::to_string(kMaxEngineDevices));
+        for (size_t i = 0; i < devices->size(); ++i) {
+            if (std::find(devices->begin(), devices->begin() + std::ptrdiff_t(i), (*devices)[i]) !=
+                devices->begin() + std::ptrdiff_t(i))
+                reject("option '--devices' names device " + std::to_string((*devices)[i]) +
+                       " twice; each device once");
+        }
         out.options.devices = *devices;
     });
     addInt(line, "--threads", 0, kMaxThreads, "an integer in " + rangeText(0, kMaxThreads) + " (0 = all)",

@@ -92,6 +92,7 @@ int run(const std::vector<std::string>& argv) {
     Options options = args.options;
     if (args.allDevices) {
         options.devices = everyRtDevice(options.backend);
+        if (options.devices.size() > kMaxEngineDevices) options.devices.resize(kMaxEngineDevices);
         if (options.devices.empty())
             return fail(kExitNoDevice, "--devices all: no device with hardware ray tracing for the " +
                                            std::string(backendName(options.backend)) + " backend");
@@ -111,7 +112,7 @@ int run(const std::vector<std::string>& argv) {
     options.progress = [&meter](const char* stage, double fraction) { meter.update(stage, fraction); };
     Result<HausdorffResult> result = hausdorff(a->view(), b->view(), options);
     meter.finish();
-    if (!result) return failWith(result.error());
+    if (!result) return failWith(withFileNames(result.error(), args.pathA, args.pathB));
 
     std::optional<HausdorffStats> stats;
     if (args.perPoint) {

@@ -4,6 +4,8 @@
 #include <cinttypes>
 #include <cstdarg>
 #include <cstdio>
+#include <string>
+#include <utility>
 
 #include "cli/json_output.hpp"
 #include "cli/stats_report.hpp"
@@ -222,6 +224,17 @@ std::string devicesJson(const std::vector<DeviceInfo>& devices) {
         for (const auto& [name, value] : d.limits) limits[name] = value;
     }
     return jsonText(Json{{"devices", std::move(list)}}) + "\n";
+}
+
+Error withFileNames(Error error, const std::string& pathA, const std::string& pathB) {
+    const std::pair<std::string, std::string> names[] = {
+        {"point sets A and B", pathA + ", " + pathB}, {"point set A", pathA}, {"point set B", pathB}};
+    for (const auto& [subject, files] : names) {
+        if (error.message.rfind(subject, 0) != 0) continue;
+        error.message.insert(subject.size(), " (" + files + ")");
+        break;
+    }
+    return error;
 }
 
 }  // namespace rthdist::cli

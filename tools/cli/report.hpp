@@ -39,6 +39,10 @@ struct RunReport {
 [[nodiscard]] std::string summaryText(const RunReport& report);
 [[nodiscard]] std::string jsonReport(const RunReport& report);
 
+// A library error about "point set A", "point set B" or "point sets A and
+// B" (the input checks, core/input_limits.hpp) with the files' names added.
+[[nodiscard]] Error withFileNames(Error error, const std::string& pathA, const std::string& pathB);
+
 [[nodiscard]] std::string devicesText(const std::vector<DeviceInfo>& devices);
 [[nodiscard]] std::string devicesJson(const std::vector<DeviceInfo>& devices);
 

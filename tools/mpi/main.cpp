@@ -5,13 +5,18 @@
 // failure ends in "rthdist: <message>" on rank 0's stderr and the same exit
 // code on every rank (cli/exit_codes.hpp): errors are agreed on before any
 // collective that could block; an unexpected exception aborts the job
-// (MPI_Abort) rather than leave the other ranks waiting.
+// (MPI_Abort) rather than leave the other ranks waiting. Before any work the
+// ranks agree on their command line (exit 2 when one differs) and on each
+// input file as read (points, precision, checksum: exit 3 when one differs).
 #include <mpi.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -72,6 +77,53 @@ int listDevicesCommand(const Rank& r, const CliArgs& args) {
     return writeFromRoot(r, text);
 }
 
+// Every rank's command line is rank 0's, compared before parsing: a rank
+// started with another (an option on one rank only) would take other
+// collectives and hang the job, or answer another question. A difference
+// is a usage error (exit 2) on every rank.
+std::optional<std::string> commandLineDifference(const Rank& r, const std::vector<std::string>& argv) {
+    std::string mine;
+    for (const std::string& a : argv) mine += std::to_string(a.size()) + ":" + a;
+    uint64_t size = mine.size();
+    MPI_Bcast(&size, 1, MPI_UINT64_T, 0, r.comm);
+    std::string root = r.root() ? mine : std::string(size_t(size), '\0');
+    for (uint64_t done = 0; done < size;) {  // in pieces of at most 2^30 bytes (MPI counts are int)
+        const int piece = int(std::min<uint64_t>(size - done, uint64_t(1) << 30));
+        MPI_Bcast(root.data() + done, piece, MPI_CHAR, 0, r.comm);
+        done += uint64_t(piece);
+    }
+    int first = root == mine ? r.size : r.rank;  // the lowest rank that differs
+    MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, r.comm);
+    if (first == r.size) return std::nullopt;
+    return "rank " + std::to_string(first) +
+           " was started with other arguments than rank 0; every rank of rthdist-mpi needs the same "
+           "command line";
+}
+
+// Every rank read the same file: the same number of points, precision and
+// checksum of the whole file (slice_loader.hpp), compared before any work. A
+// difference (a file changed between the ranks' reads, node-local copies
+// that differ) is kBadInput (exit 3) on every rank, naming the ranks.
+std::optional<Error> fileDifference(const Rank& r, const std::string& path, const LoadedSlice& slice) {
+    const uint64_t mine[3] = {slice.fileCount, uint64_t(slice.points.scalar), slice.checksum};
+    std::vector<uint64_t> all(3 * size_t(r.size));
+    MPI_Allgather(mine, 3, MPI_UINT64_T, all.data(), 3, MPI_UINT64_T, r.comm);
+    auto describe = [&all](int rank) {
+        const uint64_t* v = all.data() + 3 * size_t(rank);
+        char sum[32];
+        std::snprintf(sum, sizeof(sum), "%016llx", static_cast<unsigned long long>(v[2]));
+        return "rank " + std::to_string(rank) + " read " + std::to_string(v[0]) + " points (" +
+               (v[1] == uint64_t(Scalar::kFloat64) ? "float64" : "float32") + ", checksum " + sum + ")";
+    };
+    for (int rank = 1; rank < r.size; ++rank) {
+        if (std::equal(all.begin(), all.begin() + 3, all.begin() + 3 * rank)) continue;
+        return Error{ErrorCode::kBadInput, path + ": the ranks read different contents: " + describe(0) +
+                                               ", " + describe(rank) +
+                                               "; every rank must read the same file"};
+    }
+    return std::nullopt;
+}
+
 int compute(const Rank& r, const MpiCliArgs& parsed, Clock::time_point start) {
     const CliArgs& args = parsed.cli;
     const Clock::time_point loadStart = Clock::now();
@@ -80,9 +132,11 @@ int compute(const Rank& r, const MpiCliArgs& parsed, Clock::time_point start) {
     Result<LoadedSlice> a = loadSlice(args.pathA, loadOptions, r.rank, r.size);
     std::optional<Error> error = a ? std::nullopt : std::optional<Error>(a.error());
     if (auto agreed = agreeOnError(r.comm, error)) return failWith(r, *agreed);
+    if (auto differ = fileDifference(r, args.pathA, *a)) return failWith(r, *differ);
     Result<LoadedSlice> b = loadSlice(args.pathB, loadOptions, r.rank, r.size);
     error = b ? std::nullopt : std::optional<Error>(b.error());
     if (auto agreed = agreeOnError(r.comm, error)) return failWith(r, *agreed);
+    if (auto differ = fileDifference(r, args.pathB, *b)) return failWith(r, *differ);
     double loadMs = msSince(loadStart);
     MPI_Allreduce(MPI_IN_PLACE, &loadMs, 1, MPI_DOUBLE, MPI_MAX, r.comm);
 
@@ -92,7 +146,7 @@ int compute(const Rank& r, const MpiCliArgs& parsed, Clock::time_point start) {
     mpiOptions.mode = parsed.mode;
     Result<HausdorffResult> result =
         hausdorffMpi(r.comm, a->points.view(), b->points.view(), options, mpiOptions);
-    if (!result) return failWith(r, result.error());
+    if (!result) return failWith(r, withFileNames(result.error(), args.pathA, args.pathB));
 
     RunReport report;
     report.args = &args;
@@ -109,6 +163,8 @@ int compute(const Rank& r, const MpiCliArgs& parsed, Clock::time_point start) {
 
 int run(const Rank& r, const std::vector<std::string>& argv) {
     const Clock::time_point start = Clock::now();
+    if (auto differ = commandLineDifference(r, argv))
+        return fail(r, kExitUsage, *differ + "\nTry 'rthdist-mpi --help'.");
     Result<MpiCliArgs> parsed = parseMpiArgs(argv);  // the same on every rank
     if (!parsed) return fail(r, kExitUsage, parsed.error().message + "\nTry 'rthdist-mpi --help'.");
     const CliArgs& args = parsed->cli;

@@ -17,7 +17,15 @@ namespace rthdist::cli {
 struct LoadedSlice {
     io::PointCloud points;   // this rank's slice
     uint64_t fileCount = 0;  // points in the whole file
+    // A 64-bit digest of every point of the whole file as read (its scalar
+    // type and coordinate bytes): ranks compare it before any work, so that
+    // ranks that read different contents (a file changed between reads, node-
+    // local copies that differ) fail instead of computing a mixture.
+    uint64_t checksum = 0;
 };
+
+// The digest of LoadedSlice::checksum over a cloud's points. Local.
+[[nodiscard]] uint64_t pointsChecksum(const io::PointCloud& cloud);
 
 // Local (no MPI). Errors name the file; an empty file is kBadInput "<path>: no points", as in rthdist.
 [[nodiscard]] Result<LoadedSlice> loadSlice(const std::string& path, const io::LoadOptions& options, int rank,
