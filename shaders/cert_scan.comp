@@ -1,10 +1,11 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // The certificate's brute force (core/certificate.hpp): every target of the
-// direction against up to RTHDIST_CERT_ENTRIES band queries, each with its
-// squared bound (search units); every target within a query's bound is
-// appended as a candidate, which the host settles in double. One read of the
-// targets, whatever the number of queries; a grid-stride loop.
+// direction against up to RTHDIST_CERT_ENTRIES band queries. Mode 0 appends
+// every target within an entry's squared bound as a candidate, which the host
+// settles in double; mode 1 finds each entry's float nearest target (its
+// bound for a second mode-0 pass when the first one's candidates overflowed).
+// One read of the targets, whatever the number of queries; a grid-stride loop.
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CertScanPush pc; };
@@ -19,7 +20,11 @@ void main() {
     for (uint t = gl_GlobalInvocationID.x; t < pc.n; t += step) {
         const vec4 p = vec4At(pc.targets, t).v;
         for (uint k = 0u; k < count; ++k) {
-            if (dist2(entries[k].xyz, p.xyz) <= entries[k].w) {
+            const float d2 = dist2(entries[k].xyz, p.xyz);
+            if (pc.mode == 1u) {
+                const uint64_t packed = packDistIndex(d2, floatBitsToUint(p.w));
+                if (packed < u64At(pc.found, k).v) atomicMin(u64At(pc.found, k).v, packed);
+            } else if (d2 <= entries[k].w) {
                 const uint j = atomicAdd(UintRef(pc.found).v, 1u);
                 if (j < pc.capacity) uvec2At(pc.found + 8ul, j).v = uvec2(k, floatBitsToUint(p.w));
             }

@@ -331,7 +331,8 @@ struct CertScanPush {
     uint n;
     uint entryCount;
     uint capacity;  // candidates `found` holds (the count goes on past it: overflow)
-    uint pad;
+    uint mode;      // 0: append every target within an entry's bound; 1: each entry's float nearest
+                    // (squared distance bits << 32 | target) by atomicMin into uint64 `found`[entry]
 };
 
 // refine.comp: exact scan of the candidate pairs' cells.

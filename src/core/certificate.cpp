@@ -76,8 +76,12 @@ DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, co
                                    std::make_pair(q, (const std::vector<uint64_t>*)nullptr));
         return it != known.end() && it->first == q ? it->second : nullptr;
     };
+    // Below (hf - e) / s a query cannot matter: the proof needs a value at or
+    // above it, which no such query can exceed.
+    const double floor = (band.hf - band.slack) / band.scale;
     BandNearest win;
     bool have = false;
+    auto settles = [&](double upper) { return upper >= floor && (!have || upper > win.distance); };
     auto take = [&](const BandNearest& b) {
         if (!have || b.distance > win.distance || (b.distance == win.distance && b.query < win.query))
             win = b;
@@ -88,20 +92,21 @@ DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, co
         // A query whose bound does not exceed the largest exact distance so
         // far cannot raise it (nor win a tie: its index is larger, or it ties
         // a value already reached); neither can any after it.
-        if (have && !(order[i].upper > win.distance)) break;
+        if (!settles(order[i].upper)) break;
         if (const std::vector<uint64_t>* list = candidatesOf(order[i].query)) {
             BandNearest b{order[i].query};
             const glm::dvec3 q = query(order[i].query);
             b.offer(order[i].best, order[i].upper);
             for (uint64_t t : *list) b.offer(t, exactDistance(q, target(t)));
             ++p.bruteForced;
+            p.settled.push_back(b);
             take(b);
             ++i;
             continue;
         }
         std::vector<BandNearest> batch;
         for (size_t j = i; j < order.size() && batch.size() < kBruteForceBatch; ++j) {
-            if (have && !(order[j].upper > win.distance)) break;
+            if (!settles(order[j].upper)) break;
             if (candidatesOf(order[j].query) != nullptr) break;
             BandNearest b{order[j].query};
             b.offer(order[j].best, order[j].upper);  // the bound a device brute force needs
@@ -118,9 +123,15 @@ DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, co
                 p.failure = "band query " + std::to_string(b.query) + " found no target in its brute force";
                 return p;
             }
+            p.settled.push_back(b);
             take(b);
         }
         i += batch.size();
+    }
+    if (!have) {
+        p.failure = "no query of the band reaches the search's maximum " + number(band.hf / band.scale) +
+                    " within the slack";
+        return p;
     }
     p.query = win.query;
     p.target = win.target;
@@ -136,10 +147,17 @@ DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, co
     return p;
 }
 
-void applyProof(Directed& d, const DirectedProof& proof, const PointAt& query, const PointAt& target) {
+void applyProof(Directed& d, const DirectedProof& proof, const PointAt& query, const PointAt& target,
+                PerPoint* perPoint) {
     d.certificate = Certificate{};
     d.certificate.band = proof.band;
     if (!proof.proven) return;
+    if (perPoint != nullptr && !perPoint->nearest.empty()) {
+        for (const BandNearest& b : proof.settled) {
+            perPoint->nearest[b.query] = uint32_t(b.target);
+            if (!perPoint->distance.empty()) perPoint->distance[b.query] = b.distance;
+        }
+    }
     d.queryIndex = proof.query;
     d.targetIndex = proof.target;
     d.queryPoint = query(proof.query);
@@ -153,15 +171,16 @@ void applyProof(Directed& d, const DirectedProof& proof, const PointAt& query, c
 
 void proveFromViews(HausdorffResult& r, const PointView& a, const PointView& b, int threads) {
     if (!r.proofMaterial) return;
-    auto one = [threads](Directed& d, const DirectionBand& band, const PointView& q, const PointView& t) {
+    auto one = [threads](Directed& d, PerPoint& pp, const DirectionBand& band, const PointView& q,
+                         const PointView& t) {
         if (!band.present) return;
         const PointAt query = [&q](uint64_t i) { return q.at(i); };
         const PointAt target = [&t](uint64_t i) { return t.at(i); };
         applyProof(d, proveDirection(band, query, target, hostBruteForce(query, target, t.size(), threads)),
-                   query, target);
+                   query, target, &pp);
     };
-    one(r.aToB, r.proofMaterial->aToB, a, b);
-    if (!r.directedOnly) one(r.bToA, r.proofMaterial->bToA, b, a);
+    one(r.aToB, r.aNearest, r.proofMaterial->aToB, a, b);
+    if (!r.directedOnly) one(r.bToA, r.bNearest, r.proofMaterial->bToA, b, a);
 }
 
 }  // namespace rthdist::core

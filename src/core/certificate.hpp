@@ -103,13 +103,14 @@ using BruteForce = std::function<bool(std::span<BandNearest>)>;
 
 // What the certificate of one direction found.
 struct DirectedProof {
-    bool proven = false;       // the argument above holds: `distance` is h, exact in double
-    uint64_t query = 0;        // the winning query (ties: the smaller index)
-    uint64_t target = 0;       // its nearest target in double (ties: the smaller index)
-    double distance = 0.0;     // their distance, in the input's units
-    uint64_t band = 0;         // queries of the band
-    uint64_t bruteForced = 0;  // band queries whose nearest target was searched in double
-    std::string failure;       // why not proven (empty when proven)
+    bool proven = false;               // the argument above holds: `distance` is h, exact in double
+    uint64_t query = 0;                // the winning query (ties: the smaller index)
+    uint64_t target = 0;               // its nearest target in double (ties: the smaller index)
+    double distance = 0.0;             // their distance, in the input's units
+    uint64_t band = 0;                 // queries of the band
+    uint64_t bruteForced = 0;          // band queries whose nearest target was searched in double
+    std::vector<BandNearest> settled;  // those queries and their exact nearest targets
+    std::string failure;               // why not proven (empty when proven)
 };
 
 // The proof of one direction from its band (see the top of this file). Band
@@ -134,8 +135,11 @@ void proveFromViews(HausdorffResult& r, const PointView& a, const PointView& b, 
 
 // Sets d's witness, value and certificate from a proof that holds (points
 // from `query` and `target`); an unproven one leaves d's witness and value,
-// its certificate unconfirmed.
-void applyProof(Directed& d, const DirectedProof& proof, const PointAt& query, const PointAt& target);
+// its certificate unconfirmed. A per-point array (`perPoint`, if not empty)
+// takes the settled queries' exact nearest targets, so that its maximum is
+// the witness.
+void applyProof(Directed& d, const DirectedProof& proof, const PointAt& query, const PointAt& target,
+                PerPoint* perPoint = nullptr);
 
 }  // namespace rthdist::core
 

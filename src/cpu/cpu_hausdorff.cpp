@@ -533,12 +533,12 @@ core::DirectionBand bandOf(const Direction& d, std::vector<core::BandQuery> quer
 // The certificate from the float sets the backend searched (their own
 // coordinates; HausdorffResult::proofMaterial keeps the band for a proof
 // from the caller's): out.directed takes the proof's witness when it holds.
-void proveDirection(const Direction& d, DirectedOutput& out) {
+void proveDirection(const Direction& d, DirectedOutput& out, PerPoint* perPoint = nullptr) {
     const core::PointAt query = [&d](uint64_t i) { return glm::dvec3(d.queries[i]); };
     const core::PointAt target = [&d](uint64_t i) { return glm::dvec3(d.targets[i]); };
     const core::DirectedProof proof = core::proveDirection(
         out.band, query, target, core::hostBruteForce(query, target, d.targets.size(), d.threads));
-    core::applyProof(out.directed, proof, query, target);
+    core::applyProof(out.directed, proof, query, target, perPoint);
     if (!proof.proven) out.band.failure = proof.failure;
 }
 
@@ -612,11 +612,7 @@ void perPointDirection(const Direction& d, PerPoint& perPoint, Progress& progres
         if (perPoint.distance[i] * d.scale >= top - 2.0 * slack) band.push_back({i, perPoint.nearest[i]});
     out.band = bandOf(d, std::move(band), top);
     out.refineMs = msSince(start);
-    proveDirection(d, out);
-    if (out.directed.certificate.confirmed) {  // the witness's entry as proven
-        perPoint.nearest[out.directed.queryIndex] = uint32_t(out.directed.targetIndex);
-        perPoint.distance[out.directed.queryIndex] = out.directed.distance;
-    }
+    proveDirection(d, out, &perPoint);  // the settled queries' entries as proven
     progress.report("refine", 1.0);
 }
 

@@ -22,8 +22,9 @@ void CertificatePass::startDirection(DirectionRun& d, size_t direction) {
     d.slack =
         core::searchSlack(std::max(core::largestMagnitude(d.Q.bounds), core::largestMagnitude(d.T.bounds)));
     DirectionBuffers& memory = m_ws.scratch.directions[direction];
+    d.bandCapacity = std::min<uint32_t>(kBandCapacity, d.Q.n);  // the band holds at most every query
     d.band =
-        &m_ws.grow(memory.band, 8 + VkDeviceSize(kBandCapacity) * 8, d.name() + ".band", MemoryKind::kHost);
+        &m_ws.grow(memory.band, 8 + VkDeviceSize(d.bandCapacity) * 8, d.name() + ".band", MemoryKind::kHost);
     std::memset(d.band->mapped(), 0, 8);
 }
 
@@ -36,9 +37,9 @@ core::DirectionBand CertificatePass::prove(DirectionRun& d, Directed& out) {
     band.witness = out.queryIndex;
     const auto* words = static_cast<const uint32_t*>(d.band->mapped());
     const uint32_t count = words[0];
-    if (count > kBandCapacity) {
+    if (count > d.bandCapacity) {
         band.failure = "the band of " + std::to_string(count) + " queries within the rounding slack of the " +
-                       "maximum is past its capacity of " + std::to_string(kBandCapacity);
+                       "maximum is past its capacity of " + std::to_string(d.bandCapacity);
     } else {
         std::vector<uint32_t> queries(count), targets(count);
         band.queries.resize(count);
@@ -57,7 +58,25 @@ core::DirectionBand CertificatePass::prove(DirectionRun& d, Directed& out) {
     const core::DirectedProof proof = core::proveDirection(band, query, target, device);
     core::applyProof(out, proof, query, target);
     if (!proof.proven) band.failure = proof.failure;
+    d.settled = proof.proven ? proof.settled : std::vector<core::BandNearest>{};
     return band;
+}
+
+void CertificatePass::scan(DirectionRun& d, uint32_t entries, uint32_t capacity, uint32_t mode) {
+    const sh::CertScanPush push{d.T.sorted->address(),
+                                m_ws.scratch.certificate.entries.address(),
+                                m_ws.scratch.certificate.candidates.address(),
+                                d.T.n,
+                                entries,
+                                capacity,
+                                mode};
+    const uint32_t groups = std::max<uint32_t>(
+        1, std::min({gpu::groupsFor(d.T.n, RTHDIST_WG), kCertGroups, m_ws.ctx.limits().maxGroupsX}));
+    VkCommandBuffer cmd = m_ws.ctx.begin();
+    m_ws.pipelines.cmdDispatch(cmd, Kernel::kCertScan, &push, sizeof(push), groups);
+    gpu::cmdHostReadBarrier(cmd);
+    m_ws.ctx.submitAndWait(cmd);
+    m_ws.timings->gpuCertificate += m_ws.ctx.lastGpuMs();
 }
 
 bool CertificatePass::bruteForce(DirectionRun& d, core::DirectionBand& band,
@@ -65,10 +84,16 @@ bool CertificatePass::bruteForce(DirectionRun& d, core::DirectionBand& band,
     if (batch.size() > RTHDIST_CERT_ENTRIES) return false;
     Buffer& entries = m_ws.grow(m_ws.scratch.certificate.entries, RTHDIST_CERT_ENTRIES * 16, "cert.entries",
                                 MemoryKind::kHost);
-    Buffer& found = m_ws.grow(m_ws.scratch.certificate.candidates, 8 + VkDeviceSize(kCandidateCapacity) * 8,
-                              "cert.candidates", MemoryKind::kHost);
+    // At most every target per query, at most kCandidateCapacity.
+    const auto capacity = uint32_t(std::min<uint64_t>(kCandidateCapacity, uint64_t(d.T.n) * batch.size()));
+    Buffer& found =
+        m_ws.grow(m_ws.scratch.certificate.candidates,
+                  std::max<VkDeviceSize>(8 + VkDeviceSize(capacity) * 8, RTHDIST_CERT_ENTRIES * 8),
+                  "cert.candidates", MemoryKind::kHost);
     auto* e = static_cast<float*>(entries.mapped());
-    for (size_t k = 0; k < batch.size(); ++k) {
+    auto* words = static_cast<uint32_t*>(found.mapped());
+    const auto n = uint32_t(batch.size());
+    for (uint32_t k = 0; k < n; ++k) {
         const glm::vec3 q = d.qPts.searched(uint32_t(batch[k].query));
         // Every target within the query's bound U (its best so far, exact)
         // is within U + e in float; 3e and a relative 2^-20 leave room for a
@@ -79,36 +104,37 @@ bool CertificatePass::bruteForce(DirectionRun& d, core::DirectionBand& band,
         e[4 * k + 2] = q.z;
         e[4 * k + 3] = float(bound * bound * (1.0 + core::kSlackPerMagnitude));
     }
-    std::memset(found.mapped(), 0, 8);
-    const sh::CertScanPush push{d.T.sorted->address(),
-                                entries.address(),
-                                found.address(),
-                                d.T.n,
-                                uint32_t(batch.size()),
-                                kCandidateCapacity,
-                                0u};
-    const uint32_t groups = std::max<uint32_t>(
-        1, std::min({gpu::groupsFor(d.T.n, RTHDIST_WG), kCertGroups, m_ws.ctx.limits().maxGroupsX}));
-    VkCommandBuffer cmd = m_ws.ctx.begin();
-    m_ws.pipelines.cmdDispatch(cmd, Kernel::kCertScan, &push, sizeof(push), groups);
-    gpu::cmdHostReadBarrier(cmd);
-    m_ws.ctx.submitAndWait(cmd);
-    m_ws.timings->gpuCertificate += m_ws.ctx.lastGpuMs();
-    const auto* words = static_cast<const uint32_t*>(found.mapped());
+    std::memset(words, 0, 8);
+    scan(d, n, capacity, 0);
+    if (words[0] > capacity) {
+        // Too many targets within the bounds (a query that died on a far
+        // point): each query's float nearest first, then every target within
+        // it + 2e (where its nearest in double lies: design.md §10).
+        auto* mins = reinterpret_cast<uint64_t*>(words);
+        std::fill(mins, mins + n, ~uint64_t(0));
+        scan(d, n, capacity, 1);
+        for (uint32_t k = 0; k < n; ++k) {
+            const double nearest = std::sqrt(double(std::bit_cast<float>(uint32_t(mins[k] >> 32))));
+            const double bound = nearest + 3.0 * d.slack;
+            e[4 * k + 3] = std::min(e[4 * k + 3], float(bound * bound * (1.0 + core::kSlackPerMagnitude)));
+        }
+        std::memset(words, 0, 8);
+        scan(d, n, capacity, 0);
+        if (words[0] > capacity) return false;
+    }
     const uint32_t count = words[0];
-    if (count > kCandidateCapacity) return false;
-    std::vector<std::vector<uint64_t>> lists(batch.size());
+    std::vector<std::vector<uint64_t>> lists(n);
     std::vector<uint32_t> targets;
     for (uint32_t j = 0; j < count; ++j) {
         const uint32_t k = words[2 + 2 * j], t = words[3 + 2 * j];
-        if (k >= batch.size() || t >= d.T.n) return false;
+        if (k >= n || t >= d.T.n) return false;
         lists[k].push_back(t);
         targets.push_back(t);
     }
     std::vector<uint32_t> queries;
     for (const core::BandNearest& b : batch) queries.push_back(uint32_t(b.query));
     m_check.fetchPoints(d, queries, targets);
-    for (size_t k = 0; k < batch.size(); ++k) {
+    for (uint32_t k = 0; k < n; ++k) {
         const glm::dvec3 q = d.qPts.original(uint32_t(batch[k].query));
         for (uint64_t t : lists[k]) batch[k].offer(t, core::exactDistance(q, d.tPts.original(uint32_t(t))));
         band.candidates.emplace_back(batch[k].query, std::move(lists[k]));

@@ -40,6 +40,9 @@ public:
 private:
     // The brute force of `batch` over d's targets on the device.
     bool bruteForce(DirectionRun& d, core::DirectionBand& band, std::span<core::BandNearest> batch);
+    // One cert_scan.comp pass over d's targets (its entries and candidates
+    // in the certificate scratch), in its own submission.
+    void scan(DirectionRun& d, uint32_t entries, uint32_t capacity, uint32_t mode);
 
     Workspace& m_ws;
     QueryCheck& m_check;

@@ -3,6 +3,8 @@
 // (candidate_search.hpp, refinement.hpp), the self-check (query_check.hpp).
 #pragma once
 
+#include "core/certificate.hpp"
+
 #include <glm/vec3.hpp>
 
 #include <cstdint>
@@ -38,7 +40,9 @@ struct DirectionRun {
     Buffer* nearestHost = nullptr;           // per-point: `nearest` copied by each self-check
     std::vector<uint32_t> checkSlots;        // the self-check's sampled query slots
     Buffer* band = nullptr;                  // host: the certificate's band (certificate_pass.hpp)
+    uint32_t bandCapacity = 0;               // queries `band` holds
     double slack = 0.0;                      // the certificate's e, search units
+    std::vector<core::BandNearest> settled;  // band queries the certificate settled in double
     [[nodiscard]] std::string name() const { return Q.name + "->" + T.name; }
 };
 

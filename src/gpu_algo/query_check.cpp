@@ -36,7 +36,7 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, Che
                      uint32_t(d.checkSlots.size()),
                      d.nearest != nullptr ? d.nearest->address() : 0,
                      d.band != nullptr ? d.band->address() : 0,
-                     kBandCapacity,
+                     d.bandCapacity,
                      float(d.slack * (1.0 + 0x1.0p-20))};
     if (at == CheckAt::kBehindSearch)  // groups written by search_advance.comp: none while queries go on
         m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kCheckQueries, &cp, sizeof(cp),
@@ -146,6 +146,12 @@ void QueryCheck::readPerPoint(const DirectionRun& d, PerPoint& out) {
     if (firstBad.load() != UINT64_MAX)
         throw std::runtime_error("per-point read-back: query " + std::to_string(firstBad.load()) +
                                  " has no nearest point of " + d.T.name);
+    // The queries the certificate settled in double take their exact nearest
+    // targets, so that the array's maximum is the proven witness.
+    for (const core::BandNearest& b : d.settled) {
+        out.nearest[b.query] = uint32_t(b.target);
+        if (distances) out.distance[b.query] = b.distance;
+    }
 }
 
 }  // namespace rthdist::gpu_algo

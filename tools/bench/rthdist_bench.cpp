@@ -146,7 +146,7 @@ int main(int argc, char** argv) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
     std::vector<double> wall, total, index, cull, search, refine, check, gIndex, gCull, gSearch, gRefine,
-        upload;
+        gCert, cert, upload;
     HausdorffResult last;
     const double budgetMs = budgetS * 1e3;
     double warmMs = 0.0, timedMs = 0.0;
@@ -180,6 +180,8 @@ int main(int argc, char** argv) {
         gCull.push_back(t.gpuCull);
         gSearch.push_back(t.gpuSearch);
         gRefine.push_back(t.gpuRefine);
+        gCert.push_back(t.gpuCertificate);
+        cert.push_back(t.certificate);
         last = std::move(res.value());
     }
 
@@ -213,40 +215,43 @@ int main(int argc, char** argv) {
     }
     struct rusage ru {};
     getrusage(RUSAGE_SELF, &ru);
-    const cli::Json j = {{"case", name.empty() ? files[0] + " vs " + files[1] : name},
-                         {"points", {{"a", a.size()}, {"b", b.size()}}},
-                         {"backend", backendName(last.backend)},
-                         {"per_point", options.perPointDistances},
-                         {"growth", double(options.radiusGrowth)},
-                         {"device", last.device},
-                         {"runs", int(wall.size())},
-                         {"warmup", warmDone},
-                         {"hausdorff", last.hausdorff},
-                         {"h_ab", last.aToB.distance},
-                         {"h_ba", last.bToA.distance},
-                         {"bits", {last.aToB.counters.bits, last.bToA.counters.bits}},
-                         {"load_ms", loadMs},
-                         {"setup_ms", setupMs},
-                         {"median_ms",
-                          {{"wall", median(wall)},
-                           {"total", median(total)},
-                           {"upload", median(upload)},
-                           {"index", median(index)},
-                           {"cull", median(cull)},
-                           {"search", median(search)},
-                           {"refine", median(refine)},
-                           {"check", median(check)},
-                           {"gpu_index", median(gIndex)},
-                           {"gpu_cull", median(gCull)},
-                           {"gpu_search", median(gSearch)},
-                           {"gpu_refine", median(gRefine)},
-                           {"gpu_sum", median(gIndex) + median(gCull) + median(gSearch) + median(gRefine)}}},
-                         {"wall_ms_all", wall},
-                         {"counters", std::move(counters)},
-                         {"max_rss_kb", int64_t(ru.ru_maxrss)},
-                         {"cpu_hausdorff", cpuH},
-                         {"cpu_ms", cpuMs},
-                         {"agree", agree}};
+    const cli::Json j = {
+        {"case", name.empty() ? files[0] + " vs " + files[1] : name},
+        {"points", {{"a", a.size()}, {"b", b.size()}}},
+        {"backend", backendName(last.backend)},
+        {"per_point", options.perPointDistances},
+        {"growth", double(options.radiusGrowth)},
+        {"device", last.device},
+        {"runs", int(wall.size())},
+        {"warmup", warmDone},
+        {"hausdorff", last.hausdorff},
+        {"h_ab", last.aToB.distance},
+        {"h_ba", last.bToA.distance},
+        {"bits", {last.aToB.counters.bits, last.bToA.counters.bits}},
+        {"load_ms", loadMs},
+        {"setup_ms", setupMs},
+        {"median_ms",
+         {{"wall", median(wall)},
+          {"total", median(total)},
+          {"upload", median(upload)},
+          {"index", median(index)},
+          {"cull", median(cull)},
+          {"search", median(search)},
+          {"refine", median(refine)},
+          {"check", median(check)},
+          {"gpu_index", median(gIndex)},
+          {"gpu_cull", median(gCull)},
+          {"gpu_search", median(gSearch)},
+          {"gpu_refine", median(gRefine)},
+          {"certificate", median(cert)},
+          {"gpu_certificate", median(gCert)},
+          {"gpu_sum", median(gIndex) + median(gCull) + median(gSearch) + median(gRefine) + median(gCert)}}},
+        {"wall_ms_all", wall},
+        {"counters", std::move(counters)},
+        {"max_rss_kb", int64_t(ru.ru_maxrss)},
+        {"cpu_hausdorff", cpuH},
+        {"cpu_ms", cpuMs},
+        {"agree", agree}};
     std::printf("%s\n", cli::jsonText(j, cli::JsonLayout::kCompact).c_str());
     return agree ? cli::kExitOk : cli::kExitInternal;
 }

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# The certificate's cost on the rows of docs/bench/gpu.md (issue 32): the
+# builds before and after it, alternated in one session on one machine
+# (rthdist-bench, median of 7 runs after 3 warm-ups, no CPU check).
+#   tools/bench/gpu_certificate_ab.sh BUNDLE OUTDIR [ROUNDS]
+# BUNDLE holds rthdist-bench (after), rthdist-bench-before and
+# data/dragon_vrip{,_res2}.ply.gz. Writes OUTDIR/ab.jsonl (one line per round,
+# build and case: the bench's JSON with "build" and "round") and prints a table.
+set -uo pipefail
+B=$(cd "${1:?bundle dir}" && pwd); OUT=${2:?out dir}; ROUNDS=${3:-2}; D=$B/data; S=/tmp/rthdist-samples
+mkdir -p "$OUT" "$S"
+here=$(cd "$(dirname "$0")" && pwd)
+nvidia-smi --query-gpu=name,driver_version --format=csv,noheader > "$OUT/machine.txt" 2>&1
+for spec in "1000000 1 s1m_a" "1000000 2 s1m_b" "5000000 3 s5m_a" "5000000 4 s5m_b"; do
+  set -- $spec
+  [ -f "$S/$3.ply" ] || python3 "$here/sample_surface.py" "$D/dragon_vrip.ply.gz" "$1" "$2" "$S/$3.ply" &
+done
+python3 - "$D/dragon_vrip.ply.gz" "$S" "$here" <<'PY' &
+import sys; sys.path.insert(0, sys.argv[3])
+from ply_points import read_ply, write_ply
+a = read_ply(sys.argv[1])
+for t in (0.3, 0.5, 0.7):
+    b = a.copy(); b[:, 0] += (float(a[:, 0].max()) - float(a[:, 0].min())) * t
+    write_ply("%s/dragon_t%s.ply" % (sys.argv[2], t), b)
+PY
+wait
+cases=(
+  "dragon-res2 $D/dragon_vrip.ply.gz $D/dragon_vrip_res2.ply.gz"
+  "dragon-t0.3 $D/dragon_vrip.ply.gz $S/dragon_t0.3.ply"
+  "dragon-t0.5 $D/dragon_vrip.ply.gz $S/dragon_t0.5.ply"
+  "dragon-t0.7 $D/dragon_vrip.ply.gz $S/dragon_t0.7.ply"
+  "surface-1M $S/s1m_a.ply $S/s1m_b.ply"
+  "surface-5M $S/s5m_a.ply $S/s5m_b.ply"
+)
+for round in $(seq 1 "$ROUNDS"); do
+  for build in before after; do
+    bin=$B/rthdist-bench; [ $build = before ] && bin=$B/rthdist-bench-before
+    for c in "${cases[@]}"; do
+      set -- $c
+      "$bin" "$2" "$3" --name "$1" --backend rt-pipeline --runs 7 --warmup 3 --no-verify 2>> "$OUT/errors.txt" |
+        python3 -c "import json,sys; d=json.load(sys.stdin); d['build']='$build'; d['round']=$round; print(json.dumps(d))" \
+        >> "$OUT/ab.jsonl"
+    done
+  done
+done
+python3 - "$OUT/ab.jsonl" <<'PY' | tee "$OUT/table.txt"
+import json, sys, statistics
+rows = [json.loads(l) for l in open(sys.argv[1])]
+names = []
+for r in rows:
+    if r["name"] not in names: names.append(r["name"])
+print("case | before gpu ms | after gpu ms | certificate gpu ms | share of after | before total ms | after total ms | H equal")
+for n in names:
+    def med(build, key):
+        return statistics.median(r["median_ms"].get(key, 0.0) for r in rows if r["name"] == n and r["build"] == build)
+    hb = {r["hausdorff"] for r in rows if r["name"] == n and r["build"] == "before"}
+    ha = {r["hausdorff"] for r in rows if r["name"] == n and r["build"] == "after"}
+    ga, gc = med("after", "gpu_sum"), med("after", "gpu_certificate")
+    print(f"{n} | {med('before', 'gpu_sum'):.3f} | {ga:.3f} | {gc:.3f} | {100 * gc / ga if ga else 0:.2f}% | "
+          f"{med('before', 'total'):.2f} | {med('after', 'total'):.2f} | {hb == ha} {sorted(ha)}")
+PY
