@@ -128,6 +128,7 @@ struct Certificate {
     uint64_t nearest = 0;     // its nearest target by the brute force in double (= targetIndex)
     double distance = 0.0;    // their distance in double (= Directed::distance)
     uint64_t band = 0;        // queries settled again in double
+    std::string failure;      // with `recomputed`: why the first answer's proof failed
 };
 
 // One directed distance h(Q,T) with its witness.

@@ -69,7 +69,12 @@ std::optional<Error> settleCertificates(HausdorffResult& r, const PointView& a, 
             return Error{ErrorCode::kInternal,
                          std::string("the certificate of ") + name + " did not hold" +
                              (hasBand && !band->failure.empty() ? ": " + band->failure : std::string())};
-        return recompute(d, perPoint, q, t, r.origin, threads, name);
+        const std::string why = hasBand && !band->failure.empty() ? band->failure
+                                : hasBand ? "its proof from the caller's coordinates failed"
+                                          : "the witness query has a nearer target";
+        auto err = recompute(d, perPoint, q, t, r.origin, threads, name);
+        if (!err) d.certificate.failure = why;
+        return err;
     };
     const detail::ProofMaterial* m = r.proofMaterial.get();
     if (auto err = settle(r.aToB, r.aNearest, m ? &m->aToB : nullptr, a, b, "h(A,B)")) return err;

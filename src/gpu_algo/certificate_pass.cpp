@@ -120,7 +120,16 @@ bool CertificatePass::bruteForce(DirectionRun& d, core::DirectionBand& band,
         }
         std::memset(words, 0, 8);
         scan(d, n, capacity, 0);
-        if (words[0] > capacity) return false;
+        if (words[0] > capacity) {
+            // More targets than the candidates hold within the slack of the
+            // nearest (e.g. a dense cluster seen from far away: its extent is
+            // below e, so float cannot order its points): the host measures
+            // every target in double (host arrays; device views cannot).
+            if (d.tPts.onDevice()) return false;
+            const core::PointAt query = [&d](uint64_t i) { return d.qPts.original(uint32_t(i)); };
+            const core::PointAt target = [&d](uint64_t i) { return d.tPts.original(uint32_t(i)); };
+            return core::hostBruteForce(query, target, d.T.n, m_ws.threads)(batch);
+        }
     }
     const uint32_t count = words[0];
     std::vector<std::vector<uint64_t>> lists(n);

@@ -20,16 +20,24 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Largest distance first, then the smallest query index: one engine's rule.
+// The ranks' witnesses compared by their exact values (each rank's engine
+// proved its own: Directed::certificate), the smaller query index among
+// ties; the winner is confirmed when every rank's value was.
 mpi::Candidate winnerOf(MPI_Comm comm, const mpi::Candidate& mine) {
     Result<std::vector<mpi::Candidate>> all = mpi::allgatherRecords(comm, std::vector<mpi::Candidate>{mine});
     mpi::Candidate best;
     if (!all) return best;  // a few bytes per rank; agreed on every rank
+    bool confirmed = true;
+    uint64_t band = 0;
     for (const mpi::Candidate& c : *all) {
         if (!c.any) continue;
-        if (!best.any || c.squaredFloat > best.squaredFloat ||
-            (c.squaredFloat == best.squaredFloat && c.query < best.query))
+        confirmed = confirmed && c.confirmed != 0;
+        band += c.band;
+        if (!best.any || c.distance > best.distance || (c.distance == best.distance && c.query < best.query))
             best = c;
     }
+    best.confirmed = confirmed ? 1 : 0;
+    best.band = band;
     return best;
 }
 
@@ -82,6 +90,11 @@ Result<Directed> direction(MPI_Comm comm, Engine& engine, const mpi::GlobalSets&
     d.queryPoint = mpi::broadcastPoint(comm, q, best.query);
     d.targetPoint = mpi::broadcastPoint(comm, t, best.target);
     d.distance = glm::length(d.queryPoint - d.targetPoint);
+    d.certificate.confirmed = best.confirmed != 0;
+    d.certificate.query = d.queryIndex;
+    d.certificate.nearest = d.targetIndex;
+    d.certificate.distance = d.distance;
+    d.certificate.band = best.band;
     d.counters = reduceCounters(comm, pass->counters);
     mpi::addTimings(timings, pass->timings);
     validation += pass->validationMessages;

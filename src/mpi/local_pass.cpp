@@ -44,6 +44,8 @@ PassOutcome outcomeOf(const HausdorffResult& r, std::span<const glm::vec3> queri
     out.best.query = queryIds[r.aToB.queryIndex];
     out.best.target = targetIds[r.aToB.targetIndex];
     out.best.any = 1;
+    out.best.confirmed = r.aToB.certificate.confirmed ? 1 : 0;
+    out.best.band = r.aToB.certificate.band;
     out.counters = r.aToB.counters;
     out.timings = r.timings;
     out.validationMessages = r.validationMessages;

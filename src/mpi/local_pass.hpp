@@ -22,7 +22,9 @@ struct Candidate {
     float squaredFloat = -1.0f;
     uint32_t query = 0;
     uint32_t target = 0;
-    int32_t any = 0;  // 0: this rank had no query
+    int32_t any = 0;        // 0: this rank had no query
+    int32_t confirmed = 0;  // the rank's engine proved its value (Directed::certificate)
+    uint64_t band = 0;      // the rank's certificate's band
 };
 
 struct PassOutcome {

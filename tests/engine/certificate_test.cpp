@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -102,6 +103,34 @@ TEST(Certificate, FloatTiesAreSettledInDouble) {
     EXPECT_EQ(r->hausdorff, 1.0);
     expectCertificateIsTheWitness(r->aToB);
     expectCertificateIsTheWitness(r->bToA);
+}
+
+// A far query sees a dense cluster whose extent (2 mm) lies below the float
+// slack at its distance (5 km): every cluster point is a candidate of its
+// nearest. More than the device's candidate buffer holds: the host settles
+// them in double, without a recomputation.
+TEST(Certificate, AClusterSeenFromFarIsSettledInDouble) {
+    auto engine = Engine::create(engineUnderTest());
+    ASSERT_TRUE(engine) << engine.error().message;
+    std::vector<glm::vec3> a = randomCloud(70000, 71, glm::vec3(0.0f), 2e-3f);
+    const std::vector<glm::vec3> b = randomCloud(70000, 72, glm::vec3(0.0f), 2e-3f);
+    a.emplace_back(3000.0f, 4000.0f, 0.0f);
+    CallOptions call;
+    call.directedOnly = true;
+    auto r = engine->compute(a, b, call);
+    ASSERT_TRUE(r) << r.error().message;
+    double want = INFINITY;
+    uint64_t nearest = 0;
+    for (size_t t = 0; t < b.size(); ++t) {
+        const glm::dvec3 d = glm::dvec3(a.back()) - glm::dvec3(b[t]);
+        const double dist = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+        if (dist < want) want = dist, nearest = t;
+    }
+    EXPECT_EQ(r->aToB.distance, want);
+    EXPECT_EQ(r->aToB.queryIndex, a.size() - 1);
+    EXPECT_EQ(r->aToB.targetIndex, nearest);
+    expectCertificateIsTheWitness(r->aToB);
+    EXPECT_FALSE(r->aToB.certificate.recomputed) << r->aToB.certificate.failure;
 }
 
 }  // namespace

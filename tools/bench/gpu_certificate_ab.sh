@@ -48,13 +48,13 @@ import json, sys, statistics
 rows = [json.loads(l) for l in open(sys.argv[1])]
 names = []
 for r in rows:
-    if r["name"] not in names: names.append(r["name"])
+    if r["case"] not in names: names.append(r["case"])
 print("case | before gpu ms | after gpu ms | certificate gpu ms | share of after | before total ms | after total ms | H equal")
 for n in names:
     def med(build, key):
-        return statistics.median(r["median_ms"].get(key, 0.0) for r in rows if r["name"] == n and r["build"] == build)
-    hb = {r["hausdorff"] for r in rows if r["name"] == n and r["build"] == "before"}
-    ha = {r["hausdorff"] for r in rows if r["name"] == n and r["build"] == "after"}
+        return statistics.median(r["median_ms"].get(key, 0.0) for r in rows if r["case"] == n and r["build"] == build)
+    hb = {r["hausdorff"] for r in rows if r["case"] == n and r["build"] == "before"}
+    ha = {r["hausdorff"] for r in rows if r["case"] == n and r["build"] == "after"}
     ga, gc = med("after", "gpu_sum"), med("after", "gpu_certificate")
     print(f"{n} | {med('before', 'gpu_sum'):.3f} | {ga:.3f} | {gc:.3f} | {100 * gc / ga if ga else 0:.2f}% | "
           f"{med('before', 'total'):.2f} | {med('after', 'total'):.2f} | {hb == ha} {sorted(ha)}")

@@ -77,7 +77,10 @@ Json certificateJson(const Certificate& c) {
               {"nearest", c.nearest},
               {"distance", c.distance},
               {"band", c.band}};
-    if (c.recomputed) j["recomputed"] = true;
+    if (c.recomputed) {
+        j["recomputed"] = true;
+        j["failure"] = c.failure;
+    }
     return j;
 }
 
