@@ -139,6 +139,15 @@ std::string summaryText(const RunReport& report) {
             "refine %.2f | check %.2f | total %.2f | wall %.2f\n",
             report.loadMs, t.setup, t.upload, t.index, t.cull, t.search, t.refine, t.check, t.total,
             report.wallMs);
+    auto proof = [](const Certificate& c) {
+        std::string text = c.confirmed ? "confirmed" : "not confirmed";
+        appendf(text, " (band %llu)", (unsigned long long)c.band);
+        if (c.recomputed) text += ", recomputed on the CPU backend: " + c.failure;
+        return text;
+    };
+    appendf(s, "certificate h(A,B) %s", proof(r.aToB.certificate).c_str());
+    if (!r.directedOnly) appendf(s, ", h(B,A) %s", proof(r.bToA.certificate).c_str());
+    s += "\n";
     appendf(s, "counters   A->B %s\n", countersText(r.aToB.counters).c_str());
     if (!r.directedOnly) appendf(s, "           B->A %s\n", countersText(r.bToA.counters).c_str());
     if (report.stats != nullptr) s += statsText(*report.stats, r.directedOnly);
