@@ -212,6 +212,7 @@ bool searchTree(const TargetIndex& t, const Query& q, float kill, Best& best, Se
     if (best.d2 < kill) return true;
     if (best.d2 == 0.0f) return false;
     if (level == 0) level = uint32_t(t.levels.size() - 1);
+    const bool mutant = core::searchMutant().load(std::memory_order_relaxed);  // tests only
     struct Entry {
         float d2;
         uint32_t level;
@@ -247,7 +248,7 @@ bool searchTree(const TargetIndex& t, const Query& q, float kill, Best& best, Se
                 ++stats.bucketsScanned;
                 const uint32_t bucket = children[k].node;
                 // Tests only (core/search_mutant.hpp): a search that misses candidates.
-                if (bucket % 3 == 1 && core::searchMutant().load(std::memory_order_relaxed)) continue;
+                if (mutant && bucket % 3 == 1) continue;
                 scanRange(t, t.bucketFirst[bucket], t.bucketFirst[bucket + 1], q, best);
                 if (best.d2 < kill) return true;
                 if (best.d2 == 0.0f) return false;
@@ -512,12 +513,7 @@ inline Best nearestOf(const Direction& d, size_t i, Seeds& seeds, CellCache& cel
 // The certificate's slack e for a direction (core/certificate.hpp): 2^-20 of
 // the largest |coordinate| of both sets (scaled, as searched).
 double slackOf(const Direction& d) {
-    const core::Bounds& q = d.qBounds;
-    const core::Bounds& t = d.tBounds;
-    double m = 0.0;
-    for (const core::Bounds* b : {&q, &t})
-        for (int k = 0; k < 3; ++k) m = std::max({m, std::abs(b->lo[k]), std::abs(b->hi[k])});
-    return core::searchSlack(m);
+    return core::searchSlack(std::max(core::largestMagnitude(d.qBounds), core::largestMagnitude(d.tBounds)));
 }
 
 core::DirectionBand bandOf(const Direction& d, std::vector<core::BandQuery> queries, double hf) {

@@ -179,11 +179,9 @@ core::DirectionBand SmallPairScan::bandOf(const ScanSet& q, const ScanSet& t, co
     core::DirectionBand band;
     band.present = true;
     band.hf = std::sqrt(double(maxD2));
-    double m = 0.0;
-    for (const ScanSet* s : {&q, &t})
-        for (const glm::vec3& p : s->points)
-            m = std::max({m, std::abs(double(p.x)), std::abs(double(p.y)), std::abs(double(p.z))});
-    band.slack = core::searchSlack(m * std::max(q.pointsScale, t.pointsScale));
+    band.slack =
+        core::searchSlack(std::max(core::largestMagnitude(q.points), core::largestMagnitude(t.points)) *
+                          std::max(q.pointsScale, t.pointsScale));
     band.scale = q.inputScale;
     for (size_t i = 0; i < q.points.size(); ++i) {
         const double u = core::exactDistance(glm::dvec3(q.points[i]) * q.pointsScale,
