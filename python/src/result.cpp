@@ -51,6 +51,15 @@ py::dict certificate(const Certificate& c) {
     return d;
 }
 
+// {"a_to_b": of(aToB), "b_to_a": of(bToA) or None when directed}.
+template <class Of>
+py::dict perDirection(const HausdorffResult& r, Of&& of) {
+    py::dict d;
+    d["a_to_b"] = of(r.aToB);
+    d["b_to_a"] = r.directedOnly ? py::object(py::none()) : py::object(of(r.bToA));
+    return d;
+}
+
 py::dict timings(const Timings& t) {
     py::dict d;
     d["setup"] = t.setup;
@@ -304,21 +313,13 @@ void bindResult(py::module_& m) {
         .def_property_readonly(
             "counters",
             [](const PyResult& r) {
-                py::dict d;
-                d["a_to_b"] = counters(r.result.aToB.counters);
-                d["b_to_a"] = r.result.directedOnly ? py::object(py::none())
-                                                    : py::object(counters(r.result.bToA.counters));
-                return d;
+                return perDirection(r.result, [](const Directed& d) { return counters(d.counters); });
             },
             "per direction: bits, occupied_cells, queries, culled_by_neighbourhood, ... (the CLI's keys)")
         .def_property_readonly(
             "certificate",
             [](const PyResult& r) {
-                py::dict d;
-                d["a_to_b"] = certificate(r.result.aToB.certificate);
-                d["b_to_a"] = r.result.directedOnly ? py::object(py::none())
-                                                    : py::object(certificate(r.result.bToA.certificate));
-                return d;
+                return perDirection(r.result, [](const Directed& d) { return certificate(d.certificate); });
             },
             "per direction: the proof that the value is exact in double (the CLI's certificate keys)")
         .def_property_readonly(

@@ -16,6 +16,7 @@
 #include "masks/masks.hpp"
 #include "masks/surfel_area.hpp"
 #include "masks/surfels.hpp"
+#include "masks_test_support.hpp"
 
 namespace rthdist::masks {
 namespace {
@@ -180,13 +181,6 @@ TEST(DeepmindAreaWeighted, FirstCumulativeFractionReachingP) {
     EXPECT_EQ(detail::areaWeightedPercentile(e, ones, 50.0), 2.0);
     EXPECT_EQ(detail::areaWeightedPercentile(e, ones, 50.1), 3.0);
     EXPECT_TRUE(std::isinf(detail::areaWeightedPercentile({}, {}, 50.0)));
-}
-
-Backend backendUnderTest() {
-    const char* env = std::getenv("RTHDIST_TEST_BACKEND");
-    Backend b = Backend::kCpu;
-    if (env && !parseBackend(env, b)) ADD_FAILURE() << "unknown RTHDIST_TEST_BACKEND=" << env;
-    return b;
 }
 
 Volume unitVolume(std::array<int64_t, 3> dims) {

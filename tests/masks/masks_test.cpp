@@ -16,18 +16,12 @@
 #include "masks/gpu_boundary.hpp"
 #include "masks/masks.hpp"
 #include "masks_gpu/boundary_pass.hpp"
+#include "masks_test_support.hpp"
 
 namespace rthdist::masks {
 namespace {
 
 const std::string kNifti = RTHDIST_SHARED_NIFTI_DIR;
-
-Backend backendUnderTest() {
-    const char* env = std::getenv("RTHDIST_TEST_BACKEND");
-    Backend b = Backend::kCpu;
-    if (env && !parseBackend(env, b)) ADD_FAILURE() << "unknown RTHDIST_TEST_BACKEND=" << env;
-    return b;
-}
 
 std::string tempPath(const std::string& name) {
     const char* dir = std::getenv("TMPDIR");

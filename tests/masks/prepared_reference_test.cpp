@@ -15,16 +15,10 @@
 
 #include "masks/masks.hpp"
 #include "masks/prepared_reference.hpp"
+#include "masks_test_support.hpp"
 
 namespace rthdist::masks {
 namespace {
-
-Backend backendUnderTest() {
-    const char* env = std::getenv("RTHDIST_TEST_BACKEND");
-    Backend b = Backend::kCpu;
-    if (env && !parseBackend(env, b)) ADD_FAILURE() << "unknown RTHDIST_TEST_BACKEND=" << env;
-    return b;
-}
 
 MaskEngine engineUnderTest() {
     Options o;
