@@ -92,12 +92,20 @@ void raiseMax(uint64_t maxPacked, uint64_t packed) {
 }
 
 // The threshold below which a query cannot raise h: the larger of the exact
-// running maximum (has a witness) and the witness-less lower bound.
+// running maximum (has a witness) and the witness-less lower bound, lowered
+// by 3e (e: the certificate's slack in the counter block, 0 where none), so
+// that a query killed below it lies below the band the self-check hands to
+// the certificate (check_queries.comp: 2e under the final maximum, which
+// is at least this one): dead queries need no brute force in double.
 // A negative lowerBound2 turns the early break off (per-point distances).
 float deadThreshold(uint64_t maxPacked, float lowerBound2) {
     if (lowerBound2 < 0.0) return 0.0;
     uint64_t m = U64Ref(maxPacked).v;
-    return max(packedDist2(m), lowerBound2);
+    float thr = max(packedDist2(m), lowerBound2);
+    float e = FloatRef(maxPacked + uint64_t(RTHDIST_CTR_KILL_SLACK - RTHDIST_CTR_MAX_PACKED)).v;
+    if (e == 0.0) return thr;
+    float lo = max(sqrt(thr) * (1.0 - 1.0 / 1048576.0) - 3.0 * e, 0.0);
+    return lo * lo * (1.0 - 1.0 / 1048576.0);
 }
 
 // Order-preserving uint of a float (for atomicMin/atomicMax of floats) and back.

@@ -48,6 +48,7 @@ struct vec3f {
 #define RTHDIST_CTR_READBACK 64      // host read-back area after the counters
 #define RTHDIST_CTR_INGEST 1152      // IngestSummary: ingest.comp, one set's bounds and first bad point
 #define RTHDIST_CTR_INGEST64 1184    // IngestSummary64: ingest_f64.comp, one device view's box in double
+#define RTHDIST_CTR_KILL_SLACK 1272  // float: the certificate's slack e (deadThreshold kills below its band)
 #define RTHDIST_CTR_SEARCH_LOG 1280  // SearchLogEntry[RTHDIST_SEARCH_LOG_MAX]: the radii of one submission
 #define RTHDIST_CTR_SEARCH_ARGS \
     1600  // uint[3] groups of the search and resolve, uint[3] rays (search_advance.comp)
@@ -321,6 +322,24 @@ struct CheckPush {
     float bandSlack;      // e of the certificate, search units (rounded up)
 };
 
+// cert_witness.comp: the certificate's brute force of the witness query
+// (the slot in the low half of the maximum), recorded with the final
+// self-check: every target within (sqrt(max) + 4e)^2, rounded up, which holds
+// every target within the host's bound for it (U + 3e, certificate_pass.cpp).
+struct CertWitnessPush {
+    uint64_t targets;   // vec4[n] the target set's points (w = original index)
+    uint64_t queries;   // vec4[queryCount] the query set's cell-sorted points (w = original index)
+    uint64_t counters;  // the counter block (RTHDIST_CTR_MAX_PACKED, RTHDIST_CTR_ACTIVE)
+    uint64_t found;     // uint ran (1), uint query (original index), uint count, uint pad, then
+                        // uint[capacity] targets (original indices)
+    uint n;
+    uint queryCount;
+    uint capacity;   // targets `found` holds (the count goes on past it: overflow)
+    float slack;     // e of the certificate, search units (rounded up)
+    uint afterCull;  // as CheckPush::afterCull: nothing to do when queries survived the cull
+    uint pad0, pad1, pad2;
+};
+
 // cert_scan.comp: the certificate's brute force over every target of a
 // direction for up to RTHDIST_CERT_ENTRIES band queries at once.
 #define RTHDIST_CERT_ENTRIES 64
@@ -512,12 +531,14 @@ static_assert(sizeof(ProbeLevelsPush) == 64 &&
               RTHDIST_CTR_PROBE + (RTHDIST_PROBE_LEVELS + 1) * 4 <= RTHDIST_CTR_SEARCH_ARGS &&
               RTHDIST_CTR_SEARCH_ARGS + 24 <= RTHDIST_CTR_CHECK_ARGS &&
               RTHDIST_CTR_CHECK_ARGS + 12 <= RTHDIST_CTR_BYTES);
-static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDIST_CTR_SEARCH_LOG &&
+static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDIST_CTR_KILL_SLACK &&
+              RTHDIST_CTR_KILL_SLACK + 4 <= RTHDIST_CTR_SEARCH_LOG &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
 static_assert(sizeof(TailScanPush) == 80);
 static_assert(sizeof(CheckPush) == 112 && offsetof(CheckPush, nearestOut) == 88);
 static_assert(sizeof(CertScanPush) == 40);
+static_assert(sizeof(CertWitnessPush) == 64);
 static_assert(sizeof(IngestDevicePush) == 64 && offsetof(IngestDevicePush, n) == 48);
 static_assert(sizeof(BatchDirection) == RTHDIST_BATCH_DIRECTION_BYTES);
 static_assert(sizeof(IngestSummary64) == 56 && offsetof(IngestSummary64, firstBad) == 48);

@@ -68,13 +68,14 @@ DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, co
     std::sort(order.begin(), order.end(), [](const Entry& x, const Entry& y) {
         return x.upper > y.upper || (x.upper == y.upper && x.query < y.query);
     });
-    std::vector<std::pair<uint64_t, const std::vector<uint64_t>*>> known;
-    for (const auto& [q, list] : band.candidates) known.emplace_back(q, &list);
+    // Indices into band.candidates, not pointers: a device brute force
+    // appends to it while the proof runs (CertificatePass::bruteForce).
+    std::vector<std::pair<uint64_t, size_t>> known;
+    for (size_t k = 0; k < band.candidates.size(); ++k) known.emplace_back(band.candidates[k].first, k);
     std::sort(known.begin(), known.end());
     auto candidatesOf = [&](uint64_t q) -> const std::vector<uint64_t>* {
-        auto it = std::lower_bound(known.begin(), known.end(),
-                                   std::make_pair(q, (const std::vector<uint64_t>*)nullptr));
-        return it != known.end() && it->first == q ? it->second : nullptr;
+        auto it = std::lower_bound(known.begin(), known.end(), std::make_pair(q, size_t(0)));
+        return it != known.end() && it->first == q ? &band.candidates[it->second].second : nullptr;
     };
     // Below (hf - e) / s a query cannot matter: the proof needs a value at or
     // above it, which no such query can exceed.

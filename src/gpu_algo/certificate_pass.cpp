@@ -16,16 +16,49 @@ namespace {
 // device, few enough that each loads the band queries once per many targets.
 constexpr uint32_t kCertGroups = 4096;
 
+// The witness's brute force in d's band buffer (cert_witness.comp):
+// uint ran, query, count, pad, then the targets.
+VkDeviceSize witnessOffset(const DirectionRun& d) { return 8 + VkDeviceSize(d.bandCapacity) * 8; }
+
 }  // namespace
+
+void cmdScanWitness(Workspace& ws, VkCommandBuffer cmd, const DirectionRun& d, CheckAt at) {
+    if (d.band == nullptr) return;
+    const sh::CertWitnessPush push{d.T.sorted->address(),
+                                   d.Q.sorted->address(),
+                                   d.blk.device,
+                                   d.band->address() + witnessOffset(d),
+                                   d.T.n,
+                                   d.Q.n,
+                                   kWitnessCapacity,
+                                   float(d.slack * (1.0 + 0x1.0p-20)),
+                                   at == CheckAt::kBehindCull ? 1u : 0u,
+                                   0,
+                                   0,
+                                   0};
+    if (at == CheckAt::kBehindSearch) {  // the check's groups: none while queries go on
+        ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kCertWitness, &push, sizeof(push), ws.hostSmall.handle(),
+                                         d.blk.offset + RTHDIST_CTR_CHECK_ARGS);
+        return;
+    }
+    const uint32_t groups = std::max<uint32_t>(
+        1, std::min({gpu::groupsFor(d.T.n, RTHDIST_WG), kCertGroups, ws.ctx.limits().maxGroupsX}));
+    ws.pipelines.cmdDispatch(cmd, Kernel::kCertWitness, &push, sizeof(push), groups);
+}
 
 void CertificatePass::startDirection(DirectionRun& d, size_t direction) {
     d.slack =
         core::searchSlack(std::max(core::largestMagnitude(d.Q.bounds), core::largestMagnitude(d.T.bounds)));
     DirectionBuffers& memory = m_ws.scratch.directions[direction];
     d.bandCapacity = std::min<uint32_t>(kBandCapacity, d.Q.n);  // the band holds at most every query
-    d.band =
-        &m_ws.grow(memory.band, 8 + VkDeviceSize(d.bandCapacity) * 8, d.name() + ".band", MemoryKind::kHost);
+    d.band = &m_ws.grow(memory.band, witnessOffset(d) + 16 + VkDeviceSize(kWitnessCapacity) * 4,
+                        d.name() + ".band", MemoryKind::kHost);
     std::memset(d.band->mapped(), 0, 8);
+    std::memset(static_cast<char*>(d.band->mapped()) + witnessOffset(d), 0, 16);
+    // The kill threshold's margin (common.glsl, deadThreshold): rounded up,
+    // as the band's slack is (QueryCheck::cmdCheckQueries).
+    const float killSlack = float(d.slack * (1.0 + 0x1.0p-20));
+    std::memcpy(d.blk.host + RTHDIST_CTR_KILL_SLACK, &killSlack, 4);
 }
 
 core::DirectionBand CertificatePass::prove(DirectionRun& d, Directed& out) {
@@ -47,6 +80,21 @@ core::DirectionBand CertificatePass::prove(DirectionRun& d, Directed& out) {
             queries[k] = words[2 + 2 * k];
             targets[k] = words[3 + 2 * k];
             band.queries[k] = {queries[k], targets[k]};
+        }
+        // The witness's brute force, where it ran with the check and its
+        // targets fit: the proof settles the witness from them.
+        const auto* witness = reinterpret_cast<const uint32_t*>(static_cast<const char*>(d.band->mapped()) +
+                                                                witnessOffset(d));
+        const uint32_t found = witness[2];
+        if (witness[0] == 1 && found <= kWitnessCapacity &&
+            std::any_of(queries.begin(), queries.end(), [&](uint32_t q) { return q == witness[1]; })) {
+            std::vector<uint64_t> list;
+            for (uint32_t k = 0; k < found; ++k) {
+                if (witness[4 + k] >= d.T.n) continue;
+                list.push_back(witness[4 + k]);
+                targets.push_back(witness[4 + k]);
+            }
+            band.candidates.emplace_back(witness[1], std::move(list));
         }
         m_check.fetchPoints(d, queries, targets);
     }

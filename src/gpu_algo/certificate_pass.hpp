@@ -21,6 +21,15 @@ namespace rthdist::gpu_algo {
 inline constexpr uint32_t kBandCapacity = uint32_t(1) << 18;
 // Candidates one brute force holds (8 bytes each, host memory).
 inline constexpr uint32_t kCandidateCapacity = uint32_t(1) << 16;
+// Targets the witness's brute force with the self-check holds (4 bytes
+// each, after the band in its buffer); more leave the witness to a brute
+// force of its own.
+inline constexpr uint32_t kWitnessCapacity = uint32_t(1) << 12;
+
+// Records cert_witness.comp (the witness's brute force) beside the
+// direction's check recorded at `at`, with the same early exit: it runs
+// where the check runs whole, once per direction.
+void cmdScanWitness(Workspace& ws, VkCommandBuffer cmd, const DirectionRun& d, CheckAt at);
 
 class CertificatePass {
 public:

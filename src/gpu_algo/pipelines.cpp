@@ -19,6 +19,7 @@
 #include "cell_heads.comp.h"
 #include "cell_keys.comp.h"
 #include "cert_scan.comp.h"
+#include "cert_witness.comp.h"
 #include "check_index.comp.h"
 #include "check_queries.comp.h"
 #include "coarsen.comp.h"
@@ -90,6 +91,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_probe_levels_comp, "probe_levels"},
     {k_spv_tail_scan_comp, "tail_scan"},
     {k_spv_cert_scan_comp, "cert_scan"},
+    {k_spv_cert_witness_comp, "cert_witness"},
 }};
 
 }  // namespace

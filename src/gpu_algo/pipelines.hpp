@@ -46,6 +46,7 @@ enum class Kernel : uint32_t {
     kProbeLevels,    // the bit count's probe (probe_levels.comp): only with shaderFloat64
     kTailScan,       // the candidate search's far tail: whole levels scanned (tail_scan.comp)
     kCertScan,       // the certificate's brute force over a direction's targets (cert_scan.comp)
+    kCertWitness,    // and of the witness alone, with the final self-check (cert_witness.comp)
     kCount
 };
 

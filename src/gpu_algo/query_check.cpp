@@ -43,6 +43,7 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, Che
                                            m_ws.hostSmall.handle(), d.blk.offset + RTHDIST_CTR_CHECK_ARGS);
     else
         m_ws.dispatch(cmd, Kernel::kCheckQueries, cp, d.Q.n);
+    cmdScanWitness(m_ws, cmd, d, at);
     if (d.nearest != nullptr) {
         // Per-point: the whole direction's nearest targets come back with
         // the check (a check behind the cull that found survivors copies

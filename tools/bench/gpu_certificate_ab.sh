@@ -4,7 +4,8 @@
 # (rthdist-bench, median of 7 runs after 3 warm-ups, no CPU check).
 #   tools/bench/gpu_certificate_ab.sh BUNDLE OUTDIR [ROUNDS]
 # BUNDLE holds rthdist-bench (after), rthdist-bench-before and
-# data/dragon_vrip{,_res2}.ply.gz. Writes OUTDIR/ab.jsonl (one line per round,
+# data/dragon_vrip{,_res2}.ply.gz; with SCALE="case ..." (tools/bench/scale_cases.sh)
+# also rthdist-scale-gen, and those cases join the rows (3 runs after 1 warm-up). Writes OUTDIR/ab.jsonl (one line per round,
 # build and case: the bench's JSON with "build" and "round") and prints a table.
 set -uo pipefail
 B=$(cd "${1:?bundle dir}" && pwd); OUT=${2:?out dir}; ROUNDS=${3:-2}; D=$B/data; S=/tmp/rthdist-samples
@@ -13,12 +14,18 @@ here=$(cd "$(dirname "$0")" && pwd)
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader > "$OUT/machine.txt" 2>&1
 # The rows of docs/bench/gpu.md: their inputs and `cases`.
 source "$here/gpu_rows.sh"
+source "$here/scale_cases.sh"
+for c in ${SCALE:-}; do
+  scale_specs "$c" || exit 2
+  scale_files "$B" "$S"
+  cases+=("$c ${files[0]} ${files[1]} 3 1")
+done
 for round in $(seq 1 "$ROUNDS"); do
   for build in before after; do
     bin=$B/rthdist-bench; [ $build = before ] && bin=$B/rthdist-bench-before
     for c in "${cases[@]}"; do
       set -- $c
-      "$bin" "$2" "$3" --name "$1" --backend rt-pipeline --runs 7 --warmup 3 --no-verify 2>> "$OUT/errors.txt" |
+      "$bin" "$2" "$3" --name "$1" --backend rt-pipeline --runs "${4:-7}" --warmup "${5:-3}" --no-verify 2>> "$OUT/errors.txt" |
         python3 -c "import json,sys; d=json.load(sys.stdin); d['build']='$build'; d['round']=$round; print(json.dumps(d))" \
         >> "$OUT/ab.jsonl"
     done

@@ -9,14 +9,9 @@
 #
 #   tools/bench/gpu_scale_suite.sh BUNDLE OUTDIR [CASE...]
 #
-# BUNDLE holds rthdist and rthdist-scale-gen. Cases (default: all but
-# torus-1000x1000, which needs ~24 GB of disk and a long CPU check):
-#   torus-300x400    noisy torus (issue 32), 300M vs 400M points
-#   shell-400x400    noisy unit spherical shells, 400M vs 400M
-#   cluster-100M     100M points in a 2 mm cube beside 10 points 1-10 km away, each set
-#   cube-300x300     uniform in the unit cube, 300M vs 300M
-#   crowded-20M      issue 32's small noisy sphere in a unit box, 20M vs 20M
-#   torus-1000x1000  1B vs 1B: past one device's memory (pieces; --memory-budget applies)
+# BUNDLE holds rthdist and rthdist-scale-gen. Cases: tools/bench/scale_cases.sh
+# (default: all but torus-1000x1000, which needs ~24 GB of disk and a long
+# CPU check).
 # Environment: PROCS (default 2), EXTRA (more rthdist options, e.g. "--memory-budget 20000"),
 # SCRATCH (where the inputs go; default /tmp/rthdist-scale).
 set -uo pipefail
@@ -33,24 +28,11 @@ here=$(cd "$(dirname "$0")" && pwd)
   nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader 2>/dev/null
   nproc
 } > "$OUT/machine.txt"
+source "$here/scale_cases.sh"
 for c in "${cases[@]}"; do
-  case $c in
-    torus-300x400) specs=("torus 300000000 11" "torus 400000000 12") ;;
-    shell-400x400) specs=("shell 400000000 21" "shell 400000000 22") ;;
-    cluster-100M) specs=("cluster 100000000 31" "cluster 100000000 32") ;;
-    cube-300x300) specs=("cube 300000000 41" "cube 300000000 42") ;;
-    crowded-20M) specs=("crowded 20000000 51" "crowded 20000000 52") ;;
-    torus-1000x1000) specs=("torus 1000000000 61" "torus 1000000000 62") ;;
-    *) echo "unknown case $c" >&2; exit 2 ;;
-  esac
-  files=()
+  scale_specs "$c" || exit 2
   t0=$(date +%s%N)
-  for s in "${specs[@]}"; do
-    read -r shape n seed <<< "$s"
-    f="$S/${shape}_${n}_${seed}.ply"
-    files+=("$f")
-    [ -f "$f" ] || "$B/rthdist-scale-gen" "$shape" "$n" "$seed" "$f"
-  done
+  scale_files "$B" "$S"
   echo "$c generated in $(( ($(date +%s%N) - t0) / 1000000 )) ms" >> "$OUT/log.txt"
   for p in $(seq 1 "$PROCS"); do
     # Read once before the first process: every process reads from the page cache.
