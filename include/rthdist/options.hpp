@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "rthdist/export.hpp"
+#include "rthdist/tuning.hpp"
 
 namespace rthdist {
 
@@ -65,14 +66,18 @@ struct EngineOptions {
     // points (checks, bounds, copies); 0 = all hardware threads. The work
     // runs on one persistent worker pool per process (core/thread_pool),
     // whose waiting threads poll for up to 200 us before they sleep
-    // (RTHDIST_POOL_SPIN_US sets it; 0: never).
+    // (Tuning::poolSpinMicros sets it; 0: never).
     int threads = 0;
     // GPU backends: the directory of the pipeline cache file, which spares a
     // new process the pipeline compilation on the same device and driver.
-    // Empty: $RTHDIST_CACHE_DIR, else $XDG_CACHE_HOME/rthdist, else
-    // $HOME/.cache/rthdist; "off": no file. A missing, foreign or damaged
+    // Empty: Tuning::pipelineCacheDir ($RTHDIST_CACHE_DIR, else
+    // $XDG_CACHE_HOME/rthdist, else $HOME/.cache/rthdist); "off": no file. A missing, foreign or damaged
     // file only means compiling again (Engine::pipelineCacheStatus).
     std::string pipelineCacheDir;
+    // Every knob that is not an option (rthdist/tuning.hpp): the search's
+    // radius schedule, the small-pair limit, polling, diagnostics. Empty:
+    // tuningFromEnvironment() when the Engine is created.
+    std::optional<Tuning> tuning;
     // Out-of-core: the memory one backend call may hold, in bytes. A pair of
     // sets larger than that is computed exactly as a sequence of calls over
     // query chunks and target tiles (README, "Inputs larger than the

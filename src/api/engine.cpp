@@ -19,6 +19,7 @@
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
 #include "core/input_limits.hpp"
+#include "core/thread_pool.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 #include "gpu/context.hpp"
 #include "gpu/pipeline_cache.hpp"
@@ -177,17 +178,26 @@ namespace {
 // `borrowed`: the embedder's device (vulkan_interop.hpp) instead of one of ours.
 std::optional<Error> openDevice(const EngineOptions& options, Backend backend, int deviceIndex,
                                 Device& device, const VulkanDevice* borrowed = nullptr) {
-    auto ctx = borrowed ? gpu::Context::borrow(*borrowed, backend, options.validation)
-                        : gpu::Context::create(backend, deviceIndex, options.validation);
+    const Tuning& tuning = *options.tuning;  // Engine::create fills it
+    auto ctx = borrowed ? gpu::Context::borrow(*borrowed, backend, options.validation, tuning)
+                        : gpu::Context::create(backend, deviceIndex, options.validation, tuning);
     if (!ctx) return ctx.error();
     device.context = std::move(ctx.value());
     const std::string cacheDir = options.pipelineCacheDir == "off"  ? std::string()
-                                 : options.pipelineCacheDir.empty() ? gpu::defaultPipelineCacheDir()
+                                 : options.pipelineCacheDir.empty() ? tuning.pipelineCacheDir
                                                                     : options.pipelineCacheDir;
-    auto g = gpu_algo::GpuHausdorff::create(*device.context, cacheDir, options.threads);
+    auto g = gpu_algo::GpuHausdorff::create(*device.context, cacheDir, options.threads, tuning);
     if (!g) return g.error();
     device.gpu = std::move(g.value());
     return std::nullopt;
+}
+
+// The engine's tuning: the caller's, else the environment's (the one read of
+// it, rthdist/tuning.hpp); the worker pool's polling is process-wide.
+void settleTuning(EngineOptions& options) {
+    if (!options.tuning) options.tuning = tuningFromEnvironment();
+    if (options.tuning->poolSpinMicros)
+        core::setPoolSpin(std::chrono::microseconds(*options.tuning->poolSpinMicros));
 }
 
 }  // namespace
@@ -197,6 +207,7 @@ Result<Engine> Engine::create(const EngineOptions& given) {
     auto t0 = std::chrono::steady_clock::now();
     auto impl = std::make_unique<Impl>();
     impl->options = given;
+    settleTuning(impl->options);
     const EngineOptions& options = impl->options;
     if (!options.devices.empty()) impl->options.deviceIndex = options.devices.front();
     impl->device = std::make_shared<Device>();
@@ -242,6 +253,7 @@ Result<Engine> Engine::create(const VulkanDevice& device, const EngineOptions& g
     auto t0 = std::chrono::steady_clock::now();
     auto impl = std::make_unique<Impl>();
     impl->options = given;
+    settleTuning(impl->options);
     impl->options.devices.clear();
     impl->device = std::make_shared<Device>();
     if (auto err = openDevice(impl->options, given.backend, -1, *impl->device, &device)) return *err;

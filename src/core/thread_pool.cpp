@@ -33,15 +33,13 @@
 namespace rthdist::core {
 namespace {
 
-// How long a waiting thread polls before it sleeps: 200 us, or the
-// RTHDIST_POOL_SPIN_US environment variable's value read at the first call
-// (0: never polls; benchmarks compare both).
+// How long a waiting thread polls before it sleeps: 200 us unless
+// setPoolSpin (Tuning::poolSpinMicros) said otherwise (0: never polls;
+// benchmarks compare both).
+std::atomic<int64_t> g_spinMicros{200};
+
 std::chrono::microseconds spinTime() {
-    static const std::chrono::microseconds spin = [] {
-        const char* env = std::getenv("RTHDIST_POOL_SPIN_US");
-        return std::chrono::microseconds(env != nullptr ? std::strtol(env, nullptr, 10) : 200);
-    }();
-    return spin;
+    return std::chrono::microseconds(g_spinMicros.load(std::memory_order_relaxed));
 }
 
 void cpuRelax() {
@@ -287,6 +285,10 @@ WorkerPool& pool() {
 }
 
 }  // namespace
+
+void setPoolSpin(std::chrono::microseconds spin) noexcept {
+    g_spinMicros.store(spin.count(), std::memory_order_relaxed);
+}
 
 void runOnPool(const ChunkTask& task) noexcept {
     auto job = std::make_shared<ChunkJob>(task);

@@ -16,6 +16,7 @@
 //   gone in the child).
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 
 namespace rthdist::core {
@@ -39,6 +40,11 @@ struct ChunkTask {
 // (nested) and from many threads at once always complete.
 // Threading: any thread. run must not throw (std::terminate).
 void runOnPool(const ChunkTask& task) noexcept;
+
+// How long the pool's waiting threads poll before they sleep (default 200
+// us; 0: never). Process-wide; Engine::create sets it from
+// Tuning::poolSpinMicros where given. Threading: any thread.
+void setPoolSpin(std::chrono::microseconds spin) noexcept;
 
 // Pool workers alive now (diagnostics and tests).
 [[nodiscard]] size_t poolWorkerCount() noexcept;

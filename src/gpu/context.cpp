@@ -43,15 +43,6 @@ void throwVulkanError(VkResult result, const char* expr, const char* file, int l
 
 namespace {
 
-// RTHDIST_HOST_IMPORT=1 turns the in-place reads of host arrays on. Off by
-// default: on the H200 (driver 580) importing cost more than the copy it
-// saves (docs/bench/prepared: the pages are pinned on every call; 5M x 5M
-// points: 10.9 ms imported against 6.0 ms copied).
-bool wantsHostImport() {
-    const char* env = std::getenv("RTHDIST_HOST_IMPORT");
-    return env != nullptr && std::string(env) == "1";
-}
-
 bool instanceHasExtension(const char* name) {
     uint32_t n = 0;
     vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr);
@@ -140,17 +131,11 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBit
     return VK_FALSE;
 }
 
-// Whether RTHDIST_DEBUG_LABELS asks for debug names and labels without
-// validation (for GPU captures). Off by default: on the H100 the names and
-// labels cost ~0.1 ms per prepared set and ~0.15 ms per batched pair.
-bool debugLabelsRequested() {
-    const char* v = std::getenv("RTHDIST_DEBUG_LABELS");
-    return v != nullptr && *v != '\0' && std::string_view(v) != "0";
-}
-
 // An instance of Vulkan 1.3, with the validation layer when asked for, and
-// VK_EXT_debug_utils with validation or RTHDIST_DEBUG_LABELS.
-Result<UniqueInstance> makeInstance(bool validation) {
+// VK_EXT_debug_utils with validation or Tuning::debugLabels (names and labels
+// for GPU captures without validation; off by default: on the H100 they cost
+// ~0.1 ms per prepared set and ~0.15 ms per batched pair).
+Result<UniqueInstance> makeInstance(bool validation, bool debugLabels) {
     VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
     app.pApplicationName = "rthdist";
     app.apiVersion = VK_API_VERSION_1_3;
@@ -162,7 +147,7 @@ Result<UniqueInstance> makeInstance(bool validation) {
                          "(Debian: vulkan-validationlayers)"};
         layers.push_back("VK_LAYER_KHRONOS_validation");
     }
-    if (validation || (debugLabelsRequested() && instanceHasExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME)))
+    if (validation || (debugLabels && instanceHasExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME)))
         exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
     ci.pApplicationInfo = &app;
@@ -228,7 +213,7 @@ std::optional<Choice> chooseDevice(const std::vector<VkPhysicalDevice>& pds,
 }  // namespace
 
 Result<std::vector<DeviceInfo>> describeDevices() {
-    auto instance = makeInstance(false);
+    auto instance = makeInstance(false, false);
     if (!instance) return instance.error();
     std::vector<DeviceInfo> out;
     int i = 0;
@@ -236,17 +221,20 @@ Result<std::vector<DeviceInfo>> describeDevices() {
     return out;
 }
 
-Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceIndex, bool validation) {
+Result<std::unique_ptr<Context>> Context::create(Backend backend, int deviceIndex, bool validation,
+                                                 const Tuning& tuning) {
     std::vector<DeviceRequirements> alternatives;
     if (backend != Backend::kRtPipeline) alternatives.push_back(backendRequirements(Backend::kRayQuery));
     if (backend != Backend::kRayQuery) alternatives.push_back(backendRequirements(Backend::kRtPipeline));
-    return create(alternatives, std::string("backend ") + backendName(backend), deviceIndex, validation);
+    return create(alternatives, std::string("backend ") + backendName(backend), deviceIndex, validation,
+                  tuning);
 }
 
 Result<std::unique_ptr<Context>> Context::create(std::span<const DeviceRequirements> alternatives,
-                                                 const std::string& purpose, int deviceIndex,
-                                                 bool validation) {
+                                                 const std::string& purpose, int deviceIndex, bool validation,
+                                                 const Tuning& tuning) {
     std::unique_ptr<Context> ctx(new Context());
+    ctx->m_tuning = tuning;
     try {
         if (std::optional<Error> err = ctx->createInstance(validation)) return *err;
         const std::vector<VkPhysicalDevice> pds = physicalDevices(ctx->m_instance.get());
@@ -274,7 +262,7 @@ Result<std::unique_ptr<Context>> Context::create(std::span<const DeviceRequireme
 }
 
 std::optional<Error> Context::createInstance(bool validation) {
-    Result<UniqueInstance> instance = makeInstance(validation);
+    Result<UniqueInstance> instance = makeInstance(validation, m_tuning.debugLabels);
     if (!instance) return instance.error();
     m_instance = std::move(instance.value());
     m_instanceHandle = m_instance.get();
@@ -322,8 +310,11 @@ void Context::createDevice(const DeviceRequirements& required) {
         deviceHasFeature(m_physical, DeviceFeature::kTraceRaysIndirect))
         req.features.push_back(DeviceFeature::kTraceRaysIndirect);
     // Optional: the device reads the caller's arrays in place (gpu/host_import.hpp).
+    // Off by default (Tuning::hostImport): on the H200 (driver 580) importing
+    // cost more than the copy it saves (docs/bench/prepared: the pages are
+    // pinned on every call; 5M x 5M points: 10.9 ms imported, 6.0 ms copied).
     m_hostImport =
-        wantsHostImport() && deviceHasExtension(m_physical, VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
+        m_tuning.hostImport && deviceHasExtension(m_physical, VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
     std::vector<const char*> optional;
     if (m_hostImport) optional.push_back(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
     VkDevice device;
@@ -350,7 +341,7 @@ void Context::loadLabelFunctions() {
 }
 
 Result<std::unique_ptr<Context>> Context::borrow(const VulkanDevice& handles, Backend backend,
-                                                 bool validation) {
+                                                 bool validation, const Tuning& tuning) {
     if (!handles.instance || !handles.physicalDevice || !handles.device || !handles.queue)
         return Error{ErrorCode::kInvalidArgument,
                      "VulkanDevice: instance, physicalDevice, device and queue must all be set"};
@@ -362,6 +353,7 @@ Result<std::unique_ptr<Context>> Context::borrow(const VulkanDevice& handles, Ba
                       : Backend::kRtPipeline;
     const DeviceRequirements req = backendRequirements(backend);
     std::unique_ptr<Context> ctx(new Context());
+    ctx->m_tuning = tuning;
     try {
         if (std::optional<Error> err = ctx->adopt(handles, req, validation)) return *err;
         if (std::optional<Error> err = ctx->loadRtFunctions(req))
@@ -487,15 +479,14 @@ void Context::createCommandObjects() {
     qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
     qpi.queryCount = kTimestampSlots;
     m_timestamps = RTHDIST_VK_CREATE(UniqueQueryPool, vkCreateQueryPool, d, qpi);
-    m_traceSubmits = std::getenv("RTHDIST_SUBMIT_TRACE") != nullptr;
+    m_traceSubmits = m_tuning.traceSubmits;
     // Not on a CPU device (lavapipe): the polling thread would take a core
     // from the device's own threads (2 cores: 39 -> 51 ms per call).
     VkPhysicalDeviceProperties props{};
     vkGetPhysicalDeviceProperties(m_physical, &props);
     m_cpuDevice = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     m_spinMicros = m_cpuDevice ? 0 : 2000;
-    if (const char* spin = std::getenv("RTHDIST_FENCE_SPIN_US"))
-        m_spinMicros = std::strtoul(spin, nullptr, 10);
+    if (m_tuning.fenceSpinMicros) m_spinMicros = *m_tuning.fenceSpinMicros;
 }
 
 Context::~Context() {

@@ -50,15 +50,17 @@ public:
     // backend: kAuto, kRayQuery or kRtPipeline (backendRequirements; kAuto:
     // ray query where the chosen device has it, else the ray-tracing
     // pipeline). deviceIndex -1 = the best usable device (discrete first).
+    // `tuning`: host import, debug labels, submit trace, fence polling
+    // (rthdist/tuning.hpp; default: none of them, the library's fence time).
     [[nodiscard]] static Result<std::unique_ptr<Context>> create(Backend backend, int deviceIndex,
-                                                                 bool validation);
+                                                                 bool validation, const Tuning& tuning = {});
     // The device (deviceIndex, or the best usable one) that meets one of
     // `alternatives`, the first it meets on that device; backend() is that
     // alternative's. kNoDevice names `purpose` ("backend ray-query", "the
     // splat renderer") and every rejected device with what it lacks.
     [[nodiscard]] static Result<std::unique_ptr<Context>> create(
         std::span<const DeviceRequirements> alternatives, const std::string& purpose, int deviceIndex,
-        bool validation);
+        bool validation, const Tuning& tuning = {});
     // Wraps an embedder's instance, device and queue (rthdist/vulkan_interop.hpp)
     // without owning them: the context creates and destroys only its own
     // children (command pool, fence, query pool, messenger). `backend`
@@ -67,7 +69,7 @@ public:
     // physical device must meet its requirements (kNoDevice naming what it
     // lacks), and the queue family must have compute and timestamps.
     [[nodiscard]] static Result<std::unique_ptr<Context>> borrow(const VulkanDevice& handles, Backend backend,
-                                                                 bool validation);
+                                                                 bool validation, const Tuning& tuning = {});
     ~Context();
     Context(const Context&) = delete;
     Context& operator=(const Context&) = delete;
@@ -126,7 +128,7 @@ public:
     void countValidationMessage() { ++m_validationMessages; }
 
     // Debug utilities (VK_EXT_debug_utils, enabled with validation, or with
-    // RTHDIST_DEBUG_LABELS=1 in the environment for GPU captures). Without it
+    // Tuning::debugLabels, RTHDIST_DEBUG_LABELS=1, for GPU captures). Without it
     // they do nothing, so callers never test for it.
     //
     // Gives a Vulkan object a debug name (shown in validation messages and
@@ -174,13 +176,14 @@ private:
     UniqueQueryPool m_timestamps;
     double m_lastGpuMs = 0.0;
     uint32_t m_marks = 1;  // timestamps written since begin()
-    // RTHDIST_SUBMIT_TRACE=1: one stderr line per submission (host time
+    Tuning m_tuning;       // create's or borrow's
+    // Tuning::traceSubmits: one stderr line per submission (host time
     // recording it, waiting for it, its device time; a benchmark's tool).
     bool m_traceSubmits = false;
     bool m_cpuDevice = false;
     void traceSubmit();
     // How long submitAndWait polls its fence before it sleeps on it
-    // (RTHDIST_FENCE_SPIN_US; 0: never).
+    // (Tuning::fenceSpinMicros; 0: never).
     unsigned long m_spinMicros = 2000;
     [[nodiscard]] VkResult waitBriefly(VkFence fence) const;
     std::chrono::steady_clock::time_point m_begun, m_submitted, m_lastDone;

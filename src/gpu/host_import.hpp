@@ -10,7 +10,7 @@
 // the import before the call returns. An import the driver refuses (memory
 // it cannot pin, an alignment past the page size) is not an error: create()
 // returns nothing and the caller copies instead. Used only when
-// RTHDIST_HOST_IMPORT=1 (gpu/context.cpp says why).
+// Tuning::hostImport (RTHDIST_HOST_IMPORT=1; gpu/context.cpp says why).
 #pragma once
 
 #include <vulkan/vulkan.h>

@@ -92,13 +92,6 @@ std::vector<char> readFile(const std::string& path, std::string& status) {
 
 }  // namespace
 
-std::string defaultPipelineCacheDir() {
-    if (const char* d = std::getenv("RTHDIST_CACHE_DIR"); d && *d) return d;
-    if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return std::string(x) + "/rthdist";
-    if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/rthdist";
-    return "";
-}
-
 PipelineCache::PipelineCache(VkDevice device, VkPhysicalDevice physical, const std::string& dir)
     : m_device(device) {
     VkPhysicalDeviceProperties props;

@@ -55,9 +55,5 @@ private:
     size_t m_loadedBytes = 0;
 };
 
-// Where Engine keeps the file when EngineOptions::pipelineCacheDir is empty:
-// $RTHDIST_CACHE_DIR, else $XDG_CACHE_HOME/rthdist, else $HOME/.cache/rthdist
-// (empty when none is set).
-[[nodiscard]] std::string defaultPipelineCacheDir();
 
 }  // namespace rthdist::gpu

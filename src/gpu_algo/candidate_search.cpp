@@ -18,16 +18,12 @@ static_assert(2 * RTHDIST_SEARCH_LOG_MAX + 2 < gpu::Context::kTimestampSlots);
 CandidateSearch::CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, Refinement& refinement,
                                  QueryCheck& check)
     : m_ws(workspace), m_index(indexBuild), m_refine(refinement), m_check(check) {
-    if (const char* env = std::getenv("RTHDIST_SEARCH_RADII"))
-        radiiPerSubmission =
-            uint32_t(std::clamp<unsigned long>(std::strtoul(env, nullptr, 10), 1, RTHDIST_SEARCH_LOG_MAX));
-    if (const char* env = std::getenv("RTHDIST_SEARCH_TAIL")) squaredTailGrowth = std::strcmp(env, "0") != 0;
-    tailScanWork = m_ws.ctx.cpuDevice() ? kTailScanWorkCpuDevice : kTailScanWorkGpu;
-    if (const char* env = std::getenv("RTHDIST_TAIL_SCAN_WORK"))
-        tailScanWork = std::strtoull(env, nullptr, 10);
-    tailScanStartWork = kTailScanStartWorkGpu;
-    if (const char* env = std::getenv("RTHDIST_TAIL_SCAN_START"))
-        tailScanStartWork = std::strtoull(env, nullptr, 10);
+    const Tuning& t = m_ws.tuning;
+    if (t.searchRadiiPerSubmission)
+        radiiPerSubmission = std::clamp<uint32_t>(*t.searchRadiiPerSubmission, 1, RTHDIST_SEARCH_LOG_MAX);
+    squaredTailGrowth = t.squaredTailGrowth.value_or(true);
+    tailScanWork = t.tailScanWork.value_or(m_ws.ctx.cpuDevice() ? kTailScanWorkCpuDevice : kTailScanWorkGpu);
+    tailScanStartWork = t.tailScanStartWork.value_or(kTailScanStartWorkGpu);
 }
 
 void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options,

@@ -104,20 +104,18 @@ public:
     RadiiOutcome runRadii(DirectionRun& d, int level, bool sameLevel, std::span<const double> radii,
                           Buffer& pairs, uint64_t pairCapacity, uint32_t numActive, bool wholeLevel = false);
 
-    // Radii per submission at most (1 to RTHDIST_SEARCH_LOG_MAX; the
-    // RTHDIST_SEARCH_RADII environment variable sets it for tests and
-    // benchmarks).
+    // Radii per submission at most (1 to RTHDIST_SEARCH_LOG_MAX;
+    // Tuning::searchRadiiPerSubmission sets it for tests and benchmarks).
     uint32_t radiiPerSubmission = RTHDIST_SEARCH_LOG_MAX;
-    // tailStep's squared growth (RTHDIST_SEARCH_TAIL=0 turns it off, for
-    // tests and benchmarks).
+    // tailStep's squared growth (Tuning::squaredTailGrowth = false turns it
+    // off, for tests and benchmarks).
     bool squaredTailGrowth = true;
     // tailScanLevel's work limit: kTailScanWorkGpu, or kTailScanWorkCpuDevice
-    // on a CPU device; the RTHDIST_TAIL_SCAN_WORK environment variable sets
-    // it for tests and benchmarks (0: never).
+    // on a CPU device; Tuning::tailScanWork sets it for tests and
+    // benchmarks (0: never).
     uint64_t tailScanWork = kTailScanWorkGpu;
     // Before any radius: kTailScanStartWorkGpu (0: never), also on a CPU
-    // device; the RTHDIST_TAIL_SCAN_START environment variable sets it
-    // (tests, benchmarks).
+    // device; Tuning::tailScanStartWork sets it (tests, benchmarks).
     uint64_t tailScanStartWork = kTailScanStartWorkGpu;
 
     // Records the search of one radius: the level's boxes grown by the

@@ -37,8 +37,8 @@ void cmdScanWitness(Workspace& ws, VkCommandBuffer cmd, const DirectionRun& d, C
                                    0,
                                    0};
     if (at == CheckAt::kBehindSearch) {  // the check's groups: none while queries go on
-        ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kCertWitness, &push, sizeof(push), ws.hostSmall.handle(),
-                                         d.blk.offset + RTHDIST_CTR_CHECK_ARGS);
+        ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kCertWitness, &push, sizeof(push),
+                                         ws.hostSmall.handle(), d.blk.offset + RTHDIST_CTR_CHECK_ARGS);
         return;
     }
     const uint32_t groups = std::max<uint32_t>(
@@ -83,8 +83,8 @@ core::DirectionBand CertificatePass::prove(DirectionRun& d, Directed& out) {
         }
         // The witness's brute force, where it ran with the check and its
         // targets fit: the proof settles the witness from them.
-        const auto* witness = reinterpret_cast<const uint32_t*>(static_cast<const char*>(d.band->mapped()) +
-                                                                witnessOffset(d));
+        const auto* witness =
+            reinterpret_cast<const uint32_t*>(static_cast<const char*>(d.band->mapped()) + witnessOffset(d));
         const uint32_t found = witness[2];
         if (witness[0] == 1 && found <= kWitnessCapacity &&
             std::any_of(queries.begin(), queries.end(), [&](uint32_t q) { return q == witness[1]; })) {

@@ -60,8 +60,8 @@ std::vector<glm::vec3> scaledCopy(std::span<const glm::vec3> pts, double scale, 
 // indexed (host staging or device ingest), both directions culled together,
 // each direction's search and self-check, the result.
 struct GpuHausdorff::State {
-    State(gpu::Context& ctx, const std::string& cacheDir, int threads)
-        : ws(ctx, cacheDir, threads),
+    State(gpu::Context& ctx, const std::string& cacheDir, int threads, const Tuning& tuning)
+        : ws(ctx, cacheDir, threads, tuning),
           index(ws),
           check(ws),
           cull(ws, check),
@@ -440,10 +440,10 @@ void GpuHausdorff::releaseScratch() {
 uint32_t GpuHausdorff::handedBack() const { return m_state->handedBack; }
 
 Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, const std::string& cacheDir,
-                                                           int threads) {
+                                                           int threads, const Tuning& tuning) {
     try {
         return std::unique_ptr<GpuHausdorff>(
-            new GpuHausdorff(std::make_unique<State>(ctx, cacheDir, threads)));
+            new GpuHausdorff(std::make_unique<State>(ctx, cacheDir, threads, tuning)));
     } catch (const gpu::VulkanError& e) {
         return Error{ErrorCode::kInternal, std::string("pipeline creation failed: ") + e.what()};
     }

@@ -44,7 +44,7 @@ public:
     // 0: every hardware thread).
     [[nodiscard]] static Result<std::unique_ptr<GpuHausdorff>> create(gpu::Context& ctx,
                                                                       const std::string& cacheDir,
-                                                                      int threads);
+                                                                      int threads, const Tuning& tuning);
     ~GpuHausdorff();
 
     // One-shot: both sets indexed for this call, in buffers pooled between

@@ -46,10 +46,9 @@ struct SmallPairScan::Layout {
 };
 
 SmallPairScan::SmallPairScan(Workspace& ws) : m_ws(ws) {
-    m_maxWork = ws.ctx.cpuDevice() ? kMaxWorkCpuDevice : kMaxWorkGpu;
-    // Benchmarks compare both paths on one machine: RTHDIST_SMALL_PAIR_WORK
+    // Benchmarks compare both paths on one machine: Tuning::smallPairWork
     // replaces the limit (0: every pair takes the RT path).
-    if (const char* env = std::getenv("RTHDIST_SMALL_PAIR_WORK")) m_maxWork = std::strtoull(env, nullptr, 10);
+    m_maxWork = ws.tuning.smallPairWork.value_or(ws.ctx.cpuDevice() ? kMaxWorkCpuDevice : kMaxWorkGpu);
 }
 
 bool SmallPairScan::takes(uint64_t queries, uint64_t targets) const {

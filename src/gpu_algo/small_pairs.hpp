@@ -66,7 +66,7 @@ public:
     // Whether a direction of `queries` x `targets` is scanned whole: each at
     // most 2^22 points and the product at most 2^28 on a GPU, 2^20 on a CPU
     // device (lavapipe: its scan of 2,000-10,000-point pairs took 3x the RT
-    // path's time). The environment variable RTHDIST_SMALL_PAIR_WORK
+    // path's time). Tuning::smallPairWork (RTHDIST_SMALL_PAIR_WORK)
     // replaces the product's limit (benchmarks of both paths; 0: none is
     // scanned whole).
     [[nodiscard]] bool takes(uint64_t queries, uint64_t targets) const;

@@ -13,8 +13,9 @@ void reportProgress(const CallOptions& options, const char* stage, double fracti
     throwIfCancelled(options);
 }
 
-Workspace::Workspace(gpu::Context& c, const std::string& cacheDir, int hostThreads)
+Workspace::Workspace(gpu::Context& c, const std::string& cacheDir, int hostThreads, const Tuning& tuned)
     : ctx(c),
+      tuning(tuned),
       pipelineCache(c.device(), c.physicalDevice(), cacheDir),
       pipelines(c, c.backend() == Backend::kRayQuery, pipelineCache.handle()),
       accel(c),

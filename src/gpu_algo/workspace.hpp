@@ -78,9 +78,10 @@ struct Workspace {
     // Creates the pipelines (seeded from the cache file in cacheDir, which is
     // then saved) and the counter blocks. threads: the host's passes over the
     // points (EngineOptions::threads; 0: every hardware thread).
-    Workspace(gpu::Context& c, const std::string& cacheDir, int threads);
+    Workspace(gpu::Context& c, const std::string& cacheDir, int threads, const Tuning& tuning);
 
     gpu::Context& ctx;
+    Tuning tuning;                     // the Engine's (EngineOptions::tuning): read by the stages it tunes
     gpu::PipelineCache pipelineCache;  // before the pipelines it seeds
     gpu::Pipelines pipelines;
     gpu::AccelStructures accel;

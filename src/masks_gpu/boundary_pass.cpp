@@ -141,7 +141,8 @@ uint64_t BoundaryPass::validationMessageCount() const { return m_impl->ctx->vali
 
 Result<std::unique_ptr<BoundaryPass>> BoundaryPass::create(int deviceIndex, bool validation) {
     const std::array<gpu::DeviceRequirements, 1> needs{gpu::computeRequirements()};
-    auto ctx = gpu::Context::create(needs, "the masks boundary pass", deviceIndex, validation);
+    auto ctx = gpu::Context::create(needs, "the masks boundary pass", deviceIndex, validation,
+                                    tuningFromEnvironment());
     if (!ctx) return ctx.error();
     auto impl = std::make_unique<Impl>();
     impl->ctx = std::move(ctx.value());

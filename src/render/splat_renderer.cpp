@@ -152,7 +152,8 @@ Result<std::unique_ptr<SplatRenderer>> SplatRenderer::create(int deviceIndex, bo
     // Compute only: no ray tracing, so any Vulkan 1.3 compute device with
     // 64-bit buffer atomics qualifies.
     const std::array<gpu::DeviceRequirements, 1> needs{gpu::computeRequirements()};
-    auto ctx = gpu::Context::create(needs, "the splat renderer", deviceIndex, validation);
+    auto ctx =
+        gpu::Context::create(needs, "the splat renderer", deviceIndex, validation, tuningFromEnvironment());
     if (!ctx) return ctx.error();
     auto impl = std::make_unique<Impl>();
     impl->ctx = std::move(ctx.value());

@@ -29,22 +29,26 @@ std::vector<glm::vec3> uniformCloud(size_t n, uint64_t seed, glm::vec3 offset, f
     return p;
 }
 
-// Two engines of gpuOptions(): the first made with environment variable
-// `name` set to `value`, the second without it; the variable is restored.
-// Either is empty (whyNot says why) when no device runs the backend.
-std::pair<std::optional<Engine>, std::optional<Engine>> enginesWithAndWithout(const char* name,
-                                                                              const char* value,
-                                                                              std::string& whyNot) {
-    std::optional<Engine> with, without;
-    {
-        const ScopedEnv set(name, value);
-        with = makeEngine(gpuOptions(), whyNot);
-    }
-    {
-        const ScopedEnv unset(name, nullptr);
-        without = makeEngine(gpuOptions(), whyNot);
-    }
-    return {std::move(with), std::move(without)};
+// gpuOptions() with its tuning changed by `tune`.
+Options tunedOptions(const std::function<void(Tuning&)>& tune) {
+    Options o = gpuOptions();
+    tune(*o.tuning);
+    return o;
+}
+
+// Two engines: the first of tunedOptions(with), the second of
+// tunedOptions(base) alone. Either is empty (whyNot says why) when no device
+// runs the backend.
+std::pair<std::optional<Engine>, std::optional<Engine>> enginesWithAndWithout(
+    const std::function<void(Tuning&)>& with, std::string& whyNot,
+    const std::function<void(Tuning&)>& base = [](Tuning&) {}) {
+    std::optional<Engine> tuned = makeEngine(tunedOptions([&](Tuning& t) {
+                                                 base(t);
+                                                 with(t);
+                                             }),
+                                             whyNot);
+    std::optional<Engine> plain = makeEngine(tunedOptions(base), whyNot);
+    return {std::move(tuned), std::move(plain)};
 }
 
 void expectExact(Engine& engine, const std::string& name, uint64_t seed, std::vector<glm::vec3> a,
@@ -144,12 +148,12 @@ TEST(GpuEngine, ReusedEngineStaysExactAcrossSizes) {
 
 // The radii of one search level run in one submission (the count of queries
 // each searches kept on the device) or one per submission
-// (RTHDIST_SEARCH_RADII=1): the same radii, so the same answers, witnesses
+// (Tuning::searchRadiiPerSubmission = 1): the same radii, so the same answers, witnesses
 // and per-point distances (not the same counters: how many queries die early
 // depends on when the running maximum rises, in either mode).
 TEST(GpuEngine, RadiiInOneSubmissionEqualOnePerSubmission) {
     std::string whyNot;
-    auto [single, fused] = enginesWithAndWithout("RTHDIST_SEARCH_RADII", "1", whyNot);
+    auto [single, fused] = enginesWithAndWithout([](Tuning& t) { t.searchRadiiPerSubmission = 1; }, whyNot);
     if (!single || !fused) GTEST_SKIP() << "no device for this backend: " << whyNot;
     uint32_t mostIterations = 0;
     for (uint64_t seed = 31; seed < 38; ++seed) {
@@ -188,13 +192,16 @@ TEST(GpuEngine, RadiiInOneSubmissionEqualOnePerSubmission) {
 // A dense cloud with a few isolated points far from the other set (a noisy
 // mask's outliers): their search is the tail whose radius grows by the
 // square of the growth (CandidateSearch::tailStep). Per-point distances and
-// witnesses equal those with the plain growth (RTHDIST_SEARCH_TAIL=0) and
+// witnesses equal those with the plain growth (Tuning::squaredTailGrowth
+// false) and
 // the brute force; the tail takes fewer radius iterations.
 TEST(GpuEngine, FarTailGrowsFasterAndStaysExact) {
-    const ScopedEnv radiiOnly("RTHDIST_TAIL_SCAN_WORK", "0");  // the tail traced, not scanned
-    const ScopedEnv noStart("RTHDIST_TAIL_SCAN_START", "0");
     std::string whyNot;
-    auto [plain, tail] = enginesWithAndWithout("RTHDIST_SEARCH_TAIL", "0", whyNot);
+    auto [plain, tail] = enginesWithAndWithout([](Tuning& t) { t.squaredTailGrowth = false; }, whyNot,
+                                               [](Tuning& t) {
+                                                   t.tailScanWork = 0;  // the tail traced, not scanned
+                                                   t.tailScanStartWork = 0;
+                                               });
     if (!plain || !tail) GTEST_SKIP() << "no device for this backend: " << whyNot;
     std::vector<glm::vec3> a = uniformCloud(6000, 41, glm::vec3(0.0f));
     const std::vector<glm::vec3> far = uniformCloud(60, 42, glm::vec3(-40.0f), 80.0f);
@@ -223,21 +230,18 @@ TEST(GpuEngine, FarTailGrowsFasterAndStaysExact) {
 // per point and for H alone (where the running maximum kills queries), with
 // every target doubled (copies), and with one bit per axis (the pair buffer
 // overflows before the tail); and with the scan taking the queries the
-// neighbourhood pass left before any radius (RTHDIST_TAIL_SCAN_START, off by
-// default).
+// neighbourhood pass left before any radius (Tuning::tailScanStartWork, off
+// by default).
 TEST(GpuEngine, TailScanEqualsRadiiAndBruteForce) {
     std::string whyNot;
     std::optional<Engine> radiiOnly, tail, fromStart;
-    {
-        const ScopedEnv noTail("RTHDIST_TAIL_SCAN_WORK", "0");
-        const ScopedEnv noStart("RTHDIST_TAIL_SCAN_START", "0");
-        radiiOnly = makeEngine(gpuOptions(), whyNot);
-    }
+    radiiOnly = makeEngine(tunedOptions([](Tuning& t) {
+                               t.tailScanWork = 0;
+                               t.tailScanStartWork = 0;
+                           }),
+                           whyNot);
     tail = makeEngine(gpuOptions(), whyNot);
-    {
-        const ScopedEnv start("RTHDIST_TAIL_SCAN_START", "4294967296");
-        fromStart = makeEngine(gpuOptions(), whyNot);
-    }
+    fromStart = makeEngine(tunedOptions([](Tuning& t) { t.tailScanStartWork = uint64_t(1) << 32; }), whyNot);
     if (!radiiOnly || !tail || !fromStart) GTEST_SKIP() << "no device for this backend: " << whyNot;
     uint64_t scanned = 0;
     uint32_t scannedWhole = 0;  // directions whose whole search was one scan

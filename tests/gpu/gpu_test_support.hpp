@@ -20,10 +20,14 @@ inline Backend backendUnderTest() {
     return b;
 }
 
+// Small one-shot pairs take the RT path (Tuning::smallPairWork = 0): these
+// tests are the RT search's, the small-pair scan has its own.
 inline Options gpuOptions() {
     Options o;
     o.backend = backendUnderTest();
     o.validation = true;
+    o.tuning = tuningFromEnvironment();
+    o.tuning->smallPairWork = 0;
     return o;
 }
 

@@ -121,8 +121,9 @@ TEST(IngestPath, DeviceBitCountEqualsTheHostCount) {
 TEST(IngestPath, ImportedOrCopiedArraysStartingAnywhere) {
     const std::vector<OracleCase> cases = makeOracleCases();
     for (const char* import : {"1", "0"}) {
-        const ScopedEnv imports("RTHDIST_HOST_IMPORT", import);  // read when the device is made
-        RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+        Options options = gpuOptions();
+        options.tuning->hostImport = import[0] == '1';
+        RTHDIST_REQUIRE_ENGINE(engine, options);
         for (size_t k = 5; k < cases.size(); k += 41) {
             const OracleCase& c = cases[k];
             SCOPED_TRACE(c.name + (import[0] == '1' ? " imported" : " copied"));

@@ -107,7 +107,7 @@ TEST(LargeSizes, ExactWhenEverySplitIsForcedSmall) {
     limits.maxGroupsX = 3;
     limits.maxRayDispatch = 5;
     ctx->setLimits(limits);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
     ASSERT_TRUE(engine) << engine.error().message;
     (*engine)->setMaxPairCapacity(600);
     const std::vector<OracleCase> cases = makeOracleCases();
@@ -138,7 +138,7 @@ TEST(LargeSizes, ExactWhenEverySplitIsForcedSmall) {
 // points a set; before the fix its H came out 16 % too large).
 TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
     ASSERT_TRUE(engine) << engine.error().message;
     std::vector<OracleCase> cases;
     for (const OracleCase& c : makeDensityCases())
@@ -174,7 +174,7 @@ TEST(LargeSizes, BufferPastMaxBufferSizeIsRefusedWithTheLimitNamed) {
     gpu::DeviceLimits limits = ctx->limits();
     limits.maxBufferBytes = 64 << 10;  // 4096 points of 16 bytes
     ctx->setLimits(limits);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
     ASSERT_TRUE(engine) << engine.error().message;
     std::vector<glm::vec3> a(10000), b(3);
     for (size_t i = 0; i < a.size(); ++i) a[i] = glm::vec3(float(i % 100), float(i / 100), 0.0f);
@@ -194,7 +194,7 @@ TEST(LargeSizes, BlasPastMaxPrimitiveCountIsRefusedWithTheLimitNamed) {
     gpu::DeviceLimits limits = ctx->limits();
     limits.maxPrimitives = 2;
     ctx->setLimits(limits);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
     ASSERT_TRUE(engine) << engine.error().message;
     // Far-apart sets: queries survive the neighbourhood pass and need rays.
     std::vector<glm::vec3> a, b;

@@ -1,0 +1,69 @@
+// Tuning: every knob of the library that is not an option of a call or an
+// engine, in one struct, each with the reason it exists. None changes a
+// result: each trades one cost against another, or turns a diagnostic on.
+// The library reads them from the environment in exactly one place
+// (tuningFromEnvironment, src/core/tuning.cpp; README "Tuning" lists the
+// variables); an Engine takes EngineOptions::tuning where set, else that.
+// Tests and benchmarks set fields. An empty optional keeps the library's
+// choice for the device at hand (it differs between GPUs and lavapipe).
+// Threading: a plain value; tuningFromEnvironment may run on any thread
+// (it only reads the environment).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "rthdist/export.hpp"
+
+namespace rthdist {
+
+struct Tuning {
+    // Pairs of at most this many queries x targets take the small-pair scan
+    // (one exact compute pass, no index) instead of the RT search; 0: every
+    // pair takes the RT path (the GPU oracle tests, so that they test it).
+    // RTHDIST_SMALL_PAIR_WORK.
+    std::optional<uint64_t> smallPairWork;
+    // Search radii recorded per submission at most, 1-16 (fewer: the search's
+    // submissions can be counted by tests). RTHDIST_SEARCH_RADII.
+    std::optional<uint32_t> searchRadiiPerSubmission;
+    // The radius of a far tail of queries grows by its square, not by the
+    // growth factor (false: the plain schedule, for tests and benchmarks).
+    // RTHDIST_SEARCH_TAIL (0: false).
+    std::optional<bool> squaredTailGrowth;
+    // The far tail's whole-level scan takes a level of at most this many
+    // query x cell pairs after the radii (0: never). RTHDIST_TAIL_SCAN_WORK.
+    std::optional<uint64_t> tailScanWork;
+    // The same before the first radius (0: never, the default).
+    // RTHDIST_TAIL_SCAN_START.
+    std::optional<uint64_t> tailScanStartWork;
+    // Read host arrays in place (VK_EXT_external_memory_host) instead of
+    // copying them: off by default, on the H200 pinning cost more than the
+    // copy it saves (docs/bench/prepared). RTHDIST_HOST_IMPORT=1.
+    bool hostImport = false;
+    // Debug names and labels on Vulkan objects and command buffers without
+    // validation, for GPU captures (~0.1 ms per prepared set on an H100).
+    // RTHDIST_DEBUG_LABELS (set and not 0).
+    bool debugLabels = false;
+    // One line per submission on stderr (host and device times).
+    // RTHDIST_SUBMIT_TRACE (set).
+    bool traceSubmits = false;
+    // How long the host polls a fence before it sleeps, microseconds
+    // (default 2000 on a GPU, 0 on lavapipe, where the polling thread takes a
+    // core from the device's own). RTHDIST_FENCE_SPIN_US.
+    std::optional<uint32_t> fenceSpinMicros;
+    // How long the worker pool's waiting threads poll before they sleep,
+    // microseconds (default 200; 0: never). The pool is one per process:
+    // the last Engine created with a value sets it. RTHDIST_POOL_SPIN_US.
+    std::optional<uint32_t> poolSpinMicros;
+    // Where the pipeline cache file goes when EngineOptions::pipelineCacheDir
+    // is empty: $RTHDIST_CACHE_DIR, else $XDG_CACHE_HOME/rthdist, else
+    // $HOME/.cache/rthdist; empty: no file.
+    std::string pipelineCacheDir;
+};
+
+// The tuning the environment asks for (the variables named above; unset or
+// unparsable ones leave the field empty or false).
+[[nodiscard]] RTHDIST_API Tuning tuningFromEnvironment();
+
+}  // namespace rthdist
