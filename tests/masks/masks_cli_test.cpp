@@ -13,6 +13,16 @@
 #include "cli/cli_runner.hpp"
 #include "volume_files.hpp"
 
+// Under AddressSanitizer (preset asan) the CLI's resident set holds the
+// shadow memory and the quarantine: VoxelsAreHeldOnce checks the run, not the bound.
+#if defined(__SANITIZE_ADDRESS__)
+#define RTHDIST_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define RTHDIST_TEST_ASAN 1
+#endif
+#endif
+
 namespace rthdist::masks_test {
 namespace {
 
@@ -193,6 +203,9 @@ TEST(MasksCli, VoxelsAreHeldOnce) {
     }
     const CliRun run = masks({"--backend", "cpu", "--csv", a, b});
     ASSERT_EQ(run.exitCode, 0) << run;
+#ifdef RTHDIST_TEST_ASAN
+    return;
+#endif
     rusage usage{};
     ASSERT_EQ(::getrusage(RUSAGE_CHILDREN, &usage), 0);
     const double peakMiB = double(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB
