@@ -19,7 +19,7 @@ if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 
 BASE_PKGS=(cmake g++ make pkg-config libvulkan-dev glslang-tools libglm-dev
   libtinygltf-dev libgtest-dev libnanoflann-dev zlib1g-dev vulkan-validationlayers
-  vulkan-tools nlohmann-json3-dev libcli11-dev libstb-dev strace libnifti2-dev
+  vulkan-tools nlohmann-json3-dev libcli11-dev libstb-dev strace
   openmpi-bin libopenmpi-dev)
 EXTRA_PKGS=()
 if [ "${RTHDIST_MASKS_DEPS:-1}" = 1 ]; then

@@ -3,8 +3,11 @@
 // fail, because CI must provide lavapipe (README "lavapipe").
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -177,6 +180,59 @@ TEST_P(CliGpu, DevicesEachOnceAndBounded) {
     for (int i = 1; i < 17; ++i) seventeen += "," + std::to_string(i);
     const CliRun over = runCli({"--backend", GetParam(), "--devices", seventeen, kSampleA, kSampleB});
     EXPECT_EQ(over.exitCode, 2) << over;
+    // The issue's case: one device listed 2,000 times (it opened the device
+    // 2,000 times, minutes and gigabytes); `timeout` turns a hang into 137.
+    std::string same = "0";
+    for (int i = 1; i < 2000; ++i) same += ",0";
+    const CliRun repeated =
+        runCli({"--backend", GetParam(), "--devices", same, kSampleA, kSampleB}, "", "timeout -s KILL 60");
+    EXPECT_EQ(repeated.exitCode, 2) << repeated.exitCode << repeated.err;
+}
+
+// The pipeline cache through the CLI (issue 36; the library's cases are
+// tests/engine PipelineCache). The temporary file used to be <cache>.tmp<pid>,
+// opened with O_TRUNC through whatever was there: a symlink planted at that
+// name (the shell's pid is the CLI's after exec) made rthdist overwrite the
+// file it points to. It is neither followed nor written through now.
+TEST_P(CliGpu, PipelineCacheWritesThroughNoPlantedSymlink) {
+    namespace fs = std::filesystem;
+    TempDir dir;
+    const fs::path cache = dir.path() / "cache";
+    ASSERT_EQ(::mkdir(cache.c_str(), 0700), 0);
+    const std::string victim = dir.write("victim", "precious");
+    const std::string env = "export RTHDIST_CACHE_DIR=" + shellQuote(cache.string()) + ";";
+    const std::vector<std::string> args = {"--backend", GetParam(), kSampleA, kSampleB};
+    const CliRun first = runCli(args, env);
+    ASSERT_EQ(first.exitCode, 0) << first;
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(cache)) files.push_back(e.path());
+    ASSERT_EQ(files.size(), 1u) << "the cache file";
+    const std::string file = files[0].string();
+    fs::remove(file);  // written again by the next run
+    const CliRun planted =
+        runCli(args, env + " ln -s " + shellQuote(victim) + " " + shellQuote(file) + ".tmp$$;");
+    EXPECT_EQ(planted.exitCode, 0) << planted;
+    EXPECT_EQ(readFile(victim), "precious");
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(file))) << "the cache, written anew";
+}
+
+// A cache directory that other users can write is neither read nor written
+// (unless it is sticky and ours); the run itself succeeds.
+TEST_P(CliGpu, PipelineCacheDirectoryOthersCanWriteIsLeftAlone) {
+    namespace fs = std::filesystem;
+    TempDir dir;
+    const fs::path cache = dir.path() / "shared";
+    ASSERT_EQ(::mkdir(cache.c_str(), 0700), 0);
+    const std::string env = "export RTHDIST_CACHE_DIR=" + shellQuote(cache.string()) + ";";
+    for (const mode_t mode : {mode_t(0777), mode_t(0775), mode_t(01777)}) {
+        SCOPED_TRACE("mode " + std::to_string(mode));
+        ASSERT_EQ(::chmod(cache.c_str(), mode), 0);
+        const CliRun run = runCli({"--backend", GetParam(), kSampleA, kSampleB}, env);
+        EXPECT_EQ(run.exitCode, 0) << run;
+        const bool sticky = (mode & 01000) != 0;
+        EXPECT_EQ(fs::is_empty(cache), !sticky) << "written only when sticky and ours";
+        for (const auto& e : fs::directory_iterator(cache)) fs::remove(e.path());
+    }
 }
 
 // A device of --devices that does not exist is no device (exit 4), named.

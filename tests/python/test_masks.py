@@ -246,6 +246,24 @@ def test_empty_masks_are_a_status(which, tmp_path, pair):
     assert deepmind.convention_value["a_to_b"]["surface_overlap"] == ("0" if which == "b_empty" else "nan")
 
 
+def test_spacing_below_the_limit_is_a_value_error(backend):
+    """Issue 36: a spacing below what the engine computes exactly gave wrong
+    values silently (1e-40 mm along x: H 3e-40 for 2e-40); below 1e-30 mm it
+    is a ValueError naming the axis and the limit, just above it exact."""
+    a = np.zeros((8, 8, 8), np.uint8)
+    a[2:4, 2:4, 2:4] = 1
+    b = np.zeros_like(a)
+    b[3:6, 2:4, 2:4] = 1
+    limit = r"below the smallest spacing rthdist computes exactly, 1e-30 mm"
+    for spacing in [(1e-40, 1.0, 1.0), (1.0, 1e-40, 1.0)]:
+        with pytest.raises(ValueError, match=limit):
+            rthdist.compare_masks(a, b, spacing=spacing, backend=backend)
+    with pytest.raises(ValueError, match=limit):
+        rthdist.compare_masks(a, b, affine=np.diag([1e-40, 1.0, 1.0, 1.0]), backend=backend)
+    exact = rthdist.compare_masks(a, b, spacing=(1e-29, 1.0, 1.0), backend=backend)
+    assert exact.hd == pytest.approx(2e-29, rel=1e-12)
+
+
 def test_bad_inputs_raise_value_errors(pair):
     a, b = pair
     with pytest.raises(ValueError, match="different grids.*22x18x10"):
