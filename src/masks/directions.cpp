@@ -79,10 +79,6 @@ void addPercentiles(Convention c, const std::vector<double>& percentiles, Direct
 
 }  // namespace
 
-double msSince(Clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
-
 // MONAI and plastimatch have no connectivity parameter (SciPy's default cross;
 // plastimatch's face neighbours): 6 whatever is asked. rthdist and MedPy take one.
 int connectivityOf(Convention c, int requested) {
