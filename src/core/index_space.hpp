@@ -14,7 +14,9 @@
 #include <cstdint>
 #include <span>
 
-#include "rthdist_morton.h"
+// By its path from here: every target that includes this header finds it
+// (the shaders' own include path is the library layers').
+#include "../../shaders/shared/rthdist_morton.h"
 
 namespace rthdist::core {
 
