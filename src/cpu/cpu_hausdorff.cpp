@@ -93,7 +93,9 @@ inline v8f load8(const float* p) {
     return v;
 }
 inline v8f splat(float s) { return v8f{s, s, s, s, s, s, s, s}; }
-inline float hmin(v8f v) {
+// By reference: a 32-byte vector passed by value without AVX makes GCC note
+// an ABI change (-Wpsabi) in every build.
+inline float hmin(const v8f& v) {
     float m = v[0];
     for (int l = 1; l < 8; ++l) m = v[l] < m ? v[l] : m;
     return m;
