@@ -21,8 +21,8 @@
 
 #include "core/stopwatch.hpp"
 #include "core/uninit_vector.hpp"
-#include "masks/masks.hpp"
 #include "masks/voxel_metric.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks::detail {
 
