@@ -1,5 +1,6 @@
 # Install rules and the two ways to consume the installed library:
-#   CMake:      find_package(rthdist [COMPONENTS io]) -> rthdist::rthdist, rthdist::io
+#   CMake:      find_package(rthdist [COMPONENTS io masks]) -> rthdist::rthdist, rthdist::io,
+#               rthdist::masks (static builds)
 #   pkg-config: rthdist.pc, rthdist-io.pc
 # Static builds also install the internal layers librthdist.a needs
 # (librthdist_core.a, _cpu.a, _gpu.a, _gpu_algo.a; exported as rthdist::core,
@@ -28,6 +29,15 @@ install(TARGETS rthdist_io EXPORT rthdistIoTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The masks component (static builds): rthdist::masks and the two archives it links.
+if(TARGET rthdist_masks_core AND NOT BUILD_SHARED_LIBS)
+  set_target_properties(rthdist_masks_core PROPERTIES EXPORT_NAME masks)
+  set_target_properties(rthdist_masks_volumes PROPERTIES EXPORT_NAME masks_volumes)
+  set_target_properties(rthdist_masks_gpu PROPERTIES EXPORT_NAME masks_gpu)
+  install(TARGETS rthdist_masks_core rthdist_masks_volumes rthdist_masks_gpu EXPORT rthdistMasksTargets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(EXPORT rthdistMasksTargets NAMESPACE rthdist:: DESTINATION ${RTHDIST_CMAKE_DIR})
+endif()
 install(DIRECTORY include/rthdist ${RTHDIST_GENERATED_INCLUDE}/rthdist DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(EXPORT rthdistTargets NAMESPACE rthdist:: DESTINATION ${RTHDIST_CMAKE_DIR})
 install(EXPORT rthdistIoTargets NAMESPACE rthdist:: DESTINATION ${RTHDIST_CMAKE_DIR})

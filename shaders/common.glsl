@@ -8,6 +8,7 @@
 #extension GL_EXT_shader_atomic_int64 : require
 #extension GL_EXT_scalar_block_layout : require
 
+#include "rthdist_morton.h"
 #include "rthdist_shared.h"
 
 // Every record is reached at a 64-bit byte offset from its buffer's device
@@ -38,16 +39,8 @@ uint searchedCount(uint64_t counters, uint dispatched) {
     return min(dispatched, UintRef(counters + RTHDIST_CTR_SEARCH_ACTIVE).v);
 }
 
-uint spreadBits(uint v) {
-    v &= 0x3ffu;
-    v = (v | (v << 16)) & 0x030000ffu;
-    v = (v | (v << 8)) & 0x0300f00fu;
-    v = (v | (v << 4)) & 0x030c30c3u;
-    v = (v | (v << 2)) & 0x09249249u;
-    return v;
-}
-
-uint mortonKey(uvec3 c) { return spreadBits(c.x) | (spreadBits(c.y) << 1) | (spreadBits(c.z) << 2); }
+// spreadBits and mortonEncode: rthdist_morton.h (the C++ side's too).
+uint mortonKey(uvec3 c) { return mortonEncode(c.x, c.y, c.z); }
 
 vec3 gridOrigin(GridParams g) { return vec3(g.originX, g.originY, g.originZ); }
 

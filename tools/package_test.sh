@@ -2,7 +2,7 @@
 # The installed package, as a user gets it: for a static and a shared build
 # (build-pkg-static/, build-pkg-shared/; library only), `cmake --install` to a
 # temporary prefix, then tests/package/consumer built and run against it
-#   1. with CMake (find_package(rthdist [COMPONENTS io]); the compiler's
+#   1. with CMake (find_package(rthdist [COMPONENTS io masks]); the compiler's
 #      default C++ standard, so the targets must carry cxx_std_20),
 #   2. with pkg-config (g++ -std=c++20 $(pkg-config --cflags --libs rthdist)).
 # The shared libraries must export rthdist's public API only, and README.md's
@@ -39,6 +39,12 @@ for kind in static shared; do
   cmake --build "$work/consumer-$kind" -j "$jobs"
   "$work/consumer-$kind/app"
   "$work/consumer-$kind/app_io"
+  # The masks component: in the static package, not in the shared one.
+  if [[ $kind == static ]]; then
+    "$work/consumer-$kind/app_masks"
+  elif [[ -e "$work/consumer-$kind/app_masks" ]]; then
+    echo "the shared package has a masks component"; exit 1
+  fi
 
   echo "-- pkg-config consumer"
   pcdir=$(dirname "$(find "$prefix" -name rthdist.pc)")

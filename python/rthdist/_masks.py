@@ -1,7 +1,7 @@
 """Segmentation masks from Python: rthdist.compare_masks, MaskEngine, MaskVolume,
 PreparedReference.
 
-The C++ masks library (src/masks/masks.hpp, README "Segmentation masks") on
+The C++ masks library (include/rthdist/masks.hpp, README "Segmentation masks") on
 NumPy label arrays and nibabel images: HD, HD-p, ASSD/MSD and surface Dice in
 the convention of a named tool, exactly, with the rows of `rthdist-masks
 --json` as results (MaskResult.to_dict() is such a row).
@@ -214,7 +214,7 @@ def _percentiles(percentiles):
 
 class PreparedReference:
     """A reference (ground-truth) mask prepared once on a MaskEngine
-    (MaskEngine.prepare_reference; src/masks/prepared_reference.hpp): its
+    (MaskEngine.prepare_reference; include/rthdist/masks.hpp): its
     boundary voxels (itk: also its foreground) extracted and indexed on the
     engine's device (deepmind: its surfels extracted), so that each
     comparison with a prediction extracts and indexes only the prediction.

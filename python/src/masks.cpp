@@ -18,8 +18,7 @@
 
 #include "engine.hpp"
 #include "errors.hpp"
-#include "masks/masks.hpp"
-#include "masks/prepared_reference.hpp"
+#include "rthdist/masks.hpp"
 
 namespace py = pybind11;
 
@@ -112,7 +111,7 @@ py::dict directedDict(const masks::DirectedMask& d, const MaskResult& r, bool ok
     out["hd"] = number(d.hd);
     out["mean"] = number(d.mean);
     out["surface_overlap"] = number(d.surfaceOverlap);
-    const bool corners = r.convention == Convention::kDeepmind;
+    const bool corners = masks::conventionRules(r.convention).points == masks::PointSet::kSurfels;
     if (corners) out["area_mm2"] = number(d.area);
     out["percentiles"] = percentileRows(r.percentiles, d.percentiles);
     out[corners ? "corner" : "voxel"] = py::cast(d.voxel);
@@ -171,10 +170,8 @@ py::dict rowDict(const std::string& label, const MaskResult& r) {
     out["convention"] = masks::conventionName(r.convention);
     out["rule"] = masks::conventionRule(r.convention);
     out["connectivity"] = r.connectivity;
-    out["geometry"] = r.convention == Convention::kRthdist ? "world" : "spacing";
-    out["points_are"] = r.convention == Convention::kDeepmind ? "surfels"
-                        : r.convention == Convention::kItk    ? "voxels"
-                                                              : "boundary_voxels";
+    out["geometry"] = masks::metricName(masks::conventionRules(r.convention).metric);
+    out["points_are"] = masks::pointSetName(masks::conventionRules(r.convention).points);
     out["status"] = masks::emptyStatusName(r.empty);
     if (!ok) out["convention_value"] = emptyDict(r);
     out["hd"] = number(r.hd);
@@ -194,12 +191,18 @@ py::dict rowDict(const std::string& label, const MaskResult& r) {
     return out;
 }
 
+// 'rthdist', 'monai', ...: every convention's name, quoted, in table order.
+std::string quotedNames() {
+    std::string out;
+    for (const masks::ConventionRules& row : masks::kConventionRules)
+        out += (out.empty() ? "'" : ", '") + std::string(row.name) + "'";
+    return out;
+}
+
 Convention conventionFrom(const std::string& name) {
     Convention c;
     if (!masks::parseConvention(name, c))
-        throw py::value_error("unknown convention '" + name +
-                              "' (expected 'rthdist', 'monai', 'medpy', 'plastimatch', 'itk', 'deepmind' "
-                              "or 'all')");
+        throw py::value_error("unknown convention '" + name + "' (expected " + quotedNames() + " or 'all')");
     return c;
 }
 

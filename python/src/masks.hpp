@@ -1,4 +1,4 @@
-// rthdist Python module — segmentation masks (src/masks/masks.hpp): label
+// rthdist Python module — segmentation masks (include/rthdist/masks.hpp): label
 // volumes from NumPy arrays (_MaskVolume: the labels copied once, i fastest,
 // with their voxel-to-world affine) and _MaskEngine (the masks' Engine and,
 // on a GPU backend, its boundary pass, kept between calls). A comparison

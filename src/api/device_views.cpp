@@ -4,6 +4,7 @@
 
 #include "api/out_of_core.hpp"
 #include "gpu/device_requirements.hpp"
+#include "gpu/vk_struct.hpp"
 
 namespace rthdist {
 
@@ -69,7 +70,8 @@ Result<gpu_algo::DeviceInput> checkDeviceView(const DevicePointView& view, const
         return refuse("offset " + std::to_string(view.offset) + " + (count - 1) * strideBytes + 3 scalars (" +
                       std::to_string(span) + " bytes) is past bufferBytes " +
                       std::to_string(view.bufferBytes));
-    VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+    VkBufferDeviceAddressInfo info =
+        gpu::vkStruct<VkBufferDeviceAddressInfo>(VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO);
     info.buffer = view.buffer;
     gpu_algo::DeviceInput in;
     in.buffer = view.buffer;

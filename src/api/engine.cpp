@@ -19,6 +19,7 @@
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
 #include "core/input_limits.hpp"
+#include "core/stopwatch.hpp"
 #include "core/thread_pool.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 #include "gpu/context.hpp"
@@ -81,9 +82,7 @@ std::optional<Error> validatePreparedSize(const PointView& points) {
                      std::to_string(points.count) + ": compute it one-shot (Engine::compute of point views)"};
 }
 
-double msSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
+using core::msSince;
 
 // auto picks a Vulkan backend only on a device with RT hardware paths that is
 // not a software rasterizer: on lavapipe (VK_PHYSICAL_DEVICE_TYPE_CPU) the

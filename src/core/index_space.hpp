@@ -14,6 +14,10 @@
 #include <cstdint>
 #include <span>
 
+// By its path from here: every target that includes this header finds it
+// (the shaders' own include path is the library layers').
+#include "../../shaders/shared/rthdist_morton.h"
+
 namespace rthdist::core {
 
 // Largest bit count with a dense cell table (2^(3k) entries) that we allow.
@@ -91,21 +95,12 @@ using LevelCounts = std::array<size_t, kMaxBits + 1>;
 // The same from a set's box (the extremes of |p| lie on its corners).
 [[nodiscard]] double largestMagnitude(const Bounds& box);
 
-// The low 10 bits of v, two zero bits after each (one axis of a Morton key).
-[[nodiscard]] inline uint32_t spreadBits(uint32_t v) {
-    v &= 0x3ffu;
-    v = (v | (v << 16)) & 0x030000ffu;
-    v = (v | (v << 8)) & 0x0300f00fu;
-    v = (v | (v << 4)) & 0x030c30c3u;
-    v = (v | (v << 2)) & 0x09249249u;
-    return v;
-}
-
-// Interleaves the low 10 bits of x, y, z (x in bit 0). Inline: the CPU
-// backend computes one per point.
-[[nodiscard]] inline uint32_t mortonEncode(uint32_t x, uint32_t y, uint32_t z) {
-    return spreadBits(x) | (spreadBits(y) << 1) | (spreadBits(z) << 2);
-}
+// spreadBits (one axis of a Morton key) and mortonEncode (the low 10 bits
+// of x, y, z interleaved, x in bit 0): shaders/shared/rthdist_morton.h, the
+// definition the GLSL index uses too. Inline: the CPU backend computes one
+// per point.
+using shared::mortonEncode;
+using shared::spreadBits;
 
 // Cell coordinate of p on one axis, clamped to the grid.
 [[nodiscard]] inline uint32_t cellCoord(double p, double origin, double cellSize, uint32_t cellsPerAxis) {

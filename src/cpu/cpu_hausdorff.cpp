@@ -53,6 +53,7 @@
 #include "core/certificate.hpp"
 #include "core/parallel.hpp"
 #include "core/search_mutant.hpp"
+#include "core/stopwatch.hpp"
 #include "cpu/target_index.hpp"
 
 namespace rthdist::cpu {
@@ -83,10 +84,8 @@ constexpr uint32_t kLocalLevel = 2;
 // organ boundaries, whose distances often exceed a cell; the BVH beyond).
 constexpr uint32_t kGridSpan = 3;
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using core::Clock;
+using core::msSince;
 
 inline v8f load8(const float* p) {
     v8f v;
@@ -94,7 +93,9 @@ inline v8f load8(const float* p) {
     return v;
 }
 inline v8f splat(float s) { return v8f{s, s, s, s, s, s, s, s}; }
-inline float hmin(v8f v) {
+// By reference: a 32-byte vector passed by value without AVX makes GCC note
+// an ABI change (-Wpsabi) in every build.
+inline float hmin(const v8f& v) {
     float m = v[0];
     for (int l = 1; l < 8; ++l) m = v[l] < m ? v[l] : m;
     return m;

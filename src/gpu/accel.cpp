@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "gpu/context.hpp"
+#include "gpu/vk_struct.hpp"
 
 namespace rthdist::gpu {
 
@@ -14,11 +15,12 @@ VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * 
 // The geometry, build description and sizes of one acceleration structure.
 // info.pGeometries points at geometry, so a BuildDesc stays where it is made.
 struct BuildDesc {
-    VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
-    VkAccelerationStructureBuildGeometryInfoKHR info{
-        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-    VkAccelerationStructureBuildSizesInfoKHR sizes{
-        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
+    VkAccelerationStructureGeometryKHR geometry =
+        vkStruct<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
+    VkAccelerationStructureBuildGeometryInfoKHR info = vkStruct<VkAccelerationStructureBuildGeometryInfoKHR>(
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR);
+    VkAccelerationStructureBuildSizesInfoKHR sizes = vkStruct<VkAccelerationStructureBuildSizesInfoKHR>(
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR);
     uint32_t primitives = 0;
 
     BuildDesc() = default;
@@ -42,7 +44,8 @@ struct BuildDesc {
 void describeBlas(BuildDesc& d, VkDeviceAddress aabbs, uint32_t count) {
     d.geometry.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
     d.geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
-    d.geometry.geometry.aabbs = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR};
+    d.geometry.geometry.aabbs = vkStruct<VkAccelerationStructureGeometryAabbsDataKHR>(
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR);
     d.geometry.geometry.aabbs.data.deviceAddress = aabbs;
     d.geometry.geometry.aabbs.stride = sizeof(VkAabbPositionsKHR);
     d.info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
@@ -54,7 +57,8 @@ void describeBlas(BuildDesc& d, VkDeviceAddress aabbs, uint32_t count) {
 // A TLAS of one instance (its address is set once the instance is written).
 void describeTlas(BuildDesc& d) {
     d.geometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
-    d.geometry.geometry.instances = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR};
+    d.geometry.geometry.instances = vkStruct<VkAccelerationStructureGeometryInstancesDataKHR>(
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR);
     d.info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
     d.info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
     d.info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
@@ -68,7 +72,8 @@ UniqueAccel AccelStructures::createIn(Buffer& storage, VkDeviceSize size,
     if (storage.size() < size)
         storage =
             Buffer(m_ctx, size, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR, MemoryKind::kDevice);
-    VkAccelerationStructureCreateInfoKHR ci{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
+    VkAccelerationStructureCreateInfoKHR ci = vkStruct<VkAccelerationStructureCreateInfoKHR>(
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR);
     ci.buffer = storage.handle();
     ci.size = size;
     ci.type = type;
@@ -90,8 +95,8 @@ void AccelStructures::writeInstance() {
         m_instances =
             Buffer(m_ctx, sizeof(VkAccelerationStructureInstanceKHR),
                    VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR, MemoryKind::kHost);
-    VkAccelerationStructureDeviceAddressInfoKHR ai{
-        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
+    VkAccelerationStructureDeviceAddressInfoKHR ai = vkStruct<VkAccelerationStructureDeviceAddressInfoKHR>(
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR);
     ai.accelerationStructure = m_blas.get();
     VkAccelerationStructureInstanceKHR inst{};
     inst.transform.matrix[0][0] = inst.transform.matrix[1][1] = inst.transform.matrix[2][2] = 1.0f;

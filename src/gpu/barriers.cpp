@@ -1,15 +1,17 @@
 #include "gpu/barriers.hpp"
 
+#include "gpu/vk_struct.hpp"
+
 namespace rthdist::gpu {
 
 void cmdBarrier2(VkCommandBuffer cmd, VkPipelineStageFlags2 src, VkAccessFlags2 srcAccess,
                  VkPipelineStageFlags2 dst, VkAccessFlags2 dstAccess) {
-    VkMemoryBarrier2 mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+    VkMemoryBarrier2 mb = vkStruct<VkMemoryBarrier2>(VK_STRUCTURE_TYPE_MEMORY_BARRIER_2);
     mb.srcStageMask = src;
     mb.srcAccessMask = srcAccess;
     mb.dstStageMask = dst;
     mb.dstAccessMask = dstAccess;
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    VkDependencyInfo dep = vkStruct<VkDependencyInfo>(VK_STRUCTURE_TYPE_DEPENDENCY_INFO);
     dep.memoryBarrierCount = 1;
     dep.pMemoryBarriers = &mb;
     vkCmdPipelineBarrier2(cmd, &dep);

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "gpu/context.hpp"
+#include "gpu/vk_struct.hpp"
 
 namespace rthdist::gpu {
 
@@ -29,9 +30,10 @@ uint32_t memoryTypeFor(const Context& ctx, uint32_t typeBits, MemoryKind kind) {
 
 // Device-address memory for `req`; a failure names the device's limits.
 UniqueMemory allocateMemory(const Context& ctx, const VkMemoryRequirements& req, uint32_t type) {
-    VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+    VkMemoryAllocateFlagsInfo flags =
+        vkStruct<VkMemoryAllocateFlagsInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
     flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
-    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags};
+    VkMemoryAllocateInfo ai = vkStruct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags);
     ai.allocationSize = req.size;
     ai.memoryTypeIndex = type;
     VkDeviceMemory memory;
@@ -53,7 +55,7 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
     const VkDevice d = ctx.device();
     const VkDeviceSize bytes = size == 0 ? 16 : size;
     requireWithin(bytes, ctx.limits().maxBufferBytes, "a buffer", "maxBufferSize");
-    VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    VkBufferCreateInfo bi = vkStruct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
     bi.size = bytes;
     bi.usage = usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
     bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
@@ -65,7 +67,8 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
     RTHDIST_VK_CHECK(vkBindBufferMemory(d, buffer, m_memory.get(), 0));
     if (kind != MemoryKind::kDevice)
         RTHDIST_VK_CHECK(vkMapMemory(d, m_memory.get(), 0, VK_WHOLE_SIZE, 0, &m_mapped));
-    VkBufferDeviceAddressInfo dai{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+    VkBufferDeviceAddressInfo dai =
+        vkStruct<VkBufferDeviceAddressInfo>(VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO);
     dai.buffer = buffer;
     m_address = vkGetBufferDeviceAddress(d, &dai);
     m_size = bytes;

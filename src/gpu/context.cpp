@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "gpu/barriers.hpp"
+#include "gpu/vk_struct.hpp"
 
 namespace rthdist::gpu {
 
@@ -102,8 +103,10 @@ DeviceInfo describeDevice(VkPhysicalDevice pd, int index) {
     info.name = props.deviceName;
     info.type = typeName(props.deviceType);
     if (props.apiVersion >= VK_API_VERSION_1_2) {
-        VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
-        VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver};
+        VkPhysicalDeviceDriverProperties driver =
+            vkStruct<VkPhysicalDeviceDriverProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES);
+        VkPhysicalDeviceProperties2 props2 =
+            vkStruct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver);
         vkGetPhysicalDeviceProperties2(pd, &props2);
         info.driver = std::string(driver.driverName) + " " + driver.driverInfo;
         info.limits = readDeviceLimits(pd).named();
@@ -136,7 +139,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBit
 // for GPU captures without validation; off by default: on the H100 they cost
 // ~0.1 ms per prepared set and ~0.15 ms per batched pair).
 Result<UniqueInstance> makeInstance(bool validation, bool debugLabels) {
-    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    VkApplicationInfo app = vkStruct<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);
     app.pApplicationName = "rthdist";
     app.apiVersion = VK_API_VERSION_1_3;
     std::vector<const char*> layers, exts;
@@ -149,7 +152,7 @@ Result<UniqueInstance> makeInstance(bool validation, bool debugLabels) {
     }
     if (validation || (debugLabels && instanceHasExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME)))
         exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-    VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    VkInstanceCreateInfo ci = vkStruct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
     ci.pApplicationInfo = &app;
     ci.enabledLayerCount = uint32_t(layers.size());
     ci.ppEnabledLayerNames = layers.data();
@@ -281,7 +284,8 @@ std::optional<Error> Context::createMessenger() {
         vkGetInstanceProcAddr(inst, "vkDestroyDebugUtilsMessengerEXT"));
     if (!createFn || !destroyMessenger)
         return Error{ErrorCode::kNoDevice, "validation requested but VK_EXT_debug_utils has no messenger"};
-    VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    VkDebugUtilsMessengerCreateInfoEXT mi =
+        vkStruct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
     mi.messageSeverity =
         VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
     mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
@@ -430,12 +434,14 @@ std::optional<Error> Context::loadRtFunctions(const DeviceRequirements& req) {
 }
 
 void Context::readProperties(const DeviceRequirements& req) {
-    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    VkPhysicalDeviceProperties2 p2 =
+        vkStruct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
     // Only structures of extensions the device has enabled go into the chain.
     m_rtProps.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR;
     m_asProps.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
-    VkPhysicalDeviceExternalMemoryHostPropertiesEXT hostProps{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_MEMORY_HOST_PROPERTIES_EXT};
+    VkPhysicalDeviceExternalMemoryHostPropertiesEXT hostProps =
+        vkStruct<VkPhysicalDeviceExternalMemoryHostPropertiesEXT>(
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_MEMORY_HOST_PROPERTIES_EXT);
     const auto chain = [&](auto& s) {
         s.pNext = p2.pNext;
         p2.pNext = &s;
@@ -464,18 +470,20 @@ void Context::readProperties(const DeviceRequirements& req) {
 // The one command buffer, its fence and the timestamp queries.
 void Context::createCommandObjects() {
     const VkDevice d = m_deviceHandle;
-    VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    VkCommandPoolCreateInfo pci =
+        vkStruct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
     pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     pci.queueFamilyIndex = m_queueFamily;
     m_pool = RTHDIST_VK_CREATE(UniqueCommandPool, vkCreateCommandPool, d, pci);
-    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    VkCommandBufferAllocateInfo ai =
+        vkStruct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
     ai.commandPool = m_pool.get();
     ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     ai.commandBufferCount = 1;
     RTHDIST_VK_CHECK(vkAllocateCommandBuffers(d, &ai, &m_cmd));
-    const VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    const VkFenceCreateInfo fci = vkStruct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
     m_fence = RTHDIST_VK_CREATE(UniqueFence, vkCreateFence, d, fci);
-    VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    VkQueryPoolCreateInfo qpi = vkStruct<VkQueryPoolCreateInfo>(VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO);
     qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
     qpi.queryCount = kTimestampSlots;
     m_timestamps = RTHDIST_VK_CREATE(UniqueQueryPool, vkCreateQueryPool, d, qpi);
@@ -498,7 +506,8 @@ Context::~Context() {
 
 void Context::setDebugName(VkObjectType type, uint64_t handle, const char* name) const {
     if (!m_setObjectName || !m_deviceHandle || !handle) return;
-    VkDebugUtilsObjectNameInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT};
+    VkDebugUtilsObjectNameInfoEXT info =
+        vkStruct<VkDebugUtilsObjectNameInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT);
     info.objectType = type;
     info.objectHandle = handle;
     info.pObjectName = name;
@@ -507,7 +516,7 @@ void Context::setDebugName(VkObjectType type, uint64_t handle, const char* name)
 
 void Context::cmdBeginLabel(VkCommandBuffer cmd, const char* name) const {
     if (!m_cmdBeginLabel) return;
-    VkDebugUtilsLabelEXT label{VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT};
+    VkDebugUtilsLabelEXT label = vkStruct<VkDebugUtilsLabelEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT);
     label.pLabelName = name;
     m_cmdBeginLabel(cmd, &label);
 }
@@ -524,7 +533,8 @@ uint32_t Context::memoryTypeIndex(uint32_t typeBits, VkMemoryPropertyFlags wante
 
 VkCommandBuffer Context::begin() {
     RTHDIST_VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
-    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    VkCommandBufferBeginInfo bi =
+        vkStruct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     RTHDIST_VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
     vkCmdResetQueryPool(m_cmd, m_timestamps.get(), 0, kTimestampSlots);
@@ -553,7 +563,7 @@ void Context::submitAndWait(VkCommandBuffer cmd) {
     const uint32_t last = m_marks;
     vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_timestamps.get(), last);
     RTHDIST_VK_CHECK(vkEndCommandBuffer(cmd));
-    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    VkSubmitInfo si = vkStruct<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cmd;
     const VkFence fence = m_fence.get();

@@ -3,17 +3,18 @@
 #include <algorithm>
 
 #include "gpu/device_requirements.hpp"
+#include "gpu/vk_struct.hpp"
 
 namespace rthdist::gpu {
 
 namespace {
 
 void readHeaps(VkPhysicalDevice pd, DeviceLimits& out) {
-    VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT};
+    VkPhysicalDeviceMemoryBudgetPropertiesEXT budget = vkStruct<VkPhysicalDeviceMemoryBudgetPropertiesEXT>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT);
     const bool hasBudget = deviceHasExtension(pd, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
-    VkPhysicalDeviceMemoryProperties2 mem2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2,
-                                           hasBudget ? &budget : nullptr};
+    VkPhysicalDeviceMemoryProperties2 mem2 = vkStruct<VkPhysicalDeviceMemoryProperties2>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2, hasBudget ? &budget : nullptr);
     vkGetPhysicalDeviceMemoryProperties2(pd, &mem2);
     const VkPhysicalDeviceMemoryProperties& mem = mem2.memoryProperties;
     uint64_t device = 0, host = 0, deviceBudget = 0;
@@ -39,13 +40,16 @@ DeviceLimits readDeviceLimits(VkPhysicalDevice pd) {
     const bool hasRtPipeline = deviceHasExtension(pd, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
     const bool hasAccel = deviceHasExtension(pd, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
     const bool hasMaintenance4 = deviceHasExtension(pd, VK_KHR_MAINTENANCE_4_EXTENSION_NAME);
-    VkPhysicalDeviceRayTracingPipelinePropertiesKHR rt{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR};
-    VkPhysicalDeviceAccelerationStructurePropertiesKHR as{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
-    VkPhysicalDeviceMaintenance4PropertiesKHR m4{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_PROPERTIES_KHR};
-    VkPhysicalDeviceMaintenance3Properties m3{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
+    VkPhysicalDeviceRayTracingPipelinePropertiesKHR rt =
+        vkStruct<VkPhysicalDeviceRayTracingPipelinePropertiesKHR>(
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR);
+    VkPhysicalDeviceAccelerationStructurePropertiesKHR as =
+        vkStruct<VkPhysicalDeviceAccelerationStructurePropertiesKHR>(
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR);
+    VkPhysicalDeviceMaintenance4PropertiesKHR m4 = vkStruct<VkPhysicalDeviceMaintenance4PropertiesKHR>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_PROPERTIES_KHR);
+    VkPhysicalDeviceMaintenance3Properties m3 = vkStruct<VkPhysicalDeviceMaintenance3Properties>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES);
     // Only structures of extensions the device has go into the chain.
     void* chain = nullptr;
     if (hasRtPipeline) {
@@ -61,7 +65,8 @@ DeviceLimits readDeviceLimits(VkPhysicalDevice pd) {
         chain = &m4;
     }
     m3.pNext = chain;
-    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &m3};
+    VkPhysicalDeviceProperties2 p2 =
+        vkStruct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &m3);
     vkGetPhysicalDeviceProperties2(pd, &p2);
     const VkPhysicalDeviceLimits& l = p2.properties.limits;
     out.maxAllocationBytes = m3.maxMemoryAllocationSize;

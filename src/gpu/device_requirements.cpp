@@ -5,6 +5,8 @@
 #include <cstring>
 #include <iterator>
 
+#include "gpu/vk_struct.hpp"
+
 namespace rthdist::gpu {
 
 namespace {
@@ -235,11 +237,13 @@ VkResult createDeviceFor(VkPhysicalDevice pd, const DeviceRequirements& req,
         features.link(f);
     }
     const float priority = 1.0f;
-    VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    VkDeviceQueueCreateInfo qci =
+        vkStruct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
     qci.queueFamilyIndex = queueFamily;
     qci.queueCount = 1;
     qci.pQueuePriorities = &priority;
-    VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, features.head()};
+    VkDeviceCreateInfo dci =
+        vkStruct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, features.head());
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qci;
     dci.enabledExtensionCount = uint32_t(exts.size());

@@ -3,6 +3,7 @@
 #include <cstdint>
 
 #include "gpu/context.hpp"
+#include "gpu/vk_struct.hpp"
 
 namespace rthdist::gpu {
 
@@ -15,7 +16,8 @@ std::optional<HostImport> HostImport::create(Context& ctx, const void* data, siz
     const VkDeviceSize size = ((begin + bytes - base + align - 1) / align) * align;
     void* basePtr = reinterpret_cast<void*>(base);
 
-    VkMemoryHostPointerPropertiesEXT props{VK_STRUCTURE_TYPE_MEMORY_HOST_POINTER_PROPERTIES_EXT};
+    VkMemoryHostPointerPropertiesEXT props =
+        vkStruct<VkMemoryHostPointerPropertiesEXT>(VK_STRUCTURE_TYPE_MEMORY_HOST_POINTER_PROPERTIES_EXT);
     if (ctx.getHostPointerProperties()(d, VK_EXTERNAL_MEMORY_HANDLE_TYPE_HOST_ALLOCATION_BIT_EXT, basePtr,
                                        &props) != VK_SUCCESS ||
         props.memoryTypeBits == 0)
@@ -23,9 +25,10 @@ std::optional<HostImport> HostImport::create(Context& ctx, const void* data, siz
 
     HostImport im;
     im.m_offset = VkDeviceSize(begin - base);
-    VkExternalMemoryBufferCreateInfo ext{VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO};
+    VkExternalMemoryBufferCreateInfo ext =
+        vkStruct<VkExternalMemoryBufferCreateInfo>(VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO);
     ext.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_HOST_ALLOCATION_BIT_EXT;
-    VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, &ext};
+    VkBufferCreateInfo bi = vkStruct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, &ext);
     bi.size = size;
     bi.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
     bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
@@ -37,10 +40,11 @@ std::optional<HostImport> HostImport::create(Context& ctx, const void* data, siz
     const uint32_t type = ctx.memoryTypeIndex(req.memoryTypeBits & props.memoryTypeBits, 0);
     if (type == ~0u) return std::nullopt;
 
-    VkImportMemoryHostPointerInfoEXT import{VK_STRUCTURE_TYPE_IMPORT_MEMORY_HOST_POINTER_INFO_EXT};
+    VkImportMemoryHostPointerInfoEXT import =
+        vkStruct<VkImportMemoryHostPointerInfoEXT>(VK_STRUCTURE_TYPE_IMPORT_MEMORY_HOST_POINTER_INFO_EXT);
     import.handleType = VK_EXTERNAL_MEMORY_HANDLE_TYPE_HOST_ALLOCATION_BIT_EXT;
     import.pHostPointer = basePtr;
-    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &import};
+    VkMemoryAllocateInfo ai = vkStruct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &import);
     ai.allocationSize = size;
     ai.memoryTypeIndex = type;
     VkDeviceMemory memory;

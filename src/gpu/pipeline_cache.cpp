@@ -13,6 +13,7 @@
 #include <cerrno>
 
 #include "gpu/vk_check.hpp"
+#include "gpu/vk_struct.hpp"
 
 namespace rthdist::gpu {
 
@@ -116,7 +117,8 @@ PipelineCache::PipelineCache(VkDevice device, VkPhysicalDevice physical, const s
             }
         }
     }
-    VkPipelineCacheCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
+    VkPipelineCacheCreateInfo ci =
+        vkStruct<VkPipelineCacheCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO);
     ci.initialDataSize = data.size();
     ci.pInitialData = data.empty() ? nullptr : data.data();
     m_cache = RTHDIST_VK_CREATE(UniquePipelineCache, vkCreatePipelineCache, device, ci);

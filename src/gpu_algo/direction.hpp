@@ -29,20 +29,20 @@ struct DirectionRun {
     const CounterBlock& blk;
     PerPoint* perPoint = nullptr;
     bool perPointDistances = true;  // false: perPoint's nearest only (CallOptions::perPointNearestOnly)
-    Directed out;
+    Directed out{};
     double lowerBound2Exact = 0.0;  // the boxes' bound (double), for the witness check
     float lowerBound2 = 0.0f;       // < 0: per-point (no early break)
     float epsilon = 0.0f;
-    Buffer* state = nullptr;                 // QueryState per query slot
-    Buffer* active[2] = {nullptr, nullptr};  // active slots, ping-pong
-    int cur = 0;                             // active[cur] holds this iteration's slots
-    Buffer* nearest = nullptr;               // per-point: uint nearest target per query (device)
-    Buffer* nearestHost = nullptr;           // per-point: `nearest` copied by each self-check
-    std::vector<uint32_t> checkSlots;        // the self-check's sampled query slots
-    Buffer* band = nullptr;                  // host: the certificate's band (certificate_pass.hpp)
-    uint32_t bandCapacity = 0;               // queries `band` holds
-    double slack = 0.0;                      // the certificate's e, search units
-    std::vector<core::BandNearest> settled;  // band queries the certificate settled in double
+    Buffer* state = nullptr;                   // QueryState per query slot
+    Buffer* active[2] = {nullptr, nullptr};    // active slots, ping-pong
+    int cur = 0;                               // active[cur] holds this iteration's slots
+    Buffer* nearest = nullptr;                 // per-point: uint nearest target per query (device)
+    Buffer* nearestHost = nullptr;             // per-point: `nearest` copied by each self-check
+    std::vector<uint32_t> checkSlots{};        // the self-check's sampled query slots
+    Buffer* band = nullptr;                    // host: the certificate's band (certificate_pass.hpp)
+    uint32_t bandCapacity = 0;                 // queries `band` holds
+    double slack = 0.0;                        // the certificate's e, search units
+    std::vector<core::BandNearest> settled{};  // band queries the certificate settled in double
     [[nodiscard]] std::string name() const { return Q.name + "->" + T.name; }
 };
 

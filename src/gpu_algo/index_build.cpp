@@ -149,8 +149,13 @@ void IndexBuild::cmdCellBuild(VkCommandBuffer cmd, const sh::CellsPush& cp) {
 void IndexBuild::cmdCheckIndex(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {
     blk.fields().checkSum = 0;
     blk.fields().checkBad = 0;
-    sh::CheckPush cp{
-        ix.sorted->address(), ix.sortedKeys->address(), 0, blk.device, gridParams(ix.grid), ix.n, 0u};
+    // check_index reads the index's fields; check_queries' (state, perPoint, the outputs) stay 0.
+    sh::CheckPush cp{};
+    cp.sorted = ix.sorted->address();
+    cp.sortedKeys = ix.sortedKeys->address();
+    cp.counters = blk.device;
+    cp.grid = gridParams(ix.grid);
+    cp.n = ix.n;
     m_ws.dispatch(cmd, Kernel::kCheckIndex, cp, ix.n);
 }
 

@@ -8,6 +8,7 @@
 
 #include "gpu/compute_pipeline.hpp"
 #include "gpu/context.hpp"
+#include "gpu/vk_struct.hpp"
 #include "rthdist_shared.h"
 
 // SPIR-V embedded at build time (cmake/Shaders.cmake).
@@ -121,19 +122,22 @@ void Pipelines::createLayout() {
     b.descriptorType = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
     b.descriptorCount = 1;
     b.stageFlags = m_stages;
-    VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    VkDescriptorSetLayoutCreateInfo sl =
+        vkStruct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
     sl.bindingCount = 1;
     sl.pBindings = &b;
     m_setLayout = RTHDIST_VK_CREATE(UniqueDescriptorSetLayout, vkCreateDescriptorSetLayout, d, sl);
     m_layout = createPipelineLayout(d, {m_setLayout.ptr(), 1}, m_stages, kPushBytes);
 
     VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1};
-    VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    VkDescriptorPoolCreateInfo dp =
+        vkStruct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
     dp.maxSets = 1;
     dp.poolSizeCount = 1;
     dp.pPoolSizes = &ps;
     m_pool = RTHDIST_VK_CREATE(UniqueDescriptorPool, vkCreateDescriptorPool, d, dp);
-    VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    VkDescriptorSetAllocateInfo da =
+        vkStruct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
     da.descriptorPool = m_pool.get();
     da.descriptorSetCount = 1;
     da.pSetLayouts = m_setLayout.ptr();
@@ -161,11 +165,13 @@ void Pipelines::createRtPipeline(VkPipelineCache cache) {
     VkPipelineShaderStageCreateInfo st[3]{};
     VkRayTracingShaderGroupCreateInfoKHR g[3]{};
     for (int i = 0; i < 3; ++i) {
-        st[i] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+        st[i] = gpu::vkStruct<VkPipelineShaderStageCreateInfo>(
+            VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
         st[i].stage = kinds[i];
         st[i].module = mods[i].get();
         st[i].pName = "main";
-        g[i] = {VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR};
+        g[i] = gpu::vkStruct<VkRayTracingShaderGroupCreateInfoKHR>(
+            VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR);
         g[i].generalShader = g[i].closestHitShader = g[i].anyHitShader = g[i].intersectionShader =
             VK_SHADER_UNUSED_KHR;
     }
@@ -175,7 +181,8 @@ void Pipelines::createRtPipeline(VkPipelineCache cache) {
     g[1].generalShader = 1;
     g[2].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_PROCEDURAL_HIT_GROUP_KHR;
     g[2].intersectionShader = 2;
-    VkRayTracingPipelineCreateInfoKHR rci{VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_CREATE_INFO_KHR};
+    VkRayTracingPipelineCreateInfoKHR rci =
+        vkStruct<VkRayTracingPipelineCreateInfoKHR>(VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_CREATE_INFO_KHR);
     rci.stageCount = 3;
     rci.pStages = st;
     rci.groupCount = 3;
@@ -211,11 +218,11 @@ void Pipelines::createShaderBindingTable() {
 }
 
 void Pipelines::bindTlas(VkAccelerationStructureKHR tlas) {
-    VkWriteDescriptorSetAccelerationStructureKHR as{
-        VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR};
+    VkWriteDescriptorSetAccelerationStructureKHR as = vkStruct<VkWriteDescriptorSetAccelerationStructureKHR>(
+        VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR);
     as.accelerationStructureCount = 1;
     as.pAccelerationStructures = &tlas;
-    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, &as};
+    VkWriteDescriptorSet w = vkStruct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, &as);
     w.dstSet = m_set;
     w.dstBinding = 0;
     w.descriptorCount = 1;

@@ -11,6 +11,7 @@
 #include <deque>
 #include <string>
 
+#include "core/stopwatch.hpp"
 #include "gpu/accel.hpp"
 #include "gpu/buffer.hpp"
 #include "gpu/context.hpp"
@@ -27,10 +28,8 @@ namespace rthdist::gpu_algo {
 using gpu::Kernel;
 using gpu::MemoryKind;
 
-using Clock = std::chrono::steady_clock;
-[[nodiscard]] inline double msSince(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using core::Clock;
+using core::msSince;
 
 inline constexpr uint64_t kMaxPairCapacity = uint64_t(1) << 26;  // 512 MiB of pairs at most
 // Pooled buffers get this much room to grow (a quarter, at most 64 MiB, never

@@ -16,7 +16,7 @@
 
 #include "core/uninit_vector.hpp"
 
-#include "masks/masks.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks::detail {
 

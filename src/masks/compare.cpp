@@ -1,5 +1,6 @@
-// Mask comparison in a named convention (masks.hpp has the definitions;
-// ../shared/MASKS.md the peers' sources they were read from).
+// Mask comparison in a named convention (rthdist/masks.hpp has the
+// definitions, rthdist/mask_conventions.hpp each convention's rules and
+// docs/masks.md the peers' sources they were read from).
 //
 // Both directions run on the exact engine with per-point distances: the
 // boundary conventions in one call (both boundaries uploaded and indexed
@@ -24,10 +25,10 @@
 #include "masks/deepmind.hpp"
 #include "masks/directions.hpp"
 #include "masks/gpu_boundary.hpp"
-#include "masks/masks.hpp"
 #include "masks/per_point_call.hpp"
 #include "masks/voxel_metric.hpp"
 #include "masks_gpu/boundary_pass.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks {
 namespace {
@@ -46,7 +47,7 @@ Result<std::array<Direction, 2>> bothDirections(Engine& engine, const Volume& a,
                                                 const Volume& b, std::span<const uint64_t> bb,
                                                 const MaskOptions& options, MaskResult& timed) {
     const auto t0 = Clock::now();
-    const detail::VoxelMetric metric(a, options.convention == Convention::kRthdist);
+    const detail::VoxelMetric metric(a, conventionRules(options.convention).metric == Metric::kWorld);
     const detail::SearchPoints pa = metric.searchPoints(ba, options.threads);
     const detail::SearchPoints pb = metric.searchPoints(bb, options.threads);
     timed.extractMs += msSince(t0);
@@ -87,16 +88,16 @@ std::array<DirectionPoints, 2> itkPoints(const Volume& a, LabelSelect selectA, u
     return d;
 }
 
-// itk: each direction its own call (X's voxels outside Y against Y's
-// boundary), both in A's spacing frame.
+// itk (PointSet::kForeground): each direction its own call (X's voxels
+// outside Y against Y's boundary), both in A's frame of the convention's metric.
 Result<std::array<Direction, 2>> itkDirections(Engine& engine, const Volume& a, LabelSelect selectA,
                                                const detail::Extraction& ea, const Volume& b,
-                                               LabelSelect selectB, const detail::Extraction& eb, int threads,
-                                               MaskResult& r) {
+                                               LabelSelect selectB, const detail::Extraction& eb, bool world,
+                                               int threads, MaskResult& r) {
     const auto t0 = Clock::now();
     const std::array<DirectionPoints, 2> p = itkPoints(a, selectA, ea.count, b, selectB, eb.count, threads);
     r.extractMs += msSince(t0);
-    const detail::VoxelMetric metric(a, false);
+    const detail::VoxelMetric metric(a, world);
     Result<Direction> ab =
         detail::directed(metric, a, p[0].queries, p[0].zeros, p[0].zeroWitness, eb.boundary,
                          detail::oneShotCall(engine, metric, eb.boundary, threads, r), threads, r);
@@ -108,66 +109,43 @@ Result<std::array<Direction, 2>> itkDirections(Engine& engine, const Volume& a, 
     return std::array<Direction, 2>{std::move(*ab), std::move(*ba)};
 }
 
-// Each convention's name and one-line rule, in kAllConventions order.
-struct ConventionText {
-    Convention convention;
-    const char* name;
-    const char* rule;
-};
-
-constexpr std::array<ConventionText, kAllConventions.size()> kConventionTexts{{
-    {Convention::kRthdist, "rthdist",
-     "boundary voxels (connectivity), world coordinates (affine); HD-p = max of the two directed "
-     "nearest-rank percentiles"},
-    {Convention::kMonai, "monai",
-     "mask XOR erosion (6-connected), spacing; HD-p = max of the two directed linear percentiles "
-     "(torch.quantile)"},
-    {Convention::kMedpy, "medpy",
-     "mask XOR erosion (connectivity), spacing; HD-p = linear percentile of both directions pooled"},
-    {Convention::kPlastimatch, "plastimatch",
-     "boundary voxels (6-connected), spacing; HD-p = mean of the two directed k-th smallest, "
-     "k = floor(p/100 n - 1)"},
-    {Convention::kItk, "itk",
-     "all foreground voxels (inside the other = 0), spacing; HD only; average = mean of the directed means"},
-    {Convention::kDeepmind, "deepmind",
-     "surfels on the half-voxel-shifted grid with marching-cubes areas, spacing; HD-p = max of the two "
-     "directed area-weighted percentiles (first cumulative area fraction >= p/100)"},
-}};
-
-constexpr bool conventionTextsInOrder() {
-    for (size_t i = 0; i < kConventionTexts.size(); ++i) {
-        if (kConventionTexts[i].convention != kAllConventions[i] || size_t(kAllConventions[i]) != i)
-            return false;
-    }
-    return true;
-}
-static_assert(conventionTextsInOrder(), "kConventionTexts[i] describes Convention(i)");
-
-const ConventionText* textOf(Convention c) {
-    return size_t(c) < kConventionTexts.size() ? &kConventionTexts[size_t(c)] : nullptr;
-}
-
 }  // namespace
 
 const char* conventionName(Convention c) {
-    const ConventionText* t = textOf(c);
-    return t != nullptr ? t->name : "?";
+    return size_t(c) < kConventionRules.size() ? conventionRules(c).name : "?";
+}
+
+const char* conventionRule(Convention c) {
+    return size_t(c) < kConventionRules.size() ? conventionRules(c).rule : "?";
 }
 
 bool parseConvention(const std::string& text, Convention& out) {
-    for (Convention c : kAllConventions) {
-        if (text == conventionName(c)) {
-            out = c;
+    for (const ConventionRules& row : kConventionRules) {
+        if (text == row.name) {
+            out = row.convention;
             return true;
         }
     }
     return false;
 }
 
-const char* conventionRule(Convention c) {
-    const ConventionText* t = textOf(c);
-    return t != nullptr ? t->rule : "?";
+std::string conventionNames() {
+    std::string names;
+    for (const ConventionRules& row : kConventionRules)
+        names += (names.empty() ? "" : ", ") + std::string(row.name);
+    return names;
 }
+
+const char* pointSetName(PointSet p) {
+    switch (p) {
+        case PointSet::kBoundary: return "boundary_voxels";
+        case PointSet::kForeground: return "voxels";
+        case PointSet::kSurfels: return "surfels";
+    }
+    return "?";
+}
+
+const char* metricName(Metric m) { return m == Metric::kWorld ? "world" : "spacing"; }
 
 const char* emptyStatusName(EmptyStatus s) {
     switch (s) {
@@ -199,9 +177,12 @@ Result<MaskResult> compareMasks(MaskEngine& maskEngine, const Volume& a, LabelSe
     if (auto e = checkInputs(a, b, options)) return *e;
     Engine& engine = maskEngine.engine;
     const Convention c = options.convention;
-    if (c == Convention::kDeepmind) return detail::compareDeepmind(engine, a, selectA, b, selectB, options);
+    const ConventionRules& rules = conventionRules(c);
+    if (rules.points == PointSet::kSurfels)
+        return detail::compareDeepmind(engine, a, selectA, b, selectB, options);
     const int conn = detail::connectivityOf(c, options.connectivity);
-    const bool itk = c == Convention::kItk;
+    // Foreground conventions (itk): every voxel a point; the boundary serves the search (above).
+    const bool itk = rules.points == PointSet::kForeground;
     MaskResult r;
     r.convention = c;
     r.connectivity = itk ? 0 : conn;
@@ -224,7 +205,8 @@ Result<MaskResult> compareMasks(MaskEngine& maskEngine, const Volume& a, LabelSe
         return r;
     }
     Result<std::array<Direction, 2>> both =
-        itk ? itkDirections(engine, a, selectA, *ea, b, selectB, *eb, threads, r)
+        itk ? itkDirections(engine, a, selectA, *ea, b, selectB, *eb, rules.metric == Metric::kWorld, threads,
+                            r)
             : bothDirections(engine, a, ea->boundary, b, eb->boundary, options, r);
     if (!both) return both.error();
     detail::combine(options, (*both)[0], (*both)[1], r);

@@ -154,7 +154,7 @@ double areaWithin(const SurfelDirection& d, double tolerance) {
 MaskResult summary(const MaskOptions& options, SurfelDirection& ab, SurfelDirection& ba, const Timing& timing,
                    Clock::time_point start) {
     MaskResult r;
-    r.convention = Convention::kDeepmind;
+    r.convention = options.convention;
     r.connectivity = 0;
     r.percentiles = options.percentiles;
     r.hd = std::max(ab.out.hd, ba.out.hd);
@@ -194,7 +194,7 @@ Result<MaskResult> compareSurfels(Engine& engine, const Volume& a, const Surfels
     timing.extractMs = extractMs;
     if (sa.selected == 0 || sb.selected == 0) {
         MaskResult r;
-        r.convention = Convention::kDeepmind;
+        r.convention = options.convention;
         r.connectivity = 0;
         r.percentiles = options.percentiles;
         setEmpty(sa.corners.size(), sb.corners.size(), options.percentiles, r);

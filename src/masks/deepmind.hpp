@@ -4,12 +4,12 @@
 #pragma once
 
 #include "masks/directions.hpp"
-#include "masks/masks.hpp"
 #include "masks/surfels.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks::detail {
 
-// compareMasks for Convention::kDeepmind, once compareMasks has checked the
+// compareMasks for a surfel convention (deepmind), once compareMasks has checked the
 // grids and options.
 [[nodiscard]] Result<MaskResult> compareDeepmind(Engine& engine, const Volume& a, LabelSelect selectA,
                                                  const Volume& b, LabelSelect selectB,

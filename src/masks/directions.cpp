@@ -28,20 +28,22 @@ void finishDirection(const Volume& v, Direction& d) {
     d.out.mean = d.out.points ? d.sum / double(d.out.points) : 0.0;
 }
 
-// This direction's HD-p under the options' convention (none for itk and deepmind).
+// This direction's HD-p under the options' convention's rule (the
+// area-weighted one is deepmind.cpp's; none: 0).
 double directedPercentile(const MaskOptions& options, Direction& d, double p) {
+    const ConventionRules& rules = conventionRules(options.convention);
     const ValueRange range{{d.least, d.out.hd}};
     const int threads = options.threads;
-    switch (options.convention) {
-        case Convention::kRthdist: return percentileNearestRank(d.distances, p, threads, range);
-        case Convention::kMonai:
-            if (p == 0.0) return d.out.hd;  // MONAI: `if not percentile: return max`
+    if (p == 0.0 && rules.percentileAt0IsMax) return d.out.hd;  // MONAI: `if not percentile: return max`
+    switch (rules.percentile) {
+        case DirectedPercentile::kNearestRank: return percentileNearestRank(d.distances, p, threads, range);
+        case DirectedPercentile::kTorchQuantile:
             return options.monaiFloat32 ? percentileTorchFloat32(d.distances, p, threads, range)
                                         : percentileLinear(d.distances, p, threads, range);
-        case Convention::kMedpy: return percentileLinear(d.distances, p, threads, range);
-        case Convention::kPlastimatch: return percentilePlastimatch(d.distances, p, threads, range);
-        case Convention::kItk:
-        case Convention::kDeepmind: break;
+        case DirectedPercentile::kLinear: return percentileLinear(d.distances, p, threads, range);
+        case DirectedPercentile::kKthSmallest: return percentilePlastimatch(d.distances, p, threads, range);
+        case DirectedPercentile::kNone:
+        case DirectedPercentile::kAreaWeighted: break;
     }
     return 0.0;
 }
@@ -56,13 +58,13 @@ void summarise(const Direction& da, const Direction& db, MaskResult& r) {
 }
 
 // Every requested HD-p combined from the directions' own (directionNumbers)
-// in convention c: the larger, the mean, or (medpy) the linear percentile of
-// both directions' distances pooled.
-void addPercentiles(Convention c, const std::vector<double>& percentiles, Direction& da, Direction& db,
+// by `how`: the larger, the mean, or (kPooled) the linear percentile of both
+// directions' distances together.
+void addPercentiles(Combination how, const std::vector<double>& percentiles, Direction& da, Direction& db,
                     int threads, MaskResult& r) {
-    if (c == Convention::kItk || c == Convention::kDeepmind) return;
+    if (how == Combination::kNone) return;
     core::UninitVector<double> pooled;
-    if (c == Convention::kMedpy) {
+    if (how == Combination::kPooled) {
         pooled.reserve(da.distances.size() + db.distances.size());
         pooled.assign(da.distances.begin(), da.distances.end());
         pooled.insert(pooled.end(), db.distances.begin(), db.distances.end());
@@ -70,24 +72,19 @@ void addPercentiles(Convention c, const std::vector<double>& percentiles, Direct
     const ValueRange both{{std::min(da.least, db.least), std::max(da.out.hd, db.out.hd)}};
     for (size_t i = 0; i < percentiles.size(); ++i) {
         const double a = da.out.percentiles[i], b = db.out.percentiles[i];
-        r.hdPercentile.push_back(c == Convention::kMedpy
+        r.hdPercentile.push_back(how == Combination::kPooled
                                      ? percentileLinear(pooled, percentiles[i], threads, both)
-                                 : c == Convention::kPlastimatch ? 0.5 * (a + b)
-                                                                 : std::max(a, b));
+                                 : how == Combination::kMean ? 0.5 * (a + b)
+                                                             : std::max(a, b));
     }
 }
 
 }  // namespace
 
-double msSince(Clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
-
-// MONAI and plastimatch have no connectivity parameter (SciPy's default cross;
-// plastimatch's face neighbours): 6 whatever is asked. rthdist and MedPy take one.
+// A convention without a connectivity parameter (MONAI: SciPy's default
+// cross; plastimatch: face neighbours) measures 6 whatever is asked.
 int connectivityOf(Convention c, int requested) {
-    const bool configurable = c == Convention::kRthdist || c == Convention::kMedpy;
-    return configurable && requested != 0 ? requested : 6;
+    return conventionRules(c).connectivityOption && requested != 0 ? requested : 6;
 }
 
 std::optional<Error> checkOptions(const MaskOptions& options) {
@@ -137,13 +134,16 @@ Result<Direction> directionOf(const Volume& v, const VoxelMetric& metric, std::s
 void directionNumbers(const MaskOptions& options, Direction& d) {
     d.numbered = true;
     d.out.percentiles.clear();
-    if (options.convention == Convention::kItk) return;  // neither: combine reports NaN
-    const double limit = toleranceLimit(options);
-    if (d.countedAt != limit) {
-        d.withinTolerance = countAtMost(d.distances, limit, options.threads);
-        d.countedAt = limit;
+    const ConventionRules& rules = conventionRules(options.convention);
+    if (rules.surfaceMeasures) {  // else combine reports NaN
+        const double limit = toleranceLimit(options);
+        if (d.countedAt != limit) {
+            d.withinTolerance = countAtMost(d.distances, limit, options.threads);
+            d.countedAt = limit;
+        }
+        d.out.surfaceOverlap = double(d.withinTolerance) / double(d.out.points);
     }
-    d.out.surfaceOverlap = double(d.withinTolerance) / double(d.out.points);
+    if (rules.percentile == DirectedPercentile::kNone) return;
     for (double p : options.percentiles) d.out.percentiles.push_back(directedPercentile(options, d, p));
 }
 
@@ -231,14 +231,14 @@ void setEmpty(uint64_t na, uint64_t nb, const std::vector<double>& percentiles, 
     r.empty = na == 0 && nb == 0 ? EmptyStatus::kBothEmpty
               : na == 0          ? EmptyStatus::kAEmpty
                                  : EmptyStatus::kBEmpty;
-    const bool itk = r.convention == Convention::kItk;
-    r.emptyValues = emptyValues(r.convention, r.empty, itk ? std::vector<double>{} : percentiles);
+    const bool noPercentile = conventionRules(r.convention).percentile == DirectedPercentile::kNone;
+    r.emptyValues = emptyValues(r.convention, r.empty, noPercentile ? std::vector<double>{} : percentiles);
     const double nan = std::numeric_limits<double>::quiet_NaN();
     r.hd = r.assd = r.msd = r.surfaceDice = nan;
-    r.hdPercentile.assign(itk ? 0 : percentiles.size(), nan);
+    r.hdPercentile.assign(noPercentile ? 0 : percentiles.size(), nan);
     for (DirectedMask* d : {&r.aToB, &r.bToA}) {
         d->hd = d->mean = d->surfaceOverlap = nan;
-        d->percentiles.assign(itk ? 0 : percentiles.size(), nan);
+        d->percentiles.assign(noPercentile ? 0 : percentiles.size(), nan);
     }
     r.aToB.points = na;
     r.bToA.points = nb;
@@ -246,7 +246,7 @@ void setEmpty(uint64_t na, uint64_t nb, const std::vector<double>& percentiles, 
 
 double toleranceLimit(const MaskOptions& options) {
     const double t = options.tolerance;
-    if (options.convention != Convention::kMonai || !options.monaiFloat32) return t;
+    if (!conventionRules(options.convention).float32Tolerance || !options.monaiFloat32) return t;
     // float(d) <= f for every d below the midpoint m of f and the next float
     // up; at m itself when rounding to even picks f.
     const float f = float(t);
@@ -261,11 +261,11 @@ void combine(const MaskOptions& options, Direction& ab, Direction& ba, MaskResul
     for (Direction* d : {&ab, &ba})
         if (!d->numbered) directionNumbers(options, *d);
     summarise(ab, ba, r);
-    if (options.convention == Convention::kItk)
+    const ConventionRules& rules = conventionRules(options.convention);
+    if (!rules.surfaceMeasures)
         r.assd = r.surfaceDice = ab.out.surfaceOverlap = ba.out.surfaceOverlap =
             std::numeric_limits<double>::quiet_NaN();
-    else
-        addPercentiles(options.convention, options.percentiles, ab, ba, options.threads, r);
+    addPercentiles(rules.combination, options.percentiles, ab, ba, options.threads, r);
     r.aToB = std::move(ab.out);
     r.bToA = std::move(ba.out);
 }

@@ -19,14 +19,15 @@
 #include <span>
 #include <vector>
 
+#include "core/stopwatch.hpp"
 #include "core/uninit_vector.hpp"
-#include "masks/masks.hpp"
 #include "masks/voxel_metric.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks::detail {
 
-using Clock = std::chrono::steady_clock;
-[[nodiscard]] double msSince(Clock::time_point t);
+using core::Clock;
+using core::msSince;
 
 struct Direction {
     core::UninitVector<double> distances;  // all of X's distances, in no particular order (zeros included)

@@ -11,7 +11,7 @@
 #include <limits>
 #include <type_traits>
 
-#include "masks/masks.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks::detail {
 namespace {

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "masks/label_types.hpp"
-#include "masks/masks.hpp"
 #include "masks/nifti_header.hpp"
 #include "masks/volume_file.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks {
 namespace {

@@ -1,8 +1,7 @@
-// A reference prepared once (prepared_reference.hpp): the reference's side
+// A reference prepared once (rthdist/masks.hpp, PreparedReference): the reference's side
 // of every convention is extracted and indexed here, and each comparison
 // does the prediction's side and the same arithmetic as compareMasks
 // (directions.hpp, deepmind.hpp).
-#include "masks/prepared_reference.hpp"
 
 #include <array>
 #include <optional>
@@ -18,6 +17,7 @@
 #include "masks/surfels.hpp"
 #include "masks/voxel_metric.hpp"
 #include "masks_gpu/boundary_pass.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks {
 
@@ -41,39 +41,33 @@ using detail::Direction;
 using detail::msSince;
 using State = PreparedReference::State;
 
-enum class PointKind { kBoundary, kForeground, kSurfels };
-
-PointKind kindOf(Convention c) {
-    return c == Convention::kItk        ? PointKind::kForeground
-           : c == Convention::kDeepmind ? PointKind::kSurfels
-                                        : PointKind::kBoundary;
-}
+PointSet kindOf(Convention c) { return conventionRules(c).points; }
+bool worldMetric(Convention c) { return conventionRules(c).metric == Metric::kWorld; }
 
 // The frame both directions search in: the reference's (A's) grid.
 detail::VoxelMetric metricOf(const State& s) {
-    return s.convention == Convention::kDeepmind
+    return kindOf(s.convention) == PointSet::kSurfels
                ? detail::VoxelMetric::corners(s.grid)
-               : detail::VoxelMetric(s.grid, s.convention == Convention::kRthdist);
+               : detail::VoxelMetric(s.grid, worldMetric(s.convention));
 }
 
 std::string pointsText(Convention c, int connectivity) {
     switch (kindOf(c)) {
-        case PointKind::kForeground: return "all foreground voxels";
-        case PointKind::kSurfels: return "surfels";
-        case PointKind::kBoundary: break;
+        case PointSet::kForeground: return "all foreground voxels";
+        case PointSet::kSurfels: return "surfels";
+        case PointSet::kBoundary: break;
     }
     return std::to_string(connectivity) + "-connected boundary voxels in the " +
-           (c == Convention::kRthdist ? "world" : "spacing") + " metric";
+           metricName(conventionRules(c).metric) + " metric";
 }
 
 // Empty when `options` measure the point set the reference was prepared with.
 std::optional<Error> checkPreparedFor(const State& s, const MaskOptions& options) {
     const Convention c = options.convention;
     const int conn = detail::connectivityOf(c, options.connectivity);
-    const bool same =
-        kindOf(c) == kindOf(s.convention) &&
-        (kindOf(c) != PointKind::kBoundary ||
-         (conn == s.connectivity && (c == Convention::kRthdist) == (s.convention == Convention::kRthdist)));
+    const bool same = kindOf(c) == kindOf(s.convention) &&
+                      (kindOf(c) != PointSet::kBoundary ||
+                       (conn == s.connectivity && worldMetric(c) == worldMetric(s.convention)));
     if (same) return std::nullopt;
     return Error{ErrorCode::kInvalidArgument,
                  std::string("masks: the reference ") + s.grid.path + " was prepared for convention '" +
@@ -155,7 +149,7 @@ Result<std::array<Direction, 2>> itkDirections(Engine& engine, const State& s, c
 // Every convention but deepmind.
 Result<MaskResult> compareVoxels(MaskEngine& engine, const State& s, const Volume& b, LabelSelect sb,
                                  const MaskOptions& options, Clock::time_point start) {
-    const bool itk = options.convention == Convention::kItk;
+    const bool itk = kindOf(options.convention) == PointSet::kForeground;
     MaskResult r;
     r.convention = options.convention;
     r.connectivity = itk ? 0 : s.connectivity;
@@ -183,7 +177,7 @@ Result<MaskResult> compareVoxels(MaskEngine& engine, const State& s, const Volum
 std::optional<Error> extractReference(MaskEngine& engine, const Volume& ref, const MaskOptions& options,
                                       State& s) {
     const int threads = options.threads;
-    if (s.convention == Convention::kDeepmind) {
+    if (kindOf(s.convention) == PointSet::kSurfels) {
         s.surfels = detail::extractSurfels(ref, s.select, threads);
         return std::nullopt;  // no prepared set: see the header
     } else {
@@ -192,7 +186,8 @@ std::optional<Error> extractReference(MaskEngine& engine, const Volume& ref, con
         if (!e) return e.error();
         s.extracted = std::move(*e);
         if (s.extracted.count == 0) return std::nullopt;
-        if (s.convention == Convention::kItk) s.bits = detail::SelectionBits(ref, s.select, threads);
+        if (kindOf(s.convention) == PointSet::kForeground)
+            s.bits = detail::SelectionBits(ref, s.select, threads);
     }
     Result<PreparedSet> set = prepareSet(engine.engine, metricOf(s), s.extracted.boundary, threads);
     if (!set) return set.error();
@@ -208,17 +203,17 @@ const Volume& PreparedReference::grid() const { return m_state->grid; }
 LabelSelect PreparedReference::select() const { return m_state->select; }
 Convention PreparedReference::convention() const { return m_state->convention; }
 int PreparedReference::connectivity() const {
-    return kindOf(m_state->convention) == PointKind::kBoundary ? m_state->connectivity : 0;
+    return kindOf(m_state->convention) == PointSet::kBoundary ? m_state->connectivity : 0;
 }
 uint64_t PreparedReference::selectedVoxels() const {
-    return m_state->convention == Convention::kDeepmind ? m_state->surfels.selected
-                                                        : m_state->extracted.count;
+    return kindOf(m_state->convention) == PointSet::kSurfels ? m_state->surfels.selected
+                                                             : m_state->extracted.count;
 }
 uint64_t PreparedReference::points() const {
     switch (kindOf(m_state->convention)) {
-        case PointKind::kForeground: return m_state->extracted.count;
-        case PointKind::kSurfels: return m_state->surfels.corners.size();
-        case PointKind::kBoundary: break;
+        case PointSet::kForeground: return m_state->extracted.count;
+        case PointSet::kSurfels: return m_state->surfels.corners.size();
+        case PointSet::kBoundary: break;
     }
     return m_state->extracted.boundary.size();
 }
@@ -244,7 +239,7 @@ Result<PreparedReference> prepareReference(MaskEngine& engine, const Volume& ref
     s->grid.transform = reference.transform;
     s->select = select;
     s->convention = options.convention;
-    s->connectivity = kindOf(options.convention) == PointKind::kBoundary
+    s->connectivity = kindOf(options.convention) == PointSet::kBoundary
                           ? detail::connectivityOf(options.convention, options.connectivity)
                           : 6;
     if (auto e = extractReference(engine, reference, options, *s)) return *e;
@@ -260,7 +255,7 @@ Result<MaskResult> compareMasks(MaskEngine& engine, const PreparedReference& ref
     if (auto e = checkSameGrid(s.grid, prediction)) return *e;
     if (auto e = detail::checkOptions(options)) return *e;
     if (auto e = checkPreparedFor(s, options)) return *e;
-    if (options.convention != Convention::kDeepmind)
+    if (kindOf(options.convention) != PointSet::kSurfels)
         return compareVoxels(engine, s, prediction, select, options, start);
     const auto t0 = Clock::now();
     const detail::Surfels sb = detail::extractSurfels(prediction, select, options.threads);

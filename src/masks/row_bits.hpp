@@ -22,7 +22,7 @@
 
 #include "core/uninit_vector.hpp"
 #include "masks/boundary.hpp"
-#include "masks/masks.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks::detail {
 

@@ -7,7 +7,7 @@
 #include <type_traits>
 
 #include "masks/byte_rows.hpp"
-#include "masks/masks.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks::detail {
 

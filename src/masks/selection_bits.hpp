@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "masks/boundary.hpp"
-#include "masks/masks.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks::detail {
 

@@ -1,4 +1,4 @@
-// DeepMind surface-distance's surfel areas (../shared/MASKS.md, the DeepMind
+// DeepMind surface-distance's surfel areas (docs/masks.md, the DeepMind
 // row), derived here from the geometry. Internal to rthdist_masks.
 //
 // A surfel sits at a corner of the voxel grid; its 2x2x2 neighbourhood is the

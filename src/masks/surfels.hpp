@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "masks/masks.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks::detail {
 

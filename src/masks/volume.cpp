@@ -16,9 +16,9 @@
 
 #include "core/parallel.hpp"
 #include "masks/label_types.hpp"
-#include "masks/masks.hpp"
 #include "masks/npy_header.hpp"
 #include "masks/volume_file.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks {
 

@@ -3,7 +3,11 @@
 #include <chrono>
 #include <iterator>
 
+#include "core/stopwatch.hpp"
+
 namespace rthdist::mpi {
+
+using core::msSince;
 
 namespace {
 
@@ -50,10 +54,6 @@ PassOutcome outcomeOf(const HausdorffResult& r, std::span<const glm::vec3> queri
     out.timings = r.timings;
     out.validationMessages = r.validationMessages;
     return out;
-}
-
-double msSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace

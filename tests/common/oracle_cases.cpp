@@ -315,9 +315,10 @@ void expectMatchesOracle(const OracleCase& c, const HausdorffResult& r, bool dir
         return (ab ? r.proofMaterial->aToB : r.proofMaterial->bToA).failure;
     };
     EXPECT_TRUE(r.aToB.certificate.confirmed) << "h(A,B) carries no confirmed certificate: " << why(true);
-    if (!directedOnly)
+    if (!directedOnly) {
         EXPECT_TRUE(r.bToA.certificate.confirmed)
             << "h(B,A) carries no confirmed certificate: " << why(false);
+    }
     expectDirected("h(A,B)", c.a, c.b, r.aToB, hab, tolerance);
     if (!directedOnly) {
         expectDirected("h(B,A)", c.b, c.a, r.bToA, hba, tolerance);

@@ -18,6 +18,7 @@
 #include "common/brute_force.hpp"
 #include "common/geo_cases.hpp"
 #include "engine/engine_test_support.hpp"
+#include "gpu/vk_struct.hpp"
 #include "rthdist/vulkan_interop.hpp"
 
 namespace rthdist::test {
@@ -39,7 +40,7 @@ class Embedder {
 public:
     // Empty (why() says why) when no device can run `backend`.
     explicit Embedder(Backend backend) {
-        VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+        VkApplicationInfo app = gpu::vkStruct<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);
         app.apiVersion = VK_API_VERSION_1_3;
         const char* layer = "VK_LAYER_KHRONOS_validation";
         const char* ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
@@ -48,7 +49,7 @@ public:
         // environment (docs/gpu.md). Not forced here: under the asan preset the
         // layer's synchronization validation leaves allocations LeakSanitizer
         // cannot attribute to it.
-        VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+        VkInstanceCreateInfo ci = gpu::vkStruct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
         ci.pApplicationInfo = &app;
         ci.enabledLayerCount = 1;
         ci.ppEnabledLayerNames = &layer;
@@ -111,19 +112,21 @@ public:
         std::memcpy(mapped, bytes, size);
         vkUnmapMemory(m_device, m_buffers.back().second);
         VkBuffer dst = makeBuffer(size, usage, 0);
-        VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+        VkCommandBufferAllocateInfo ai =
+            gpu::vkStruct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
         ai.commandPool = m_pool;
         ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
         ai.commandBufferCount = 1;
         VkCommandBuffer cmd;
         vkAllocateCommandBuffers(m_device, &ai, &cmd);
-        VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        VkCommandBufferBeginInfo bi =
+            gpu::vkStruct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
         bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         vkBeginCommandBuffer(cmd, &bi);
         const VkBufferCopy region{0, 0, size};
         vkCmdCopyBuffer(cmd, staging, dst, 1, &region);
         vkEndCommandBuffer(cmd);
-        VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+        VkSubmitInfo si = gpu::vkStruct<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
         si.commandBufferCount = 1;
         si.pCommandBuffers = &cmd;
         EXPECT_EQ(vkQueueSubmit(m_handles.queue, 1, &si, VK_NULL_HANDLE), VK_SUCCESS);
@@ -138,7 +141,8 @@ private:
     void createMessenger() {
         auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
             vkGetInstanceProcAddr(m_instance, "vkCreateDebugUtilsMessengerEXT"));
-        VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+        VkDebugUtilsMessengerCreateInfoEXT mi = gpu::vkStruct<VkDebugUtilsMessengerCreateInfoEXT>(
+            VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
         mi.messageSeverity =
             VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
         mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
@@ -151,11 +155,12 @@ private:
 
     void createDevice(VkPhysicalDevice pd, VulkanDeviceSetup& setup) {
         const float priority = 1.0f;
-        VkDeviceQueueCreateInfo qi{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+        VkDeviceQueueCreateInfo qi =
+            gpu::vkStruct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
         qi.queueFamilyIndex = setup.queueFamily;
         qi.queueCount = 1;
         qi.pQueuePriorities = &priority;
-        VkDeviceCreateInfo di{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+        VkDeviceCreateInfo di = gpu::vkStruct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
         di.pNext = setup.chain();
         di.queueCreateInfoCount = 1;
         di.pQueueCreateInfos = &qi;
@@ -170,13 +175,14 @@ private:
         m_handles = VulkanDevice{m_instance,          pd,  m_device, VK_NULL_HANDLE, setup.queueFamily,
                                  setup.shaderFloat64, true};
         vkGetDeviceQueue(m_device, setup.queueFamily, 0, &m_handles.queue);
-        VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+        VkCommandPoolCreateInfo pci =
+            gpu::vkStruct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
         pci.queueFamilyIndex = setup.queueFamily;
         vkCreateCommandPool(m_device, &pci, nullptr, &m_pool);
     }
 
     VkBuffer makeBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags wanted) {
-        VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+        VkBufferCreateInfo bci = gpu::vkStruct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
         bci.size = size;
         bci.usage = usage;
         VkBuffer buffer;
@@ -189,9 +195,11 @@ private:
         while (!((req.memoryTypeBits >> type) & 1u) ||
                (props.memoryTypes[type].propertyFlags & wanted) != wanted)
             ++type;
-        VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+        VkMemoryAllocateFlagsInfo flags =
+            gpu::vkStruct<VkMemoryAllocateFlagsInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
         flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
-        VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+        VkMemoryAllocateInfo mai =
+            gpu::vkStruct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
         mai.pNext = &flags;
         mai.allocationSize = req.size;
         mai.memoryTypeIndex = type;

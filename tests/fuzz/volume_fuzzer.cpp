@@ -18,7 +18,7 @@
 #include <string>
 #include <string_view>
 
-#include "masks/masks.hpp"
+#include "rthdist/masks.hpp"
 
 #ifndef RTHDIST_FUZZ_FORMAT
 #error "RTHDIST_FUZZ_FORMAT must name the format (nifti, npy)"

@@ -19,6 +19,7 @@
 #include "common/rng.hpp"
 #include "gpu/buffer.hpp"
 #include "gpu/context.hpp"
+#include "gpu/vk_struct.hpp"
 #include "gpu_algo/gpu_hausdorff.hpp"
 #include "gpu_test_support.hpp"
 
@@ -43,7 +44,8 @@ std::unique_ptr<gpu::Context> makeContext(std::string& whyNot) {
 std::vector<uint64_t> probeAddresses(gpu::Context& ctx, uint64_t base, uint32_t index) {
     VkDevice d = ctx.device();
     gpu::Buffer out(ctx, 7 * 8, gpu::kStorageUsage, gpu::MemoryKind::kHost);
-    VkShaderModuleCreateInfo mi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    VkShaderModuleCreateInfo mi =
+        gpu::vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
     mi.codeSize = sizeof(k_spv_address_probe_comp);
     mi.pCode = k_spv_address_probe_comp;
     VkShaderModule module = VK_NULL_HANDLE;
@@ -53,13 +55,16 @@ std::vector<uint64_t> probeAddresses(gpu::Context& ctx, uint64_t base, uint32_t 
         uint32_t index;
     } push{base, out.address(), index};
     VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Push)};
-    VkPipelineLayoutCreateInfo li{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    VkPipelineLayoutCreateInfo li =
+        gpu::vkStruct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
     li.pushConstantRangeCount = 1;
     li.pPushConstantRanges = &range;
     VkPipelineLayout layout = VK_NULL_HANDLE;
     EXPECT_EQ(vkCreatePipelineLayout(d, &li, nullptr, &layout), VK_SUCCESS);
-    VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    VkComputePipelineCreateInfo ci =
+        gpu::vkStruct<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
+    ci.stage =
+        gpu::vkStruct<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
     ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     ci.stage.module = module;
     ci.stage.pName = "main";

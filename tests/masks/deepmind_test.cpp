@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "masks/area_weighted.hpp"
-#include "masks/masks.hpp"
 #include "masks/surfel_area.hpp"
 #include "masks/surfels.hpp"
 #include "masks_test_support.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks {
 namespace {

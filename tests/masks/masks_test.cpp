@@ -14,9 +14,9 @@
 
 #include "masks/boundary.hpp"
 #include "masks/gpu_boundary.hpp"
-#include "masks/masks.hpp"
 #include "masks_gpu/boundary_pass.hpp"
 #include "masks_test_support.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <cstdlib>
 
-#include "masks/masks.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks {
 

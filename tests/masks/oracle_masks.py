@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Oracle test of rthdist-masks: every convention recomputed here from its
-definition (../shared/MASKS.md; src/masks/masks.hpp) with NumPy/SciPy, on
+definition (docs/masks.md; include/rthdist/masks.hpp) with NumPy/SciPy, on
 synthetic masks and on the atlases of ../shared/data/nifti, compared with the
 CLI's JSON to 1e-6 of the volume's world diagonal.
 

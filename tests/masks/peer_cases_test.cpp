@@ -22,8 +22,8 @@
 #include <limits>
 #include <string>
 
-#include "masks/masks.hpp"
 #include "masks_test_support.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks {
 namespace {

@@ -1,4 +1,4 @@
-// The prepared reference (masks/prepared_reference.hpp): one reference
+// The prepared reference (rthdist/masks.hpp PreparedReference): one reference
 // prepared once and compared with many predictions gives, value for value,
 // compareMasks(reference, prediction) in every convention, on the backend of
 // RTHDIST_TEST_BACKEND (the *Backend* tests also run on ray-query and
@@ -13,9 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "masks/masks.hpp"
-#include "masks/prepared_reference.hpp"
 #include "masks_test_support.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::masks {
 namespace {

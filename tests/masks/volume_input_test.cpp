@@ -18,8 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "masks/masks.hpp"
-#include "masks/prepared_reference.hpp"
+#include "rthdist/masks.hpp"
 #include "volume_files.hpp"
 
 namespace rthdist::masks {

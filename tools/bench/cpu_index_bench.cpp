@@ -22,6 +22,7 @@
 #include <sys/resource.h>
 
 #include "core/index_space.hpp"
+#include "core/stopwatch.hpp"
 #include "cpu/target_index.hpp"
 #include "rthdist/io.hpp"
 
@@ -29,11 +30,8 @@ using namespace rthdist;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using core::Clock;
+using core::msSince;
 
 // User + system CPU time of the whole process (all threads), ms.
 double cpuMs() {

@@ -25,17 +25,16 @@
 #include <string>
 #include <vector>
 
+#include "core/stopwatch.hpp"
+#include "gpu/vk_struct.hpp"
 #include "rthdist/io.hpp"
 #include "rthdist/rthdist.hpp"
 #include "rthdist/vulkan_interop.hpp"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using rthdist::core::Clock;
+using rthdist::core::msSince;
 
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
@@ -50,9 +49,10 @@ void check(VkResult r, const char* what) {
 class Embedder {
 public:
     explicit Embedder(rthdist::Backend backend) {
-        VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+        VkApplicationInfo app = rthdist::gpu::vkStruct<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);
         app.apiVersion = VK_API_VERSION_1_3;
-        VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+        VkInstanceCreateInfo ci =
+            rthdist::gpu::vkStruct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
         ci.pApplicationInfo = &app;
         check(vkCreateInstance(&ci, nullptr, &m_instance), "vkCreateInstance");
         uint32_t n = 0;
@@ -102,19 +102,21 @@ public:
                                   VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
                                       VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                   VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-        VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+        VkCommandBufferAllocateInfo ai = rthdist::gpu::vkStruct<VkCommandBufferAllocateInfo>(
+            VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
         ai.commandPool = m_pool;
         ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
         ai.commandBufferCount = 1;
         VkCommandBuffer cmd;
         check(vkAllocateCommandBuffers(m_device, &ai, &cmd), "vkAllocateCommandBuffers");
-        VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        VkCommandBufferBeginInfo bi =
+            rthdist::gpu::vkStruct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
         bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         vkBeginCommandBuffer(cmd, &bi);
         const VkBufferCopy region{0, 0, size};
         vkCmdCopyBuffer(cmd, staging, dst, 1, &region);
         vkEndCommandBuffer(cmd);
-        VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+        VkSubmitInfo si = rthdist::gpu::vkStruct<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
         si.commandBufferCount = 1;
         si.pCommandBuffers = &cmd;
         check(vkQueueSubmit(m_handles.queue, 1, &si, VK_NULL_HANDLE), "vkQueueSubmit");
@@ -125,11 +127,13 @@ public:
 private:
     void createDevice(VkPhysicalDevice pd, rthdist::VulkanDeviceSetup setup) {
         const float priority = 1.0f;
-        VkDeviceQueueCreateInfo qi{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+        VkDeviceQueueCreateInfo qi =
+            rthdist::gpu::vkStruct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
         qi.queueFamilyIndex = setup.queueFamily;
         qi.queueCount = 1;
         qi.pQueuePriorities = &priority;
-        VkDeviceCreateInfo di{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+        VkDeviceCreateInfo di =
+            rthdist::gpu::vkStruct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
         di.pNext = setup.chain();
         di.queueCreateInfoCount = 1;
         di.pQueueCreateInfos = &qi;
@@ -138,7 +142,8 @@ private:
         check(vkCreateDevice(pd, &di, nullptr, &m_device), "vkCreateDevice");
         m_physical = pd;
         vkGetDeviceQueue(m_device, setup.queueFamily, 0, &m_handles.queue);
-        VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+        VkCommandPoolCreateInfo pi =
+            rthdist::gpu::vkStruct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
         pi.queueFamilyIndex = setup.queueFamily;
         check(vkCreateCommandPool(m_device, &pi, nullptr, &m_pool), "vkCreateCommandPool");
         m_handles.instance = m_instance;
@@ -149,7 +154,8 @@ private:
     }
 
     VkBuffer makeBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags wanted) {
-        VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+        VkBufferCreateInfo bi =
+            rthdist::gpu::vkStruct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
         bi.size = size;
         bi.usage = usage;
         VkBuffer buffer;
@@ -163,9 +169,11 @@ private:
                                                 (props.memoryTypes[type].propertyFlags & wanted) != wanted))
             ++type;
         if (type == props.memoryTypeCount) throw std::runtime_error("no memory type for a buffer");
-        VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+        VkMemoryAllocateFlagsInfo flags =
+            rthdist::gpu::vkStruct<VkMemoryAllocateFlagsInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
         flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
-        VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+        VkMemoryAllocateInfo ai =
+            rthdist::gpu::vkStruct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
         ai.pNext = &flags;
         ai.allocationSize = req.size;
         ai.memoryTypeIndex = type;

@@ -23,17 +23,15 @@
 #include <string>
 #include <vector>
 
+#include "core/stopwatch.hpp"
 #include "rthdist/io.hpp"
 #include "rthdist/rthdist.hpp"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using rthdist::HausdorffResult;
-
-double msSince(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using rthdist::core::Clock;
+using rthdist::core::msSince;
 
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());

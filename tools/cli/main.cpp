@@ -18,6 +18,7 @@
 #include "cli/progress_meter.hpp"
 #include "cli/report.hpp"
 #include "cli/verify.hpp"
+#include "core/stopwatch.hpp"
 #include "rthdist/io.hpp"
 #include "rthdist/rthdist.hpp"
 #include "rthdist/stats.hpp"
@@ -25,11 +26,8 @@
 namespace rthdist::cli {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using core::Clock;
+using core::msSince;
 
 int fail(int code, const std::string& message) {
     std::fflush(stdout);

@@ -28,7 +28,8 @@ void ProgressMeter::update(const char* stage, double fraction) {
     char line[128];
     const int n = std::snprintf(line, sizeof line, "rthdist: %-8s %3d%%", stage,
                                 int(std::clamp(fraction, 0.0, 1.0) * 100.0));
-    std::string text = "\r" + std::string(line, size_t(std::max(n, 0)));
+    std::string text = "\r";  // then the line appended (GCC 12's -Wrestrict misreads "\r" + std::string&&)
+    text.append(line, size_t(std::max(n, 0)));
     const size_t visible = text.size() - 1;
     if (visible < m_width) text.append(m_width - visible, ' ');
     m_width = std::max(m_width, visible);

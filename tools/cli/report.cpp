@@ -41,7 +41,16 @@ std::string coordinateText(double v) {
 }
 
 std::string pointText(const glm::dvec3& p) {
-    return "(" + coordinateText(p.x) + ", " + coordinateText(p.y) + ", " + coordinateText(p.z) + ")";
+    // Appended in order: GCC 12 reads `"(" + std::string&&` (an insert at 0)
+    // as an overlapping memcpy (-Wrestrict, GCC bug 105329).
+    std::string text = "(";
+    text += coordinateText(p.x);
+    text += ", ";
+    text += coordinateText(p.y);
+    text += ", ";
+    text += coordinateText(p.z);
+    text += ")";
+    return text;
 }
 
 Json pointJson(const glm::dvec3& p) { return Json::array({p.x, p.y, p.z}); }

@@ -22,6 +22,7 @@
 
 #include "cli/exit_codes.hpp"
 #include "cli/report.hpp"
+#include "core/stopwatch.hpp"
 #include "mpi_args.hpp"
 #include "rank_device.hpp"
 #include "rthdist/mpi.hpp"
@@ -30,11 +31,8 @@
 namespace rthdist::cli {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using core::Clock;
+using core::msSince;
 
 struct Rank {
     MPI_Comm comm = MPI_COMM_WORLD;

@@ -1,6 +1,6 @@
 // rthdist-masks — HD, HD-p, ASSD/MSD and surface Dice between two
 // segmentation masks (NIfTI-1/2 .nii/.nii.gz, NumPy .npy) in a named tool's
-// convention (src/masks/masks.hpp; README "Segmentation masks").
+// convention (include/rthdist/masks.hpp; README "Segmentation masks").
 //
 //   rthdist-masks A B [B2 ...] [--label N | --labels all] [--convention NAME|all]
 //                 [--percentile P]... [--connectivity 6|18|26] [--tolerance MM]
@@ -11,7 +11,7 @@
 //                 [--unprepared] [--json | --csv]
 //
 // With more than one B, A is a reference compared with each B in turn
-// through a prepared reference (masks/prepared_reference.hpp: A extracted
+// through a prepared reference (rthdist/masks.hpp PreparedReference: A extracted
 // and indexed once per label and convention); one row per (B, label,
 // convention), each naming its B.
 // A separate executable from `rthdist` (tools/cli/main.cpp), with its own
@@ -38,8 +38,7 @@
 #include "cli/command_line.hpp"
 #include "cli/exit_codes.hpp"
 #include "cli/json_output.hpp"
-#include "masks/masks.hpp"
-#include "masks/prepared_reference.hpp"
+#include "rthdist/masks.hpp"
 
 namespace rthdist::cli {
 namespace {
@@ -68,39 +67,45 @@ struct MasksArgs {
     int repeat = 1;                 // --repeat N: each comparison N times (benchmarks)
 };
 
-const char* kUsage =
-    "usage: rthdist-masks A B [B2 ...] [options]\n"
-    "Hausdorff distance, HD-p, ASSD/MSD and surface Dice between two segmentation masks\n"
-    "(.nii, .nii.gz: NIfTI-1/2 with sform, else qform, else pixdim; .npy with --spacing).\n"
-    "With several Bs, A is a reference compared with each (one row per B, label and\n"
-    "convention), extracted and indexed once per label and convention.\n"
-    "  --label N            compare label N in both volumes (default: every non-zero voxel)\n"
-    "  --labels all         one row per label present in either volume\n"
-    "  --convention NAME    rthdist (default), monai, medpy, plastimatch, itk, deepmind,\n"
-    "                       or all (one row each)\n"
-    "  --percentile P       HD-p to report, repeatable (default 95)\n"
-    "  --connectivity C     boundary connectivity 6, 18 or 26 (default 6; itk uses all voxels,\n"
-    "                       deepmind surfels)\n"
-    "  --tolerance MM       surface Dice tolerance in mm (default 1)\n"
-    "  --monai-precision float32|double  monai: compare distances with the tolerance and\n"
-    "                       compute torch.quantile's rank in float32 as MONAI does (default),\n"
-    "                       or in double\n"
-    "  --spacing X,Y,Z      voxel spacing of .npy inputs along axes 0,1,2 (default 1,1,1)\n"
-    "  --affine R00,R01,R02,T0,R10,...,T2  voxel-to-world of .npy inputs: 3x4, row-major\n"
-    "  --max-volume-mib N   the most voxel data one volume may have, in MiB, as stored\n"
-    "                       (inflated) and as held (1 byte a voxel for uint8/bool, else 4);\n"
-    "                       default 2048; a larger file is refused (exit 3) before reading\n"
-    "  --backend B          auto, cpu, ray-query, rt-pipeline (default auto)\n"
-    "  --device N           Vulkan device index;  --threads N  CPU threads (0 = all)\n"
-    "  --device-extraction  GPU backends: find boundary voxels with a compute shader\n"
-    "                       (default: on the host, which measured faster)\n"
-    "  --host-extraction    with --device-extraction: the host all the same (tests)\n"
-    "  --repeat N           run each comparison N times in this process (benchmarks: JSON\n"
-    "                       lists every run's time; the numbers are the last run's)\n"
-    "  --unprepared         several Bs: extract and index A again for each (benchmarks;\n"
-    "                       the same numbers)\n"
-    "  --json | --csv       output format (default: text)\n"
-    "Exit codes: 0 ok, 1 internal error, 2 usage, 3 bad input or different grids, 4 no device.\n";
+// The --help text; the conventions' names come from their table.
+std::string usageText() {
+    std::string names = masks::conventionNames();
+    names.insert(names.find(',') == std::string::npos ? names.size() : names.find(','), " (default)");
+    return "usage: rthdist-masks A B [B2 ...] [options]\n"
+           "Hausdorff distance, HD-p, ASSD/MSD and surface Dice between two segmentation masks\n"
+           "(.nii, .nii.gz: NIfTI-1/2 with sform, else qform, else pixdim; .npy with --spacing).\n"
+           "With several Bs, A is a reference compared with each (one row per B, label and\n"
+           "convention), extracted and indexed once per label and convention.\n"
+           "  --label N            compare label N in both volumes (default: every non-zero voxel)\n"
+           "  --labels all         one row per label present in either volume\n"
+           "  --convention NAME    " +
+           names +
+           ",\n"
+           "                       or all (one row each)\n"
+           "  --percentile P       HD-p to report, repeatable (default 95)\n"
+           "  --connectivity C     boundary connectivity 6, 18 or 26 (default 6; itk uses all voxels,\n"
+           "                       deepmind surfels)\n"
+           "  --tolerance MM       surface Dice tolerance in mm (default 1)\n"
+           "  --monai-precision float32|double  monai: compare distances with the tolerance and\n"
+           "                       compute torch.quantile's rank in float32 as MONAI does (default),\n"
+           "                       or in double\n"
+           "  --spacing X,Y,Z      voxel spacing of .npy inputs along axes 0,1,2 (default 1,1,1)\n"
+           "  --affine R00,R01,R02,T0,R10,...,T2  voxel-to-world of .npy inputs: 3x4, row-major\n"
+           "  --max-volume-mib N   the most voxel data one volume may have, in MiB, as stored\n"
+           "                       (inflated) and as held (1 byte a voxel for uint8/bool, else 4);\n"
+           "                       default 2048; a larger file is refused (exit 3) before reading\n"
+           "  --backend B          auto, cpu, ray-query, rt-pipeline (default auto)\n"
+           "  --device N           Vulkan device index;  --threads N  CPU threads (0 = all)\n"
+           "  --device-extraction  GPU backends: find boundary voxels with a compute shader\n"
+           "                       (default: on the host, which measured faster)\n"
+           "  --host-extraction    with --device-extraction: the host all the same (tests)\n"
+           "  --repeat N           run each comparison N times in this process (benchmarks: JSON\n"
+           "                       lists every run's time; the numbers are the last run's)\n"
+           "  --unprepared         several Bs: extract and index A again for each (benchmarks;\n"
+           "                       the same numbers)\n"
+           "  --json | --csv       output format (default: text)\n"
+           "Exit codes: 0 ok, 1 internal error, 2 usage, 3 bad input or different grids, 4 no device.\n";
+}
 
 Error usage(const std::string& m) { return Error{ErrorCode::kInvalidArgument, m}; }
 
@@ -183,8 +188,7 @@ void addMeasureOptions(CommandLine& line, MasksArgs& a, bool& conventionSet) {
         } else if (masks::parseConvention(v, c)) {
             a.conventions.push_back(c);
         } else {
-            reject("--convention expects rthdist, monai, medpy, plastimatch, itk, deepmind or all, got '" +
-                   v + "'");
+            reject("--convention expects " + masks::conventionNames() + " or all, got '" + v + "'");
         }
     });
     value("--percentile", [&a](const std::string& v) {
@@ -304,10 +308,10 @@ Json directedJson(const masks::DirectedMask& d, const MaskResult& r, bool ok) {
     out["hd"] = d.hd;
     out["mean"] = d.mean;
     out["surface_overlap"] = d.surfaceOverlap;
-    if (r.convention == Convention::kDeepmind) out["area_mm2"] = d.area;
+    const bool corners = masks::conventionRules(r.convention).points == masks::PointSet::kSurfels;
+    if (corners) out["area_mm2"] = d.area;
     out["percentiles"] = std::move(percentiles);
-    // deepmind's points are surfel corners: corner (i, j, k) at voxel coordinates (i - 1/2, ...).
-    const bool corners = r.convention == Convention::kDeepmind;
+    // Surfels (deepmind) are corners: corner (i, j, k) at voxel coordinates (i - 1/2, ...).
     out[corners ? "corner" : "voxel"] = d.voxel;
     out["point"] = Json::array({d.point.x, d.point.y, d.point.z});
     out[corners ? "nearest_corner" : "nearest_voxel"] = d.nearestVoxel;
@@ -350,10 +354,8 @@ Json rowJson(const Row& row) {
                     {"convention", masks::conventionName(r.convention)},
                     {"rule", masks::conventionRule(r.convention)},
                     {"connectivity", r.connectivity},
-                    {"geometry", r.convention == Convention::kRthdist ? "world" : "spacing"},
-                    {"points_are", r.convention == Convention::kDeepmind ? "surfels"
-                                   : r.convention == Convention::kItk    ? "voxels"
-                                                                         : "boundary_voxels"},
+                    {"geometry", masks::metricName(masks::conventionRules(r.convention).metric)},
+                    {"points_are", masks::pointSetName(masks::conventionRules(r.convention).points)},
                     {"status", masks::emptyStatusName(r.empty)}});
     if (!ok) out["convention_value"] = emptyJson(r);
     Json hdPercentile = Json::array();
@@ -436,11 +438,19 @@ std::string csvReport(const MasksArgs& args, const std::vector<Row>& rows) {
         if (several) out += row.b + ",";
         out += row.label + "," + masks::conventionName(r.convention) + "," + masks::emptyStatusName(r.empty) +
                "," + num(r.hd);
+        // Each field appended after its comma (GCC 12 misreads "," + std::string&&
+        // as an overlapping memcpy: -Wrestrict, GCC bug 105329).
+        const auto field = [&out](const std::string& v) {
+            out += ',';
+            out += v;
+        };
         for (size_t i = 0; i < args.percentiles.size(); ++i)
-            out += "," + (i < r.hdPercentile.size() ? num(r.hdPercentile[i]) : "");
-        out += "," + num(r.assd) + "," + num(r.msd) + "," + num(r.surfaceDice) + "," + num(r.aToB.hd) + "," +
-               num(r.bToA.hd) + "," + std::to_string(r.aToB.points) + "," + std::to_string(r.bToA.points) +
-               "," + num(r.totalMs) + "\n";
+            field(i < r.hdPercentile.size() ? num(r.hdPercentile[i]) : "");
+        for (double v : {r.assd, r.msd, r.surfaceDice, r.aToB.hd, r.bToA.hd}) field(num(v));
+        field(std::to_string(r.aToB.points));
+        field(std::to_string(r.bToA.points));
+        field(num(r.totalMs));
+        out += "\n";
     }
     return out;
 }
@@ -600,7 +610,7 @@ int run(int argc, char** argv) {
     Result<MasksArgs> parsed = parse(list);
     if (!parsed) return fail(kExitUsage, parsed.error().message + "\nTry 'rthdist-masks --help'.");
     const MasksArgs& args = *parsed;
-    if (args.help) return std::fputs(kUsage, stdout) >= 0 ? kExitOk : kExitInternal;
+    if (args.help) return std::fputs(usageText().c_str(), stdout) >= 0 ? kExitOk : kExitInternal;
     if (args.version) return std::printf("rthdist-masks %s\n", versionString()) > 0 ? kExitOk : kExitInternal;
 
     Result<masks::Volume> a = masks::loadVolume(args.pathA, args.spacing, args.affine, args.limits);

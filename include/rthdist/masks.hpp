@@ -1,67 +1,62 @@
 // rthdist masks — Hausdorff distance, HD-p, ASSD/MSD and surface Dice between
 // two segmentation masks (NIfTI-1/2 or NumPy volumes), exact, in the
-// convention of a named tool (../shared/MASKS.md, README "Segmentation masks").
+// convention of a named tool. The package's `masks` component:
+// find_package(rthdist COMPONENTS masks) -> rthdist::masks (static builds;
+// README "Segmentation masks", docs/masks.md).
 //
 // Pipeline per label: select the label's voxels in each volume, extract the
-// convention's point set (boundary voxels under a stated connectivity, or all
-// foreground voxels), convert voxel centres to coordinates in double, then
-// the exact engine (rthdist.hpp, per-point distances) for every point's
-// nearest distance in the other set; the convention's percentile rule and
-// combination of the two directions make the numbers.
+// convention's point set (boundary voxels under a stated connectivity, all
+// foreground voxels, or surfels), convert voxel centres (corners) to
+// coordinates in double, then the exact engine (rthdist.hpp, per-point
+// distances) for every point's nearest distance in the other set; the
+// convention's percentile rule and combination of the two directions make
+// the numbers.
 //
-// Conventions (Convention; conventionName/parseConvention):
-//   rthdist     boundary = foreground voxels with a background (or outside
-//               the volume) neighbour under `connectivity` (default 6);
-//               coordinates = the voxel-to-world affine (a shear counts);
-//               HD-p = max of the two directed nearest-rank percentiles
-//               (rthdist/stats.hpp percentileNearestRank); empty -> status, no value.
-//   monai       boundary = mask XOR erosion (6-connected cross); spacing only;
-//               HD-p = max of the two directed linear percentiles
-//               (torch.quantile: rank and weight in float32; p = 0 -> the
-//               maximum); surface Dice counts float(d) <= float(tolerance)
-//               (MaskOptions::monaiFloat32); empty: emptyValues.
+// Conventions: one row each in rthdist/mask_conventions.hpp (the point set,
+// metric, connectivity, percentile rule, combination, tolerance arithmetic
+// and empty-mask values), which the library reads; docs/masks.md explains
+// each row and the tool it reproduces. In short:
+//   rthdist     boundary voxels under `connectivity` (default 6), world
+//               coordinates (the affine, a shear counts); HD-p = max of the
+//               two directed nearest-rank percentiles; empty -> status, no value.
+//   monai       mask XOR erosion (6-connected cross), spacing; HD-p = max of
+//               the two directed linear percentiles (torch.quantile's float32
+//               rank and weight: MaskOptions::monaiFloat32; p = 0 -> the
+//               maximum); surface Dice counts float(d) <= float(tolerance).
 //   medpy       boundary as monai (connectivity 6 by default); HD-p = linear
-//               percentile of the POOLED distances of both directions;
-//               HD = max; empty -> undefined (MedPy raises).
+//               percentile of the POOLED distances of both directions.
 //   plastimatch boundary voxels (6-connected); HD-p per direction = the k-th
-//               smallest, k = floor(f n - 1) clamped to [0, n-1], f = p/100;
-//               HD-p = MEAN of the two; "average" = mean of the directed means;
-//               both empty -> 0.
-//   itk         ALL foreground voxels (HausdorffDistanceImageFilter): a voxel
-//               inside the other mask counts 0; no percentile; "average" =
-//               mean of the directed means (AverageHausdorffDistance).
-//   deepmind    surface-distance (1f805ce): surfels = corners of the voxel grid
-//               (voxel coordinates (i - 1/2, j - 1/2, k - 1/2)) whose 2x2x2
-//               neighbour code is neither 0 nor 255, each with the area of its
-//               marching-cubes piece (surfel_area.hpp); distance from each
-//               surfel of X to the nearest surfel of Y; every statistic weighted
-//               by area: HD-p per direction = d_i of the first i (sorted by
-//               distance, then area) whose cumulative area / total >= p/100,
-//               no interpolation; HD-p = max of the two ("robust HD");
-//               directed mean = sum(a d) / sum(a); ASSD = both surfaces' sum(a d)
-//               / both areas; MSD = mean of the directed means; surface overlap
-//               = area within the tolerance / area, per direction; surface
-//               Dice = (both areas within the tolerance) / (both areas).
-//               Empty: HD and HD-p inf; surface Dice 0 (one empty) or NaN
-//               (both); the empty side's mean NaN, the other's inf.
-// Every convention but rthdist measures with the voxel spacing only (the
-// column norms of the affine's 3x3 part), as those tools do; for an
-// orthonormal direction matrix the distances equal the world ones. DeepMind
-// takes only spacing_mm: an oblique affine's direction matrix is ignored
-// (witness points are still reported in world coordinates).
+//               smallest, k = floor(p/100 n - 1) clamped to [0, n-1]; HD-p =
+//               MEAN of the two.
+//   itk         ALL foreground voxels (a voxel inside the other mask counts
+//               0); no percentile, no surface measures.
+//   deepmind    surfels (corners of the half-voxel-shifted grid whose 2x2x2
+//               code is neither 0 nor 255) weighted by their marching-cubes
+//               areas; every statistic area-weighted; HD-p per direction =
+//               the first distance whose cumulative area fraction >= p/100;
+//               HD-p = max of the two ("robust HD").
+// "average" (MaskResult::msd) is the mean of the two directed means for
+// every convention. Every convention but rthdist measures with the voxel
+// spacing only (the column norms of the affine's 3x3 part), as those tools
+// do; for an orthonormal direction matrix the distances equal the world
+// ones. DeepMind takes only spacing_mm: an oblique affine's direction matrix
+// is ignored (witness points are still reported in world coordinates).
 //
 // Precision: coordinates in double; distances are the engine's exact values
 // (within 1e-6 of the union's bounding-box diagonal of the brute force in
 // double, rthdist.hpp), so every order statistic is as well. deepmind
 // recomputes each distance from the engine's nearest surfel with SciPy's EDT
 // arithmetic, sqrt(((di sx)^2 + (dj sy)^2) + (dk sz)^2), and sums areas in
-// NumPy's order (area_weighted.hpp), so its area-weighted percentiles pick
-// the index DeepMind's own run picks, rounding included.
+// NumPy's order, so its area-weighted percentiles pick the index DeepMind's
+// own run picks, rounding included.
 // Threading: extraction, the recomputed distances and the percentiles use
-// options.threads (0 = all); the Engine passed in is not thread-safe (one per
-// thread). Functions are otherwise reentrant.
-// Limits: volumes up to 2^31 - 1 selected points per mask (engine limit);
-// labels are int32 values (wider or non-integral values -> kBadInput).
+// options.threads (0 = all); a MaskEngine (and a PreparedReference, which
+// belongs to one) is not thread-safe: one per thread, as Engine. Functions
+// are otherwise reentrant.
+// Limits: up to 2^31 - 1 selected points per mask (engine limit); labels are
+// int32 values (wider or non-integral values -> kBadInput); a volume file's
+// voxel data within VolumeLimits; geometry within kMinSpacing and
+// kMaxCoordinate (below).
 #pragma once
 
 #include <glm/mat4x4.hpp>
@@ -75,6 +70,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rthdist/mask_conventions.hpp"
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
 
@@ -129,8 +125,7 @@ struct VolumeLimits {
 inline constexpr double kMinSpacing = 1e-30;
 inline constexpr double kMaxCoordinate = 1e30;
 
-// Reads a NIfTI-1 or NIfTI-2 file (.nii, .nii.gz; nifti.cpp, in target
-// rthdist_masks, not rthdist_masks_core) with rthdist's own reader: the
+// Reads a NIfTI-1 or NIfTI-2 file (.nii, .nii.gz) with rthdist's own reader: the
 // header is validated field by field (README "Segmentation masks": dim,
 // datatype, pixdim, vox_offset, scl_slope/scl_inter, qform/sform codes,
 // quatern_b/c/d, qoffset, srow) before any value is used, then the voxels
@@ -144,7 +139,7 @@ inline constexpr double kMaxCoordinate = 1e30;
 [[nodiscard]] Result<Volume> loadNifti(const std::string& path, const VolumeLimits& limits = {});
 
 // Reads a NumPy .npy file (format 1.0, 2.0 or 3.0, read as NumPy's format
-// specification says: npy_header.hpp; 3-D; bool, int8..int64,
+// specification says; 3-D; bool, int8..int64,
 // uint8..uint64, float32, float64, either byte order; C or Fortran order).
 // Array axes 0, 1, 2 are i, j, k; the voxel spacing along them is `spacing`
 // (origin 0) unless `affine` (a 4x4 whose last row is 0 0 0 1) is given.
@@ -153,8 +148,7 @@ inline constexpr double kMaxCoordinate = 1e30;
                                      const std::optional<glm::dmat4>& affine = std::nullopt,
                                      const VolumeLimits& limits = {});
 
-// Loads by extension: .nii / .nii.gz through loadNifti, .npy through loadNpy
-// (rthdist_masks, as loadNifti).
+// Loads by extension: .nii / .nii.gz through loadNifti, .npy through loadNpy.
 [[nodiscard]] Result<Volume> loadVolume(const std::string& path, glm::dvec3 spacing = glm::dvec3(1.0),
                                         const std::optional<glm::dmat4>& affine = std::nullopt,
                                         const VolumeLimits& limits = {});
@@ -192,14 +186,18 @@ struct LabelArray {
 // Sorted distinct non-zero labels present in the volume.
 [[nodiscard]] std::vector<int32_t> labelsPresent(const Volume& v);
 
-enum class Convention { kRthdist, kMonai, kMedpy, kPlastimatch, kItk, kDeepmind };
-inline constexpr std::array<Convention, 6> kAllConventions{Convention::kRthdist, Convention::kMonai,
-                                                           Convention::kMedpy,   Convention::kPlastimatch,
-                                                           Convention::kItk,     Convention::kDeepmind};
+// Convention (the enum, kAllConventions and each one's rules): rthdist/mask_conventions.hpp.
+// Its row's name and one-line rule ("?" for a value outside the table).
 [[nodiscard]] const char* conventionName(Convention c);
-[[nodiscard]] bool parseConvention(const std::string& text, Convention& out);
-// One line naming the point set, the metric, the percentile rule and the combination.
 [[nodiscard]] const char* conventionRule(Convention c);
+// The convention named `text` (a row's name) into `out`; false when none is.
+[[nodiscard]] bool parseConvention(const std::string& text, Convention& out);
+// Every convention's name, in table order, joined by ", " ("rthdist, monai, ...").
+[[nodiscard]] std::string conventionNames();
+// The point set and metric as the CLI's JSON names them: "boundary_voxels",
+// "voxels" or "surfels"; "world" or "spacing".
+[[nodiscard]] const char* pointSetName(PointSet p);
+[[nodiscard]] const char* metricName(Metric m);
 
 // Which voxels form a mask: label == value, or (anyNonZero) label != 0.
 struct LabelSelect {
@@ -246,20 +244,13 @@ struct EmptyValues {
 };
 
 // The values convention c reports when A or B (or both) is empty, for the
-// requested percentiles (none for itk):
-//   rthdist, itk  "undefined" everywhere.
-//   monai (d388d1c)  both: "nan" everywhere. One: every distance of both
-//                 directions is inf (get_surface_distance), so HD, the
-//                 directed HDs and means, ASSD and MSD "inf"; HD-p "nan"
-//                 (torch.quantile interpolates inf - inf) except p = 0
-//                 ("inf": the maximum); surface Dice and overlaps "0".
-//   medpy         "error" everywhere (RuntimeError: no binary object).
-//   plastimatch   both: "0" (its statistics stay 0) but surface Dice and
-//                 overlaps "undefined"; one: "undefined".
-//   deepmind (1f805ce)  HD, HD-p and every directed HD-p "inf"; a side
-//                 without surfels: mean and overlap "nan" (0/0), the other
-//                 side's "inf" and "0"; surface Dice "0" (one) or "nan"
-//                 (both); ASSD "inf" (one) or "nan"; MSD "nan".
+// requested percentiles (none for a convention without HD-p): its row's
+// bothEmpty or oneEmpty texts (rthdist/mask_conventions.hpp), each HD-p at
+// p = 0 from the percentileAt0 text. In short: rthdist, itk "undefined";
+// monai (d388d1c) "nan" for both, with one empty every distance inf (HD-p
+// "nan" but at p = 0, Dice "0"); medpy "error" (it raises); plastimatch "0"
+// for both (no Dice); deepmind (1f805ce) inf HDs, "nan" means and Dice of two
+// empty masks.
 [[nodiscard]] EmptyValues emptyValues(Convention c, EmptyStatus s, const std::vector<double>& percentiles);
 
 // One direction X -> Y.
@@ -308,13 +299,11 @@ struct MaskResult {
 };
 
 // The engine of compareMasks and, when asked for on a GPU backend, the
-// boundary pass (masks_gpu/boundary_pass.hpp) opened on the same device
+// boundary pass (a compute shader, src/masks_gpu) opened on the same device
 // index: boundary voxels are then found by a compute shader, the points'
-// distances by the engine. Without it the host finds them (row_bits.hpp:
-// one read of each label, then word arithmetic), which measured faster on
-// the H100 machine (docs/bench/masks): the pass needs the same host read to
-// find and stage the labels' box, then an upload and a read-back. Not
-// thread-safe (one per thread), as Engine.
+// distances by the engine. Without it the host finds them (one read of each label, then word arithmetic),
+// which measured faster on the H100 machine (docs/bench/masks): the pass needs the same host read to find and
+// stage the labels' box, then an upload and a read-back. Not thread-safe (one per thread), as Engine.
 struct MaskEngine {
     Engine engine;
     std::shared_ptr<masks_gpu::BoundaryPass> boundaryPass;  // null: extraction on the host
@@ -332,5 +321,107 @@ struct MaskEngine {
 // devicePass on a GPU backend, the boundary pass on options.deviceIndex
 // (a second Vulkan device of its own).
 [[nodiscard]] Result<MaskEngine> makeMaskEngine(Options options, bool devicePass = false);
+
+// PreparedReference: a reference (ground-truth) mask prepared once and compared with many
+// predictions (models, epochs, raters): its point set is extracted and
+// indexed on the MaskEngine once instead of at every compareMasks call.
+//
+// Contract: compareMasks(engine, prepareReference(engine, ref, sel, o),
+// prediction, sel, o) returns the MaskResult of compareMasks(engine, ref,
+// sel, prediction, sel, o), the reference as A: every value (hd, HD-p per
+// direction and combined, ASSD, MSD, surface overlaps and Dice, points,
+// area, witness voxels/corners and world points, empty status and the
+// convention's empty values) is the same double, bit for bit; only the
+// timings and `extraction` (where the prediction's boundary was found)
+// differ. It holds because both calls send the engine the same float
+// coordinates in the same order (every convention searches in A's frame), the engine's per-point nearest
+// point depends on those alone (the smallest target index among float ties), and the numbers are then made by
+// the same code.
+//
+// What is kept, per convention (PreparedReference::points()):
+//   rthdist, monai, medpy, plastimatch  the boundary voxels under the
+//       convention's connectivity, and the engine's PreparedSet of them (A's
+//       frame: world for rthdist, spacing otherwise); each comparison
+//       prepares the prediction's boundary and runs ONE engine call on the
+//       two prepared sets.
+//   itk       the selection as one bit per voxel (the
+//       voxels inside the reference are at 0 in both directions) and its
+//       6-connected boundary with its PreparedSet: the prediction's voxels
+//       outside the reference query it (prepared, then one call on the two
+//       sets); the reference's voxels outside the prediction query the
+//       prediction's boundary in a one-shot call.
+//   deepmind  the surfels (corners, codes) only: both directions stay
+//       one-shot calls, as in compareMasks. Each direction queries a subset
+//       that depends on the prediction, and a PreparedSet of the reference's
+//       surfels needs the prediction's queries prepared too (indexed, which a
+//       one-shot directed call does not do): 0.73x on the CPU backend when
+//       tried (docs/bench/masks). What it saves is the reference's surfels.
+// Options: the convention's point set is fixed at preparation: a comparison
+// whose options need another set (convention with other points or metric,
+// another connectivity) is refused with kInvalidArgument naming both; it is
+// not recomputed (the labels are not kept). The conventions that share a
+// set share a prepared reference: monai and plastimatch (6-connected
+// boundary, spacing metric), and medpy with the same connectivity.
+// Percentiles, tolerance, threads and hostExtraction are free per call.
+// Grids: the prediction must share the reference's grid (checkSameGrid: the
+// same error as compareMasks, naming both files); an empty reference or
+// prediction gives compareMasks's empty statuses.
+//
+// Precision: compareMasks's (above): distances recomputed in double from
+// the voxel (corner) indices of the engine's nearest pair.
+// Memory: the point lists (8 bytes a point; deepmind 9), itk's bits (one per
+// voxel) and the PreparedSet (on the engine's device, plus its host copy);
+// hostBytes()/deviceBytes() report them; everything is released with the
+// last copy of the object (copies share it).
+// Threading: a PreparedReference belongs to the MaskEngine that prepared it
+// (its engine's device) and is used by that engine's calls, one at a time,
+// as MaskEngine itself; comparing it on another MaskEngine is refused.
+// Limits: as compareMasks; a prepared set holds at most 2^31 - 1 points.
+
+class PreparedReference {
+public:
+    // The reference's grid: path, dims, affine and transform (no labels).
+    [[nodiscard]] const Volume& grid() const;
+    [[nodiscard]] LabelSelect select() const;
+    // What it was prepared for: the convention asked and its effective
+    // connectivity (0 for itk and deepmind, as MaskResult::connectivity).
+    [[nodiscard]] Convention convention() const;
+    [[nodiscard]] int connectivity() const;
+    // Its selected voxels, and its point count under the convention (what
+    // MaskResult::aToB.points reports: boundary voxels, foreground voxels
+    // (itk) or surfels (deepmind)).
+    [[nodiscard]] uint64_t selectedVoxels() const;
+    [[nodiscard]] uint64_t points() const;
+    // Memory held now: host (point lists, bits, the PreparedSet's host part)
+    // and device (the PreparedSet's buffers; 0 on the CPU backend).
+    [[nodiscard]] uint64_t hostBytes() const;
+    [[nodiscard]] uint64_t deviceBytes() const;
+    // The preparation's wall time, and where its boundary was found
+    // ("device" or "host", as MaskResult::extraction).
+    [[nodiscard]] double prepareMs() const;
+    [[nodiscard]] const std::string& extraction() const;
+
+    struct State;
+
+private:
+    friend Result<PreparedReference> prepareReference(MaskEngine&, const Volume&, LabelSelect,
+                                                      const MaskOptions&);
+    friend Result<MaskResult> compareMasks(MaskEngine&, const PreparedReference&, const Volume&, LabelSelect,
+                                           const MaskOptions&);
+    explicit PreparedReference(std::shared_ptr<const State> state);
+    std::shared_ptr<const State> m_state;
+};
+
+// Extracts label `select` of `reference` under options.convention (and
+// connectivity) and prepares its points on the engine. Errors: compareMasks's
+// checks of the volume and options (kInvalidArgument), the engine's.
+[[nodiscard]] Result<PreparedReference> prepareReference(MaskEngine& engine, const Volume& reference,
+                                                         LabelSelect select, const MaskOptions& options);
+
+// compareMasks(engine, reference's volume, its select, prediction, select,
+// options) through the prepared reference (the contract above).
+[[nodiscard]] Result<MaskResult> compareMasks(MaskEngine& engine, const PreparedReference& reference,
+                                              const Volume& prediction, LabelSelect select,
+                                              const MaskOptions& options);
 
 }  // namespace rthdist::masks
