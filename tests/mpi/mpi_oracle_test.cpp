@@ -20,6 +20,7 @@
 #include <cmath>
 #include <limits>
 
+#include "common/case_sample.hpp"
 #include "common/geo_cases.hpp"
 #include "common/oracle_cases.hpp"
 #include "mpi_test_support.hpp"
@@ -84,12 +85,12 @@ class MpiOracle : public testing::TestWithParam<std::tuple<Backend, TargetMode>>
 
 TEST_P(MpiOracle, EveryOracleCaseAsOneProcess) {
     const auto [backend, mode] = GetParam();
-    runCases(test::makeOracleCases(), backend, mode);
+    runCases(test::sampledCases(test::makeOracleCases()), backend, mode);
 }
 
 TEST_P(MpiOracle, GeoCasesAsOneProcess) {
     const auto [backend, mode] = GetParam();
-    runCases(test::makeGeoCases(), backend, mode);
+    runCases(test::sampledCases(test::makeGeoCases()), backend, mode);
 }
 
 TEST_P(MpiOracle, DirectedOnlyAsOneProcess) {
