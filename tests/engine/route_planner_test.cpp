@@ -128,7 +128,7 @@ TEST(RoutePlanner, SeveralDevicesTakeAShareOfTheQueriesWithAllTheTargets) {
     MemoryBudget budget = budgetOf(10000);
     budget.maxPiecePoints = 3000;
     // Each device's share (half the queries and all the targets) fits: targets whole.
-    const Plan plan = planRoute(hostViews(8000, 5000, false), CallOptions{}, budget, gpuCaps(2));
+    const Plan plan = planRoute(hostViews(8000, 4000, false), CallOptions{}, budget, gpuCaps(2));
     EXPECT_EQ(plan.route, Route::kSeveralDevices);
     EXPECT_EQ(plan.pieces.maxPiecePoints, UINT64_MAX);
     EXPECT_EQ(plan.pieces.bytes, budget.bytes);
@@ -137,8 +137,9 @@ TEST(RoutePlanner, SeveralDevicesTakeAShareOfTheQueriesWithAllTheTargets) {
     EXPECT_EQ(pieces.route, Route::kPieces);
     EXPECT_EQ(pieces.pieces.maxPiecePoints, 3000u);
     // A pair that fits stays on one device.
-    EXPECT_EQ(planRoute(hostViews(4000, 5000, false), CallOptions{}, budget, gpuCaps(2)).route,
-              Route::kOneCall);
+    CallOptions indexed;
+    indexed.bits = 5;  // not scanned whole
+    EXPECT_EQ(planRoute(hostViews(4000, 5000, false), indexed, budget, gpuCaps(2)).route, Route::kOneCall);
 }
 
 TEST(RoutePlanner, SmallPiecesAreScannedWhole) {
