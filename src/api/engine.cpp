@@ -159,8 +159,6 @@ Result<std::unique_ptr<Engine::Impl>> createImpl(const EngineOptions& given, con
     impl->options = given;
     if (borrowed) impl->options.devices.clear();
     if (!impl->options.devices.empty()) impl->options.deviceIndex = impl->options.devices.front();
-    if (borrowed && given.backend == Backend::kCpu)  // before the tuning is read, as ever
-        return Error{ErrorCode::kInvalidArgument, "the cpu backend takes no Vulkan device (VulkanDevice)"};
     settleTuning(impl->options);
     Result<std::unique_ptr<api::ComputeBackend>> backend = api::openBackend(impl->options, borrowed);
     if (!backend) return backend.error();
