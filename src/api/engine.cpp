@@ -1,5 +1,8 @@
-// Public entry of rthdist: input validation, backend choice, and the Engine
-// that keeps a Vulkan device and its pipelines between calls.
+// Public entry of rthdist: input validation, the frame, and the Engine that
+// keeps its backend (api/backend.hpp: the CPU one, or a Vulkan device and its
+// pipelines) between calls. Each call asks the route planner
+// (api/route_planner.hpp) how it runs and runs that route through the
+// backend interface; the frame is entered and left here.
 #include "rthdist/rthdist.hpp"
 #include "rthdist/version.hpp"
 #include "rthdist/vulkan_interop.hpp"
@@ -13,18 +16,15 @@
 #include <utility>
 #include <vector>
 
+#include "api/backend.hpp"
 #include "api/certify.hpp"
-#include "api/device_views.hpp"
 #include "api/out_of_core.hpp"
+#include "api/route_planner.hpp"
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
 #include "core/input_limits.hpp"
 #include "core/stopwatch.hpp"
 #include "core/thread_pool.hpp"
-#include "cpu/cpu_hausdorff.hpp"
-#include "gpu/context.hpp"
-#include "gpu/pipeline_cache.hpp"
-#include "gpu_algo/gpu_hausdorff.hpp"
 
 namespace rthdist {
 
@@ -84,54 +84,26 @@ std::optional<Error> validatePreparedSize(const PointView& points) {
 
 using core::msSince;
 
-// auto picks a Vulkan backend only on a device with RT hardware paths that is
-// not a software rasterizer: on lavapipe (VK_PHYSICAL_DEVICE_TYPE_CPU) the
-// native CPU backend is 10-100x faster (docs/bench). An explicit --device
-// keeps the Vulkan path on whatever device it names.
-bool hardwareRtDevice(const EngineOptions& o) {
-    auto devices = listDevices();
-    if (!devices) return false;
-    for (const DeviceInfo& d : devices.value()) {
-        if (!(d.rayQuery || d.rtPipeline)) continue;
-        if (o.deviceIndex >= 0) {
-            if (d.index == o.deviceIndex) return true;
-            continue;
-        }
-        if (d.type != "cpu") return true;
-    }
-    return false;
-}
-
-// The device of an Engine, shared with the sets it prepared (their buffers
-// must be destroyed before it). Empty on the CPU backend.
-struct Device {
-    std::unique_ptr<gpu::Context> context;
-    std::unique_ptr<gpu_algo::GpuHausdorff> gpu;  // destroyed before the context
-};
-
 }  // namespace
 
 struct Engine::Impl {
     EngineOptions options;
-    CallOptions callDefaults;        // compute(a, b) without call options
-    std::shared_ptr<Device> device;  // never null; identifies the Engine's prepared sets
-    // EngineOptions::devices past the first: the other lanes of one-shot calls.
-    std::vector<std::unique_ptr<Device>> moreDevices;
-    Backend backend = Backend::kCpu;
-    std::string deviceName = "cpu";
+    CallOptions callDefaults;  // compute(a, b) without call options
+    // Never null; shared with the sets it prepared (their buffers must be
+    // destroyed before it), which it identifies.
+    std::shared_ptr<api::ComputeBackend> backend;
     double setupMs = 0.0;
     uint64_t preparedCount = 0;
 };
 
 struct PreparedSet::Impl {
-    std::shared_ptr<Device> device;  // keeps the device alive; first member, destroyed last
+    std::shared_ptr<api::ComputeBackend> backend;  // keeps it alive; first member, destroyed last
     core::SetSummary summary;
     glm::dvec3 origin{0.0};
     std::vector<glm::vec3> floats;      // p - origin rounded: what the backend searches
     std::vector<glm::dvec3> originals;  // the input when it is not float-exact
     double ownScale = 1.0;              // core::exactScale of `floats` alone
-    std::shared_ptr<gpu_algo::DeviceSet> gpuSet;
-    std::shared_ptr<cpu::CpuSet> cpuSet;
+    std::shared_ptr<api::BackendSet> set;
     size_t count = 0;
     // Prepared from a device view: no host copy of its points (floats and
     // originals empty); its witnesses come from its device copy.
@@ -153,17 +125,11 @@ PreparedSet::~PreparedSet() = default;
 
 size_t PreparedSet::size() const { return m_impl->count; }
 glm::dvec3 PreparedSet::origin() const { return m_impl->origin; }
-int PreparedSet::bits() const {
-    return m_impl->gpuSet ? gpu_algo::GpuHausdorff::bits(*m_impl->gpuSet) : m_impl->cpuSet->order.grid.bits;
-}
-uint64_t PreparedSet::deviceBytes() const {
-    return m_impl->gpuSet ? gpu_algo::GpuHausdorff::deviceBytes(*m_impl->gpuSet) : 0;
-}
+int PreparedSet::bits() const { return m_impl->set->bits(); }
+uint64_t PreparedSet::deviceBytes() const { return m_impl->set->deviceBytes(); }
 uint64_t PreparedSet::hostBytes() const {
-    uint64_t bytes =
-        m_impl->floats.capacity() * sizeof(glm::vec3) + m_impl->originals.capacity() * sizeof(glm::dvec3);
-    if (m_impl->cpuSet) bytes += m_impl->cpuSet->hostBytes();
-    return bytes;
+    return m_impl->floats.capacity() * sizeof(glm::vec3) + m_impl->originals.capacity() * sizeof(glm::dvec3) +
+           m_impl->set->hostBytes();
 }
 
 Engine::Engine(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
@@ -172,24 +138,6 @@ Engine& Engine::operator=(Engine&&) noexcept = default;
 Engine::~Engine() = default;
 
 namespace {
-
-// One device of an Engine: its context and the GPU algorithm on it.
-// `borrowed`: the embedder's device (vulkan_interop.hpp) instead of one of ours.
-std::optional<Error> openDevice(const EngineOptions& options, Backend backend, int deviceIndex,
-                                Device& device, const VulkanDevice* borrowed = nullptr) {
-    const Tuning& tuning = *options.tuning;  // Engine::create fills it
-    auto ctx = borrowed ? gpu::Context::borrow(*borrowed, backend, options.validation, tuning)
-                        : gpu::Context::create(backend, deviceIndex, options.validation, tuning);
-    if (!ctx) return ctx.error();
-    device.context = std::move(ctx.value());
-    const std::string cacheDir = options.pipelineCacheDir == "off"  ? std::string()
-                                 : options.pipelineCacheDir.empty() ? tuning.pipelineCacheDir
-                                                                    : options.pipelineCacheDir;
-    auto g = gpu_algo::GpuHausdorff::create(*device.context, cacheDir, options.threads, tuning);
-    if (!g) return g.error();
-    device.gpu = std::move(g.value());
-    return std::nullopt;
-}
 
 // The engine's tuning: the caller's, else the environment's (the one read of
 // it, rthdist/tuning.hpp); the worker pool's polling is process-wide.
@@ -201,41 +149,30 @@ void settleTuning(EngineOptions& options) {
 
 }  // namespace
 
-Result<Engine> Engine::create(const EngineOptions& given) {
+namespace {
+
+// An Engine's state on its backend (api::openBackend); `borrowed`: the embedder's device.
+Result<std::unique_ptr<Engine::Impl>> createImpl(const EngineOptions& given, const VulkanDevice* borrowed) {
     if (auto err = validateEngineOptions(given)) return *err;
     auto t0 = std::chrono::steady_clock::now();
-    auto impl = std::make_unique<Impl>();
+    auto impl = std::make_unique<Engine::Impl>();
     impl->options = given;
+    if (borrowed) impl->options.devices.clear();
+    if (!impl->options.devices.empty()) impl->options.deviceIndex = impl->options.devices.front();
     settleTuning(impl->options);
-    const EngineOptions& options = impl->options;
-    if (!options.devices.empty()) impl->options.deviceIndex = options.devices.front();
-    impl->device = std::make_shared<Device>();
-    if (options.backend == Backend::kCpu ||
-        (options.backend == Backend::kAuto && !hardwareRtDevice(options))) {
-        if (options.devices.size() > 1) {
-            return Error{
-                ErrorCode::kInvalidArgument,
-                "several devices (EngineOptions::devices) need a GPU backend; the " +
-                    std::string(options.backend == Backend::kCpu ? "cpu backend was asked for"
-                                                                 : "first device has no RT hardware")};
-        }
-        impl->backend = Backend::kCpu;
-        return Engine(std::move(impl));
-    }
-    if (auto err = openDevice(options, options.backend, options.deviceIndex, *impl->device)) return *err;
-    impl->backend = impl->device->context->backend();
-    impl->deviceName = impl->device->context->deviceName();
-    for (size_t i = 1; i < options.devices.size(); ++i) {
-        auto device = std::make_unique<Device>();
-        if (auto err = openDevice(options, impl->backend, options.devices[i], *device)) {
-            return Error{err->code, "device " + std::to_string(options.devices[i]) +
-                                        " of EngineOptions::devices: " + err->message};
-        }
-        impl->deviceName += " + " + device->context->deviceName();
-        impl->moreDevices.push_back(std::move(device));
-    }
+    Result<std::unique_ptr<api::ComputeBackend>> backend = api::openBackend(impl->options, borrowed);
+    if (!backend) return backend.error();
+    impl->backend = std::move(backend.value());
     impl->setupMs = msSince(t0);
-    return Engine(std::move(impl));
+    return impl;
+}
+
+}  // namespace
+
+Result<Engine> Engine::create(const EngineOptions& given) {
+    Result<std::unique_ptr<Impl>> impl = createImpl(given, nullptr);
+    if (!impl) return impl.error();
+    return Engine(std::move(impl.value()));
 }
 
 Result<Engine> Engine::create(const Options& options) {
@@ -246,30 +183,15 @@ Result<Engine> Engine::create(const Options& options) {
 }
 
 Result<Engine> Engine::create(const VulkanDevice& device, const EngineOptions& given) {
-    if (auto err = validateEngineOptions(given)) return *err;
-    if (given.backend == Backend::kCpu)
-        return Error{ErrorCode::kInvalidArgument, "the cpu backend takes no Vulkan device (VulkanDevice)"};
-    auto t0 = std::chrono::steady_clock::now();
-    auto impl = std::make_unique<Impl>();
-    impl->options = given;
-    settleTuning(impl->options);
-    impl->options.devices.clear();
-    impl->device = std::make_shared<Device>();
-    if (auto err = openDevice(impl->options, given.backend, -1, *impl->device, &device)) return *err;
-    impl->backend = impl->device->context->backend();
-    impl->deviceName = impl->device->context->deviceName();
-    impl->setupMs = msSince(t0);
-    return Engine(std::move(impl));
+    Result<std::unique_ptr<Impl>> impl = createImpl(given, &device);
+    if (!impl) return impl.error();
+    return Engine(std::move(impl.value()));
 }
 
-const std::string& Engine::deviceName() const { return m_impl->deviceName; }
-Backend Engine::backend() const { return m_impl->backend; }
-std::string Engine::pipelineCachePath() const {
-    return m_impl->device->gpu ? m_impl->device->gpu->pipelineCachePath() : std::string();
-}
-std::string Engine::pipelineCacheStatus() const {
-    return m_impl->device->gpu ? m_impl->device->gpu->pipelineCacheStatus() : std::string("none");
-}
+const std::string& Engine::deviceName() const { return m_impl->backend->deviceName(); }
+Backend Engine::backend() const { return m_impl->backend->kind(); }
+std::string Engine::pipelineCachePath() const { return m_impl->backend->pipelineCachePath(); }
+std::string Engine::pipelineCacheStatus() const { return m_impl->backend->pipelineCacheStatus(); }
 
 namespace {
 
@@ -288,18 +210,11 @@ Result<CheckedInputs> checkInputs(const PointView& a, const PointView& b, int th
     return CheckedInputs{*sa, *sb};
 }
 
-// The Engine's devices in lane order (out_of_core.hpp): the first device, then
-// EngineOptions::devices past it.
-size_t laneCount(const Engine::Impl& impl) { return 1 + impl.moreDevices.size(); }
-Device& laneDevice(const Engine::Impl& impl, size_t lane) {
-    return lane == 0 ? *impl.device : *impl.moreDevices[lane - 1];
-}
-
 // CallOptions::perPointReady for each direction of a complete result that
-// the backend did not hand back early itself (GpuHausdorff::handedBack).
+// the backend did not hand back early itself (ComputeBackend::handedBack).
 void handBackTheRest(const Engine::Impl& impl, const HausdorffResult& r, const CallOptions& call) {
     if (!call.perPointReady) return;
-    const uint32_t done = impl.device->gpu ? impl.device->gpu->handedBack() : 0u;
+    const uint32_t done = impl.backend->handedBack();
     if ((done & 1u) == 0) call.perPointReady(0, r.aNearest.nearest);
     if (!r.directedOnly && (done & 2u) == 0) call.perPointReady(1, r.bNearest.nearest);
 }
@@ -317,96 +232,91 @@ void finishResult(Engine::Impl& impl, HausdorffResult& r, const CallOptions& cal
     r.timings.setup = impl.setupMs;
     impl.setupMs = 0.0;  // only the first call pays for creation
     r.timings.total = msSince(t0);
-    r.validationMessages = 0;
-    for (size_t lane = 0; lane < laneCount(impl); ++lane) {
-        if (laneDevice(impl, lane).context)
-            r.validationMessages += laneDevice(impl, lane).context->validationMessageCount();
-    }
+    r.validationMessages = impl.backend->validationMessages();
 }
 
-// What one backend call may hold (out_of_core.hpp): the caller's
-// EngineOptions::memoryBudget, else on a GPU three quarters of the device's
-// budget; set pieces up to the largest allocation the device promises.
-api::MemoryBudget memoryBudget(const Engine::Impl& impl) {
-    api::MemoryBudget budget;
-    if (impl.options.memoryBudget > 0) {
-        budget.bytes = impl.options.memoryBudget;
-        budget.source = "EngineOptions::memoryBudget";
-    }
-    if (!impl.device->context) return budget;
-    if (impl.options.memoryBudget == 0) {
-        budget.bytes = UINT64_MAX;
-        budget.source = "3/4 of the device's memory budget";
-    }
-    for (size_t lane = 0; lane < laneCount(impl); ++lane) {  // the smallest device sets the pieces
-        const gpu::DeviceLimits& limits = laneDevice(impl, lane).context->limits();
-        if (impl.options.memoryBudget == 0)
-            budget.bytes = std::min(budget.bytes, limits.deviceBudgetBytes / 4 * 3);
-        budget.maxPiecePoints =
-            std::min({budget.maxPiecePoints, limits.maxAllocationBytes / api::kLargestBufferBytesPerPoint,
-                      limits.maxBufferBytes / api::kLargestBufferBytesPerPoint, limits.maxPrimitives});
-    }
-    return budget;
+// The pair's frame: where the backend searched it and how its result comes
+// back to the caller's coordinates.
+struct Frame {
+    glm::dvec3 origin{0.0};
+    // The inputs as given, for witnesses in double and the certificate; empty
+    // views for device views (the host cannot read them).
+    PointView a, b;
+    bool restore = false;  // the backend searched copies: distances recomputed from a and b
+    bool onHost = true;    // the host can read a and b (else the device's own proof stands)
+};
+
+// Leaves the frame: the one place a result returns to the caller's
+// coordinates (core::restoreOriginal), is certified (certify.hpp) and finished.
+std::optional<Error> leaveFrame(Engine::Impl& impl, HausdorffResult& r, const Frame& frame,
+                                const CallOptions& call, std::chrono::steady_clock::time_point t0) {
+    if (frame.restore) core::restoreOriginal(r, frame.a, frame.b, impl.options.threads);
+    r.origin = frame.origin;
+    if (auto err = api::settleCertificates(r, frame.a, frame.b, impl.options.threads, frame.onHost))
+        return err;
+    finishResult(impl, r, call, t0);
+    return std::nullopt;
 }
 
-// One call of the Engine's backend, on device `lane`, on float sets of one
-// frame and scale.
-Result<HausdorffResult> runBackend(Engine::Impl& impl, size_t lane, std::span<const glm::vec3> a,
-                                   std::span<const glm::vec3> b, double scale, const CallOptions& call) {
-    if (impl.device->gpu) return laneDevice(impl, lane).gpu->compute(a, b, scale, call);
-    Options options;
-    static_cast<CallOptions&>(options) = call;
-    static_cast<EngineOptions&>(options) = impl.options;
-    return cpu::cpuHausdorff(a, b, options);
-}
-
-// The pair in one backend call (on the first device) when it fits the
-// memory budget, else (or when the device runs out of memory under the
-// automatic budget) in pieces spread over the Engine's devices. A pair that
-// fits stays on one device: split over several, every device would index
-// all the targets and the host stages each set once per device (H200s,
-// 300M x 300M points: 5.8 s on one, 20.7 s on two; README "Several GPUs").
-// With several devices, a pair whose every device's share (its queries and
-// all targets) fits the bytes runs with the targets whole, past the pieces'
-// maxMemoryAllocationSize bound, as one device tries the whole pair (a
-// device short of memory then halves the budget: out_of_core.hpp).
-Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm::vec3> a,
-                                        std::span<const glm::vec3> b, double scale, const CallOptions& call) {
-    const api::MemoryBudget budget = memoryBudget(impl);
-    const uint64_t lanes = laneCount(impl);
-    const bool automatic = impl.options.memoryBudget == 0 && impl.device->gpu;
-    if (api::fitsOneCall(budget, a.size(), b.size())) {
-        Result<HausdorffResult> r = runBackend(impl, 0, a, b, scale, call);
-        if (r || r.error().code != ErrorCode::kOutOfMemory || !automatic) return r;
-        // A direction already handed back (perPointReady) is not handed back again from pieces.
-        if (impl.device->gpu && impl.device->gpu->handedBack() != 0) return r;
-    }
-    const std::function<void()> release = [&impl] {
-        for (size_t lane = 0; lane < laneCount(impl); ++lane)
-            if (laneDevice(impl, lane).gpu) laneDevice(impl, lane).gpu->releaseScratch();
-    };
-    const api::DirectedCall directed = [&](int lane, std::span<const glm::vec3> q,
-                                           std::span<const glm::vec3> t, const CallOptions& piece) {
-        return runBackend(impl, size_t(lane), q, t, scale, piece);
-    };
-    const api::RecycleCall recycle = [&impl](int lane, PerPoint&& spent) {
-        if (laneDevice(impl, size_t(lane)).gpu)
-            laneDevice(impl, size_t(lane)).gpu->recyclePerPoint(std::move(spent));
-    };
-    const bool sharesFit = api::fitsOneCall(budget, (a.size() + lanes - 1) / lanes, b.size()) &&
-                           api::fitsOneCall(budget, (b.size() + lanes - 1) / lanes, a.size());
-    api::MemoryBudget pieces = budget;
-    if (lanes > 1 && sharesFit) pieces.maxPiecePoints = UINT64_MAX;  // a kOutOfMemory halves the bytes
-    release();
-    Result<HausdorffResult> r = api::computeInPieces(a, b, scale, call, pieces, directed, release, int(lanes),
-                                                     impl.options.threads, recycle);
-    release();  // the pieces' scratch is no use to the next call
+Result<HausdorffResult> finished(Engine::Impl& impl, Result<HausdorffResult> r, const Frame& frame,
+                                 const CallOptions& call, std::chrono::steady_clock::time_point t0) {
     if (!r) return r;
-    r->backend = impl.backend;
-    r->device = impl.deviceName;
+    if (auto err = leaveFrame(impl, *r, frame, call, t0)) return *err;
     return r;
 }
 
+Error refusal(const api::Plan& plan) { return Error{plan.code, plan.reason}; }
+
+// One backend call of a framed pair, on device `lane`: scanned whole or
+// indexed, as the planner says (every piece of the pieces' routes too).
+Result<HausdorffResult> runFramed(Engine::Impl& impl, int lane, std::span<const glm::vec3> a,
+                                  std::span<const glm::vec3> b, double scale, const CallOptions& call) {
+    const api::Plan plan =
+        api::planFramedCall(a.size(), b.size(), call, api::MemoryBudget{}, impl.backend->caps());
+    return plan.route == api::Route::kSmallPairScan ? impl.backend->scanFramed(lane, a, b, scale, call)
+                                                    : impl.backend->computeFramed(lane, a, b, scale, call);
+}
+
+// Route::kPieces and kSeveralDevices (out_of_core.hpp), over the backend's lanes.
+Result<HausdorffResult> runInPieces(Engine::Impl& impl, std::span<const glm::vec3> a,
+                                    std::span<const glm::vec3> b, double scale, const CallOptions& call,
+                                    const api::MemoryBudget& pieces) {
+    api::ComputeBackend& backend = *impl.backend;
+    const std::function<void()> release = [&backend] { backend.releaseScratch(); };
+    const api::DirectedCall directed = [&](int lane, std::span<const glm::vec3> q,
+                                           std::span<const glm::vec3> t, const CallOptions& piece) {
+        return runFramed(impl, lane, q, t, scale, piece);
+    };
+    const api::RecycleCall recycle = [&backend](int lane, PerPoint&& spent) {
+        backend.recyclePerPoint(lane, std::move(spent), PerPoint{});
+    };
+    release();
+    Result<HausdorffResult> r = api::computeInPieces(a, b, scale, call, pieces, directed, release,
+                                                     backend.caps().lanes, impl.options.threads, recycle);
+    release();  // the pieces' scratch is no use to the next call
+    if (!r) return r;
+    r->backend = backend.kind();
+    r->device = backend.deviceName();
+    return r;
+}
+
+// A framed pair on the planner's route: one call (scanned whole or indexed;
+// in pieces after a kOutOfMemory under the automatic budget), or pieces.
+Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm::vec3> a,
+                                        std::span<const glm::vec3> b, double scale, const CallOptions& call) {
+    const api::Plan plan =
+        api::planFramedCall(a.size(), b.size(), call, impl.backend->memoryBudget(), impl.backend->caps());
+    if (plan.route == api::Route::kSmallPairScan || plan.route == api::Route::kOneCall) {
+        Result<HausdorffResult> r = runFramed(impl, 0, a, b, scale, call);
+        if (r || r.error().code != ErrorCode::kOutOfMemory || !plan.piecesOnOutOfMemory) return r;
+        // A direction already handed back (perPointReady) is not handed back again from pieces.
+        if (impl.backend->handedBack() != 0) return r;
+    }
+    return runInPieces(impl, a, b, scale, call, plan.pieces);
+}
+
+// Host views checked on the host: the frame entered (origin, float copies
+// where needed, the exact scale), the pair run, the frame left.
 Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, const PointView& b,
                                      const CheckedInputs& checked, const CallOptions& call,
                                      std::chrono::steady_clock::time_point t0) {
@@ -418,22 +328,34 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     const core::FloatSet fa(a, origin, impl.options.threads), fb(b, origin, impl.options.threads);
     const double scale = core::exactScale(
         std::max(core::searchMagnitude(checked.a, origin), core::searchMagnitude(checked.b, origin)));
-    Result<HausdorffResult> r = runWithinBudget(impl, fa.span(), fb.span(), scale, call);
-    if (!r) return r;
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
-    if (copied) core::restoreOriginal(*r, a, b, impl.options.threads);
-    r->origin = origin;
-    if (auto err = api::settleCertificates(*r, a, b, impl.options.threads)) return *err;
-    finishResult(impl, *r, call, t0);
-    return r;
+    return finished(impl, runWithinBudget(impl, fa.span(), fb.span(), scale, call),
+                    Frame{origin, a, b, copied}, call, t0);
 }
 
 // Whether two prepared sets can be searched as they are: one frame, within
 // the contract's bound, and one exact scale.
-bool shareFrame(const PreparedSet::Impl& a, const PreparedSet::Impl& b) {
-    if (a.origin != b.origin || !core::frameKeepsBound(a.summary, b.summary, a.origin)) return false;
+api::PairShape preparedShape(const Engine::Impl& impl, const PreparedSet::Impl& a,
+                             const PreparedSet::Impl& b) {
+    api::PairShape shape;
+    shape.input = api::PairShape::Input::kPreparedSets;
+    shape.a = a.count;
+    shape.b = b.count;
+    shape.sameEngine = a.backend == impl.backend && b.backend == impl.backend;
+    shape.onDevice = a.onDevice || b.onDevice;
+    shape.hostCopies = !a.originals.empty() || !b.originals.empty();
+    shape.oneOrigin = a.origin == b.origin && core::frameKeepsBound(a.summary, b.summary, a.origin);
     const double pairScale = std::min(a.ownScale, b.ownScale);  // of the larger magnitude
-    return a.ownScale == pairScale && b.ownScale == pairScale;
+    shape.oneScale = a.ownScale == pairScale && b.ownScale == pairScale;
+    return shape;
+}
+
+// Two prepared sets' frame: their origin, their inputs.
+Frame preparedFrame(const PreparedSet::Impl& a, const PreparedSet::Impl& b) {
+    // Sets prepared from device views keep no host copy: their proof is the device's own.
+    const bool onHost = !a.onDevice && !b.onDevice;
+    return Frame{a.origin, onHost ? a.input() : PointView{}, onHost ? b.input() : PointView{},
+                 !a.originals.empty() || !b.originals.empty(), onHost};
 }
 
 }  // namespace
@@ -444,8 +366,8 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b) {
 
 namespace {
 
-// A one-shot GPU call on packed float arrays: the device checks, bounds and
-// samples the points (GpuHausdorff::computePacked); the host only copies them.
+// Route::kDeviceIngest: a one-shot call on packed float arrays: the device
+// checks, bounds and samples the points; the host only copies them.
 Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
                                         const CallOptions& call, std::chrono::steady_clock::time_point t0) {
     if (auto err = core::checkShape(a, "A")) return *err;
@@ -454,25 +376,22 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
     auto asVec3 = [](const PointView& v) {
         return std::span<const glm::vec3>(static_cast<const glm::vec3*>(v.data), v.count);
     };
-    Result<HausdorffResult> r = impl.device->gpu->computePacked(asVec3(a), asVec3(b), call);
-    if (!r) return r;
-    r->origin = glm::dvec3(0.0);
-    if (auto err = api::settleCertificates(*r, a, b, impl.options.threads)) return *err;
-    finishResult(impl, *r, call, t0);
-    return r;
+    return finished(impl, impl.backend->computeIngested(asVec3(a), asVec3(b), call),
+                    Frame{glm::dvec3(0.0), a, b}, call, t0);
 }
 
 }  // namespace
 
 Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOptions& call) {
     const auto t0 = std::chrono::steady_clock::now();
-    // Small pairs are scanned whole from the host's float copies
-    // (GpuHausdorff::scansWhole): the points are checked on the host.
-    if (m_impl->device->gpu && a.packedFloat() && b.packedFloat() &&
-        !m_impl->device->gpu->scansWhole(a.count, b.count, call) &&
-        gpu_algo::GpuHausdorff::ingests(a.count, b.count) &&
-        api::fitsOneCall(memoryBudget(*m_impl), a.count, b.count))
-        return computeIngested(*m_impl, a, b, call, t0);
+    api::PairShape shape;
+    shape.input = api::PairShape::Input::kHostViews;
+    shape.a = a.count;
+    shape.b = b.count;
+    shape.packedFloat = a.packedFloat() && b.packedFloat();
+    const api::Plan plan =
+        api::planRoute(shape, call, m_impl->backend->memoryBudget(), m_impl->backend->caps());
+    if (plan.route == api::Route::kDeviceIngest) return computeIngested(*m_impl, a, b, call, t0);
     if (auto err = validatePerPointSizes(a, b, call)) return *err;
     Result<CheckedInputs> checked = checkInputs(a, b, m_impl->options.threads);
     if (!checked) return checked.error();
@@ -480,8 +399,7 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOpti
 }
 
 void Engine::recycle(HausdorffResult&& spent) {
-    if (m_impl->device->gpu)
-        m_impl->device->gpu->recyclePerPoint(std::move(spent.aNearest), std::move(spent.bNearest));
+    m_impl->backend->recyclePerPoint(0, std::move(spent.aNearest), std::move(spent.bNearest));
 }
 
 Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& options) {
@@ -492,7 +410,7 @@ Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& opti
     Result<core::SetSummary> summary = core::summarizeSet(points, "to prepare", m_impl->options.threads);
     if (!summary) return summary.error();
     auto set = std::make_shared<PreparedSet::Impl>();
-    set->device = m_impl->device;
+    set->backend = m_impl->backend;
     set->summary = *summary;
     set->count = points.count;
     set->origin = core::preparedOrigin(*summary, options.origin);
@@ -506,15 +424,11 @@ Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& opti
         for (size_t i = 0; i < points.count; ++i) set->originals[i] = points.at(i);
     }
     set->ownScale = core::exactScale(core::searchMagnitude(*summary, set->origin));
-    if (m_impl->device->gpu) {
-        Timings timings;
-        const std::string name = "set#" + std::to_string(++m_impl->preparedCount);
-        auto g = m_impl->device->gpu->prepare(set->floats, set->ownScale, options.bits, name, timings);
-        if (!g) return g.error();
-        set->gpuSet = std::move(g.value());
-    } else {
-        set->cpuSet = cpu::prepareCpuSet(set->floats, set->ownScale, options.bits, m_impl->options.threads);
-    }
+    const std::string name = "set#" + std::to_string(++m_impl->preparedCount);
+    Result<std::shared_ptr<api::BackendSet>> prepared =
+        m_impl->backend->prepare(set->floats, set->ownScale, options.bits, name);
+    if (!prepared) return prepared.error();
+    set->set = std::move(prepared.value());
     return PreparedSet(std::move(set));
 }
 
@@ -522,38 +436,22 @@ namespace {
 
 using SetPair = std::pair<const PreparedSet::Impl*, const PreparedSet::Impl*>;
 
-// A pair of computeBatch that the GPU scans whole with the batch's other
-// small pairs (gpu_algo/small_pairs.hpp): sets of this Engine's GPU, host
-// arrays, one origin that keeps the bound (their scales may differ).
-bool scannedWhole(const Engine::Impl& impl, const SetPair& p) {
-    const PreparedSet::Impl& a = *p.first;
-    const PreparedSet::Impl& b = *p.second;
-    return impl.device->gpu && a.device == impl.device && b.device == impl.device && !a.onDevice &&
-           !b.onDevice && a.origin == b.origin && core::frameKeepsBound(a.summary, b.summary, a.origin) &&
-           impl.device->gpu->scansWhole(*a.gpuSet, *b.gpuSet);
-}
-
-// The small pairs in one submission; each reports an equal share of the
-// call's wall time.
+// Route::kSmallPairScan of prepared sets: the pairs in one submission; each
+// reports an equal share of the call's wall time.
 std::vector<Result<HausdorffResult>> scanSmallPairs(Engine::Impl& impl, std::span<const SetPair> pairs,
                                                     const CallOptions& call) {
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<std::pair<const gpu_algo::DeviceSet*, const gpu_algo::DeviceSet*>> sets;
-    for (const auto& [a, b] : pairs) sets.emplace_back(a->gpuSet.get(), b->gpuSet.get());
-    std::vector<Result<HausdorffResult>> out = impl.device->gpu->computeSmallPairs(sets, call);
+    std::vector<api::BackendSetPair> sets;
+    for (const auto& [a, b] : pairs) sets.emplace_back(a->set.get(), b->set.get());
+    std::vector<Result<HausdorffResult>> out = impl.backend->scanPrepared(sets, call);
     const double share = msSince(t0) / double(pairs.size());
     for (size_t i = 0; i < out.size(); ++i) {
         if (!out[i]) continue;
-        const PreparedSet::Impl& a = *pairs[i].first;
-        const PreparedSet::Impl& b = *pairs[i].second;
-        if (!a.originals.empty() || !b.originals.empty())
-            core::restoreOriginal(*out[i], a.input(), b.input(), impl.options.threads);
-        out[i]->origin = a.origin;
-        if (auto err = api::settleCertificates(*out[i], a.input(), b.input(), impl.options.threads)) {
+        if (auto err =
+                leaveFrame(impl, *out[i], preparedFrame(*pairs[i].first, *pairs[i].second), call, t0)) {
             out[i] = *err;
             continue;
         }
-        finishResult(impl, *out[i], call, t0);
         out[i]->timings.total = share;
     }
     return out;
@@ -566,36 +464,22 @@ Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet&
     if (auto err = validateCallOptions(call)) return *err;
     const PreparedSet::Impl& ia = *a.m_impl;
     const PreparedSet::Impl& ib = *b.m_impl;
-    if (ia.device != m_impl->device || ib.device != m_impl->device)
-        return Error{ErrorCode::kInvalidArgument, "a prepared set belongs to another Engine"};
-    if ((ia.onDevice || ib.onDevice) &&
-        (!shareFrame(ia, ib) || !ia.originals.empty() || !ib.originals.empty())) {
-        return Error{ErrorCode::kInvalidArgument,
-                     "a set prepared from a device view keeps no host copy: it meets only sets of its frame "
-                     "(prepare both with one PrepareOptions::origin) whose coordinates are float values or "
-                     "also device views"};
+    const api::Plan plan = api::planRoute(preparedShape(*m_impl, ia, ib), call,
+                                          m_impl->backend->memoryBudget(), m_impl->backend->caps());
+    switch (plan.route) {
+        case api::Route::kSmallPairScan: {
+            const SetPair pair{&ia, &ib};
+            return std::move(scanSmallPairs(*m_impl, std::span(&pair, 1), call)[0]);
+        }
+        case api::Route::kReframe:
+            // Different frames or scales: both indexed afresh in the union's frame.
+            return computeViews(*m_impl, ia.input(), ib.input(), CheckedInputs{ia.summary, ib.summary}, call,
+                                t0);
+        case api::Route::kPrepared:
+            return finished(*m_impl, m_impl->backend->computePrepared(*ia.set, *ib.set, call),
+                            preparedFrame(ia, ib), call, t0);
+        default: return refusal(plan);
     }
-    if (const SetPair pair{&ia, &ib}; scannedWhole(*m_impl, pair))
-        return std::move(scanSmallPairs(*m_impl, std::span(&pair, 1), call)[0]);
-    if (!shareFrame(ia, ib)) {
-        // Different frames or scales: both indexed afresh in the union's frame.
-        return computeViews(*m_impl, ia.input(), ib.input(), CheckedInputs{ia.summary, ib.summary}, call, t0);
-    }
-    Result<HausdorffResult> r =
-        m_impl->device->gpu ? m_impl->device->gpu->compute(*ia.gpuSet, *ib.gpuSet, call)
-                            : cpu::cpuHausdorff(*ia.cpuSet, *ib.cpuSet, call, m_impl->options.threads);
-    if (!r) return r;
-    if (!ia.originals.empty() || !ib.originals.empty())
-        core::restoreOriginal(*r, ia.input(), ib.input(), m_impl->options.threads);
-    r->origin = ia.origin;
-    // Sets prepared from device views keep no host copy: their proof is the device's own.
-    const bool onHost = !ia.onDevice && !ib.onDevice;
-    if (auto err =
-            api::settleCertificates(*r, onHost ? ia.input() : PointView{}, onHost ? ib.input() : PointView{},
-                                    m_impl->options.threads, onHost))
-        return *err;
-    finishResult(*m_impl, *r, call, t0);
-    return r;
 }
 
 std::vector<Result<HausdorffResult>> Engine::computeBatch(std::span<const PreparedSet> sets,
@@ -606,6 +490,8 @@ std::vector<Result<HausdorffResult>> Engine::computeBatch(std::span<const Prepar
     call.perPointReady = nullptr;  // compute() calls only (CallOptions::perPointReady)
     const bool cancelled = call.cancel != nullptr && call.cancel->load();
     const bool callValid = !validateCallOptions(call).has_value();
+    const api::MemoryBudget budget = m_impl->backend->memoryBudget();
+    const api::BackendCaps caps = m_impl->backend->caps();
     std::vector<size_t> scanned;
     std::vector<SetPair> scannedSets;
     for (size_t i = 0; i < pairs.size(); ++i) {
@@ -617,7 +503,10 @@ std::vector<Result<HausdorffResult>> Engine::computeBatch(std::span<const Prepar
             continue;
         }
         const SetPair setPair{sets[p.a].m_impl.get(), sets[p.b].m_impl.get()};
-        if (cancelled || !callValid || !scannedWhole(*m_impl, setPair)) continue;
+        if (cancelled || !callValid ||
+            api::planRoute(preparedShape(*m_impl, *setPair.first, *setPair.second), call, budget, caps)
+                    .route != api::Route::kSmallPairScan)
+            continue;
         scanned.push_back(i);
         scannedSets.push_back(setPair);
     }
@@ -652,27 +541,6 @@ Result<HausdorffResult> hausdorff(PointView a, PointView b, const Options& optio
     return computeViews(*engine->m_impl, a, b, *checked, options, std::chrono::steady_clock::now());
 }
 
-}  // namespace rthdist
-
-namespace rthdist {
-
-namespace {
-
-// The Engine's device when it can read device views, or why not.
-std::optional<Error> deviceInputEngine(const Engine::Impl& impl) {
-    if (!impl.device->gpu)
-        return Error{
-            ErrorCode::kInvalidArgument,
-            "device views (DevicePointView) need a GPU backend: the cpu backend cannot read VkBuffers"};
-    if (!impl.device->context->borrowed())
-        return Error{ErrorCode::kInvalidArgument,
-                     "device views (DevicePointView) need an Engine created on your VkDevice "
-                     "(Engine::create(const VulkanDevice&, ...))"};
-    return std::nullopt;
-}
-
-}  // namespace
-
 Result<HausdorffResult> Engine::compute(const DevicePointView& a, const DevicePointView& b) {
     return compute(a, b, m_impl->callDefaults);
 }
@@ -680,47 +548,46 @@ Result<HausdorffResult> Engine::compute(const DevicePointView& a, const DevicePo
 Result<HausdorffResult> Engine::compute(const DevicePointView& a, const DevicePointView& b,
                                         const CallOptions& call) {
     const auto t0 = std::chrono::steady_clock::now();
-    if (auto err = deviceInputEngine(*m_impl)) return *err;
+    api::PairShape shape;
+    shape.input = api::PairShape::Input::kDeviceViews;
+    shape.a = a.count;
+    shape.b = b.count;
+    const api::Plan plan =
+        api::planRoute(shape, call, m_impl->backend->memoryBudget(), m_impl->backend->caps());
+    // A backend that reads no device views, before the call's own checks; the budget after them.
+    if (plan.route == api::Route::kRefused && plan.code != ErrorCode::kOutOfMemory) return refusal(plan);
     if (auto err = validateCallOptions(call)) return *err;
-    const VkDevice device = m_impl->device->context->device();
-    Result<gpu_algo::DeviceInput> da = api::checkDeviceView(a, "A", device);
-    if (!da) return da.error();
-    Result<gpu_algo::DeviceInput> db = api::checkDeviceView(b, "B", device);
-    if (!db) return db.error();
-    if (!api::fitsOneCall(memoryBudget(*m_impl), a.count, b.count))
-        return Error{ErrorCode::kOutOfMemory, "device views of " + std::to_string(a.count) + " and " +
-                                                  std::to_string(b.count) +
-                                                  " points do not fit the memory budget of one call "
-                                                  "(device input is not split into pieces)"};
-    Result<HausdorffResult> r = m_impl->device->gpu->computeDevice(*da, *db, call);
-    if (!r) return r;
+    if (auto err = m_impl->backend->checkDeviceView(a, "A")) return *err;
+    if (auto err = m_impl->backend->checkDeviceView(b, "B")) return *err;
+    if (plan.route == api::Route::kRefused) return refusal(plan);
     // The host cannot read device views: the device's own proof stands, or the call fails.
-    if (auto err = api::settleCertificates(*r, PointView{}, PointView{}, m_impl->options.threads, false))
-        return *err;
-    finishResult(*m_impl, *r, call, t0);
+    Frame frame;
+    frame.onHost = false;
+    Result<HausdorffResult> r = m_impl->backend->computeDeviceViews(a, b, call);
+    if (!r) return r;
+    frame.origin = r->origin;  // the frame the device chose
+    if (auto err = leaveFrame(*m_impl, *r, frame, call, t0)) return *err;
     return r;
 }
 
 Result<PreparedSet> Engine::prepare(const DevicePointView& points, const PrepareOptions& options) {
-    if (auto err = deviceInputEngine(*m_impl)) return *err;
+    if (const std::string& no = m_impl->backend->caps().noDeviceViews; !no.empty())
+        return Error{ErrorCode::kInvalidArgument, no};
     if (auto err = validateBits(options.bits)) return *err;
     if (options.origin)
         if (auto err = core::checkOrigin(*options.origin, "PrepareOptions::origin")) return *err;
-    Result<gpu_algo::DeviceInput> view =
-        api::checkDeviceView(points, "to prepare", m_impl->device->context->device());
-    if (!view) return view.error();
-    Timings timings;
     const std::string name = "set#" + std::to_string(++m_impl->preparedCount);
-    auto g = m_impl->device->gpu->prepareDevice(*view, options.origin, options.bits, name, timings);
+    Result<api::DeviceViewSet> g =
+        m_impl->backend->prepareDeviceView(points, options.origin, options.bits, name);
     if (!g) return g.error();
     auto set = std::make_shared<PreparedSet::Impl>();
-    set->device = m_impl->device;
+    set->backend = m_impl->backend;
     set->summary = g->summary;
     set->origin = g->origin;
     set->count = points.count;
     set->onDevice = true;
-    set->ownScale = 1.0;  // prepareDevice refuses sets that need the exact scale
-    set->gpuSet = std::move(g->set);
+    set->ownScale = 1.0;  // prepareDeviceView refuses sets that need the exact scale
+    set->set = std::move(g->set);
     return PreparedSet(std::move(set));
 }
 

@@ -451,13 +451,23 @@ Result<std::unique_ptr<GpuHausdorff>> GpuHausdorff::create(gpu::Context& ctx, co
 
 Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                               double scale, const CallOptions& options) {
+    return scansWhole(a.size(), b.size(), options) ? scanWhole(a, b, scale, options)
+                                                   : computeIndexed(a, b, scale, options);
+}
+
+Result<HausdorffResult> GpuHausdorff::scanWhole(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                                double scale, const CallOptions& options) {
     State& st = *m_state;
-    if (scansWhole(a.size(), b.size(), options)) {
-        const std::pair<PointView, PointView> inputs{PointView(a), PointView(b)};
-        return std::move(st.scanPairs(std::span(&inputs, 1), options, [&](const HausdorffResult& blank) {
-            return st.smallPairs.runHostArrays(a, b, scale, options, blank);
-        })[0]);
-    }
+    const std::pair<PointView, PointView> inputs{PointView(a), PointView(b)};
+    return std::move(st.scanPairs(std::span(&inputs, 1), options, [&](const HausdorffResult& blank) {
+        return st.smallPairs.runHostArrays(a, b, scale, options, blank);
+    })[0]);
+}
+
+Result<HausdorffResult> GpuHausdorff::computeIndexed(std::span<const glm::vec3> a,
+                                                     std::span<const glm::vec3> b, double scale,
+                                                     const CallOptions& options) {
+    State& st = *m_state;
     HausdorffResult res = st.emptyResult(options);
     // Squared distances are float on the device: coordinates so large (or so
     // small) that they overflow (or underflow) are scaled by a power of two,
@@ -489,7 +499,7 @@ Result<HausdorffResult> GpuHausdorff::computePacked(std::span<const glm::vec3> a
     return res;
 }
 
-bool GpuHausdorff::ingests(size_t aPoints, size_t bPoints) { return aPoints + bPoints <= kFusedBuildPoints; }
+uint64_t GpuHausdorff::ingestPoints() { return kFusedBuildPoints; }
 
 Result<HausdorffResult> GpuHausdorff::compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                               const CallOptions& options) {
@@ -519,14 +529,10 @@ Result<HausdorffResult> GpuHausdorff::compute(DeviceSet& a, DeviceSet& b, const 
     return res;
 }
 
-bool GpuHausdorff::scansWhole(const DeviceSet& a, const DeviceSet& b) const {
-    const SmallPairScan& scan = m_state->smallPairs;
-    return !a.pts.onDevice() && !b.pts.onDevice() && scan.takes(a.ix.n, b.ix.n) && scan.takes(b.ix.n, a.ix.n);
-}
+const core::ScanLimits& GpuHausdorff::scanLimits() const { return m_state->smallPairs.limits(); }
 
 bool GpuHausdorff::scansWhole(size_t aPoints, size_t bPoints, const CallOptions& options) const {
-    const SmallPairScan& scan = m_state->smallPairs;
-    return options.bits == 0 && scan.takes(aPoints, bPoints) && scan.takes(bPoints, aPoints);
+    return options.bits == 0 && scanLimits().takesPair(aPoints, bPoints);
 }
 
 std::vector<Result<HausdorffResult>> GpuHausdorff::computeSmallPairs(

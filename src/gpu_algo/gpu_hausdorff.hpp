@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "core/input_frame.hpp"
+#include "core/scan_limits.hpp"
 #include "gpu_algo/set_points.hpp"
 #include "rthdist/rthdist.hpp"
 
@@ -49,9 +50,19 @@ public:
 
     // One-shot: both sets indexed for this call, in buffers pooled between
     // calls. `scale`: the exact power of two of index_space.hpp for both sets
-    // (core::exactScale of their largest magnitude).
+    // (core::exactScale of their largest magnitude). The Engine's planner
+    // (api/route_planner.hpp) picks scanWhole or computeIndexed itself;
+    // compute picks by scansWhole.
     [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                   double scale, const CallOptions& options);
+    [[nodiscard]] Result<HausdorffResult> computeIndexed(std::span<const glm::vec3> a,
+                                                         std::span<const glm::vec3> b, double scale,
+                                                         const CallOptions& options);
+    // A small pair (scanLimits) staged by the host and scanned whole in one
+    // submission (small_pairs.hpp).
+    [[nodiscard]] Result<HausdorffResult> scanWhole(std::span<const glm::vec3> a,
+                                                    std::span<const glm::vec3> b, double scale,
+                                                    const CallOptions& options);
     // One-shot from packed float host arrays through the device ingest path
     // (ingest.comp): the host copies each array once into memory the device
     // reads; validation (NaN/Inf: kInvalidArgument naming the set and the
@@ -61,9 +72,9 @@ public:
     [[nodiscard]] Result<HausdorffResult> computePacked(std::span<const glm::vec3> a,
                                                         std::span<const glm::vec3> b,
                                                         const CallOptions& options);
-    // Whether computePacked takes sets of these sizes (both indexed in one
-    // submission, each with scratch of its own: up to 2^25 points together).
-    [[nodiscard]] static bool ingests(size_t aPoints, size_t bPoints);
+    // The points (both sets together) computePacked takes: both indexed in
+    // one submission, each with scratch of its own (2^25).
+    [[nodiscard]] static uint64_t ingestPoints();
     // As above, the scale taken from the points (one pass over each).
     [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                   const CallOptions& options);
@@ -79,18 +90,18 @@ public:
     // levels are built on first use and kept.
     [[nodiscard]] Result<HausdorffResult> compute(DeviceSet& a, DeviceSet& b, const CallOptions& options);
 
-    // computeBatch's small pairs (small_pairs.hpp): whether two prepared sets
-    // of host arrays are small enough to be scanned whole, and every such pair
-    // of a batch in one submission, witnesses and per-point distances
+    // computeBatch's small pairs (small_pairs.hpp): which pairs are small
+    // enough to be scanned whole (the planner's rule for prepared sets of
+    // host arrays, one-shot pairs and pieces), and every such pair of a
+    // batch in one submission, witnesses and per-point distances
     // recomputed in double from the sets' inputs (as compute(DeviceSet&, ...)
     // returns them). The sets must share an origin; their scales may differ
     // (both brought to the smaller, exactly). A device error fails every
     // pair; a pair that breaks the self-check fails alone (kInternal).
-    [[nodiscard]] bool scansWhole(const DeviceSet& a, const DeviceSet& b) const;
-    // Whether one-shot sets of these sizes are scanned whole instead (with
-    // the automatic bit count only: a call that sets bits asks for the index).
-    // compute(a, b, scale, options) then stages and scans them in one
-    // submission.
+    [[nodiscard]] const core::ScanLimits& scanLimits() const;
+    // Whether compute(a, b, scale, options) scans one-shot sets of these
+    // sizes whole (with the automatic bit count only: a call that sets bits
+    // asks for the index).
     [[nodiscard]] bool scansWhole(size_t aPoints, size_t bPoints, const CallOptions& options) const;
     [[nodiscard]] std::vector<Result<HausdorffResult>> computeSmallPairs(
         std::span<const std::pair<const DeviceSet*, const DeviceSet*>> pairs, const CallOptions& options);

@@ -48,12 +48,8 @@ struct SmallPairScan::Layout {
 SmallPairScan::SmallPairScan(Workspace& ws) : m_ws(ws) {
     // Benchmarks compare both paths on one machine: Tuning::smallPairWork
     // replaces the limit (0: every pair takes the RT path).
-    m_maxWork = ws.tuning.smallPairWork.value_or(ws.ctx.cpuDevice() ? kMaxWorkCpuDevice : kMaxWorkGpu);
-}
-
-bool SmallPairScan::takes(uint64_t queries, uint64_t targets) const {
-    return queries > 0 && targets > 0 && queries <= kMaxSide && targets <= kMaxSide &&
-           queries <= m_maxWork / targets;
+    m_limits = core::ScanLimits{
+        kMaxSide, ws.tuning.smallPairWork.value_or(ws.ctx.cpuDevice() ? kMaxWorkCpuDevice : kMaxWorkGpu)};
 }
 
 SmallPairScan::Layout SmallPairScan::layOut(std::span<const SmallPair> pairs, bool directedOnly,

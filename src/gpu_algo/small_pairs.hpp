@@ -26,6 +26,7 @@
 #pragma once
 
 #include "core/certificate.hpp"
+#include "core/scan_limits.hpp"
 
 #include <cstdint>
 #include <functional>
@@ -69,7 +70,10 @@ public:
     // path's time). Tuning::smallPairWork (RTHDIST_SMALL_PAIR_WORK)
     // replaces the product's limit (benchmarks of both paths; 0: none is
     // scanned whole).
-    [[nodiscard]] bool takes(uint64_t queries, uint64_t targets) const;
+    [[nodiscard]] bool takes(uint64_t queries, uint64_t targets) const {
+        return m_limits.takes(queries, targets);
+    }
+    [[nodiscard]] const core::ScanLimits& limits() const { return m_limits; }
 
     // Every pair's witnesses (input indices) and, with perPointDistances,
     // nearest indices, in `results` (one per pair, filled from `blank`); the
@@ -106,7 +110,7 @@ private:
                                                     const uint32_t* nearest, float maxD2);
 
     Workspace& m_ws;
-    uint64_t m_maxWork;
+    core::ScanLimits m_limits;
 };
 
 }  // namespace rthdist::gpu_algo

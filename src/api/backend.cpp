@@ -1,0 +1,88 @@
+// The backend interface's optional methods (a backend whose caps() never
+// plan their route leaves them) and the choice of the Engine's backend.
+#include "api/backend.hpp"
+
+#include <string>
+
+namespace rthdist::api {
+
+namespace {
+
+Error notOffered(const char* what) {
+    return Error{ErrorCode::kInternal, std::string("the backend offers no ") + what +
+                                           " (the route planner chose a route outside its caps)"};
+}
+
+// auto picks a Vulkan backend only on a device with RT hardware paths that is
+// not a software rasterizer: on lavapipe (VK_PHYSICAL_DEVICE_TYPE_CPU) the
+// native CPU backend is 10-100x faster (docs/bench). An explicit --device
+// keeps the Vulkan path on whatever device it names.
+bool hardwareRtDevice(const EngineOptions& o) {
+    auto devices = listDevices();
+    if (!devices) return false;
+    for (const DeviceInfo& d : devices.value()) {
+        if (!(d.rayQuery || d.rtPipeline)) continue;
+        if (o.deviceIndex >= 0) {
+            if (d.index == o.deviceIndex) return true;
+            continue;
+        }
+        if (d.type != "cpu") return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+Result<HausdorffResult> ComputeBackend::scanFramed(int, std::span<const glm::vec3>,
+                                                   std::span<const glm::vec3>, double, const CallOptions&) {
+    return notOffered("small-pair scan");
+}
+
+Result<HausdorffResult> ComputeBackend::computeIngested(std::span<const glm::vec3>,
+                                                        std::span<const glm::vec3>, const CallOptions&) {
+    return notOffered("device ingest");
+}
+
+std::vector<Result<HausdorffResult>> ComputeBackend::scanPrepared(std::span<const BackendSetPair> pairs,
+                                                                  const CallOptions&) {
+    return std::vector<Result<HausdorffResult>>(pairs.size(), notOffered("small-pair scan"));
+}
+
+std::optional<Error> ComputeBackend::checkDeviceView(const DevicePointView&, const char*) const {
+    return notOffered("device views");
+}
+
+Result<HausdorffResult> ComputeBackend::computeDeviceViews(const DevicePointView&, const DevicePointView&,
+                                                           const CallOptions&) {
+    return notOffered("device views");
+}
+
+Result<DeviceViewSet> ComputeBackend::prepareDeviceView(const DevicePointView&,
+                                                        const std::optional<glm::dvec3>&, int,
+                                                        const std::string&) {
+    return notOffered("device views");
+}
+
+Result<std::unique_ptr<ComputeBackend>> openBackend(const EngineOptions& options,
+                                                    const VulkanDevice* borrowed) {
+    if (borrowed) {
+        if (options.backend == Backend::kCpu)
+            return Error{ErrorCode::kInvalidArgument,
+                         "the cpu backend takes no Vulkan device (VulkanDevice)"};
+        return makeGpuBackend(options, borrowed);
+    }
+    if (options.backend == Backend::kCpu ||
+        (options.backend == Backend::kAuto && !hardwareRtDevice(options))) {
+        if (options.devices.size() > 1) {
+            return Error{
+                ErrorCode::kInvalidArgument,
+                "several devices (EngineOptions::devices) need a GPU backend; the " +
+                    std::string(options.backend == Backend::kCpu ? "cpu backend was asked for"
+                                                                 : "first device has no RT hardware")};
+        }
+        return makeCpuBackend(options);
+    }
+    return makeGpuBackend(options, nullptr);
+}
+
+}  // namespace rthdist::api

@@ -1,0 +1,121 @@
+// The backend interface of the Engine: what the CPU backend (src/cpu) and
+// the GPU algorithm (src/gpu_algo, on one or more devices) do for a call, in
+// one shape, so that engine.cpp runs the planner's route
+// (api/route_planner.hpp) with no branch on the backend. The frame (origin,
+// float rounding, exact scale) is entered and left in engine.cpp: every
+// method here takes float sets already in it and hands back witnesses by
+// input index, distances of the framed floats (the Engine restores them).
+//
+// Adapters: cpu_backend.cpp (Backend::kCpu) and gpu_backend.cpp (the Vulkan
+// backends); openBackend picks one.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "api/out_of_core.hpp"
+#include "api/route_planner.hpp"
+#include "core/input_frame.hpp"
+#include "rthdist/rthdist.hpp"
+#include "rthdist/vulkan_interop.hpp"
+
+namespace rthdist::api {
+
+// A set prepared by a backend (its index or order), kept by a PreparedSet.
+class BackendSet {
+public:
+    virtual ~BackendSet() = default;
+    [[nodiscard]] virtual int bits() const = 0;
+    [[nodiscard]] virtual uint64_t deviceBytes() const = 0;
+    [[nodiscard]] virtual uint64_t hostBytes() const = 0;
+};
+
+// A set prepared from a device view, with the frame the device chose.
+struct DeviceViewSet {
+    std::shared_ptr<BackendSet> set;
+    core::SetSummary summary;
+    glm::dvec3 origin{0.0};
+};
+
+using BackendSetPair = std::pair<const BackendSet*, const BackendSet*>;
+
+class ComputeBackend {
+public:
+    virtual ~ComputeBackend() = default;
+
+    [[nodiscard]] virtual Backend kind() const = 0;
+    [[nodiscard]] virtual const std::string& deviceName() const = 0;
+    // What the planner needs to know of it.
+    [[nodiscard]] virtual BackendCaps caps() const = 0;
+    // What one call may hold (out_of_core.hpp): the caller's
+    // EngineOptions::memoryBudget, else the devices'.
+    [[nodiscard]] virtual MemoryBudget memoryBudget() const = 0;
+
+    // A framed pair in one call on device `lane` (0 .. caps().lanes - 1):
+    // indexed (Route::kOneCall and the pieces), or scanned whole
+    // (Route::kSmallPairScan; backends whose caps scan no pair need not).
+    [[nodiscard]] virtual Result<HausdorffResult> computeFramed(int lane, std::span<const glm::vec3> a,
+                                                                std::span<const glm::vec3> b, double scale,
+                                                                const CallOptions& call) = 0;
+    [[nodiscard]] virtual Result<HausdorffResult> scanFramed(int lane, std::span<const glm::vec3> a,
+                                                             std::span<const glm::vec3> b, double scale,
+                                                             const CallOptions& call);
+    // Route::kDeviceIngest: packed float arrays in their own coordinates
+    // (origin 0), checked by the device.
+    [[nodiscard]] virtual Result<HausdorffResult> computeIngested(std::span<const glm::vec3> a,
+                                                                  std::span<const glm::vec3> b,
+                                                                  const CallOptions& call);
+
+    // A set of floats (before the exact power of two `scale`) indexed once;
+    // `floats` must outlive the set; `name` labels its buffers.
+    [[nodiscard]] virtual Result<std::shared_ptr<BackendSet>> prepare(std::span<const glm::vec3> floats,
+                                                                      double scale, int bits,
+                                                                      const std::string& name) = 0;
+    // Route::kPrepared: two sets of this backend, one frame and scale.
+    [[nodiscard]] virtual Result<HausdorffResult> computePrepared(const BackendSet& a, const BackendSet& b,
+                                                                  const CallOptions& call) = 0;
+    // Route::kSmallPairScan of prepared sets: every pair in one submission
+    // (witnesses by input index, distances of the framed floats).
+    [[nodiscard]] virtual std::vector<Result<HausdorffResult>> scanPrepared(
+        std::span<const BackendSetPair> pairs, const CallOptions& call);
+
+    // Route::kDeviceViews and sets prepared from device views (caps().noDeviceViews empty).
+    // The view's checks against the contract's limits (device_views.hpp), kInvalidArgument naming `name`.
+    [[nodiscard]] virtual std::optional<Error> checkDeviceView(const DevicePointView& view,
+                                                               const char* name) const;
+    [[nodiscard]] virtual Result<HausdorffResult> computeDeviceViews(const DevicePointView& a,
+                                                                     const DevicePointView& b,
+                                                                     const CallOptions& call);
+    [[nodiscard]] virtual Result<DeviceViewSet> prepareDeviceView(const DevicePointView& points,
+                                                                  const std::optional<glm::dvec3>& origin,
+                                                                  int bits, const std::string& name);
+
+    // Frees what every lane keeps between one-shot calls (out_of_core.hpp's `release`).
+    virtual void releaseScratch() {}
+    // Hands a result's per-point arrays back to lane `lane` for its next call.
+    virtual void recyclePerPoint(int /*lane*/, PerPoint&& /*a*/, PerPoint&& /*b*/) {}
+    // CallOptions::perPointReady directions the last call handed back itself (bit k: direction k).
+    [[nodiscard]] virtual uint32_t handedBack() const { return 0; }
+    // Vulkan validation messages over every device so far.
+    [[nodiscard]] virtual uint64_t validationMessages() const { return 0; }
+    [[nodiscard]] virtual std::string pipelineCachePath() const { return {}; }
+    [[nodiscard]] virtual std::string pipelineCacheStatus() const { return "none"; }
+};
+
+// The Engine's backend: the CPU one, or the GPU algorithm on the devices of
+// `options` (or on the embedder's device `borrowed`). `options.tuning` is set.
+[[nodiscard]] Result<std::unique_ptr<ComputeBackend>> openBackend(const EngineOptions& options,
+                                                                  const VulkanDevice* borrowed);
+
+[[nodiscard]] std::unique_ptr<ComputeBackend> makeCpuBackend(const EngineOptions& options);
+[[nodiscard]] Result<std::unique_ptr<ComputeBackend>> makeGpuBackend(const EngineOptions& options,
+                                                                     const VulkanDevice* borrowed);
+
+}  // namespace rthdist::api

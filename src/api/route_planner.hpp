@@ -1,0 +1,103 @@
+// The route of a call: one pure function from what the call is (its pair's
+// shape, its options, the memory budget, what the backend can do) to how the
+// Engine runs it. It reads no device and holds no backend object, so every
+// route is unit-tested on the host (tests/engine/route_planner_test.cpp);
+// engine.cpp runs the route it returns through the backend interface
+// (api/backend.hpp).
+//
+// The routes, in the order they are tried:
+//   host views (Engine::compute(PointView, PointView), hausdorff()):
+//     the pair within one call's budget:
+//       kSmallPairScan  small enough to be scanned whole (GPU, automatic bits)
+//       kDeviceIngest   packed float arrays the device checks and bounds itself
+//       kOneCall        checked and framed on the host, one backend call
+//                       (pieces after a kOutOfMemory under the automatic budget)
+//     past it:
+//       kSeveralDevices each device a share of the queries with all the targets
+//       kPieces         out of core: query chunks x target tiles (out_of_core.hpp)
+//   prepared sets (Engine::compute(PreparedSet, ...), computeBatch):
+//       kRefused        another Engine's set, or a device view's set outside its frame
+//       kSmallPairScan  one frame, small: scanned whole (a batch's in one submission)
+//       kReframe        different frames or scales: the inputs as host views in the
+//                       union's frame (the framed routes above, no device ingest)
+//       kPrepared       the sets' own indexes
+//   device views (Engine::compute(DevicePointView, ...)):
+//       kRefused        a backend that reads no device views, or past the budget
+//       kDeviceViews    ingested and searched on the device
+// The pieces of kPieces and kSeveralDevices are planned as framed pairs
+// (planFramedCall): a small piece is scanned whole.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "api/out_of_core.hpp"
+#include "core/scan_limits.hpp"
+#include "rthdist/rthdist.hpp"
+
+namespace rthdist::api {
+
+enum class Route {
+    kRefused,
+    kSmallPairScan,
+    kDeviceIngest,
+    kOneCall,
+    kSeveralDevices,
+    kPieces,
+    kReframe,
+    kPrepared,
+    kDeviceViews,
+};
+
+[[nodiscard]] const char* routeName(Route route);
+
+// What the call's pair is, as the planner needs it.
+struct PairShape {
+    enum class Input { kHostViews, kPreparedSets, kDeviceViews };
+    Input input = Input::kHostViews;
+    uint64_t a = 0, b = 0;  // points of each set
+    // Host views: both packed float arrays (PointView::packedFloat).
+    bool packedFloat = false;
+    // Prepared sets:
+    bool sameEngine = true;   // both prepared by this Engine
+    bool onDevice = false;    // either prepared from a device view (no host copy)
+    bool hostCopies = false;  // either keeps its double input (not float-exact)
+    bool oneOrigin = false;   // one origin that keeps the contract's bound
+    bool oneScale = false;    // and one exact scale (core::exactScale)
+};
+
+// What the Engine's backend can do (Backend::caps).
+struct BackendCaps {
+    core::ScanLimits scan;      // pairs scanned whole (maxWork 0: none)
+    uint64_t ingestPoints = 0;  // device ingest of packed floats, both sets together (0: none)
+    int lanes = 1;              // devices one-shot calls spread pieces over
+    // A one-shot call that fit the budget but found the device short of
+    // memory runs again in pieces (the automatic budget of a device).
+    bool piecesOnOutOfMemory = false;
+    // Why the backend reads no device views; empty when it does.
+    std::string noDeviceViews;
+};
+
+struct Plan {
+    Route route = Route::kRefused;
+    // kRefused: the error the call returns.
+    ErrorCode code = ErrorCode::kInvalidArgument;
+    std::string reason;
+    // kOneCall, kSmallPairScan: pieces after a kOutOfMemory (BackendCaps).
+    bool piecesOnOutOfMemory = false;
+    // The budget pieces are cut to: kSeveralDevices and kPieces, and
+    // kOneCall and kSmallPairScan after a kOutOfMemory.
+    MemoryBudget pieces;
+};
+
+// The route of a call.
+[[nodiscard]] Plan planRoute(const PairShape& shape, const CallOptions& call, const MemoryBudget& budget,
+                             const BackendCaps& caps);
+
+// The route of a pair already checked and framed on the host (float sets of
+// one frame and scale): kSmallPairScan, kOneCall, kSeveralDevices or kPieces.
+// kReframe's pair and every piece of kPieces take it.
+[[nodiscard]] Plan planFramedCall(uint64_t a, uint64_t b, const CallOptions& call, const MemoryBudget& budget,
+                                  const BackendCaps& caps);
+
+}  // namespace rthdist::api
