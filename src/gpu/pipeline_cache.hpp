@@ -55,5 +55,4 @@ private:
     size_t m_loadedBytes = 0;
 };
 
-
 }  // namespace rthdist::gpu
