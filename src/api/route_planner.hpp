@@ -1,7 +1,7 @@
 // The route of a call: one pure function from what the call is (its pair's
 // shape, its options, the memory budget, what the backend can do) to how the
 // Engine runs it. It reads no device and holds no backend object, so every
-// route is unit-tested on the host (tests/engine/route_planner_test.cpp);
+// route is unit-tested on the host (tests/api/route_planner_test.cpp);
 // engine.cpp runs the route it returns through the backend interface
 // (api/backend.hpp).
 //

@@ -165,7 +165,7 @@ TEST_P(CliGpu, DeviceIndexOutOfRangeIsNoDevice) {
 // --devices opens each device once (issue 36: 0,0,0,... opened the device
 // once per entry, unbounded): a repeated index or more than 16 entries is a
 // usage error (exit 2) before any device is opened. Several lanes on one
-// device are tested through the library (tests/engine/several_devices_test).
+// device are tested through the library (tests/api/several_devices_test).
 TEST_P(CliGpu, DevicesEachOnceAndBounded) {
     const CliRun twice = runCli({"--backend", GetParam(), "--devices", "0,0", kSampleA, kSampleB});
     EXPECT_EQ(twice.exitCode, 2) << twice;
@@ -190,7 +190,7 @@ TEST_P(CliGpu, DevicesEachOnceAndBounded) {
 }
 
 // The pipeline cache through the CLI (issue 36; the library's cases are
-// tests/engine PipelineCache). The temporary file used to be <cache>.tmp<pid>,
+// tests/api PipelineCache). The temporary file used to be <cache>.tmp<pid>,
 // opened with O_TRUNC through whatever was there: a symlink planted at that
 // name (the shell's pid is the CLI's after exec) made rthdist overwrite the
 // file it points to. It is neither followed nor written through now.

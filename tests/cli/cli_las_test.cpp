@@ -241,7 +241,7 @@ TEST(CliPrecision, DoublePlyAtUtmMatchesTheDoubleBruteForce) {
     SCOPED_TRACE("seed " + std::to_string(c.seed) + ", brute force H " + std::to_string(truth));
     const CliRun rounded = runCli({"--backend", "cpu", "--json", fa, fb});
     ASSERT_EQ(rounded.exitCode, 0) << rounded;
-    // The GPU backends on the same cases: tests/algo/precision_test.cpp.
+    // The GPU backends on the same cases: tests/core/precision_test.cpp.
     std::printf("utm_cm_3 (seed %llu): double brute force H %.9f, float32 PLYs give %.9f\n",
                 static_cast<unsigned long long>(c.seed), truth, hausdorffOf(rounded));
     for (const std::string backend : {"cpu", "auto"}) {

@@ -11,7 +11,7 @@
 #include "common/brute_force.hpp"
 #include "common/geo_cases.hpp"
 #include "common/oracle_cases.hpp"
-#include "engine/engine_test_support.hpp"
+#include "engine_test_support.hpp"
 
 namespace rthdist::test {
 namespace {

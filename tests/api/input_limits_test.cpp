@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/engine_test_support.hpp"
+#include "engine_test_support.hpp"
 
 namespace rthdist::test {
 namespace {

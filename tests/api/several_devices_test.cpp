@@ -13,7 +13,7 @@
 #include "api/out_of_core.hpp"
 #include "common/case_sample.hpp"
 #include "common/oracle_cases.hpp"
-#include "engine/engine_test_support.hpp"
+#include "engine_test_support.hpp"
 
 namespace rthdist::test {
 namespace {

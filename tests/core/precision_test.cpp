@@ -1,6 +1,6 @@
 // Exact on the user's own coordinates (issue 10): double inputs far from the
 // origin against a double brute force on the CPU backend (the GPU backends
-// run the same cases in tests/gpu), point views with strides, and proof that
+// run the same cases in tests/gpu_algo), point views with strides, and proof that
 // the cases need the shift: rounding the doubles to float32 misses the truth.
 #include <gtest/gtest.h>
 

@@ -17,7 +17,7 @@
 
 #include "common/brute_force.hpp"
 #include "common/geo_cases.hpp"
-#include "engine/engine_test_support.hpp"
+#include "engine_test_support.hpp"
 #include "gpu/vk_struct.hpp"
 #include "rthdist/vulkan_interop.hpp"
 

@@ -18,7 +18,7 @@
 #include "api/out_of_core.hpp"
 #include "common/brute_force.hpp"
 #include "common/oracle_cases.hpp"
-#include "engine/engine_test_support.hpp"
+#include "engine_test_support.hpp"
 
 namespace rthdist::test {
 namespace {

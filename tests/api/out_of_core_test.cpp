@@ -13,7 +13,7 @@
 #include "common/brute_force.hpp"
 #include "common/case_sample.hpp"
 #include "common/oracle_cases.hpp"
-#include "engine/engine_test_support.hpp"
+#include "engine_test_support.hpp"
 
 namespace rthdist::test {
 namespace {
