@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "gpu/gpu_test_support.hpp"
+#include "gpu_algo/gpu_test_support.hpp"
 #include "rthdist/rthdist.hpp"
 
 namespace rthdist::test {
