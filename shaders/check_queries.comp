@@ -45,8 +45,7 @@ void main() {
     // rounded down (a relative 2^-20 on the maximum and on the square), so it
     // is never above (hf - 2e)^2 in real numbers.
     if (pc.bandOut != 0ul) {
-        float lo = max(sqrt(maxD2) * (1.0 - 1.0 / 1048576.0) - 2.0 * pc.bandSlack, 0.0);
-        if (packedDist2(st.best) >= lo * lo * (1.0 - 1.0 / 1048576.0)) {
+        if (packedDist2(st.best) >= shrunkDist2(maxD2, 2.0 * pc.bandSlack)) {
             uint k = atomicAdd(UintRef(pc.bandOut).v, 1u);
             if (k < pc.bandCapacity)
                 uvec2At(pc.bandOut + 8ul, k).v = uvec2(floatBitsToUint(vec4At(pc.sorted, i).v.w), uint(st.best & 0xffffffffu));

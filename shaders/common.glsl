@@ -84,6 +84,15 @@ void raiseMax(uint64_t maxPacked, uint64_t packed) {
     if (packed > U64Ref(maxPacked).v) atomicMax(U64Ref(maxPacked).v, packed);
 }
 
+// (sqrt(d2) - by)^2, rounded down (a relative 2^-20 on the root and on the
+// square; 0 when by exceeds the root): the certificate's band threshold
+// (check_queries.comp, by = 2e) and the kill threshold under it
+// (deadThreshold, by = 3e), one formula so that the second stays below the first.
+float shrunkDist2(float d2, float by) {
+    float lo = max(sqrt(d2) * (1.0 - 1.0 / 1048576.0) - by, 0.0);
+    return lo * lo * (1.0 - 1.0 / 1048576.0);
+}
+
 // The threshold below which a query cannot raise h: the larger of the exact
 // running maximum (has a witness) and the witness-less lower bound, lowered
 // by 3e (e: the certificate's slack in the counter block, 0 where none), so
@@ -96,9 +105,7 @@ float deadThreshold(uint64_t maxPacked, float lowerBound2) {
     uint64_t m = U64Ref(maxPacked).v;
     float thr = max(packedDist2(m), lowerBound2);
     float e = FloatRef(maxPacked + uint64_t(RTHDIST_CTR_KILL_SLACK - RTHDIST_CTR_MAX_PACKED)).v;
-    if (e == 0.0) return thr;
-    float lo = max(sqrt(thr) * (1.0 - 1.0 / 1048576.0) - 3.0 * e, 0.0);
-    return lo * lo * (1.0 - 1.0 / 1048576.0);
+    return e == 0.0 ? thr : shrunkDist2(thr, 3.0 * e);
 }
 
 // Order-preserving uint of a float (for atomicMin/atomicMax of floats) and back.

@@ -20,7 +20,15 @@ constexpr uint32_t kCertGroups = 4096;
 // uint ran, query, count, pad, then the targets.
 VkDeviceSize witnessOffset(const DirectionRun& d) { return 8 + VkDeviceSize(d.bandCapacity) * 8; }
 
+// Groups of a grid-stride pass over d's targets (cert_scan.comp, cert_witness.comp).
+uint32_t targetScanGroups(const Workspace& ws, const DirectionRun& d) {
+    return std::max<uint32_t>(
+        1, std::min({gpu::groupsFor(d.T.n, RTHDIST_WG), kCertGroups, ws.ctx.limits().maxGroupsX}));
+}
+
 }  // namespace
+
+float deviceSlack(const DirectionRun& d) { return float(d.slack * (1.0 + 0x1.0p-20)); }
 
 void cmdScanWitness(Workspace& ws, VkCommandBuffer cmd, const DirectionRun& d, CheckAt at) {
     if (d.band == nullptr) return;
@@ -31,7 +39,7 @@ void cmdScanWitness(Workspace& ws, VkCommandBuffer cmd, const DirectionRun& d, C
                                    d.T.n,
                                    d.Q.n,
                                    kWitnessCapacity,
-                                   float(d.slack * (1.0 + 0x1.0p-20)),
+                                   deviceSlack(d),
                                    at == CheckAt::kBehindCull ? 1u : 0u,
                                    0,
                                    0,
@@ -41,9 +49,7 @@ void cmdScanWitness(Workspace& ws, VkCommandBuffer cmd, const DirectionRun& d, C
                                          ws.hostSmall.handle(), d.blk.offset + RTHDIST_CTR_CHECK_ARGS);
         return;
     }
-    const uint32_t groups = std::max<uint32_t>(
-        1, std::min({gpu::groupsFor(d.T.n, RTHDIST_WG), kCertGroups, ws.ctx.limits().maxGroupsX}));
-    ws.pipelines.cmdDispatch(cmd, Kernel::kCertWitness, &push, sizeof(push), groups);
+    ws.pipelines.cmdDispatch(cmd, Kernel::kCertWitness, &push, sizeof(push), targetScanGroups(ws, d));
 }
 
 void CertificatePass::startDirection(DirectionRun& d, size_t direction) {
@@ -55,9 +61,8 @@ void CertificatePass::startDirection(DirectionRun& d, size_t direction) {
                         d.name() + ".band", MemoryKind::kHost);
     std::memset(d.band->mapped(), 0, 8);
     std::memset(static_cast<char*>(d.band->mapped()) + witnessOffset(d), 0, 16);
-    // The kill threshold's margin (common.glsl, deadThreshold): rounded up,
-    // as the band's slack is (QueryCheck::cmdCheckQueries).
-    const float killSlack = float(d.slack * (1.0 + 0x1.0p-20));
+    // The kill threshold's margin (common.glsl, deadThreshold): the band's e.
+    const float killSlack = deviceSlack(d);
     std::memcpy(d.blk.host + RTHDIST_CTR_KILL_SLACK, &killSlack, 4);
 }
 
@@ -118,10 +123,8 @@ void CertificatePass::scan(DirectionRun& d, uint32_t entries, uint32_t capacity,
                                 entries,
                                 capacity,
                                 mode};
-    const uint32_t groups = std::max<uint32_t>(
-        1, std::min({gpu::groupsFor(d.T.n, RTHDIST_WG), kCertGroups, m_ws.ctx.limits().maxGroupsX}));
     VkCommandBuffer cmd = m_ws.ctx.begin();
-    m_ws.pipelines.cmdDispatch(cmd, Kernel::kCertScan, &push, sizeof(push), groups);
+    m_ws.pipelines.cmdDispatch(cmd, Kernel::kCertScan, &push, sizeof(push), targetScanGroups(m_ws, d));
     gpu::cmdHostReadBarrier(cmd);
     m_ws.ctx.submitAndWait(cmd);
     m_ws.timings->gpuCertificate += m_ws.ctx.lastGpuMs();

@@ -26,6 +26,10 @@ inline constexpr uint32_t kCandidateCapacity = uint32_t(1) << 16;
 // force of its own.
 inline constexpr uint32_t kWitnessCapacity = uint32_t(1) << 12;
 
+// The certificate's e of d as the shaders take it: float, rounded up (the
+// band, the kill margin and the witness's bound all use this one value).
+[[nodiscard]] float deviceSlack(const DirectionRun& d);
+
 // Records cert_witness.comp (the witness's brute force) beside the
 // direction's check recorded at `at`, with the same early exit: it runs
 // where the check runs whole, once per direction.

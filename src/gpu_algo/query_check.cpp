@@ -37,7 +37,7 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, Che
                      d.nearest != nullptr ? d.nearest->address() : 0,
                      d.band != nullptr ? d.band->address() : 0,
                      d.bandCapacity,
-                     float(d.slack * (1.0 + 0x1.0p-20))};
+                     deviceSlack(d)};
     if (at == CheckAt::kBehindSearch)  // groups written by search_advance.comp: none while queries go on
         m_ws.pipelines.cmdDispatchIndirect(cmd, Kernel::kCheckQueries, &cp, sizeof(cp),
                                            m_ws.hostSmall.handle(), d.blk.offset + RTHDIST_CTR_CHECK_ARGS);

@@ -58,9 +58,7 @@ TEST(OutOfCore, OracleSuiteUnderAForcedBudget) {
     RTHDIST_REQUIRE_TEST_ENGINE(whole);
     uint64_t splitCases = 0;
     const size_t stride = caseStride();
-    size_t index = 0;
-    for (const OracleCase& c : makeOracleCases()) {
-        if (index++ % stride != 0) continue;
+    for (const OracleCase& c : sampledCases(makeOracleCases())) {
         SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed));
         const uint64_t points = std::max<uint64_t>(2, (c.a.size() + c.b.size()) / 3);
         Engine split = budgetEngine(points);
