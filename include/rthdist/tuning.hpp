@@ -37,6 +37,10 @@ struct Tuning {
     // The same before the first radius (0: never, the default).
     // RTHDIST_TAIL_SCAN_START.
     std::optional<uint64_t> tailScanStartWork;
+    // The search's sweep (every open query against every target, no rays)
+    // takes over while open queries x targets is at most this (0: never).
+    // RTHDIST_SWEEP_WORK.
+    std::optional<uint64_t> sweepWork;
     // Read host arrays in place (VK_EXT_external_memory_host) instead of
     // copying them: off by default, on the H200 pinning cost more than the
     // copy it saves (docs/bench/prepared). RTHDIST_HOST_IMPORT=1.

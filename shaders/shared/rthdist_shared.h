@@ -393,6 +393,18 @@ struct TailScanPush {
     uint numFineCells;
 };
 
+// sweep_targets.comp: every open query against every target (the search's
+// sweep, CandidateSearch::sweepWork). Targets per thread of one item.
+#define RTHDIST_SWEEP_PER_THREAD 32u
+struct SweepPush {
+    uint64_t queries;     // vec4 sorted queries
+    uint64_t targets;     // vec4[n] the targets (w = original index)
+    uint64_t state;       // QueryState per query
+    uint64_t activeList;  // the open queries' slots
+    uint n;               // targets
+    uint numActive;       // open queries (slots of activeList)
+};
+
 // sample_gather.comp: records j * stride (j < count) of `points` (vec4) into
 // `gathered` (float[3 count]), the bit count's sample of a device-input set.
 struct SampleGatherPush {
@@ -536,6 +548,7 @@ static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDI
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
 static_assert(sizeof(TailScanPush) == 80);
+static_assert(sizeof(SweepPush) == 40);
 static_assert(sizeof(CheckPush) == 112 && offsetof(CheckPush, nearestOut) == 88);
 static_assert(sizeof(CertScanPush) == 40);
 static_assert(sizeof(CertWitnessPush) == 64);

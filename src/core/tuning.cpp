@@ -39,6 +39,7 @@ Tuning tuningFromEnvironment() {
     if (const char* v = std::getenv("RTHDIST_SEARCH_TAIL")) t.squaredTailGrowth = std::string_view(v) != "0";
     t.tailScanWork = number("RTHDIST_TAIL_SCAN_WORK");
     t.tailScanStartWork = number("RTHDIST_TAIL_SCAN_START");
+    t.sweepWork = number("RTHDIST_SWEEP_WORK");
     t.hostImport = text("RTHDIST_HOST_IMPORT") == "1";
     const std::string labels = text("RTHDIST_DEBUG_LABELS");
     t.debugLabels = !labels.empty() && labels != "0";

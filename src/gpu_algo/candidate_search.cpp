@@ -24,6 +24,7 @@ CandidateSearch::CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, R
     squaredTailGrowth = t.squaredTailGrowth.value_or(true);
     tailScanWork = t.tailScanWork.value_or(m_ws.ctx.cpuDevice() ? kTailScanWorkCpuDevice : kTailScanWorkGpu);
     tailScanStartWork = t.tailScanStartWork.value_or(kTailScanStartWorkGpu);
+    sweepWork = t.sweepWork.value_or(m_ws.ctx.cpuDevice() ? kSweepWorkCpuDevice : kSweepWorkGpu);
 }
 
 void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options,
@@ -62,10 +63,19 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
             pairs = &m_ws.grow(m_ws.scratch.search.pairs, pairCapacity * 8, "pairs");
             pairCapacity = std::min<uint64_t>(pairs->size() / 8, m_ws.maxPairCapacity);
         }
+        if (uint64_t(numActive) * T.n <= sweepWork) {
+            const RadiiOutcome out =
+                runRadii(d, 0, false, {}, *pairs, pairCapacity, numActive, SearchStep::kSweep);
+            if (out.stillOpen != 0) throw std::runtime_error("candidate search: the sweep left queries open");
+            d.out.counters.iterations += out.run;
+            d.out.counters.tailScanned += numActive;
+            break;
+        }
         const int tail = traced ? tailScanLevel(T, numActive, searched, tailScanWork)
                                 : tailScanLevel(T, numActive, d.Q.n, tailScanStartWork);
         if (tail >= 0) {
-            const RadiiOutcome out = runRadii(d, tail, false, {}, *pairs, pairCapacity, numActive, true);
+            const RadiiOutcome out =
+                runRadii(d, tail, false, {}, *pairs, pairCapacity, numActive, SearchStep::kTailScan);
             if (out.stillOpen != 0)
                 throw std::runtime_error("candidate search: the tail scan left queries open");
             d.out.counters.iterations += out.run;
@@ -133,7 +143,8 @@ std::vector<double> CandidateSearch::radiiAtLevel(const PointIndex& T, double ra
 
 RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLevel,
                                        std::span<const double> radii, Buffer& pairs, uint64_t pairCapacity,
-                                       uint32_t numActive, bool wholeLevel) {
+                                       uint32_t numActive, SearchStep step) {
+    const bool wholeLevel = step != SearchStep::kRadii;
     const PointIndex::Level lv = m_index.levelCells(d.T, level);  // may build the level (a submission)
     const auto t0 = Clock::now();
     sh::CounterFields& counters = d.blk.fields();
@@ -153,7 +164,9 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
             gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                              VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                              VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
-        if (wholeLevel) {  // no rays: its device time counts as refinement
+        if (step == SearchStep::kSweep) {  // no rays: its device time counts as refinement
+            m_refine.cmdSweep(cmd, d, numActive);
+        } else if (step == SearchStep::kTailScan) {
             m_refine.cmdTailScan(cmd, d, lv, level > 0, numActive);
         } else {
             const uint32_t before = i == 0 ? 0 : marks.back().second + 1;
@@ -201,7 +214,10 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
         d.out.counters.candidatePairs += std::min<uint64_t>(log[i].pairs, pairCapacity);
     }
     if (out.run == 0) throw std::runtime_error("candidate search: the device searched no query");
-    if (m_ws.ctx.tracingSubmits() && wholeLevel)
+    if (m_ws.ctx.tracingSubmits() && step == SearchStep::kSweep)
+        std::fprintf(stderr, "rthdist sweep of %u targets: searched %u, going on %u\n", d.T.n, log[0].searched,
+                     log[0].goingOn);
+    else if (m_ws.ctx.tracingSubmits() && wholeLevel)
         std::fprintf(stderr, "rthdist tail scan level %d (%u cells): searched %u, going on %u\n", level,
                      lv.count, log[0].searched, log[0].goingOn);
     else if (m_ws.ctx.tracingSubmits())

@@ -39,6 +39,19 @@ inline constexpr uint64_t kTailScanWorkCpuDevice = uint64_t(1) << 24;
 // change on the masks: no rule found yet that picks only the wins.
 inline constexpr uint64_t kTailScanStartWorkGpu = 0;
 inline constexpr uint32_t kTailScanCells = 4096;
+// The sweep (every open query against every target, sweep_targets.comp)
+// replaces the radii while (open queries) x (targets) is at most this, on a
+// GPU and on a CPU device: a far query beside a dense cluster otherwise
+// grows its radius through tens of iterations and scans the cluster's cells
+// one thread each (the scale suite's cluster-100M spent 17 s there on an
+// H200). 2^31 distances are ~2-3 ms on an H200 (memory-bound at one read of
+// the targets per query); 2^24 ~30 ms on lavapipe's 2 cores.
+inline constexpr uint64_t kSweepWorkGpu = uint64_t(1) << 31;
+inline constexpr uint64_t kSweepWorkCpuDevice = uint64_t(1) << 24;
+
+// What one step of the search does: radii (rays and pairs), the far tail's
+// scan of a whole level, or the sweep of every target.
+enum class SearchStep { kRadii, kTailScan, kSweep };
 
 // What the radii of one submission reported.
 struct RadiiOutcome {
@@ -98,11 +111,12 @@ public:
     // the queries of the first radius (the later ones search at most as
     // many). The host reads the log once, at the end. The direction's
     // self-check follows the radii where it folds into the search (groups
-    // only once no query goes on). `wholeLevel`: one step, the far tail's
-    // scan of every cell of `level` (radii unused), after which no query
-    // goes on.
+    // only once no query goes on). `step` kTailScan: one step, the far
+    // tail's scan of every cell of `level`; kSweep: one step, every target
+    // (radii unused); after either no query goes on.
     RadiiOutcome runRadii(DirectionRun& d, int level, bool sameLevel, std::span<const double> radii,
-                          Buffer& pairs, uint64_t pairCapacity, uint32_t numActive, bool wholeLevel = false);
+                          Buffer& pairs, uint64_t pairCapacity, uint32_t numActive,
+                          SearchStep step = SearchStep::kRadii);
 
     // Radii per submission at most (1 to RTHDIST_SEARCH_LOG_MAX;
     // Tuning::searchRadiiPerSubmission sets it for tests and benchmarks).
@@ -117,6 +131,9 @@ public:
     // Before any radius: kTailScanStartWorkGpu (0: never), also on a CPU
     // device; Tuning::tailScanStartWork sets it (tests, benchmarks).
     uint64_t tailScanStartWork = kTailScanStartWorkGpu;
+    // The sweep's work limit: kSweepWorkGpu or kSweepWorkCpuDevice;
+    // Tuning::sweepWork sets it (0: never).
+    uint64_t sweepWork = kSweepWorkGpu;
 
     // Records the search of one radius: the level's boxes grown by the
     // radius, the BLAS refitted (same level) or rebuilt, one ray per active

@@ -45,6 +45,7 @@
 #include "search.rmiss.h"
 #include "search_advance.comp.h"
 #include "search_rq.comp.h"
+#include "sweep_targets.comp.h"
 #include "tail_scan.comp.h"
 
 namespace rthdist::gpu {
@@ -93,6 +94,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_tail_scan_comp, "tail_scan"},
     {k_spv_cert_scan_comp, "cert_scan"},
     {k_spv_cert_witness_comp, "cert_witness"},
+    {k_spv_sweep_targets_comp, "sweep_targets"},
 }};
 
 }  // namespace

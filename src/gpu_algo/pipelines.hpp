@@ -47,6 +47,7 @@ enum class Kernel : uint32_t {
     kTailScan,       // the candidate search's far tail: whole levels scanned (tail_scan.comp)
     kCertScan,       // the certificate's brute force over a direction's targets (cert_scan.comp)
     kCertWitness,    // and of the witness alone, with the final self-check (cert_witness.comp)
+    kSweepTargets,   // the search's sweep: few open queries against every target (sweep_targets.comp)
     kCount
 };
 

@@ -3,7 +3,8 @@
 // appended, sized by the device (indirect dispatch), with the early break;
 // then every active query resolved: exact, dead, or on to the next radius.
 // The search's far tail skips the rays: every open query scans all cells of
-// one level (tail_scan.comp) and is then settled.
+// one level (tail_scan.comp), or every target (sweep_targets.comp), and is
+// then settled.
 #pragma once
 
 #include "gpu_algo/direction.hpp"
@@ -29,6 +30,11 @@ public:
     // workgroup per query: numActive at most the device's maxGroupsX.
     void cmdTailScan(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool coarse,
                      uint32_t numActive);
+
+    // Records the sweep: each of the numActive open queries against every
+    // target of the direction (sweep_targets.comp), then all are resolved at
+    // radius +inf (exact or dead; none goes on).
+    void cmdSweep(VkCommandBuffer cmd, DirectionRun& d, uint32_t numActive);
 
 private:
     // Every active query resolved at `radius` (resolve.comp): exact, dead,

@@ -288,6 +288,83 @@ TEST(GpuEngine, TailScanEqualsRadiiAndBruteForce) {
     EXPECT_GT(scannedWhole, 0u);
 }
 
+// A dense cluster with one stray point far from it in each set (a LiDAR
+// scan with one stray return): the stray's search is the sweep.
+OracleCase farClusterCase(uint64_t seed, size_t n, double gap) {
+    OracleCase c{"far-cluster-" + std::to_string(seed), seed, uniformCloud(n, seed, glm::vec3(0.0f), 2e-3f),
+                 uniformCloud(n, seed + 1, glm::vec3(0.0f), 2e-3f)};
+    c.a.push_back(glm::vec3(float(gap), 0.25f, -0.5f));
+    c.b.push_back(glm::vec3(-0.5f, float(-gap * 0.8), 1.0f));
+    return c;
+}
+
+// The sweep (CandidateSearch::sweepWork: every open query against every
+// target, no rays) gives the brute force's distances and the radii's
+// results: for a far cluster with strays (the default limit takes it, in a
+// few submissions), for far outliers per point and for H alone, with every
+// target doubled (ties: the smallest index), and with the sweep taking every
+// query the neighbourhood pass left.
+TEST(GpuEngine, SweepEqualsRadiiAndBruteForce) {
+    std::string whyNot;
+    std::optional<Engine> radiiOnly = makeEngine(tunedOptions([](Tuning& t) {
+                                                     t.tailScanWork = 0;
+                                                     t.tailScanStartWork = 0;
+                                                 }),
+                                                 whyNot);
+    std::optional<Engine> always = makeEngine(tunedOptions([](Tuning& t) { t.sweepWork = uint64_t(1) << 40; }), whyNot);
+    std::optional<Engine> byDefault = makeEngine(tunedOptions([](Tuning& t) { t.sweepWork.reset(); }), whyNot);
+    if (!radiiOnly || !always || !byDefault) GTEST_SKIP() << "no device for this backend: " << whyNot;
+    std::vector<OracleCase> cases{farClusterCase(71, 3000, 3000.0), farClusterCase(72, 2000, 40.0)};
+    for (uint64_t seed = 73; seed < 76; ++seed) {
+        OracleCase c{"outliers-" + std::to_string(seed), seed, uniformCloud(3000, seed, glm::vec3(0.0f)),
+                     uniformCloud(2500, seed + 20, glm::vec3(0.2f, 0.05f, 0.0f))};
+        const std::vector<glm::vec3> far = uniformCloud(40, seed + 10, glm::vec3(-30.0f), 60.0f);
+        c.a.insert(c.a.end(), far.begin(), far.end());
+        if (seed == 74) {
+            const std::vector<glm::vec3> copies = c.b;
+            c.b.insert(c.b.end(), copies.begin(), copies.end());
+        }
+        cases.push_back(std::move(c));
+    }
+    uint64_t sweptByDefault = 0;
+    for (const OracleCase& c : cases) {
+        SCOPED_TRACE(c.name);
+        for (bool perPoint : {false, true}) {
+            CallOptions call;
+            call.perPointDistances = perPoint;
+            auto r = radiiOnly->compute(c.a, c.b, call);
+            ASSERT_TRUE(r.ok()) << r.error().message;
+            EXPECT_EQ(r->aToB.counters.tailScanned + r->bToA.counters.tailScanned, 0u);
+            for (Engine* e : {&*always, &*byDefault}) {
+                auto t = e->compute(c.a, c.b, call);
+                ASSERT_TRUE(t.ok()) << t.error().message;
+                for (const Directed* d : {&t->aToB, &t->bToA}) {
+                    // The search's own answer was proven (no CPU recomputation).
+                    EXPECT_TRUE(d->certificate.confirmed);
+                    EXPECT_FALSE(d->certificate.recomputed) << d->certificate.failure;
+                    if (e == &*always) EXPECT_EQ(d->counters.tailScanned, d->counters.survivingQueries);
+                    if (e == &*byDefault && c.name.starts_with("far-cluster")) sweptByDefault += d->counters.tailScanned;
+                }
+                expectMatchesOracle(c, *t);
+                EXPECT_EQ(t->hausdorff, r->hausdorff);
+                EXPECT_EQ(t->aToB.distance, r->aToB.distance);
+                EXPECT_EQ(t->aToB.queryIndex, r->aToB.queryIndex);
+                EXPECT_EQ(t->aToB.targetIndex, r->aToB.targetIndex);
+                EXPECT_EQ(t->bToA.distance, r->bToA.distance);
+                EXPECT_EQ(t->bToA.targetIndex, r->bToA.targetIndex);
+                if (perPoint) {
+                    EXPECT_EQ(t->aNearest.distance, oracle::bruteForceNearest(c.a, c.b));
+                    EXPECT_EQ(t->bNearest.distance, oracle::bruteForceNearest(c.b, c.a));
+                    EXPECT_EQ(t->aNearest.nearest, r->aNearest.nearest);
+                    EXPECT_EQ(t->bNearest.nearest, r->bNearest.nearest);
+                }
+                EXPECT_EQ(t->validationMessages, 0u);
+            }
+        }
+    }
+    EXPECT_GT(sweptByDefault, 0u);
+}
+
 // Per-point arrays handed back (Engine::recycle), of other sizes and
 // holding stale values, are filled whole by the next call: the same
 // distances and nearest points as fresh arrays and the brute force, for a

@@ -28,6 +28,9 @@ inline Options gpuOptions() {
     o.validation = true;
     o.tuning = tuningFromEnvironment();
     o.tuning->smallPairWork = 0;
+    // The rays stay under test: the sweep (few open queries against every
+    // target) has suites of its own (GpuEngine.Sweep*).
+    o.tuning->sweepWork = 0;
     return o;
 }
 
