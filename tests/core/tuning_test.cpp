@@ -14,13 +14,15 @@ TEST(Tuning, EveryVariableLandsInItsField) {
         c("RTHDIST_SEARCH_TAIL", "0"), d("RTHDIST_TAIL_SCAN_WORK", "12345"),
         e("RTHDIST_TAIL_SCAN_START", "4294967296"), f("RTHDIST_HOST_IMPORT", "1"),
         g("RTHDIST_DEBUG_LABELS", "yes"), h("RTHDIST_SUBMIT_TRACE", "1"), i("RTHDIST_FENCE_SPIN_US", "7"),
-        j("RTHDIST_POOL_SPIN_US", "0"), k("RTHDIST_CACHE_DIR", "/tmp/rthdist-tuning-test");
+        j("RTHDIST_POOL_SPIN_US", "0"), k("RTHDIST_CACHE_DIR", "/tmp/rthdist-tuning-test"),
+        l("RTHDIST_SWEEP_WORK", "99");
     const Tuning t = tuningFromEnvironment();
     EXPECT_EQ(t.smallPairWork, 0u);
     EXPECT_EQ(t.searchRadiiPerSubmission, 3u);
     EXPECT_EQ(t.squaredTailGrowth, false);
     EXPECT_EQ(t.tailScanWork, 12345u);
     EXPECT_EQ(t.tailScanStartWork, uint64_t(1) << 32);
+    EXPECT_EQ(t.sweepWork, 99u);
     EXPECT_TRUE(t.hostImport);
     EXPECT_TRUE(t.debugLabels);
     EXPECT_TRUE(t.traceSubmits);
@@ -35,13 +37,14 @@ TEST(Tuning, UnsetOrUnparsableLeavesTheLibrarysChoice) {
         e("RTHDIST_TAIL_SCAN_START", ""), f("RTHDIST_HOST_IMPORT", "yes"), g("RTHDIST_DEBUG_LABELS", "0"),
         h("RTHDIST_SUBMIT_TRACE", nullptr), i("RTHDIST_FENCE_SPIN_US", "12us"),
         j("RTHDIST_POOL_SPIN_US", nullptr), k("RTHDIST_CACHE_DIR", nullptr), l("XDG_CACHE_HOME", "/tmp/xdg"),
-        m("HOME", "/tmp/home");
+        m("HOME", "/tmp/home"), n("RTHDIST_SWEEP_WORK", "x");
     const Tuning t = tuningFromEnvironment();
     EXPECT_FALSE(t.smallPairWork);
     EXPECT_FALSE(t.searchRadiiPerSubmission);
     EXPECT_FALSE(t.squaredTailGrowth);
     EXPECT_FALSE(t.tailScanWork);
     EXPECT_FALSE(t.tailScanStartWork);
+    EXPECT_FALSE(t.sweepWork);
     EXPECT_FALSE(t.hostImport);
     EXPECT_FALSE(t.debugLabels);
     EXPECT_FALSE(t.traceSubmits);
