@@ -3,11 +3,21 @@
 // Neighbourhood pass (before any ray): exact NN of each query within the
 // 3x3x3 block of target cells around its own cell. A target outside the block
 // is at least dOut away (distance from q to the block's faces, minus epsilon),
-// so a minimum m <= dOut is the exact NN, provided every cell of the block was
-// scanned: a cell of more than scanMax points contributes only its first
-// point (bounded work per query; the candidate search settles the query), and
-// a minimum of 0 is exact whatever was skipped. A point strictly closer than the
-// running maximum kills the query at once (early break, Taha & Hanbury 2015).
+// so a minimum m <= dOut is the exact NN, provided every point of the block
+// nearer than m was scanned:
+// - the own cell first, then the neighbours; a neighbour whose box (grown by
+//   epsilon, as dOut is shrunk) is farther than the running best holds no
+//   nearer point and is skipped;
+// - a crowded cell (more than scanMax points: a split index's cell) is
+//   scanned through its leaves (leaf_first.comp finds the first), each
+//   skipped when its tight box is farther than the running best (float
+//   rounding is monotone: scan_cells.glsl); one of more than leafScanMax
+//   leaves, or any crowded cell of an index without leaves (copies of one
+//   point), contributes what was scanned (its first point at least) and
+//   the query is left to the candidate search;
+// a minimum of 0 is exact whatever was skipped. A point strictly closer than
+// the running maximum kills the query at once (early break, Taha & Hanbury
+// 2015).
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CullPush pc; };
@@ -40,12 +50,43 @@ void main() {
         ivec3 cc = c + ivec3(m % 3, (m / 3) % 3, m / 9) - 1;
         if (any(lessThan(cc, ivec3(0))) || any(greaterThanEqual(cc, ivec3(cpa)))) continue;
         if (pc.mutant != 0u && j == 0) continue;  // tests only: a search that misses candidates
+        if (j > 0) {  // a neighbour farther than the best holds no nearer point
+            vec3 lo = origin + vec3(cc) * s - pc.epsilon;
+            if (boxDist2(q, lo, lo + (s + 2.0 * pc.epsilon)) > best) continue;
+        }
         uint key = mortonKey(uvec3(cc));
         uint end = uintAt(dense, key).v;
         uint start = key == 0 ? 0u : uintAt(dense, key - 1).v;
+        if (end - start > pc.scanMax && pc.leafFirst != 0ul) {
+            // A crowded cell of a split index: its leaves near q.
+            uint scanned = 0u;
+            for (uint l = uintAt(pc.leafFirst, key).v; l < pc.numLeaves && !dead; ++l) {
+                Cell leaf = cellAt(pc.leaves, l).v;
+                if (leaf.first >= end) break;
+                if (++scanned > pc.leafScanMax) {
+                    complete = false;
+                    break;
+                }
+                if (boxDist2(q, leaf.lo, leaf.hi) > best) continue;
+                uint leafEnd = all(equal(leaf.lo, leaf.hi)) ? leaf.first + 1u : leaf.first + leaf.count;
+                for (uint t = leaf.first; t < leafEnd; ++t) {
+                    vec4 tv = vec4At(targets, t).v;
+                    float d2 = dist2(q, tv.xyz);
+                    uint t_ = floatBitsToUint(tv.w);
+                    if (d2 < best || (d2 == best && t_ < bestT)) {
+                        best = d2;
+                        bestT = t_;
+                    }
+                }
+                if (best < thr) dead = true;
+            }
+            if (!dead && j == 0) thr = deadThreshold(maxPacked, pc.lowerBound2);
+            continue;
+        }
         if (end - start > pc.scanMax) {
-            // A crowded cell (the index split it into leaves for the search):
-            // its first point still bounds the query, the rest is left to it.
+            // A crowded cell without leaves (copies of one point, or a
+            // bounded pass): its first point still bounds the query, the
+            // rest is left to the search.
             complete = false;
             end = start + 1u;
         }

@@ -236,6 +236,20 @@ struct CullPush {
     uint scanMax;       // a cell of more points is not scanned (only its first point):
                         // the query then cannot be settled by this pass
     uint mutant;        // tests only (core/search_mutant.hpp): 1 = skip the query's own cell
+    uint numLeaves;     // leaves of a split index (0: not split)
+    uint64_t leaves;    // Cell[numLeaves] (a split index's cells), 0: not split
+    uint64_t leafFirst; // uint per key: the first leaf of an occupied crowded cell
+    uint leafScanMax;   // a crowded cell of more leaves is not scanned whole
+    uint pad0;
+};
+
+// leaf_first.comp: the first leaf of each grid cell of a split index.
+struct LeafFirstPush {
+    uint64_t leaves;      // Cell[numLeaves]
+    uint64_t sortedKeys;  // grid key per sorted point
+    uint64_t leafFirst;   // uint per grid key (out)
+    uint numLeaves;
+    uint pad0;
 };
 
 // coarsen.comp: search cells of level j (edge s * 2^j) from those of level
@@ -549,6 +563,7 @@ static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDI
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
 static_assert(sizeof(TailScanPush) == 80);
 static_assert(sizeof(SweepPush) == 40);
+static_assert(sizeof(CullPush) <= 128 && sizeof(LeafFirstPush) == 32);
 static_assert(sizeof(CheckPush) == 112 && offsetof(CheckPush, nearestOut) == 88);
 static_assert(sizeof(CertScanPush) == 40);
 static_assert(sizeof(CertWitnessPush) == 64);

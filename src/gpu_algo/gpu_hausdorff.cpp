@@ -418,6 +418,8 @@ struct GpuHausdorff::State {
 GpuHausdorff::GpuHausdorff(std::unique_ptr<State> state) : m_state(std::move(state)) {}
 GpuHausdorff::~GpuHausdorff() = default;
 
+void GpuHausdorff::setCullLeafScanMax(uint32_t leaves) { m_state->ws.cullLeafScanMax = leaves; }
+
 void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
     m_state->ws.maxPairCapacity = std::max<uint64_t>(1, pairs);
 }

@@ -135,6 +135,10 @@ public:
     // Caps the candidate-pair buffer (default 2^26 pairs); tests shrink it
     // so that queries must retry until their pairs fit.
     void setMaxPairCapacity(uint64_t pairs);
+    // Leaves of a crowded cell the neighbourhood pass scans at most (default
+    // kCullLeafScanMax); tests set 0 (a crowded cell gives its first point
+    // only) so that crowded queries reach the search.
+    void setCullLeafScanMax(uint32_t leaves);
     // Frees the scratch buffers and acceleration structures kept between
     // one-shot calls (the next call allocates them again). Out-of-core calls
     // free one direction's before the other's. Prepared sets keep theirs.

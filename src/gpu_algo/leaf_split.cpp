@@ -99,7 +99,14 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
     ix.split = true;
     const float edge = std::bit_cast<float>(m_ws.counters().minEdge);
     ix.minEdge = std::isfinite(edge) ? double(edge) : 0.0;
+    // The first leaf of each grid cell, for the neighbourhood pass (its keys:
+    // the grid's, every occupied one written).
+    ix.leafFirst =
+        &m_ws.setBuffer(ix, ix.store->leafFirst, ".leafFirst", VkDeviceSize(1u << (3 * ix.grid.bits)) * 4);
     VkCommandBuffer cmd = m_ws.ctx.begin();
+    const sh::LeafFirstPush lp{ix.cells->address(), ix.sortedKeys->address(), ix.leafFirst->address(),
+                               ix.numCells, 0u};
+    m_ws.dispatch(cmd, Kernel::kLeafFirst, lp, ix.numCells);
     cmdCheckIndex(cmd, ix, m_ws.blocks[0]);
     m_ws.ctx.submitAndWait(cmd);
     verifyIndex(ix, ix.n, m_ws.blocks[0]);

@@ -29,6 +29,7 @@
 #include "grow_boxes.comp.h"
 #include "ingest.comp.h"
 #include "ingest_f64.comp.h"
+#include "leaf_first.comp.h"
 #include "leaf_keys.comp.h"
 #include "leaf_scatter.comp.h"
 #include "leaf_slots.comp.h"
@@ -95,6 +96,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_cert_scan_comp, "cert_scan"},
     {k_spv_cert_witness_comp, "cert_witness"},
     {k_spv_sweep_targets_comp, "sweep_targets"},
+    {k_spv_leaf_first_comp, "leaf_first"},
 }};
 
 }  // namespace

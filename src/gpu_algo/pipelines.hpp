@@ -48,6 +48,7 @@ enum class Kernel : uint32_t {
     kCertScan,       // the certificate's brute force over a direction's targets (cert_scan.comp)
     kCertWitness,    // and of the witness alone, with the final self-check (cert_witness.comp)
     kSweepTargets,   // the search's sweep: few open queries against every target (sweep_targets.comp)
+    kLeafFirst,      // a split index's first leaf per grid cell (leaf_first.comp)
     kCount
 };
 

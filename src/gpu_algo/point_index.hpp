@@ -38,6 +38,10 @@ namespace sh = rthdist::shared;
 // work per query depends on how many points share a grid cell. (The Dragon's
 // fullest cell holds 134 points; even data stays on the grid path.)
 inline constexpr uint32_t kCrowdedCell = 512;
+// The neighbourhood pass scans a crowded cell through its leaves (those whose
+// box is nearer than the query's best) while it has at most this many; past
+// it the cell contributes what it scanned and the query is left to the rays.
+inline constexpr uint32_t kCullLeafScanMax = 1024;
 inline constexpr uint32_t kLeafMax = RTHDIST_LEAF_MAX;
 // Each round narrows a leaf >= 2x per axis; past it: bigger leaves.
 inline constexpr int kMaxSplitRounds = 12;
@@ -52,6 +56,7 @@ struct PointIndex;
 struct SetBuffers {
     Buffer sorted, sortedKeys, dense, cells;
     Buffer sorted2, sortedKeys2, leaves0, leaves1;  // the leaf split's ping-pong
+    Buffer leafFirst;                               // a split index's first leaf per grid key
     struct Level {
         Buffer cells, fineFirst;
     };
@@ -69,6 +74,7 @@ struct PointIndex {
     core::Bounds bounds;
     Buffer* sorted = nullptr;  // vec4: xyz, w = original index bits (cell order)
     Buffer* dense = nullptr;   // uint per key: end of the key's cell
+    Buffer* leafFirst = nullptr;  // split: uint per key, the first leaf of the key's cell
     Buffer* cells = nullptr;   // Cell per occupied cell
     uint32_t numCells = 0;
     uint64_t cellCapacity = 0;                // room of `cells` at the build: min(n, keys)

@@ -90,6 +90,7 @@ struct Workspace {
     Buffer hostSmall;                    // the counter blocks (RTHDIST_CTR_*), read-backs after each
     std::array<CounterBlock, 2> blocks;  // blocks[0]: every stage; [1]: a second index build
     uint64_t maxPairCapacity = kMaxPairCapacity;
+    uint32_t cullLeafScanMax = kCullLeafScanMax;  // 0: crowded cells give their first point only
     bool mutant = false;  // tests only: core::searchMutant() when the call started
     Timings* timings = nullptr;
     // Buffers live across calls and only grow: allocation is a large share of
