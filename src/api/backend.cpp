@@ -48,10 +48,6 @@ std::vector<Result<HausdorffResult>> ComputeBackend::scanPrepared(std::span<cons
     return std::vector<Result<HausdorffResult>>(pairs.size(), notOffered("small-pair scan"));
 }
 
-std::optional<Error> ComputeBackend::checkDeviceView(const DevicePointView&, const char*) const {
-    return notOffered("device views");
-}
-
 Result<HausdorffResult> ComputeBackend::computeDeviceViews(const DevicePointView&, const DevicePointView&,
                                                            const CallOptions&) {
     return notOffered("device views");

@@ -86,10 +86,9 @@ public:
     [[nodiscard]] virtual std::vector<Result<HausdorffResult>> scanPrepared(
         std::span<const BackendSetPair> pairs, const CallOptions& call);
 
-    // Route::kDeviceViews and sets prepared from device views (caps().noDeviceViews empty).
-    // The view's checks against the contract's limits (device_views.hpp), kInvalidArgument naming `name`.
-    [[nodiscard]] virtual std::optional<Error> checkDeviceView(const DevicePointView& view,
-                                                               const char* name) const;
+    // Route::kDeviceViews and sets prepared from device views (caps().noDeviceViews
+    // empty), of views that passed api::checkDeviceView (device_views.hpp: the
+    // Engine checks each view once, before the backend sees it).
     [[nodiscard]] virtual Result<HausdorffResult> computeDeviceViews(const DevicePointView& a,
                                                                      const DevicePointView& b,
                                                                      const CallOptions& call);

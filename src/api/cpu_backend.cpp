@@ -44,12 +44,12 @@ public:
     }
 
     [[nodiscard]] Result<HausdorffResult> computeFramed(int /*lane*/, std::span<const glm::vec3> a,
-                                                        std::span<const glm::vec3> b, double /*scale*/,
+                                                        std::span<const glm::vec3> b, double scale,
                                                         const CallOptions& call) override {
         Options options;
         static_cast<CallOptions&>(options) = call;
         static_cast<EngineOptions&>(options) = m_options;
-        return cpu::cpuHausdorff(a, b, options);
+        return cpu::cpuHausdorff(a, b, scale, options);
     }
 
     [[nodiscard]] Result<std::shared_ptr<BackendSet>> prepare(std::span<const glm::vec3> floats, double scale,

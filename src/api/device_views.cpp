@@ -5,6 +5,7 @@
 #include "api/out_of_core.hpp"
 #include "gpu/device_requirements.hpp"
 #include "gpu/vk_struct.hpp"
+#include "gpu_algo/set_points.hpp"
 
 namespace rthdist {
 
@@ -47,8 +48,7 @@ Result<VulkanDeviceSetup> vulkanDeviceSetup(VkPhysicalDevice pd, Backend backend
 
 namespace api {
 
-Result<gpu_algo::DeviceInput> checkDeviceView(const DevicePointView& view, const char* name,
-                                              VkDevice device) {
+std::optional<Error> checkDeviceView(const DevicePointView& view, const char* name) {
     const std::string set = std::string("device view ") + name + ": ";
     const VkDeviceSize scalar = scalarBytes(view.scalar);
     const auto refuse = [&](const std::string& why) { return Error{ErrorCode::kInvalidArgument, set + why}; };
@@ -70,6 +70,10 @@ Result<gpu_algo::DeviceInput> checkDeviceView(const DevicePointView& view, const
         return refuse("offset " + std::to_string(view.offset) + " + (count - 1) * strideBytes + 3 scalars (" +
                       std::to_string(span) + " bytes) is past bufferBytes " +
                       std::to_string(view.bufferBytes));
+    return std::nullopt;
+}
+
+gpu_algo::DeviceInput deviceInputOf(const DevicePointView& view, VkDevice device) {
     VkBufferDeviceAddressInfo info =
         gpu::vkStruct<VkBufferDeviceAddressInfo>(VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO);
     info.buffer = view.buffer;

@@ -18,6 +18,7 @@
 
 #include "api/backend.hpp"
 #include "api/certify.hpp"
+#include "api/device_views.hpp"
 #include "api/out_of_core.hpp"
 #include "api/route_planner.hpp"
 #include "core/index_space.hpp"
@@ -557,8 +558,8 @@ Result<HausdorffResult> Engine::compute(const DevicePointView& a, const DevicePo
     // A backend that reads no device views, before the call's own checks; the budget after them.
     if (plan.route == api::Route::kRefused && plan.code != ErrorCode::kOutOfMemory) return refusal(plan);
     if (auto err = validateCallOptions(call)) return *err;
-    if (auto err = m_impl->backend->checkDeviceView(a, "A")) return *err;
-    if (auto err = m_impl->backend->checkDeviceView(b, "B")) return *err;
+    if (auto err = api::checkDeviceView(a, "A")) return *err;
+    if (auto err = api::checkDeviceView(b, "B")) return *err;
     if (plan.route == api::Route::kRefused) return refusal(plan);
     // The host cannot read device views: the device's own proof stands, or the call fails.
     Frame frame;
@@ -577,6 +578,7 @@ Result<PreparedSet> Engine::prepare(const DevicePointView& points, const Prepare
     if (options.origin)
         if (auto err = core::checkOrigin(*options.origin, "PrepareOptions::origin")) return *err;
     const std::string name = "set#" + std::to_string(++m_impl->preparedCount);
+    if (auto err = api::checkDeviceView(points, "to prepare")) return *err;
     Result<api::DeviceViewSet> g =
         m_impl->backend->prepareDeviceView(points, options.origin, options.bits, name);
     if (!g) return g.error();

@@ -143,30 +143,18 @@ public:
         return gpu().computeSmallPairs(sets, call);
     }
 
-    [[nodiscard]] std::optional<Error> checkDeviceView(const DevicePointView& view,
-                                                       const char* name) const override {
-        Result<gpu_algo::DeviceInput> in = api::checkDeviceView(view, name, first().context->device());
-        if (!in) return in.error();
-        return std::nullopt;
-    }
     [[nodiscard]] Result<HausdorffResult> computeDeviceViews(const DevicePointView& a,
                                                              const DevicePointView& b,
                                                              const CallOptions& call) override {
         const VkDevice device = first().context->device();
-        Result<gpu_algo::DeviceInput> da = api::checkDeviceView(a, "A", device);
-        if (!da) return da.error();
-        Result<gpu_algo::DeviceInput> db = api::checkDeviceView(b, "B", device);
-        if (!db) return db.error();
-        return gpu().computeDevice(*da, *db, call);
+        return gpu().computeDevice(deviceInputOf(a, device), deviceInputOf(b, device), call);
     }
     [[nodiscard]] Result<DeviceViewSet> prepareDeviceView(const DevicePointView& points,
                                                           const std::optional<glm::dvec3>& origin, int bits,
                                                           const std::string& name) override {
-        Result<gpu_algo::DeviceInput> view =
-            api::checkDeviceView(points, "to prepare", first().context->device());
-        if (!view) return view.error();
         Timings timings;
-        auto g = gpu().prepareDevice(*view, origin, bits, name, timings);
+        auto g = gpu().prepareDevice(deviceInputOf(points, first().context->device()), origin, bits, name,
+                                     timings);
         if (!g) return g.error();
         return DeviceViewSet{std::make_shared<GpuSet>(std::move(g->set)), g->summary, g->origin};
     }

@@ -605,8 +605,11 @@ Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const Call
         material->bToA = ba->band;
     }
     // The certificate of the whole from the pieces' bands, on the float sets
-    // the pieces searched (core::restoreOriginal proves it again from the
-    // caller's coordinates when they differ).
+    // the pieces searched: what a backend's own certificate pass is to one
+    // call (the merged witness carries a piece's proof until then). The
+    // result is still in the search frame; the Engine leaves it as every
+    // route's (engine.cpp, leaveFrame: core::restoreOriginal proves it again
+    // from the caller's coordinates when they differ).
     r.proofMaterial = std::move(material);
     core::proveFromViews(r, PointView(a), PointView(b), threads);
     return r;

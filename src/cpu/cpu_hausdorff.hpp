@@ -88,7 +88,14 @@ private:
 [[nodiscard]] Result<HausdorffResult> cpuHausdorff(const CpuSet& a, const CpuSet& b,
                                                    const CallOptions& options, int threads);
 
-// One-shot: both sets prepared for this call.
+// One-shot: both sets prepared for this call at `scale`, the exact power of
+// two of the pair's frame (core::exactScale of the largest coordinate
+// magnitude of both; the Engine decides it once per call).
+[[nodiscard]] Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                                   double scale, const Options& options);
+
+// One-shot at the scale of the shared rule over both sets (core::exactScale
+// of their largest magnitude, a pass over the points).
 [[nodiscard]] Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                    const Options& options);
 

@@ -17,29 +17,23 @@ static_assert(2 * RTHDIST_SEARCH_LOG_MAX + 2 < gpu::Context::kTimestampSlots);
 
 CandidateSearch::CandidateSearch(Workspace& workspace, IndexBuild& indexBuild, Refinement& refinement,
                                  QueryCheck& check)
-    : m_ws(workspace), m_index(indexBuild), m_refine(refinement), m_check(check) {
-    const Tuning& t = m_ws.tuning;
-    if (t.searchRadiiPerSubmission)
-        radiiPerSubmission = std::clamp<uint32_t>(*t.searchRadiiPerSubmission, 1, RTHDIST_SEARCH_LOG_MAX);
-    squaredTailGrowth = t.squaredTailGrowth.value_or(true);
-    tailScanWork = t.tailScanWork.value_or(m_ws.ctx.cpuDevice() ? kTailScanWorkCpuDevice : kTailScanWorkGpu);
-    tailScanStartWork = t.tailScanStartWork.value_or(kTailScanStartWorkGpu);
-    sweepWork = t.sweepWork.value_or(m_ws.ctx.cpuDevice() ? kSweepWorkCpuDevice : kSweepWorkGpu);
-}
+    : m_schedule(
+          scheduleSettings(workspace.tuning, workspace.ctx.cpuDevice(), workspace.ctx.limits().maxGroupsX)),
+      m_ws(workspace),
+      m_index(indexBuild),
+      m_refine(refinement),
+      m_check(check) {}
+
+namespace {
+
+SearchGrid searchGridOf(const PointIndex& T) { return {T.grid.cellSize, T.grid.bits, T.split, T.minEdge}; }
+
+}  // namespace
 
 void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallOptions& options,
                                 double progressFrom, double progressTo) {
     PointIndex& T = d.T;
-    // Small first radius, grown geometrically: measured against starting
-    // at the threshold's root, which makes every ray visit far more boxes
-    // (docs/bench/gpu.md, growth sweep).
-    double radius = 2.0 * T.grid.cellSize;
-    // Leaves: start at half the narrowest split sub-cell's edge, about the
-    // nearest-neighbour spacing of ~8 points per sub-cell (measured on
-    // lavapipe, cluster + outlier: 2x the edge made rays visit ~4x more
-    // leaves, 1/4 cost an iteration); the growth reaches the grid's scale
-    // in a few iterations.
-    if (T.split && T.minEdge > 0.0) radius = std::min(radius, 0.5 * T.minEdge);
+    RadiusSchedule schedule(searchGridOf(T), m_schedule, double(options.radiusGrowth), numActive, d.Q.n);
     // Room for ~4 pairs per cell, or per query when a split index sends
     // the crowded regions' queries to the search (a full buffer costs a
     // repeated iteration).
@@ -48,22 +42,12 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
         std::min(std::clamp<uint64_t>(pairBase * 4, 1u << 16, 1u << 22), m_ws.maxPairCapacity);
     Buffer* pairs = nullptr;
     int builtLevel = -1;  // level of the BLAS now built (-1: none yet)
-    // Radii per submission: 2, doubled while most queries go on (a radius
-    // recorded after the search ended costs a BLAS refit, ~a submission's
-    // overhead on an H100: docs/bench/prepared).
-    uint32_t chunk = 2;
-    // The radius's growth per step: options.radiusGrowth, squared for a tail
-    // of far queries (tailStep below).
-    const double growth = double(options.radiusGrowth);
-    double step = growth;
-    const uint32_t searched = numActive;
-    bool traced = false;  // a submission of radii has run
     while (numActive > 0) {
         if (!pairs) {
             pairs = &m_ws.grow(m_ws.scratch.search.pairs, pairCapacity * 8, "pairs");
             pairCapacity = std::min<uint64_t>(pairs->size() / 8, m_ws.maxPairCapacity);
         }
-        if (uint64_t(numActive) * T.n <= sweepWork) {
+        if (schedule.sweeps(numActive, T.n)) {
             const RadiiOutcome out =
                 runRadii(d, 0, false, {}, *pairs, pairCapacity, numActive, SearchStep::kSweep);
             if (out.stillOpen != 0) throw std::runtime_error("candidate search: the sweep left queries open");
@@ -71,8 +55,7 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
             d.out.counters.tailScanned += numActive;
             break;
         }
-        const int tail = traced ? tailScanLevel(T, numActive, searched, tailScanWork)
-                                : tailScanLevel(T, numActive, d.Q.n, tailScanStartWork);
+        const int tail = tailScanLevel(schedule, T, numActive);
         if (tail >= 0) {
             const RadiiOutcome out =
                 runRadii(d, tail, false, {}, *pairs, pairCapacity, numActive, SearchStep::kTailScan);
@@ -82,16 +65,12 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
             d.out.counters.tailScanned += numActive;
             break;
         }
-        traced = true;
-        const int level = IndexBuild::searchLevelFor(T, radius);
-        const std::vector<double> radii = radiiAtLevel(T, radius, step, chunk);
+        const int level = schedule.level();
+        const std::vector<double> submitted = schedule.nextRadii();
         const RadiiOutcome out =
-            runRadii(d, level, level == builtLevel, radii, *pairs, pairCapacity, numActive);
-        chunk = 2 * uint64_t(out.stillOpen) > numActive
-                    ? std::min<uint32_t>(2 * chunk, RTHDIST_SEARCH_LOG_MAX)
-                    : 2;
+            runRadii(d, level, level == builtLevel, submitted, *pairs, pairCapacity, numActive);
+        schedule.advance(submitted, numActive, out);
         builtLevel = level;
-        step = squaredTailGrowth ? tailStep(growth, searched, numActive, out.stillOpen) : growth;
         d.out.counters.iterations += out.run;
         if (d.out.counters.iterations > kMaxIterations)
             throw std::runtime_error("candidate search did not converge");
@@ -102,10 +81,7 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
                 (progressTo - progressFrom) *
                     (0.2 + 0.8 * (1.0 - double(numActive) /
                                             double(std::max<uint64_t>(1, d.out.counters.survivingQueries)))));
-        radius = radii[out.run - 1];
-        if (!out.overflowed) {
-            radius *= step;
-        } else if (pairCapacity < m_ws.maxPairCapacity) {
+        if (out.overflowed && pairCapacity < m_ws.maxPairCapacity) {
             // Some queries lost pairs: redo them at the same radius with room.
             pairCapacity =
                 std::min<uint64_t>(m_ws.maxPairCapacity, std::max<uint64_t>(out.lastPairs, pairCapacity * 2));
@@ -114,31 +90,9 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
     }
 }
 
-int CandidateSearch::tailScanLevel(PointIndex& T, uint32_t open, uint64_t from, uint64_t work) {
-    if (work == 0 || uint64_t(open) * 4 > from || open > m_ws.ctx.limits().maxGroupsX) return -1;
-    const int last = std::max(1, T.grid.bits - 1);
-    int level = std::max(1, int(T.levels.size()));
-    uint32_t cells = m_index.levelCells(T, level).count;  // may build it (a submission)
-    while (cells > kTailScanCells && level < last) cells = m_index.levelCells(T, ++level).count;
-    return uint64_t(open) * cells <= work ? level : -1;
-}
-
-double CandidateSearch::tailStep(double growth, uint32_t searched, uint32_t before, uint32_t after) {
-    const bool fewLeft = uint64_t(after) * 8 <= searched;
-    const bool mostGoOn = 2 * uint64_t(after) > before;
-    return fewLeft && mostGoOn ? growth * growth : growth;
-}
-
-std::vector<double> CandidateSearch::radiiAtLevel(const PointIndex& T, double radius, double growth,
-                                                  uint32_t most) const {
-    const int level = IndexBuild::searchLevelFor(T, radius);
-    std::vector<double> radii{radius};
-    while (radii.size() < std::min(most, radiiPerSubmission)) {
-        const double next = radii.back() * growth;
-        if (IndexBuild::searchLevelFor(T, next) != level) break;
-        radii.push_back(next);
-    }
-    return radii;
+int CandidateSearch::tailScanLevel(const RadiusSchedule& schedule, PointIndex& T, uint32_t open) {
+    return schedule.tailLevel(open, int(T.levels.size()),
+                              [&](int level) { return m_index.levelCells(T, level).count; });
 }
 
 RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLevel,

@@ -105,13 +105,6 @@ public:
     // below on first use (coarsen.comp: head flags, scan, build).
     const PointIndex::Level& searchLevel(PointIndex& T, int level);
 
-    // Search cells about an eighth of the radius wide: level j with
-    // s * 2^j <= R / 8, at least 1, at most bits - 1. Wider cells mean fewer
-    // boxes per ray but longer scans in the refinement; R/2 and R/4 were
-    // slower overall on the lavapipe scenarios (README). A split index
-    // searches its leaves (level 0) until level 1 is due.
-    [[nodiscard]] static int searchLevelFor(const PointIndex& T, double radius);
-
     // The search cells of `level` (0: the index's own cells or leaves).
     PointIndex::Level levelCells(PointIndex& T, int level);
 

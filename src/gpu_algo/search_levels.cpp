@@ -58,11 +58,6 @@ const PointIndex::Level& IndexBuild::searchLevel(PointIndex& T, int level) {
     return T.levels[size_t(level - 1)];
 }
 
-int IndexBuild::searchLevelFor(const PointIndex& T, double radius) {
-    const int wanted = int(std::floor(std::log2(radius / (8.0 * T.grid.cellSize))));
-    return T.split && wanted < 1 ? 0 : std::clamp(wanted, 1, std::max(1, T.grid.bits - 1));
-}
-
 PointIndex::Level IndexBuild::levelCells(PointIndex& T, int level) {
     return level > 0 ? searchLevel(T, level) : PointIndex::Level{T.cells, nullptr, T.numCells};
 }

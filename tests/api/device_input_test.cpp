@@ -457,6 +457,14 @@ TEST(DeviceInput, BadViewsAreErrors) {
         expectError(DevicePointView::doubles(emb.upload(d), d.size() * 8, 50), ErrorCode::kInvalidArgument,
                     "point set B: point 9 has a NaN or infinite");
     }
+    // The same checks, once, before a set is prepared from a view.
+    const Result<PreparedSet> prepared = engine->prepare(DevicePointView::floats(good, p.size() * 4, 101));
+    ASSERT_FALSE(prepared);
+    EXPECT_EQ(prepared.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(prepared.error().message.find("device view to prepare: "), std::string::npos)
+        << prepared.error().message;
+    EXPECT_NE(prepared.error().message.find("past bufferBytes"), std::string::npos)
+        << prepared.error().message;
     // The Engine stays usable.
     const Result<HausdorffResult> r = engine->compute(ok, ok);
     ASSERT_TRUE(r) << r.error().message;

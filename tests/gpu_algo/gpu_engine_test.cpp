@@ -191,7 +191,7 @@ TEST(GpuEngine, RadiiInOneSubmissionEqualOnePerSubmission) {
 
 // A dense cloud with a few isolated points far from the other set (a noisy
 // mask's outliers): their search is the tail whose radius grows by the
-// square of the growth (CandidateSearch::tailStep). Per-point distances and
+// square of the growth (RadiusSchedule::tailStep). Per-point distances and
 // witnesses equal those with the plain growth (Tuning::squaredTailGrowth
 // false) and
 // the brute force; the tail takes fewer radius iterations.
@@ -225,7 +225,7 @@ TEST(GpuEngine, FarTailGrowsFasterAndStaysExact) {
 }
 
 // The search's far tail scans every cell of a coarse level instead of
-// tracing more radii (CandidateSearch::tailScanLevel): the same distances as
+// tracing more radii (RadiusSchedule::tailLevel): the same distances as
 // the brute force and the same results as the radii alone, for far outliers
 // per point and for H alone (where the running maximum kills queries), with
 // every target doubled (copies), and with one bit per axis (the pair buffer

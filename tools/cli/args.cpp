@@ -23,7 +23,7 @@ Error usageError(std::string message) { return Error{ErrorCode::kInvalidArgument
 // Documented ranges of the numeric options (README "Usage", --help).
 //
 // --radius-growth: the candidate search starts at a radius of 2 cells and
-// gives up after 4096 iterations (kMaxIterations in src/gpu_algo/candidate_search.hpp),
+// gives up after 4096 iterations (kMaxIterations in src/gpu_algo/radius_schedule.hpp),
 // so growth^4096 must cover the largest possible ratio of a nearest distance
 // to a cell: at most 2^130 (float range, sqrt(3) across) over 2^-157 (a
 // subnormal extent split into 2^8 cells), 2^287 in all. 1.05^4096 = 2^288
