@@ -92,6 +92,7 @@
 #include <vector>
 
 #include "rthdist/export.hpp"
+#include "rthdist/mesh.hpp"
 #include "rthdist/point_view.hpp"
 #include "rthdist/result.hpp"
 
@@ -123,6 +124,40 @@ struct LoadOptions {
 
 [[nodiscard]] RTHDIST_IO_API Result<PointCloud> loadPointCloud(const std::string& path,
                                                                const LoadOptions& options = {});
+
+// A loaded triangle mesh (loadMesh): its vertices in the file's precision
+// (as loadPointCloud reads them) and three vertex indices per triangle.
+struct RTHDIST_IO_API TriangleMesh {
+    PointCloud vertices;
+    std::vector<uint32_t> indices;  // 3 per triangle, each below vertices.size()
+
+    [[nodiscard]] size_t triangleCount() const { return indices.size() / 3; }
+    // A view for hausdorffToSurface (rthdist/surface.hpp); valid while this
+    // mesh lives and is not modified.
+    [[nodiscard]] MeshView view() const;
+};
+
+// The faces of a mesh file with its vertices (the formats with faces):
+//   .obj  "f" lines (v, v/vt, v//vn, v/vt/vn; 1-based, negative = relative
+//         to the vertices defined so far); other lines ignored.
+//   .ply  the element "face" with a list property "vertex_indices" (or
+//         "vertex_index") of any integer type; ascii and binary.
+//   .off  the face block after the vertices ("n i0 .. in-1", colours after
+//         the indices ignored).
+//   .stl  every facet is a triangle (its three vertices, unshared).
+//   .gltf / .glb  every primitive of mode TRIANGLES, TRIANGLE_STRIP or
+//         TRIANGLE_FAN with its indices accessor (or the vertices in order),
+//         node transforms applied as for points; POINTS and LINES primitives
+//         give vertices but no triangles.
+// Polygons of n > 3 vertices are fan-triangulated (i0 i1 i2, i0 i2 i3, ...);
+// degenerate triangles (repeated or collinear vertices) are kept. Errors
+// (kBadInput, "<path>: <where>: <what>"): a vertex index out of range or
+// not an integer, and a face of fewer than 3 vertices, each naming the face
+// and its line or byte offset; a file with no triangle; a format without
+// faces (xyz, txt, pcd, las). Vertices as loadPointCloud (finite; the same
+// precision rules); more than 2^32 - 1 vertices is an error.
+[[nodiscard]] RTHDIST_IO_API Result<TriangleMesh> loadMesh(const std::string& path,
+                                                           const LoadOptions& options = {});
 
 // The points rounded to float32 (earlier releases' loader).
 [[nodiscard]] RTHDIST_IO_API Result<std::vector<glm::vec3>> loadPoints(const std::string& path);

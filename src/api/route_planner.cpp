@@ -95,8 +95,16 @@ const char* routeName(Route route) {
         case Route::kReframe: return "reframe";
         case Route::kPrepared: return "prepared";
         case Route::kDeviceViews: return "device views";
+        case Route::kSurfaceCpu: return "surface (cpu)";
     }
     return "?";
+}
+
+Plan planSurfaceRoute(Backend requested) {
+    if (requested == Backend::kCpu || requested == Backend::kAuto) return routed(Route::kSurfaceCpu);
+    return refused(ErrorCode::kInvalidArgument,
+                   std::string("point-to-surface distances run on the CPU backend for now: the ") +
+                       backendName(requested) + " backend cannot search triangles (use backend cpu or auto)");
 }
 
 Plan planFramedCall(uint64_t a, uint64_t b, const CallOptions& call, const MemoryBudget& budget,

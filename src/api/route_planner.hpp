@@ -24,6 +24,9 @@
 //   device views (Engine::compute(DevicePointView, ...)):
 //       kRefused        a backend that reads no device views, or past the budget
 //       kDeviceViews    ingested and searched on the device
+//   a point set against a triangle surface (hausdorffToSurface, planSurfaceRoute):
+//       kRefused        a GPU backend named by the caller (none searches triangles yet)
+//       kSurfaceCpu     the CPU backend's triangle BVH (api/surface.cpp)
 // The pieces of kPieces and kSeveralDevices are planned as framed pairs
 // (planFramedCall): a small piece is scanned whole.
 #pragma once
@@ -47,6 +50,7 @@ enum class Route {
     kReframe,
     kPrepared,
     kDeviceViews,
+    kSurfaceCpu,
 };
 
 [[nodiscard]] const char* routeName(Route route);
@@ -93,6 +97,13 @@ struct Plan {
 // The route of a call.
 [[nodiscard]] Plan planRoute(const PairShape& shape, const CallOptions& call, const MemoryBudget& budget,
                              const BackendCaps& caps);
+
+// The route of a point set against a triangle surface, chosen before any
+// backend is opened: Backend::kCpu and kAuto take kSurfaceCpu (the CPU
+// backend is the one that searches triangles for now, so kAuto picks it);
+// a GPU backend the caller named is kRefused with kInvalidArgument, never
+// computed on the CPU in its place.
+[[nodiscard]] Plan planSurfaceRoute(Backend requested);
 
 // The route of a pair already checked and framed on the host (float sets of
 // one frame and scale): kSmallPairScan, kOneCall, kSeveralDevices or kPieces.

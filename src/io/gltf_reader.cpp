@@ -108,7 +108,8 @@ public:
     std::optional<Error> count(const std::vector<int>& roots) {
         uint64_t total = 0;
         return walk(roots,
-                    [&](int accessor, const glm::dmat4&, const std::string& where) -> std::optional<Error> {
+                    [&](const tinygltf::Primitive&, int accessor, const glm::dmat4&,
+                        const std::string& where) -> std::optional<Error> {
                         auto view = checkedAccessor(accessor);
                         if (!view) return view.error();
                         total += view->count;
@@ -126,25 +127,35 @@ public:
     // Pass 2: the points, transformed.
     std::optional<Error> read(const std::vector<int>& roots) {
         m_points.reserve(static_cast<size_t>(m_total));
-        return walk(
-            roots, [&](int accessor, const glm::dmat4& world, const std::string&) -> std::optional<Error> {
-                auto view = checkedAccessor(accessor);
-                if (!view) return view.error();
-                for (size_t k = 0; k < view->count; ++k) {
-                    const char* p = view->base + k * view->stride;
-                    glm::dvec4 v(0.0, 0.0, 0.0, 1.0);
-                    for (int c = 0; c < 3; ++c) {
-                        const double raw = loadScalar(p + c * scalarSize(view->scalar), view->scalar, false);
-                        v[c] = view->normalized ? normalize(raw, view->scalar) : raw;
-                    }
-                    const glm::dvec4 w = world * v;
-                    m_points.emplace_back(narrowToFloat(w.x), narrowToFloat(w.y), narrowToFloat(w.z));
-                }
-                return std::nullopt;
-            });
+        return walk(roots,
+                    [&](const tinygltf::Primitive& prim, int accessor, const glm::dmat4& world,
+                        const std::string& where) -> std::optional<Error> {
+                        auto view = checkedAccessor(accessor);
+                        if (!view) return view.error();
+                        if (m_faces) {
+                            if (auto err = addTriangles(prim, view->count, where)) return err;
+                        }
+                        for (size_t k = 0; k < view->count; ++k) {
+                            const char* p = view->base + k * view->stride;
+                            glm::dvec4 v(0.0, 0.0, 0.0, 1.0);
+                            for (int c = 0; c < 3; ++c) {
+                                const double raw =
+                                    loadScalar(p + c * scalarSize(view->scalar), view->scalar, false);
+                                v[c] = view->normalized ? normalize(raw, view->scalar) : raw;
+                            }
+                            const glm::dvec4 w = world * v;
+                            m_points.emplace_back(narrowToFloat(w.x), narrowToFloat(w.y), narrowToFloat(w.z));
+                        }
+                        return std::nullopt;
+                    });
     }
 
     std::vector<glm::vec3> take() { return std::move(m_points); }
+
+    // With read(): also the triangles of every TRIANGLES, TRIANGLE_STRIP and
+    // TRIANGLE_FAN primitive, by index into the points read.
+    void collectTriangles() { m_faces = true; }
+    std::vector<uint32_t> takeTriangles() { return std::move(m_triangles); }
 
 private:
     struct AccessorView {
@@ -194,7 +205,7 @@ private:
                          m_model.meshes[static_cast<size_t>(n.mesh)].primitives) {
                         const auto it = prim.attributes.find("POSITION");
                         if (it == prim.attributes.end()) continue;
-                        if (auto err = visit(it->second, world, where)) return err;
+                        if (auto err = visit(prim, it->second, world, where)) return err;
                     }
                 }
                 for (auto child = n.children.rbegin(); child != n.children.rend(); ++child) {
@@ -205,16 +216,82 @@ private:
         return std::nullopt;
     }
 
+    // The primitive's vertex numbers in drawing order: its indices accessor
+    // (SCALAR, unsigned byte, short or int; every value below `count`), or
+    // 0 .. count - 1.
+    Result<std::vector<uint32_t>> drawOrder(const tinygltf::Primitive& prim, size_t count,
+                                            const std::string& where) const {
+        std::vector<uint32_t> order;
+        if (prim.indices < 0) {
+            order.resize(count);
+            for (size_t k = 0; k < count; ++k) order[k] = uint32_t(k);
+            return order;
+        }
+        auto view = checkedAccessor(prim.indices, TINYGLTF_TYPE_SCALAR, "indices");
+        if (!view) return view.error();
+        if (view->scalar != ScalarType::kUInt8 && view->scalar != ScalarType::kUInt16 &&
+            view->scalar != ScalarType::kUInt32) {
+            return badInput(m_path, "accessor " + std::to_string(prim.indices),
+                            "indices are not unsigned byte, short or int");
+        }
+        order.resize(view->count);
+        for (size_t k = 0; k < view->count; ++k) {
+            const double v = loadScalar(view->base + k * view->stride, view->scalar, false);
+            if (v >= double(count)) {
+                return badInput(m_path, where + ", accessor " + std::to_string(prim.indices),
+                                "face vertex " + std::to_string(k) + ": vertex index " +
+                                    std::to_string(uint64_t(v)) + " out of range (" + std::to_string(count) +
+                                    " vertices)");
+            }
+            order[k] = uint32_t(v);
+        }
+        return order;
+    }
+
+    std::optional<Error> addTriangles(const tinygltf::Primitive& prim, size_t count,
+                                      const std::string& where) {
+        const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+        if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+            mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+            return std::nullopt;  // points and lines: vertices only
+        }
+        auto order = drawOrder(prim, count, where);
+        if (!order) return order.error();
+        const auto base = uint32_t(m_points.size());
+        const std::vector<uint32_t>& o = *order;
+        if (m_triangles.size() / 3 + o.size() > kMaxGltfInstancedTriangles) {
+            return badInput(m_path, where,
+                            "the scene instances more than " + std::to_string(kMaxGltfInstancedTriangles) +
+                                " triangles (limit of this loader)");
+        }
+        auto add = [&](size_t i, size_t j, size_t k) {
+            m_triangles.insert(m_triangles.end(), {base + o[i], base + o[j], base + o[k]});
+        };
+        if (mode == TINYGLTF_MODE_TRIANGLES) {
+            for (size_t t = 0; t + 2 < o.size(); t += 3) add(t, t + 1, t + 2);
+        } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+            for (size_t t = 0; t + 2 < o.size(); ++t)
+                t % 2 == 0 ? add(t, t + 1, t + 2) : add(t + 1, t, t + 2);
+        } else {
+            for (size_t t = 1; t + 1 < o.size(); ++t) add(0, t, t + 1);
+        }
+        return std::nullopt;
+    }
+
     // The accessor's elements, every index and byte range checked.
-    Result<AccessorView> checkedAccessor(int index) const {
+    Result<AccessorView> checkedAccessor(int index, int type = TINYGLTF_TYPE_VEC3,
+                                         const char* what = "POSITION") const {
         const std::string where = "accessor " + std::to_string(index);
         if (index < 0 || static_cast<size_t>(index) >= m_model.accessors.size()) {
             return badInput(m_path, where, "index out of range");
         }
         const tinygltf::Accessor& acc = m_model.accessors[static_cast<size_t>(index)];
         if (acc.sparse.isSparse)
-            return badInput(m_path, where, "sparse POSITION accessors are not supported");
-        if (acc.type != TINYGLTF_TYPE_VEC3) return badInput(m_path, where, "POSITION is not VEC3");
+            return badInput(m_path, where, std::string("sparse ") + what + " accessors are not supported");
+        if (acc.type != type)
+            return badInput(
+                m_path, where,
+                std::string(what) + (type == TINYGLTF_TYPE_VEC3 ? " is not VEC3" : " is not SCALAR"));
         const auto scalar = componentScalar(acc.componentType);
         if (!scalar)
             return badInput(m_path, where, "unknown componentType " + std::to_string(acc.componentType));
@@ -232,9 +309,9 @@ private:
             return badInput(m_path, "bufferView " + std::to_string(acc.bufferView),
                             "byte range exceeds its buffer of " + std::to_string(data.size()) + " bytes");
         }
-        const uint64_t elementSize = 3 * scalarSize(*scalar);
+        const uint64_t elementSize = (type == TINYGLTF_TYPE_VEC3 ? 3 : 1) * scalarSize(*scalar);
         const uint64_t stride = view.byteStride != 0 ? view.byteStride : elementSize;
-        if (stride < elementSize) return badInput(m_path, where, "byteStride smaller than a VEC3");
+        if (stride < elementSize) return badInput(m_path, where, "byteStride smaller than an element");
         // All of count * stride must lie inside the view: checked before allocating.
         const uint64_t viewLength = view.byteLength;
         if (acc.byteOffset > viewLength || viewLength - acc.byteOffset < elementSize ||
@@ -252,6 +329,8 @@ private:
     const std::string& m_path;
     uint64_t m_total = 0;
     std::vector<glm::vec3> m_points;
+    bool m_faces = false;
+    std::vector<uint32_t> m_triangles;
 };
 
 // The scene's root nodes: the default scene's, else every scene's, else (no
@@ -315,7 +394,9 @@ std::pair<std::string_view, size_t> jsonText(std::string_view bytes, bool binary
 
 }  // namespace
 
-Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::string& path) {
+namespace {
+
+Result<tinygltf::Model> loadModel(std::string_view bytes, const std::string& path) {
     if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
         return badInput(path, "file", "larger than 4 GiB, beyond what tinygltf reads");
     }
@@ -349,12 +430,32 @@ Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::strin
         return badInput(path, "glTF",
                         "malformed: " + (err.empty() ? std::string("tinygltf failed") : trimmed(err)));
 
-    auto roots = rootNodes(model, path);
+    return model;
+}
+
+}  // namespace
+
+Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::string& path) {
+    Result<tinygltf::Model> model = loadModel(bytes, path);
+    if (!model) return model.error();
+    auto roots = rootNodes(*model, path);
     if (!roots) return roots.error();
-    PointCollector collector(model, path);
+    PointCollector collector(*model, path);
     if (auto e = collector.count(*roots)) return *e;
     if (auto e = collector.read(*roots)) return *e;
     return collector.take();
+}
+
+Result<GltfMesh> readGltfMesh(std::string_view bytes, const std::string& path) {
+    Result<tinygltf::Model> model = loadModel(bytes, path);
+    if (!model) return model.error();
+    auto roots = rootNodes(*model, path);
+    if (!roots) return roots.error();
+    PointCollector collector(*model, path);
+    collector.collectTriangles();
+    if (auto e = collector.count(*roots)) return *e;
+    if (auto e = collector.read(*roots)) return *e;
+    return GltfMesh{collector.take(), collector.takeTriangles()};
 }
 
 Result<uint64_t> glbInflatedBound(std::string_view head, bool whole, const std::string& path) {

@@ -1,6 +1,7 @@
 // loadPointCloud: map (or read and gunzip), dispatch on the extension, then enforce
 // the contract shared by every format: at least one point, every coordinate
-// finite. loadPoints: the same, rounded to float.
+// finite. loadPoints: the same, rounded to float. loadMesh: the vertices as
+// loadPointCloud reads them and the format's faces from the same bytes.
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -105,6 +106,26 @@ std::optional<Error> firstNonFinite(const std::vector<Vec>& points, const std::s
 
 }  // namespace
 
+namespace {
+
+// The file's bytes for a format (mapped, or read and gunzipped).
+Result<FileBytes> formatBytes(const std::string& path, const Format& format, const LoadTuning& tuning) {
+    auto bytes = openFileBytes(path, format.gzipBound, tuning.access);
+    if (!bytes) return bytes.error();
+    if (bytes->view().empty()) return badInput(path, "file", "empty file");
+    return bytes;
+}
+
+// The contract shared by every format: at least one point, every coordinate finite.
+std::optional<Error> checkCloud(const PointCloud& cloud, const std::string& path, const ChunkPlan& plan) {
+    if (cloud.size() == 0) return badInput(path, "file", "contains no points");
+    return cloud.scalar == Scalar::kFloat64
+               ? firstNonFinite(cloud.doubles, path, "", plan)
+               : firstNonFinite(cloud.floats, path, " (or beyond float range)", plan);
+}
+
+}  // namespace
+
 Result<PointCloud> loadPointCloudTuned(const std::string& path, const LoadOptions& options,
                                        const LoadTuning& tuning) {
     const std::string ext = formatExtension(path);
@@ -115,21 +136,77 @@ Result<PointCloud> loadPointCloudTuned(const std::string& path, const LoadOption
                         "unsupported extension '" + ext +
                             "' (ply, xyz, txt, obj, gltf, glb, stl, off, pcd, las, optionally .gz)");
     }
-
-    auto bytes = openFileBytes(path, format.gzipBound, tuning.access);
+    auto bytes = formatBytes(path, format, tuning);
     if (!bytes) return bytes.error();
-    if (bytes->view().empty()) return badInput(path, "file", "empty file");
-
     const ChunkPlan plan{options.threads, tuning.chunkBytes};
     auto cloud = format.read(bytes->view(), path, options, plan);
     if (!cloud) return cloud;
-    if (cloud->size() == 0) return badInput(path, "file", "contains no points");
-    const std::optional<Error> bad =
-        cloud->scalar == Scalar::kFloat64
-            ? firstNonFinite(cloud->doubles, path, "", plan)
-            : firstNonFinite(cloud->floats, path, " (or beyond float range)", plan);
-    if (bad) return *bad;
+    if (auto bad = checkCloud(*cloud, path, plan)) return *bad;
     return cloud;
+}
+
+namespace {
+
+// Every facet's three vertices, in file order (STL shares no vertex).
+std::vector<uint32_t> facetTriangles(size_t vertices) {
+    std::vector<uint32_t> indices(vertices - vertices % 3);
+    for (size_t i = 0; i < indices.size(); ++i) indices[i] = uint32_t(i);
+    return indices;
+}
+
+Result<std::vector<uint32_t>> readFaces(const std::string& ext, std::string_view bytes,
+                                        const std::string& path, uint64_t vertexCount) {
+    if (ext == ".obj") return readObjFaces(bytes, path, vertexCount);
+    if (ext == ".off") return readOffFaces(bytes, path, vertexCount);
+    if (ext == ".ply") return readPlyFaces(bytes, path, vertexCount);
+    return facetTriangles(size_t(vertexCount));  // .stl
+}
+
+}  // namespace
+
+Result<TriangleMesh> loadMeshTuned(const std::string& path, const LoadOptions& options,
+                                   const LoadTuning& tuning) {
+    const std::string ext = formatExtension(path);
+    const bool faces =
+        ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl" || ext == ".gltf" || ext == ".glb";
+    if (!faces) {
+        return badInput(path, "file",
+                        "'" + ext +
+                            "' files have no faces: a surface needs a triangle mesh (obj, ply, off, stl, "
+                            "gltf, glb, optionally .gz)");
+    }
+    const Format format = formatFor(ext);
+    auto bytes = formatBytes(path, format, tuning);
+    if (!bytes) return bytes.error();
+    const ChunkPlan plan{options.threads, tuning.chunkBytes};
+    TriangleMesh mesh;
+    if (ext == ".gltf" || ext == ".glb") {
+        auto gltf = readGltfMesh(bytes->view(), path);
+        if (!gltf) return gltf.error();
+        mesh.vertices = PointCloud{Scalar::kFloat32, std::move(gltf->points), {}};
+        mesh.indices = std::move(gltf->triangles);
+    } else {
+        auto cloud = format.read(bytes->view(), path, options, plan);
+        if (!cloud) return cloud.error();
+        mesh.vertices = std::move(cloud).value();
+    }
+    if (auto bad = checkCloud(mesh.vertices, path, plan)) return *bad;
+    if (mesh.vertices.size() > UINT32_MAX) {
+        return badInput(path, "file",
+                        std::to_string(mesh.vertices.size()) +
+                            " vertices: a mesh holds at most 2^32 - 1 (32-bit triangle indices)");
+    }
+    if (ext != ".gltf" && ext != ".glb") {
+        auto indices = readFaces(ext, bytes->view(), path, mesh.vertices.size());
+        if (!indices) return indices.error();
+        mesh.indices = std::move(indices).value();
+    }
+    if (mesh.indices.empty()) return badInput(path, "file", "has no triangles (a surface needs faces)");
+    return mesh;
+}
+
+Result<TriangleMesh> loadMesh(const std::string& path, const LoadOptions& options) {
+    return loadMeshTuned(path, options, LoadTuning{});
 }
 
 Result<PointCloud> loadPointCloud(const std::string& path, const LoadOptions& options) {

@@ -20,4 +20,8 @@ struct LoadTuning {
 [[nodiscard]] Result<PointCloud> loadPointCloudTuned(const std::string& path, const LoadOptions& options,
                                                      const LoadTuning& tuning);
 
+// loadMesh with explicit tuning (loadMesh passes {}).
+[[nodiscard]] Result<TriangleMesh> loadMeshTuned(const std::string& path, const LoadOptions& options,
+                                                 const LoadTuning& tuning);
+
 }  // namespace rthdist::io

@@ -1,4 +1,5 @@
-// Wavefront OBJ: the "v x y z" lines; everything else is ignored.
+// Wavefront OBJ: the "v x y z" lines (points), and the "f" lines (faces);
+// everything else is ignored.
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -18,5 +19,12 @@ namespace rthdist::io {
 // depend on it).
 [[nodiscard]] Result<PointCloud> readObj(std::string_view bytes, const std::string& path,
                                          const ChunkPlan& plan = {});
+
+// The triangles of the "f" lines (face_list.hpp), in one serial pass:
+// "f v v v ...", each v as "i", "i/t", "i//n" or "i/t/n"; i is 1-based, or
+// negative (relative to the "v" lines before the face). vertexCount: the
+// file's vertices (readObj's count).
+[[nodiscard]] Result<std::vector<uint32_t>> readObjFaces(std::string_view bytes, const std::string& path,
+                                                         uint64_t vertexCount);
 
 }  // namespace rthdist::io

@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 
+#include "io/face_list.hpp"
 #include "io/io_error.hpp"
 #include "io/number_parse.hpp"
 #include "io/text_chunks.hpp"
@@ -72,7 +73,19 @@ Result<PointCloud> readVertices(std::string_view text, size_t countLine, uint64_
 
 }  // namespace
 
-Result<PointCloud> readOff(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
+namespace {
+
+// The header: the keyword line and the counts "nv nf ne" (on the same line
+// or the next content line).
+struct OffHeader {
+    uint64_t vertexCount = 0;
+    uint64_t faceCount = 0;
+    bool hasFaceCount = false;
+    size_t countLine = 0;   // the line of the counts
+    size_t bodyOffset = 0;  // the first byte after it
+};
+
+Result<OffHeader> parseOffHeader(std::string_view bytes, const std::string& path) {
     TextCursor cursor(bytes);
     std::string_view line;
     if (!nextContentLine(cursor, line)) return badInput(path, lineWhere(1), "no OFF header");
@@ -101,19 +114,85 @@ Result<PointCloud> readOff(std::string_view bytes, const std::string& path, cons
         n = splitTokens(line, tok.data(), tok.size());
         first = 0;
     }
-    uint64_t vertexCount = 0;
-    if (n < first + 1 || !parseUInt(tok[first], vertexCount)) {
+    OffHeader header;
+    if (n < first + 1 || !parseUInt(tok[first], header.vertexCount)) {
         return badInput(path, lineWhere(cursor.line()), "bad vertex count (want 'nv nf ne')");
     }
-    const size_t countLine = cursor.line();
+    header.hasFaceCount = n >= first + 2 && parseUInt(tok[first + 1], header.faceCount);
+    header.countLine = cursor.line();
+    header.bodyOffset = cursor.offset();
     // The shortest vertex line is "0 0 0\n".
-    if (vertexCount > (cursor.remaining() + 1) / 6) {
-        return badInput(path, lineWhere(countLine),
-                        "declares " + std::to_string(vertexCount) + " vertices but only " +
+    if (header.vertexCount > (cursor.remaining() + 1) / 6) {
+        return badInput(path, lineWhere(header.countLine),
+                        "declares " + std::to_string(header.vertexCount) + " vertices but only " +
                             std::to_string(cursor.remaining()) +
                             " bytes follow (truncated file or wrong count)");
     }
-    return readVertices(bytes.substr(cursor.offset()), countLine, vertexCount, path, plan);
+    return header;
+}
+
+// One face line "n i0 .. in-1 [colour]" into polygon.
+std::optional<Error> parseFaceLine(std::string_view line, size_t lineNo, uint64_t face,
+                                   const std::string& path, std::vector<int64_t>& polygon) {
+    TextCursor tokens(line, lineNo);
+    const std::string_view countToken = tokens.nextToken();
+    uint64_t count = 0;
+    if (!parseUInt(countToken, count)) {
+        return badInput(
+            path, lineWhere(lineNo),
+            "face " + std::to_string(face) + ": bad vertex count '" + std::string(countToken) + "'");
+    }
+    polygon.clear();
+    for (uint64_t k = 0; k < count; ++k) {
+        const std::string_view token = tokens.nextToken();
+        uint64_t v = 0;
+        if (token.empty()) {
+            return badInput(path, lineWhere(lineNo),
+                            "face " + std::to_string(face) + ": the line ends after " + std::to_string(k) +
+                                " of its " + std::to_string(count) + " vertex indices");
+        }
+        if (!parseUInt(token, v) || v > uint64_t(INT64_MAX)) {
+            return badInput(
+                path, lineWhere(lineNo),
+                "face " + std::to_string(face) + ": '" + std::string(token) + "' is not a vertex index");
+        }
+        polygon.push_back(int64_t(v));
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
+Result<PointCloud> readOff(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
+    Result<OffHeader> header = parseOffHeader(bytes, path);
+    if (!header) return header.error();
+    return readVertices(bytes.substr(header->bodyOffset), header->countLine, header->vertexCount, path, plan);
+}
+
+Result<std::vector<uint32_t>> readOffFaces(std::string_view bytes, const std::string& path,
+                                           uint64_t vertexCount) {
+    Result<OffHeader> header = parseOffHeader(bytes, path);
+    if (!header) return header.error();
+    if (!header->hasFaceCount) {
+        return badInput(path, lineWhere(header->countLine), "no face count (want 'nv nf ne')");
+    }
+    TextCursor cursor(bytes.substr(header->bodyOffset), header->countLine + 1);
+    std::string_view line;
+    for (uint64_t k = 0; k < header->vertexCount; ++k) {
+        if (!nextContentLine(cursor, line)) break;  // readOff has refused a short vertex block
+    }
+    FaceList faces(vertexCount);
+    std::vector<int64_t> polygon;
+    for (uint64_t f = 0; f < header->faceCount; ++f) {
+        if (!nextContentLine(cursor, line)) {
+            return badInput(
+                path, lineWhere(cursor.line()),
+                "file ends at face " + std::to_string(f) + " of " + std::to_string(header->faceCount));
+        }
+        if (auto err = parseFaceLine(line, cursor.line(), f, path, polygon)) return *err;
+        if (auto err = faces.addPolygon(path, lineWhere(cursor.line()), f, polygon)) return *err;
+    }
+    return faces.take();
 }
 
 }  // namespace rthdist::io

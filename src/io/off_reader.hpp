@@ -1,4 +1,5 @@
-// OFF / COFF / NOFF / CNOFF / STOFF (ascii): the vertex block; '#' comments.
+// OFF / COFF / NOFF / CNOFF / STOFF (ascii): the vertex block and the face
+// block; '#' comments.
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -18,5 +19,11 @@ namespace rthdist::io {
 // depend on it).
 [[nodiscard]] Result<PointCloud> readOff(std::string_view bytes, const std::string& path,
                                          const ChunkPlan& plan = {});
+
+// The triangles of the face block (face_list.hpp): the header's face count
+// of content lines "n i0 .. in-1" (0-based indices; a colour after them is
+// ignored) after the vertices. vertexCount: readOff's count.
+[[nodiscard]] Result<std::vector<uint32_t>> readOffFaces(std::string_view bytes, const std::string& path,
+                                                         uint64_t vertexCount);
 
 }  // namespace rthdist::io

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "io/face_list.hpp"
 #include "io/gzip_inflate.hpp"
 #include "io/io_error.hpp"
 #include "io/number_parse.hpp"
@@ -288,6 +289,44 @@ public:
         return std::nullopt;
     }
 
+    // Walks one item of the face element, the list property `listProp`'s
+    // values into polygon (each an integer >= 0, else the error naming the
+    // face).
+    std::optional<Error> faceItem(const PlyElement& e, uint64_t index, size_t listProp,
+                                  std::vector<int64_t>& polygon) {
+        polygon.clear();
+        const size_t start = m_pos;
+        for (size_t i = 0; i < e.properties.size(); ++i) {
+            const PlyProperty& p = e.properties[i];
+            if (i != listProp) {
+                if (auto err = skipProperty(e, index, p)) return err;
+                continue;
+            }
+            const size_t countSize = scalarSize(p.countType);
+            if (m_bytes.size() - m_pos < countSize) return truncated(e, index);
+            const double count = loadScalar(m_bytes.data() + m_pos, p.countType, m_bigEndian);
+            const size_t itemSize = scalarSize(p.type);
+            if (count < 0 || count > static_cast<double>((m_bytes.size() - m_pos - countSize) / itemSize)) {
+                return count < 0 ? badInput(m_path, offsetWhere(m_pos),
+                                            "face " + std::to_string(index) + ": negative list length")
+                                 : truncated(e, index);
+            }
+            m_pos += countSize;
+            for (size_t k = 0; k < static_cast<size_t>(count); ++k, m_pos += itemSize) {
+                const double v = loadScalar(m_bytes.data() + m_pos, p.type, m_bigEndian);
+                if (!(v >= 0) || v != std::floor(v) || v > 9.0e18) {
+                    return badInput(m_path, offsetWhere(start),
+                                    "face " + std::to_string(index) + ": vertex index " + std::to_string(v) +
+                                        " is not an index");
+                }
+                polygon.push_back(static_cast<int64_t>(v));
+            }
+        }
+        return std::nullopt;
+    }
+
+    [[nodiscard]] size_t position() const { return m_pos; }
+
     // Steps over bytes the caller has read (and checked to be there).
     void advance(uint64_t bytes) { m_pos += static_cast<size_t>(bytes); }
     [[nodiscard]] const char* here() const { return m_bytes.data() + m_pos; }
@@ -306,6 +345,27 @@ public:
     }
 
 private:
+    std::optional<Error> skipProperty(const PlyElement& e, uint64_t index, const PlyProperty& p) {
+        if (!p.isList) {
+            if (m_bytes.size() - m_pos < scalarSize(p.type)) return truncated(e, index);
+            m_pos += scalarSize(p.type);
+            return std::nullopt;
+        }
+        const size_t countSize = scalarSize(p.countType);
+        if (m_bytes.size() - m_pos < countSize) return truncated(e, index);
+        const double count = loadScalar(m_bytes.data() + m_pos, p.countType, m_bigEndian);
+        if (count < 0) {
+            return badInput(
+                m_path, offsetWhere(m_pos),
+                "element " + e.name + " item " + std::to_string(index) + ": negative list length");
+        }
+        m_pos += countSize;
+        if (count > static_cast<double>((m_bytes.size() - m_pos) / scalarSize(p.type)))
+            return truncated(e, index);
+        m_pos += static_cast<size_t>(count) * scalarSize(p.type);
+        return std::nullopt;
+    }
+
     Error truncated(const PlyElement& e, uint64_t index) const {
         return badInput(m_path, offsetWhere(m_pos),
                         "element " + e.name + " item " + std::to_string(index) +
@@ -525,7 +585,105 @@ Result<PointCloud> readAsciiBody(std::string_view bytes, const PlyHeader& header
     return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }
 
+// The face element and its index list: "face" with "vertex_indices" (or
+// "vertex_index", older files).
+struct FaceIndex {
+    size_t element = 0;
+    size_t list = 0;
+};
+
+Result<FaceIndex> findFaces(const PlyHeader& header, const std::string& path) {
+    for (size_t ei = 0; ei < header.elements.size(); ++ei) {
+        const PlyElement& e = header.elements[ei];
+        if (e.name != "face") continue;
+        for (size_t i = 0; i < e.properties.size(); ++i) {
+            const PlyProperty& p = e.properties[i];
+            if ((p.name == "vertex_indices" || p.name == "vertex_index") && p.isList) return FaceIndex{ei, i};
+        }
+        return badInput(path, "element face", "no list property 'vertex_indices' (or 'vertex_index')");
+    }
+    return badInput(path, "header", "no 'face' element: the file has no triangles");
+}
+
+Result<std::vector<uint32_t>> readBinaryFaces(std::string_view bytes, const PlyHeader& header,
+                                              const FaceIndex& faceIndex, uint64_t vertexCount,
+                                              const std::string& path) {
+    BinaryBody body(bytes, header.bodyOffset, header.format == PlyFormat::kBinaryBigEndian, path);
+    for (size_t ei = 0; ei < faceIndex.element; ++ei) {
+        if (auto err = body.checkFit(header.elements, ei, ei + 1)) return *err;
+        if (auto err = body.skipElement(header.elements[ei])) return *err;
+    }
+    const PlyElement& face = header.elements[faceIndex.element];
+    if (auto err = body.checkFit(header.elements, faceIndex.element, faceIndex.element + 1)) return *err;
+    FaceList faces(vertexCount);
+    std::vector<int64_t> polygon;
+    for (uint64_t f = 0; f < face.count; ++f) {
+        const size_t at = body.position();
+        if (auto err = body.faceItem(face, f, faceIndex.list, polygon)) return *err;
+        if (auto err = faces.addPolygon(path, offsetWhere(at), f, polygon)) return *err;
+    }
+    return faces.take();
+}
+
+// The face element's lines (one item per non-blank line, after the items of
+// the elements before it), in one serial pass.
+Result<std::vector<uint32_t>> readAsciiFaces(std::string_view bytes, const PlyHeader& header,
+                                             const FaceIndex& faceIndex, uint64_t vertexCount,
+                                             const std::string& path) {
+    uint64_t skip = 0;
+    for (size_t ei = 0; ei < faceIndex.element; ++ei) {
+        if (!header.elements[ei].properties.empty()) skip += header.elements[ei].count;
+    }
+    const PlyElement& face = header.elements[faceIndex.element];
+    TextCursor cursor(bytes.substr(header.bodyOffset), header.bodyLine);
+    FaceList faces(vertexCount);
+    std::vector<int64_t> polygon;
+    std::string_view line;
+    uint64_t item = 0;
+    uint64_t f = 0;
+    while (f < face.count && cursor.nextLine(line)) {
+        if (!isItemLine(line)) continue;
+        if (item++ < skip) continue;
+        TextCursor tokens(line, cursor.line());
+        polygon.clear();
+        for (size_t i = 0; i < face.properties.size(); ++i) {
+            const std::string_view tok = tokens.nextToken();
+            uint64_t length = 0;
+            if (!face.properties[i].isList) continue;
+            if (!parseUInt(tok, length)) {
+                return badInput(path, lineWhere(cursor.line()),
+                                "face " + std::to_string(f) + ": bad list length '" + std::string(tok) + "'");
+            }
+            for (uint64_t k = 0; k < length; ++k) {
+                const std::string_view v = tokens.nextToken();
+                if (i != faceIndex.list) continue;
+                uint64_t index = 0;
+                if (!parseUInt(v, index) || index > uint64_t(INT64_MAX)) {
+                    return badInput(
+                        path, lineWhere(cursor.line()),
+                        "face " + std::to_string(f) + ": '" + std::string(v) + "' is not a vertex index");
+                }
+                polygon.push_back(int64_t(index));
+            }
+        }
+        if (auto err = faces.addPolygon(path, lineWhere(cursor.line()), f, polygon)) return *err;
+        ++f;
+    }
+    return faces.take();
+}
+
 }  // namespace
+
+Result<std::vector<uint32_t>> readPlyFaces(std::string_view bytes, const std::string& path,
+                                           uint64_t vertexCount) {
+    auto header = parseHeader(bytes, path);
+    if (!header) return header.error();
+    auto faceIndex = findFaces(*header, path);
+    if (!faceIndex) return faceIndex.error();
+    if (header->format == PlyFormat::kAscii)
+        return readAsciiFaces(bytes, *header, *faceIndex, vertexCount, path);
+    return readBinaryFaces(bytes, *header, *faceIndex, vertexCount, path);
+}
 
 Result<PointCloud> readPly(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
     auto header = parseHeader(bytes, path);

@@ -23,6 +23,12 @@ namespace rthdist::io {
 [[nodiscard]] Result<PointCloud> readPly(std::string_view bytes, const std::string& path,
                                          const ChunkPlan& plan = {});
 
+// The triangles of the element "face" (face_list.hpp), read after readPly
+// has read and checked the whole body: its list property "vertex_indices"
+// (or "vertex_index"), any integer type. vertexCount: readPly's count.
+[[nodiscard]] Result<std::vector<uint32_t>> readPlyFaces(std::string_view bytes, const std::string& path,
+                                                         uint64_t vertexCount);
+
 // The gunzip header check (gzip_inflate.hpp): a binary PLY inflates to at
 // most its header plus every declared item at its largest; ascii: no bound.
 [[nodiscard]] Result<uint64_t> plyInflatedBound(std::string_view head, bool whole, const std::string& path);

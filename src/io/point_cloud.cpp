@@ -1,4 +1,5 @@
-// PointCloud: a loaded set in its file's precision, seen as a PointView.
+// PointCloud: a loaded set in its file's precision, seen as a PointView;
+// TriangleMesh: its vertices and triangles, seen as a MeshView.
 #include "rthdist/io.hpp"
 
 namespace rthdist::io {
@@ -9,5 +10,7 @@ PointView PointCloud::view() const {
     if (scalar == Scalar::kFloat64) return PointView(doubles);
     return PointView(floats);
 }
+
+MeshView TriangleMesh::view() const { return MeshView{vertices.view(), indices}; }
 
 }  // namespace rthdist::io

@@ -240,10 +240,23 @@ TEST(RoutePlanner, DeviceViewsAreRefusedWithoutSupportOrPastTheBudget) {
     EXPECT_NE(big.reason.find("not split into pieces"), std::string::npos);
 }
 
+TEST(RoutePlanner, SurfacesRunOnTheCpuBackend) {
+    EXPECT_EQ(planSurfaceRoute(Backend::kCpu).route, Route::kSurfaceCpu);
+    EXPECT_EQ(planSurfaceRoute(Backend::kAuto).route, Route::kSurfaceCpu);
+    // A GPU backend the caller named is refused, never replaced by the CPU.
+    for (Backend gpu : {Backend::kRayQuery, Backend::kRtPipeline}) {
+        const Plan plan = planSurfaceRoute(gpu);
+        EXPECT_EQ(plan.route, Route::kRefused);
+        EXPECT_EQ(plan.code, ErrorCode::kInvalidArgument);
+        EXPECT_NE(plan.reason.find("run on the CPU backend for now"), std::string::npos) << plan.reason;
+        EXPECT_NE(plan.reason.find(backendName(gpu)), std::string::npos) << plan.reason;
+    }
+}
+
 TEST(RoutePlanner, EveryRouteHasAName) {
-    for (Route r :
-         {Route::kRefused, Route::kSmallPairScan, Route::kDeviceIngest, Route::kOneCall,
-          Route::kSeveralDevices, Route::kPieces, Route::kReframe, Route::kPrepared, Route::kDeviceViews})
+    for (Route r : {Route::kRefused, Route::kSmallPairScan, Route::kDeviceIngest, Route::kOneCall,
+                    Route::kSeveralDevices, Route::kPieces, Route::kReframe, Route::kPrepared,
+                    Route::kDeviceViews, Route::kSurfaceCpu})
         EXPECT_STRNE(routeName(r), "?");
 }
 

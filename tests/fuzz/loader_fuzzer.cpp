@@ -4,7 +4,8 @@
 // is a gzipped PLY: the bounded gunzip with the PLY header check, then the
 // PLY reader, as loadPoints does for a .ply.gz.
 //
-// Any input must give points or a kBadInput error; a crash, a sanitizer
+// Any input must give points (and, for the formats with faces, triangles
+// whose every index is below the vertex count) or a kBadInput error; a crash, a sanitizer
 // report, a leak, a timeout or an allocation beyond -rss_limit_mb is a bug,
 // and so is a result that changes with the parse's chunk size.
 #include <unistd.h>
@@ -77,16 +78,38 @@ void differential(std::string_view bytes, Read&& read) {
     if (whole.ok() && !sameCloud(*whole, *tiny)) std::abort();
 }
 
+// loadMesh's face pass over the same bytes, after the vertices read: any
+// input gives triangles (every index below the vertex count) or kBadInput.
+template <class ReadFaces>
+void faces(std::string_view bytes, const char* path, ReadFaces&& readFaces) {
+    const auto cloud = [&] {
+        using namespace rthdist::io;
+        if (kFormat == "ply") return readPly(bytes, path);
+        if (kFormat == "obj") return readObj(bytes, path);
+        return readOff(bytes, path);
+    }();
+    if (!cloud.ok()) return;
+    const auto triangles = readFaces(bytes, path, cloud->size());
+    if (!triangles.ok()) return;
+    if (triangles->size() % 3 != 0) std::abort();
+    for (uint32_t v : *triangles) {
+        if (v >= cloud->size()) std::abort();
+    }
+}
+
 void loadBytes(std::string_view bytes) {
     using namespace rthdist::io;
     auto with = [&](auto reader, const char* path) {
         differential(bytes, [&](const ChunkPlan& plan) { return reader(bytes, path, plan); });
     };
     if (kFormat == "ply") with(&readPly, "fuzz.ply");
+    if (kFormat == "ply") faces(bytes, "fuzz.ply", &readPlyFaces);
     if (kFormat == "xyz") with(&readXyz, "fuzz.xyz");
     if (kFormat == "obj") with(&readObj, "fuzz.obj");
+    if (kFormat == "obj") faces(bytes, "fuzz.obj", &readObjFaces);
     if (kFormat == "stl") (void)readStl(bytes, "fuzz.stl");
     if (kFormat == "off") with(&readOff, "fuzz.off");
+    if (kFormat == "off") faces(bytes, "fuzz.off", &readOffFaces);
     if (kFormat == "pcd") with(&readPcd, "fuzz.pcd");
     if (kFormat == "las") {
         for (const std::vector<int>& classes : {std::vector<int>{}, std::vector<int>{2, 6}}) {
@@ -97,6 +120,12 @@ void loadBytes(std::string_view bytes) {
     }
     if (kFormat == "gltf" || kFormat == "glb") {
         (void)readGltf(bytes, scratchDir() + "/fuzz." + std::string(kFormat));
+        const auto mesh = readGltfMesh(bytes, scratchDir() + "/fuzz." + std::string(kFormat));
+        if (mesh.ok()) {
+            for (uint32_t v : mesh->triangles) {
+                if (v >= mesh->points.size()) std::abort();
+            }
+        }
     }
 }
 

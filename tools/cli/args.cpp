@@ -121,6 +121,10 @@ Options:
   --validation        enable the Vulkan validation layer, count its messages
   --list-devices      list Vulkan devices, the paths each supports, and why not
   --quiet             no progress on stderr (progress is shown only on a terminal)
+  --surface SIDE      a | b: the exact distance from the other file's points to
+                      the triangles of SIDE's mesh (obj, ply, off, stl, gltf,
+                      glb), directed only: --surface b is h(A, surface of B);
+                      the cpu backend (auto picks it)
   --las-classes LIST  read only the LAS points of these classification values,
                       comma-separated integers 0..255 (e.g. 2,6: ground and
                       buildings); needs a .las input, other formats are read whole
@@ -244,6 +248,12 @@ void addComputeOptions(CommandLine& line, CliArgs& out) {
             outOfRange("--radius-growth", v, "a number in " + rangeText(kMinRadiusGrowth, kMaxRadiusGrowth));
         out.options.radiusGrowth = float(*f);
     });
+    addValue(line, "--surface", [&out](const std::string& v) {
+        if (v == "both")
+            reject("option '--surface both' (surface to surface) is not implemented yet; --surface a or b");
+        if (v != "a" && v != "b") reject("option '--surface' expects a or b, got '" + v + "'");
+        out.surface = v;
+    });
     addValue(line, "--las-classes", [&out](const std::string& v) {
         const auto classes = parseIntList(v, 0, kMaxLasClass);
         if (!classes)
@@ -296,6 +306,23 @@ void addPerPointOptions(CommandLine& line, CliArgs& out) {
     }
 }
 
+// --surface runs on the CPU backend and reports the directed value alone:
+// the options it cannot honour are refused, never ignored.
+std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
+    if (out.surface.empty()) return std::nullopt;
+    const Backend b = out.options.backend;
+    if (b != Backend::kAuto && b != Backend::kCpu)
+        return usageError(std::string("option '--surface' runs on the cpu backend for now: the ") +
+                          backendName(b) + " backend cannot search triangles (use --backend cpu or auto)");
+    if (out.perPoint)
+        return usageError("option '--surface' has no per-point outputs yet (--per-point and its options)");
+    if (out.verify)
+        return usageError("option '--surface' runs on the cpu backend: --verify has nothing to compare");
+    if (!out.options.devices.empty() || out.allDevices)
+        return usageError("option '--surface' runs on the cpu backend: --devices spreads work over GPUs");
+    return std::nullopt;
+}
+
 }  // namespace
 
 std::vector<int> everyRtDevice(Backend backend) {
@@ -344,6 +371,7 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
     }
     if ((!out.options.devices.empty() || out.allDevices) && out.options.backend == Backend::kCpu)
         return usageError("option '--devices' spreads the work over GPUs; the cpu backend uses --threads");
+    if (auto error = checkSurfaceOptions(out)) return *error;
     out.options.perPointDistances = out.perPoint;
     out.pathA = positional[0];
     out.pathB = positional[1];

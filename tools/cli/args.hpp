@@ -38,6 +38,9 @@ struct CliArgs {
     bool quiet = false;           // --quiet: no progress on stderr
     std::vector<int> lasClasses;  // --las-classes 2,6: LAS classification filter (empty = all)
     bool allDevices = false;      // --devices all (options.devices: everyRtDevice)
+    // --surface a|b: the points of the other file to this file's triangles
+    // (cli/surface_command.hpp); empty: point sets.
+    std::string surface;
 };
 
 // Parses argv[1..]. Accepts "--option value" and "--option=value"; "--" ends

@@ -17,6 +17,7 @@
 #include "cli/per_point_outputs.hpp"
 #include "cli/progress_meter.hpp"
 #include "cli/report.hpp"
+#include "cli/surface_command.hpp"
 #include "cli/verify.hpp"
 #include "core/stopwatch.hpp"
 #include "rthdist/io.hpp"
@@ -87,6 +88,7 @@ int run(const std::vector<std::string>& argv) {
     if (args.version)
         return writeStdout(std::string("rthdist ") + versionString() + "\n") ? kExitOk : kExitInternal;
     if (args.listDevices) return listDevicesCommand(args);
+    if (!args.surface.empty()) return surfaceCommand(args);
     Options options = args.options;
     if (args.allDevices) {
         options.devices = everyRtDevice(options.backend);

@@ -1,0 +1,87 @@
+// Public entry of the point-to-surface distance (rthdist/surface.hpp):
+// the inputs checked (shape, finite coordinates, triangle indices, the
+// rule's magnitude limit), the route chosen (api::planSurfaceRoute: the CPU
+// backend, or a refusal naming the backend), then the CPU backend's search
+// (cpu/surface_search.hpp). The route runs the CPU search directly: no GPU
+// backend searches triangles yet; when one does, the search becomes a
+// method of api::ComputeBackend and this file opens the backend.
+#include "rthdist/surface.hpp"
+
+#include <glm/common.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "api/route_planner.hpp"
+#include "core/input_frame.hpp"
+#include "core/stopwatch.hpp"
+#include "cpu/surface_search.hpp"
+
+namespace rthdist {
+namespace {
+
+// Every coordinate of both inputs at most 2^250 in magnitude: the rule's
+// degree-4 products of differences stay finite (rthdist_point_triangle.h).
+constexpr double kMaxSurfaceMagnitude = 0x1p250;
+
+double magnitudeOf(const core::Bounds& box) {
+    const glm::dvec3 m = glm::max(glm::abs(box.lo), glm::abs(box.hi));
+    return std::max({m.x, m.y, m.z});
+}
+
+std::optional<Error> checkMagnitude(const core::Bounds& box, const char* name) {
+    const double m = magnitudeOf(box);
+    if (m <= kMaxSurfaceMagnitude) return std::nullopt;
+    return Error{ErrorCode::kInvalidArgument, std::string(name) + ": a coordinate of magnitude " +
+                                                  std::to_string(m) +
+                                                  " is past the point-to-surface limit of 2^250 (~1.8e75)"};
+}
+
+std::optional<Error> checkTriangles(const MeshView& surface) {
+    if (surface.indices.size() % 3 != 0) {
+        return Error{ErrorCode::kInvalidArgument,
+                     "surface B: " + std::to_string(surface.indices.size()) +
+                         " indices are not a whole number of triangles (3 each)"};
+    }
+    if (surface.triangleCount() == 0)
+        return Error{ErrorCode::kInvalidArgument, "surface B has no triangles: the distance is undefined"};
+    if (surface.triangleCount() > UINT32_MAX || surface.vertices.count > UINT32_MAX) {
+        return Error{ErrorCode::kInvalidArgument,
+                     "surface B: at most 2^32 - 1 triangles and vertices (32-bit indices), not " +
+                         std::to_string(surface.triangleCount()) + " triangles of " +
+                         std::to_string(surface.vertices.count) + " vertices"};
+    }
+    const auto it = std::find_if(surface.indices.begin(), surface.indices.end(),
+                                 [&](uint32_t v) { return v >= surface.vertices.count; });
+    if (it == surface.indices.end()) return std::nullopt;
+    const auto at = size_t(it - surface.indices.begin());
+    return Error{ErrorCode::kInvalidArgument,
+                 "surface B: triangle " + std::to_string(at / 3) + ": vertex index " + std::to_string(*it) +
+                     " out of range (" + std::to_string(surface.vertices.count) + " vertices)"};
+}
+
+}  // namespace
+
+Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, const SurfaceOptions& options) {
+    const core::Clock::time_point start = core::Clock::now();
+    if (options.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
+    const api::Plan plan = api::planSurfaceRoute(options.backend);
+    if (plan.route == api::Route::kRefused) return Error{plan.code, plan.reason};
+    if (auto err = core::checkShape(points, "A")) return *err;
+    if (auto err = core::checkShape(surface.vertices, "B")) return *err;
+    if (auto err = checkTriangles(surface)) return *err;
+    Result<core::SetSummary> a = core::summarizeSet(points, "A", options.threads);
+    if (!a) return a.error();
+    Result<core::SetSummary> b = core::summarizeSet(surface.vertices, "B", options.threads);
+    if (!b) return b.error();
+    if (auto err = checkMagnitude(a->box, "point set A")) return *err;
+    if (auto err = checkMagnitude(b->box, "point set B")) return *err;
+    const double magnitude = std::max(magnitudeOf(a->box), magnitudeOf(b->box));
+    Result<SurfaceResult> result = cpu::surfaceSearch(points, surface, magnitude, options);
+    if (result) result->totalMs = core::msSince(start);
+    return result;
+}
+
+}  // namespace rthdist

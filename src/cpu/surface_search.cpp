@@ -1,0 +1,149 @@
+#include "cpu/surface_search.hpp"
+
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "core/parallel.hpp"
+#include "core/point_triangle.hpp"
+#include "core/stopwatch.hpp"
+#include "cpu/triangle_bvh.hpp"
+
+namespace rthdist::cpu {
+namespace {
+
+constexpr size_t kChunk = 256;
+
+// The maximum so far of one thread: the query with the largest distance,
+// the smallest index on a tie.
+struct ThreadBest {
+    NearestTriangle hit;
+    uint64_t query = 0;
+    bool any = false;
+    SurfaceCounters counters;
+    bool cancelled = false;
+};
+
+bool beats(const NearestTriangle& hit, uint64_t query, const ThreadBest& best) {
+    if (!best.any) return true;
+    return hit.distance2 > best.hit.distance2 || (hit.distance2 == best.hit.distance2 && query < best.query);
+}
+
+// Non-negative doubles order as their bit patterns: the running maximum of
+// squared distances is one atomic word.
+void raiseMax(std::atomic<uint64_t>& bits, double value) {
+    const uint64_t v = std::bit_cast<uint64_t>(value);
+    uint64_t seen = bits.load(std::memory_order_relaxed);
+    while (seen < v && !bits.compare_exchange_weak(seen, v, std::memory_order_relaxed)) {
+    }
+}
+
+// The witness's nearest triangle by every triangle, in index order.
+NearestTriangle bruteNearest(const glm::dvec3& p, const MeshView& surface) {
+    NearestTriangle best;
+    best.distance2 = std::numeric_limits<double>::infinity();
+    for (size_t t = 0; t < surface.triangleCount(); ++t) {
+        const core::TriangleClosest r =
+            core::closestOnTriangle(p, surface.corner(t, 0), surface.corner(t, 1), surface.corner(t, 2));
+        if (r.distance2 < best.distance2) {
+            best.distance2 = r.distance2;
+            best.triangle = uint32_t(t);
+            best.point = r.point;
+        }
+    }
+    return best;
+}
+
+}  // namespace
+
+Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& surface, double magnitude,
+                                    const SurfaceOptions& options) {
+    const core::Clock::time_point start = core::Clock::now();
+    SurfaceResult result;
+    result.backend = Backend::kCpu;
+    result.device = "cpu";
+    const TriangleBvh bvh(surface);
+    result.buildMs = core::msSince(start);
+
+    const core::Clock::time_point searchStart = core::Clock::now();
+    const double slack = core::closestSlack(magnitude);
+    const bool perPoint = options.perPointDistances;
+    if (perPoint) {
+        result.perPoint.distance.resize(points.count);
+        result.perPoint.triangle.resize(points.count);
+        result.perPoint.closest.resize(points.count);
+    }
+    const int threads = core::resolveThreads(options.threads, (points.count + kChunk - 1) / kChunk);
+    std::vector<ThreadBest> best(static_cast<size_t>(threads));
+    std::atomic<uint64_t> runningMax{0};
+    core::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int thread) {
+        ThreadBest& mine = best[size_t(thread)];
+        if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) {
+            mine.cancelled = true;
+            return;
+        }
+        for (size_t q = begin; q < end; ++q) {
+            const double stop =
+                perPoint ? 0.0 : std::bit_cast<double>(runningMax.load(std::memory_order_relaxed));
+            const NearestTriangle hit = bvh.nearest(points.at(q), slack, stop);
+            mine.counters.nodesVisited += hit.nodesVisited;
+            mine.counters.trianglesTested += hit.trianglesTested;
+            if (hit.dominated) {
+                ++mine.counters.dominated;
+                continue;
+            }
+            if (perPoint) {
+                result.perPoint.distance[q] = std::sqrt(hit.distance2);
+                result.perPoint.triangle[q] = hit.triangle;
+                result.perPoint.closest[q] = hit.point;
+            }
+            if (beats(hit, q, mine)) {
+                mine.hit = hit;
+                mine.query = q;
+                mine.any = true;
+                raiseMax(runningMax, hit.distance2);
+            }
+        }
+    });
+
+    ThreadBest overall;
+    SurfaceCounters& counters = result.directed.counters;
+    for (const ThreadBest& b : best) {
+        if (b.cancelled)
+            return Error{ErrorCode::kCancelled, "the call was cancelled (SurfaceOptions::cancel)"};
+        counters.nodesVisited += b.counters.nodesVisited;
+        counters.trianglesTested += b.counters.trianglesTested;
+        counters.dominated += b.counters.dominated;
+        if (b.any && beats(b.hit, b.query, overall)) overall = b;
+    }
+    if (!overall.any) return Error{ErrorCode::kInternal, "surface search: no query was settled"};
+
+    const glm::dvec3 q = points.at(overall.query);
+    const NearestTriangle check = bruteNearest(q, surface);
+    if (check.distance2 != overall.hit.distance2 || check.triangle != overall.hit.triangle) {
+        return Error{ErrorCode::kInternal,
+                     "surface search: the witness query " + std::to_string(overall.query) +
+                         " found triangle " + std::to_string(overall.hit.triangle) + " at squared distance " +
+                         std::to_string(overall.hit.distance2) + ", every triangle gives triangle " +
+                         std::to_string(check.triangle) + " at " + std::to_string(check.distance2)};
+    }
+    SurfaceDirected& d = result.directed;
+    d.distance = std::sqrt(overall.hit.distance2);
+    d.queryIndex = overall.query;
+    d.triangle = overall.hit.triangle;
+    d.queryPoint = q;
+    d.surfacePoint = overall.hit.point;
+    d.barycentric = overall.hit.barycentric;
+    counters.queries = points.count;
+    counters.triangles = surface.triangleCount();
+    counters.bvhNodes = bvh.nodeCount();
+    result.hausdorff = d.distance;
+    result.searchMs = core::msSince(searchStart);
+    result.totalMs = core::msSince(start);
+    return result;
+}
+
+}  // namespace rthdist::cpu

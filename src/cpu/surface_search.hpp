@@ -1,0 +1,18 @@
+// The CPU backend's exact point-to-surface search (design.md §11): a
+// TriangleBvh over the surface, every query's nearest triangle on the
+// worker pool, the directed maximum with the early break of Taha & Hanbury
+// (2015) against the running maximum (off with per-point output), and the
+// witness query checked against every triangle.
+#pragma once
+
+#include "rthdist/surface.hpp"
+
+namespace rthdist::cpu {
+
+// points and surface checked by the caller (api/surface.cpp): finite,
+// non-empty, indices in range. magnitude: the largest |coordinate| over
+// both (the pruning's slack, core::closestSlack).
+[[nodiscard]] Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& surface,
+                                                  double magnitude, const SurfaceOptions& options);
+
+}  // namespace rthdist::cpu

@@ -1,0 +1,139 @@
+// The public point-to-surface call (rthdist/surface.hpp) on the CPU backend:
+// float and double inputs of any stride against the brute force over every
+// triangle, and every refusal as an Error value naming the set, the vertex
+// or the triangle.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+#include "common/surface_brute_force.hpp"
+#include "common/surface_cases.hpp"
+#include "rthdist/surface.hpp"
+
+namespace rthdist {
+namespace {
+
+struct Small {
+    std::vector<glm::dvec3> vertices{{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {4, 4, 0}};
+    std::vector<uint32_t> indices{0, 1, 2, 1, 3, 2};
+    std::vector<glm::dvec3> points{{1, 1, 2}, {3, 3, -1}, {8, 4, 3}};
+    [[nodiscard]] MeshView mesh() const { return MeshView{PointView(vertices), indices}; }
+};
+
+TEST(SurfaceApi, AutoAndCpuRunTheCpuBackend) {
+    const Small s;
+    for (Backend backend : {Backend::kAuto, Backend::kCpu}) {
+        SurfaceOptions options;
+        options.backend = backend;
+        Result<SurfaceResult> r = hausdorffToSurface(PointView(s.points), s.mesh(), options);
+        ASSERT_TRUE(r) << r.error().message;
+        EXPECT_EQ(r->backend, Backend::kCpu);
+        EXPECT_EQ(r->device, "cpu");
+        EXPECT_EQ(r->hausdorff, 5.0);  // (8, 4, 3) to the corner edge (4, 4, 0)
+        EXPECT_EQ(r->directed.queryIndex, 2u);
+        EXPECT_EQ(r->directed.surfacePoint, glm::dvec3(4, 4, 0));
+    }
+}
+
+TEST(SurfaceApi, GpuBackendsAreRefusedNotReplaced) {
+    const Small s;
+    for (Backend backend : {Backend::kRayQuery, Backend::kRtPipeline}) {
+        SurfaceOptions options;
+        options.backend = backend;
+        Result<SurfaceResult> r = hausdorffToSurface(PointView(s.points), s.mesh(), options);
+        ASSERT_FALSE(r);
+        EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+        EXPECT_NE(r.error().message.find("CPU backend for now"), std::string::npos) << r.error().message;
+    }
+}
+
+TEST(SurfaceApi, FloatStridedInputsMatchTheBruteForce) {
+    const test::SurfaceCase c = test::heightField(3415, 12, 6.0);
+    // Interleaved float vertices (position + a colour) and float queries.
+    std::vector<float> interleaved;
+    std::vector<glm::dvec3> vertices;
+    for (const glm::dvec3& v : c.vertices) {
+        interleaved.insert(interleaved.end(), {float(v.x), float(v.y), float(v.z), 0.5f, 0.25f, 1.0f});
+        vertices.emplace_back(float(v.x), float(v.y), float(v.z));
+    }
+    std::vector<glm::vec3> queries;
+    std::vector<glm::dvec3> queriesD;
+    for (int i = 0; i < 300; ++i) {
+        const glm::vec3 q(float(i % 17) * 0.4f - 0.5f, float(i % 13) * 0.5f - 0.3f, float(i % 7) - 3.0f);
+        queries.push_back(q);
+        queriesD.emplace_back(q);
+    }
+    const MeshView mesh{PointView::floats(interleaved.data(), vertices.size(), 6 * sizeof(float)), c.indices};
+    SurfaceOptions options;
+    options.perPointDistances = true;
+    Result<SurfaceResult> r = hausdorffToSurface(PointView(queries), mesh, options);
+    ASSERT_TRUE(r) << r.error().message;
+    const oracle::SurfaceDirectedExact want = oracle::bruteForceSurface(queriesD, vertices, c.indices);
+    EXPECT_EQ(r->hausdorff, want.distance);
+    EXPECT_EQ(r->directed.triangle, want.nearest.triangle);
+    EXPECT_EQ(r->directed.surfacePoint, want.nearest.point);
+    for (size_t i = 0; i < queries.size(); ++i)
+        ASSERT_EQ(r->perPoint.distance[i], std::sqrt(want.perQuery[i].distance2));
+}
+
+TEST(SurfaceApi, IndexOutOfRangeNamesTheTriangle) {
+    Small s;
+    s.indices[4] = 9;
+    Result<SurfaceResult> r = hausdorffToSurface(PointView(s.points), s.mesh());
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_EQ(r.error().message, "surface B: triangle 1: vertex index 9 out of range (4 vertices)");
+}
+
+TEST(SurfaceApi, IndicesNotInTriplesAreRefused) {
+    Small s;
+    s.indices.pop_back();
+    Result<SurfaceResult> r = hausdorffToSurface(PointView(s.points), s.mesh());
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("not a whole number of triangles"), std::string::npos);
+}
+
+TEST(SurfaceApi, NoTrianglesIsRefused) {
+    Small s;
+    s.indices.clear();
+    Result<SurfaceResult> r = hausdorffToSurface(PointView(s.points), s.mesh());
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("no triangles"), std::string::npos);
+}
+
+TEST(SurfaceApi, EmptyPointsAreRefused) {
+    const Small s;
+    Result<SurfaceResult> r = hausdorffToSurface(PointView(std::vector<glm::dvec3>{}), s.mesh());
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(r.error().message.find("point set A is empty"), std::string::npos) << r.error().message;
+}
+
+TEST(SurfaceApi, NanVertexNamesTheVertex) {
+    Small s;
+    s.vertices[3].y = std::numeric_limits<double>::quiet_NaN();
+    Result<SurfaceResult> r = hausdorffToSurface(PointView(s.points), s.mesh());
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("point set B: point 3"), std::string::npos) << r.error().message;
+}
+
+TEST(SurfaceApi, MagnitudePastTheLimitIsRefused) {
+    Small s;
+    s.points[1].x = 1e80;
+    Result<SurfaceResult> r = hausdorffToSurface(PointView(s.points), s.mesh());
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("2^250"), std::string::npos) << r.error().message;
+}
+
+TEST(SurfaceApi, NegativeThreadsAreRefused) {
+    const Small s;
+    SurfaceOptions options;
+    options.threads = -1;
+    EXPECT_FALSE(hausdorffToSurface(PointView(s.points), s.mesh(), options));
+}
+
+}  // namespace
+}  // namespace rthdist
