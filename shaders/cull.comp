@@ -40,7 +40,8 @@ void main() {
     uint64_t targets = pc.targets;
     uint64_t dense = pc.dense;
     int cpa = int(pc.grid.cellsPerAxis);
-    float best = uintBitsToFloat(0x7f800000u);
+    const float kInf = uintBitsToFloat(0x7f800000u);
+    float best = kInf;
     uint bestT = 0;
     bool dead = false;
     bool complete = true;  // every point of the block was scanned
@@ -50,7 +51,7 @@ void main() {
         ivec3 cc = c + ivec3(m % 3, (m / 3) % 3, m / 9) - 1;
         if (any(lessThan(cc, ivec3(0))) || any(greaterThanEqual(cc, ivec3(cpa)))) continue;
         if (pc.mutant != 0u && j == 0) continue;  // tests only: a search that misses candidates
-        if (j > 0) {  // a neighbour farther than the best holds no nearer point
+        if (j > 0 && best < kInf) {  // a neighbour farther than the best holds no nearer point
             vec3 lo = origin + vec3(cc) * s - pc.epsilon;
             if (boxDist2(q, lo, lo + (s + 2.0 * pc.epsilon)) > best) continue;
         }

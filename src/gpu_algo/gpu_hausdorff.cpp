@@ -420,6 +420,11 @@ GpuHausdorff::~GpuHausdorff() = default;
 
 void GpuHausdorff::setCullLeafScanMax(uint32_t leaves) { m_state->ws.cullLeafScanMax = leaves; }
 
+void GpuHausdorff::setUploadChunks(size_t past, size_t chunk) {
+    m_state->ws.chunkedUploadPoints = past;
+    m_state->ws.uploadChunkPoints = std::max<size_t>(1, chunk);
+}
+
 void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
     m_state->ws.maxPairCapacity = std::max<uint64_t>(1, pairs);
 }

@@ -20,23 +20,45 @@ int clampedBits(int bits, uint32_t n) {
     return bits;
 }
 
+namespace {
+
+// Points [begin, end) as vec4 records (w = 0) at dst, their box into lo, hi.
+void toRecords(std::span<const glm::vec3> pts, size_t begin, size_t end, float* dst, glm::vec3& lo,
+               glm::vec3& hi) {
+    for (size_t i = begin; i < end; ++i) {
+        const glm::vec3 p = pts[i];
+        dst[4 * (i - begin) + 0] = p.x;
+        dst[4 * (i - begin) + 1] = p.y;
+        dst[4 * (i - begin) + 2] = p.z;
+        dst[4 * (i - begin) + 3] = 0.0f;
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+}
+
+}  // namespace
+
 void IndexBuild::stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int bits) {
     ix.n = uint32_t(pts.size());
-    const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
-    Buffer& staging = m_ws.grow(ix.scratch->staging, bytes, ix.name + ".staging", MemoryKind::kHost);
-    auto* dst = static_cast<float*>(staging.mapped());
+    const bool chunked = pts.size() > m_ws.chunkedUploadPoints;
+    ix.hostSource = chunked ? pts : std::span<const glm::vec3>();
+    float* dst = nullptr;
+    if (!chunked) {
+        Buffer& staging =
+            m_ws.grow(ix.scratch->staging, VkDeviceSize(ix.n) * 16, ix.name + ".staging", MemoryKind::kHost);
+        dst = static_cast<float*>(staging.mapped());
+    }
     const int threads = core::resolveThreads(m_ws.threads, ix.n / kHostChunk + 1);
     std::vector<glm::vec3> lo(size_t(threads), pts[0]), hi(size_t(threads), pts[0]);
     core::parallelChunks(ix.n, kHostChunk, threads, [&](size_t begin, size_t end, int t) {
         glm::vec3 l = lo[size_t(t)], h = hi[size_t(t)];
-        for (size_t i = begin; i < end; ++i) {
-            const glm::vec3 p = pts[i];
-            dst[4 * i + 0] = p.x;
-            dst[4 * i + 1] = p.y;
-            dst[4 * i + 2] = p.z;
-            dst[4 * i + 3] = 0.0f;
-            l = glm::min(l, p);
-            h = glm::max(h, p);
+        if (dst != nullptr) {
+            toRecords(pts, begin, end, dst + 4 * begin, l, h);
+        } else {  // the box only: the records go up in chunks (uploadChunked)
+            for (size_t i = begin; i < end; ++i) {
+                l = glm::min(l, pts[i]);
+                h = glm::max(h, pts[i]);
+            }
         }
         lo[size_t(t)] = l;
         hi[size_t(t)] = h;
@@ -51,6 +73,34 @@ void IndexBuild::stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int 
         bits = clampedBits(core::chooseBits(pts, ix.bounds), ix.n);
     }
     ix.grid = core::makeGrid(ix.bounds, bits);
+}
+
+void IndexBuild::uploadChunked(PointIndex& ix) {
+    const size_t chunkPoints = std::max<size_t>(1, m_ws.uploadChunkPoints);
+    const VkDeviceSize chunkBytes = VkDeviceSize(chunkPoints) * 16;
+    Buffer& chunk = m_ws.grow(m_ws.scratch.uploadChunk, chunkBytes, "uploadChunk", MemoryKind::kHost, false);
+    Buffer& points = m_ws.grow(ix.scratch->points, VkDeviceSize(ix.n) * 16, ix.name + ".points");
+    auto* dst = static_cast<float*>(chunk.mapped());
+    const std::span<const glm::vec3> pts = ix.hostSource;
+    for (size_t first = 0; first < pts.size(); first += chunkPoints) {
+        const size_t count = std::min(chunkPoints, pts.size() - first);
+        const auto t0 = Clock::now();
+        core::parallelChunks(count, kHostChunk, m_ws.threads, [&](size_t begin, size_t end, int) {
+            glm::vec3 lo(0.0f), hi(0.0f);  // the box was taken by stageIndex
+            toRecords(pts.subspan(first), begin, end, dst + 4 * begin, lo, hi);
+        });
+        m_ws.timings->upload += msSince(t0);
+        VkCommandBuffer cmd = m_ws.ctx.begin();
+        {
+            const gpu::ScopedLabel label(m_ws.ctx, cmd, "upload");
+            const VkBufferCopy region{0, VkDeviceSize(first) * 16, VkDeviceSize(count) * 16};
+            vkCmdCopyBuffer(cmd, chunk.handle(), points.handle(), 1, &region);
+        }
+        m_ws.ctx.submitAndWait(cmd);
+        m_ws.timings->upload += m_ws.ctx.lastGpuMs();
+        m_ws.timings->gpuUpload += m_ws.ctx.lastGpuMs();
+    }
+    ix.hostSource = {};
 }
 
 void IndexBuild::cmdUpload(VkCommandBuffer cmd, PointIndex& ix) {
@@ -122,10 +172,17 @@ void IndexBuild::finishIndex(PointIndex& ix, const CounterBlock& blk) {
 void IndexBuild::buildIndexes(std::span<PointIndex* const> sets, bool ingested) {
     if (sets.size() > m_ws.blocks.size())
         throw std::logic_error("buildIndexes: more sets than counter blocks");
+    std::vector<PointIndex*> staged;  // staged whole: copied in the build's submission
+    for (PointIndex* ix : sets) {
+        if (ingested) continue;
+        if (ix->hostSource.empty())
+            staged.push_back(ix);
+        else
+            uploadChunked(*ix);  // own submissions, upload time
+    }
     auto t0 = Clock::now();
     VkCommandBuffer cmd = m_ws.ctx.begin();
-    for (PointIndex* ix : sets)
-        if (!ingested) cmdUpload(cmd, *ix);
+    for (PointIndex* ix : staged) cmdUpload(cmd, *ix);
     const uint32_t uploaded = m_ws.ctx.cmdMark(cmd);
     m_ws.barrier(cmd);
     for (size_t k = 0; k < sets.size(); ++k) cmdBuildIndex(cmd, *sets[k], m_ws.blocks[k]);

@@ -26,13 +26,21 @@ public:
     explicit IndexBuild(Workspace& workspace) : m_ws(workspace) {}
 
     // Host half of an index build: the points into the set's staging buffer
-    // (vec4) in one parallel pass that also takes their bounds, then the bit
-    // count and the grid. Nothing is submitted.
+    // (vec4) in one parallel pass that also takes their bounds (past
+    // kChunkedUploadPoints: the bounds alone, the points go up in chunks,
+    // uploadChunked), then the bit count and the grid. Nothing is submitted.
     void stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int bits);
 
     // The staged points' copy to the device (before cmdBuildIndex, with a
     // barrier between: several sets' copies run back to back).
     void cmdUpload(VkCommandBuffer cmd, PointIndex& ix);
+
+    // A large set's upload (ix.hostSource, set by stageIndex past
+    // kChunkedUploadPoints): chunks of kUploadChunkPoints converted to vec4
+    // records by the host's threads into one reused host buffer, each copied
+    // by a submission of its own into the set's points. buildIndexes runs it
+    // before the build's submission.
+    void uploadChunked(PointIndex& ix);
 
     // Device half of an index build, recorded into `cmd` after the upload:
     // cell keys, counting sort over the dense key table, run-length encoding

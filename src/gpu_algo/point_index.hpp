@@ -47,6 +47,12 @@ inline constexpr uint32_t kLeafMax = RTHDIST_LEAF_MAX;
 inline constexpr int kMaxSplitRounds = 12;
 // Points per host work item (the host's copies and bounds).
 inline constexpr size_t kHostChunk = size_t(1) << 16;
+// A set of more points is not staged whole in host-visible memory (a
+// pinned buffer of 16 bytes a point, allocated per call): its bounds come
+// from one read on the host and its points go up in chunks of
+// kUploadChunkPoints through one reused host buffer (IndexBuild::uploadChunked).
+inline constexpr size_t kChunkedUploadPoints = size_t(1) << 23;
+inline constexpr size_t kUploadChunkPoints = size_t(1) << 23;
 
 struct PointIndex;
 
@@ -75,6 +81,9 @@ struct PointIndex {
     Buffer* sorted = nullptr;  // vec4: xyz, w = original index bits (cell order)
     Buffer* dense = nullptr;   // uint per key: end of the key's cell
     Buffer* leafFirst = nullptr;  // split: uint per key, the first leaf of the key's cell
+    // A large set staged by the host: its points, still on the host, which
+    // buildIndexes uploads in chunks (empty: staged whole, or ingested).
+    std::span<const glm::vec3> hostSource;
     Buffer* cells = nullptr;   // Cell per occupied cell
     uint32_t numCells = 0;
     uint64_t cellCapacity = 0;                // room of `cells` at the build: min(n, keys)

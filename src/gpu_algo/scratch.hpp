@@ -20,7 +20,7 @@ using ScanScratch = std::vector<Buffer>;
 // One index build (index_build.cpp, ingest.cpp). Two exist so that two sets
 // are built in one submission.
 struct BuildScratch {
-    Buffer staging;  // host: the points as vec4 (host path)
+    Buffer staging;  // host: the points as vec4 (host path, sets of at most kChunkedUploadPoints)
     Buffer source;   // host: the caller's packed floats (device ingest)
     Buffer raw;      // the packed floats on the device (device ingest)
     Buffer points;   // vec4 points before the sort
@@ -82,6 +82,7 @@ struct BatchScratch {
 
 struct Scratch {
     std::array<BuildScratch, 2> builds;  // set A (and every single build), set B
+    Buffer uploadChunk;                  // host: one chunk of a large set's vec4 points (IndexBuild::uploadChunked)
     LeafScratch leaves;
     LevelScratch levels;
     std::array<DirectionBuffers, 2> directions;  // A->B, B->A

@@ -1,6 +1,7 @@
 #include "gpu_algo/workspace.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace rthdist::gpu_algo {
 
@@ -31,6 +32,7 @@ Workspace::Workspace(gpu::Context& c, const std::string& cacheDir, int hostThrea
 Buffer& Workspace::grow(Buffer& b, VkDeviceSize bytes, const std::string& name, MemoryKind kind, bool slack) {
     if (!b || b.size() < bytes) {
         b.reset();
+        const auto t0 = Clock::now();
         const VkDeviceSize room =
             !slack ? bytes
                    : std::min<VkDeviceSize>(bytes + std::min(bytes / 4, kMaxSlack),
@@ -39,6 +41,10 @@ Buffer& Workspace::grow(Buffer& b, VkDeviceSize bytes, const std::string& name, 
                    gpu::kStorageUsage | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
                    kind);
         ctx.setDebugName(VK_OBJECT_TYPE_BUFFER, uint64_t(b.handle()), name.c_str());
+        if (ctx.tracingSubmits())
+            std::fprintf(stderr, "rthdist buffer %s: %.1f MiB (%s) in %.3f ms\n", name.c_str(),
+                         double(b.size()) / double(1 << 20), kind == MemoryKind::kDevice ? "device" : "host",
+                         msSince(t0));
     }
     return b;
 }

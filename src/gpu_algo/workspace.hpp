@@ -91,6 +91,8 @@ struct Workspace {
     std::array<CounterBlock, 2> blocks;  // blocks[0]: every stage; [1]: a second index build
     uint64_t maxPairCapacity = kMaxPairCapacity;
     uint32_t cullLeafScanMax = kCullLeafScanMax;  // 0: crowded cells give their first point only
+    size_t chunkedUploadPoints = kChunkedUploadPoints;  // a larger host-staged set goes up in chunks
+    size_t uploadChunkPoints = kUploadChunkPoints;
     bool mutant = false;  // tests only: core::searchMutant() when the call started
     Timings* timings = nullptr;
     // Buffers live across calls and only grow: allocation is a large share of

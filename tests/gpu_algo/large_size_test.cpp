@@ -188,6 +188,38 @@ TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
+// A large set staged by the host goes up in chunks through one reused host
+// buffer (IndexBuild::uploadChunked, past kChunkedUploadPoints): forced at
+// small sizes, chunks that do not divide the set, the same results as the
+// whole staging and the brute force (one set chunked, the other whole; both).
+TEST(LargeSizes, ChunkedUploadEqualsWholeStaging) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    auto whole = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
+    auto chunked = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
+    ASSERT_TRUE(whole && chunked);
+    std::vector<OracleCase> cases;
+    for (const OracleCase& c : makeOracleCases())
+        if (c.a.size() + c.b.size() >= 3000 && c.a.size() + c.b.size() <= 20000 && cases.size() < 6) cases.push_back(c);
+    ASSERT_GE(cases.size(), 3u);
+    for (size_t past : {size_t(2500), size_t(100)}) {
+        (*chunked)->setUploadChunks(past, 777);
+        for (const OracleCase& c : cases) {
+            SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed) + " past " + std::to_string(past));
+            auto w = (*whole)->compute(c.a, c.b, Options{});
+            auto r = (*chunked)->compute(c.a, c.b, Options{});
+            ASSERT_TRUE(w) << w.error().message;
+            ASSERT_TRUE(r) << r.error().message;
+            expectMatchesOracle(c, *r);
+            EXPECT_EQ(r->hausdorff, w->hausdorff);
+            EXPECT_EQ(r->aToB.queryIndex, w->aToB.queryIndex);
+            EXPECT_EQ(r->aToB.targetIndex, w->aToB.targetIndex);
+            EXPECT_EQ(r->bToA.queryIndex, w->bToA.queryIndex);
+            EXPECT_EQ(r->bToA.targetIndex, w->bToA.targetIndex);
+        }
+    }
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
 TEST(LargeSizes, BufferPastMaxBufferSizeIsRefusedWithTheLimitNamed) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
     gpu::DeviceLimits limits = ctx->limits();
