@@ -138,10 +138,15 @@ TEST_P(CliGpu, ValidationLayerIsSilent) {
 // documented range, 1.001 was accepted and the search gave up after 4096.
 TEST_P(CliGpu, SmallestRadiusGrowthConverges) {
     // The RT path's radius schedule: a pair this small is otherwise scanned
-    // whole (gpu_algo/small_pairs.hpp), which has no radius.
+    // whole (gpu_algo/small_pairs.hpp) or swept (every open query against
+    // every target), neither of which has a radius.
     ::setenv("RTHDIST_SMALL_PAIR_WORK", "0", 1);
+    ::setenv("RTHDIST_SWEEP_WORK", "0", 1);
     struct Unset {
-        ~Unset() { ::unsetenv("RTHDIST_SMALL_PAIR_WORK"); }
+        ~Unset() {
+            ::unsetenv("RTHDIST_SMALL_PAIR_WORK");
+            ::unsetenv("RTHDIST_SWEEP_WORK");
+        }
     } unset;
     TempDir dir;
     Points tiny = spherePoints(400, 21);
