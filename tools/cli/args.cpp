@@ -124,7 +124,12 @@ Options:
   --surface SIDE      a | b: the exact distance from the other file's points to
                       the triangles of SIDE's mesh (obj, ply, off, stl, gltf,
                       glb), directed only: --surface b is h(A, surface of B);
-                      the cpu backend (auto picks it)
+                      both: certified bounds [lower, upper] on H between the
+                      surfaces of both meshes (--directed: h(A, B)); the cpu
+                      backend (auto picks it)
+  --tolerance T       --surface both: the largest width upper - lower, a
+                      finite distance > 0 (default 1e-4 of the diagonal of
+                      both meshes' box; at least ~4e-12 of their extent)
   --las-classes LIST  read only the LAS points of these classification values,
                       comma-separated integers 0..255 (e.g. 2,6: ground and
                       buildings); needs a .las input, other formats are read whole
@@ -249,10 +254,14 @@ void addComputeOptions(CommandLine& line, CliArgs& out) {
         out.options.radiusGrowth = float(*f);
     });
     addValue(line, "--surface", [&out](const std::string& v) {
-        if (v == "both")
-            reject("option '--surface both' (surface to surface) is not implemented yet; --surface a or b");
-        if (v != "a" && v != "b") reject("option '--surface' expects a or b, got '" + v + "'");
+        if (v != "a" && v != "b" && v != "both")
+            reject("option '--surface' expects a, b or both, got '" + v + "'");
         out.surface = v;
+    });
+    addValue(line, "--tolerance", [&out](const std::string& v) {
+        const auto t = parseNumber(v);
+        if (!t || !(*t > 0.0)) outOfRange("--tolerance", v, "a finite distance > 0");
+        out.tolerance = *t;
     });
     addValue(line, "--las-classes", [&out](const std::string& v) {
         const auto classes = parseIntList(v, 0, kMaxLasClass);
@@ -309,6 +318,9 @@ void addPerPointOptions(CommandLine& line, CliArgs& out) {
 // --surface runs on the CPU backend and reports the directed value alone:
 // the options it cannot honour are refused, never ignored.
 std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
+    if (out.tolerance > 0.0 && out.surface != "both")
+        return usageError(
+            "option '--tolerance' sets the width of surface-to-surface bounds: it needs --surface both");
     if (out.surface.empty()) return std::nullopt;
     const Backend b = out.options.backend;
     if (b != Backend::kAuto && b != Backend::kCpu)

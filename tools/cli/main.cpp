@@ -18,6 +18,7 @@
 #include "cli/progress_meter.hpp"
 #include "cli/report.hpp"
 #include "cli/surface_command.hpp"
+#include "cli/surface_pair_command.hpp"
 #include "cli/verify.hpp"
 #include "core/stopwatch.hpp"
 #include "rthdist/io.hpp"
@@ -88,6 +89,7 @@ int run(const std::vector<std::string>& argv) {
     if (args.version)
         return writeStdout(std::string("rthdist ") + versionString() + "\n") ? kExitOk : kExitInternal;
     if (args.listDevices) return listDevicesCommand(args);
+    if (args.surface == "both") return surfacePairCommand(args);
     if (!args.surface.empty()) return surfaceCommand(args);
     Options options = args.options;
     if (args.allDevices) {
