@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli/args.hpp"
+#include "cli/eval_command.hpp"
 #include "cli/exit_codes.hpp"
 #include "cli/per_point_outputs.hpp"
 #include "cli/progress_meter.hpp"
@@ -89,6 +90,7 @@ int run(const std::vector<std::string>& argv) {
     if (args.version)
         return writeStdout(std::string("rthdist ") + versionString() + "\n") ? kExitOk : kExitInternal;
     if (args.listDevices) return listDevicesCommand(args);
+    if (!args.evalThresholds.empty()) return evalCommand(args);
     if (args.surface == "both") return surfacePairCommand(args);
     if (!args.surface.empty()) return surfaceCommand(args);
     Options options = args.options;
