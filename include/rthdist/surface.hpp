@@ -118,4 +118,106 @@ struct SurfaceResult {
 [[nodiscard]] RTHDIST_API Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface,
                                                                    const SurfaceOptions& options = {});
 
+// ---------------------------------------------------------------------------
+// Surface to surface (issue 34, phase 2: the CPU backend)
+//
+// Contract
+//   H(SA, SB) = max(h(SA, SB), h(SB, SA)) between the surfaces of two meshes,
+//   h(SA, SB) = max over EVERY point p of SA's triangles (not only the
+//   vertices) of d(p, SB), d as in hausdorffToSurface. A continuum has no
+//   brute force, so the answer is a pair of CERTIFIED bounds in real
+//   arithmetic: lower <= H <= upper and upper - lower <= the tolerance.
+//   lower is realized by a witness: a point of SA (or SB) and its closest
+//   point on the other surface, found by the exact point-to-surface search;
+//   lower = the witness's distance less the rounding slack below (0 at
+//   least). upper holds for every point of the surfaces: each triangle is
+//   split into patches (four by its edge midpoints, recursively) until every
+//   patch's upper bound is within the tolerance of the best lower bound. A
+//   patch's bound is the smaller of (design.md §12):
+//   - convexity (Tang, Lee & Kim 2009): d(., t) is convex for any triangle
+//     t of the other surface, so over the patch d <= d(., t) <= the largest
+//     of d(corner, t); t runs over the nearest triangles of the corners (and
+//     of the centroid, queried when the corners' bound is not enough);
+//   - Lipschitz: d is 1-Lipschitz, and every point of a triangle lies within
+//     2/3 of its longest edge of one corner: d <= max corner d + 2/3 edge
+//     (with the centroid c: d(c) + the largest |corner - c|).
+//   Each round queries the new corners and centroids in one batch on the
+//   worker pool (the exact nearest-triangle search of hausdorffToSurface).
+//   The bounds of each direction are certified too, but only H's (or with
+//   directedOnly h(SA, SB)'s) width is held to the tolerance: a patch is
+//   settled once it cannot raise H past lower + tolerance.
+//
+// Precision: the work runs in a frame centred on the box of both meshes
+//   (translation does not change H; the shift rounds each vertex by at most
+//   2^-53 of its distance to the centre). slack = 2^-40 m, m the largest
+//   |coordinate| in that frame, exceeds every rounding of the rule, of the
+//   midpoints (exact dyadic barycentric coordinates, rounded once per level)
+//   and of the edge lengths by a factor above 16 (design.md §12); lower and
+//   upper each carry it. Witness points are reported in the input's frame
+//   (shifted back, rounded once).
+//
+// Inputs: two MeshViews as for hausdorffToSurface (at least one triangle
+//   each, indices in range, finite coordinates at most 2^250). Vertices that
+//   no triangle uses are not part of a surface. tolerance: an absolute
+//   distance, finite; 0 (default) is 1e-4 of the diagonal of the box of both
+//   meshes' vertices; it must be at least 4 slack (2^-38 m: ~4e-12 of the
+//   meshes' extent), else kInvalidArgument naming the floor (1e-6 of the
+//   diagonal is reachable unless the box is flatter than 1e-5 of its
+//   longest side). maxQueries bounds the point-to-surface queries (the
+//   memory: 40 bytes each, plus 16 per open patch); a call that would need
+//   more is kOutOfMemory naming the bounds reached and the limit.
+//
+// Backends and threading as hausdorffToSurface (kAuto, kCpu; GPU backends
+//   refused). Deterministic: the same bounds and witnesses whatever the
+//   thread count (the rounds are batches; ties go to the smaller index).
+struct SurfaceBoundsOptions {
+    Backend backend = Backend::kAuto;  // kAuto or kCpu
+    int threads = 0;                   // 0: every hardware thread
+    double tolerance = 0.0;            // absolute; 0: 1e-4 of the bounding diagonal
+    bool directedOnly = false;         // h(SA, SB) alone
+    uint64_t maxQueries = uint64_t(1) << 26;
+    // Read at every chunk of queries: true -> kCancelled.
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+struct SurfaceBoundsCounters {
+    uint64_t queries = 0;   // point-to-surface queries (corners, midpoints, centroids)
+    uint64_t patches = 0;   // patch bounds evaluated
+    uint64_t splits = 0;    // patches split in four
+    uint64_t rounds = 0;    // batches of queries
+    uint64_t maxDepth = 0;  // deepest split level reached
+};
+
+// One direction, h(from, to): its certified bounds and the witness of lower.
+struct SurfaceBoundsDirected {
+    double lower = 0.0, upper = 0.0;
+    double distance = 0.0;            // the witness's |fromPoint - toPoint|, in the work frame
+    uint32_t fromTriangle = 0;        // the triangle of `from` holding fromPoint
+    glm::dvec3 fromPoint{0.0};        // on `from`'s surface, input frame
+    glm::dvec3 fromBarycentric{0.0};  // of fromPoint in fromTriangle, index order
+    uint32_t toTriangle = 0;          // fromPoint's nearest triangle of `to`
+    glm::dvec3 toPoint{0.0};          // its closest point, input frame
+    glm::dvec3 toBarycentric{0.0};
+    SurfaceBoundsCounters counters;
+};
+
+struct SurfaceBoundsResult {
+    double lower = 0.0, upper = 0.0;  // lower <= H <= upper, upper - lower <= tolerance
+    double tolerance = 0.0;           // the tolerance used (absolute)
+    double slack = 0.0;               // the rounding slack each bound carries
+    glm::dvec3 origin{0.0};           // the work frame's origin in the input frame
+    SurfaceBoundsDirected aToB;       // h(SA, SB)
+    SurfaceBoundsDirected bToA;       // h(SB, SA); zeros with directedOnly
+    bool directed = false;            // directedOnly: bounds are h(SA, SB)'s
+    Backend backend = Backend::kCpu;
+    std::string device;     // "cpu"
+    double buildMs = 0.0;   // the BVHs
+    double searchMs = 0.0;  // the rounds
+    double totalMs = 0.0;
+};
+
+// Certified bounds on H(surface a, surface b) (contract above).
+[[nodiscard]] RTHDIST_API Result<SurfaceBoundsResult> surfaceHausdorff(
+    MeshView a, MeshView b, const SurfaceBoundsOptions& options = {});
+
 }  // namespace rthdist

@@ -29,6 +29,7 @@ from . import _rthdist
 from ._device_owner import DeviceOwner as _DeviceOwner
 from ._masks import CONVENTIONS, DirectedMask, MaskEngine, MaskResult, MaskVolume, PreparedReference, compare_masks
 from ._points import as_points
+from ._surface import evaluate, hausdorff_to_surface, surface_hausdorff
 from ._rthdist import (  # noqa: F401 - re-exported
     CancelledError,
     DeviceError,
@@ -44,6 +45,9 @@ from ._rthdist import (  # noqa: F401 - re-exported
 __version__ = _rthdist.__version__
 __all__ = [
     "hausdorff",
+    "hausdorff_to_surface",
+    "surface_hausdorff",
+    "evaluate",
     "Engine",
     "load",
     "list_devices",

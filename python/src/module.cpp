@@ -2,7 +2,8 @@
 // (python/rthdist/__init__.py is the public face; docs/python.md the guide).
 // One file per concept: errors (Error -> exceptions), points (NumPy ->
 // PointView), result (HausdorffResult), engine (hausdorff, Engine), io
-// (loaders, device list), masks (segmentation masks: volumes, MaskEngine).
+// (loaders, device list), masks (segmentation masks: volumes, MaskEngine),
+// surface (point to surface, surface to surface, the evaluation summary).
 #include <pybind11/pybind11.h>
 
 #include "engine.hpp"
@@ -10,6 +11,7 @@
 #include "io.hpp"
 #include "masks.hpp"
 #include "result.hpp"
+#include "surface.hpp"
 #include "rthdist/rthdist.hpp"
 
 PYBIND11_MODULE(_rthdist, m) {
@@ -20,4 +22,5 @@ PYBIND11_MODULE(_rthdist, m) {
     rthdist::python::bindEngine(m);
     rthdist::python::bindIo(m);
     rthdist::python::bindMasks(m);
+    rthdist::python::bindSurface(m);
 }

@@ -2,8 +2,8 @@
 // height field and random points written by the test, the JSON's directed
 // value and witness (a_to_b.triangle, a_to_b.b_point) against the brute
 // force over every triangle (tests/common) with ==; --surface a's mirror
-// image; the refusals (a GPU backend, per-point outputs, --surface both:
-// exit 2; a bad face index, a file without faces: exit 3 naming the file).
+// image; the refusals (a GPU backend, per-point outputs: exit 2; a bad
+// face index, a file without faces: exit 3 naming the file).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -115,7 +115,6 @@ TEST_F(CliSurface, GpuBackendsAreRefusedWithExit2) {
 }
 
 TEST_F(CliSurface, UnsupportedCombinationsAreUsageErrors) {
-    EXPECT_EQ(runCli({m_xyz, m_mesh, "--surface", "both"}).exitCode, 2);
     EXPECT_EQ(runCli({m_xyz, m_mesh, "--surface", "c"}).exitCode, 2);
     EXPECT_EQ(runCli({m_xyz, m_mesh, "--surface", "b", "--per-point"}).exitCode, 2);
     EXPECT_EQ(runCli({m_xyz, m_mesh, "--surface", "b", "--verify"}).exitCode, 2);

@@ -81,6 +81,19 @@ std::optional<std::vector<int>> parseIntList(std::string_view text, int lo, int 
     }
 }
 
+// Comma-separated finite numbers > 0, at least one.
+std::optional<std::vector<double>> parsePositiveList(std::string_view text) {
+    std::vector<double> values;
+    for (;;) {
+        const size_t comma = text.find(',');
+        const auto v = parseNumber(text.substr(0, comma));
+        if (!v || !(*v > 0.0)) return std::nullopt;
+        values.push_back(*v);
+        if (comma == std::string_view::npos) return values;
+        text.remove_prefix(comma + 1);
+    }
+}
+
 // A LAS file by its name: ".las", optionally ".gz" (case-insensitive).
 bool isLasPath(std::string path) {
     for (char& c : path) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -124,7 +137,20 @@ Options:
   --surface SIDE      a | b: the exact distance from the other file's points to
                       the triangles of SIDE's mesh (obj, ply, off, stl, gltf,
                       glb), directed only: --surface b is h(A, surface of B);
-                      the cpu backend (auto picks it)
+                      both: certified bounds [lower, upper] on H between the
+                      surfaces of both meshes (--directed: h(A, B)); the cpu
+                      backend (auto picks it)
+  --tolerance T       --surface both: the largest width upper - lower, a
+                      finite distance > 0 (default 1e-4 of the diagonal of
+                      both meshes' box; at least ~4e-12 of their extent)
+  --eval LIST         reconstruction evaluation, A the reconstruction and B the
+                      ground truth: accuracy (A -> B) and completeness (B -> A)
+                      mean and median, Chamfer, precision, recall and F-score
+                      at each threshold of LIST (comma-separated, > 0);
+                      with --surface b, accuracy to B's triangles
+  --eval-cap D        drop distances >= D from the means, medians and Chamfer
+                      (DTU: 20 mm); precision and recall keep them
+  --eval-csv FILE     also write the summary as CSV, one row per threshold
   --las-classes LIST  read only the LAS points of these classification values,
                       comma-separated integers 0..255 (e.g. 2,6: ground and
                       buildings); needs a .las input, other formats are read whole
@@ -249,10 +275,28 @@ void addComputeOptions(CommandLine& line, CliArgs& out) {
         out.options.radiusGrowth = float(*f);
     });
     addValue(line, "--surface", [&out](const std::string& v) {
-        if (v == "both")
-            reject("option '--surface both' (surface to surface) is not implemented yet; --surface a or b");
-        if (v != "a" && v != "b") reject("option '--surface' expects a or b, got '" + v + "'");
+        if (v != "a" && v != "b" && v != "both")
+            reject("option '--surface' expects a, b or both, got '" + v + "'");
         out.surface = v;
+    });
+    addValue(line, "--tolerance", [&out](const std::string& v) {
+        const auto t = parseNumber(v);
+        if (!t || !(*t > 0.0)) outOfRange("--tolerance", v, "a finite distance > 0");
+        out.tolerance = *t;
+    });
+    addValue(line, "--eval", [&out](const std::string& v) {
+        const auto list = parsePositiveList(v);
+        if (!list) outOfRange("--eval", v, "comma-separated finite thresholds > 0 (e.g. 0.01,0.02)");
+        out.evalThresholds = *list;
+    });
+    addValue(line, "--eval-cap", [&out](const std::string& v) {
+        const auto d = parseNumber(v);
+        if (!d || !(*d > 0.0)) outOfRange("--eval-cap", v, "a finite distance > 0");
+        out.evalCap = *d;
+    });
+    addValue(line, "--eval-csv", [&out](const std::string& v) {
+        if (v.empty()) reject("option '--eval-csv' needs a value");
+        out.evalCsv = v;
     });
     addValue(line, "--las-classes", [&out](const std::string& v) {
         const auto classes = parseIntList(v, 0, kMaxLasClass);
@@ -309,6 +353,9 @@ void addPerPointOptions(CommandLine& line, CliArgs& out) {
 // --surface runs on the CPU backend and reports the directed value alone:
 // the options it cannot honour are refused, never ignored.
 std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
+    if (out.tolerance > 0.0 && out.surface != "both")
+        return usageError(
+            "option '--tolerance' sets the width of surface-to-surface bounds: it needs --surface both");
     if (out.surface.empty()) return std::nullopt;
     const Backend b = out.options.backend;
     if (b != Backend::kAuto && b != Backend::kCpu)
@@ -320,6 +367,30 @@ std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
         return usageError("option '--surface' runs on the cpu backend: --verify has nothing to compare");
     if (!out.options.devices.empty() || out.allDevices)
         return usageError("option '--surface' runs on the cpu backend: --devices spreads work over GPUs");
+    return std::nullopt;
+}
+
+// --eval: both directions' per-point distances, A the reconstruction, B
+// the ground truth (points, or B's surface with --surface b).
+std::optional<Error> checkEvalOptions(const CliArgs& out) {
+    if (out.evalThresholds.empty()) {
+        if (out.evalCap > 0.0)
+            return usageError("option '--eval-cap' caps the distances of --eval: it needs --eval");
+        if (!out.evalCsv.empty())
+            return usageError("option '--eval-csv' writes the --eval summary: it needs --eval");
+        return std::nullopt;
+    }
+    if (!out.surface.empty() && out.surface != "b")
+        return usageError(
+            "option '--eval' measures A (the reconstruction) to B (the ground truth): with a "
+            "surface, only --surface b");
+    if (out.options.directedOnly)
+        return usageError("option '--eval' needs both directions: not with --directed");
+    if (out.perPoint)
+        return usageError("option '--eval' has no per-point outputs (--per-point and its options)");
+    if (out.verify) return usageError("option '--eval': --verify compares Hausdorff values, not the summary");
+    if (!out.options.devices.empty() || out.allDevices)
+        return usageError("option '--eval' runs on one device: not with --devices");
     return std::nullopt;
 }
 
@@ -371,6 +442,7 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
     }
     if ((!out.options.devices.empty() || out.allDevices) && out.options.backend == Backend::kCpu)
         return usageError("option '--devices' spreads the work over GPUs; the cpu backend uses --threads");
+    if (auto error = checkEvalOptions(out)) return *error;
     if (auto error = checkSurfaceOptions(out)) return *error;
     out.options.perPointDistances = out.perPoint;
     out.pathA = positional[0];

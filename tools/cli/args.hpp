@@ -39,8 +39,19 @@ struct CliArgs {
     std::vector<int> lasClasses;  // --las-classes 2,6: LAS classification filter (empty = all)
     bool allDevices = false;      // --devices all (options.devices: everyRtDevice)
     // --surface a|b: the points of the other file to this file's triangles
-    // (cli/surface_command.hpp); empty: point sets.
+    // (cli/surface_command.hpp); both: surface to surface
+    // (cli/surface_pair_command.hpp); empty: point sets.
     std::string surface;
+    // --tolerance T: the width of surface-to-surface bounds (--surface both),
+    // absolute; 0: the library's default (1e-4 of the bounding diagonal).
+    double tolerance = 0.0;
+    // --eval TAU[,TAU...]: the reconstruction-evaluation summary (A the
+    // reconstruction, B the ground truth; cli/eval_command.hpp) at these
+    // thresholds; --eval-cap D drops distances >= D from means and medians;
+    // --eval-csv FILE writes the summary as CSV.
+    std::vector<double> evalThresholds;
+    double evalCap = 0.0;
+    std::string evalCsv;
 };
 
 // Parses argv[1..]. Accepts "--option value" and "--option=value"; "--" ends

@@ -13,11 +13,13 @@
 #include <vector>
 
 #include "cli/args.hpp"
+#include "cli/eval_command.hpp"
 #include "cli/exit_codes.hpp"
 #include "cli/per_point_outputs.hpp"
 #include "cli/progress_meter.hpp"
 #include "cli/report.hpp"
 #include "cli/surface_command.hpp"
+#include "cli/surface_pair_command.hpp"
 #include "cli/verify.hpp"
 #include "core/stopwatch.hpp"
 #include "rthdist/io.hpp"
@@ -88,6 +90,8 @@ int run(const std::vector<std::string>& argv) {
     if (args.version)
         return writeStdout(std::string("rthdist ") + versionString() + "\n") ? kExitOk : kExitInternal;
     if (args.listDevices) return listDevicesCommand(args);
+    if (!args.evalThresholds.empty()) return evalCommand(args);
+    if (args.surface == "both") return surfacePairCommand(args);
     if (!args.surface.empty()) return surfaceCommand(args);
     Options options = args.options;
     if (args.allDevices) {

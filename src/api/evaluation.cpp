@@ -1,0 +1,55 @@
+// evaluatePoints and evaluateToSurface (rthdist/eval.hpp): the exact
+// per-point distances of both directions from the engine (point targets)
+// or the point-to-surface search (accuracy to a surface), then the summary
+// (cpu/eval_summary.cpp). The reconstruction is the first input.
+#include <vector>
+
+#include "rthdist/eval.hpp"
+#include "rthdist/rthdist.hpp"
+
+namespace rthdist {
+namespace {
+
+// The vertices the triangles use, each once, in the order first used.
+std::vector<glm::dvec3> usedVertices(const MeshView& mesh) {
+    std::vector<bool> seen(mesh.vertices.count, false);
+    std::vector<glm::dvec3> out;
+    for (uint32_t v : mesh.indices) {
+        if (v >= mesh.vertices.count || seen[v]) continue;  // out of range: refused by the surface call
+        seen[v] = true;
+        out.push_back(mesh.vertices.at(v));
+    }
+    return out;
+}
+
+}  // namespace
+
+Result<EvalSummary> evaluatePoints(PointView reconstruction, PointView groundTruth, const EvalOptions& eval,
+                                   const Options& options) {
+    Options o = options;
+    o.perPointDistances = true;
+    o.directedOnly = false;
+    Result<HausdorffResult> r = hausdorff(reconstruction, groundTruth, o);
+    if (!r) return r.error();
+    return evaluationSummary(r->aNearest.distance, r->bNearest.distance, eval);
+}
+
+Result<EvalSummary> evaluateToSurface(PointView reconstruction, MeshView groundTruth, const EvalOptions& eval,
+                                      const SurfaceOptions& options) {
+    SurfaceOptions so = options;
+    so.perPointDistances = true;
+    Result<SurfaceResult> accuracy = hausdorffToSurface(reconstruction, groundTruth, so);
+    if (!accuracy) return accuracy.error();
+    const std::vector<glm::dvec3> samples = usedVertices(groundTruth);
+    Options o;
+    o.backend = options.backend;
+    o.threads = options.threads;
+    o.cancel = options.cancel;
+    o.perPointDistances = true;
+    o.directedOnly = true;
+    Result<HausdorffResult> completeness = hausdorff(PointView(samples), reconstruction, o);
+    if (!completeness) return completeness.error();
+    return evaluationSummary(accuracy->perPoint.distance, completeness->aNearest.distance, eval);
+}
+
+}  // namespace rthdist

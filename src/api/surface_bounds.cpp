@@ -1,0 +1,139 @@
+// Public entry of surface to surface (rthdist/surface.hpp,
+// surfaceHausdorff): both meshes checked (shape, finite coordinates,
+// triangle indices, the rule's magnitude limit), the route chosen
+// (api::planSurfaceRoute, as for point to surface), both meshes shifted to
+// a frame centred on their common box (design.md §12: the slack then scales
+// with the meshes' extent, not their distance from the origin), the
+// tolerance resolved and checked against its floor, then the CPU backend's
+// refinement (cpu/surface_bounds.hpp) and the witnesses shifted back.
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "api/route_planner.hpp"
+#include "core/input_frame.hpp"
+#include "core/point_triangle.hpp"
+#include "core/stopwatch.hpp"
+#include "cpu/surface_bounds.hpp"
+#include "rthdist/surface.hpp"
+
+namespace rthdist {
+namespace {
+
+// As point to surface (api/surface.cpp): the rule's degree-4 products stay finite.
+constexpr double kMaxMagnitude = 0x1p250;
+// The default tolerance, relative to the diagonal of both meshes' box.
+constexpr double kDefaultRelativeTolerance = 1e-4;
+
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return buf;
+}
+
+double magnitudeOf(const core::Bounds& box) {
+    const glm::dvec3 m = glm::max(glm::abs(box.lo), glm::abs(box.hi));
+    return std::max({m.x, m.y, m.z});
+}
+
+std::optional<Error> checkTriangles(const MeshView& mesh, const std::string& name) {
+    if (mesh.indices.size() % 3 != 0) {
+        return Error{ErrorCode::kInvalidArgument,
+                     name + ": " + std::to_string(mesh.indices.size()) +
+                         " indices are not a whole number of triangles (3 each)"};
+    }
+    if (mesh.triangleCount() == 0)
+        return Error{ErrorCode::kInvalidArgument, name + " has no triangles: the distance is undefined"};
+    if (mesh.triangleCount() > UINT32_MAX || mesh.vertices.count > UINT32_MAX) {
+        return Error{ErrorCode::kInvalidArgument, name + ": at most 2^32 - 1 triangles and vertices, not " +
+                                                      std::to_string(mesh.triangleCount()) +
+                                                      " triangles of " + std::to_string(mesh.vertices.count) +
+                                                      " vertices"};
+    }
+    const auto it = std::find_if(mesh.indices.begin(), mesh.indices.end(),
+                                 [&](uint32_t v) { return v >= mesh.vertices.count; });
+    if (it == mesh.indices.end()) return std::nullopt;
+    const auto at = size_t(it - mesh.indices.begin());
+    return Error{ErrorCode::kInvalidArgument,
+                 name + ": triangle " + std::to_string(at / 3) + ": vertex index " + std::to_string(*it) +
+                     " out of range (" + std::to_string(mesh.vertices.count) + " vertices)"};
+}
+
+// The mesh checked and summarized (its box), or the error naming it.
+Result<core::SetSummary> checkMesh(const MeshView& mesh, const char* set, int threads) {
+    const std::string name = std::string("surface ") + set;
+    if (auto err = core::checkShape(mesh.vertices, set)) return *err;
+    if (auto err = checkTriangles(mesh, name)) return *err;
+    Result<core::SetSummary> s = core::summarizeSet(mesh.vertices, set, threads);
+    if (!s) return s.error();
+    if (magnitudeOf(s->box) > kMaxMagnitude) {
+        return Error{ErrorCode::kInvalidArgument, name + ": a coordinate of magnitude " +
+                                                      number(magnitudeOf(s->box)) +
+                                                      " is past the surface limit of 2^250 (~1.8e75)"};
+    }
+    return s;
+}
+
+// The mesh's vertices in the work frame: p - origin, in double.
+std::vector<glm::dvec3> shifted(const MeshView& mesh, const glm::dvec3& origin) {
+    std::vector<glm::dvec3> v(mesh.vertices.count);
+    for (size_t i = 0; i < v.size(); ++i) v[i] = mesh.vertices.at(i) - origin;
+    return v;
+}
+
+Result<double> resolveTolerance(double requested, double diagonal, double slack) {
+    if (!std::isfinite(requested) || requested < 0.0)
+        return Error{ErrorCode::kInvalidArgument,
+                     "tolerance must be a finite distance >= 0, not " + number(requested)};
+    const double tolerance = requested > 0.0 ? requested : kDefaultRelativeTolerance * diagonal;
+    const double floor = 4.0 * slack;
+    if (tolerance >= floor) return tolerance;
+    return Error{
+        ErrorCode::kInvalidArgument,
+        "tolerance " + number(tolerance) + " is below the rounding floor " + number(floor) +
+            " of these meshes (4 x 2^-40 of their largest coordinate around the centre of their box)"};
+}
+
+void shiftBack(SurfaceBoundsDirected& d, const glm::dvec3& origin) {
+    d.fromPoint += origin;
+    d.toPoint += origin;
+}
+
+}  // namespace
+
+Result<SurfaceBoundsResult> surfaceHausdorff(MeshView a, MeshView b, const SurfaceBoundsOptions& options) {
+    const core::Clock::time_point start = core::Clock::now();
+    if (options.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
+    const api::Plan plan = api::planSurfaceRoute(options.backend);
+    if (plan.route == api::Route::kRefused) return Error{plan.code, plan.reason};
+    Result<core::SetSummary> sa = checkMesh(a, "A", options.threads);
+    if (!sa) return sa.error();
+    Result<core::SetSummary> sb = checkMesh(b, "B", options.threads);
+    if (!sb) return sb.error();
+
+    const glm::dvec3 lo = glm::min(sa->box.lo, sb->box.lo), hi = glm::max(sa->box.hi, sb->box.hi);
+    const glm::dvec3 origin = (lo * 0.5) + (hi * 0.5);  // halves first: no overflow near the limit
+    const std::vector<glm::dvec3> va = shifted(a, origin), vb = shifted(b, origin);
+    const double magnitude = std::max(magnitudeOf({lo - origin, hi - origin}), 0.0);
+    const double slack = core::closestSlack(magnitude);
+    Result<double> tolerance = resolveTolerance(options.tolerance, glm::distance(lo, hi), slack);
+    if (!tolerance) return tolerance.error();
+
+    const MeshView wa{PointView(va), a.indices}, wb{PointView(vb), b.indices};
+    Result<SurfaceBoundsResult> result = cpu::surfaceBounds(wa, wb, *tolerance, slack, options);
+    if (!result) return result;
+    result->tolerance = *tolerance;
+    result->origin = origin;
+    shiftBack(result->aToB, origin);
+    if (!options.directedOnly) shiftBack(result->bToA, origin);
+    result->totalMs = core::msSince(start);
+    return result;
+}
+
+}  // namespace rthdist

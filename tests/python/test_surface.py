@@ -1,0 +1,115 @@
+"""Triangle surfaces from Python (rthdist.hausdorff_to_surface,
+surface_hausdorff, evaluate): NumPy vertex + face arrays of every accepted
+dtype; point-to-surface values known in closed form (points over a flat
+square: |z|); surface-to-surface bounds bracketing known values within the
+tolerance; the evaluation summary against an independent NumPy brute force
+on a pair of a few thousand points (fixed seed, conftest.SEED); bad faces
+and thresholds as ValueError naming them."""
+
+import numpy as np
+import pytest
+
+import rthdist
+
+SQUARE_V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=np.float64)
+SQUARE_F = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+@pytest.mark.parametrize("vdtype", [np.float32, np.float64])
+@pytest.mark.parametrize("fdtype", [np.int32, np.int64, np.uint32])
+def test_points_over_a_square_are_their_height(rng, vdtype, fdtype):
+    pts = np.column_stack([rng.uniform(0, 1, 500), rng.uniform(0, 1, 500), rng.uniform(-1, 1, 500)])
+    r = rthdist.hausdorff_to_surface(pts, SQUARE_V.astype(vdtype), SQUARE_F.astype(fdtype), per_point=True)
+    assert r["hausdorff"] == np.abs(pts[:, 2]).max()
+    assert r["query_index"] == int(np.argmax(np.abs(pts[:, 2])))
+    np.testing.assert_array_equal(r["distances"], np.abs(pts[:, 2]))
+    q = pts[r["query_index"]]
+    assert r["surface_point"] == (q[0], q[1], 0.0)
+    assert r["backend"] == "cpu"
+
+
+def test_triangle_and_its_offset_copy():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float64)
+    f = np.array([[0, 1, 2]], dtype=np.int32)
+    r = rthdist.surface_hausdorff(v, f, v + [0, 0, 0.25], f, tolerance=1e-9)
+    lower, upper = r["bounds"]
+    assert lower <= 0.25 <= upper and upper - lower <= 1e-9
+    assert r["a_to_b"]["distance"] == 0.25
+    assert r["a_to_b"]["to_point"][2] == 0.25
+    d = rthdist.surface_hausdorff(v, f, v + [0, 0, 0.25], f, directed=True)
+    assert d["directed"] and d["b_to_a"] is None
+
+
+def test_square_split_both_ways_is_zero():
+    other = np.array([[0, 1, 3], [1, 2, 3]], dtype=np.uint32)
+    r = rthdist.surface_hausdorff(SQUARE_V, SQUARE_F, SQUARE_V, other, tolerance=1e-3)
+    assert r["bounds"][0] == 0.0 and r["bounds"][1] <= 1e-3
+
+
+def _nearest(q, t):
+    """Every row of q's distance to its nearest row of t: NumPy, in blocks."""
+    out = np.empty(len(q))
+    for i in range(0, len(q), 500):
+        d2 = ((q[i:i + 500, None, :] - t[None, :, :]) ** 2).sum(axis=2)
+        out[i:i + 500] = np.sqrt(d2.min(axis=1))
+    return out
+
+
+def _expected(acc, comp, taus, cap):
+    def side(d):
+        kept = d[d < cap] if cap > 0 else d
+        return {"count": len(d), "kept": len(kept), "mean": kept.mean(), "median": np.median(kept),
+                "mean_squared": (kept ** 2).mean(), "max": kept.max()}
+    a, c = side(acc), side(comp)
+    rows = []
+    for t in taus:
+        p, r = (acc < t).mean(), (comp < t).mean()
+        rows.append({"threshold": t, "precision": p, "recall": r, "fscore": 2 * p * r / (p + r) if p + r else 0.0})
+    return a, c, rows
+
+
+@pytest.mark.parametrize("cap", [0.0, 0.08])
+def test_evaluation_matches_numpy(rng, cap):
+    def sphere(n, noise):
+        v = rng.normal(size=(n, 3))
+        return v / np.linalg.norm(v, axis=1)[:, None] * (1 + rng.uniform(-noise, noise, (n, 1)))
+    recon, truth = sphere(3000, 0.05), sphere(2500, 0.0)
+    truth[truth[:, 2] > 0.8] *= 1.3  # a part the reconstruction misses
+    taus = [0.01, 0.05, 0.2]
+    s = rthdist.evaluate(recon, truth, taus, cap=cap, backend="cpu")
+    a, c, rows = _expected(_nearest(recon, truth), _nearest(truth, recon), taus, cap)
+    for got, want in ((s["accuracy"], a), (s["completeness"], c)):
+        assert got["count"] == want["count"] and got["kept"] == want["kept"]
+        for key in ("mean", "median", "mean_squared", "max"):
+            assert got[key] == pytest.approx(want[key], rel=1e-12), key
+    assert s["chamfer"]["mean_of_means"] == pytest.approx((a["mean"] + c["mean"]) / 2, rel=1e-12)
+    assert s["chamfer"]["sum_of_means"] == pytest.approx(a["mean"] + c["mean"], rel=1e-12)
+    assert s["chamfer"]["sum_of_mean_squares"] == pytest.approx(a["mean_squared"] + c["mean_squared"], rel=1e-12)
+    for got, want in zip(s["thresholds"], rows):
+        assert got == pytest.approx(want, rel=1e-12)
+    assert s["cap"] == (cap if cap > 0 else None)
+    if cap > 0:
+        assert s["completeness"]["kept"] < s["completeness"]["count"]
+
+
+def test_evaluation_to_a_surface():
+    recon = np.array([[0.5, 0.5, 1.0], [0.0, 0.0, 0.0]])
+    s = rthdist.evaluate(recon, SQUARE_V, 0.5, faces=SQUARE_F)
+    assert s["accuracy"]["mean"] == 0.5 and s["accuracy"]["max"] == 1.0
+    assert s["completeness"]["count"] == 4 and s["completeness"]["median"] == 1.0
+    assert s["thresholds"][0]["recall"] == 0.25
+
+
+def test_bad_faces_and_thresholds_are_value_errors():
+    with pytest.raises(ValueError, match="face 1: vertex index 4 out of range"):
+        rthdist.hausdorff_to_surface(SQUARE_V, SQUARE_V, np.array([[0, 1, 2], [0, 2, 4]]))
+    with pytest.raises(ValueError, match="face 0: vertex index -1"):
+        rthdist.hausdorff_to_surface(SQUARE_V, SQUARE_V, np.array([[0, 1, -1]], dtype=np.int32))
+    with pytest.raises(ValueError, match="faces"):
+        rthdist.hausdorff_to_surface(SQUARE_V, SQUARE_V, SQUARE_F.astype(np.float32))
+    with pytest.raises(ValueError, match=r"\(F, 3\)"):
+        rthdist.surface_hausdorff(SQUARE_V, SQUARE_F.ravel(), SQUARE_V, SQUARE_F)
+    with pytest.raises(ValueError, match="evaluation threshold 0"):
+        rthdist.evaluate(SQUARE_V, SQUARE_V, [0.0])
+    with pytest.raises(ValueError, match="tolerance"):
+        rthdist.surface_hausdorff(SQUARE_V, SQUARE_F, SQUARE_V, SQUARE_F, tolerance=-1.0)
