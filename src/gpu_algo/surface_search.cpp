@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "gpu/barriers.hpp"
+#include "gpu/device_limits.hpp"
 #include "gpu_algo/workspace.hpp"
 #include "rthdist_surface_search.h"
 
