@@ -29,7 +29,7 @@ struct SurfaceSearchPush {
     float settled2;  // a query whose best is at most this was settled by an earlier radius
     float rayTMax;
     uint slotBase;  // rt-pipeline: first query of this trace (traces are split by the device's limit)
-    uint pad;
+    uint mutant;    // 1: core::searchMutant (tests only): every third triangle is skipped
 };
 
 #ifdef __cplusplus

@@ -201,6 +201,7 @@ void SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled
     // Rounded down: a query is settled only when its best is within the radius.
     sp.settled2 = settled2 < 0.0 ? -1.0f : std::nextafter(float(settled2), 0.0f);
     sp.rayTMax = float(m_rayTMax);
+    sp.mutant = m_ws.mutant ? 1u : 0u;
     if (m_ws.rayQuery) {
         m_ws.dispatch(cmd, Kernel::kSurfaceSearchRayQuery, sp, m_queries);
         return;

@@ -15,6 +15,7 @@
 
 #include "common/surface_brute_force.hpp"
 #include "common/surface_cases.hpp"
+#include "core/search_mutant.hpp"
 #include "gpu_algo/gpu_test_support.hpp"
 #include "rthdist/surface.hpp"
 
@@ -123,6 +124,34 @@ TEST(GpuSurface, TiesGoToTheSmallestTriangleAndQuery) {
     test::SurfaceCase c{"ties", 3434, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {2, 1, 0, 0, 1, 2, 1, 2, 0}, {}};
     c.queries = {{0.2, 0.2, -1.0}, {0.2, 0.2, 1.0}, {0.1, 0.3, 1.0}, {0.2, 0.2, -1.0}};
     expectBruteForce(c, backend);
+}
+
+// A device search that misses every third triangle (core::searchMutant):
+// queries settle on triangles that are not their nearest, or on none; the
+// host's proof searches them again and the value is still the brute
+// force's.
+TEST(GpuSurface, AMissingSearchIsCaughtByTheProof) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    struct Mutant {
+        Mutant() { core::searchMutant() = true; }
+        ~Mutant() { core::searchMutant() = false; }
+    };
+    uint64_t clean = 0, missing = 0;
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        Result<SurfaceResult> r = onDevice(c, backend);
+        ASSERT_TRUE(r) << c.name << ": " << r.error().message;
+        clean += r->directed.counters.band;
+        const Mutant mutant;
+        expectBruteForce(c, backend);
+        r = onDevice(c, backend);
+        ASSERT_TRUE(r) << c.name << ": " << r.error().message;
+        missing += r->directed.counters.band;
+    }
+    // The missed triangles showed: the proof searched more queries again.
+    std::printf("band %llu with the mutant, %llu without\n", static_cast<unsigned long long>(missing),
+                static_cast<unsigned long long>(clean));
+    EXPECT_GT(missing, clean);
 }
 
 TEST(GpuSurface, PerPointDistancesAreRefusedNotReplaced) {
