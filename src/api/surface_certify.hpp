@@ -9,11 +9,12 @@
 //   2. q* = the query of largest U (smallest index on a tie) is measured
 //      against every triangle: L = d(q*) <= h.
 //   3. A query with U(q) < L has d(q) < L <= h: it neither realizes h nor
-//      ties it. The others (the band, U(q) >= L, q* among them) are searched
-//      exactly by the CPU backend's BVH search (cpu/surface_search.hpp, its
-//      own proof and witness check), in index order, so its answer is h
-//      with the brute force's witness (ties: smallest triangle, smallest
-//      query).
+//      ties it. The others (the band, U(q) >= L, q* among them) are
+//      measured exactly, in index order: against every triangle while the
+//      band times the triangles is small (the usual band of one query),
+//      else by the CPU backend's BVH search (cpu/surface_search.hpp, its
+//      own proof and witness check); so the answer is h with the brute
+//      force's witness (ties: smallest triangle, smallest query).
 // Good candidates make the band small (the queries within the float
 // search's rounding of the maximum); bad ones only make it larger.
 #pragma once

@@ -78,6 +78,29 @@ TEST(SurfaceCertify, AnyCandidatesGiveTheBruteForce) {
     }
 }
 
+// A small band is measured against every triangle, a large one (no
+// candidates: every query is in it) by the CPU backend's BVH search.
+TEST(SurfaceCertify, ALargeBandTakesTheBvhSearch) {
+    test::SurfaceCase c = test::heightField(3437, 64, 32.0);
+    test::Rng rng(3437);
+    for (int i = 0; i < 2100; ++i)
+        c.queries.emplace_back(rng.uniform(-1, 33), rng.uniform(-1, 33), rng.uniform(-4, 4));
+    std::printf("%s: seed %llu, %zu triangles, %zu queries\n", c.name.c_str(),
+                static_cast<unsigned long long>(c.seed), c.indices.size() / 3, c.queries.size());
+    const oracle::SurfaceDirectedExact want = oracle::bruteForceSurface(c.queries, c.vertices, c.indices);
+    std::vector<uint32_t> nearest(c.queries.size()), none(c.queries.size(), UINT32_MAX);
+    for (size_t q = 0; q < c.queries.size(); ++q) nearest[q] = want.perQuery[q].triangle;
+    const Result<SurfaceResult> small = certify(c, nearest);
+    expectExact(c, small, want, "nearest");
+    ASSERT_TRUE(small);
+    EXPECT_EQ(small->directed.counters.bvhNodes, 0u);
+    const Result<SurfaceResult> large = certify(c, none);
+    expectExact(c, large, want, "none");
+    ASSERT_TRUE(large);
+    EXPECT_EQ(large->directed.counters.band, c.queries.size());
+    EXPECT_GT(large->directed.counters.bvhNodes, 0u);
+}
+
 TEST(SurfaceCertify, PerPointAndWrongSizesAreErrors) {
     const test::SurfaceCase c = test::heightField(3436, 4, 1.0);
     const std::vector<glm::dvec3> points{{0.5, 0.5, 1.0}, {0.25, 0.5, -1.0}};
