@@ -37,15 +37,25 @@
 //   finite. Violations: kInvalidArgument (kBadInput for NaN/Inf), naming
 //   the set, the vertex or the triangle.
 //
-// Backends: the CPU backend only, for now. Backend::kAuto and kCpu run on
-//   it (SurfaceResult::backend says kCpu); kRayQuery and kRtPipeline are
-//   refused with kInvalidArgument ("surfaces run on the CPU backend for
-//   now"), never computed on the CPU in their place.
+// Backends: Backend::kAuto and kCpu run on the CPU backend (a GPU call
+//   opens its device per call, so auto keeps the CPU). kRayQuery and
+//   kRtPipeline search on the device (design.md §11, "The GPU backends"):
+//   triangle boxes in a BLAS grown by a radius, each query's nearest
+//   triangle measured by the same rule in float; the directed maximum is
+//   then proven on the host in double (the queries whose float nearest
+//   triangle measures in double at or above the largest query's exact
+//   value are searched again exactly by the CPU backend's BVH), so the
+//   value and witness are the same as on the CPU backend (==), whatever
+//   the float search found. perPointDistances on a GPU backend is
+//   kInvalidArgument (per-point values come from the CPU backend for now).
 //
-// Threading: reentrant; the search runs on SurfaceOptions::threads threads
-//   of the library's worker pool. Memory: at most 132 bytes per triangle
-//   (its corners in double and at most one 56-byte BVH node), plus 44 bytes
-//   per point with perPointDistances.
+// Threading: reentrant; the search (on a GPU backend: the proof) runs on
+//   SurfaceOptions::threads threads of the library's worker pool.
+// Memory: at most 132 bytes per triangle (its corners in double and at
+//   most one 56-byte BVH node), plus 44 bytes per point with
+//   perPointDistances. GPU backends: on the device 104 bytes per triangle
+//   and 24 per point (and the BLAS), on the host 36 per triangle and 24
+//   per point more.
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -72,6 +82,11 @@ struct SurfaceOptions {
     bool perPointDistances = false;
     // Read at every chunk of 256 queries: true -> kCancelled.
     const std::atomic<bool>* cancel = nullptr;
+    // GPU backends: the Vulkan device (listDevices() index; -1: the first
+    // that runs the backend) and the validation layer, whose messages are
+    // counted (SurfaceResult::validationMessages), as EngineOptions.
+    int deviceIndex = -1;
+    bool validation = false;
 };
 
 // What the search did (diagnostics; not part of the exactness contract).
@@ -82,6 +97,10 @@ struct SurfaceCounters {
     uint64_t nodesVisited = 0;     // BVH nodes whose box was tested, over all queries
     uint64_t trianglesTested = 0;  // point-triangle evaluations, over all queries
     uint64_t dominated = 0;        // queries stopped early: a triangle nearer than the running maximum
+    // GPU backends: the device search and the host's proof.
+    uint32_t radii = 0;  // radii searched on the device
+    uint64_t rays = 0;   // rays cast over all radii
+    uint64_t band = 0;   // queries searched again exactly on the host (the others are proven below h)
 };
 
 // h(points, surface) with its witness.
@@ -107,10 +126,14 @@ struct SurfaceResult {
     SurfaceDirected directed;
     SurfacePerPoint perPoint;
     Backend backend = Backend::kCpu;  // the backend that ran
-    std::string device;               // "cpu"
+    std::string device;               // "cpu", or the device's name
     double buildMs = 0.0;             // the BVH over the triangles
     double searchMs = 0.0;            // every query's nearest triangle (and the witness's check)
     double totalMs = 0.0;             // the whole call, checks included
+    // GPU backends: device setup, the device's search and the host's proof
+    // (buildMs: the device and its pipelines; searchMs: the rest).
+    double gpuMs = 0.0;               // device time of the search
+    uint64_t validationMessages = 0;  // with SurfaceOptions::validation
 };
 
 // h(points, surface): the points' distances to the surface and the largest

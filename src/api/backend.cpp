@@ -53,6 +53,11 @@ Result<HausdorffResult> ComputeBackend::computeDeviceViews(const DevicePointView
     return notOffered("device views");
 }
 
+Result<TriangleCandidates> ComputeBackend::nearestTriangles(std::span<const glm::vec3>,
+                                                            std::span<const glm::vec3>) {
+    return notOffered("triangle search");
+}
+
 Result<DeviceViewSet> ComputeBackend::prepareDeviceView(const DevicePointView&,
                                                         const std::optional<glm::dvec3>&, int,
                                                         const std::string&) {

@@ -46,6 +46,17 @@ struct DeviceViewSet {
 
 using BackendSetPair = std::pair<const BackendSet*, const BackendSet*>;
 
+// The point-to-surface search of a backend that searches in float
+// (design.md §11): every query's nearest triangle as it found it
+// (UINT32_MAX: none), a candidate the caller proves in double
+// (api/surface_certify.hpp).
+struct TriangleCandidates {
+    std::vector<uint32_t> triangle;
+    uint32_t radii = 0;  // radii searched
+    uint64_t rays = 0;   // rays cast
+    double gpuMs = 0.0;  // device time
+};
+
 class ComputeBackend {
 public:
     virtual ~ComputeBackend() = default;
@@ -95,6 +106,11 @@ public:
     [[nodiscard]] virtual Result<DeviceViewSet> prepareDeviceView(const DevicePointView& points,
                                                                   const std::optional<glm::dvec3>& origin,
                                                                   int bits, const std::string& name);
+
+    // Route::kSurfaceGpu: queries and triangle corners (3 per triangle) in
+    // one float frame, on the first device.
+    [[nodiscard]] virtual Result<TriangleCandidates> nearestTriangles(std::span<const glm::vec3> queries,
+                                                                      std::span<const glm::vec3> corners);
 
     // Frees what every lane keeps between one-shot calls (out_of_core.hpp's `release`).
     virtual void releaseScratch() {}

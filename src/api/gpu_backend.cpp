@@ -159,6 +159,13 @@ public:
         return DeviceViewSet{std::make_shared<GpuSet>(std::move(g->set)), g->summary, g->origin};
     }
 
+    [[nodiscard]] Result<TriangleCandidates> nearestTriangles(std::span<const glm::vec3> queries,
+                                                              std::span<const glm::vec3> corners) override {
+        auto found = gpu().nearestTriangles(queries, corners);
+        if (!found) return found.error();
+        return TriangleCandidates{std::move(found->triangle), found->radii, found->rays, found->gpuMs};
+    }
+
     void releaseScratch() override {
         for (const auto& lane : m_lanes) lane->gpu->releaseScratch();
     }

@@ -96,15 +96,20 @@ const char* routeName(Route route) {
         case Route::kPrepared: return "prepared";
         case Route::kDeviceViews: return "device views";
         case Route::kSurfaceCpu: return "surface (cpu)";
+        case Route::kSurfaceGpu: return "surface (gpu)";
     }
     return "?";
 }
 
-Plan planSurfaceRoute(Backend requested) {
+Plan planSurfaceRoute(Backend requested, bool perPoint) {
     if (requested == Backend::kCpu || requested == Backend::kAuto) return routed(Route::kSurfaceCpu);
-    return refused(ErrorCode::kInvalidArgument,
-                   std::string("point-to-surface distances run on the CPU backend for now: the ") +
-                       backendName(requested) + " backend cannot search triangles (use backend cpu or auto)");
+    if (perPoint)
+        return refused(
+            ErrorCode::kInvalidArgument,
+            std::string("per-point distances to a surface come from the CPU backend for now: the ") +
+                backendName(requested) +
+                " backend proves the directed maximum only (use backend cpu or auto)");
+    return routed(Route::kSurfaceGpu);
 }
 
 Plan planFramedCall(uint64_t a, uint64_t b, const CallOptions& call, const MemoryBudget& budget,

@@ -25,8 +25,10 @@
 //       kRefused        a backend that reads no device views, or past the budget
 //       kDeviceViews    ingested and searched on the device
 //   a point set against a triangle surface (hausdorffToSurface, planSurfaceRoute):
-//       kRefused        a GPU backend named by the caller (none searches triangles yet)
-//       kSurfaceCpu     the CPU backend's triangle BVH (api/surface.cpp)
+//       kRefused        per-point distances on a GPU backend (the CPU backend gives them)
+//       kSurfaceCpu     the CPU backend's triangle BVH (api/surface.cpp); also kAuto
+//       kSurfaceGpu     a GPU backend named by the caller: the device's float search
+//                       over triangle boxes, proven in double on the host (api/surface_gpu.cpp)
 // The pieces of kPieces and kSeveralDevices are planned as framed pairs
 // (planFramedCall): a small piece is scanned whole.
 #pragma once
@@ -51,6 +53,7 @@ enum class Route {
     kPrepared,
     kDeviceViews,
     kSurfaceCpu,
+    kSurfaceGpu,
 };
 
 [[nodiscard]] const char* routeName(Route route);
@@ -99,11 +102,13 @@ struct Plan {
                              const BackendCaps& caps);
 
 // The route of a point set against a triangle surface, chosen before any
-// backend is opened: Backend::kCpu and kAuto take kSurfaceCpu (the CPU
-// backend is the one that searches triangles for now, so kAuto picks it);
-// a GPU backend the caller named is kRefused with kInvalidArgument, never
-// computed on the CPU in its place.
-[[nodiscard]] Plan planSurfaceRoute(Backend requested);
+// backend is opened: Backend::kCpu and kAuto take kSurfaceCpu (a GPU call
+// opens a device per call, whose setup outweighs the CPU search at the
+// sizes one call takes for now, so kAuto picks the CPU); a GPU backend the
+// caller named takes kSurfaceGpu, or kRefused (kInvalidArgument) with
+// per-point distances, which only the CPU backend gives: never computed on
+// the CPU in its place.
+[[nodiscard]] Plan planSurfaceRoute(Backend requested, bool perPoint = false);
 
 // The route of a pair already checked and framed on the host (float sets of
 // one frame and scale): kSmallPairScan, kOneCall, kSeveralDevices or kPieces.

@@ -2,9 +2,8 @@
 // the inputs checked (shape, finite coordinates, triangle indices, the
 // rule's magnitude limit), the route chosen (api::planSurfaceRoute: the CPU
 // backend, or a refusal naming the backend), then the CPU backend's search
-// (cpu/surface_search.hpp). The route runs the CPU search directly: no GPU
-// backend searches triangles yet; when one does, the search becomes a
-// method of api::ComputeBackend and this file opens the backend.
+// (cpu/surface_search.hpp), or on a GPU backend the device's search proven
+// on the host (api/surface_gpu.hpp: it opens the backend).
 #include "rthdist/surface.hpp"
 
 #include <glm/common.hpp>
@@ -15,6 +14,7 @@
 #include <string>
 
 #include "api/route_planner.hpp"
+#include "api/surface_gpu.hpp"
 #include "core/input_frame.hpp"
 #include "core/stopwatch.hpp"
 #include "cpu/surface_search.hpp"
@@ -67,7 +67,7 @@ std::optional<Error> checkTriangles(const MeshView& surface) {
 Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, const SurfaceOptions& options) {
     const core::Clock::time_point start = core::Clock::now();
     if (options.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
-    const api::Plan plan = api::planSurfaceRoute(options.backend);
+    const api::Plan plan = api::planSurfaceRoute(options.backend, options.perPointDistances);
     if (plan.route == api::Route::kRefused) return Error{plan.code, plan.reason};
     if (auto err = core::checkShape(points, "A")) return *err;
     if (auto err = core::checkShape(surface.vertices, "B")) return *err;
@@ -79,7 +79,9 @@ Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, con
     if (auto err = checkMagnitude(a->box, "point set A")) return *err;
     if (auto err = checkMagnitude(b->box, "point set B")) return *err;
     const double magnitude = std::max(magnitudeOf(a->box), magnitudeOf(b->box));
-    Result<SurfaceResult> result = cpu::surfaceSearch(points, surface, magnitude, options);
+    Result<SurfaceResult> result = plan.route == api::Route::kSurfaceGpu
+                                       ? api::surfaceOnGpu(points, surface, *a, *b, magnitude, options)
+                                       : cpu::surfaceSearch(points, surface, magnitude, options);
     if (result) result->totalMs = core::msSince(start);
     return result;
 }

@@ -2,7 +2,9 @@
 // while set, the GPU backends' neighbourhood pass skips each query's own cell
 // and their refinement drops every third candidate pair, and the CPU
 // backend's tree search skips every third bucket, so that queries settle
-// with a target that is not their nearest. The certificate must catch every
+// with a target that is not their nearest; the GPU backends' surface
+// search skips every third triangle (its host proof must still give the
+// brute force: api/surface_certify.hpp). The certificate must catch every
 // wrong value this makes and the Engine recompute it (api/certify.hpp), whose
 // CPU recomputation runs with the mutant paused. Off unless a test sets it;
 // one process-wide flag, read when a backend call starts.

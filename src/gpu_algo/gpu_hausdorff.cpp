@@ -591,4 +591,18 @@ const std::string& GpuHausdorff::pipelineCacheStatus() const {
     return m_state->ws.pipelineCache.loadStatus();
 }
 
+Result<SurfaceCandidates> GpuHausdorff::nearestTriangles(std::span<const glm::vec3> queries,
+                                                         std::span<const glm::vec3> corners) {
+    Timings timings;
+    SurfaceCandidates out;
+    auto err = m_state->guarded(timings, [&] {
+        out = SurfaceSearch(m_state->ws).run(queries, corners);
+        // The BLAS of triangles is no point search's: the next call builds its own.
+        m_state->ws.accel.release();
+        m_state->ws.tlasBound = false;
+    });
+    if (err) return *err;
+    return out;
+}
+
 }  // namespace rthdist::gpu_algo

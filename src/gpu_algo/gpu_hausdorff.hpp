@@ -26,6 +26,7 @@
 #include "core/input_frame.hpp"
 #include "core/scan_limits.hpp"
 #include "gpu_algo/set_points.hpp"
+#include "gpu_algo/surface_search.hpp"
 #include "rthdist/rthdist.hpp"
 
 namespace rthdist::gpu {
@@ -158,6 +159,12 @@ public:
     // faults cost about as much as the read-back itself (10^8 queries);
     // `b` serves the next h(B,A) (Engine::recycle).
     void recyclePerPoint(PerPoint&& a, PerPoint&& b = PerPoint{});
+
+    // The point-to-surface search (surface_search.hpp): every query's
+    // nearest triangle as the device found it, a candidate the caller proves
+    // in double. queries and corners (3 per triangle) in one float frame.
+    [[nodiscard]] Result<SurfaceCandidates> nearestTriangles(std::span<const glm::vec3> queries,
+                                                             std::span<const glm::vec3> corners);
 
     struct State;
 

@@ -48,6 +48,10 @@
 #include "search_rq.comp.h"
 #include "sweep_targets.comp.h"
 #include "tail_scan.comp.h"
+// The point-to-surface search (prepareSurfaceSearch).
+#include "surface_search.rgen.h"
+#include "surface_search.rint.h"
+#include "surface_search_rq.comp.h"
 
 namespace rthdist::gpu {
 
@@ -97,6 +101,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_cert_witness_comp, "cert_witness"},
     {k_spv_sweep_targets_comp, "sweep_targets"},
     {k_spv_leaf_first_comp, "leaf_first"},
+    {k_spv_surface_search_rq_comp, "surface_search_rq"},
 }};
 
 }  // namespace
@@ -151,6 +156,7 @@ void Pipelines::createLayout() {
 void Pipelines::createComputePipelines(VkPipelineCache cache) {
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !m_rayQuery) continue;
+        if (Kernel(k) == Kernel::kSurfaceSearchRayQuery) continue;  // prepareSurfaceSearch
         // Float64 SPIR-V is valid only on a device with shaderFloat64 enabled.
         if ((Kernel(k) == Kernel::kIngestF64 || Kernel(k) == Kernel::kProbeLevels) && !m_ctx.shaderFloat64())
             continue;
@@ -160,10 +166,16 @@ void Pipelines::createComputePipelines(VkPipelineCache cache) {
 }
 
 void Pipelines::createRtPipeline(VkPipelineCache cache) {
+    m_rtPipeline = createRtPipelineOf(cache, k_spv_search_rgen, k_spv_search_rmiss, k_spv_search_rint,
+                                      "search_rt_pipeline");
+}
+
+UniquePipeline Pipelines::createRtPipelineOf(VkPipelineCache cache, std::span<const uint32_t> rgen,
+                                             std::span<const uint32_t> rmiss, std::span<const uint32_t> rint,
+                                             const char* name) {
     const VkDevice d = m_ctx.device();
-    const UniqueShaderModule mods[3] = {createShaderModule(d, k_spv_search_rgen),
-                                        createShaderModule(d, k_spv_search_rmiss),
-                                        createShaderModule(d, k_spv_search_rint)};
+    const UniqueShaderModule mods[3] = {createShaderModule(d, rgen), createShaderModule(d, rmiss),
+                                        createShaderModule(d, rint)};
     const VkShaderStageFlagBits kinds[3] = {VK_SHADER_STAGE_RAYGEN_BIT_KHR, VK_SHADER_STAGE_MISS_BIT_KHR,
                                             VK_SHADER_STAGE_INTERSECTION_BIT_KHR};
     VkPipelineShaderStageCreateInfo st[3]{};
@@ -195,13 +207,20 @@ void Pipelines::createRtPipeline(VkPipelineCache cache) {
     rci.layout = m_layout.get();
     VkPipeline pipeline;
     RTHDIST_VK_CHECK(m_ctx.rt().createRtPipelines(d, VK_NULL_HANDLE, cache, 1, &rci, nullptr, &pipeline));
-    m_rtPipeline = UniquePipeline(pipeline, d);
-    m_ctx.setDebugName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline), "search_rt_pipeline");
+    m_ctx.setDebugName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline), name);
+    return UniquePipeline(pipeline, d);
 }
 
 // Shader binding table: raygen | miss | hit, each region aligned to the base
 // alignment; the buffer's address is rounded up, so over-allocate.
 void Pipelines::createShaderBindingTable() {
+    createShaderBindingTableOf(m_rtPipeline.get(), m_sbt, m_raygen, m_miss, m_hit);
+}
+
+void Pipelines::createShaderBindingTableOf(VkPipeline pipeline, Buffer& sbt,
+                                           VkStridedDeviceAddressRegionKHR& raygen,
+                                           VkStridedDeviceAddressRegionKHR& miss,
+                                           VkStridedDeviceAddressRegionKHR& hit) {
     const auto& props = m_ctx.rtProps();
     const uint32_t handleSize = props.shaderGroupHandleSize;
     const VkDeviceSize stride = alignUp(handleSize, props.shaderGroupHandleAlignment);
@@ -209,16 +228,16 @@ void Pipelines::createShaderBindingTable() {
     const VkDeviceSize region = alignUp(stride, base);
     std::vector<uint8_t> handles(3 * handleSize);
     RTHDIST_VK_CHECK(
-        m_ctx.rt().getGroupHandles(m_ctx.device(), m_rtPipeline.get(), 0, 3, handles.size(), handles.data()));
-    m_sbt = Buffer(m_ctx, 3 * region + base,
-                   VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                   MemoryKind::kHost);
-    const VkDeviceAddress start = alignUp(m_sbt.address(), base);
-    auto* bytes = static_cast<uint8_t*>(m_sbt.mapped()) + (start - m_sbt.address());
+        m_ctx.rt().getGroupHandles(m_ctx.device(), pipeline, 0, 3, handles.size(), handles.data()));
+    sbt = Buffer(m_ctx, 3 * region + base,
+                 VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                 MemoryKind::kHost);
+    const VkDeviceAddress start = alignUp(sbt.address(), base);
+    auto* bytes = static_cast<uint8_t*>(sbt.mapped()) + (start - sbt.address());
     for (int i = 0; i < 3; ++i) std::memcpy(bytes + i * region, handles.data() + i * handleSize, handleSize);
-    m_raygen = {start, stride, stride};
-    m_miss = {start + region, stride, stride};
-    m_hit = {start + 2 * region, stride, stride};
+    raygen = {start, stride, stride};
+    miss = {start + region, stride, stride};
+    hit = {start + 2 * region, stride, stride};
 }
 
 void Pipelines::bindTlas(VkAccelerationStructureKHR tlas) {
@@ -237,7 +256,7 @@ void Pipelines::bindTlas(VkAccelerationStructureKHR tlas) {
 void Pipelines::cmdBindCompute(VkCommandBuffer cmd, Kernel kernel, const void* push,
                                uint32_t pushSize) const {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_compute[size_t(kernel)].get());
-    if (kernel == Kernel::kSearchRayQuery)
+    if (kernel == Kernel::kSearchRayQuery || kernel == Kernel::kSurfaceSearchRayQuery)
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_layout.get(), 0, 1, &m_set, 0,
                                 nullptr);
     vkCmdPushConstants(cmd, m_layout.get(), m_stages, 0, pushSize, push);
@@ -281,6 +300,29 @@ void Pipelines::cmdTraceRaysIndirect(VkCommandBuffer cmd, const void* push, uint
                                      VkDeviceAddress args) const {
     cmdBindRt(cmd, push, pushSize);
     m_ctx.rt().cmdTraceRaysIndirect(cmd, &m_raygen, &m_miss, &m_hit, &m_callable, args);
+}
+
+void Pipelines::prepareSurfaceSearch(VkPipelineCache cache) {
+    const auto k = size_t(Kernel::kSurfaceSearchRayQuery);
+    if (m_rayQuery && !m_compute[k]) {
+        m_compute[k] = createComputePipeline(m_ctx, kComputeSpirv[k].code, m_layout.get(), cache,
+                                             VK_PIPELINE_CREATE_DISPATCH_BASE_BIT, kComputeSpirv[k].name);
+    } else if (!m_rayQuery && !m_surfaceRt) {
+        m_surfaceRt = createRtPipelineOf(cache, k_spv_surface_search_rgen, k_spv_search_rmiss,
+                                         k_spv_surface_search_rint, "surface_search_rt_pipeline");
+        createShaderBindingTableOf(m_surfaceRt.get(), m_surfaceSbt, m_surfaceRaygen, m_surfaceMiss,
+                                   m_surfaceHit);
+    }
+}
+
+void Pipelines::cmdTraceSurfaceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize,
+                                    uint32_t width) const {
+    if (width == 0) return;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, m_surfaceRt.get());
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, m_layout.get(), 0, 1, &m_set, 0,
+                            nullptr);
+    vkCmdPushConstants(cmd, m_layout.get(), m_stages, 0, pushSize, push);
+    m_ctx.rt().cmdTraceRays(cmd, &m_surfaceRaygen, &m_surfaceMiss, &m_surfaceHit, &m_callable, width, 1, 1);
 }
 
 }  // namespace rthdist::gpu

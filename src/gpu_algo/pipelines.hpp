@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 
 #include "gpu/buffer.hpp"
 #include "gpu/unique_handle.hpp"
@@ -49,6 +50,9 @@ enum class Kernel : uint32_t {
     kCertWitness,    // and of the witness alone, with the final self-check (cert_witness.comp)
     kSweepTargets,   // the search's sweep: few open queries against every target (sweep_targets.comp)
     kLeafFirst,      // a split index's first leaf per grid cell (leaf_first.comp)
+    // The point-to-surface search, ray-query path (surface_search_rq.comp):
+    // created by prepareSurfaceSearch only.
+    kSurfaceSearchRayQuery,
     kCount
 };
 
@@ -77,6 +81,14 @@ public:
                               VkDeviceAddress args) const;
     [[nodiscard]] bool tracesIndirect() const;
 
+    // The point-to-surface search's pipeline (design.md §11), created on
+    // first use so that point calls never compile it: the ray-query kernel
+    // (Kernel::kSurfaceSearchRayQuery), or the ray-tracing pipeline of
+    // surface_search.rgen/rint and its shader binding table.
+    void prepareSurfaceSearch(VkPipelineCache cache);
+    // One surface-search ray-generation invocation per index in [0, width).
+    void cmdTraceSurfaceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize, uint32_t width) const;
+
     [[nodiscard]] VkPipelineStageFlags shaderStages() const { return m_shaderStages; }
 
 private:
@@ -87,6 +99,14 @@ private:
     void createComputePipelines(VkPipelineCache cache);
     void createRtPipeline(VkPipelineCache cache);
     void createShaderBindingTable();
+    // A ray-tracing pipeline of raygen | miss | procedural hit group, and
+    // its shader binding table (regions: raygen, miss, hit).
+    UniquePipeline createRtPipelineOf(VkPipelineCache cache, std::span<const uint32_t> rgen,
+                                      std::span<const uint32_t> rmiss, std::span<const uint32_t> rint,
+                                      const char* name);
+    void createShaderBindingTableOf(VkPipeline pipeline, Buffer& sbt, VkStridedDeviceAddressRegionKHR& raygen,
+                                    VkStridedDeviceAddressRegionKHR& miss,
+                                    VkStridedDeviceAddressRegionKHR& hit);
     // Binds a compute kernel (and the TLAS for ray queries) and its push constants.
     void cmdBindCompute(VkCommandBuffer cmd, Kernel kernel, const void* push, uint32_t pushSize) const;
 
@@ -100,6 +120,10 @@ private:
     UniquePipeline m_rtPipeline;
     Buffer m_sbt;
     VkStridedDeviceAddressRegionKHR m_raygen{}, m_miss{}, m_hit{}, m_callable{};
+    // The point-to-surface search's ray-tracing pipeline (prepareSurfaceSearch).
+    UniquePipeline m_surfaceRt;
+    Buffer m_surfaceSbt;
+    VkStridedDeviceAddressRegionKHR m_surfaceRaygen{}, m_surfaceMiss{}, m_surfaceHit{};
     VkShaderStageFlags m_stages;  // that see set 0 and the push constants
     VkPipelineStageFlags m_shaderStages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
 };

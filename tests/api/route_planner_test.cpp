@@ -240,15 +240,18 @@ TEST(RoutePlanner, DeviceViewsAreRefusedWithoutSupportOrPastTheBudget) {
     EXPECT_NE(big.reason.find("not split into pieces"), std::string::npos);
 }
 
-TEST(RoutePlanner, SurfacesRunOnTheCpuBackend) {
+TEST(RoutePlanner, SurfacesRunOnTheBackendNamed) {
     EXPECT_EQ(planSurfaceRoute(Backend::kCpu).route, Route::kSurfaceCpu);
     EXPECT_EQ(planSurfaceRoute(Backend::kAuto).route, Route::kSurfaceCpu);
-    // A GPU backend the caller named is refused, never replaced by the CPU.
+    EXPECT_EQ(planSurfaceRoute(Backend::kCpu, true).route, Route::kSurfaceCpu);
+    EXPECT_EQ(planSurfaceRoute(Backend::kAuto, true).route, Route::kSurfaceCpu);
     for (Backend gpu : {Backend::kRayQuery, Backend::kRtPipeline}) {
-        const Plan plan = planSurfaceRoute(gpu);
+        EXPECT_EQ(planSurfaceRoute(gpu).route, Route::kSurfaceGpu);
+        // Per-point distances on a GPU backend are refused, never replaced by the CPU.
+        const Plan plan = planSurfaceRoute(gpu, true);
         EXPECT_EQ(plan.route, Route::kRefused);
         EXPECT_EQ(plan.code, ErrorCode::kInvalidArgument);
-        EXPECT_NE(plan.reason.find("run on the CPU backend for now"), std::string::npos) << plan.reason;
+        EXPECT_NE(plan.reason.find("per-point distances to a surface"), std::string::npos) << plan.reason;
         EXPECT_NE(plan.reason.find(backendName(gpu)), std::string::npos) << plan.reason;
     }
 }
@@ -256,7 +259,7 @@ TEST(RoutePlanner, SurfacesRunOnTheCpuBackend) {
 TEST(RoutePlanner, EveryRouteHasAName) {
     for (Route r : {Route::kRefused, Route::kSmallPairScan, Route::kDeviceIngest, Route::kOneCall,
                     Route::kSeveralDevices, Route::kPieces, Route::kReframe, Route::kPrepared,
-                    Route::kDeviceViews, Route::kSurfaceCpu})
+                    Route::kDeviceViews, Route::kSurfaceCpu, Route::kSurfaceGpu})
         EXPECT_STRNE(routeName(r), "?");
 }
 

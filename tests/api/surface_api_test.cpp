@@ -1,4 +1,5 @@
-// The public point-to-surface call (rthdist/surface.hpp) on the CPU backend:
+// The public point-to-surface call (rthdist/surface.hpp) on the CPU backend
+// (the GPU backends: tests/gpu_algo/gpu_surface_test.cpp):
 // float and double inputs of any stride against the brute force over every
 // triangle, and every refusal as an Error value naming the set, the vertex
 // or the triangle.
@@ -38,15 +39,19 @@ TEST(SurfaceApi, AutoAndCpuRunTheCpuBackend) {
     }
 }
 
-TEST(SurfaceApi, GpuBackendsAreRefusedNotReplaced) {
+// Per-point distances come from the CPU backend only: a GPU backend the
+// caller named is refused before any device is opened, never replaced.
+TEST(SurfaceApi, PerPointOnAGpuBackendIsRefusedNotReplaced) {
     const Small s;
     for (Backend backend : {Backend::kRayQuery, Backend::kRtPipeline}) {
         SurfaceOptions options;
         options.backend = backend;
+        options.perPointDistances = true;
         Result<SurfaceResult> r = hausdorffToSurface(PointView(s.points), s.mesh(), options);
         ASSERT_FALSE(r);
         EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
-        EXPECT_NE(r.error().message.find("CPU backend for now"), std::string::npos) << r.error().message;
+        EXPECT_NE(r.error().message.find("per-point distances to a surface"), std::string::npos)
+            << r.error().message;
     }
 }
 

@@ -2,8 +2,9 @@
 // height field and random points written by the test, the JSON's directed
 // value and witness (a_to_b.triangle, a_to_b.b_point) against the brute
 // force over every triangle (tests/common) with ==; --surface a's mirror
-// image; the refusals (a GPU backend, per-point outputs: exit 2; a bad
-// face index, a file without faces: exit 3 naming the file).
+// image; the refusals (per-point outputs: exit 2; a bad face index, a file
+// without faces: exit 3 naming the file). The GPU backends:
+// cli_surface_gpu_test.cpp; --surface both: cli_surface_pair_test.cpp.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -103,15 +104,6 @@ TEST_F(CliSurface, SummaryNamesTheDirectedValue) {
     ASSERT_EQ(run.exitCode, 0) << run;
     EXPECT_NE(run.out.find("h(A, surface B) = "), std::string::npos) << run;
     EXPECT_NE(run.out.find("triangle " + std::to_string(m_want.nearest.triangle)), std::string::npos) << run;
-}
-
-TEST_F(CliSurface, GpuBackendsAreRefusedWithExit2) {
-    for (const char* backend : {"ray-query", "rt-pipeline"}) {
-        const CliRun run = runCli({m_xyz, m_mesh, "--surface", "b", "--backend", backend});
-        EXPECT_EQ(run.exitCode, 2) << run;
-        EXPECT_NE(run.err.find("runs on the cpu backend for now"), std::string::npos) << run;
-        EXPECT_TRUE(run.out.empty()) << run;
-    }
 }
 
 TEST_F(CliSurface, UnsupportedCombinationsAreUsageErrors) {

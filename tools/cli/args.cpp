@@ -350,23 +350,20 @@ void addPerPointOptions(CommandLine& line, CliArgs& out) {
     }
 }
 
-// --surface runs on the CPU backend and reports the directed value alone:
-// the options it cannot honour are refused, never ignored.
+// --surface reports the directed value alone (on the cpu backend, or on
+// one device of a GPU backend): the options it cannot honour are refused,
+// never ignored.
 std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
     if (out.tolerance > 0.0 && out.surface != "both")
         return usageError(
             "option '--tolerance' sets the width of surface-to-surface bounds: it needs --surface both");
     if (out.surface.empty()) return std::nullopt;
-    const Backend b = out.options.backend;
-    if (b != Backend::kAuto && b != Backend::kCpu)
-        return usageError(std::string("option '--surface' runs on the cpu backend for now: the ") +
-                          backendName(b) + " backend cannot search triangles (use --backend cpu or auto)");
     if (out.perPoint)
         return usageError("option '--surface' has no per-point outputs yet (--per-point and its options)");
     if (out.verify)
-        return usageError("option '--surface' runs on the cpu backend: --verify has nothing to compare");
+        return usageError("option '--surface' proves its value itself: --verify has nothing to compare");
     if (!out.options.devices.empty() || out.allDevices)
-        return usageError("option '--surface' runs on the cpu backend: --devices spreads work over GPUs");
+        return usageError("option '--surface' runs on one device: --devices spreads work over GPUs");
     return std::nullopt;
 }
 

@@ -46,7 +46,10 @@ Json countersJson(const SurfaceCounters& c) {
             {"bvh_nodes", c.bvhNodes},
             {"nodes_visited", c.nodesVisited},
             {"triangles_tested", c.trianglesTested},
-            {"dominated", c.dominated}};
+            {"dominated", c.dominated},
+            {"radii", c.radii},
+            {"rays", c.rays},
+            {"band", c.band}};
 }
 
 const char* precisionName(Scalar s) { return s == Scalar::kFloat64 ? "float64" : "float32"; }
@@ -77,7 +80,8 @@ std::string jsonReport(const Run& run) {
         {"backend", backendName(r.backend)},
         {"device", r.device},
         {"directed", true},
-        {"hausdorff", r.hausdorff}};
+        {"hausdorff", r.hausdorff},
+        {"validation_messages", r.validationMessages}};
     j["a_to_b"] = b ? directedJson(r.directed, run.sides) : Json();
     j["b_to_a"] = b ? Json() : directedJson(r.directed, run.sides);
     j["timings_ms"] = {{"load", run.loadMs},
@@ -144,6 +148,8 @@ int surfaceCommand(const CliArgs& args) {
     SurfaceOptions options;
     options.backend = args.options.backend;
     options.threads = args.options.threads;
+    options.deviceIndex = args.options.deviceIndex;
+    options.validation = args.options.validation;
     Result<SurfaceResult> result = hausdorffToSurface(points->view(), mesh->view(), options);
     // The library names the points "A" and the surface "B".
     if (!result) return fail(withFileNames(result.error(), sides.pointsPath, sides.surfacePath));

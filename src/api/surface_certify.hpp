@@ -1,0 +1,38 @@
+// The proof of a point-to-surface answer found by a search that is not
+// exact (the GPU backends' float search, gpu_algo/surface_search.hpp):
+// design.md §11, "The GPU backends". Given any triangle per query (the
+// search's nearest, or none), the directed maximum and its witness are
+// computed exactly, equal (==) to the brute force over every triangle in
+// double, whatever the candidates are:
+//   1. U(q) = the shared rule in double between q and its candidate
+//      (infinite without one) is at least q's exact nearest distance d(q).
+//   2. q* = the query of largest U (smallest index on a tie) is measured
+//      against every triangle: L = d(q*) <= h.
+//   3. A query with U(q) < L has d(q) < L <= h: it neither realizes h nor
+//      ties it. The others (the band, U(q) >= L, q* among them) are
+//      measured exactly, in index order: against every triangle while the
+//      band times the triangles is small (the usual band of one query),
+//      else by the CPU backend's BVH search (cpu/surface_search.hpp, its
+//      own proof and witness check); so the answer is h with the brute
+//      force's witness (ties: smallest triangle, smallest query).
+// Good candidates make the band small (the queries within the float
+// search's rounding of the maximum); bad ones only make it larger.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "rthdist/surface.hpp"
+
+namespace rthdist::api {
+
+// points and surface checked by the caller (api/surface.cpp); candidate:
+// one triangle index per point, UINT32_MAX (or any index past the last
+// triangle) for none; magnitude: the largest |coordinate| over both
+// (core::closestSlack). perPointDistances is not offered (kInvalidArgument).
+// SurfaceResult::directed.counters.band: the queries searched exactly.
+[[nodiscard]] Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface,
+                                                   double magnitude, std::span<const uint32_t> candidate,
+                                                   const SurfaceOptions& options);
+
+}  // namespace rthdist::api

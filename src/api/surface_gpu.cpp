@@ -1,0 +1,96 @@
+#include "api/surface_gpu.hpp"
+
+#include <glm/common.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "api/backend.hpp"
+#include "api/surface_certify.hpp"
+#include "core/parallel.hpp"
+#include "core/stopwatch.hpp"
+
+namespace rthdist::api {
+namespace {
+
+// The device's frame: the centre of the union's box, then a power of two
+// that brings every coordinate to at most 1 in magnitude (the rule's
+// degree-4 products stay far from float's range at any input scale).
+struct SearchFrame {
+    glm::dvec3 origin{0.0};
+    double scale = 1.0;
+
+    SearchFrame(const core::Bounds& a, const core::Bounds& b) {
+        const glm::dvec3 lo = glm::min(a.lo, b.lo), hi = glm::max(a.hi, b.hi);
+        origin = (lo + hi) * 0.5;
+        const glm::dvec3 half = glm::max(hi - origin, origin - lo);
+        const double m = std::max({half.x, half.y, half.z});
+        int exponent = 0;
+        if (m > 0.0 && std::isfinite(m)) std::frexp(m, &exponent);  // m < 2^exponent
+        scale = std::ldexp(1.0, -exponent);
+    }
+    [[nodiscard]] glm::vec3 operator()(const glm::dvec3& p) const { return glm::vec3((p - origin) * scale); }
+};
+
+std::vector<glm::vec3> framedPoints(const PointView& points, const SearchFrame& frame, int threads) {
+    std::vector<glm::vec3> out(points.count);
+    core::parallelChunks(points.count, 1 << 16, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) out[i] = frame(points.at(i));
+    });
+    return out;
+}
+
+std::vector<glm::vec3> framedCorners(const MeshView& surface, const SearchFrame& frame, int threads) {
+    std::vector<glm::vec3> out(3 * surface.triangleCount());
+    core::parallelChunks(surface.triangleCount(), 1 << 16, threads, [&](size_t begin, size_t end, int) {
+        for (size_t t = begin; t < end; ++t) {
+            for (int k = 0; k < 3; ++k) out[3 * t + size_t(k)] = frame(surface.corner(t, k));
+        }
+    });
+    return out;
+}
+
+}  // namespace
+
+Result<SurfaceResult> surfaceOnGpu(const PointView& points, const MeshView& surface,
+                                   const core::SetSummary& a, const core::SetSummary& b, double magnitude,
+                                   const SurfaceOptions& options) {
+    const core::Clock::time_point start = core::Clock::now();
+    EngineOptions engine;
+    engine.backend = options.backend;
+    engine.deviceIndex = options.deviceIndex;
+    engine.validation = options.validation;
+    engine.threads = options.threads;
+    engine.tuning = tuningFromEnvironment();
+    Result<std::unique_ptr<ComputeBackend>> backend = openBackend(engine, nullptr);
+    if (!backend) return backend.error();
+    ComputeBackend& device = *backend.value();
+    const double setupMs = core::msSince(start);
+
+    const core::Clock::time_point searchStart = core::Clock::now();
+    const SearchFrame frame(a.box, b.box);
+    const std::vector<glm::vec3> queries = framedPoints(points, frame, options.threads);
+    const std::vector<glm::vec3> corners = framedCorners(surface, frame, options.threads);
+    Result<TriangleCandidates> found = device.nearestTriangles(queries, corners);
+    if (!found) return found.error();
+    if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed))
+        return Error{ErrorCode::kCancelled, "the call was cancelled (SurfaceOptions::cancel)"};
+
+    Result<SurfaceResult> result = certifySurface(points, surface, magnitude, found->triangle, options);
+    if (!result) return result.error();
+    SurfaceResult& r = result.value();
+    r.backend = device.kind();
+    r.device = device.deviceName();
+    r.directed.counters.radii = found->radii;
+    r.directed.counters.rays = found->rays;
+    r.directed.counters.triangles = surface.triangleCount();
+    r.gpuMs = found->gpuMs;
+    r.buildMs = setupMs;
+    r.searchMs = core::msSince(searchStart);
+    r.validationMessages = device.validationMessages();
+    return result;
+}
+
+}  // namespace rthdist::api

@@ -1,0 +1,120 @@
+// The proof of a point-to-surface answer from candidate triangles
+// (api/surface_certify.hpp, design.md §11 "The GPU backends"), on the host:
+// whatever the candidates (each query's true nearest, none, the wrong
+// triangle, a random one), the value and witness equal (==) the brute
+// force over every triangle; good candidates keep the band small.
+#include <gtest/gtest.h>
+
+#include <glm/common.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+#include "api/surface_certify.hpp"
+#include "common/rng.hpp"
+#include "common/surface_brute_force.hpp"
+#include "common/surface_cases.hpp"
+
+namespace rthdist {
+namespace {
+
+double magnitude(const test::SurfaceCase& c) {
+    double m = 0.0;
+    for (const auto* set : {&c.vertices, &c.queries}) {
+        for (const glm::dvec3& v : *set) m = std::max({m, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    }
+    return m;
+}
+
+Result<SurfaceResult> certify(const test::SurfaceCase& c, const std::vector<uint32_t>& candidate) {
+    return api::certifySurface(PointView(c.queries), MeshView{PointView(c.vertices), c.indices}, magnitude(c),
+                               candidate, SurfaceOptions{});
+}
+
+void expectExact(const test::SurfaceCase& c, const Result<SurfaceResult>& r,
+                 const oracle::SurfaceDirectedExact& want, const char* candidates) {
+    ASSERT_TRUE(r) << c.name << " (" << candidates << "): " << r.error().message;
+    EXPECT_EQ(r->hausdorff, want.distance) << c.name << " (" << candidates << ")";
+    EXPECT_EQ(r->directed.queryIndex, want.queryIndex) << c.name << " (" << candidates << ")";
+    EXPECT_EQ(r->directed.triangle, want.nearest.triangle) << c.name << " (" << candidates << ")";
+    EXPECT_EQ(r->directed.surfacePoint, want.nearest.point) << c.name << " (" << candidates << ")";
+    EXPECT_EQ(r->directed.queryPoint, c.queries[want.queryIndex]) << c.name << " (" << candidates << ")";
+    EXPECT_EQ(r->directed.counters.queries, c.queries.size());
+}
+
+TEST(SurfaceCertify, AnyCandidatesGiveTheBruteForce) {
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        std::printf("%s: seed %llu, %zu triangles, %zu queries\n", c.name.c_str(),
+                    static_cast<unsigned long long>(c.seed), c.indices.size() / 3, c.queries.size());
+        const oracle::SurfaceDirectedExact want = oracle::bruteForceSurface(c.queries, c.vertices, c.indices);
+        const auto triangles = uint32_t(c.indices.size() / 3);
+        std::vector<uint32_t> nearest(c.queries.size()), none(c.queries.size(), UINT32_MAX);
+        std::vector<uint32_t> shiftedByOne(c.queries.size()), random(c.queries.size());
+        test::Rng rng(c.seed);
+        for (size_t q = 0; q < c.queries.size(); ++q) {
+            nearest[q] = want.perQuery[q].triangle;
+            shiftedByOne[q] = (nearest[q] + 1) % triangles;
+            random[q] = uint32_t(rng.uniform(0.0, double(triangles))) % triangles;
+        }
+        const Result<SurfaceResult> exact = certify(c, nearest);
+        expectExact(c, exact, want, "nearest");
+        // The band is the queries at h: the witness and its ties.
+        if (exact) {
+            size_t atMax = 0;
+            for (const oracle::SurfaceNearest& n : want.perQuery)
+                atMax += std::sqrt(n.distance2) == want.distance;
+            EXPECT_EQ(exact->directed.counters.band, atMax) << c.name;
+        }
+        expectExact(c, certify(c, none), want, "none");
+        expectExact(c, certify(c, shiftedByOne), want, "the next triangle");
+        expectExact(c, certify(c, random), want, "random");
+        // An index past the last triangle is none.
+        std::vector<uint32_t> past(c.queries.size(), triangles);
+        expectExact(c, certify(c, past), want, "past the last");
+    }
+}
+
+// A small band is measured against every triangle, a large one (no
+// candidates: every query is in it) by the CPU backend's BVH search.
+TEST(SurfaceCertify, ALargeBandTakesTheBvhSearch) {
+    test::SurfaceCase c = test::heightField(3437, 64, 32.0);
+    test::Rng rng(3437);
+    for (int i = 0; i < 2100; ++i)
+        c.queries.emplace_back(rng.uniform(-1, 33), rng.uniform(-1, 33), rng.uniform(-4, 4));
+    std::printf("%s: seed %llu, %zu triangles, %zu queries\n", c.name.c_str(),
+                static_cast<unsigned long long>(c.seed), c.indices.size() / 3, c.queries.size());
+    const oracle::SurfaceDirectedExact want = oracle::bruteForceSurface(c.queries, c.vertices, c.indices);
+    std::vector<uint32_t> nearest(c.queries.size()), none(c.queries.size(), UINT32_MAX);
+    for (size_t q = 0; q < c.queries.size(); ++q) nearest[q] = want.perQuery[q].triangle;
+    const Result<SurfaceResult> small = certify(c, nearest);
+    expectExact(c, small, want, "nearest");
+    ASSERT_TRUE(small);
+    EXPECT_EQ(small->directed.counters.bvhNodes, 0u);
+    const Result<SurfaceResult> large = certify(c, none);
+    expectExact(c, large, want, "none");
+    ASSERT_TRUE(large);
+    EXPECT_EQ(large->directed.counters.band, c.queries.size());
+    EXPECT_GT(large->directed.counters.bvhNodes, 0u);
+}
+
+TEST(SurfaceCertify, PerPointAndWrongSizesAreErrors) {
+    const test::SurfaceCase c = test::heightField(3436, 4, 1.0);
+    const std::vector<glm::dvec3> points{{0.5, 0.5, 1.0}, {0.25, 0.5, -1.0}};
+    const MeshView mesh{PointView(c.vertices), c.indices};
+    SurfaceOptions perPoint;
+    perPoint.perPointDistances = true;
+    const std::vector<uint32_t> two{0, 1}, one{0};
+    Result<SurfaceResult> r = api::certifySurface(PointView(points), mesh, 2.0, two, perPoint);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+    r = api::certifySurface(PointView(points), mesh, 2.0, one, SurfaceOptions{});
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kInternal);
+}
+
+}  // namespace
+}  // namespace rthdist

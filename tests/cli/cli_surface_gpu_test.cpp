@@ -1,0 +1,77 @@
+// `rthdist A B --surface b --backend ray-query|rt-pipeline` end to end on
+// lavapipe (design.md §11, "The GPU backends"): a georeferenced OBJ height
+// field and points around it, the JSON's directed value and witness against
+// the brute force over every triangle (tests/common) with ==, the
+// validation layer silent; per-point outputs refused (exit 2). Never
+// skipped: without a device the runs fail (CI must have lavapipe).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "cli_runner.hpp"
+#include "common/rng.hpp"
+#include "common/surface_brute_force.hpp"
+#include "common/surface_cases.hpp"
+#include "surface_files.hpp"
+
+namespace rthdist::cli_test {
+namespace {
+
+using Json = nlohmann::json;
+
+class CliSurfaceGpu : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const glm::dvec3 utm(512345.25, 5412345.5, 250.0);
+        m_case = test::heightField(3440, 10, 20.0);
+        for (glm::dvec3& v : m_case.vertices) v += utm;
+        test::Rng rng(3440);
+        for (int i = 0; i < 300; ++i)
+            m_points.push_back(utm +
+                               glm::dvec3(rng.uniform(-2, 22), rng.uniform(-2, 22), rng.uniform(-5, 5)));
+        m_mesh = m_dir.write("field.obj", objOf(m_case));
+        m_xyz = m_dir.write("points.xyz", xyzOf(m_points));
+        m_want = oracle::bruteForceSurface(m_points, m_case.vertices, m_case.indices);
+        std::printf("seed 3440: %zu triangles, %zu points, h = %.17g\n", m_case.indices.size() / 3,
+                    m_points.size(), m_want.distance);
+    }
+
+    TempDir m_dir;
+    test::SurfaceCase m_case;
+    std::vector<glm::dvec3> m_points;
+    std::string m_mesh, m_xyz;
+    oracle::SurfaceDirectedExact m_want;
+};
+
+TEST_F(CliSurfaceGpu, PointsToSurfaceMatchTheBruteForceOnEveryGpuBackend) {
+    for (const char* backend : {"ray-query", "rt-pipeline"}) {
+        const CliRun run =
+            runCli({m_xyz, m_mesh, "--surface", "b", "--backend", backend, "--json", "--validation"});
+        ASSERT_EQ(run.exitCode, 0) << run;
+        const Json j = Json::parse(run.out);
+        EXPECT_EQ(j["backend"], backend);
+        EXPECT_EQ(j["mode"], "point-to-surface");
+        EXPECT_EQ(j["hausdorff"].get<double>(), m_want.distance) << backend;
+        EXPECT_EQ(j["validation_messages"].get<uint64_t>(), 0u) << backend;
+        const Json& d = j["a_to_b"];
+        EXPECT_EQ(d["distance"].get<double>(), m_want.distance) << backend;
+        EXPECT_EQ(d["a_index"].get<uint64_t>(), m_want.queryIndex) << backend;
+        EXPECT_EQ(d["triangle"].get<uint32_t>(), m_want.nearest.triangle) << backend;
+        const glm::dvec3& p = m_want.nearest.point;
+        EXPECT_EQ(d["b_point"], Json::array({p.x, p.y, p.z})) << backend;
+        const Json& c = j["counters"]["a_to_b"];
+        EXPECT_GE(c["radii"].get<uint32_t>(), 1u) << backend;
+        EXPECT_GE(c["band"].get<uint64_t>(), 1u) << backend;
+    }
+}
+
+TEST_F(CliSurfaceGpu, PerPointOutputsAreUsageErrors) {
+    const CliRun run = runCli({m_xyz, m_mesh, "--surface", "b", "--backend", "ray-query", "--per-point"});
+    EXPECT_EQ(run.exitCode, 2) << run;
+    EXPECT_TRUE(run.out.empty()) << run;
+}
+
+}  // namespace
+}  // namespace rthdist::cli_test
