@@ -112,6 +112,12 @@ Plan planSurfaceRoute(Backend requested, bool perPoint) {
     return routed(Route::kSurfaceGpu);
 }
 
+Plan planSurfacePairRoute(Backend requested) {
+    if (requested == Backend::kCpu || requested == Backend::kAuto) return routed(Route::kSurfaceCpu);
+    return refused(ErrorCode::kInvalidArgument, std::string("surface to surface runs on the cpu backend for now (") +
+                                                    backendName(requested) + " requested)");
+}
+
 Plan planFramedCall(uint64_t a, uint64_t b, const CallOptions& call, const MemoryBudget& budget,
                     const BackendCaps& caps) {
     if (!fitsOneCall(budget, a, b)) return inPieces(a, b, budget, caps);

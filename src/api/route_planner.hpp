@@ -110,6 +110,12 @@ struct Plan {
 // the CPU in its place.
 [[nodiscard]] Plan planSurfaceRoute(Backend requested, bool perPoint = false);
 
+// The route of two triangle surfaces (surfaceHausdorff, certified bounds):
+// kSurfaceCpu for kCpu and kAuto (the refinement's batches run on the CPU
+// backend's BVH); a GPU backend is kRefused (kInvalidArgument) for now,
+// never computed on the CPU in its place.
+[[nodiscard]] Plan planSurfacePairRoute(Backend requested);
+
 // The route of a pair already checked and framed on the host (float sets of
 // one frame and scale): kSmallPairScan, kOneCall, kSeveralDevices or kPieces.
 // kReframe's pair and every piece of kPieces take it.

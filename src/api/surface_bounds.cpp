@@ -110,7 +110,7 @@ void shiftBack(SurfaceBoundsDirected& d, const glm::dvec3& origin) {
 Result<SurfaceBoundsResult> surfaceHausdorff(MeshView a, MeshView b, const SurfaceBoundsOptions& options) {
     const core::Clock::time_point start = core::Clock::now();
     if (options.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
-    const api::Plan plan = api::planSurfaceRoute(options.backend);
+    const api::Plan plan = api::planSurfacePairRoute(options.backend);
     if (plan.route == api::Route::kRefused) return Error{plan.code, plan.reason};
     Result<core::SetSummary> sa = checkMesh(a, "A", options.threads);
     if (!sa) return sa.error();

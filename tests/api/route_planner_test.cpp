@@ -256,6 +256,19 @@ TEST(RoutePlanner, SurfacesRunOnTheBackendNamed) {
     }
 }
 
+TEST(RoutePlanner, SurfacePairsRunOnTheCpuBackend) {
+    EXPECT_EQ(planSurfacePairRoute(Backend::kCpu).route, Route::kSurfaceCpu);
+    EXPECT_EQ(planSurfacePairRoute(Backend::kAuto).route, Route::kSurfaceCpu);
+    for (Backend gpu : {Backend::kRayQuery, Backend::kRtPipeline}) {
+        // Refused, never replaced by the CPU.
+        const Plan plan = planSurfacePairRoute(gpu);
+        EXPECT_EQ(plan.route, Route::kRefused);
+        EXPECT_EQ(plan.code, ErrorCode::kInvalidArgument);
+        EXPECT_NE(plan.reason.find("runs on the cpu backend for now"), std::string::npos) << plan.reason;
+        EXPECT_NE(plan.reason.find(backendName(gpu)), std::string::npos) << plan.reason;
+    }
+}
+
 TEST(RoutePlanner, EveryRouteHasAName) {
     for (Route r : {Route::kRefused, Route::kSmallPairScan, Route::kDeviceIngest, Route::kOneCall,
                     Route::kSeveralDevices, Route::kPieces, Route::kReframe, Route::kPrepared,

@@ -364,6 +364,9 @@ std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
         return usageError("option '--surface' proves its value itself: --verify has nothing to compare");
     if (!out.options.devices.empty() || out.allDevices)
         return usageError("option '--surface' runs on one device: --devices spreads work over GPUs");
+    if (out.surface == "both" &&
+        (out.options.backend == Backend::kRayQuery || out.options.backend == Backend::kRtPipeline))
+        return usageError("option '--surface both': surface to surface runs on the cpu backend for now");
     return std::nullopt;
 }
 
