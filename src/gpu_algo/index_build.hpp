@@ -91,8 +91,9 @@ public:
     void finishIngest(PointIndex& ix, const CounterBlock& blk);
 
     // Cuts the crowded cells of `ix` into leaves (leaf_*.comp), round by
-    // round, then checks the index again. Each round is one submission: a
-    // counting sort by slot inside every cell, and the cells of the new order.
+    // round, then checks the index again. Each round is two submissions: a
+    // counting sort by slot inside every cell that also counts the new
+    // cells, then the cells of the new order in a buffer of that size.
     void splitLeaves(PointIndex& ix);
 
     // The buffers of one leaf-split round: cells, points and keys in and out.
@@ -105,9 +106,13 @@ public:
         Buffer* cellsOut;
         uint64_t numSlots;  // one per kept cell, 8^k <= count per split one
     };
-    // Records one round: a counting sort by slot inside every cell, then the
-    // cells of the new order.
+    // Records one round's sort: a counting sort by slot inside every cell,
+    // the new order's cell heads scanned and counted (cells_total.comp, into
+    // the cells counter), so that the host sizes the leaves' buffer.
     void cmdSplitRound(VkCommandBuffer cmd, const PointIndex& ix, const LeafRound& r);
+    // Records the round's `leaves` cells of the new order into r.cellsOut
+    // (sized by the host for them) and their tight boxes.
+    void cmdBuildLeaves(VkCommandBuffer cmd, const PointIndex& ix, const LeafRound& r, uint32_t leaves);
 
     // Search cells of level `level` (>= 1) of T, coarsened from the level
     // below on first use (coarsen.comp: head flags, scan, build).

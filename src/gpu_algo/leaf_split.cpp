@@ -52,10 +52,10 @@ void IndexBuild::cmdSplitRound(VkCommandBuffer cmd, const PointIndex& ix, const 
                      outSlotKeys.address(),
                      flags.address(),
                      dense.address(),
-                     r.cellsOut->address(),
+                     0,  // cells and boundsU: the leaf build's (cmdBuildLeaves, sized by the leaves)
                      m_ws.cellsCounterAddr(),
                      m_ws.maxCountAddr(),
-                     m_ws.grow(leaf.boundsU, n * 24, "leaf.boundsU").address(),
+                     0,
                      m_ws.blocks[0].addr(RTHDIST_CTR_LARGE_CELLS),
                      ix.n,
                      ix.n};
@@ -63,6 +63,24 @@ void IndexBuild::cmdSplitRound(VkCommandBuffer cmd, const PointIndex& ix, const 
     m_ws.barrier(cmd);
     m_ws.cmdScan(cmd, flags.address(), ix.n, leaf.scanFlags, "leaf.scanFlags");
     m_ws.barrier(cmd);
+    m_ws.pipelines.cmdDispatch(cmd, Kernel::kCellsTotal, &cp, sizeof(cp), 1);
+}
+
+void IndexBuild::cmdBuildLeaves(VkCommandBuffer cmd, const PointIndex& ix, const LeafRound& r, uint32_t leaves) {
+    LeafScratch& leaf = m_ws.scratch.leaves;
+    const uint64_t n = ix.n;
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "leaf build");
+    sh::CellsPush cp{r.sortedOut->address(),
+                     m_ws.grow(leaf.outSlotKeys, n * 4, "leaf.outSlotKeys").address(),
+                     m_ws.grow(leaf.flags, n * 4, "leaf.flags").address(),
+                     m_ws.grow(leaf.slotDense, VkDeviceSize(r.numSlots) * 4, "leaf.slotDense").address(),
+                     r.cellsOut->address(),
+                     m_ws.cellsCounterAddr(),
+                     m_ws.maxCountAddr(),
+                     m_ws.grow(leaf.boundsU, VkDeviceSize(leaves) * 24, "leaf.boundsU").address(),
+                     m_ws.blocks[0].addr(RTHDIST_CTR_LARGE_CELLS),
+                     ix.n,
+                     leaves};
     cmdCellBuild(cmd, cp);
 }
 
@@ -70,8 +88,7 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
     const VkDeviceSize n = ix.n;
     Buffer* sorted[2] = {ix.sorted, &m_ws.setBuffer(ix, ix.store->sorted2, ".sorted2", n * 16)};
     Buffer* gridKeys[2] = {ix.sortedKeys, &m_ws.setBuffer(ix, ix.store->sortedKeys2, ".sortedKeys2", n * 4)};
-    Buffer* leaves[2] = {&m_ws.setBuffer(ix, ix.store->leaves0, ".leaves0", n * sizeof(sh::Cell)),
-                         &m_ws.setBuffer(ix, ix.store->leaves1, ".leaves1", n * sizeof(sh::Cell))};
+    Buffer* leaves[2] = {&ix.store->leaves0, &ix.store->leaves1};  // sized each round by its leaves
     Buffer* cells = ix.cells;
     int cur = 0;
     m_ws.counters().minEdge = 0x7f800000u;  // +inf
@@ -86,6 +103,15 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
         m_ws.counters().largeCells = 0;
         VkCommandBuffer cmd = m_ws.ctx.begin();
         cmdSplitRound(cmd, ix, r);
+        m_ws.ctx.submitAndWait(cmd);
+        m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
+        // The leaves of this round, counted on the device: their buffer and
+        // the large ones' box reduction sized by them, then built.
+        const uint32_t count = m_ws.counters().cells;
+        const char* name = round % 2 == 0 ? ".leaves0" : ".leaves1";
+        m_ws.setBuffer(ix, *r.cellsOut, name, VkDeviceSize(std::max<uint32_t>(count, 1)) * sizeof(sh::Cell));
+        cmd = m_ws.ctx.begin();
+        cmdBuildLeaves(cmd, ix, r, count);
         m_ws.ctx.submitAndWait(cmd);
         m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
         cur = 1 - cur;

@@ -19,6 +19,7 @@
 #include "cell_build.comp.h"
 #include "cell_heads.comp.h"
 #include "cell_keys.comp.h"
+#include "cells_total.comp.h"
 #include "cert_scan.comp.h"
 #include "cert_witness.comp.h"
 #include "check_index.comp.h"
@@ -101,6 +102,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_cert_witness_comp, "cert_witness"},
     {k_spv_sweep_targets_comp, "sweep_targets"},
     {k_spv_leaf_first_comp, "leaf_first"},
+    {k_spv_cells_total_comp, "cells_total"},
     {k_spv_surface_search_rq_comp, "surface_search_rq"},
 }};
 
