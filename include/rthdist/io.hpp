@@ -75,7 +75,10 @@
 // regular (a FIFO, a device) is refused. A file truncated by another
 // process while it is being loaded ends the process with SIGBUS, as with
 // any reader of a mapped file. Memory: the cloud (24 bytes per point in
-// double, 12 in float) beside the page cache's copy of the file.
+// double, 12 in float) beside the page cache's copy of the file; the binary
+// readers write each point once, in the pass that converts and checks it,
+// into an array nothing has zeroed first (PointAllocator), so that the
+// threads that convert a chunk are the first to touch its memory.
 // Limits: extended VLRs and LAS waveform data after the points are not
 // read. A glTF mesh instanced by
 // several nodes gives its points once per instance; NaN points (e.g. in
@@ -88,7 +91,10 @@
 
 #include <glm/vec3.hpp>
 
+#include <cstddef>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "rthdist/export.hpp"
@@ -98,12 +104,53 @@
 
 namespace rthdist::io {
 
+namespace detail {
+// PointAllocator's memory: arrays of 4 MiB and more are mapped on their own
+// and marked for transparent huge pages (Linux; one page fault per 2 MiB),
+// smaller ones come from operator new. Throws std::bad_alloc.
+[[nodiscard]] RTHDIST_IO_API void* allocatePointBytes(size_t bytes);
+RTHDIST_IO_API void freePointBytes(void* p, size_t bytes) noexcept;
+}  // namespace detail
+
+// The allocator of PointCloud's arrays: resize(n) leaves the new points
+// unwritten (a loader writes every point of a file once, chunk by chunk in
+// parallel, instead of one thread zeroing gigabytes first); resize(n, value),
+// copies and moves behave as in any std::vector. Whoever grows an array
+// with resize(n) writes the new points before reading them.
+template <class T>
+struct PointAllocator {
+    static_assert(std::is_trivially_copyable_v<T>);
+    using value_type = T;
+
+    PointAllocator() = default;
+    template <class U>
+    PointAllocator(const PointAllocator<U>&) noexcept {}
+
+    [[nodiscard]] T* allocate(size_t n) { return static_cast<T*>(detail::allocatePointBytes(n * sizeof(T))); }
+    void deallocate(T* p, size_t n) noexcept { detail::freePointBytes(p, n * sizeof(T)); }
+
+    // Construction without a value writes nothing; with values, as usual.
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        if constexpr (sizeof...(Args) == 0) {
+            ::new (static_cast<void*>(p)) U;
+        } else {
+            ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+        }
+    }
+
+    friend bool operator==(const PointAllocator&, const PointAllocator&) noexcept { return true; }
+};
+
+template <class T>
+using PointArray = std::vector<T, PointAllocator<T>>;
+
 // A loaded point set in the precision of its file: exactly one of floats
 // (scalar kFloat32) and doubles (kFloat64) holds the points.
 struct RTHDIST_IO_API PointCloud {
     Scalar scalar = Scalar::kFloat32;
-    std::vector<glm::vec3> floats;
-    std::vector<glm::dvec3> doubles;
+    PointArray<glm::vec3> floats;
+    PointArray<glm::dvec3> doubles;
 
     [[nodiscard]] size_t size() const;
     // A view of the points for hausdorff() / Engine::compute(); valid while

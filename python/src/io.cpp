@@ -19,11 +19,11 @@ namespace {
 
 // An (N, 3) array over the vector's memory; the array owns the vector.
 template <class Vec>
-py::array adopt(std::vector<Vec>&& points) {
+py::array adopt(io::PointArray<Vec>&& points) {
     using Scalar = typename Vec::value_type;
     static_assert(sizeof(Vec) == 3 * sizeof(Scalar));
-    auto* owned = new std::vector<Vec>(std::move(points));
-    py::capsule owner(owned, [](void* p) { delete static_cast<std::vector<Vec>*>(p); });
+    auto* owned = new io::PointArray<Vec>(std::move(points));
+    py::capsule owner(owned, [](void* p) { delete static_cast<io::PointArray<Vec>*>(p); });
     const auto n = py::ssize_t(owned->size());
     return py::array_t<Scalar>({n, py::ssize_t(3)}, {py::ssize_t(sizeof(Vec)), py::ssize_t(sizeof(Scalar))},
                                reinterpret_cast<const Scalar*>(owned->data()), owner);

@@ -150,7 +150,7 @@ public:
                     });
     }
 
-    std::vector<glm::vec3> take() { return std::move(m_points); }
+    PointArray<glm::vec3> take() { return std::move(m_points); }
 
     // With read(): also the triangles of every TRIANGLES, TRIANGLE_STRIP and
     // TRIANGLE_FAN primitive, by index into the points read.
@@ -328,7 +328,7 @@ private:
     const tinygltf::Model& m_model;
     const std::string& m_path;
     uint64_t m_total = 0;
-    std::vector<glm::vec3> m_points;
+    PointArray<glm::vec3> m_points;
     bool m_faces = false;
     std::vector<uint32_t> m_triangles;
 };
@@ -435,7 +435,7 @@ Result<tinygltf::Model> loadModel(std::string_view bytes, const std::string& pat
 
 }  // namespace
 
-Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::string& path) {
+Result<PointArray<glm::vec3>> readGltf(std::string_view bytes, const std::string& path) {
     Result<tinygltf::Model> model = loadModel(bytes, path);
     if (!model) return model.error();
     auto roots = rootNodes(*model, path);

@@ -18,6 +18,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rthdist/io.hpp"
 #include "rthdist/result.hpp"
 
 namespace rthdist::io {
@@ -28,14 +29,14 @@ inline constexpr uint64_t kMaxGltfInstancedTriangles = 200'000'000;
 
 // bytes: the whole file (".glb" is recognised by its "glTF" magic); external
 // buffers are resolved relative to path's directory.
-[[nodiscard]] Result<std::vector<glm::vec3>> readGltf(std::string_view bytes, const std::string& path);
+[[nodiscard]] Result<PointArray<glm::vec3>> readGltf(std::string_view bytes, const std::string& path);
 
 // The points as readGltf reads them and the triangles of every primitive of
 // mode TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN (its indices accessor, or
 // its vertices in order; an index past the primitive's POSITION count is an
 // error naming the node and the accessor), indices into those points.
 struct GltfMesh {
-    std::vector<glm::vec3> points;
+    PointArray<glm::vec3> points;
     std::vector<uint32_t> triangles;
 };
 [[nodiscard]] Result<GltfMesh> readGltfMesh(std::string_view bytes, const std::string& path);

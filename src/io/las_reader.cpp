@@ -300,7 +300,7 @@ Result<PointCloud> readLas(std::string_view bytes, const std::string& path, cons
 
     PointCloud cloud;
     cloud.scalar = Scalar::kFloat64;
-    cloud.doubles.resize(static_cast<size_t>(firstKept.back()));
+    cloud.doubles.resize(static_cast<size_t>(firstKept.back()));  // unwritten: each chunk writes its points
     auto err = forEachChunk(chunks.count(), plan, [&](size_t c) -> std::optional<Error> {
         glm::dvec3* out = cloud.doubles.data() + firstKept[c];
         return classes.empty() ? convertPoints<false>(chunks, c, keep, out, path)

@@ -37,11 +37,14 @@ std::string formatExtension(const std::string& path) {
 }
 
 // A reader and, for formats whose header bounds the file size, the check
-// that caps a .gz before it is inflated.
+// that caps a .gz before it is inflated. checksFinite: the reader returns
+// only clouds whose every coordinate is finite (the binary readers check
+// each chunk in the pass that writes it), so no second pass reads them.
 struct Format {
     Result<PointCloud> (*read)(std::string_view, const std::string&, const LoadOptions&,
                                const ChunkPlan&) = nullptr;
     InflatedBound gzipBound = nullptr;
+    bool checksFinite = false;
 };
 
 template <Result<PointCloud> (*kRead)(std::string_view, const std::string&, const ChunkPlan&)>
@@ -68,40 +71,15 @@ Result<PointCloud> readLasCloud(std::string_view bytes, const std::string& path,
 }
 
 Format formatFor(const std::string& ext) {
-    if (ext == ".ply") return {&withPlan<&readPly>, &plyInflatedBound};
+    if (ext == ".ply") return {&withPlan<&readPly>, &plyInflatedBound, true};
     if (ext == ".xyz" || ext == ".txt") return {&withPlan<&readXyz>};
     if (ext == ".obj") return {&withPlan<&readObj>};
     if (ext == ".gltf" || ext == ".glb") return {&readGltfCloud, &glbInflatedBound};
     if (ext == ".stl") return {&readStlCloud, &stlInflatedBound};
     if (ext == ".off") return {&withPlan<&readOff>};
-    if (ext == ".pcd") return {&withPlan<&readPcd>};
-    if (ext == ".las") return {&readLasCloud};
+    if (ext == ".pcd") return {&withPlan<&readPcd>, nullptr, true};
+    if (ext == ".las") return {&readLasCloud, nullptr, true};
     return {};
-}
-
-// The first coordinate that is NaN or infinite, as the error naming it;
-// checked in parallel chunks (the lowest chunk's first is the first).
-template <class Vec>
-std::optional<Error> firstNonFinite(const std::vector<Vec>& points, const std::string& path, const char* note,
-                                    const ChunkPlan& plan) {
-    const uint64_t perChunk = plan.items(sizeof(Vec));
-    const size_t chunks = chunkCount(points.size(), perChunk);
-    return forEachChunk(chunks, plan, [&](size_t c) -> std::optional<Error> {
-        const size_t begin = static_cast<size_t>(c * perChunk);
-        const size_t end = static_cast<size_t>(std::min<uint64_t>(points.size(), (c + 1) * perChunk));
-        if (!anyNonFinite(points.data() + begin, end - begin)) return std::nullopt;
-        for (size_t i = begin; i < end; ++i) {
-            const Vec& p = points[i];
-            for (int axis = 0; axis < 3; ++axis) {
-                if (!std::isfinite(p[axis])) {
-                    return badInput(path, "vertex " + std::to_string(i),
-                                    std::string("coordinate ") + "xyz"[axis] + " is " +
-                                        (std::isnan(p[axis]) ? "NaN" : "infinite") + note);
-                }
-            }
-        }
-        return std::nullopt;
-    });
 }
 
 }  // namespace
@@ -116,12 +94,13 @@ Result<FileBytes> formatBytes(const std::string& path, const Format& format, con
     return bytes;
 }
 
-// The contract shared by every format: at least one point, every coordinate finite.
-std::optional<Error> checkCloud(const PointCloud& cloud, const std::string& path, const ChunkPlan& plan) {
+// The contract shared by every format: at least one point, every coordinate
+// finite (checked here unless the format's reader has).
+std::optional<Error> checkCloud(const PointCloud& cloud, const Format& format, const std::string& path,
+                                const ChunkPlan& plan) {
     if (cloud.size() == 0) return badInput(path, "file", "contains no points");
-    return cloud.scalar == Scalar::kFloat64
-               ? firstNonFinite(cloud.doubles, path, "", plan)
-               : firstNonFinite(cloud.floats, path, " (or beyond float range)", plan);
+    if (format.checksFinite) return std::nullopt;
+    return checkFiniteCloud(cloud, path, plan);
 }
 
 }  // namespace
@@ -141,7 +120,7 @@ Result<PointCloud> loadPointCloudTuned(const std::string& path, const LoadOption
     const ChunkPlan plan{options.threads, tuning.chunkBytes};
     auto cloud = format.read(bytes->view(), path, options, plan);
     if (!cloud) return cloud;
-    if (auto bad = checkCloud(*cloud, path, plan)) return *bad;
+    if (auto bad = checkCloud(*cloud, format, path, plan)) return *bad;
     return cloud;
 }
 
@@ -190,7 +169,7 @@ Result<TriangleMesh> loadMeshTuned(const std::string& path, const LoadOptions& o
         if (!cloud) return cloud.error();
         mesh.vertices = std::move(cloud).value();
     }
-    if (auto bad = checkCloud(mesh.vertices, path, plan)) return *bad;
+    if (auto bad = checkCloud(mesh.vertices, format, path, plan)) return *bad;
     if (mesh.vertices.size() > UINT32_MAX) {
         return badInput(path, "file",
                         std::to_string(mesh.vertices.size()) +
@@ -216,7 +195,8 @@ Result<PointCloud> loadPointCloud(const std::string& path, const LoadOptions& op
 Result<std::vector<glm::vec3>> loadPoints(const std::string& path) {
     auto cloud = loadPointCloud(path);
     if (!cloud) return cloud.error();
-    if (cloud->scalar == Scalar::kFloat32) return std::move(cloud->floats);
+    if (cloud->scalar == Scalar::kFloat32)
+        return std::vector<glm::vec3>(cloud->floats.begin(), cloud->floats.end());
     const ChunkPlan plan;
     std::vector<glm::vec3> points(cloud->doubles.size());
     const uint64_t perChunk = plan.items(sizeof(glm::dvec3));
@@ -229,7 +209,7 @@ Result<std::vector<glm::vec3>> loadPoints(const std::string& path) {
         }
         return std::nullopt;
     });
-    if (auto bad = firstNonFinite(points, path, " (or beyond float range)", plan)) return *bad;
+    if (auto bad = firstNonFinite(points.data(), points.size(), path, plan)) return *bad;
     return points;
 }
 

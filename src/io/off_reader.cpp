@@ -40,7 +40,7 @@ Result<PointCloud> readVertices(std::string_view text, size_t countLine, uint64_
                                 const std::string& path, const ChunkPlan& plan) {
     TextChunks chunks = splitLines(text, countLine + 1, &isContentLine, plan);
     keepItems(chunks, text, &isContentLine, vertexCount);
-    std::vector<glm::dvec3> points(static_cast<size_t>(vertexCount));
+    PointArray<glm::dvec3> points(static_cast<size_t>(vertexCount), glm::dvec3(0.0));
     auto err = parseChunks(chunks, text, plan,
                            [&](const TextChunk& chunk, TextCursor& cursor) -> std::optional<Error> {
                                uint64_t k = chunk.firstItem;

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "io/io_error.hpp"
+#include "io/non_finite.hpp"
 #include "io/number_parse.hpp"
 #include "io/record_convert.hpp"
 #include "io/scalar_type.hpp"
@@ -191,13 +192,15 @@ Result<PointCloud> readBinaryRows(std::string_view bytes, const PcdHeader& h, co
     PointCloud out;
     out.scalar =
         std::any_of(l.scalar.begin(), l.scalar.end(), needsDouble) ? Scalar::kFloat64 : Scalar::kFloat32;
+    std::optional<Error> bad;
     if (out.scalar == Scalar::kFloat64) {
-        out.doubles.resize(static_cast<size_t>(h.points));
-        convertRecords(rows, out.doubles.data(), plan);
+        out.doubles.resize(static_cast<size_t>(h.points));  // unwritten: convertRecords writes each point
+        bad = convertRecords(rows, out.doubles.data(), plan, path);
     } else {
         out.floats.resize(static_cast<size_t>(h.points));
-        convertRecords(rows, out.floats.data(), plan);
+        bad = convertRecords(rows, out.floats.data(), plan, path);
     }
+    if (bad) return *bad;
     return out;
 }
 
@@ -227,7 +230,7 @@ Result<PointCloud> readAsciiRows(std::string_view bytes, const PcdHeader& h, con
     }
     TextChunks chunks = splitLines(text, h.dataLine + 1, &isRowLine, plan);
     keepItems(chunks, text, &isRowLine, h.points);
-    std::vector<glm::dvec3> out(static_cast<size_t>(h.points));
+    PointArray<glm::dvec3> out(static_cast<size_t>(h.points), glm::dvec3(0.0));
     auto err = parseChunks(
         chunks, text, plan, [&](const TextChunk& chunk, TextCursor& cursor) -> std::optional<Error> {
             std::array<std::string_view, 3> tok{};
@@ -258,6 +261,7 @@ Result<PointCloud> readAsciiRows(std::string_view bytes, const PcdHeader& h, con
             path, lineWhere(chunks.lastLine() + 1),
             "file ends at point " + std::to_string(chunks.items) + " of " + std::to_string(h.points));
     }
+    if (auto bad = firstNonFinite(out.data(), out.size(), path, plan)) return *bad;
     return PointCloud{Scalar::kFloat64, {}, std::move(out)};
 }
 

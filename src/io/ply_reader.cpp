@@ -11,6 +11,7 @@
 #include "io/face_list.hpp"
 #include "io/gzip_inflate.hpp"
 #include "io/io_error.hpp"
+#include "io/non_finite.hpp"
 #include "io/number_parse.hpp"
 #include "io/record_convert.hpp"
 #include "io/scalar_type.hpp"
@@ -326,6 +327,7 @@ public:
     }
 
     [[nodiscard]] size_t position() const { return m_pos; }
+    [[nodiscard]] const std::string& path() const { return m_path; }
 
     // Steps over bytes the caller has read (and checked to be there).
     void advance(uint64_t bytes) { m_pos += static_cast<size_t>(bytes); }
@@ -403,18 +405,21 @@ std::optional<RecordLayout> fixedLayout(const PlyElement& vertex, const XyzIndex
     return layout;
 }
 
-// Reads the vertex element into points (sized already): fixed-size records
-// in parallel chunks, vertices with list properties item by item.
+// Reads the vertex element into points (sized already, not yet written):
+// fixed-size records in parallel chunks, each checked as it is written,
+// vertices with list properties item by item. Returns the error of the
+// body's structure; nonFinite receives the first vertex with a NaN or
+// infinite coordinate, which the caller reports only once the rest of the
+// body has been walked (a structural error comes first, as ever).
 std::optional<Error> readVertices(BinaryBody& body, const PlyElement& vertex, const XyzIndex& xyz,
-                                  bool bigEndian, const ChunkPlan& plan, PointCloud& points) {
+                                  bool bigEndian, const ChunkPlan& plan, PointCloud& points,
+                                  std::optional<Error>& nonFinite) {
     const bool doubles = points.scalar == Scalar::kFloat64;
+    const std::string& path = body.path();
     if (auto layout = fixedLayout(vertex, xyz, body.here(), bigEndian)) {
         // checkFit has made sure that every record is in the file.
-        if (doubles) {
-            convertRecords(*layout, points.doubles.data(), plan);
-        } else {
-            convertRecords(*layout, points.floats.data(), plan);
-        }
+        nonFinite = doubles ? convertRecords(*layout, points.doubles.data(), plan, path)
+                            : convertRecords(*layout, points.floats.data(), plan, path);
         body.advance(vertex.count * layout->stride);
         return std::nullopt;
     }
@@ -427,6 +432,7 @@ std::optional<Error> readVertices(BinaryBody& body, const PlyElement& vertex, co
             points.floats[k] = glm::vec3(narrowToFloat(v[0]), narrowToFloat(v[1]), narrowToFloat(v[2]));
         }
     }
+    nonFinite = checkFiniteCloud(points, path, plan);
     return std::nullopt;
 }
 
@@ -442,16 +448,18 @@ Result<PointCloud> readBinaryBody(std::string_view bytes, const PlyHeader& heade
     const PlyElement& vertex = header.elements[vertexElement];
     PointCloud points;
     points.scalar = binaryPrecision(vertex, xyz);
-    if (points.scalar == Scalar::kFloat64) {
+    if (points.scalar == Scalar::kFloat64) {  // unwritten: readVertices writes each vertex
         points.doubles.resize(static_cast<size_t>(vertex.count));
     } else {
         points.floats.resize(static_cast<size_t>(vertex.count));
     }
-    if (auto err = readVertices(body, vertex, xyz, bigEndian, plan, points)) return *err;
+    std::optional<Error> nonFinite;
+    if (auto err = readVertices(body, vertex, xyz, bigEndian, plan, points, nonFinite)) return *err;
     for (size_t ei = vertexElement + 1; ei < header.elements.size(); ++ei) {
         if (auto err = body.skipElement(header.elements[ei])) return *err;
     }
     if (auto err = body.checkEnd()) return *err;
+    if (nonFinite) return *nonFinite;
     return points;
 }
 
@@ -556,7 +564,7 @@ Result<PointCloud> readAsciiBody(std::string_view bytes, const PlyHeader& header
     if (auto err = checkAsciiFit(header.elements, chunks.items, path)) return *err;
     uint64_t need = 0;
     const std::vector<ItemRange> ranges = itemRanges(header.elements, need);
-    std::vector<glm::dvec3> points(static_cast<size_t>(header.elements[vertexElement].count));
+    PointArray<glm::dvec3> points(static_cast<size_t>(header.elements[vertexElement].count), glm::dvec3(0.0));
     auto err = parseChunks(
         chunks, text, plan, [&](const TextChunk& chunk, TextCursor& cursor) -> std::optional<Error> {
             uint64_t g = chunk.firstItem;
@@ -582,6 +590,7 @@ Result<PointCloud> readAsciiBody(std::string_view bytes, const PlyHeader& header
             return std::nullopt;
         });
     if (err) return *err;
+    if (auto bad = firstNonFinite(points.data(), points.size(), path, plan)) return *bad;
     return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }
 

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <type_traits>
 
+#include "io/non_finite.hpp"
 #include "io/number_parse.hpp"
 
 namespace rthdist::io {
@@ -79,11 +80,12 @@ void convertRange(const RecordLayout& l, uint64_t begin, uint64_t end, Vec* out)
 }
 
 template <class Vec>
-void convertAll(const RecordLayout& l, Vec* out, const ChunkPlan& plan) {
+std::optional<Error> convertAll(const RecordLayout& l, Vec* out, const ChunkPlan& plan,
+                                const std::string& path) {
     const uint64_t perChunk = plan.items(l.stride);
     const size_t chunks = chunkCount(l.count, perChunk);
     const bool swap = l.bigEndian != (std::endian::native == std::endian::big);
-    (void)forEachChunk(chunks, plan, [&](size_t c) -> std::optional<Error> {
+    return forEachChunk(chunks, plan, [&](size_t c) -> std::optional<Error> {
         const uint64_t begin = c * perChunk;
         const uint64_t end = std::min(l.count, begin + perChunk);
         if (swap) {
@@ -91,18 +93,20 @@ void convertAll(const RecordLayout& l, Vec* out, const ChunkPlan& plan) {
         } else {
             convertRange<false>(l, begin, end, out);
         }
-        return std::nullopt;
+        return firstNonFiniteIn(out, begin, end, path);
     });
 }
 
 }  // namespace
 
-void convertRecords(const RecordLayout& layout, glm::vec3* out, const ChunkPlan& plan) {
-    convertAll(layout, out, plan);
+std::optional<Error> convertRecords(const RecordLayout& layout, glm::vec3* out, const ChunkPlan& plan,
+                                    const std::string& path) {
+    return convertAll(layout, out, plan, path);
 }
 
-void convertRecords(const RecordLayout& layout, glm::dvec3* out, const ChunkPlan& plan) {
-    convertAll(layout, out, plan);
+std::optional<Error> convertRecords(const RecordLayout& layout, glm::dvec3* out, const ChunkPlan& plan,
+                                    const std::string& path) {
+    return convertAll(layout, out, plan, path);
 }
 
 }  // namespace rthdist::io

@@ -15,7 +15,7 @@ constexpr size_t kHeaderSize = 80;
 constexpr size_t kFacetSize = 50;  // normal, 3 vertices (float32 LE), uint16 attribute
 
 PointCloud readBinary(std::string_view bytes, uint64_t facets) {
-    std::vector<glm::vec3> points(static_cast<size_t>(facets) * 3);
+    PointArray<glm::vec3> points(static_cast<size_t>(facets) * 3, glm::vec3(0.0f));
     const char* p = bytes.data() + kHeaderSize + 4;
     for (uint64_t f = 0; f < facets; ++f, p += kFacetSize) {
         for (size_t c = 0; c < 3; ++c) {
@@ -29,7 +29,7 @@ PointCloud readBinary(std::string_view bytes, uint64_t facets) {
 }
 
 Result<PointCloud> readAscii(std::string_view bytes, const std::string& path) {
-    std::vector<glm::dvec3> points;
+    PointArray<glm::dvec3> points;
     TextCursor cursor(bytes);
     for (std::string_view tok = cursor.nextToken(); !tok.empty(); tok = cursor.nextToken()) {
         if (tok != "vertex") continue;

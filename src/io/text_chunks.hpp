@@ -98,7 +98,7 @@ template <const PointLineFormat& format>
 Result<PointCloud> readPointLines(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
     const std::string_view text = bytes.substr(bomLength(bytes));
     const TextChunks chunks = splitLines(text, 1, format.isItem, plan);
-    std::vector<glm::dvec3> points;
+    PointArray<glm::dvec3> points;
     auto parse = [&](const TextChunk& chunk, TextCursor& cursor) -> std::optional<Error> {
         uint64_t k = chunk.firstItem;
         std::string_view line;
@@ -123,7 +123,7 @@ Result<PointCloud> readPointLines(std::string_view bytes, const std::string& pat
     if (chunks.items > (text.size() + 1) / format.shortestLine) {
         if (auto err = parseChunks(chunks, text, plan, parse)) return *err;
     }
-    points.resize(static_cast<size_t>(chunks.items));
+    points.resize(static_cast<size_t>(chunks.items), glm::dvec3(0.0));
     if (auto err = parseChunks(chunks, text, plan, parse)) return *err;
     return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }

@@ -236,7 +236,8 @@ TEST(CliPrecision, DoublePlyAtUtmMatchesTheDoubleBruteForce) {
     const std::string fa = dir.write("fa.ply", floatPly(c.a)), fb = dir.write("fb.ply", floatPly(c.b));
     const double truth = std::max(test::bruteForceDirectedDouble(c.a, c.b).distance,
                                   test::bruteForceDirectedDouble(c.b, c.a).distance);
-    io::PointCloud ca{Scalar::kFloat64, {}, c.a}, cb{Scalar::kFloat64, {}, c.b};
+    io::PointCloud ca{Scalar::kFloat64, {}, {c.a.begin(), c.a.end()}};
+    io::PointCloud cb{Scalar::kFloat64, {}, {c.b.begin(), c.b.end()}};
     const double tolerance = 1e-6 * unionDiagonal(ca, cb);
     SCOPED_TRACE("seed " + std::to_string(c.seed) + ", brute force H " + std::to_string(truth));
     const CliRun rounded = runCli({"--backend", "cpu", "--json", fa, fb});

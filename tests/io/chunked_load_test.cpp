@@ -299,6 +299,75 @@ TEST_F(ChunkedLoad, BinaryPlyErrorsAfterTheVertices) {
     const std::string nanPath = write("nan.ply", nan);
     EXPECT_TRUE(isBadInput(serialLoad(nanPath), nanPath, "vertex 47: coordinate y is NaN"));
     EXPECT_TRUE(loadsAlike(nanPath));
+    // The vertices are checked as they are converted, but the body's
+    // structure is reported first, as when the check was a pass of its own.
+    const std::string nanAndJunk = write("nan_junk.ply", nan + "junk");
+    EXPECT_TRUE(isBadInput(serialLoad(nanAndJunk), nanAndJunk, "4 bytes follow the last declared element"));
+    EXPECT_TRUE(loadsAlike(nanAndJunk));
+    const std::string nanAndCut = write("nan_cut.ply", nan.substr(0, nan.size() - 3));
+    EXPECT_TRUE(
+        isBadInput(serialLoad(nanAndCut), nanAndCut, "element face item 1: file ends inside the item"));
+    EXPECT_TRUE(loadsAlike(nanAndCut));
+}
+
+// Enough points that the cloud is mapped on its own (PointAllocator: 4 MiB
+// and more) and every thread converts chunks of its own: the same points as
+// the serial parse, and the first of two bad vertices named, with the
+// default chunks and with page-sized ones.
+TEST_F(ChunkedLoad, LargeBinaryPlyAndPcdOnSeveralThreads) {
+    constexpr int kLarge = 400'000;  // 4.8 MB of float points, 9.6 MB of doubles
+    ByteBuilder f(false);
+    f.text("ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(kLarge) +
+           "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nend_header\n");
+    ByteBuilder d(true);
+    d.text("ply\nformat binary_big_endian 1.0\nelement vertex " + std::to_string(kLarge) +
+           "\nproperty double x\nproperty double y\nproperty double z\nend_header\n");
+    ByteBuilder c(false);
+    c.text("VERSION .7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\nPOINTS " +
+           std::to_string(kLarge) + "\nDATA binary\n");
+    for (int i = 0; i < kLarge; ++i) {
+        const glm::dvec3 p = pointAt(i);
+        f.put(float(p.x)).put(float(p.y)).put(float(p.z)).put<uint8_t>(uint8_t(i));
+        d.put(p.x).put(p.y).put(p.z);
+        c.put(float(p.x)).put(float(p.y)).put(float(p.z)).put<uint32_t>(uint32_t(i));
+    }
+    const std::string paths[] = {write("large_f.ply", f.str()), write("large_d.ply", d.str()),
+                                 write("large.pcd", c.str())};
+    for (const std::string& path : paths) {
+        const Result<PointCloud> reference = serialLoad(path);
+        ASSERT_TRUE(reference.ok()) << reference.error().message;
+        ASSERT_EQ(reference->size(), size_t(kLarge));
+        const glm::dvec3 last = pointAt(kLarge - 1);
+        if (reference->scalar == Scalar::kFloat64) {
+            EXPECT_EQ(reference->doubles.back(), last) << path;
+        } else {
+            EXPECT_EQ(reference->floats.back(), glm::vec3(float(last.x), float(last.y), float(last.z)))
+                << path;
+        }
+        for (size_t chunkBytes : {size_t(0), size_t(4096)}) {
+            for (unsigned threads : {2u, 3u}) {
+                LoadOptions o;
+                o.threads = threads;
+                const Result<PointCloud> r =
+                    loadPointCloudTuned(path, o, LoadTuning{FileAccess::kMap, chunkBytes});
+                ASSERT_TRUE(r.ok()) << r.error().message;
+                EXPECT_TRUE(sameBits(*r, *reference)) << path << ", " << threads << " threads";
+            }
+        }
+    }
+    // An infinity late in the file and a NaN later still: the infinity is named.
+    std::string bad = f.str();
+    const size_t body = bad.find("end_header\n") + 11;
+    const float inf = -INFINITY, nan = std::nanf("");
+    std::memcpy(&bad[body + 390'001 * 13 + 8], &inf, 4);  // z of vertex 390001
+    std::memcpy(&bad[body + 399'000 * 13 + 0], &nan, 4);  // x of vertex 399000
+    const std::string badPath = write("large_bad.ply", bad);
+    for (unsigned threads : {1u, 2u, 3u}) {
+        LoadOptions o;
+        o.threads = threads;
+        EXPECT_TRUE(isBadInput(loadPointCloud(badPath, o), badPath,
+                               "vertex 390001: coordinate z is infinite (or beyond float range)"));
+    }
 }
 
 TEST_F(ChunkedLoad, BinaryPcd) {
@@ -315,6 +384,15 @@ TEST_F(ChunkedLoad, BinaryPcd) {
     const std::string cut = write("cut.pcd", b.str().substr(0, b.str().size() - 1));
     EXPECT_TRUE(isBadInput(serialLoad(cut), cut, "declares 50 points of 28 bytes"));
     EXPECT_TRUE(loadsAlike(cut));
+    // Rows checked as they are converted: the first non-finite one is named.
+    std::string nan = b.str();
+    const size_t body = nan.find("DATA binary\n") + 12;
+    const double nanValue = std::nan(""), infValue = INFINITY;
+    std::memcpy(&nan[body + 31 * 28 + 20], &infValue, 8);  // z of point 31
+    std::memcpy(&nan[body + 44 * 28 + 4], &nanValue, 8);   // x of point 44
+    const std::string nanPath = write("nan.pcd", nan);
+    EXPECT_TRUE(isBadInput(serialLoad(nanPath), nanPath, "vertex 31: coordinate z is infinite"));
+    EXPECT_TRUE(loadsAlike(nanPath));
 }
 
 LasSpec lasSpec(int minor, int format, int n) {
@@ -403,7 +481,7 @@ TEST_F(ChunkedLoad, StlAndGlbMappedAsRead) {
     const std::string glbPath = write("a.glb", glb(json, bin.str()));
     auto g = serialLoad(glbPath);
     ASSERT_TRUE(g.ok()) << g.error().message;
-    EXPECT_EQ(g->floats, threePoints());
+    EXPECT_EQ(std::vector<glm::vec3>(g->floats.begin(), g->floats.end()), threePoints());
     EXPECT_TRUE(loadsAlike(glbPath));
 }
 

@@ -3,12 +3,14 @@
 
     /usr/bin/python3 tools/bench/load_ab.py --before OLD/rthdist-load-bench \\
         --after build/rthdist-load-bench --dir /tmp/rthdist-load --rounds 5 \\
-        --out docs/bench/loaders/ab.json [FILE...]
+        --out docs/bench/loaders/ab.json [--threads N] [FILE...]
 
 For every file, --rounds rounds; each round runs the before binary, then the
 after binary (order swapped every other round), each with --runs timed loads
 after --warmup, so that both see the same page cache and the same load from
-other users of the machine. The figure per binary is the median over all its
+other users of the machine; --threads N (both binaries need the option:
+rthdist-load-bench from issue 33 on) parses on N threads, 0 (default) on
+every hardware thread. The figure per binary is the median over all its
 timed loads' medians; the CPU seconds (all threads) of a load are kept
 beside the wall time. Writes every raw record and the summary as JSON and
 prints a Markdown table (file, MB, before / after / best after MB/s,
@@ -26,9 +28,11 @@ FILES = ["ply_float.ply", "ply_double.ply", "ply_float_extra.ply", "ply_double_b
          "text.xyz", "ascii.ply", "text.obj", "text.off", "ascii.pcd"]
 
 
-def run(binary, path, runs, warmup):
-    out = subprocess.run([binary, "--runs", str(runs), "--warmup", str(warmup), path],
-                         check=True, capture_output=True, text=True).stdout
+def run(binary, path, runs, warmup, threads):
+    args = [binary, "--runs", str(runs), "--warmup", str(warmup)]
+    if threads is not None:
+        args += ["--threads", str(threads)]
+    out = subprocess.run(args + [path], check=True, capture_output=True, text=True).stdout
     return json.loads(out.strip().splitlines()[-1])
 
 
@@ -45,6 +49,7 @@ def main():
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--warmup", type=int, default=1)
     ap.add_argument("--out", required=True)
+    ap.add_argument("--threads", type=int, default=None)
     ap.add_argument("files", nargs="*", default=FILES)
     a = ap.parse_args()
     records, summary = [], []
@@ -55,7 +60,7 @@ def main():
             order = ["before", "after"] if r % 2 == 0 else ["after", "before"]
             for which in order:
                 load = loadavg()
-                rec = run(getattr(a, which), path, a.runs, a.warmup)
+                rec = run(getattr(a, which), path, a.runs, a.warmup, a.threads)
                 rec.update({"binary": which, "round": r, "loadavg_1min": load, "time": time.time()})
                 records.append(rec)
                 seen[which].append(rec)
@@ -76,7 +81,8 @@ def main():
               f"{row['before_cpu_s']:.2f} | {row['after_cpu_s']:.2f} | {row['loadavg_1min']:.1f} |",
               flush=True)
     with open(a.out, "w") as f:
-        json.dump({"rounds": a.rounds, "runs": a.runs, "warmup": a.warmup, "cpus": os.cpu_count(),
+        json.dump({"rounds": a.rounds, "runs": a.runs, "warmup": a.warmup, "threads": a.threads,
+                   "cpus": os.cpu_count(),
                    "summary": summary, "records": records}, f, indent=1)
 
 

@@ -1,11 +1,12 @@
 // rthdist-load-bench: how fast the loaders turn a file into points, from the
 // page cache (issue 14's "loaders at disk speed").
 //
-//   rthdist-load-bench FILE... [--runs 7] [--warmup 2] [--floats] [--las-classes 2,6]
+//   rthdist-load-bench FILE... [--runs 7] [--warmup 2] [--threads N] [--floats] [--las-classes 2,6]
 //
 // Per file: --warmup untimed loads (they also bring the file into the page
 // cache), then --runs timed rthdist::io::loadPointCloud calls (what the CLI
-// calls; --floats: loadPoints, rounded to float32). Alongside, the same
+// calls, on --threads parsing threads, 0 every hardware thread; --floats:
+// loadPoints, rounded to float32). Alongside, the same
 // number of plain read()s of the whole file into one buffer: what the page
 // cache itself delivers on this machine. Prints one JSON object per file
 // (times in seconds, MB = 1e6 bytes of the file as stored on disk;
@@ -53,6 +54,7 @@ struct Settings {
     int runs = 7;
     int warmup = 2;
     bool floats = false;
+    unsigned threads = 0;
     std::vector<int> lasClasses;
 };
 
@@ -71,6 +73,7 @@ Loaded loadOnce(const std::string& path, const Settings& s) {
     }
     rthdist::io::LoadOptions options;
     options.lasClasses = s.lasClasses;
+    options.threads = s.threads;
     auto r = rthdist::io::loadPointCloud(path, options);
     if (!r) return {0, "", r.error().message};
     return {r->size(), r->scalar == rthdist::Scalar::kFloat64 ? "float64" : "float32", ""};
@@ -112,6 +115,7 @@ nlohmann::ordered_json benchFile(const std::string& path, const Settings& s) {
                                 {"precision", loaded.precision},
                                 {"entry", s.floats ? "loadPoints" : "loadPointCloud"},
                                 {"hardware_threads", std::thread::hardware_concurrency()},
+                                {"threads", s.threads},
                                 {"runs", load.size()},
                                 {"warmup", s.warmup},
                                 {"median_s", t},
@@ -135,6 +139,8 @@ int main(int argc, char** argv) {
     app.add_option("files", files, "point files")->required()->check(CLI::ExistingFile);
     app.add_option("--runs", s.runs, "timed loads per file")->check(CLI::Range(1, 1000));
     app.add_option("--warmup", s.warmup, "untimed loads first")->check(CLI::Range(0, 100));
+    app.add_option("--threads", s.threads, "parsing threads per load (0: every hardware thread)")
+        ->check(CLI::Range(0, 4096));
     app.add_flag("--floats", s.floats, "time loadPoints (float32) instead of loadPointCloud");
     app.add_option("--las-classes", s.lasClasses, "LAS classification filter")->delimiter(',');
     CLI11_PARSE(app, argc, argv);

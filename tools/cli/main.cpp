@@ -60,7 +60,7 @@ Result<io::PointCloud> load(const std::string& path, const io::LoadOptions& opti
 // The per-point outputs and their statistics work on float32 points: a
 // double cloud is rounded (its distances stay those of the double input).
 std::vector<glm::vec3> floatPoints(const io::PointCloud& cloud) {
-    if (cloud.scalar == Scalar::kFloat32) return cloud.floats;
+    if (cloud.scalar == Scalar::kFloat32) return {cloud.floats.begin(), cloud.floats.end()};
     constexpr double kMax = std::numeric_limits<float>::max();
     auto narrow = [](double v) {  // beyond the float range: an infinity, not undefined behaviour
         return v > kMax ? INFINITY : v < -kMax ? -INFINITY : static_cast<float>(v);

@@ -9,11 +9,11 @@ namespace rthdist::cli {
 namespace {
 
 template <class T>
-std::vector<T> sliceOf(std::vector<T>& all, int rank, int size) {
+io::PointArray<T> sliceOf(io::PointArray<T>& all, int rank, int size) {
     const uint64_t n = all.size();
     const uint64_t begin = n * uint64_t(rank) / uint64_t(size), end = n * uint64_t(rank + 1) / uint64_t(size);
-    std::vector<T> part(all.begin() + std::ptrdiff_t(begin), all.begin() + std::ptrdiff_t(end));
-    std::vector<T>().swap(all);
+    io::PointArray<T> part(all.begin() + std::ptrdiff_t(begin), all.begin() + std::ptrdiff_t(end));
+    io::PointArray<T>().swap(all);
     return part;
 }
 
@@ -27,7 +27,7 @@ uint64_t mixWord(uint64_t h, uint64_t w) {
 }
 
 template <class T>
-uint64_t digest(const std::vector<T>& points, uint64_t h) {
+uint64_t digest(const io::PointArray<T>& points, uint64_t h) {
     const auto* bytes = reinterpret_cast<const unsigned char*>(points.data());
     const size_t n = points.size() * sizeof(T);
     size_t i = 0;
