@@ -11,8 +11,8 @@
 #include "io.hpp"
 #include "masks.hpp"
 #include "result.hpp"
-#include "surface.hpp"
 #include "rthdist/rthdist.hpp"
+#include "surface.hpp"
 
 PYBIND11_MODULE(_rthdist, m) {
     m.doc() = "rthdist: exact Hausdorff distance between 3-D point sets (compiled core)";

@@ -114,8 +114,9 @@ Plan planSurfaceRoute(Backend requested, bool perPoint) {
 
 Plan planSurfacePairRoute(Backend requested) {
     if (requested == Backend::kCpu || requested == Backend::kAuto) return routed(Route::kSurfaceCpu);
-    return refused(ErrorCode::kInvalidArgument, std::string("surface to surface runs on the cpu backend for now (") +
-                                                    backendName(requested) + " requested)");
+    return refused(ErrorCode::kInvalidArgument,
+                   std::string("surface to surface runs on the cpu backend for now (") +
+                       backendName(requested) + " requested)");
 }
 
 Plan planFramedCall(uint64_t a, uint64_t b, const CallOptions& call, const MemoryBudget& budget,

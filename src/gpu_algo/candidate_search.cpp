@@ -169,8 +169,8 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
     }
     if (out.run == 0) throw std::runtime_error("candidate search: the device searched no query");
     if (m_ws.ctx.tracingSubmits() && step == SearchStep::kSweep)
-        std::fprintf(stderr, "rthdist sweep of %u targets: searched %u, going on %u\n", d.T.n, log[0].searched,
-                     log[0].goingOn);
+        std::fprintf(stderr, "rthdist sweep of %u targets: searched %u, going on %u\n", d.T.n,
+                     log[0].searched, log[0].goingOn);
     else if (m_ws.ctx.tracingSubmits() && wholeLevel)
         std::fprintf(stderr, "rthdist tail scan level %d (%u cells): searched %u, going on %u\n", level,
                      lv.count, log[0].searched, log[0].goingOn);

@@ -66,7 +66,8 @@ void IndexBuild::cmdSplitRound(VkCommandBuffer cmd, const PointIndex& ix, const 
     m_ws.pipelines.cmdDispatch(cmd, Kernel::kCellsTotal, &cp, sizeof(cp), 1);
 }
 
-void IndexBuild::cmdBuildLeaves(VkCommandBuffer cmd, const PointIndex& ix, const LeafRound& r, uint32_t leaves) {
+void IndexBuild::cmdBuildLeaves(VkCommandBuffer cmd, const PointIndex& ix, const LeafRound& r,
+                                uint32_t leaves) {
     LeafScratch& leaf = m_ws.scratch.leaves;
     const uint64_t n = ix.n;
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "leaf build");

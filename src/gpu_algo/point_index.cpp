@@ -7,14 +7,16 @@ static_assert(sizeof(sh::GridParams) == 32);
 
 uint64_t SetBuffers::bytes() const {
     uint64_t total = 0;
-    for (const Buffer* b : {&sorted, &sortedKeys, &dense, &cells, &sorted2, &sortedKeys2, &leaves0, &leaves1, &leafFirst})
+    for (const Buffer* b :
+         {&sorted, &sortedKeys, &dense, &cells, &sorted2, &sortedKeys2, &leaves0, &leaves1, &leafFirst})
         total += b->size();
     for (const Level& level : levels) total += level.cells.size() + level.fineFirst.size();
     return total;
 }
 
 void SetBuffers::releaseUnused(const PointIndex& ix) {
-    for (Buffer* b : {&sorted, &sortedKeys, &dense, &cells, &sorted2, &sortedKeys2, &leaves0, &leaves1, &leafFirst}) {
+    for (Buffer* b :
+         {&sorted, &sortedKeys, &dense, &cells, &sorted2, &sortedKeys2, &leaves0, &leaves1, &leafFirst}) {
         const bool used =
             b == ix.sorted || b == ix.dense || b == ix.cells || b == ix.sortedKeys || b == ix.leafFirst;
         if (!used) b->reset();

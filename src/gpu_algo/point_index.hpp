@@ -78,13 +78,13 @@ struct PointIndex {
     uint32_t n = 0;
     core::GridSpec grid;
     core::Bounds bounds;
-    Buffer* sorted = nullptr;  // vec4: xyz, w = original index bits (cell order)
-    Buffer* dense = nullptr;   // uint per key: end of the key's cell
+    Buffer* sorted = nullptr;     // vec4: xyz, w = original index bits (cell order)
+    Buffer* dense = nullptr;      // uint per key: end of the key's cell
     Buffer* leafFirst = nullptr;  // split: uint per key, the first leaf of the key's cell
     // A large set staged by the host: its points, still on the host, which
     // buildIndexes uploads in chunks (empty: staged whole, or ingested).
     std::span<const glm::vec3> hostSource;
-    Buffer* cells = nullptr;   // Cell per occupied cell
+    Buffer* cells = nullptr;  // Cell per occupied cell
     uint32_t numCells = 0;
     uint64_t cellCapacity = 0;                // room of `cells` at the build: min(n, keys)
     Buffer* sortedKeys = nullptr;             // fine key per sorted point (builds coarser levels)

@@ -53,13 +53,18 @@ void Refinement::cmdTailScan(VkCommandBuffer cmd, DirectionRun& d, const PointIn
 
 void Refinement::cmdSweep(VkCommandBuffer cmd, DirectionRun& d, uint32_t numActive) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "sweep");
-    const sh::SweepPush sp{d.Q.sorted->address(), d.T.sorted->address(), d.state->address(),
-                           d.active[d.cur]->address(), d.T.n, numActive};
+    const sh::SweepPush sp{d.Q.sorted->address(),
+                           d.T.sorted->address(),
+                           d.state->address(),
+                           d.active[d.cur]->address(),
+                           d.T.n,
+                           numActive};
     const uint64_t perBlock = uint64_t(RTHDIST_WG) * RTHDIST_SWEEP_PER_THREAD;
     const uint64_t items = (uint64_t(d.T.n) + perBlock - 1) / perBlock * numActive;
     const uint32_t groups =
         uint32_t(std::clamp<uint64_t>(items, 1, std::max<uint32_t>(1, m_ws.ctx.limits().maxGroupsX)));
-    m_ws.pipelines.cmdDispatch(cmd, Kernel::kSweepTargets, &sp, sizeof(sp), groups);  // grid-stride over items
+    m_ws.pipelines.cmdDispatch(cmd, Kernel::kSweepTargets, &sp, sizeof(sp),
+                               groups);  // grid-stride over items
     m_ws.barrier(cmd);
     cmdResolve(cmd, d, numActive, std::numeric_limits<float>::infinity(), true);
 }

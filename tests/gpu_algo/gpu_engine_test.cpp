@@ -311,8 +311,10 @@ TEST(GpuEngine, SweepEqualsRadiiAndBruteForce) {
                                                      t.tailScanStartWork = 0;
                                                  }),
                                                  whyNot);
-    std::optional<Engine> always = makeEngine(tunedOptions([](Tuning& t) { t.sweepWork = uint64_t(1) << 40; }), whyNot);
-    std::optional<Engine> byDefault = makeEngine(tunedOptions([](Tuning& t) { t.sweepWork.reset(); }), whyNot);
+    std::optional<Engine> always =
+        makeEngine(tunedOptions([](Tuning& t) { t.sweepWork = uint64_t(1) << 40; }), whyNot);
+    std::optional<Engine> byDefault =
+        makeEngine(tunedOptions([](Tuning& t) { t.sweepWork.reset(); }), whyNot);
     if (!radiiOnly || !always || !byDefault) GTEST_SKIP() << "no device for this backend: " << whyNot;
     std::vector<OracleCase> cases{farClusterCase(71, 3000, 3000.0), farClusterCase(72, 2000, 40.0)};
     for (uint64_t seed = 73; seed < 76; ++seed) {
@@ -343,7 +345,8 @@ TEST(GpuEngine, SweepEqualsRadiiAndBruteForce) {
                     EXPECT_TRUE(d->certificate.confirmed);
                     EXPECT_FALSE(d->certificate.recomputed) << d->certificate.failure;
                     if (e == &*always) EXPECT_EQ(d->counters.tailScanned, d->counters.survivingQueries);
-                    if (e == &*byDefault && c.name.starts_with("far-cluster")) sweptByDefault += d->counters.tailScanned;
+                    if (e == &*byDefault && c.name.starts_with("far-cluster"))
+                        sweptByDefault += d->counters.tailScanned;
                 }
                 expectMatchesOracle(c, *t);
                 EXPECT_EQ(t->hausdorff, r->hausdorff);

@@ -168,8 +168,8 @@ TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
         for (uint64_t capacity : {uint64_t(64), uint64_t(2000)}) {
             (*engine)->setMaxPairCapacity(capacity);
             for (const OracleCase& c : cases) {
-                SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed) + " pairs " + std::to_string(capacity) +
-                             " leaves " + std::to_string(leaves));
+                SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed) + " pairs " +
+                             std::to_string(capacity) + " leaves " + std::to_string(leaves));
                 auto r = (*engine)->compute(c.a, c.b, Options{});
                 ASSERT_TRUE(r) << r.error().message;
                 std::printf("  %-28s pairs %5llu leaves %4u: H %.9g, settled by the pass %llu / %llu\n",
@@ -199,7 +199,8 @@ TEST(LargeSizes, ChunkedUploadEqualsWholeStaging) {
     ASSERT_TRUE(whole && chunked);
     std::vector<OracleCase> cases;
     for (const OracleCase& c : makeOracleCases())
-        if (c.a.size() + c.b.size() >= 3000 && c.a.size() + c.b.size() <= 20000 && cases.size() < 6) cases.push_back(c);
+        if (c.a.size() + c.b.size() >= 3000 && c.a.size() + c.b.size() <= 20000 && cases.size() < 6)
+            cases.push_back(c);
     ASSERT_GE(cases.size(), 3u);
     for (size_t past : {size_t(2500), size_t(100)}) {
         (*chunked)->setUploadChunks(past, 777);

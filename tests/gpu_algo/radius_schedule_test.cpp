@@ -217,7 +217,7 @@ TEST(RadiusSchedule, SweepWhileOpenTimesTargetsIsWithinTheLimit) {
     EXPECT_TRUE(s.sweeps(1, 1000));
     EXPECT_FALSE(s.sweeps(1, 1001));
     EXPECT_FALSE(s.sweeps(0xffffffffu, uint64_t(1) << 40));  // no overflow of open x targets
-    settings.sweepWork = 0;  // never
+    settings.sweepWork = 0;                                  // never
     EXPECT_FALSE(RadiusSchedule(unitGrid(), settings, 2.0, 10, 10).sweeps(1, 1));
 }
 
