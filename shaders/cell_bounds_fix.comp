@@ -18,5 +18,19 @@ void main() {
     }
     cellAt(pc.cells, c).v.lo = lo;
     cellAt(pc.cells, c).v.hi = hi;
-    if (any(notEqual(lo, hi))) atomicMax(UintRef(pc.maxCount).v, count);
+    if (any(notEqual(lo, hi))) {
+        atomicMax(UintRef(pc.maxCount).v, count);
+        return;
+    }
+    // Copies of one position, scanned through their first point alone: the
+    // copy of the smallest original index goes first (the tie rule; one
+    // thread per such cell, a rare case: many exact copies of one point).
+    uint first = cellAt(pc.cells, c).v.first, smallest = first;
+    for (uint j = first + 1u; j < first + count; ++j)
+        if (floatBitsToUint(vec4At(pc.sorted, j).v.w) < floatBitsToUint(vec4At(pc.sorted, smallest).v.w)) smallest = j;
+    if (smallest != first) {
+        vec4 head = vec4At(pc.sorted, first).v;
+        vec4At(pc.sorted, first).v = vec4At(pc.sorted, smallest).v;
+        vec4At(pc.sorted, smallest).v = head;
+    }
 }

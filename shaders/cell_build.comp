@@ -5,6 +5,9 @@
 // largest count of a cell that can split (not all one point) goes to maxCount.
 // A cell of more than RTHDIST_SERIAL_BOX points only gets its box's start
 // values here (cell_bounds.comp reduces it in parallel).
+// A cell of copies of one position is scanned through its first point alone
+// (scan_cells.glsl, cull.comp): that first point is made the copy of the
+// smallest original index (the tie rule), whatever order the sort left.
 #include "common.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CellsPush pc; };
@@ -35,10 +38,17 @@ void main() {
     }
     uint64_t pts = pc.sorted;
     vec3 lo = vec4At(pts, i).v.xyz, hi = lo;
+    uint smallest = i;  // the point of the smallest original index
     for (uint j = i + 1; j < end; ++j) {
-        vec3 p = vec4At(pts, j).v.xyz;
-        lo = min(lo, p);
-        hi = max(hi, p);
+        vec4 p = vec4At(pts, j).v;
+        lo = min(lo, p.xyz);
+        hi = max(hi, p.xyz);
+        if (floatBitsToUint(p.w) < floatBitsToUint(vec4At(pts, smallest).v.w)) smallest = j;
+    }
+    if (all(equal(lo, hi)) && smallest != i) {  // copies: the smallest index first
+        vec4 first = vec4At(pts, i).v;
+        vec4At(pts, i).v = vec4At(pts, smallest).v;
+        vec4At(pts, smallest).v = first;
     }
     c.lo = lo;
     c.hi = hi;

@@ -9,6 +9,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include <glm/geometric.hpp>
@@ -366,6 +367,39 @@ TEST(GpuEngine, SweepEqualsRadiiAndBruteForce) {
         }
     }
     EXPECT_GT(sweptByDefault, 0u);
+}
+
+// Exact copies of a target are one position: a cell of copies is scanned
+// through its first point alone, which the index build makes the copy of
+// the smallest original index (the tie rule), whatever order the counting
+// sort left (it is not stable). Targets are `distinct` points followed by
+// their copies, so every per-point nearest index must lie in the first
+// block: few copies a point (the cell's serial box), and more than
+// RTHDIST_SERIAL_BOX copies (the parallel box reduction's fix pass).
+TEST(GpuEngine, CopiesGoToTheSmallestIndex) {
+    RTHDIST_REQUIRE_ENGINE(engine, gpuOptions());
+    CallOptions call;
+    call.perPointDistances = true;
+    for (const auto& [distinct, copies, bits] :
+         {std::tuple<size_t, size_t, int>{1500, 3, 0}, std::tuple<size_t, size_t, int>{3000, 2, 1},
+          std::tuple<size_t, size_t, int>{40, 100, 0}}) {
+        call.bits = bits;  // 1: crowded cells, cut into leaves (copies end up in leaves of their own)
+        for (uint64_t seed = 81; seed < 84; ++seed) {
+            SCOPED_TRACE(std::to_string(distinct) + " x " + std::to_string(copies) + " bits " +
+                         std::to_string(bits) + " seed " + std::to_string(seed));
+            const std::vector<glm::vec3> a = uniformCloud(2000, seed, glm::vec3(0.0f));
+            const std::vector<glm::vec3> base = uniformCloud(distinct, seed + 7, glm::vec3(0.1f, 0.0f, 0.0f));
+            std::vector<glm::vec3> b;
+            for (size_t k = 0; k < copies; ++k) b.insert(b.end(), base.begin(), base.end());
+            auto r = engine->compute(a, b, call);
+            ASSERT_TRUE(r.ok()) << r.error().message;
+            EXPECT_EQ(r->aNearest.distance, oracle::bruteForceNearest(a, b));
+            size_t past = 0;
+            for (uint32_t t : r->aNearest.nearest) past += t >= distinct;
+            EXPECT_EQ(past, 0u) << "per-point nearest indices name a later copy";
+            EXPECT_LT(r->aToB.targetIndex, distinct);
+        }
+    }
 }
 
 // Per-point arrays handed back (Engine::recycle), of other sizes and
