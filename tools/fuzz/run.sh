@@ -7,7 +7,7 @@
 # left in build-fuzz/artifacts/<target>/.
 #
 #   tools/fuzz/run.sh                         # every target, 60 s each
-#   RTHDIST_FUZZ_SECONDS=45 tools/fuzz/run.sh # 13 targets in about 11 min (CI: 20 s each)
+#   RTHDIST_FUZZ_SECONDS=45 tools/fuzz/run.sh # 13 targets in about 11 min (CI: 15 s each)
 #   tools/fuzz/run.sh ply gltf                # some targets
 #
 # Environment: RTHDIST_FUZZ_SECONDS, RTHDIST_FUZZ_BUILD (build dir),
