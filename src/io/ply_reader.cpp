@@ -260,19 +260,7 @@ public:
                 m_pos += size;
                 continue;
             }
-            const size_t countSize = scalarSize(p.countType);
-            if (m_bytes.size() - m_pos < countSize) return truncated(e, index);
-            const double count = loadScalar(m_bytes.data() + m_pos, p.countType, m_bigEndian);
-            if (count < 0) {
-                return badInput(
-                    m_path, offsetWhere(m_pos),
-                    "element " + e.name + " item " + std::to_string(index) + ": negative list length");
-            }
-            m_pos += countSize;
-            // Compared as double first: a uint64 length may not fit size_t arithmetic.
-            const size_t itemSize = scalarSize(p.type);
-            if (count > static_cast<double>((m_bytes.size() - m_pos) / itemSize)) return truncated(e, index);
-            m_pos += static_cast<size_t>(count) * itemSize;
+            if (auto err = skipProperty(e, index, p)) return err;  // a list: its count, then its items
         }
         return std::nullopt;
     }
@@ -362,6 +350,7 @@ private:
                 "element " + e.name + " item " + std::to_string(index) + ": negative list length");
         }
         m_pos += countSize;
+        // Compared as double first: a uint64 length may not fit size_t arithmetic.
         if (count > static_cast<double>((m_bytes.size() - m_pos) / scalarSize(p.type)))
             return truncated(e, index);
         m_pos += static_cast<size_t>(count) * scalarSize(p.type);

@@ -450,4 +450,11 @@ Result<CliArgs> parseArgs(std::span<const std::string> args) {
     return out;
 }
 
+io::LoadOptions loadOptionsOf(const CliArgs& args) {
+    io::LoadOptions options;
+    options.lasClasses = args.lasClasses;
+    options.threads = unsigned(args.options.threads);
+    return options;
+}
+
 }  // namespace rthdist::cli

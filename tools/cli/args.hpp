@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli/exit_codes.hpp"
+#include "rthdist/io.hpp"
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
 
@@ -62,6 +63,10 @@ struct CliArgs {
 
 // The --help text.
 [[nodiscard]] std::string usageText();
+
+// The loaders' options of a surface or evaluation command: --las-classes,
+// and --threads as the parsing threads.
+[[nodiscard]] io::LoadOptions loadOptionsOf(const CliArgs& args);
 
 // `--devices all`: the listDevices() indices of every device with a hardware
 // RT path for `backend` (software devices such as lavapipe only when named).

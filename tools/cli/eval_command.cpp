@@ -110,9 +110,7 @@ struct Loaded {
 };
 
 Result<Loaded> load(const CliArgs& args) {
-    io::LoadOptions options;
-    options.lasClasses = args.lasClasses;
-    options.threads = unsigned(args.options.threads);
+    const io::LoadOptions options = loadOptionsOf(args);
     Result<io::PointCloud> a = io::loadPointCloud(args.pathA, options);
     if (!a) return a.error();
     Loaded out{std::move(*a), std::nullopt, std::nullopt};

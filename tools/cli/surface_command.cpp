@@ -135,9 +135,7 @@ int surfaceCommand(const CliArgs& args) {
     const Clock::time_point start = Clock::now();
     Sides sides{args.surface == "b" ? "a" : "b", args.surface, args.surface == "b" ? args.pathA : args.pathB,
                 args.surface == "b" ? args.pathB : args.pathA};
-    io::LoadOptions loadOptions;
-    loadOptions.lasClasses = args.lasClasses;
-    loadOptions.threads = unsigned(args.options.threads);
+    const io::LoadOptions loadOptions = loadOptionsOf(args);
     const Clock::time_point loadStart = Clock::now();
     Result<io::PointCloud> points = io::loadPointCloud(sides.pointsPath, loadOptions);
     if (!points) return fail(points.error());

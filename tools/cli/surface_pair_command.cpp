@@ -141,9 +141,7 @@ std::string summaryText(const Run& run) {
 
 int surfacePairCommand(const CliArgs& args) {
     const Clock::time_point start = Clock::now();
-    io::LoadOptions loadOptions;
-    loadOptions.lasClasses = args.lasClasses;
-    loadOptions.threads = unsigned(args.options.threads);
+    const io::LoadOptions loadOptions = loadOptionsOf(args);
     const Clock::time_point loadStart = Clock::now();
     Result<io::TriangleMesh> a = io::loadMesh(args.pathA, loadOptions);
     if (!a) return fail(a.error());
