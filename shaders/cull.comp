@@ -19,6 +19,7 @@
 // the running maximum kills the query at once (early break, Taha & Hanbury
 // 2015).
 #include "common.glsl"
+#include "scan_cells.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CullPush pc; };
 
@@ -69,17 +70,7 @@ void main() {
                     break;
                 }
                 if (boxDist2(q, leaf.lo, leaf.hi) > best) continue;
-                uint leafEnd = all(equal(leaf.lo, leaf.hi)) ? leaf.first + 1u : leaf.first + leaf.count;
-                for (uint t = leaf.first; t < leafEnd; ++t) {
-                    vec4 tv = vec4At(targets, t).v;
-                    float d2 = dist2(q, tv.xyz);
-                    uint t_ = floatBitsToUint(tv.w);
-                    if (d2 < best || (d2 == best && t_ < bestT)) {
-                        best = d2;
-                        bestT = t_;
-                    }
-                }
-                if (best < thr) dead = true;
+                scanCellPoints(q, leaf, targets, thr, best, bestT, dead);  // the refinement's scan of a cell
             }
             if (!dead && j == 0) thr = deadThreshold(maxPacked, pc.lowerBound2);
             continue;

@@ -22,7 +22,9 @@ int clampedBits(int bits, uint32_t n) {
 
 namespace {
 
-// Points [begin, end) as vec4 records (w = 0) at dst, their box into lo, hi.
+// Points [begin, end) as vec4 records (w = 0) at dst; with kBox also their
+// box into lo, hi (a chunked upload took the box before: stageIndex).
+template <bool kBox>
 void toRecords(std::span<const glm::vec3> pts, size_t begin, size_t end, float* dst, glm::vec3& lo,
                glm::vec3& hi) {
     for (size_t i = begin; i < end; ++i) {
@@ -31,8 +33,10 @@ void toRecords(std::span<const glm::vec3> pts, size_t begin, size_t end, float* 
         dst[4 * (i - begin) + 1] = p.y;
         dst[4 * (i - begin) + 2] = p.z;
         dst[4 * (i - begin) + 3] = 0.0f;
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
+        if constexpr (kBox) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
     }
 }
 
@@ -53,7 +57,7 @@ void IndexBuild::stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int 
     core::parallelChunks(ix.n, kHostChunk, threads, [&](size_t begin, size_t end, int t) {
         glm::vec3 l = lo[size_t(t)], h = hi[size_t(t)];
         if (dst != nullptr) {
-            toRecords(pts, begin, end, dst + 4 * begin, l, h);
+            toRecords<true>(pts, begin, end, dst + 4 * begin, l, h);
         } else {  // the box only: the records go up in chunks (uploadChunked)
             for (size_t i = begin; i < end; ++i) {
                 l = glm::min(l, pts[i]);
@@ -86,8 +90,8 @@ void IndexBuild::uploadChunked(PointIndex& ix) {
         const size_t count = std::min(chunkPoints, pts.size() - first);
         const auto t0 = Clock::now();
         core::parallelChunks(count, kHostChunk, m_ws.threads, [&](size_t begin, size_t end, int) {
-            glm::vec3 lo(0.0f), hi(0.0f);  // the box was taken by stageIndex
-            toRecords(pts.subspan(first), begin, end, dst + 4 * begin, lo, hi);
+            glm::vec3 unused(0.0f);  // the box was taken by stageIndex
+            toRecords<false>(pts.subspan(first), begin, end, dst + 4 * begin, unused, unused);
         });
         m_ws.timings->upload += msSince(t0);
         VkCommandBuffer cmd = m_ws.ctx.begin();
