@@ -2,6 +2,8 @@
 // (api/backend.hpp), on one device or several (EngineOptions::devices: the
 // lanes of one-shot calls' pieces).
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <utility>
@@ -9,6 +11,7 @@
 
 #include "api/backend.hpp"
 #include "api/device_views.hpp"
+#include "core/stopwatch.hpp"
 #include "gpu/context.hpp"
 #include "gpu_algo/gpu_hausdorff.hpp"
 
@@ -53,6 +56,21 @@ gpu_algo::DeviceSet& deviceSet(const BackendSet& set) { return *static_cast<cons
 class GpuBackend final : public ComputeBackend {
 public:
     explicit GpuBackend(const EngineOptions& options) : m_options(options) {}
+    GpuBackend(const GpuBackend&) = delete;
+    GpuBackend& operator=(const GpuBackend&) = delete;
+    // Every lane's buffers, then its device; with RTHDIST_SUBMIT_TRACE, how
+    // long each took (freeing tens of GB of device memory is not free).
+    ~GpuBackend() override {
+        const bool trace =
+            !m_lanes.empty() && m_lanes.front()->context && m_lanes.front()->context->tracingSubmits();
+        const auto t0 = std::chrono::steady_clock::now();
+        for (auto& lane : m_lanes) lane->gpu.reset();
+        const auto t1 = std::chrono::steady_clock::now();
+        m_lanes.clear();
+        if (trace)
+            std::fprintf(stderr, "rthdist teardown: buffers freed in %.3f ms, devices destroyed in %.3f ms\n",
+                         std::chrono::duration<double, std::milli>(t1 - t0).count(), core::msSince(t1));
+    }
 
     [[nodiscard]] std::optional<Error> open(const VulkanDevice* borrowed) {
         if (auto err = openDevice(m_options, m_options.backend, m_options.deviceIndex, first(), borrowed))

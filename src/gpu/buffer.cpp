@@ -72,6 +72,7 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
     dai.buffer = buffer;
     m_address = vkGetBufferDeviceAddress(d, &dai);
     m_size = bytes;
+    m_kind = kind;
 }
 
 Buffer& Buffer::operator=(Buffer&& o) noexcept {
@@ -81,6 +82,7 @@ Buffer& Buffer::operator=(Buffer&& o) noexcept {
         m_address = std::exchange(o.m_address, 0);
         m_size = std::exchange(o.m_size, 0);
         m_mapped = std::exchange(o.m_mapped, nullptr);
+        m_kind = o.m_kind;
     }
     return *this;
 }

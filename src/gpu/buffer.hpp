@@ -37,6 +37,7 @@ public:
     [[nodiscard]] VkDeviceAddress address() const { return m_address; }
     [[nodiscard]] VkDeviceSize size() const { return m_size; }
     [[nodiscard]] void* mapped() const { return m_mapped; }
+    [[nodiscard]] MemoryKind kind() const { return m_kind; }
     [[nodiscard]] explicit operator bool() const { return bool(m_buffer); }
 
 private:
@@ -45,6 +46,7 @@ private:
     VkDeviceAddress m_address = 0;
     VkDeviceSize m_size = 0;
     void* m_mapped = nullptr;
+    MemoryKind m_kind = MemoryKind::kDevice;
 };
 
 // Usage flags every storage buffer of rthdist gets.

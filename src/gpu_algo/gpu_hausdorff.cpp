@@ -292,6 +292,7 @@ struct GpuHausdorff::State {
             if (!options.directedOnly) res.bNearest = std::move(spareB);
         }
         spare = spareB = PerPoint{};
+        ws.recycleBuildScratch();  // every index of the call is built
         const double mid = options.directedOnly ? 1.0 : from + 0.5 * (1.0 - from);
         DirectionRun ab{a.ix, b.ix, a.pts, b.pts, ws.blocks[0], pp ? &res.aNearest : nullptr};
         DirectionRun ba{b.ix, a.ix, b.pts, a.pts, ws.blocks[1], pp ? &res.bNearest : nullptr};
@@ -437,6 +438,9 @@ void GpuHausdorff::setUploadChunks(size_t past, size_t chunk) {
     m_state->ws.uploadChunkPoints = std::max<size_t>(1, chunk);
 }
 
+void GpuHausdorff::setAdoptMinBytes(uint64_t bytes) { m_state->ws.adoptMinBytes = bytes; }
+uint64_t GpuHausdorff::adoptedBuffers() const { return m_state->ws.adopted; }
+
 void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
     m_state->ws.maxPairCapacity = std::max<uint64_t>(1, pairs);
 }
@@ -452,6 +456,7 @@ void GpuHausdorff::releaseScratch() {
     ws.tlasBound = false;
     ws.scratch = Scratch{};
     ws.oneShot = {};
+    ws.spare.clear();
     m_state->spare = m_state->spareB = PerPoint{};
     m_state->handedBack = 0;
 }

@@ -140,10 +140,17 @@ public:
     // kCullLeafScanMax); tests set 0 (a crowded cell gives its first point
     // only) so that crowded queries reach the search.
     void setCullLeafScanMax(uint32_t leaves);
-    // A host-staged set of more than `past` points goes up in chunks of
-    // `chunk` points (defaults kChunkedUploadPoints, kUploadChunkPoints);
+    // A host-staged set of more than `past` points goes up through a host
+    // buffer of `chunk` points, in halves (defaults kChunkedUploadPoints,
+    // kUploadChunkPoints);
     // tests shrink both to run the chunked path at small sizes.
     void setUploadChunks(size_t past, size_t chunk);
+    // Requests of at least `bytes` may adopt a spent buffer of the call
+    // (Workspace::spare; default kAdoptMinBytes); tests set 0 so that small
+    // inputs adopt too.
+    void setAdoptMinBytes(uint64_t bytes);
+    // How many spent buffers requests have adopted so far (tests).
+    [[nodiscard]] uint64_t adoptedBuffers() const;
     // Frees the scratch buffers and acceleration structures kept between
     // one-shot calls (the next call allocates them again). Out-of-core calls
     // free one direction's before the other's. Prepared sets keep theirs.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <future>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -80,30 +81,44 @@ void IndexBuild::stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int 
 }
 
 void IndexBuild::uploadChunked(PointIndex& ix) {
-    const size_t chunkPoints = std::max<size_t>(1, m_ws.uploadChunkPoints);
+    // Two halves of one host buffer: the host writes the records of the next
+    // chunk into one while the device copies the other (double buffering).
+    const size_t chunkPoints = std::max<size_t>(1, m_ws.uploadChunkPoints / 2);
     const VkDeviceSize chunkBytes = VkDeviceSize(chunkPoints) * 16;
-    Buffer& chunk = m_ws.grow(m_ws.scratch.uploadChunk, chunkBytes, "uploadChunk", MemoryKind::kHost, false);
+    Buffer& chunks =
+        m_ws.grow(m_ws.scratch.uploadChunk, 2 * chunkBytes, "uploadChunk", MemoryKind::kHost, false);
     Buffer& points = m_ws.grow(ix.scratch->points, VkDeviceSize(ix.n) * 16, ix.name + ".points");
-    auto* dst = static_cast<float*>(chunk.mapped());
     const std::span<const glm::vec3> pts = ix.hostSource;
-    for (size_t first = 0; first < pts.size(); first += chunkPoints) {
+    auto fill = [&](size_t first, int half) {
+        float* dst = static_cast<float*>(chunks.mapped()) + 4 * chunkPoints * size_t(half);
         const size_t count = std::min(chunkPoints, pts.size() - first);
-        const auto t0 = Clock::now();
         core::parallelChunks(count, kHostChunk, m_ws.threads, [&](size_t begin, size_t end, int) {
             glm::vec3 unused(0.0f);  // the box was taken by stageIndex
             toRecords<false>(pts.subspan(first), begin, end, dst + 4 * begin, unused, unused);
         });
-        m_ws.timings->upload += msSince(t0);
+    };
+    const auto t0 = Clock::now();
+    fill(0, 0);
+    int half = 0;
+    for (size_t first = 0; first < pts.size(); first += chunkPoints, half ^= 1) {
+        const size_t count = std::min(chunkPoints, pts.size() - first);
+        const size_t next = first + chunkPoints;
+        // The next chunk's records, written while this one is copied (its
+        // destructor waits: nothing writes the buffer after we leave).
+        std::future<void> filling;
+        if (next < pts.size()) filling = std::async(std::launch::async, fill, next, half ^ 1);
         VkCommandBuffer cmd = m_ws.ctx.begin();
         {
             const gpu::ScopedLabel label(m_ws.ctx, cmd, "upload");
-            const VkBufferCopy region{0, VkDeviceSize(first) * 16, VkDeviceSize(count) * 16};
-            vkCmdCopyBuffer(cmd, chunk.handle(), points.handle(), 1, &region);
+            const VkBufferCopy region{VkDeviceSize(half) * chunkBytes, VkDeviceSize(first) * 16,
+                                      VkDeviceSize(count) * 16};
+            vkCmdCopyBuffer(cmd, chunks.handle(), points.handle(), 1, &region);
         }
         m_ws.ctx.submitAndWait(cmd);
-        m_ws.timings->upload += m_ws.ctx.lastGpuMs();
         m_ws.timings->gpuUpload += m_ws.ctx.lastGpuMs();
+        if (filling.valid()) filling.get();
     }
+    m_ws.timings->upload += msSince(t0);
     ix.hostSource = {};
 }
 
@@ -170,6 +185,7 @@ void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const Counte
 void IndexBuild::finishIndex(PointIndex& ix, const CounterBlock& blk) {
     ix.numCells = blk.fields().cells;
     verifyIndex(ix, ix.cellCapacity, blk);
+    if (ix.scratch != nullptr) m_ws.recycleBuild(*ix.scratch);  // sorted: the unsorted points, keys spent
     if (blk.fields().maxCount > kCrowdedCell) splitLeaves(ix);
 }
 

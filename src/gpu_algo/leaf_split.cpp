@@ -137,6 +137,12 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
     cmdCheckIndex(cmd, ix, m_ws.blocks[0]);
     m_ws.ctx.submitAndWait(cmd);
     verifyIndex(ix, ix.n, m_ws.blocks[0]);
+    // A one-shot set's spent ping-pong halves serve the rest of the call
+    // (Workspace::spare); a prepared set drops them (SetBuffers::releaseUnused).
+    if (!ix.owned) {
+        m_ws.recycle(*sorted[1 - cur]);
+        m_ws.recycle(*gridKeys[1 - cur]);
+    }
 }
 
 }  // namespace rthdist::gpu_algo

@@ -82,7 +82,7 @@ struct BatchScratch {
 
 struct Scratch {
     std::array<BuildScratch, 2> builds;  // set A (and every single build), set B
-    Buffer uploadChunk;  // host: one chunk of a large set's vec4 points (IndexBuild::uploadChunked)
+    Buffer uploadChunk;  // host: two chunks of a large set's vec4 points (IndexBuild::uploadChunked)
     LeafScratch leaves;
     LevelScratch levels;
     std::array<DirectionBuffers, 2> directions;  // A->B, B->A

@@ -29,9 +29,43 @@ Workspace::Workspace(gpu::Context& c, const std::string& cacheDir, int hostThrea
                                  hostSmall.address() + k * kCounterBlockBytes, k * kCounterBlockBytes};
 }
 
+void Workspace::recycle(Buffer& b) {
+    if (b) spare.push_back(std::move(b));
+    b.reset();
+}
+
+void Workspace::recycleBuild(BuildScratch& build) {
+    for (Buffer* b : {&build.points, &build.keys, &build.flags, &build.boundsU}) recycle(*b);
+}
+
+void Workspace::recycleBuildScratch() {
+    for (BuildScratch& s : scratch.builds) recycleBuild(s);
+    LeafScratch& leaf = scratch.leaves;
+    for (Buffer* b : {&leaf.slotKeys, &leaf.outSlotKeys, &leaf.flags, &leaf.slotDense, &leaf.boundsU})
+        recycle(*b);
+}
+
 Buffer& Workspace::grow(Buffer& b, VkDeviceSize bytes, const std::string& name, MemoryKind kind, bool slack) {
     if (!b || b.size() < bytes) {
         b.reset();
+        if (slack && bytes >= adoptMinBytes) {  // exact sizes (a prepared set's): its own
+            auto best = spare.end();
+            for (auto it = spare.begin(); it != spare.end(); ++it)
+                if (it->kind() == kind && it->size() >= bytes && it->size() / 2 <= bytes &&
+                    (best == spare.end() || it->size() < best->size()))
+                    best = it;
+            if (best != spare.end()) {
+                b = std::move(*best);
+                spare.erase(best);
+                ++adopted;
+                ctx.setDebugName(VK_OBJECT_TYPE_BUFFER, uint64_t(b.handle()), name.c_str());
+                if (ctx.tracingSubmits())
+                    std::fprintf(stderr, "rthdist buffer %s: %.1f MiB (%s) adopted, a spent one\n",
+                                 name.c_str(), double(b.size()) / double(1 << 20),
+                                 kind == MemoryKind::kDevice ? "device" : "host");
+                return b;
+            }
+        }
         const auto t0 = Clock::now();
         const VkDeviceSize room =
             !slack ? bytes

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <deque>
 #include <string>
+#include <vector>
 
 #include "core/stopwatch.hpp"
 #include "gpu/accel.hpp"
@@ -35,6 +36,9 @@ inline constexpr uint64_t kMaxPairCapacity = uint64_t(1) << 26;  // 512 MiB of p
 // Pooled buffers get this much room to grow (a quarter, at most 64 MiB, never
 // past the device's largest buffer).
 inline constexpr VkDeviceSize kMaxSlack = VkDeviceSize(64) << 20;
+// Workspace::grow adopts a spare buffer only for a request this large: small
+// buffers cost little to allocate, and a large spare is kept for a large request.
+inline constexpr VkDeviceSize kAdoptMinBytes = VkDeviceSize(16) << 20;
 // Query slots whose device records the self-check compares with the host.
 inline constexpr uint32_t kCheckSamples = RTHDIST_CHECK_SAMPLES;
 
@@ -103,12 +107,33 @@ struct Workspace {
     // stable addresses for PointIndex::source).
     std::deque<gpu::HostImport> imports;
 
+    // Buffers this call is done with (recycle): a later grow adopts one
+    // instead of allocating. Device memory costs on both ends (allocation
+    // and release run at ~40-50 GB/s on an H200: 1.7 s and 1.4 s of a
+    // 300M x 400M call before), so the index builds' scratch and the leaf
+    // split's spent ping-pong buffers become the directions' query states.
+    std::vector<Buffer> spare;
+    VkDeviceSize adoptMinBytes = kAdoptMinBytes;  // tests: 0, every request may adopt
+    uint64_t adopted = 0;                         // spare buffers adopted so far (tests)
+
     // `b` with room for `bytes` at least: replaced (contents lost) when too
-    // small, with room to grow (slack: a quarter more, at most kMaxSlack,
-    // never past the device's largest buffer) unless exact sizes are asked.
-    // `name` labels it in GPU captures and validation messages.
+    // small, by a spare buffer of the same kind where one fits (at most
+    // twice the size, the smallest such; not where exact sizes are asked),
+    // else a new one with room to grow
+    // (slack: a quarter more, at most kMaxSlack, never past the device's
+    // largest buffer) unless exact sizes are asked. `name` labels it in GPU
+    // captures and validation messages.
     Buffer& grow(Buffer& b, VkDeviceSize bytes, const std::string& name,
                  MemoryKind kind = MemoryKind::kDevice, bool slack = true);
+    // Moves `b` (if it holds a buffer) to `spare`: nothing of this call reads
+    // or writes it again through any pointer, and its slot is empty after.
+    void recycle(Buffer& b);
+    // A build's scratch (points, keys, flags, boundsU) once its index is
+    // built and checked: the leaf split and the next build adopt from it.
+    void recycleBuild(BuildScratch& build);
+    // Both builds' scratch and the leaf split's (LeafScratch), once every
+    // index of the call is built: before the directions' buffers are grown.
+    void recycleBuildScratch();
     // A buffer of set `ix`'s index (exact size for a prepared set).
     Buffer& setBuffer(PointIndex& ix, Buffer& b, const char* what, VkDeviceSize bytes) {
         return grow(b, bytes, ix.name + what, MemoryKind::kDevice, !ix.owned);

@@ -226,6 +226,56 @@ TEST(LargeSizes, ChunkedUploadEqualsWholeStaging) {
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
+// A call's spent buffers (the index builds' scratch, the leaf split's spent
+// ping-pong halves) are adopted by its later requests (Workspace::spare):
+// forced for every size here (setAdoptMinBytes(0); by default only requests
+// of 16 MiB and more adopt), crowded inputs that split, calls of growing and
+// shrinking sizes on one engine (spares kept between calls), per-point
+// calls: the same results as an engine that allocates every buffer anew and
+// the brute force.
+TEST(LargeSizes, SpentBuffersServeTheRestOfTheCall) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    auto fresh = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
+    auto adopting = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
+    ASSERT_TRUE(fresh && adopting);
+    (*fresh)->setAdoptMinBytes(UINT64_MAX);
+    (*adopting)->setAdoptMinBytes(0);
+    std::vector<OracleCase> cases;
+    for (const OracleCase& c : makeDensityCases())
+        if (c.a.size() + c.b.size() <= 25000 && c.a.size() > 1000 && c.b.size() > 1000) cases.push_back(c);
+    for (const OracleCase& c : makeOracleCases())
+        if (c.a.size() + c.b.size() >= 200 && c.a.size() + c.b.size() <= 4000 && cases.size() < 40)
+            cases.push_back(c);
+    ASSERT_GE(cases.size(), 6u);
+    const std::vector<OracleCase> run = sampledCases(cases);
+    for (bool perPoint : {false, true}) {
+        Options options;
+        options.perPointDistances = perPoint;
+        for (size_t i = 0; i < run.size(); ++i) {
+            // Growing and shrinking sizes: each case once forward, the last twice.
+            const OracleCase& c = run[i];
+            SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed) + (perPoint ? " per-point" : ""));
+            auto f = (*fresh)->compute(c.a, c.b, options);
+            ASSERT_TRUE(f) << f.error().message;
+            for (int again = 0; again < (i + 1 == run.size() ? 2 : 1); ++again) {
+                auto r = (*adopting)->compute(c.a, c.b, options);
+                ASSERT_TRUE(r) << r.error().message;
+                expectMatchesOracle(c, *r);
+                EXPECT_EQ(r->hausdorff, f->hausdorff);
+                EXPECT_EQ(r->aToB.queryIndex, f->aToB.queryIndex);
+                EXPECT_EQ(r->aToB.targetIndex, f->aToB.targetIndex);
+                EXPECT_EQ(r->bToA.queryIndex, f->bToA.queryIndex);
+                EXPECT_EQ(r->bToA.targetIndex, f->bToA.targetIndex);
+                EXPECT_EQ(r->aNearest.distance, f->aNearest.distance);
+                EXPECT_EQ(r->bNearest.distance, f->bNearest.distance);
+            }
+        }
+    }
+    EXPECT_GT((*adopting)->adoptedBuffers(), run.size());  // the path under test ran
+    EXPECT_EQ((*fresh)->adoptedBuffers(), 0u);
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
 TEST(LargeSizes, BufferPastMaxBufferSizeIsRefusedWithTheLimitNamed) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
     gpu::DeviceLimits limits = ctx->limits();
