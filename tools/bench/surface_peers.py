@@ -28,7 +28,8 @@ CGAL's tree build + queries (points) or the whole bounded-error call
 the median wall of a process that only loads the two meshes (same xvfb-run).
 "wall" is each tool's whole process (rthdist: timings_ms.wall; Open3D and
 CGAL: one process for all runs, so wall/runs; MeshLab: process wall).
-ratio = peer compute / rthdist compute (> 1: rthdist faster).
+ratio = peer compute / rthdist compute (> 1: rthdist faster); rthdist is
+rthdist-cpu unless --reference names another that ran the row.
 
 Agreement: points: |peer - rthdist| <= 1e-12 * max|coordinate| for CGAL
 (double), <= 1e-6 * max|coordinate| for Open3D (float32). surfaces: CGAL's
@@ -274,6 +275,8 @@ def main():
     ap.add_argument("--tools", default="rthdist-cpu,open3d,cgal,meshlab")
     ap.add_argument("--gpu-backends", default="", help="rthdist backends for points rows, e.g. ray-query")
     ap.add_argument("--gpu-rows", default="", help="points rows the GPU backends run (default: all points rows)")
+    ap.add_argument("--reference", default="rthdist-cpu",
+                    help="ratios against this rthdist (e.g. rthdist-rt-pipeline); rows it did not run: rthdist-cpu")
     ap.add_argument("--meshlab-samples-per-face", type=int, default=10)
     ap.add_argument("--tolerance-fraction", type=float, default=1e-4, help="surfaces: T = this x the diagonal")
     args = ap.parse_args()
@@ -335,7 +338,9 @@ def main():
                 per_tool[tool] = {"error": str(e)}
             print(name, tool, json.dumps(per_tool[tool])[:300], flush=True)
         agreement(row, per_tool)
-        ref = per_tool.get("rthdist-cpu", {}).get("compute_ms")
+        reference = args.reference if "compute_ms" in per_tool.get(args.reference, {}) else "rthdist-cpu"
+        ref = per_tool.get(reference, {}).get("compute_ms")
+        row["reference"] = reference
         for tool, r in per_tool.items():
             if ref and "compute_ms" in r and not tool.startswith("rthdist"):
                 r["ratio"] = r["compute_ms"] / ref
@@ -363,7 +368,7 @@ def write_outputs(results, out):
             if t not in tools:
                 tools.append(t)
     lines = ["| row | kind | A pts / tris | B tris | rthdist value | " + " | ".join(tools) +
-             " | ratios (peer / rthdist-cpu) | agree |",
+             " | ratios (peer / reference) | agree |",
              "|---|---|---:|---:|---|" + "---:|" * len(tools) + "---|---|"]
     for row in results["rows"]:
         rt = row["tools"].get("rthdist-cpu", {})
@@ -376,6 +381,8 @@ def write_outputs(results, out):
             a_size = "%d tris" % row["triangles"][0]
         cells = [fmt_ms(row["tools"][t]) if t in row["tools"] else "" for t in tools]
         ratios = ", ".join("%s %.2f" % (t, r["ratio"]) for t, r in row["tools"].items() if "ratio" in r)
+        if ratios and row.get("reference", "rthdist-cpu") != "rthdist-cpu":
+            ratios += " (vs %s)" % row["reference"]
         checks = [(t, r["check"]) for t, r in row["tools"].items() if "check" in r]
         agree = "yes" if checks and all(c["agrees"] for _, c in checks) else \
             "NO: " + ", ".join(t for t, c in checks if not c["agrees"])
