@@ -7,7 +7,7 @@
 # bounded-error Hausdorff on one, as CGAL 5.5 has no parallel version of it).
 # Ratios of the points rows are against rthdist-rt-pipeline, of the surfaces
 # rows against rthdist-cpu (--surface both runs on the cpu backend only).
-#   bash tools/bench/gpu_surface_run.sh BUNDLE OUTDIR [ROWS]
+#   [PYTHON=python3] bash tools/bench/gpu_surface_run.sh BUNDLE OUTDIR [ROWS]
 # ROWS: comma-separated row names of surface_peers.py (default: all).
 # Writes OUTDIR/results.json, table.md, log.txt, machine.txt (GPU, cores,
 # which libraries surface-cgal loaded).
@@ -56,6 +56,6 @@ export LD_LIBRARY_PATH=$B/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 
 rows=()
 [ -n "$ROWS" ] && rows=(--rows "$ROWS")
-PYTHONUNBUFFERED=1 timeout 580 python3 "$here/surface_peers.py" --inputs "$B/inputs" --out "$OUT" \
+PYTHONUNBUFFERED=1 timeout 580 "${PYTHON:-python3}" "$here/surface_peers.py" --inputs "$B/inputs" --out "$OUT" \
   --rthdist "$B/rthdist" --cgal "$B/surface-cgal" --tools rthdist-cpu,cgal --gpu-backends rt-pipeline \
   --reference rthdist-rt-pipeline --runs 3 --cap 120 "${rows[@]}" 2>&1 | tee "$OUT/log.txt"
