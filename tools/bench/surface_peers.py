@@ -31,7 +31,9 @@ the median wall of a process that only loads the two meshes (same xvfb-run).
 "wall" is each tool's whole process (rthdist: timings_ms.wall; Open3D and
 CGAL: one process for all runs, so wall/runs; MeshLab: process wall).
 ratio = peer compute / rthdist compute (> 1: rthdist faster); rthdist is
-rthdist-cpu unless --reference names another that ran the row.
+rthdist-cpu unless --reference names another that ran the row. rthdist-cpu-1t
+(in --tools) is the cpu backend on one thread, the thread count of CGAL's
+bounded-error Hausdorff; it is shown beside, not used in the ratios.
 
 Agreement: points: |peer - rthdist| <= 1e-12 * max|coordinate| for CGAL
 (double), <= 1e-6 * max|coordinate| for Open3D (float32). surfaces: CGAL's
@@ -115,9 +117,9 @@ def run_process(cmd, timeout, env=None):
     return p.stdout, wall
 
 
-def rthdist_tool(args, backend):
+def rthdist_tool(args, backend, threads=0):
     def run(row, a, b, tolerance):
-        cmd = [args.rthdist, a, b, "--json", "--quiet", "--backend", backend]
+        cmd = [args.rthdist, a, b, "--json", "--quiet", "--backend", backend, "--threads", str(threads)]
         cmd += ["--surface", "b"] if row["kind"] == "points" else ["--surface", "both", "--tolerance",
                                                                    repr(tolerance)]
         compute, wall, value = [], [], None
@@ -317,6 +319,8 @@ def main():
     for name in args.tools.split(","):
         if name == "rthdist-cpu":
             tools[name] = rthdist_tool(args, "cpu")
+        elif name == "rthdist-cpu-1t":  # one thread, as CGAL's bounded-error Hausdorff
+            tools[name] = rthdist_tool(args, "cpu", threads=1)
         elif name == "open3d":
             tools[name] = open3d_tool(args)
         elif name == "cgal":
@@ -425,6 +429,9 @@ def write_outputs(results, out):
         ratios = ", ".join("%s %.2f" % (t, r["ratio"]) for t, r in row["tools"].items() if "ratio" in r)
         if ratios and row.get("reference", "rthdist-cpu") != "rthdist-cpu":
             ratios += " (vs %s)" % row["reference"]
+        one = row["tools"].get("rthdist-cpu-1t", {})
+        if "compute_ms" in one and "compute_ms" in row["tools"].get("cgal", {}):
+            ratios += "; cgal / rthdist-cpu-1t %.2f" % (row["tools"]["cgal"]["compute_ms"] / one["compute_ms"])
         checks = [(t, r["check"]) for t, r in row["tools"].items() if "check" in r]
         agree = "yes" if checks and all(c["agrees"] for _, c in checks) else \
             "NO: " + ", ".join(t for t, c in checks if not c["agrees"])
