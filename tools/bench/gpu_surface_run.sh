@@ -6,7 +6,8 @@
 # backend, beside surface-cgal (CGAL 5.5: AABB_tree queries on 16 threads;
 # bounded-error Hausdorff on one, as CGAL 5.5 has no parallel version of it).
 # Ratios of the points rows are against rthdist-rt-pipeline, of the surfaces
-# rows against rthdist-cpu (--surface both runs on the cpu backend only).
+# rows against rthdist-cpu (--surface both runs on the cpu backend only);
+# rthdist-cpu-1t (one thread) is shown beside CGAL's one-threaded call.
 #   [PYTHON=python3] bash tools/bench/gpu_surface_run.sh BUNDLE OUTDIR [ROWS]
 # ROWS: comma-separated row names of surface_peers.py (default: all).
 # Writes OUTDIR/results.json, table.md, log.txt, machine.txt (GPU, cores,
@@ -27,9 +28,12 @@
 #                                       # library it lists into .devrun/surface/lib/
 #   /usr/bin/python3 tools/bench/surface_inputs.py ../shared/data .devrun/surface/inputs
 #   # (the prepared PLY files, ~33 MB: the armadillo's decimation needs Open3D,
-#   #  which the GPU machine lacks, so the inputs travel)
+#   #  which the GPU machine lacks, so the inputs travel; with the repository
+#   #  (~9 MB), the binaries (~6 MB) and .gl the call carries ~50 of its 64 MiB:
+#   #  keep nothing else in the carried folders)
 # and the Vulkan loader debs in .gl/ (docs/gpu.md). On the GPU machine, carry
-# .gl and .devrun and run from the repository root:
+# .gl and .devrun/surface (carry: [".gl", ".devrun/surface"]) and run from the
+# repository root:
 #   bash tools/bench/gpu_surface_run.sh .devrun/surface $OUT
 # About 3-6 minutes of device time (the CGAL surfaces rows dominate).
 set -uo pipefail
@@ -57,5 +61,5 @@ export LD_LIBRARY_PATH=$B/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 rows=()
 [ -n "$ROWS" ] && rows=(--rows "$ROWS")
 PYTHONUNBUFFERED=1 timeout 580 "${PYTHON:-python3}" "$here/surface_peers.py" --inputs "$B/inputs" --out "$OUT" \
-  --rthdist "$B/rthdist" --cgal "$B/surface-cgal" --tools rthdist-cpu,cgal --gpu-backends rt-pipeline \
+  --rthdist "$B/rthdist" --cgal "$B/surface-cgal" --tools rthdist-cpu,rthdist-cpu-1t,cgal --gpu-backends rt-pipeline \
   --reference rthdist-rt-pipeline --runs 3 --cap 120 "${rows[@]}" 2>&1 | tee "$OUT/log.txt"
