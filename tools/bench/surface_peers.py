@@ -310,7 +310,12 @@ def main():
     ap.add_argument("--update", action="store_true",
                     help="keep --out's results.json and replace only the rows run now")
     ap.add_argument("--tolerance-fraction", type=float, default=1e-4, help="surfaces: T = this x the diagonal")
+    ap.add_argument("--render", action="store_true", help="only write --out's table.md from its results.json")
     args = ap.parse_args()
+    if args.render:
+        with open(os.path.join(args.out, "results.json")) as f:
+            write_outputs(json.load(f), args.out)
+        return
     if args.open3d_worker:
         open3d_worker(args.open3d_worker[0], args.open3d_worker[1], int(args.open3d_worker[2]))
         return
@@ -441,7 +446,7 @@ def write_outputs(results, out):
         if notes:
             agree += " (" + "; ".join(notes) + ")"
         lines.append("| %s | %s | %s | %d | %s | %s | %s | %s |" % (
-            row["name"], row["kind"], a_size, row["triangles"][1], value, " | ".join(cells), ratios, agree))
+            row["name"].replace("|", "\\|"), row["kind"], a_size, row["triangles"][1], value, " | ".join(cells), ratios, agree))
     with open(os.path.join(out, "table.md"), "w") as f:
         f.write("Compute milliseconds, median of %d runs (the tools' own timings, file reading excluded; "
                 "MeshLab: process wall less a load-only process).\n\n" % results["runs"])
