@@ -49,8 +49,9 @@
 //   the float search found. perPointDistances on a GPU backend is
 //   kInvalidArgument (per-point values come from the CPU backend for now).
 //
-// Threading: reentrant; the search (on a GPU backend: the proof) runs on
-//   SurfaceOptions::threads threads of the library's worker pool.
+// Threading: reentrant; the BVH build and the search (on a GPU backend: the
+//   proof) run on SurfaceOptions::threads threads of the library's worker
+//   pool. The BVH, and so every result, is the same on any thread count.
 // Memory: at most 132 bytes per triangle (its corners in double and at
 //   most one 56-byte BVH node), plus 44 bytes per point with
 //   perPointDistances. GPU backends: on the device 104 bytes per triangle

@@ -303,7 +303,7 @@ Result<SurfaceBoundsResult> surfaceBounds(const MeshView& a, const MeshView& b, 
         r.dirs[1].to = &a;
     }
     for (Direction& d : r.dirs) {
-        d.bvh.emplace(*d.to);
+        d.bvh.emplace(*d.to, options.threads);
         seed(d);
     }
     SurfaceBoundsResult result;

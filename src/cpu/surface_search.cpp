@@ -65,7 +65,7 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
     SurfaceResult result;
     result.backend = Backend::kCpu;
     result.device = "cpu";
-    const TriangleBvh bvh(surface);
+    const TriangleBvh bvh(surface, options.threads);
     result.buildMs = core::msSince(start);
 
     const core::Clock::time_point searchStart = core::Clock::now();

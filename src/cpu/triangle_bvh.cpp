@@ -7,8 +7,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <numeric>
+#include <utility>
 
+#include "core/parallel.hpp"
 #include "core/point_triangle.hpp"
 
 namespace rthdist::cpu {
@@ -27,68 +28,170 @@ double pruneBound2(double best2, double slack) {
     return bound * bound;
 }
 
-}  // namespace
+// What the build partitions: a triangle's box centre beside its index, so
+// that the splits read memory in order.
+struct BuildItem {
+    glm::dvec3 centre{0.0};
+    uint32_t triangle = 0;
+};
 
-TriangleBvh::TriangleBvh(const MeshView& mesh) {
-    const size_t n = mesh.triangleCount();
-    std::vector<glm::dvec3> lo(n), hi(n), centre(n);
-    std::vector<glm::dvec3> corners(3 * n);
-    for (size_t t = 0; t < n; ++t) {
-        for (int k = 0; k < 3; ++k) corners[3 * t + size_t(k)] = mesh.corner(t, k);
-        const glm::dvec3* c = &corners[3 * t];
-        lo[t] = glm::min(glm::min(c[0], c[1]), c[2]);
-        hi[t] = glm::max(glm::max(c[0], c[1]), c[2]);
-        centre[t] = (lo[t] + hi[t]) * 0.5;
-    }
-    m_original.resize(n);
-    std::iota(m_original.begin(), m_original.end(), 0u);
-    build(lo, hi, centre);
-    m_corners.resize(3 * n);
-    for (size_t i = 0; i < n; ++i) {
-        for (size_t k = 0; k < 3; ++k) m_corners[3 * i + k] = corners[3 * size_t(m_original[i]) + k];
+// Subtrees of at most this many triangles are built whole by one task.
+constexpr uint32_t kSubtreeTriangles = 4096;
+// The top levels are split until there are this many subtrees per thread.
+constexpr size_t kSubtreesPerThread = 8;
+
+// The leaves of the median-split tree over `count` triangles. The nodes of
+// one depth hold floor or ceil of count / 2^depth triangles: a level is two
+// sizes (small and small + 1) and how many nodes have each.
+uint64_t medianSplitLeaves(uint64_t count) {
+    uint64_t small = count, nSmall = 1, nLarge = 0, leaves = 0;
+    while (true) {
+        if (small + 1 <= kLeafTriangles) return leaves + nSmall + nLarge;
+        if (small <= kLeafTriangles) {  // small leaves beside large nodes split once more
+            leaves += nSmall;
+            nSmall = 0;
+        }
+        // small even: small -> 2 x small/2, small + 1 -> small/2 and small/2 + 1;
+        // small odd: small -> small/2 and small/2 + 1, small + 1 -> 2 x (small/2 + 1).
+        const bool even = small % 2 == 0;
+        const uint64_t nextSmall = even ? 2 * nSmall + nLarge : nSmall;
+        const uint64_t nextLarge = even ? nLarge : nSmall + 2 * nLarge;
+        small /= 2;
+        nSmall = nextSmall;
+        nLarge = nextLarge;
     }
 }
 
-void TriangleBvh::build(const std::vector<glm::dvec3>& lo, const std::vector<glm::dvec3>& hi,
-                        const std::vector<glm::dvec3>& centre) {
-    const auto n = uint32_t(m_original.size());
-    m_nodes.reserve(std::max<size_t>(n, 1));  // leaves hold 2..kLeafTriangles: fewer nodes than triangles
-    m_nodes.push_back(Node{{}, {}, 0, n});
-    std::vector<uint32_t> pending{0};
-    while (!pending.empty()) {
-        const uint32_t at = pending.back();
-        pending.pop_back();
-        const uint32_t first = m_nodes[at].first;
-        const uint32_t count = m_nodes[at].count;
-        glm::dvec3 boxLo(std::numeric_limits<double>::infinity()), boxHi(-boxLo);
-        glm::dvec3 cLo = boxLo, cHi = boxHi;
-        for (uint32_t i = first; i < first + count; ++i) {
-            const uint32_t t = m_original[i];
-            boxLo = glm::min(boxLo, lo[t]);
-            boxHi = glm::max(boxHi, hi[t]);
-            cLo = glm::min(cLo, centre[t]);
-            cHi = glm::max(cHi, centre[t]);
-        }
-        m_nodes[at].lo = boxLo;
-        m_nodes[at].hi = boxHi;
-        if (count <= kLeafTriangles) continue;
-        const glm::dvec3 spread = cHi - cLo;
-        const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
-        const uint32_t half = count / 2;
-        // Ties by triangle index: the tree does not depend on the sort's whims.
-        std::nth_element(m_original.begin() + first, m_original.begin() + first + half,
-                         m_original.begin() + first + count, [&](uint32_t x, uint32_t y) {
-                             return centre[x][axis] < centre[y][axis] ||
-                                    (centre[x][axis] == centre[y][axis] && x < y);
-                         });
-        const auto left = uint32_t(m_nodes.size());
-        m_nodes[at].first = left;
-        m_nodes[at].count = 0;
-        m_nodes.push_back(Node{{}, {}, first, half});
-        m_nodes.push_back(Node{{}, {}, first + half, count - half});
-        pending.push_back(left);
-        pending.push_back(left + 1);
+// The nodes below the root of a median-split subtree over `count` triangles.
+uint32_t descendantCount(uint32_t count) { return uint32_t(2 * medianSplitLeaves(count) - 2); }
+
+// The split order along one axis (a constant, so the comparison compiles
+// to plain loads): centre, then triangle index.
+template <int Axis>
+struct CentreBefore {
+    bool operator()(const BuildItem& x, const BuildItem& y) const {
+        const double a = x.centre[Axis], b = y.centre[Axis];
+        return a < b || (a == b && x.triangle < y.triangle);
     }
+};
+
+// Reorders items[0, count) so that the first count / 2 are the smaller by
+// (centre along the longest axis of the centres' spread, triangle index),
+// and returns count / 2. The order is strict and total, so the halves
+// depend only on the set of items, never on their order or on the thread.
+uint32_t splitAtMedian(BuildItem* items, uint32_t count) {
+    glm::dvec3 cLo(std::numeric_limits<double>::infinity()), cHi(-cLo);
+    for (uint32_t i = 0; i < count; ++i) {
+        cLo = glm::min(cLo, items[i].centre);
+        cHi = glm::max(cHi, items[i].centre);
+    }
+    const glm::dvec3 spread = cHi - cLo;
+    const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
+    const uint32_t half = count / 2;
+    switch (axis) {
+        case 0: std::nth_element(items, items + half, items + count, CentreBefore<0>{}); break;
+        case 1: std::nth_element(items, items + half, items + count, CentreBefore<1>{}); break;
+        default: std::nth_element(items, items + half, items + count, CentreBefore<2>{}); break;
+    }
+    return half;
+}
+
+// One node still to build: node `at` over items [first, first + count),
+// its descendants at [base, base + descendantCount(count)).
+struct PendingNode {
+    uint32_t at = 0;
+    uint32_t first = 0;
+    uint32_t count = 0;
+    uint32_t base = 0;
+};
+
+}  // namespace
+
+TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
+    const auto n = uint32_t(mesh.triangleCount());
+    threads = core::resolveThreads(threads, n / kSubtreeTriangles);
+    std::vector<BuildItem> items(n);
+    core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
+        for (size_t t = begin; t < end; ++t) {
+            const glm::dvec3 c0 = mesh.corner(t, 0), c1 = mesh.corner(t, 1), c2 = mesh.corner(t, 2);
+            items[t] = {(glm::min(glm::min(c0, c1), c2) + glm::max(glm::max(c0, c1), c2)) * 0.5, uint32_t(t)};
+        }
+    });
+    m_nodes.resize(1 + size_t(descendantCount(n)));
+    m_corners.resize(3 * size_t(n));
+    m_original.resize(n);
+
+    // A leaf's triangles in BVH order, their corners, and its box.
+    const auto makeLeaf = [&](const PendingNode& p) {
+        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+        for (uint32_t i = p.first; i < p.first + p.count; ++i) {
+            const uint32_t t = items[i].triangle;
+            m_original[i] = t;
+            for (int k = 0; k < 3; ++k) {
+                const glm::dvec3 c = mesh.corner(t, k);
+                m_corners[3 * size_t(i) + size_t(k)] = c;
+                lo = glm::min(lo, c);
+                hi = glm::max(hi, c);
+            }
+        }
+        m_nodes[p.at] = Node{lo, hi, p.first, p.count};
+    };
+    // Node p.at becomes inner over [first, first + half) and the rest; its
+    // children are the first two of its descendants, then the left's
+    // descendants, then the right's.
+    const auto children = [&](const PendingNode& p, uint32_t half) {
+        m_nodes[p.at].first = p.base;
+        m_nodes[p.at].count = 0;
+        return std::array<PendingNode, 2>{
+            PendingNode{p.base, p.first, half, p.base + 2},
+            PendingNode{p.base + 1, p.first + half, p.count - half, p.base + 2 + descendantCount(half)}};
+    };
+    const auto unionOfChildren = [&](uint32_t at) {
+        Node& node = m_nodes[at];
+        const Node& l = m_nodes[node.first];
+        const Node& r = m_nodes[node.first + 1];
+        node.lo = glm::min(l.lo, r.lo);
+        node.hi = glm::max(l.hi, r.hi);
+    };
+    // A whole subtree on this thread, depth first.
+    const auto buildSubtree = [&](const PendingNode& root) {
+        const auto recurse = [&](const auto& self, const PendingNode& p) -> void {
+            if (p.count <= kLeafTriangles) {
+                makeLeaf(p);
+                return;
+            }
+            const std::array<PendingNode, 2> c = children(p, splitAtMedian(&items[p.first], p.count));
+            self(self, c[0]);
+            self(self, c[1]);
+            unionOfChildren(p.at);
+        };
+        recurse(recurse, root);
+    };
+
+    // The top levels one level at a time, the nodes of a level in parallel;
+    // then the subtrees below them as parallel tasks; then the boxes of the
+    // top levels from the bottom up.
+    std::vector<PendingNode> level{PendingNode{0, 0, n, 1}};
+    std::vector<uint32_t> topInner;  // parents before their children
+    while (threads > 1 && level.size() < kSubtreesPerThread * size_t(threads) &&
+           level.front().count > kSubtreeTriangles) {
+        std::vector<uint32_t> half(level.size());
+        core::parallelChunks(level.size(), 1, threads, [&](size_t begin, size_t end, int) {
+            for (size_t i = begin; i < end; ++i)
+                half[i] = splitAtMedian(&items[level[i].first], level[i].count);
+        });
+        std::vector<PendingNode> next;
+        next.reserve(2 * level.size());
+        for (size_t i = 0; i < level.size(); ++i) {
+            topInner.push_back(level[i].at);
+            for (const PendingNode& c : children(level[i], half[i])) next.push_back(c);
+        }
+        level = std::move(next);
+    }
+    core::parallelChunks(level.size(), 1, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) buildSubtree(level[i]);
+    });
+    for (auto it = topInner.rbegin(); it != topInner.rend(); ++it) unionOfChildren(*it);
 }
 
 NearestTriangle TriangleBvh::nearest(const glm::dvec3& p, double slack, double stopBelow2) const {

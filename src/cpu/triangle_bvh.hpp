@@ -4,11 +4,22 @@
 // Built top-down by median splits of the triangles' box centres along the
 // longest axis of their spread (leaves of at most kLeafTriangles), so the
 // tree is balanced (depth <= log2(n) + 2) whatever the input, duplicate and
-// degenerate triangles included. The query visits the nearer child first
-// and skips a box only when its distance exceeds the best distance so far by
-// more than core::closestSlack: the triangle with the smallest measure (the
-// smallest index on a tie) is never skipped, so the answer equals a brute
-// force over every triangle.
+// degenerate triangles included. Each split keeps the half of smaller
+// (centre, triangle index), a strict total order, so the tree is one
+// function of the mesh: the same nodes, boxes and triangle order on any
+// number of threads. The build runs on the worker pool: the top levels
+// level by level (the nodes of a level in parallel), then the subtrees
+// below them as parallel tasks, each on one thread.
+//
+// The query visits the nearer child first and skips a box only when its
+// distance exceeds the best distance so far by more than
+// core::closestSlack: the triangle with the smallest measure (the smallest
+// index on a tie) is never skipped, so the answer equals a brute force over
+// every triangle. That holds for any tree shape: it only needs each node's
+// box to contain the boxes of the triangles below it (min and max are exact,
+// and the rounded box distance only shrinks as a box grows), and a tie
+// between triangles is settled by their index, not by the order of the
+// visit.
 //
 // Layout for a later GPU path: the boxes are the triangles' own (the
 // procedural AABBs of a BLAS would be the same), and the measure is the
@@ -40,8 +51,11 @@ struct NearestTriangle {
 
 class TriangleBvh {
 public:
-    // The mesh's triangles (indices checked by the caller), copied in double.
-    explicit TriangleBvh(const MeshView& mesh);
+    // The mesh's triangles (indices checked by the caller, coordinates
+    // finite), copied in double. threads: of the worker pool for the build
+    // (core::resolveThreads: 0 = every hardware thread); the tree does not
+    // depend on it.
+    explicit TriangleBvh(const MeshView& mesh, int threads = 1);
 
     // The nearest triangle to p. slack: core::closestSlack of the largest
     // coordinate magnitude of p and the mesh. stopBelow2 > 0: return as soon
@@ -53,16 +67,17 @@ public:
     [[nodiscard]] size_t nodeCount() const { return m_nodes.size(); }
     [[nodiscard]] size_t hostBytes() const;
 
-private:
     struct Node {
-        glm::dvec3 lo{0.0}, hi{0.0};
+        glm::dvec3 lo{0.0}, hi{0.0};  // the union of the boxes of the triangles below
         uint32_t first = 0;  // leaf: first triangle (BVH order); inner: left child (right = first + 1)
         uint32_t count = 0;  // leaf: triangles; inner: 0
     };
+    // For tests and diagnostics: node 0 is the root; a node's children come
+    // after it. triangleOrder()[i]: the triangle at BVH position i.
+    [[nodiscard]] const std::vector<Node>& nodes() const { return m_nodes; }
+    [[nodiscard]] const std::vector<uint32_t>& triangleOrder() const { return m_original; }
 
-    void build(const std::vector<glm::dvec3>& lo, const std::vector<glm::dvec3>& hi,
-               const std::vector<glm::dvec3>& centre);
-
+private:
     std::vector<Node> m_nodes;
     std::vector<glm::dvec3> m_corners;  // 3 per triangle, in BVH order
     std::vector<uint32_t> m_original;   // BVH order -> triangle index

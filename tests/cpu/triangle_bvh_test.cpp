@@ -1,0 +1,241 @@
+// The CPU backend's triangle BVH (cpu/triangle_bvh.hpp): the tree's
+// invariants (each triangle in exactly one leaf, boxes that hold what is
+// below them, median splits), the same tree and the same query answers
+// whatever the build's thread count, and those answers against the brute
+// force over every triangle, on random meshes with degenerate and duplicate
+// triangles.
+#include <gtest/gtest.h>
+
+#include <glm/common.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "common/rng.hpp"
+#include "common/surface_brute_force.hpp"
+#include "core/point_triangle.hpp"
+#include "cpu/triangle_bvh.hpp"
+
+namespace rthdist {
+namespace {
+
+struct RandomMesh {
+    std::string name;
+    std::vector<glm::dvec3> vertices;
+    std::vector<uint32_t> indices;
+
+    [[nodiscard]] MeshView view() const { return MeshView{PointView(vertices), indices}; }
+    [[nodiscard]] size_t triangleCount() const { return indices.size() / 3; }
+};
+
+// `triangles` triangles over vertices on a coarse lattice (so that box
+// centres tie often), with every kind of degenerate one mixed in: repeated
+// corners, collinear corners, exact duplicates and duplicates with their
+// corners rotated.
+RandomMesh randomMesh(uint64_t seed, size_t triangles) {
+    test::Rng rng(seed);
+    RandomMesh m;
+    m.name = "seed " + std::to_string(seed) + ", " + std::to_string(triangles) + " triangles";
+    const size_t vertexCount = std::max<size_t>(triangles / 2, 3);
+    for (size_t i = 0; i < vertexCount; ++i) {
+        m.vertices.emplace_back(std::floor(rng.uniform(0, 64)) * 0.25, std::floor(rng.uniform(0, 64)) * 0.25,
+                                std::floor(rng.uniform(0, 8)) * 0.25);
+    }
+    // Three collinear vertices.
+    const auto line = uint32_t(m.vertices.size());
+    m.vertices.insert(m.vertices.end(), {{1, 1, 1}, {2, 2, 2}, {4, 4, 4}});
+    const auto vertex = [&] { return uint32_t(rng.index(vertexCount)); };
+    while (m.triangleCount() < triangles) {
+        const size_t kind = rng.index(40);
+        const size_t have = m.triangleCount();
+        if (kind == 0 && have > 0) {  // an exact duplicate
+            const size_t t = rng.index(have);
+            for (int k = 0; k < 3; ++k) m.indices.push_back(m.indices[3 * t + size_t(k)]);
+        } else if (kind == 1 && have > 0) {  // a duplicate, corners rotated
+            const size_t t = rng.index(have);
+            for (int k = 1; k <= 3; ++k) m.indices.push_back(m.indices[3 * t + size_t(k % 3)]);
+        } else if (kind == 2) {  // a point: one vertex three times
+            const uint32_t v = vertex();
+            m.indices.insert(m.indices.end(), {v, v, v});
+        } else if (kind == 3) {  // a segment: a repeated corner
+            const uint32_t a = vertex(), b = vertex();
+            m.indices.insert(m.indices.end(), {a, b, a});
+        } else if (kind == 4 && rng.index(8) == 0) {  // zero area, distinct collinear corners
+            m.indices.insert(m.indices.end(), {line, line + 2, line + 1});
+        } else {
+            m.indices.insert(m.indices.end(), {vertex(), vertex(), vertex()});
+        }
+    }
+    return m;
+}
+
+// Many copies of one triangle: every centre ties, only the index orders them.
+RandomMesh duplicateMesh(size_t triangles) {
+    RandomMesh m;
+    m.name = std::to_string(triangles) + " copies of one triangle";
+    m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    for (size_t i = 0; i < triangles; ++i) m.indices.insert(m.indices.end(), {0, 1, 2});
+    return m;
+}
+
+std::vector<glm::dvec3> queries(const RandomMesh& m, uint64_t seed, size_t count) {
+    test::Rng rng(seed);
+    std::vector<glm::dvec3> q;
+    for (size_t i = 0; i < count; ++i) {
+        switch (i % 3) {
+            case 0: q.push_back(m.vertices[rng.index(m.vertices.size())]); break;  // on a corner
+            case 1: q.emplace_back(rng.uniform(-2, 18), rng.uniform(-2, 18), rng.uniform(-2, 4)); break;
+            default:  // on a lattice point: ties between triangles
+                q.emplace_back(std::floor(rng.uniform(0, 64)) * 0.25, std::floor(rng.uniform(0, 64)) * 0.25,
+                               std::floor(rng.uniform(0, 8)) * 0.25);
+        }
+    }
+    return q;
+}
+
+bool boxHolds(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& innerLo,
+              const glm::dvec3& innerHi) {
+    return glm::all(glm::lessThanEqual(lo, innerLo)) && glm::all(glm::lessThanEqual(innerHi, hi));
+}
+
+// Walks the tree from the root and checks every invariant the query relies on.
+void expectTreeInvariants(const RandomMesh& m, const cpu::TriangleBvh& bvh) {
+    const size_t n = m.triangleCount();
+    const std::vector<cpu::TriangleBvh::Node>& nodes = bvh.nodes();
+    const std::vector<uint32_t>& order = bvh.triangleOrder();
+    ASSERT_EQ(order.size(), n) << m.name;
+    ASSERT_FALSE(nodes.empty()) << m.name;
+    std::vector<int> nodeSeen(nodes.size(), 0), triangleSeen(n, 0), positionSeen(n, 0);
+    struct Visit {
+        uint32_t node;
+        uint32_t depth;
+        size_t triangles;  // below this node, as the parent's split says
+    };
+    std::vector<Visit> stack{{0, 0, n}};
+    const double maxDepth = std::log2(double(std::max<size_t>(n, 1))) + 2;
+    while (!stack.empty()) {
+        const Visit v = stack.back();
+        stack.pop_back();
+        ASSERT_LT(v.node, nodes.size()) << m.name;
+        ASSERT_EQ(++nodeSeen[v.node], 1) << m.name << ": node " << v.node << " reached twice";
+        EXPECT_LE(double(v.depth), maxDepth) << m.name;
+        const cpu::TriangleBvh::Node& node = nodes[v.node];
+        if (node.count > 0 || v.triangles == 0) {
+            EXPECT_EQ(node.count, v.triangles) << m.name << ": leaf " << v.node;
+            EXPECT_LE(node.count, cpu::kLeafTriangles) << m.name;
+            glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+            for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+                ASSERT_LT(i, n) << m.name;
+                ++positionSeen[i];
+                const uint32_t t = order[i];
+                ASSERT_LT(t, n) << m.name;
+                ++triangleSeen[t];
+                const glm::dvec3 c0 = m.view().corner(t, 0), c1 = m.view().corner(t, 1),
+                                 c2 = m.view().corner(t, 2);
+                const glm::dvec3 tLo = glm::min(glm::min(c0, c1), c2), tHi = glm::max(glm::max(c0, c1), c2);
+                EXPECT_TRUE(boxHolds(node.lo, node.hi, tLo, tHi))
+                    << m.name << ": leaf " << v.node << ", triangle " << t;
+                lo = glm::min(lo, tLo);
+                hi = glm::max(hi, tHi);
+            }
+            if (node.count > 0) {  // the tightest box: the union of its triangles'
+                EXPECT_EQ(node.lo, lo) << m.name;
+                EXPECT_EQ(node.hi, hi) << m.name;
+            }
+            continue;
+        }
+        EXPECT_GT(v.triangles, cpu::kLeafTriangles) << m.name << ": a split node of few triangles";
+        ASSERT_LT(size_t(node.first) + 1, nodes.size()) << m.name;
+        EXPECT_GT(node.first, v.node) << m.name << ": children come after their parent";
+        const cpu::TriangleBvh::Node& l = nodes[node.first];
+        const cpu::TriangleBvh::Node& r = nodes[node.first + 1];
+        EXPECT_TRUE(boxHolds(node.lo, node.hi, l.lo, l.hi)) << m.name << ": node " << v.node;
+        EXPECT_TRUE(boxHolds(node.lo, node.hi, r.lo, r.hi)) << m.name << ": node " << v.node;
+        EXPECT_EQ(node.lo, glm::min(l.lo, r.lo)) << m.name;
+        EXPECT_EQ(node.hi, glm::max(l.hi, r.hi)) << m.name;
+        // The median split: the left child holds the smaller half.
+        stack.push_back({node.first, v.depth + 1, v.triangles / 2});
+        stack.push_back({node.first + 1, v.depth + 1, v.triangles - v.triangles / 2});
+    }
+    for (size_t i = 0; i < nodes.size(); ++i)
+        EXPECT_EQ(nodeSeen[i], 1) << m.name << ": node " << i << " unreached";
+    for (size_t i = 0; i < n; ++i) {
+        EXPECT_EQ(triangleSeen[i], 1) << m.name << ": triangle " << i;
+        EXPECT_EQ(positionSeen[i], 1) << m.name << ": BVH position " << i;
+    }
+}
+
+// The pruning slack of the meshes and queries here (coordinates within 20).
+double slack() { return core::closestSlack(20.0); }
+
+std::vector<RandomMesh> meshes() {
+    std::vector<RandomMesh> all;
+    // Small sizes around the leaf size and its doubles; then sizes whose top
+    // levels the build splits in parallel.
+    uint64_t seed = 1;
+    for (size_t n : {1, 2, 3, 4, 5, 7, 8, 9, 16, 17, 100, 4097, 30000, 65537})
+        all.push_back(randomMesh(seed++, n));
+    all.push_back(duplicateMesh(20000));
+    return all;
+}
+
+TEST(TriangleBvh, TreeInvariantsOnRandomMeshes) {
+    for (const RandomMesh& m : meshes()) {
+        for (int threads : {1, 4}) {
+            const cpu::TriangleBvh bvh(m.view(), threads);
+            expectTreeInvariants(m, bvh);
+        }
+    }
+}
+
+TEST(TriangleBvh, SameTreeAndAnswersOnAnyThreadCount) {
+    for (const RandomMesh& m : meshes()) {
+        const cpu::TriangleBvh one(m.view(), 1);
+        const std::vector<glm::dvec3> q =
+            queries(m, 1000 + m.triangleCount(), m.triangleCount() > 10000 ? 60 : 300);
+        for (int threads : {2, 8}) {
+            const cpu::TriangleBvh many(m.view(), threads);
+            ASSERT_EQ(many.nodeCount(), one.nodeCount()) << m.name << ", " << threads << " threads";
+            EXPECT_EQ(many.triangleOrder(), one.triangleOrder()) << m.name << ", " << threads << " threads";
+            for (size_t i = 0; i < one.nodeCount(); ++i) {
+                const cpu::TriangleBvh::Node &a = one.nodes()[i], &b = many.nodes()[i];
+                ASSERT_TRUE(a.lo == b.lo && a.hi == b.hi && a.first == b.first && a.count == b.count)
+                    << m.name << ", " << threads << " threads: node " << i;
+            }
+            for (const glm::dvec3& p : q) {
+                for (double stopBelow2 : {0.0, 0.5}) {
+                    const cpu::NearestTriangle x = one.nearest(p, slack(), stopBelow2);
+                    const cpu::NearestTriangle y = many.nearest(p, slack(), stopBelow2);
+                    EXPECT_EQ(x.distance2, y.distance2) << m.name;
+                    EXPECT_EQ(x.triangle, y.triangle) << m.name;
+                    EXPECT_EQ(x.point, y.point) << m.name;
+                    EXPECT_EQ(x.barycentric, y.barycentric) << m.name;
+                    EXPECT_EQ(x.dominated, y.dominated) << m.name;
+                    EXPECT_EQ(x.nodesVisited, y.nodesVisited) << m.name;
+                    EXPECT_EQ(x.trianglesTested, y.trianglesTested) << m.name;
+                }
+            }
+        }
+    }
+}
+
+TEST(TriangleBvh, NearestEqualsTheBruteForceOnRandomMeshes) {
+    for (const RandomMesh& m : meshes()) {
+        if (m.triangleCount() > 30000) continue;  // the brute force is slow
+        const cpu::TriangleBvh bvh(m.view(), 4);
+        for (const glm::dvec3& p : queries(m, 7 + m.triangleCount(), 100)) {
+            const oracle::SurfaceNearest want = oracle::bruteNearestTriangle(p, m.vertices, m.indices);
+            const cpu::NearestTriangle got = bvh.nearest(p, slack());
+            EXPECT_FALSE(got.dominated);
+            EXPECT_EQ(got.distance2, want.distance2) << m.name;
+            EXPECT_EQ(got.triangle, want.triangle) << m.name << ": the smallest index on a tie";
+            EXPECT_EQ(got.point, want.point) << m.name;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace rthdist
