@@ -27,8 +27,9 @@ void appendLe(std::string& out, T v) {
 }  // namespace
 
 Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3> points,
-                              const PerPoint& nearest, const ColourRange& range, const std::string& quality) {
-    if (nearest.distance.size() != points.size()) {
+                              std::span<const double> distance, const ColourRange& range,
+                              const std::string& quality) {
+    if (distance.size() != points.size()) {
         return Error{ErrorCode::kInvalidArgument, path + ": per-point distances missing"};
     }
     std::string out =
@@ -43,8 +44,8 @@ Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3
         appendLe(out, points[i].x);
         appendLe(out, points[i].y);
         appendLe(out, points[i].z);
-        appendLe(out, float(nearest.distance[i]));
-        const Rgb c = distanceColour(nearest.distance[i], range);
+        appendLe(out, float(distance[i]));
+        const Rgb c = distanceColour(distance[i], range);
         out.push_back(char(c.r));
         out.push_back(char(c.g));
         out.push_back(char(c.b));

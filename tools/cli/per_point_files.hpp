@@ -35,9 +35,9 @@
 
 namespace rthdist::cli {
 
-// quality: what the quality is, for the header's comment.
+// distance: one per point; quality: what it is, for the header's comment.
 [[nodiscard]] Result<bool> writeDistancePly(
-    const std::string& path, std::span<const glm::vec3> points, const PerPoint& nearest,
+    const std::string& path, std::span<const glm::vec3> points, std::span<const double> distance,
     const ColourRange& range,
     const std::string& quality = "exact distance to the nearest point of the other set");
 

@@ -56,10 +56,10 @@ Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3
     ColourRange range{stats.aToB.histogram.lo, stats.aToB.histogram.hi};
     const bool withB = !r.directedOnly;
     if (!args.outPly.empty()) {
-        Result<bool> ok = writeDistancePly(args.outPly + "_a.ply", a, r.aNearest, range);
+        Result<bool> ok = writeDistancePly(args.outPly + "_a.ply", a, r.aNearest.distance, range);
         if (!ok) return ok;
         if (withB) {
-            ok = writeDistancePly(args.outPly + "_b.ply", b, r.bNearest, range);
+            ok = writeDistancePly(args.outPly + "_b.ply", b, r.bNearest.distance, range);
             if (!ok) return ok;
         }
     }
