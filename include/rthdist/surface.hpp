@@ -47,14 +47,18 @@
 //   value are searched again exactly by the CPU backend's BVH), so the
 //   value and witness are the same as on the CPU backend (==), whatever
 //   the float search found. perPointDistances on a GPU backend is
-//   kInvalidArgument (per-point values come from the CPU backend for now).
+//   kInvalidArgument: the device's float search gives each query a
+//   candidate triangle, not its exact nearest one, and the host proves only
+//   the maximum (the queries below it are never measured exactly); per-point
+//   values come from the CPU backend (kAuto or kCpu), never a GPU backend's
+//   candidates in their place.
 //
 // Threading: reentrant; the BVH build and the search (on a GPU backend: the
 //   proof) run on SurfaceOptions::threads threads of the library's worker
 //   pool. The BVH, and so every result, is the same on any thread count.
 // Memory: at most 132 bytes per triangle (its corners in double and at
-//   most one 56-byte BVH node), plus 44 bytes per point with
-//   perPointDistances. GPU backends: on the device 104 bytes per triangle
+//   most one 56-byte BVH node), plus 60 bytes per point with
+//   perPointDistances (SurfacePerPoint). GPU backends: on the device 104 bytes per triangle
 //   and 24 per point (and the BLAS), on the host 36 per triangle and 24
 //   per point more.
 #pragma once
@@ -77,9 +81,10 @@ namespace rthdist {
 struct SurfaceOptions {
     Backend backend = Backend::kAuto;  // kAuto or kCpu (above)
     int threads = 0;                   // 0: every hardware thread
-    // Also return every point's distance, triangle and closest point
-    // (SurfaceResult::perPoint). Every query then needs its own nearest
-    // triangle: the early break against the running maximum is off.
+    // Also return every point's distance, triangle, closest point and
+    // barycentric coordinates (SurfaceResult::perPoint; kAuto and kCpu
+    // only). Every query then needs its own nearest triangle: the early
+    // break against the running maximum is off.
     bool perPointDistances = false;
     // Read at every chunk of 256 queries: true -> kCancelled.
     const std::atomic<bool>* cancel = nullptr;
@@ -115,11 +120,20 @@ struct SurfaceDirected {
     SurfaceCounters counters;
 };
 
-// Every point's nearest triangle (perPointDistances), in point order.
+// Every point's nearest triangle (perPointDistances), in point order; empty
+// without it. Each entry is what SurfaceDirected holds for the witness, for
+// every point: distance[i] = |point i - closest[i]| in double, equal (==)
+// to the brute force over every triangle (the contract above), triangle[i]
+// its nearest triangle (the smallest index on a tie), closest[i] the
+// closest point of that triangle and barycentric[i] its coordinates w.r.t.
+// the triangle's vertices in index order (non-negative, summing to 1 up to
+// rounding; closest = the vertices weighted by them, up to rounding).
+// SurfaceDirected's entry is the same as the arrays' at its queryIndex.
 struct SurfacePerPoint {
     std::vector<double> distance;
     std::vector<uint32_t> triangle;
     std::vector<glm::dvec3> closest;
+    std::vector<glm::dvec3> barycentric;
 };
 
 struct SurfaceResult {

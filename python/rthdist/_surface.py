@@ -38,9 +38,16 @@ def hausdorff_to_surface(points, vertices, faces=None, *, per_point=False, backe
 
     Returns a dict: hausdorff, query_index, triangle, query_point,
     surface_point (the closest point), barycentric, backend; with per_point
-    also distances (N,) and triangles (N,) as NumPy arrays. Exact as
-    rthdist.hausdorff is (README "Point to surface"). backend: "auto" or
-    "cpu" (the GPU backends are refused for surfaces for now).
+    also every point's values as read-only NumPy arrays in point order:
+    distances (N,) float64, triangles (N,) uint32 (the nearest triangle, the
+    smallest index on a tie), surface_points (N, 3) float64 (its closest
+    point) and barycentrics (N, 3) float64 (of that point w.r.t. the
+    triangle's vertices in face order). Exact as rthdist.hausdorff is: equal
+    to a brute force in double over every triangle (README "Point to
+    surface"). backend: "auto" or "cpu"; "ray-query" and "rt-pipeline"
+    search on a Vulkan device and give the directed value alone (per_point
+    with them is a ValueError: the device's float search proves only the
+    maximum).
     """
     v, f = _mesh(vertices, faces, "surface")
     return _rthdist._hausdorff_to_surface(as_points(points, "points"), v, f, per_point=bool(per_point),

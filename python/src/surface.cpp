@@ -56,7 +56,23 @@ Backend surfaceBackend(const std::string& backend, int threads) {
     return engineOptions(backend, std::nullopt, threads, false).backend;
 }
 
-py::dict surfaceResultDict(const SurfaceResult& r, bool perPoint) {
+// A read-only NumPy array that owns `values` (moved, not copied): (n,) for
+// scalars, (n, 3) for glm::dvec3 (three adjacent doubles).
+template <class T, class Scalar>
+py::array ownedArray(std::vector<T>&& values) {
+    static_assert(sizeof(T) % sizeof(Scalar) == 0 && alignof(T) == alignof(Scalar));
+    constexpr auto columns = py::ssize_t(sizeof(T) / sizeof(Scalar));
+    auto* heap = new std::vector<T>(std::move(values));
+    const py::capsule owner(heap, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+    const auto n = py::ssize_t(heap->size());
+    const auto* data = reinterpret_cast<const Scalar*>(heap->data());
+    py::array_t<Scalar> out =
+        columns > 1 ? py::array_t<Scalar>({n, columns}, data, owner) : py::array_t<Scalar>({n}, data, owner);
+    py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+    return out;
+}
+
+py::dict surfaceResultDict(SurfaceResult&& r, bool perPoint) {
     const SurfaceDirected& d = r.directed;
     py::dict out;
     out["hausdorff"] = r.hausdorff;
@@ -66,11 +82,12 @@ py::dict surfaceResultDict(const SurfaceResult& r, bool perPoint) {
     out["surface_point"] = vec(d.surfacePoint);
     out["barycentric"] = vec(d.barycentric);
     out["backend"] = backendName(r.backend);
-    if (perPoint) {
-        out["distances"] =
-            py::array_t<double>(py::ssize_t(r.perPoint.distance.size()), r.perPoint.distance.data());
-        out["triangles"] =
-            py::array_t<uint32_t>(py::ssize_t(r.perPoint.triangle.size()), r.perPoint.triangle.data());
+    if (perPoint) {  // moved into the arrays, in point order
+        SurfacePerPoint& p = r.perPoint;
+        out["distances"] = ownedArray<double, double>(std::move(p.distance));
+        out["triangles"] = ownedArray<uint32_t, uint32_t>(std::move(p.triangle));
+        out["surface_points"] = ownedArray<glm::dvec3, double>(std::move(p.closest));
+        out["barycentrics"] = ownedArray<glm::dvec3, double>(std::move(p.barycentric));
     }
     return out;
 }

@@ -75,6 +75,7 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
         result.perPoint.distance.resize(points.count);
         result.perPoint.triangle.resize(points.count);
         result.perPoint.closest.resize(points.count);
+        result.perPoint.barycentric.resize(points.count);
     }
     const int threads = core::resolveThreads(options.threads, (points.count + kChunk - 1) / kChunk);
     std::vector<ThreadBest> best(static_cast<size_t>(threads));
@@ -99,6 +100,7 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
                 result.perPoint.distance[q] = std::sqrt(hit.distance2);
                 result.perPoint.triangle[q] = hit.triangle;
                 result.perPoint.closest[q] = hit.point;
+                result.perPoint.barycentric[q] = hit.barycentric;
             }
             if (beats(hit, q, mine)) {
                 mine.hit = hit;

@@ -5,6 +5,9 @@
 // or the triangle.
 #include <gtest/gtest.h>
 
+#include <glm/common.hpp>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -80,8 +83,71 @@ TEST(SurfaceApi, FloatStridedInputsMatchTheBruteForce) {
     EXPECT_EQ(r->hausdorff, want.distance);
     EXPECT_EQ(r->directed.triangle, want.nearest.triangle);
     EXPECT_EQ(r->directed.surfacePoint, want.nearest.point);
-    for (size_t i = 0; i < queries.size(); ++i)
+    for (size_t i = 0; i < queries.size(); ++i) {
         ASSERT_EQ(r->perPoint.distance[i], std::sqrt(want.perQuery[i].distance2));
+        ASSERT_EQ(r->perPoint.triangle[i], want.perQuery[i].triangle);
+        ASSERT_EQ(r->perPoint.closest[i], want.perQuery[i].point);
+        ASSERT_EQ(r->perPoint.barycentric[i], want.perQuery[i].barycentric);
+    }
+}
+
+// The per-point arrays of the public call on every surface case (random
+// soups, slivers, zero-area and duplicate triangles, far-apart and
+// georeferenced placements, points on the surface): each point's distance,
+// triangle, closest point and barycentric coordinates equal (==) the double
+// brute force over every triangle; independently of the rule, the closest
+// point is its barycentric combination of the triangle's vertices (within
+// rounding at the case's magnitude), the coordinates are a convex
+// combination, the distance is |point - closest|, and the witness is the
+// arrays' entry at its query.
+TEST(SurfaceApi, PerPointArraysMatchTheBruteForceOnEveryCase) {
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        SCOPED_TRACE(c.name + ", seed " + std::to_string(c.seed));
+        SurfaceOptions options;
+        options.perPointDistances = true;
+        options.threads = 2;
+        Result<SurfaceResult> r =
+            hausdorffToSurface(PointView(c.queries), MeshView{PointView(c.vertices), c.indices}, options);
+        ASSERT_TRUE(r) << r.error().message;
+        const SurfacePerPoint& p = r->perPoint;
+        ASSERT_EQ(p.distance.size(), c.queries.size());
+        ASSERT_EQ(p.triangle.size(), c.queries.size());
+        ASSERT_EQ(p.closest.size(), c.queries.size());
+        ASSERT_EQ(p.barycentric.size(), c.queries.size());
+        const oracle::SurfaceDirectedExact want = oracle::bruteForceSurface(c.queries, c.vertices, c.indices);
+        double magnitude = 0.0;
+        for (const glm::dvec3& v : c.vertices)
+            magnitude = std::max({magnitude, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+        size_t wrong = 0;
+        for (size_t i = 0; i < c.queries.size(); ++i) {
+            const oracle::SurfaceNearest& n = want.perQuery[i];
+            const bool same = p.distance[i] == std::sqrt(n.distance2) && p.triangle[i] == n.triangle &&
+                              p.closest[i] == n.point && p.barycentric[i] == n.barycentric;
+            const glm::dvec3& b = p.barycentric[i];
+            const uint32_t t = p.triangle[i];
+            const glm::dvec3 combination = b.x * c.vertices[c.indices[3 * t]] +
+                                           b.y * c.vertices[c.indices[3 * t + 1]] +
+                                           b.z * c.vertices[c.indices[3 * t + 2]];
+            const glm::dvec3 off = glm::abs(combination - p.closest[i]);
+            const bool convex =
+                b.x >= 0.0 && b.y >= 0.0 && b.z >= 0.0 && std::abs(b.x + b.y + b.z - 1.0) <= 1e-12;
+            const bool onTriangle = std::max({off.x, off.y, off.z}) <= 1e-12 * std::max(magnitude, 1.0);
+            const glm::dvec3 d = c.queries[i] - p.closest[i];
+            const bool measured = std::abs(std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z) - p.distance[i]) <=
+                                  1e-12 * std::max(p.distance[i], 1.0);
+            if (!(same && convex && onTriangle && measured) && ++wrong <= 3)
+                ADD_FAILURE() << "point " << i << ": same " << same << ", convex " << convex
+                              << ", on triangle " << onTriangle << ", measured " << measured;
+        }
+        EXPECT_EQ(wrong, 0u);
+        const SurfaceDirected& d = r->directed;
+        EXPECT_EQ(p.distance[d.queryIndex], d.distance);
+        EXPECT_EQ(p.triangle[d.queryIndex], d.triangle);
+        EXPECT_EQ(p.closest[d.queryIndex], d.surfacePoint);
+        EXPECT_EQ(p.barycentric[d.queryIndex], d.barycentric);
+        EXPECT_EQ(*std::max_element(p.distance.begin(), p.distance.end()), r->hausdorff);
+    }
 }
 
 TEST(SurfaceApi, IndexOutOfRangeNamesTheTriangle) {

@@ -2,8 +2,9 @@
 // height field and random points written by the test, the JSON's directed
 // value and witness (a_to_b.triangle, a_to_b.b_point) against the brute
 // force over every triangle (tests/common) with ==; --surface a's mirror
-// image; the refusals (per-point outputs: exit 2; a bad face index, a file
-// without faces: exit 3 naming the file). The GPU backends:
+// image; the refusals (--verify: exit 2; a bad face index, a file without
+// faces: exit 3 naming the file). Per-point outputs:
+// cli_surface_per_point_test.cpp. The GPU backends:
 // cli_surface_gpu_test.cpp; --surface both: cli_surface_pair_test.cpp.
 #include <gtest/gtest.h>
 
@@ -108,7 +109,6 @@ TEST_F(CliSurface, SummaryNamesTheDirectedValue) {
 
 TEST_F(CliSurface, UnsupportedCombinationsAreUsageErrors) {
     EXPECT_EQ(runCli({m_xyz, m_mesh, "--surface", "c"}).exitCode, 2);
-    EXPECT_EQ(runCli({m_xyz, m_mesh, "--surface", "b", "--per-point"}).exitCode, 2);
     EXPECT_EQ(runCli({m_xyz, m_mesh, "--surface", "b", "--verify"}).exitCode, 2);
 }
 

@@ -18,6 +18,7 @@ SurfaceNearest bruteNearestTriangle(const glm::dvec3& q, std::span<const glm::dv
             best.distance2 = r.distance2;
             best.triangle = uint32_t(t);
             best.point = r.point;
+            best.barycentric = r.barycentric;
         }
     }
     return best;

@@ -18,6 +18,7 @@ struct SurfaceNearest {
     double distance2 = 0.0;
     uint32_t triangle = 0;
     glm::dvec3 point{0.0};
+    glm::dvec3 barycentric{0.0};  // of point w.r.t. the triangle's vertices, index order
 };
 
 [[nodiscard]] SurfaceNearest bruteNearestTriangle(const glm::dvec3& q, std::span<const glm::dvec3> vertices,

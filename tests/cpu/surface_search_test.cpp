@@ -1,8 +1,8 @@
 // The CPU backend's point-to-surface search (cpu/surface_search.hpp, design.md
 // §11) against the brute force over every triangle (tests/common): per-point
-// distances, triangles and closest points, and the directed maximum with its
-// witness, all with ==, on every surface case; with and without the early
-// break, on one thread and on several.
+// distances, triangles, closest points and barycentric coordinates, and the
+// directed maximum with its witness, all with ==, on every surface case;
+// with and without the early break, on one thread and on several.
 #include <gtest/gtest.h>
 
 #include <glm/common.hpp>
@@ -70,7 +70,8 @@ TEST(SurfaceSearch, EveryCaseMatchesTheBruteForce) {
             for (size_t i = 0; i < c.queries.size(); ++i) {
                 const oracle::SurfaceNearest& n = want.perQuery[i];
                 if (full->perPoint.distance[i] != std::sqrt(n.distance2) ||
-                    full->perPoint.triangle[i] != n.triangle || full->perPoint.closest[i] != n.point) {
+                    full->perPoint.triangle[i] != n.triangle || full->perPoint.closest[i] != n.point ||
+                    full->perPoint.barycentric[i] != n.barycentric) {
                     if (++wrong <= 3) ADD_FAILURE() << c.name << ": query " << i << " differs";
                 }
             }

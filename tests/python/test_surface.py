@@ -1,10 +1,13 @@
 """Triangle surfaces from Python (rthdist.hausdorff_to_surface,
 surface_hausdorff, evaluate): NumPy vertex + face arrays of every accepted
 dtype; point-to-surface values known in closed form (points over a flat
-square: |z|); surface-to-surface bounds bracketing known values within the
-tolerance; the evaluation summary against an independent NumPy brute force
-on a pair of a few thousand points (fixed seed, conftest.SEED); bad faces
-and thresholds as ValueError naming them."""
+square: |z|); the per-point arrays (distances, triangles, surface points,
+barycentrics) against a NumPy brute force over every triangle with its own
+point-triangle rule, and refused on a GPU backend; surface-to-surface
+bounds bracketing known values within the tolerance; the evaluation summary
+against an independent NumPy brute force on a pair of a few thousand points
+(fixed seed, conftest.SEED); bad faces and thresholds as ValueError naming
+them."""
 
 import numpy as np
 import pytest
@@ -23,9 +26,96 @@ def test_points_over_a_square_are_their_height(rng, vdtype, fdtype):
     assert r["hausdorff"] == np.abs(pts[:, 2]).max()
     assert r["query_index"] == int(np.argmax(np.abs(pts[:, 2])))
     np.testing.assert_array_equal(r["distances"], np.abs(pts[:, 2]))
+    np.testing.assert_array_equal(r["surface_points"], np.column_stack([pts[:, 0], pts[:, 1], np.zeros(500)]))
     q = pts[r["query_index"]]
     assert r["surface_point"] == (q[0], q[1], 0.0)
     assert r["backend"] == "cpu"
+
+
+def _closest_on_triangles(p, a, b, c):
+    """Closest points of triangles (a, b, c) to points p, row by row: the
+    Voronoi-region walk of Ericson's Real-Time Collision Detection 5.1.5 in
+    NumPy float64 (an independent rule; degenerate triangles are not drawn
+    here). Returns (distance, closest point, barycentric)."""
+    ab, ac, ap = b - a, c - a, p - a
+    d1, d2 = (ab * ap).sum(1), (ac * ap).sum(1)
+    bp = p - b
+    d3, d4 = (ab * bp).sum(1), (ac * bp).sum(1)
+    cp = p - c
+    d5, d6 = (ab * cp).sum(1), (ac * cp).sum(1)
+    va, vb, vc = d3 * d6 - d5 * d4, d5 * d2 - d1 * d6, d1 * d4 - d3 * d2
+    n = len(p)
+    bary = np.zeros((n, 3))
+    done = np.zeros(n, dtype=bool)
+
+    def take(mask, w0, w1, w2):
+        m = mask & ~done
+        bary[m] = np.column_stack([w0, w1, w2])[m]
+        done[m] = True
+
+    one, zero = np.ones(n), np.zeros(n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        take((d1 <= 0) & (d2 <= 0), one, zero, zero)
+        take((d3 >= 0) & (d4 <= d3), zero, one, zero)
+        v = d1 / (d1 - d3)
+        take((vc <= 0) & (d1 >= 0) & (d3 <= 0), 1 - v, v, zero)
+        take((d6 >= 0) & (d5 <= d6), zero, zero, one)
+        w = d2 / (d2 - d6)
+        take((vb <= 0) & (d2 >= 0) & (d6 <= 0), 1 - w, zero, w)
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        take((va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0), zero, 1 - w, w)
+        denom = va + vb + vc
+        v, w = vb / denom, vc / denom
+        take(np.ones(n, dtype=bool), 1 - v - w, v, w)
+    q = bary[:, :1] * a + bary[:, 1:2] * b + bary[:, 2:] * c
+    return np.linalg.norm(p - q, axis=1), q, bary
+
+
+def test_per_point_arrays_match_a_numpy_brute_force(rng):
+    """Every point's distance, triangle, closest point and barycentric
+    coordinates against a brute force over all triangles in NumPy (its own
+    point-triangle rule): equal to rounding; the triangle is the brute
+    force's or one within rounding of it (a near tie)."""
+    tri = rng.uniform(-1, 1, (60, 3))
+    v = np.concatenate([tri + rng.normal(0, 0.4, (60, 3)) for _ in range(3)])
+    f = np.arange(180).reshape(3, 60).T.astype(np.int64)
+    pts = rng.uniform(-1.5, 1.5, (400, 3))
+    r = rthdist.hausdorff_to_surface(pts, v, f, per_point=True)
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    dist = np.empty((len(pts), len(f)))
+    for t in range(len(f)):
+        dist[:, t] = _closest_on_triangles(pts, np.broadcast_to(a[t], pts.shape), np.broadcast_to(b[t], pts.shape),
+                                           np.broadcast_to(c[t], pts.shape))[0]
+    want = dist.min(axis=1)
+    assert r["distances"].shape == (400,) and r["distances"].dtype == np.float64
+    assert r["triangles"].shape == (400,) and r["triangles"].dtype == np.uint32
+    assert r["surface_points"].shape == (400, 3) and r["barycentrics"].shape == (400, 3)
+    for key in ("distances", "triangles", "surface_points", "barycentrics"):
+        assert not r[key].flags.writeable, key
+    np.testing.assert_allclose(r["distances"], want, rtol=1e-12, atol=1e-15)
+    t = r["triangles"].astype(np.int64)
+    assert (dist[np.arange(len(pts)), t] <= want + 1e-12).all()
+    assert (t == dist.argmin(axis=1)).mean() > 0.99
+    d_t, q_t, b_t = _closest_on_triangles(pts, a[t], b[t], c[t])
+    np.testing.assert_allclose(r["surface_points"], q_t, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(r["barycentrics"], b_t, rtol=0, atol=1e-9)
+    bary = r["barycentrics"]
+    assert (bary >= 0).all() and np.allclose(bary.sum(axis=1), 1.0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(bary[:, :1] * a[t] + bary[:, 1:2] * b[t] + bary[:, 2:] * c[t], r["surface_points"],
+                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(pts - r["surface_points"], axis=1), r["distances"], rtol=1e-12)
+    i = r["query_index"]
+    assert r["hausdorff"] == r["distances"].max() == r["distances"][i]
+    assert r["triangle"] == r["triangles"][i]
+    assert r["surface_point"] == tuple(r["surface_points"][i])
+    assert r["barycentric"] == tuple(r["barycentrics"][i])
+
+
+@pytest.mark.parametrize("gpu", ["ray-query", "rt-pipeline"])
+def test_per_point_on_a_gpu_backend_is_refused(gpu):
+    pts = np.array([[0.5, 0.5, 1.0]])
+    with pytest.raises(ValueError, match="per-point distances to a surface"):
+        rthdist.hausdorff_to_surface(pts, SQUARE_V, SQUARE_F, per_point=True, backend=gpu)
 
 
 def test_triangle_and_its_offset_copy():

@@ -137,6 +137,9 @@ Options:
   --surface SIDE      a | b: the exact distance from the other file's points to
                       the triangles of SIDE's mesh (obj, ply, off, stl, gltf,
                       glb), directed only: --surface b is h(A, surface of B);
+                      the per-point options below give the points' side's
+                      distances (cpu backend: auto picks it), their files
+                      named for that side alone (--surface b: PREFIX_a.*);
                       both: certified bounds [lower, upper] on H between the
                       surfaces of both meshes (--directed: h(A, B)); the cpu
                       backend (auto picks it)
@@ -165,6 +168,8 @@ Per-point distances (each of these implies --per-point):
   --out-ply PREFIX    write PREFIX_a.ply and PREFIX_b.ply: points with float
                       quality = distance and a red/green/blue colour ramp
   --out-csv PREFIX    write PREFIX_a.csv and PREFIX_b.csv: index,x,y,z,distance,nearest
+                      (--surface a|b: index,x,y,z,distance,triangle, the closest
+                      point closest_x,_y,_z and barycentric_0,_1,_2)
   --png FILE          picture of both sets coloured by distance, with the
                       Hausdorff segment
   --render NAME       vulkan | software: how --png draws the points (default
@@ -351,15 +356,25 @@ void addPerPointOptions(CommandLine& line, CliArgs& out) {
 }
 
 // --surface reports the directed value alone (on the cpu backend, or on
-// one device of a GPU backend): the options it cannot honour are refused,
-// never ignored.
+// one device of a GPU backend), with per-point outputs on the cpu backend
+// for a|b: the options it cannot honour are refused, never ignored.
 std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
     if (out.tolerance > 0.0 && out.surface != "both")
         return usageError(
             "option '--tolerance' sets the width of surface-to-surface bounds: it needs --surface both");
     if (out.surface.empty()) return std::nullopt;
-    if (out.perPoint)
-        return usageError("option '--surface' has no per-point outputs yet (--per-point and its options)");
+    if (out.perPoint && out.surface == "both")
+        return usageError(
+            "option '--surface both' gives certified bounds between two surfaces, not per-point distances: "
+            "--per-point and its options need --surface a or b");
+    if (out.perPoint &&
+        (out.options.backend == Backend::kRayQuery || out.options.backend == Backend::kRtPipeline))
+        return usageError(
+            std::string("option '--surface ") + out.surface +
+            "': per-point outputs (--per-point and its options) come from the cpu backend: the " +
+            backendName(out.options.backend) +
+            " backend's float search gives each point a candidate triangle and proves only the "
+            "directed maximum (use --backend cpu or auto)");
     if (out.verify)
         return usageError("option '--surface' proves its value itself: --verify has nothing to compare");
     if (!out.options.devices.empty() || out.allDevices)

@@ -18,7 +18,8 @@ constexpr Rgb kColourA{31, 119, 180}, kColourB{255, 127, 14}, kMarker{214, 39, 4
 
 }  // namespace
 
-Image plotHistogram(const HausdorffStats& stats, double hausdorff, bool directedOnly) {
+Image plotHistogram(const HausdorffStats& stats, double hausdorff, bool directedOnly,
+                    const HistogramLabels& labels) {
     const int width = 1000, height = 560;
     const int left = 90, right = 30, top = 60, bottom = 80;
     Image img(width, height, kWhite);
@@ -63,8 +64,7 @@ Image plotHistogram(const HausdorffStats& stats, double hausdorff, bool directed
         const std::string label = number(d);
         img.drawText(x - Image::textWidth(label) / 2, top + plotH + 12, label, kBlack);
     }
-    img.drawText(left + plotW / 2 - Image::textWidth("nearest-neighbour distance") / 2, height - 36,
-                 "nearest-neighbour distance", kBlack);
+    img.drawText(left + plotW / 2 - Image::textWidth(labels.axis) / 2, height - 36, labels.axis, kBlack);
     img.drawText(10, top - 30, "points", kBlack);
 
     // Markers: HD95 (symmetric) and H, when inside the range.
@@ -84,7 +84,7 @@ Image plotHistogram(const HausdorffStats& stats, double hausdorff, bool directed
     img.drawText(left, 14, "Per-point distance histogram", kBlack, 3);
     int lx = width - right - 330;
     img.fillRect(lx, 18, lx + 16, 32, kColourA);
-    img.drawText(lx + 22, 19, "A->B (" + std::to_string(stats.aToB.count) + ")", kBlack);
+    img.drawText(lx + 22, 19, labels.aToB + " (" + std::to_string(stats.aToB.count) + ")", kBlack);
     if (!directedOnly) {
         lx += 170;
         img.fillRect(lx, 18, lx + 16, 32, kColourB);

@@ -11,6 +11,13 @@
 
 namespace rthdist::cli {
 
-[[nodiscard]] Image plotHistogram(const HausdorffStats& stats, double hausdorff, bool directedOnly);
+// The legend and the x axis' title; the defaults are the point sets'.
+struct HistogramLabels {
+    std::string aToB = "A->B";  // the legend of stats.aToB
+    std::string axis = "nearest-neighbour distance";
+};
+
+[[nodiscard]] Image plotHistogram(const HausdorffStats& stats, double hausdorff, bool directedOnly,
+                                  const HistogramLabels& labels = {});
 
 }  // namespace rthdist::cli

@@ -57,22 +57,6 @@ Result<io::PointCloud> load(const std::string& path, const io::LoadOptions& opti
     return points;
 }
 
-// The per-point outputs and their statistics work on float32 points: a
-// double cloud is rounded (its distances stay those of the double input).
-std::vector<glm::vec3> floatPoints(const io::PointCloud& cloud) {
-    if (cloud.scalar == Scalar::kFloat32) return {cloud.floats.begin(), cloud.floats.end()};
-    constexpr double kMax = std::numeric_limits<float>::max();
-    auto narrow = [](double v) {  // beyond the float range: an infinity, not undefined behaviour
-        return v > kMax ? INFINITY : v < -kMax ? -INFINITY : static_cast<float>(v);
-    };
-    std::vector<glm::vec3> out(cloud.doubles.size());
-    for (size_t i = 0; i < out.size(); ++i) {
-        const glm::dvec3& p = cloud.doubles[i];
-        out[i] = glm::vec3(narrow(p.x), narrow(p.y), narrow(p.z));
-    }
-    return out;
-}
-
 int listDevicesCommand(const CliArgs& args) {
     Result<std::vector<DeviceInfo>> devices = rthdist::listDevices();
     if (!devices) return failWith(devices.error());

@@ -27,16 +27,16 @@ void appendLe(std::string& out, T v) {
 }  // namespace
 
 Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3> points,
-                              const PerPoint& nearest, const ColourRange& range) {
-    if (nearest.distance.size() != points.size()) {
+                              std::span<const double> distance, const ColourRange& range,
+                              const std::string& quality) {
+    if (distance.size() != points.size()) {
         return Error{ErrorCode::kInvalidArgument, path + ": per-point distances missing"};
     }
     std::string out =
         "ply\nformat binary_little_endian 1.0\ncomment rthdist per-point nearest distance\n"
-        "comment quality = exact distance to the nearest point of the other set\n"
-        "comment colour range " +
-        std::to_string(range.lo) + " " + std::to_string(range.hi) + "\nelement vertex " +
-        std::to_string(points.size()) +
+        "comment quality = " +
+        quality + "\ncomment colour range " + std::to_string(range.lo) + " " + std::to_string(range.hi) +
+        "\nelement vertex " + std::to_string(points.size()) +
         "\nproperty float x\nproperty float y\nproperty float z\nproperty float quality\n"
         "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
     out.reserve(out.size() + points.size() * 19);
@@ -44,8 +44,8 @@ Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3
         appendLe(out, points[i].x);
         appendLe(out, points[i].y);
         appendLe(out, points[i].z);
-        appendLe(out, float(nearest.distance[i]));
-        const Rgb c = distanceColour(nearest.distance[i], range);
+        appendLe(out, float(distance[i]));
+        const Rgb c = distanceColour(distance[i], range);
         out.push_back(char(c.r));
         out.push_back(char(c.g));
         out.push_back(char(c.b));
@@ -70,6 +70,38 @@ Result<bool> writeDistanceCsv(const std::string& path, std::span<const glm::vec3
         appendNumber(out, nearest.distance[i]);
         out.push_back(',');
         appendNumber(out, uint64_t(nearest.nearest[i]));
+        out.push_back('\n');
+    }
+    return writeOutputFile(path, out);
+}
+
+Result<bool> writeSurfaceCsv(const std::string& path, std::span<const glm::vec3> points,
+                             const SurfacePerPoint& nearest) {
+    const size_t n = points.size();
+    if (nearest.distance.size() != n || nearest.triangle.size() != n || nearest.closest.size() != n ||
+        nearest.barycentric.size() != n) {
+        return Error{ErrorCode::kInvalidArgument, path + ": per-point distances missing"};
+    }
+    std::string out =
+        "index,x,y,z,distance,triangle,closest_x,closest_y,closest_z,barycentric_0,barycentric_1,"
+        "barycentric_2\n";
+    out.reserve(n * 160);
+    for (size_t i = 0; i < n; ++i) {
+        appendNumber(out, uint64_t(i));
+        for (float c : {points[i].x, points[i].y, points[i].z}) {
+            out.push_back(',');
+            appendNumber(out, c);
+        }
+        out.push_back(',');
+        appendNumber(out, nearest.distance[i]);
+        out.push_back(',');
+        appendNumber(out, uint64_t(nearest.triangle[i]));
+        for (const glm::dvec3* v : {&nearest.closest[i], &nearest.barycentric[i]}) {
+            for (int k = 0; k < 3; ++k) {
+                out.push_back(',');
+                appendNumber(out, (*v)[k]);
+            }
+        }
         out.push_back('\n');
     }
     return writeOutputFile(path, out);

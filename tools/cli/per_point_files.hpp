@@ -7,10 +7,20 @@
 //   distance rounded to float; MeshLab shows it as vertex quality), uchar
 //   red, green, blue (cli/colour_ramp.hpp Turbo ramp over `range`). No faces:
 //   inputs are point sets. rthdist::io::loadPoints reads it back.
+//   Point to surface (`--surface a|b`): the same layout, quality the exact
+//   distance to the nearest point of the other file's triangles.
 // CSV: header "index,x,y,z,distance,nearest"; one row per point in input
 //   order; coordinates as the shortest decimal that reads back to the same
 //   float, distance as the shortest decimal of the double, nearest = index of
 //   the nearest point in the other set.
+// Surface CSV (writeSurfaceCsv, `--surface a|b`): header "index,x,y,z,
+//   distance,triangle,closest_x,closest_y,closest_z,barycentric_0,
+//   barycentric_1,barycentric_2": x, y, z and distance as above, triangle =
+//   index of the nearest triangle of the surface (in the file's face order,
+//   polygons fan-triangulated), closest_* its closest point and
+//   barycentric_* that point's coordinates w.r.t. the triangle's vertices
+//   in index order, each the shortest decimal of the double
+//   (rthdist/surface.hpp, SurfacePerPoint).
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -21,13 +31,20 @@
 #include "cli/colour_ramp.hpp"
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
+#include "rthdist/surface.hpp"
 
 namespace rthdist::cli {
 
-[[nodiscard]] Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3> points,
-                                            const PerPoint& nearest, const ColourRange& range);
+// distance: one per point; quality: what it is, for the header's comment.
+[[nodiscard]] Result<bool> writeDistancePly(
+    const std::string& path, std::span<const glm::vec3> points, std::span<const double> distance,
+    const ColourRange& range,
+    const std::string& quality = "exact distance to the nearest point of the other set");
 
 [[nodiscard]] Result<bool> writeDistanceCsv(const std::string& path, std::span<const glm::vec3> points,
                                             const PerPoint& nearest);
+
+[[nodiscard]] Result<bool> writeSurfaceCsv(const std::string& path, std::span<const glm::vec3> points,
+                                           const SurfacePerPoint& nearest);
 
 }  // namespace rthdist::cli

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -19,6 +21,20 @@ std::string baseName(const std::string& path) {
 }
 
 }  // namespace
+
+std::vector<glm::vec3> floatPoints(const io::PointCloud& cloud) {
+    if (cloud.scalar == Scalar::kFloat32) return {cloud.floats.begin(), cloud.floats.end()};
+    constexpr double kMax = std::numeric_limits<float>::max();
+    auto narrow = [](double v) {  // beyond the float range: an infinity, not undefined behaviour
+        return v > kMax ? INFINITY : v < -kMax ? -INFINITY : static_cast<float>(v);
+    };
+    std::vector<glm::vec3> out(cloud.doubles.size());
+    for (size_t i = 0; i < out.size(); ++i) {
+        const glm::dvec3& p = cloud.doubles[i];
+        out[i] = glm::vec3(narrow(p.x), narrow(p.y), narrow(p.z));
+    }
+    return out;
+}
 
 StatsOptions statsOptionsFrom(const CliArgs& args) {
     StatsOptions o;
@@ -40,10 +56,10 @@ Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3
     ColourRange range{stats.aToB.histogram.lo, stats.aToB.histogram.hi};
     const bool withB = !r.directedOnly;
     if (!args.outPly.empty()) {
-        Result<bool> ok = writeDistancePly(args.outPly + "_a.ply", a, r.aNearest, range);
+        Result<bool> ok = writeDistancePly(args.outPly + "_a.ply", a, r.aNearest.distance, range);
         if (!ok) return ok;
         if (withB) {
-            ok = writeDistancePly(args.outPly + "_b.ply", b, r.bNearest, range);
+            ok = writeDistancePly(args.outPly + "_b.ply", b, r.bNearest.distance, range);
             if (!ok) return ok;
         }
     }

@@ -6,13 +6,20 @@
 #include <glm/vec3.hpp>
 
 #include <span>
+#include <vector>
 
 #include "cli/args.hpp"
+#include "rthdist/io.hpp"
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
 #include "rthdist/stats.hpp"
 
 namespace rthdist::cli {
+
+// The per-point outputs and their statistics work on float32 points: a
+// double cloud is rounded (its distances stay those of the double input;
+// past the float range a coordinate becomes an infinity).
+[[nodiscard]] std::vector<glm::vec3> floatPoints(const io::PointCloud& cloud);
 
 // Statistics options from the command line (95 always among the percentiles).
 [[nodiscard]] StatsOptions statsOptionsFrom(const CliArgs& args);

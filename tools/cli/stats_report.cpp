@@ -91,7 +91,7 @@ Json statsJson(const HausdorffStats& s, bool directedOnly) {
             {"histogram", histogramJson(s, directedOnly)}};
 }
 
-std::string statsText(const HausdorffStats& s, bool directedOnly) {
+std::string statsText(const HausdorffStats& s, bool directedOnly, const char* directedName) {
     std::string out;
     char line[512];
     auto block = [&](const char* name, const DistanceStats& d) {
@@ -106,7 +106,7 @@ std::string statsText(const HausdorffStats& s, bool directedOnly) {
     };
     std::snprintf(line, sizeof line, "per-point  distances (bbox diagonal of A+B %.6g)\n", s.diagonal);
     out += line;
-    block("A->B", s.aToB);
+    block(directedName, s.aToB);
     if (!directedOnly) {
         block("B->A", s.bToA);
         block("pooled", s.pooled);

@@ -22,7 +22,10 @@ namespace rthdist::cli {
 // The "per_point" object.
 [[nodiscard]] Json statsJson(const HausdorffStats& stats, bool directedOnly);
 
-// Summary lines (each ends with '\n').
-[[nodiscard]] std::string statsText(const HausdorffStats& stats, bool directedOnly);
+// Summary lines (each ends with '\n'). directedName: the label of the
+// aToB block ("B->A" where the one direction measured runs from B, as for
+// `--surface a`).
+[[nodiscard]] std::string statsText(const HausdorffStats& stats, bool directedOnly,
+                                    const char* directedName = "A->B");
 
 }  // namespace rthdist::cli

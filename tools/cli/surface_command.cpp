@@ -2,11 +2,15 @@
 
 #include <cinttypes>
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "cli/exit_codes.hpp"
 #include "cli/json_output.hpp"
+#include "cli/per_point_outputs.hpp"
 #include "cli/report.hpp"
+#include "cli/surface_per_point.hpp"
 #include "core/stopwatch.hpp"
 #include "rthdist/io.hpp"
 #include "rthdist/surface.hpp"
@@ -60,6 +64,7 @@ struct Run {
     const io::PointCloud* points = nullptr;
     const io::TriangleMesh* mesh = nullptr;
     const SurfaceResult* result = nullptr;
+    const HausdorffStats* stats = nullptr;  // with per-point outputs
     double loadMs = 0.0, wallMs = 0.0;
 };
 
@@ -84,6 +89,7 @@ std::string jsonReport(const Run& run) {
         {"validation_messages", r.validationMessages}};
     j["a_to_b"] = b ? directedJson(r.directed, run.sides) : Json();
     j["b_to_a"] = b ? Json() : directedJson(r.directed, run.sides);
+    if (run.stats != nullptr) j["per_point"] = surfaceStatsJson(*run.stats, !b);
     j["timings_ms"] = {{"load", run.loadMs},
                        {"build", r.buildMs},
                        {"search", r.searchMs},
@@ -118,6 +124,7 @@ std::string summaryText(const Run& run) {
     add(std::snprintf(line, sizeof line, "  %s[%" PRIu64 "] %s -> %s triangle %u at %s\n", Q.c_str(),
                       d.queryIndex, text(d.queryPoint).c_str(), S.c_str(), d.triangle,
                       text(d.surfacePoint).c_str()));
+    if (run.stats != nullptr) s += surfaceStatsText(*run.stats, run.sides.q == "b");
     add(std::snprintf(line, sizeof line,
                       "time (ms)  load %.2f | build %.2f | search %.2f | total %.2f | wall %.2f\n",
                       run.loadMs, r.buildMs, r.searchMs, r.totalMs, run.wallMs));
@@ -148,11 +155,29 @@ int surfaceCommand(const CliArgs& args) {
     options.threads = args.options.threads;
     options.deviceIndex = args.options.deviceIndex;
     options.validation = args.options.validation;
+    options.perPointDistances = args.perPoint;
     Result<SurfaceResult> result = hausdorffToSurface(points->view(), mesh->view(), options);
     // The library names the points "A" and the surface "B".
     if (!result) return fail(withFileNames(result.error(), sides.pointsPath, sides.surfacePath));
 
-    Run run{&args, sides, &*points, &*mesh, &*result, loadMs, msSince(start)};
+    std::optional<HausdorffStats> stats;
+    if (args.perPoint) {
+        const std::vector<glm::vec3> floats = floatPoints(*points);
+        const std::vector<glm::vec3> vertices = floatPoints(mesh->vertices);
+        const SurfacePerPointRun perPoint{&args,    sides.q == "b",   floats,           vertices,
+                                          &*result, sides.pointsPath, sides.surfacePath};
+        Result<HausdorffStats> s = surfaceStats(perPoint);
+        if (!s) return fail(Error{ErrorCode::kInternal, s.error().message});
+        stats = std::move(s).value();
+        Result<bool> written = writeSurfacePerPointOutputs(perPoint, *stats);
+        if (!written) {
+            std::fflush(stdout);
+            std::fprintf(stderr, "rthdist: %s\n", written.error().message.c_str());
+            return kExitOutput;
+        }
+    }
+
+    Run run{&args, sides, &*points, &*mesh, &*result, stats ? &*stats : nullptr, loadMs, msSince(start)};
     const std::string out = args.json ? jsonReport(run) : summaryText(run);
     if (std::fwrite(out.data(), 1, out.size(), stdout) != out.size() || std::fflush(stdout) != 0)
         return fail(Error{ErrorCode::kInternal, "cannot write to stdout"});
