@@ -11,6 +11,7 @@
 #include "common/brute_force.hpp"
 #include "common/geo_cases.hpp"
 #include "common/oracle_cases.hpp"
+#include "common/oracle_memo.hpp"
 #include "engine_test_support.hpp"
 
 namespace rthdist::test {
@@ -180,7 +181,7 @@ TEST(PreparedSet, SmallPairBatchMatchesTheOracle) {
                 EXPECT_EQ(r.validationMessages, 0u);
                 if (!perPoint) continue;
                 const double tol = oracleTolerance(c.a, c.b, r.hausdorff);
-                const std::vector<double> nn = oracle::bruteForceNearest(c.a, c.b);
+                const std::vector<double> nn = oracle::memoNearest(c.a, c.b);
                 ASSERT_EQ(r.aNearest.distance.size(), c.a.size()) << c.name;
                 for (size_t q = 0; q < c.a.size(); ++q) {
                     ASSERT_NEAR(r.aNearest.distance[q], nn[q], tol) << c.name << " query " << q;
@@ -214,7 +215,7 @@ TEST(PreparedSet, SmallOneShotPairsMatchTheOracle) {
             expectMatchesOracle(c, *r, directed);
             EXPECT_EQ(r->validationMessages, 0u);
             if (!call.perPointDistances) continue;
-            const std::vector<double> nn = oracle::bruteForceNearest(c.a, c.b);
+            const std::vector<double> nn = oracle::memoNearest(c.a, c.b);
             ASSERT_EQ(r->aNearest.distance.size(), c.a.size());
             for (size_t q = 0; q < c.a.size(); ++q)
                 ASSERT_NEAR(r->aNearest.distance[q], nn[q], oracleTolerance(c.a, c.b, r->hausdorff)) << q;

@@ -17,6 +17,7 @@
 #include "common/brute_force.hpp"
 #include "common/case_sample.hpp"
 #include "common/oracle_cases.hpp"
+#include "common/oracle_memo.hpp"
 #include "common/scoped_env.hpp"
 #include "gpu_test_support.hpp"
 
@@ -278,8 +279,8 @@ TEST(GpuEngine, TailScanEqualsRadiiAndBruteForce) {
             EXPECT_EQ(t->aToB.distance, r->aToB.distance);
             EXPECT_EQ(t->bToA.distance, r->bToA.distance);
             if (call.perPointDistances) {
-                EXPECT_EQ(t->aNearest.distance, oracle::bruteForceNearest(c.a, c.b));
-                EXPECT_EQ(t->bNearest.distance, oracle::bruteForceNearest(c.b, c.a));
+                EXPECT_EQ(t->aNearest.distance, oracle::memoNearest(c.a, c.b));
+                EXPECT_EQ(t->bNearest.distance, oracle::memoNearest(c.b, c.a));
                 EXPECT_EQ(t->aNearest.nearest, r->aNearest.nearest);
                 EXPECT_EQ(t->bNearest.nearest, r->bNearest.nearest);
             }
@@ -359,8 +360,8 @@ TEST(GpuEngine, SweepEqualsRadiiAndBruteForce) {
                 EXPECT_EQ(t->bToA.distance, r->bToA.distance);
                 EXPECT_EQ(t->bToA.targetIndex, r->bToA.targetIndex);
                 if (perPoint) {
-                    EXPECT_EQ(t->aNearest.distance, oracle::bruteForceNearest(c.a, c.b));
-                    EXPECT_EQ(t->bNearest.distance, oracle::bruteForceNearest(c.b, c.a));
+                    EXPECT_EQ(t->aNearest.distance, oracle::memoNearest(c.a, c.b));
+                    EXPECT_EQ(t->bNearest.distance, oracle::memoNearest(c.b, c.a));
                     EXPECT_EQ(t->aNearest.nearest, r->aNearest.nearest);
                     EXPECT_EQ(t->bNearest.nearest, r->bNearest.nearest);
                 }
