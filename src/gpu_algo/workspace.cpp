@@ -30,8 +30,7 @@ Workspace::Workspace(gpu::Context& c, const std::string& cacheDir, int hostThrea
 }
 
 void Workspace::recycle(Buffer& b) {
-    if (b) spare.push_back(std::move(b));
-    b.reset();
+    if (b) spare.push_back(std::move(b));  // the move leaves b empty
 }
 
 void Workspace::recycleBuild(BuildScratch& build) {

@@ -193,6 +193,15 @@ TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
+// Two computations of one pair: the same H and the same witnesses.
+void expectSameValueAndWitnesses(const HausdorffResult& r, const HausdorffResult& w) {
+    EXPECT_EQ(r.hausdorff, w.hausdorff);
+    EXPECT_EQ(r.aToB.queryIndex, w.aToB.queryIndex);
+    EXPECT_EQ(r.aToB.targetIndex, w.aToB.targetIndex);
+    EXPECT_EQ(r.bToA.queryIndex, w.bToA.queryIndex);
+    EXPECT_EQ(r.bToA.targetIndex, w.bToA.targetIndex);
+}
+
 // A large set staged by the host goes up in chunks through one reused host
 // buffer (IndexBuild::uploadChunked, past kChunkedUploadPoints): forced at
 // small sizes, chunks that do not divide the set, the same results as the
@@ -216,11 +225,7 @@ TEST(LargeSizes, ChunkedUploadEqualsWholeStaging) {
             ASSERT_TRUE(w) << w.error().message;
             ASSERT_TRUE(r) << r.error().message;
             expectMatchesOracle(c, *r);
-            EXPECT_EQ(r->hausdorff, w->hausdorff);
-            EXPECT_EQ(r->aToB.queryIndex, w->aToB.queryIndex);
-            EXPECT_EQ(r->aToB.targetIndex, w->aToB.targetIndex);
-            EXPECT_EQ(r->bToA.queryIndex, w->bToA.queryIndex);
-            EXPECT_EQ(r->bToA.targetIndex, w->bToA.targetIndex);
+            expectSameValueAndWitnesses(*r, *w);
         }
     }
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
@@ -261,11 +266,7 @@ TEST(LargeSizes, SpentBuffersServeTheRestOfTheCall) {
                 auto r = (*adopting)->compute(c.a, c.b, options);
                 ASSERT_TRUE(r) << r.error().message;
                 expectMatchesOracle(c, *r);
-                EXPECT_EQ(r->hausdorff, f->hausdorff);
-                EXPECT_EQ(r->aToB.queryIndex, f->aToB.queryIndex);
-                EXPECT_EQ(r->aToB.targetIndex, f->aToB.targetIndex);
-                EXPECT_EQ(r->bToA.queryIndex, f->bToA.queryIndex);
-                EXPECT_EQ(r->bToA.targetIndex, f->bToA.targetIndex);
+                expectSameValueAndWitnesses(*r, *f);
                 EXPECT_EQ(r->aNearest.distance, f->aNearest.distance);
                 EXPECT_EQ(r->bNearest.distance, f->bNearest.distance);
             }

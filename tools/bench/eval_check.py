@@ -49,6 +49,9 @@ import numpy as np
 import scipy
 from scipy.spatial import cKDTree
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ply_points import write_ply  # noqa: E402
+
 R_MAJOR, R_MINOR = 1.0, 0.35
 NOISE = 1e-3
 OUTLIERS = 0.002
@@ -88,14 +91,6 @@ def make_pair(n, seed):
     outliers = rng.uniform(lo, -lo, (k, 3))
     recon = np.concatenate([recon, outliers])
     return recon.astype(np.float32), truth.astype(np.float32)
-
-
-def write_ply(path, points):
-    points = np.ascontiguousarray(points, dtype="<f4")
-    with open(path, "wb") as f:
-        f.write(("ply\nformat binary_little_endian 1.0\nelement vertex %d\n"
-                 "property float x\nproperty float y\nproperty float z\nend_header\n" % len(points)).encode())
-        f.write(points.tobytes())
 
 
 def nearest(query, target):

@@ -24,6 +24,17 @@ void appendLe(std::string& out, T v) {
     out.append(b, sizeof(T));
 }
 
+// A CSV row's first columns: index,x,y,z,distance (no line end).
+void appendRowStart(std::string& out, size_t index, const glm::vec3& p, double distance) {
+    appendNumber(out, uint64_t(index));
+    for (float c : {p.x, p.y, p.z}) {
+        out.push_back(',');
+        appendNumber(out, c);
+    }
+    out.push_back(',');
+    appendNumber(out, distance);
+}
+
 }  // namespace
 
 Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3> points,
@@ -61,13 +72,7 @@ Result<bool> writeDistanceCsv(const std::string& path, std::span<const glm::vec3
     std::string out = "index,x,y,z,distance,nearest\n";
     out.reserve(points.size() * 64);
     for (size_t i = 0; i < points.size(); ++i) {
-        appendNumber(out, uint64_t(i));
-        for (float c : {points[i].x, points[i].y, points[i].z}) {
-            out.push_back(',');
-            appendNumber(out, c);
-        }
-        out.push_back(',');
-        appendNumber(out, nearest.distance[i]);
+        appendRowStart(out, i, points[i], nearest.distance[i]);
         out.push_back(',');
         appendNumber(out, uint64_t(nearest.nearest[i]));
         out.push_back('\n');
@@ -87,13 +92,7 @@ Result<bool> writeSurfaceCsv(const std::string& path, std::span<const glm::vec3>
         "barycentric_2\n";
     out.reserve(n * 160);
     for (size_t i = 0; i < n; ++i) {
-        appendNumber(out, uint64_t(i));
-        for (float c : {points[i].x, points[i].y, points[i].z}) {
-            out.push_back(',');
-            appendNumber(out, c);
-        }
-        out.push_back(',');
-        appendNumber(out, nearest.distance[i]);
+        appendRowStart(out, i, points[i], nearest.distance[i]);
         out.push_back(',');
         appendNumber(out, uint64_t(nearest.triangle[i]));
         for (const glm::dvec3* v : {&nearest.closest[i], &nearest.barycentric[i]}) {

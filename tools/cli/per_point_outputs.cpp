@@ -50,6 +50,25 @@ StatsOptions statsOptionsFrom(const CliArgs& args) {
     return o;
 }
 
+Result<bool> writeScenePng(const CliArgs& args, const RenderScene& scene) {
+    RenderOptions renderOptions;
+    renderOptions.vulkan = !args.softwareRender;
+    renderOptions.deviceIndex = args.options.deviceIndex;
+    renderOptions.validation = args.options.validation;
+    RenderInfo info;
+    Result<bool> ok = renderPicture(scene, renderOptions, &info).writePng(args.png);
+    if (!ok) return ok;
+    if (!info.fallbackReason.empty()) {
+        std::fprintf(stderr, "rthdist: note: --png drawn in software, Vulkan could not: %s\n",
+                     info.fallbackReason.c_str());
+    }
+    if (info.validationMessages > 0) {
+        std::fprintf(stderr, "rthdist: note: the --png render raised %llu validation message(s)\n",
+                     static_cast<unsigned long long>(info.validationMessages));
+    }
+    return true;
+}
+
 Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3> a,
                                   std::span<const glm::vec3> b, const HausdorffResult& r,
                                   const HausdorffStats& stats) {
@@ -99,21 +118,7 @@ Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3
                       r.directedOnly ? "h(A,B)" : "H", r.hausdorff, fromB ? "B" : "A", d.queryIndex,
                       fromB ? "A" : "B", d.targetIndex, hd95, backendName(r.backend));
         scene.caption.push_back(line);
-        RenderOptions renderOptions;
-        renderOptions.vulkan = !args.softwareRender;
-        renderOptions.deviceIndex = args.options.deviceIndex;
-        renderOptions.validation = args.options.validation;
-        RenderInfo info;
-        Result<bool> ok = renderPicture(scene, renderOptions, &info).writePng(args.png);
-        if (!ok) return ok;
-        if (!info.fallbackReason.empty()) {
-            std::fprintf(stderr, "rthdist: note: --png drawn in software, Vulkan could not: %s\n",
-                         info.fallbackReason.c_str());
-        }
-        if (info.validationMessages > 0) {
-            std::fprintf(stderr, "rthdist: note: the --png render raised %llu validation message(s)\n",
-                         static_cast<unsigned long long>(info.validationMessages));
-        }
+        if (Result<bool> ok = writeScenePng(args, scene); !ok) return ok;
     }
     return true;
 }

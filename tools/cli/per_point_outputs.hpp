@@ -24,6 +24,12 @@ namespace rthdist::cli {
 // Statistics options from the command line (95 always among the percentiles).
 [[nodiscard]] StatsOptions statsOptionsFrom(const CliArgs& args);
 
+struct RenderScene;
+
+// --png: `scene` drawn (Vulkan unless --software-render; a software fallback
+// or validation messages noted on stderr) and written to args.png.
+[[nodiscard]] Result<bool> writeScenePng(const CliArgs& args, const RenderScene& scene);
+
 // Every file goes through writeOutputFile (cli/output_file.hpp); each Error
 // is an output that could not be written, its message naming the file and the
 // reason, and the CLI exits kExitOutput with it. Files written before the

@@ -117,21 +117,7 @@ Result<bool> writeSurfacePerPointOutputs(const SurfacePerPointRun& run, const Ha
                       Q.c_str(), S.c_str(), r.hausdorff, Q.c_str(), d.queryIndex, d.triangle, hd95,
                       backendName(r.backend));
         scene.caption.push_back(line);
-        RenderOptions renderOptions;
-        renderOptions.vulkan = !args.softwareRender;
-        renderOptions.deviceIndex = args.options.deviceIndex;
-        renderOptions.validation = args.options.validation;
-        RenderInfo info;
-        Result<bool> ok = renderPicture(scene, renderOptions, &info).writePng(args.png);
-        if (!ok) return ok;
-        if (!info.fallbackReason.empty()) {
-            std::fprintf(stderr, "rthdist: note: --png drawn in software, Vulkan could not: %s\n",
-                         info.fallbackReason.c_str());
-        }
-        if (info.validationMessages > 0) {
-            std::fprintf(stderr, "rthdist: note: the --png render raised %llu validation message(s)\n",
-                         static_cast<unsigned long long>(info.validationMessages));
-        }
+        if (Result<bool> ok = writeScenePng(args, scene); !ok) return ok;
     }
     return true;
 }
