@@ -104,10 +104,15 @@ struct Counters {
     uint64_t candidatePairs = 0;         // (query, cell) pairs refined
     uint64_t tailScanned = 0;            // GPU backends: queries of the search's far tail that
                                          // scanned whole cells of a coarse level instead of more radii
-    // Out-of-core (EngineOptions::memoryBudget): the calls this direction
-    // took, queryChunks x targetTiles; 1 x 1 when it fit one call.
+    // Out-of-core (EngineOptions::memoryBudget): how this direction was
+    // split; 1 x 1 when it fit one call. Targets that fit one call beside a
+    // chunk: queryChunks chunks of queries, each against every target
+    // (targetTiles 1). Otherwise pieces ordered in space: the pieces holding
+    // queries and those holding targets, and crossPieceQueries, the queries
+    // sent to another piece's targets after their own (near a piece's border).
     uint32_t queryChunks = 1;
     uint32_t targetTiles = 1;
+    uint64_t crossPieceQueries = 0;
 };
 
 // The proof of one directed value (README "Exactness"; docs/design.md, "The

@@ -35,6 +35,7 @@ py::dict counters(const Counters& c) {
     d["tail_scanned"] = c.tailScanned;
     d["query_chunks"] = c.queryChunks;
     d["target_tiles"] = c.targetTiles;
+    d["cross_piece_queries"] = c.crossPieceQueries;
     return d;
 }
 

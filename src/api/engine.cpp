@@ -289,8 +289,8 @@ Result<HausdorffResult> runInPieces(Engine::Impl& impl, std::span<const glm::vec
                                            std::span<const glm::vec3> t, const CallOptions& piece) {
         return runFramed(impl, lane, q, t, scale, piece);
     };
-    const api::RecycleCall recycle = [&backend](int lane, PerPoint&& spent) {
-        backend.recyclePerPoint(lane, std::move(spent), PerPoint{});
+    const api::RecycleCall recycle = [&backend](int lane, PerPoint&& a, PerPoint&& b) {
+        backend.recyclePerPoint(lane, std::move(a), std::move(b));
     };
     release();
     Result<HausdorffResult> r = api::computeInPieces(a, b, scale, call, pieces, directed, release,

@@ -1,5 +1,7 @@
 #include "api/out_of_core.hpp"
 
+#include "api/spatial_pieces.hpp"
+
 #include "core/certificate.hpp"
 #include "core/index_space.hpp"
 #include "core/parallel.hpp"
@@ -115,23 +117,6 @@ void addCall(SharedDirection& shared, const HausdorffResult& r, bool countTarget
     core::addStageTimings(shared.state.timings, r.timings);
 }
 
-// The early break of a chunk starting at query index q0 against the witness
-// of the chunks finished so far (design.md §3): a query whose best pair is
-// nearer than the witness's cannot be the maximum; one at the same distance
-// cannot win the tie when the witness's query index is smaller (an earlier
-// chunk). Per-point output: nothing is dropped.
-struct EarlyBreak {
-    float d2 = -1.0f;
-    bool dropTies = false;
-    [[nodiscard]] bool drops(float best) const { return best < d2 || (dropTies && best == d2); }
-};
-
-EarlyBreak earlyBreak(SharedDirection& shared, uint64_t q0, bool perPoint) {
-    if (perPoint) return {};
-    std::lock_guard lock(shared.mutex);
-    return {shared.state.witnessD2, shared.state.witness.queryIndex < q0};
-}
-
 // Progress of one call mapped into [from, from + width) of the whole.
 CallOptions pieceOptions(const CallOptions& call, bool perPoint, double from, double width) {
     CallOptions piece = call;
@@ -147,159 +132,6 @@ CallOptions pieceOptions(const CallOptions& call, bool perPoint, double from, do
     return piece;
 }
 
-// A tile of the targets: consecutive input indices from `offset`, and the box
-// of its points scaled as searched (searchDist2's frame).
-struct Tile {
-    Span points;
-    uint64_t offset = 0;
-    glm::vec3 lo{0.0f}, hi{0.0f};
-};
-
-// The float squared distance from q to a tile's box, computed as searchDist2
-// computes a pair: rounding is monotone, so it never exceeds searchDist2(q, p)
-// for a point p of the tile.
-float boxDist2(const glm::vec3& q, const Tile& tile, double scale) {
-    const glm::vec3 qs = core::scaled(q, scale);
-    return squaredLength(glm::max(glm::max(tile.lo - qs, qs - tile.hi), glm::vec3(0.0f)));
-}
-
-// The box of `points` (non-empty), scaled as searched; on `threads` threads.
-Tile boxOf(Span points, uint64_t offset, double scale, int threads) {
-    threads = core::resolveThreads(threads, points.size() / kHostChunk + 1);
-    std::vector<Tile> parts(size_t(threads), Tile{{}, 0, points[0], points[0]});
-    core::parallelChunks(points.size(), kHostChunk, threads, [&](size_t begin, size_t end, int w) {
-        Tile& part = parts[size_t(w)];
-        for (size_t i = begin; i < end; ++i) {
-            part.lo = glm::min(part.lo, points[i]);
-            part.hi = glm::max(part.hi, points[i]);
-        }
-    });
-    Tile box{points, offset, points[0], points[0]};
-    for (const Tile& part : parts) {
-        box.lo = glm::min(box.lo, part.lo);
-        box.hi = glm::max(box.hi, part.hi);
-    }
-    box.lo = core::scaled(box.lo, scale);  // an exact power of two: monotone
-    box.hi = core::scaled(box.hi, scale);
-    return box;
-}
-
-std::vector<Tile> makeTiles(Span t, uint64_t tileSize, double scale, int threads) {
-    std::vector<Tile> tiles;
-    for (uint64_t t0 = 0; t0 < t.size(); t0 += tileSize)
-        tiles.push_back(
-            boxOf(t.subspan(t0, std::min<uint64_t>(tileSize, t.size() - t0)), t0, scale, threads));
-    return tiles;
-}
-
-// The tiles nearest the chunk first (box to box), so that its queries' best
-// distances shrink early and later tiles are skipped.
-std::vector<size_t> tileOrder(Span chunk, const std::vector<Tile>& tiles, double scale, int threads) {
-    const Tile box = boxOf(chunk, 0, scale, threads);
-    std::vector<double> gap(tiles.size());
-    for (size_t j = 0; j < tiles.size(); ++j) {
-        const glm::dvec3 d = glm::max(glm::max(glm::dvec3(tiles[j].lo) - glm::dvec3(box.hi),
-                                               glm::dvec3(box.lo) - glm::dvec3(tiles[j].hi)),
-                                      glm::dvec3(0.0));
-        gap[j] = glm::dot(d, d);
-    }
-    std::vector<size_t> order(tiles.size());
-    for (size_t j = 0; j < order.size(); ++j) order[j] = j;
-    std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return gap[x] < gap[y]; });
-    return order;
-}
-
-// What a direction's chunks reuse: every query's best pair over the tiles
-// seen so far (searchDist2, the distance the call reported, the target's index
-// in the whole set), its home tile, and the gathered queries of one call.
-// UninitVector: filled, and first touched, by the parallel passes below
-// (10^8 entries per chunk).
-struct ChunkScratch {
-    core::UninitVector<float> d2;
-    core::UninitVector<double> distance;
-    core::UninitVector<uint64_t> nearest;  // index into the whole target set
-    core::UninitVector<uint32_t> home;
-    core::UninitVector<glm::vec3> subset;
-};
-
-// Each query's best pair set to none, and its home tile: the one whose box
-// is nearest (the first among ties). A query's first call goes to its home
-// tile, so that a query inside one tile's box meets its neighbourhood first
-// and its best pair is short before it is offered to any other tile.
-void startChunk(Span qc, const std::vector<Tile>& tiles, double scale, int threads, ChunkScratch& x) {
-    x.d2.resize(qc.size());
-    x.distance.resize(qc.size());
-    x.nearest.resize(qc.size());
-    x.home.resize(qc.size());
-    threads = core::resolveThreads(threads, qc.size() / kHostChunk + 1);
-    core::parallelChunks(qc.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) {
-            x.d2[i] = std::numeric_limits<float>::infinity();
-            x.distance[i] = 0.0;
-            x.nearest[i] = UINT64_MAX;
-            uint32_t home = 0;
-            float nearest = boxDist2(qc[i], tiles[0], scale);
-            for (size_t j = 1; j < tiles.size() && nearest > 0.0f; ++j) {
-                const float d2 = boxDist2(qc[i], tiles[j], scale);
-                if (d2 < nearest) {
-                    nearest = d2;
-                    home = uint32_t(j);
-                }
-            }
-            x.home[i] = home;
-        }
-    });
-}
-
-// Ascending query indices gathered by parallel tasks, each task's list in
-// task order.
-std::vector<uint32_t> concatenate(const std::vector<std::vector<uint32_t>>& parts) {
-    size_t total = 0;
-    for (const std::vector<uint32_t>& part : parts) total += part.size();
-    std::vector<uint32_t> all;
-    all.reserve(total);
-    for (const std::vector<uint32_t>& part : parts) all.insert(all.end(), part.begin(), part.end());
-    return all;
-}
-
-// The queries of each tile's first round: those whose home it is (one pass).
-std::vector<std::vector<uint32_t>> queriesByHome(const ChunkScratch& x, size_t tiles, int threads) {
-    const size_t n = x.home.size();
-    threads = core::resolveThreads(threads, n / kHostChunk + 1);
-    std::vector<std::vector<std::vector<uint32_t>>> parts((n + kHostChunk - 1) / kHostChunk,
-                                                          std::vector<std::vector<uint32_t>>(tiles));
-    core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
-        std::vector<std::vector<uint32_t>>& mine = parts[begin / kHostChunk];
-        for (size_t i = begin; i < end; ++i) mine[x.home[i]].push_back(uint32_t(i));
-    });
-    std::vector<std::vector<uint32_t>> lists(tiles);
-    std::vector<std::vector<uint32_t>> column(parts.size());
-    for (size_t j = 0; j < tiles; ++j) {
-        for (size_t t = 0; t < parts.size(); ++t) column[t] = std::move(parts[t][j]);
-        lists[j] = concatenate(column);
-    }
-    return lists;
-}
-
-// The queries of the chunk that tile `j` may still improve after the first
-// round: those whose home it is not, except where the tile's box is farther
-// than the query's best pair (no point of the tile can be nearer, nor tie
-// with a smaller index: the box distance is a lower bound) and, without
-// per-point output, where the best pair is dropped by the early break.
-std::vector<uint32_t> queriesForTile(Span qc, const Tile& tile, uint32_t j, const ChunkScratch& x,
-                                     const EarlyBreak& drop, double scale, int threads) {
-    threads = core::resolveThreads(threads, qc.size() / kHostChunk + 1);
-    std::vector<std::vector<uint32_t>> parts((qc.size() + kHostChunk - 1) / kHostChunk);
-    core::parallelChunks(qc.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
-        std::vector<uint32_t>& keep = parts[begin / kHostChunk];
-        for (size_t i = begin; i < end; ++i) {
-            if (x.home[i] == j || drop.drops(x.d2[i]) || boxDist2(qc[i], tile, scale) > x.d2[i]) continue;
-            keep.push_back(uint32_t(i));
-        }
-    });
-    return concatenate(parts);
-}
-
 // Where a lane's calls go: its device (the DirectedCall's lane argument),
 // the host threads of its passes, and whether its calls report progress
 // (lane 0, the calling thread, only).
@@ -308,8 +140,8 @@ struct Lane {
     int threads = 0;
     const DirectedCall* directed = nullptr;
     const RecycleCall* recycle = nullptr;
-    void giveBack(PerPoint&& spent) const {
-        if (recycle != nullptr && *recycle) (*recycle)(index, std::move(spent));
+    void giveBack(PerPoint&& a, PerPoint&& b = PerPoint{}) const {
+        if (recycle != nullptr && *recycle) (*recycle)(index, std::move(a), std::move(b));
     }
     [[nodiscard]] Result<HausdorffResult> call(Span q, Span t, const CallOptions& piece) const {
         if (index == 0) return (*directed)(index, q, t, piece);
@@ -318,42 +150,6 @@ struct Lane {
         return (*directed)(index, q, t, quiet);
     }
 };
-
-// One tile's call for the selected queries (per-point), merged into the
-// chunk's best pairs: a nearer pair replaces, an equal one only with a
-// smaller target index.
-std::optional<Error> searchTile(Span qc, const std::vector<uint32_t>& selected, const Tile& tile,
-                                double scale, const CallOptions& piece, const Lane& lane, ChunkScratch& x,
-                                SharedDirection& shared) {
-    const int threads = core::resolveThreads(lane.threads, selected.size() / kHostChunk + 1);
-    Span queries = qc;
-    if (selected.size() < qc.size()) {
-        x.subset.clear();  // a larger array is not copied when it grows
-        x.subset.resize(selected.size());
-        core::parallelChunks(selected.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
-            for (size_t k = begin; k < end; ++k) x.subset[k] = qc[selected[k]];
-        });
-        queries = x.subset;
-    }
-    Result<HausdorffResult> r = lane.call(queries, tile.points, piece);
-    if (!r) return r.error();
-    addCall(shared, *r, true);
-    const PerPoint& pp = r->aNearest;
-    core::parallelChunks(selected.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
-        for (size_t k = begin; k < end; ++k) {
-            const uint32_t i = selected[k];  // each query once
-            const float d2 = searchDist2(qc[i], tile.points[pp.nearest[k]], scale);
-            const uint64_t target = pp.nearest[k] + tile.offset;
-            if (d2 < x.d2[i] || (d2 == x.d2[i] && target < x.nearest[i])) {
-                x.d2[i] = d2;
-                x.distance[i] = pp.distance[k];
-                x.nearest[i] = target;
-            }
-        }
-    });
-    lane.giveBack(std::move(r->aNearest));
-    return std::nullopt;
-}
 
 // A chunk against one tile holding every target: one directed call with the
 // backend's own early break, or per-point when the caller asked for it.
@@ -381,71 +177,11 @@ std::optional<Error> chunkAgainstAll(Span qc, uint64_t q0, Span t, double scale,
     return std::nullopt;
 }
 
-// A chunk against several tiles: every query against its home tile, then the
-// other tiles nearest the chunk first, each for the queries it may still
-// improve (the early break read again before each tile: other lanes' chunks
-// may have raised the maximum); then the chunk's witness (its largest best
-// pair, the smallest query index among ties). `from`/`step`: the chunk's
-// share of the progress.
-std::optional<Error> chunkAgainstTiles(Span qc, uint64_t q0, Span t, const std::vector<Tile>& tiles,
-                                       double scale, const CallOptions& call, const Lane& lane,
-                                       ChunkScratch& x, SharedDirection& shared, double from, double step) {
-    const int threads = lane.threads;
-    startChunk(qc, tiles, scale, threads, x);
-    const std::vector<size_t> order = tileOrder(qc, tiles, scale, threads);
-    const std::vector<std::vector<uint32_t>> home = queriesByHome(x, tiles.size(), threads);
-    for (const bool homeRound : {true, false}) {
-        for (size_t k = 0; k < order.size(); ++k) {
-            const uint32_t j = uint32_t(order[k]);
-            const std::vector<uint32_t> selected =
-                homeRound ? home[j]
-                          : queriesForTile(qc, tiles[j], j, x, earlyBreak(shared, q0, call.perPointDistances),
-                                           scale, threads);
-            if (selected.empty()) continue;
-            const double at =
-                from + step * (0.5 * double(k) / double(order.size()) + (homeRound ? 0.0 : 0.5));
-            const CallOptions piece = pieceOptions(call, true, at, step * 0.5 / double(order.size()));
-            if (auto err = searchTile(qc, selected, tiles[j], scale, piece, lane, x, shared)) return err;
-        }
-    }
-    const size_t w = size_t(std::max_element(x.d2.begin(), x.d2.end()) - x.d2.begin());
-    Directed d;
-    d.distance = x.distance[w];
-    d.queryIndex = w;
-    d.targetIndex = x.nearest[w];
-    d.queryPoint = glm::dvec3(qc[w]);
-    d.targetPoint = glm::dvec3(t[x.nearest[w]]);
-    offerWitness(shared, d, x.d2[w], q0);
-    {
-        // The chunk's band from every query's best pair over the tiles (a
-        // real pair, searched as one call compares pairs).
-        core::DirectionBand band;
-        band.present = true;
-        band.hf = std::sqrt(double(x.d2[w]));
-        band.slack = shared.slack;
-        const double lo2 = core::bandThreshold2(double(x.d2[w]), band.slack);
-        for (size_t i = 0; i < qc.size(); ++i)
-            if (double(x.d2[i]) >= lo2) band.queries.push_back({i, x.nearest[i]});
-        const std::lock_guard lock(shared.mutex);
-        mergeBand(shared.state, band, q0);
-    }
-    if (call.perPointDistances) {
-        PerPoint& pp = shared.state.perPoint;
-        std::copy(x.distance.begin(), x.distance.end(), pp.distance.begin() + ptrdiff_t(q0));
-        // Per-point output holds 32-bit indices: the Engine refuses it past 2^32 - 1 targets.
-        std::transform(x.nearest.begin(), x.nearest.end(), pp.nearest.begin() + ptrdiff_t(q0),
-                       [](uint64_t i) { return uint32_t(i); });
-    }
-    return std::nullopt;
-}
-
 // The chunks of one direction as one lane takes them: the next chunk not yet
-// taken, until none is left or a lane has failed. Each lane keeps its own
-// scratch. `from`/`step`: the direction's start and each chunk's share of
-// the progress.
+// taken, until none is left or a lane has failed. `from`/`step`: the
+// direction's start and each chunk's share of the progress.
 struct ChunkQueue {
     Span q, t;
-    const std::vector<Tile>* tiles = nullptr;
     uint64_t chunkSize = 0, chunks = 0;
     std::atomic<uint64_t> next{0};
 };
@@ -454,17 +190,13 @@ struct ChunkQueue {
 // lane may be a thread of its own, where nothing would catch it) becomes
 // kOutOfMemory.
 std::optional<Error> runChunk(const ChunkQueue& queue, uint64_t c, double scale, const CallOptions& call,
-                              const Lane& lane, ChunkScratch& scratch, SharedDirection& shared, double from,
-                              double step) {
+                              const Lane& lane, SharedDirection& shared, double from, double step) {
     const uint64_t q0 = c * queue.chunkSize;
     const Span qc = queue.q.subspan(q0, std::min<uint64_t>(queue.chunkSize, queue.q.size() - q0));
     const double at = from + step * double(c);
     try {
-        return queue.tiles->empty()
-                   ? chunkAgainstAll(qc, q0, queue.t, scale,
-                                     pieceOptions(call, call.perPointDistances, at, step), lane, shared)
-                   : chunkAgainstTiles(qc, q0, queue.t, *queue.tiles, scale, call, lane, scratch, shared, at,
-                                       step);
+        return chunkAgainstAll(qc, q0, queue.t, scale, pieceOptions(call, call.perPointDistances, at, step),
+                               lane, shared);
     } catch (const std::bad_alloc&) {
         return Error{ErrorCode::kOutOfMemory, "out of host memory in query chunk " + std::to_string(c) +
                                                   " (device lane " + std::to_string(lane.index) + ")"};
@@ -473,11 +205,10 @@ std::optional<Error> runChunk(const ChunkQueue& queue, uint64_t c, double scale,
 
 void runLane(ChunkQueue& queue, double scale, const CallOptions& call, const Lane& lane,
              SharedDirection& shared, double from, double step) {
-    ChunkScratch scratch;
     for (;;) {
         const uint64_t c = queue.next.fetch_add(1);
         if (c >= queue.chunks || shared.failed.load()) return;
-        if (std::optional<Error> err = runChunk(queue, c, scale, call, lane, scratch, shared, from, step)) {
+        if (std::optional<Error> err = runChunk(queue, c, scale, call, lane, shared, from, step)) {
             std::lock_guard lock(shared.mutex);
             if (!shared.error) shared.error = *err;
             shared.failed = true;
@@ -486,23 +217,27 @@ void runLane(ChunkQueue& queue, double scale, const CallOptions& call, const Lan
     }
 }
 
-// One direction Q -> T within `split`, its chunks spread over `lanes` lanes
-// (lane 0 on the calling thread); `from`/`width`: its share of the progress.
-Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOptions& call,
-                                    const DirectionSplit& split, const DirectedCall& directed,
-                                    const RecycleCall& recycle, int lanes, int threads, double from,
-                                    double width) {
-    const std::vector<Tile> tiles =
-        t.size() > split.targetTile ? makeTiles(t, split.targetTile, scale, threads) : std::vector<Tile>{};
+// Runs fn(lane) on `lanes` lanes at once, lane 0 on the calling thread.
+template <class Fn>
+void onLanes(int lanes, Fn&& fn) {
+    std::vector<std::thread> helpers;
+    for (int l = 1; l < lanes; ++l) helpers.emplace_back([&fn, l] { fn(l); });
+    fn(0);
+    for (std::thread& h : helpers) h.join();
+}
+
+// One direction Q -> T whose targets fit one call beside a chunk: chunks of
+// `chunkSize` queries in input order, each against every target, spread over
+// `lanes` lanes; `from`/`width`: its share of the progress.
+Result<DirectionState> runChunks(Span q, Span t, double scale, const CallOptions& call, uint64_t chunkSize,
+                                 const DirectedCall& directed, const RecycleCall& recycle, int lanes,
+                                 int threads, double from, double width) {
     ChunkQueue queue;
     queue.q = q;
     queue.t = t;
-    queue.tiles = &tiles;
-    queue.chunkSize = split.queryChunk;
-    queue.chunks = (q.size() + split.queryChunk - 1) / split.queryChunk;
+    queue.chunkSize = chunkSize;
+    queue.chunks = (q.size() + chunkSize - 1) / chunkSize;
     SharedDirection shared;
-    shared.slack = core::searchSlack(
-        std::max(core::largestMagnitude(q, threads), core::largestMagnitude(t, threads)) * scale);
     shared.state.band.present = true;
     if (call.perPointDistances) {
         shared.state.perPoint.distance.resize(q.size());
@@ -512,40 +247,553 @@ Result<DirectionState> runDirection(Span q, Span t, double scale, const CallOpti
     lanes = int(std::min<uint64_t>(uint64_t(std::max(lanes, 1)), queue.chunks));
     // Every lane asks for all host threads: the pool lends idle workers to
     // whichever lane has host work while the others wait on their devices.
-    std::vector<std::thread> helpers;
-    for (int l = 1; l < lanes; ++l)
-        helpers.emplace_back([&, l] {
-            runLane(queue, scale, call, Lane{l, threads, &directed, &recycle}, shared, from, step);
-        });
-    runLane(queue, scale, call, Lane{0, threads, &directed, &recycle}, shared, from, step);
-    for (std::thread& h : helpers) h.join();
+    onLanes(lanes, [&](int l) {
+        runLane(queue, scale, call, Lane{l, threads, &directed, &recycle}, shared, from, step);
+    });
     if (shared.error) return *shared.error;
     DirectionState s = std::move(shared.state);
-    s.counters.queries = q.size();  // tiles' calls count their queries again
+    s.counters.queries = q.size();
     s.counters.queryChunks = uint32_t(queue.chunks);
-    s.counters.targetTiles = uint32_t(std::max<size_t>(1, tiles.size()));
+    s.counters.targetTiles = 1;
     s.witness.counters = s.counters;
     s.band.hf = s.reach + s.band.slack;  // the proof's bound: hf - slack = the largest piece's reach
     s.band.scale = scale;
     return s;
 }
 
-// runDirection, with the budget halved after each kOutOfMemory (the per-point
-// figure is an estimate; a device may hold less than it reports).
-Result<DirectionState> runDirectionWithin(Span q, Span t, double scale, const CallOptions& call,
-                                          MemoryBudget budget, const DirectedCall& directed,
-                                          const RecycleCall& recycle, const std::function<void()>& release,
-                                          int lanes, int threads, double from, double width) {
-    for (;;) {
-        Result<DirectionSplit> split = splitDirection(budget, q.size(), t.size(), lanes);
-        if (!split) return split.error();
-        Result<DirectionState> s =
-            runDirection(q, t, scale, call, *split, directed, recycle, lanes, threads, from, width);
-        if (s || s.error().code != ErrorCode::kOutOfMemory || budget.pointsPerCall() < 4) return s;
-        if (release) release();
-        budget.bytes /= 2;
-        budget.source += ", halved after: " + s.error().message;
+// ---- Pieces ordered in space (spatial_pieces.hpp) ----------------------
+
+// One direction Q -> T of the pieces in space: every query's best pair so
+// far, by its position in Q's gathered order (searchDist2 of the pair, the
+// distance its call reported, the target's input index), and what the
+// calls add up to.
+struct SpaceDirection {
+    int q = 0;  // Q's set in the pieces: 0 (A -> B) or 1 (B -> A)
+    core::UninitVector<float> d2;
+    core::UninitVector<double> distance;
+    core::UninitVector<uint32_t> nearest;
+    SharedDirection shared;
+    uint64_t crossPiece = 0;  // queries sent to another piece's targets
+};
+
+// The queries of one call and where they sit in the gathered order: a
+// piece's range, or a list.
+struct CallQueries {
+    uint64_t first = 0;  // with no list: positions first, first + 1, ...
+    const std::vector<uint32_t>* list = nullptr;
+    [[nodiscard]] uint64_t at(size_t k) const { return list != nullptr ? (*list)[k] : first + k; }
+};
+
+// A call's per-point result merged into the direction's bests: a nearer pair
+// replaces, an equal one only with a smaller target index. Targets: the
+// gathered target piece starting at `tileStart`.
+void mergeBests(SpaceDirection& dir, const SpatialPieces& pieces, const CallQueries& queries,
+                uint64_t tileStart, const PerPoint& pp, double scale, int threads) {
+    const SpatialPieces::Set& qs = pieces.set(dir.q);
+    const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
+    const size_t n = pp.nearest.size();
+    core::parallelChunks(n, kHostChunk, core::resolveThreads(threads, n / kHostChunk + 1),
+                         [&](size_t begin, size_t end, int) {
+                             for (size_t k = begin; k < end; ++k) {
+                                 const uint64_t p = queries.at(k);
+                                 const uint64_t g = tileStart + pp.nearest[k];
+                                 const float d2 = searchDist2(qs.points[p], ts.points[g], scale);
+                                 const uint32_t target = ts.input[g];
+                                 if (d2 < dir.d2[p] || (d2 == dir.d2[p] && target < dir.nearest[p])) {
+                                     dir.d2[p] = d2;
+                                     dir.distance[p] = pp.distance[k];
+                                     dir.nearest[p] = target;
+                                 }
+                             }
+                         });
+}
+
+void addCallTo(SharedDirection& shared, const Counters& c, const Timings* t) {
+    std::lock_guard lock(shared.mutex);
+    addCounters(shared.state.counters, c, true);
+    if (t != nullptr) core::addStageTimings(shared.state.timings, *t);
+}
+
+// The first failure of the lanes of a round; the others stop at their next call.
+struct RoundFailure {
+    std::mutex mutex;
+    std::optional<Error> error;
+    std::atomic<bool> failed{false};
+    void set(Error e) {
+        std::lock_guard lock(mutex);
+        if (!error) error = std::move(e);
+        failed = true;
     }
+};
+
+// Round one: every piece's queries against the same piece's targets, both
+// directions in one call where both are in pieces (`dirs` null where not).
+void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double scale,
+              const CallOptions& call, const Lane& lane, std::atomic<size_t>& next, RoundFailure& failure,
+              double from, double width) {
+    const bool both = dirs[0] != nullptr && dirs[1] != nullptr;
+    for (;;) {
+        const size_t k = next.fetch_add(1);
+        if (k >= pieces.count() || failure.failed.load()) return;
+        try {
+            const int qset = dirs[0] != nullptr ? 0 : 1;
+            const SpatialPieces::Set& qs = pieces.set(qset);
+            const SpatialPieces::Set& ts = pieces.set(1 - qset);
+            if (qs.size(k) == 0 || ts.size(k) == 0) continue;  // its queries go to other pieces in round two
+            CallOptions piece = pieceOptions(call, true, from + width * double(k) / double(pieces.count()),
+                                             width / double(pieces.count()));
+            piece.directedOnly = !both;
+            Result<HausdorffResult> r = lane.call(qs.piece(k), ts.piece(k), piece);
+            if (!r) {
+                failure.set(r.error());
+                return;
+            }
+            SpaceDirection& first = *dirs[qset];
+            addCallTo(first.shared, r->aToB.counters, &r->timings);
+            mergeBests(first, pieces, CallQueries{qs.start[k]}, ts.start[k], r->aNearest, scale,
+                       lane.threads);
+            if (both) {
+                addCallTo(dirs[1]->shared, r->bToA.counters, nullptr);
+                mergeBests(*dirs[1], pieces, CallQueries{ts.start[k]}, qs.start[k], r->bNearest, scale,
+                           lane.threads);
+            }
+            lane.giveBack(std::move(r->aNearest), std::move(r->bNearest));
+        } catch (const std::bad_alloc&) {
+            failure.set(Error{ErrorCode::kOutOfMemory, "out of host memory in piece " + std::to_string(k) +
+                                                           " (device lane " + std::to_string(lane.index) +
+                                                           ")"});
+            return;
+        }
+    }
+}
+
+// A query of round two: its position, its own piece, and the piece it was
+// sent to first when its own held no targets (UINT32_MAX: none).
+struct OpenQuery {
+    uint32_t p = 0;
+    uint32_t home = 0;
+    uint32_t visited = UINT32_MAX;
+};
+
+// The running maximum of round one's settled queries (design.md §3's early
+// break): a query whose best pair is nearer cannot be the maximum, one as
+// far cannot win the tie when the maximum's query has the smaller input
+// index. Per-point output: nothing is dropped (d2 -1).
+struct SettledMaximum {
+    float d2 = -1.0f;
+    uint32_t input = UINT32_MAX;
+    [[nodiscard]] bool drops(float best, uint32_t query) const {
+        return best < d2 || (best == d2 && input < query);
+    }
+};
+
+// The target pieces as tiles of round two: each piece's box, scaled as searched.
+struct TileBox {
+    glm::vec3 lo{0.0f}, hi{0.0f};
+    bool empty = true;
+};
+
+float boxDist2(const glm::vec3& q, const TileBox& box, double scale) {
+    const glm::vec3 qs = core::scaled(q, scale);
+    return squaredLength(glm::max(glm::max(box.lo - qs, qs - box.hi), glm::vec3(0.0f)));
+}
+
+std::vector<TileBox> tileBoxes(const SpatialPieces::Set& ts, double scale, int threads) {
+    std::vector<TileBox> boxes(ts.start.size() - 1);
+    for (size_t k = 0; k + 1 < ts.start.size(); ++k) {
+        const Span t = ts.piece(k);
+        if (t.empty()) continue;
+        const int n = core::resolveThreads(threads, t.size() / kHostChunk + 1);
+        std::vector<TileBox> parts(size_t(n), TileBox{t[0], t[0], false});
+        core::parallelChunks(t.size(), kHostChunk, n, [&](size_t begin, size_t end, int w) {
+            TileBox& part = parts[size_t(w)];
+            for (size_t i = begin; i < end; ++i) {
+                part.lo = glm::min(part.lo, t[i]);
+                part.hi = glm::max(part.hi, t[i]);
+            }
+        });
+        TileBox box = parts[0];
+        for (const TileBox& part : parts) {
+            box.lo = glm::min(box.lo, part.lo);
+            box.hi = glm::max(box.hi, part.hi);
+        }
+        box.lo = core::scaled(box.lo, scale);  // an exact power of two: monotone
+        box.hi = core::scaled(box.hi, scale);
+        boxes[k] = box;
+    }
+    return boxes;
+}
+
+// After round one: the queries that are done (their best pair lies in
+// their own piece and no other piece's point can be as near: the box of
+// their best distance, widened by the certificate's slack and a relative
+// margin, touches cells of their own piece only) and the maximum over
+// them; the others, open.
+std::vector<OpenQuery> openQueries(const SpaceDirection& dir, const SpatialPieces& pieces, double scale,
+                                   double slack, bool perPoint, SettledMaximum& maximum, int threads) {
+    const SpatialPieces::Set& qs = pieces.set(dir.q);
+    std::vector<std::vector<OpenQuery>> parts((qs.points.size() + kHostChunk - 1) / kHostChunk);
+    std::vector<SettledMaximum> maxima(size_t(core::resolveThreads(threads)));
+    core::parallelChunks(qs.points.size(), kHostChunk, threads, [&](size_t begin, size_t end, int w) {
+        uint32_t home =
+            uint32_t(std::upper_bound(qs.start.begin(), qs.start.end(), begin) - qs.start.begin() - 1);
+        std::vector<OpenQuery>& open = parts[begin / kHostChunk];
+        SettledMaximum& best = maxima[size_t(w)];
+        for (size_t p = begin; p < end; ++p) {
+            while (p >= qs.start[home + 1]) ++home;
+            const float d2 = dir.d2[p];
+            const double radius = std::sqrt(double(d2)) * (1.0 + 0x1p-12) + slack;
+            if (d2 == std::numeric_limits<float>::infinity() ||
+                !pieces.boxInPiece(core::scaled(qs.points[p], scale), radius, home)) {
+                open.push_back({uint32_t(p), home, UINT32_MAX});
+                continue;
+            }
+            const uint32_t input = qs.input[p];
+            if (d2 > best.d2 || (d2 == best.d2 && input < best.input)) best = {d2, input};
+        }
+    });
+    maximum = {};
+    if (!perPoint)
+        for (const SettledMaximum& m : maxima)
+            if (m.d2 > maximum.d2 || (m.d2 == maximum.d2 && m.input < maximum.input)) maximum = m;
+    size_t total = 0;
+    for (const auto& part : parts) total += part.size();
+    std::vector<OpenQuery> all;
+    all.reserve(total);
+    for (const auto& part : parts) all.insert(all.end(), part.begin(), part.end());
+    return all;
+}
+
+// Ascending positions gathered by parallel tasks, each task's list in task order.
+std::vector<uint32_t> concatenate(const std::vector<std::vector<uint32_t>>& parts) {
+    size_t total = 0;
+    for (const std::vector<uint32_t>& part : parts) total += part.size();
+    std::vector<uint32_t> all;
+    all.reserve(total);
+    for (const std::vector<uint32_t>& part : parts) all.insert(all.end(), part.begin(), part.end());
+    return all;
+}
+
+// Round two's shared state: the open queries, what they may meet, and the
+// lock under which lanes select them and merge what their calls found.
+struct RoundTwo {
+    SpaceDirection* dir = nullptr;
+    const SpatialPieces* pieces = nullptr;
+    std::vector<OpenQuery> open;
+    std::vector<TileBox> boxes;
+    SettledMaximum maximum;
+    uint64_t maxQueries = 1;  // queries beside a tile in one call (the budget less the tile)
+    std::mutex mutex;
+    std::atomic<size_t> next{0};
+};
+
+// The open queries that tile j may still improve: not dropped by the early
+// break, neither from j nor sent there first, and no farther from j's box
+// than their best pair (no point of the tile can be nearer, nor tie with a
+// smaller index: the box distance is a lower bound, rounding being monotone).
+// `first`: the queries without a pair yet, each to the tile nearest it only.
+std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double scale, int threads) {
+    SpaceDirection& dir = *round.dir;
+    const SpatialPieces::Set& qs = round.pieces->set(dir.q);
+    std::vector<std::vector<uint32_t>> parts((round.open.size() + kHostChunk - 1) / kHostChunk);
+    core::parallelChunks(round.open.size(), kHostChunk, threads, [&](size_t begin, size_t end, int) {
+        std::vector<uint32_t>& keep = parts[begin / kHostChunk];
+        for (size_t i = begin; i < end; ++i) {
+            OpenQuery& o = round.open[i];
+            const float d2 = dir.d2[o.p];
+            if (first) {
+                if (d2 != std::numeric_limits<float>::infinity()) continue;
+                uint32_t nearest = UINT32_MAX;
+                float gap = std::numeric_limits<float>::infinity();
+                for (uint32_t k = 0; k < round.boxes.size(); ++k) {
+                    if (round.boxes[k].empty) continue;
+                    const float g = boxDist2(qs.points[o.p], round.boxes[k], scale);
+                    if (nearest == UINT32_MAX || g < gap) {
+                        gap = g;
+                        nearest = k;
+                    }
+                }
+                if (nearest != j) continue;
+                o.visited = j;
+                keep.push_back(o.p);
+                continue;
+            }
+            if (o.home == j || o.visited == j || round.maximum.drops(d2, qs.input[o.p]) ||
+                boxDist2(qs.points[o.p], round.boxes[j], scale) > d2)
+                continue;
+            keep.push_back(o.p);
+        }
+    });
+    return concatenate(parts);
+}
+
+// A lane's share of round two: the next tile not yet taken, its selected
+// queries in calls within the budget, merged under the round's lock.
+void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call, const Lane& lane,
+              RoundFailure& failure, double from, double width) {
+    SpaceDirection& dir = *round.dir;
+    const SpatialPieces::Set& qs = round.pieces->set(dir.q);
+    const SpatialPieces::Set& ts = round.pieces->set(1 - dir.q);
+    std::vector<glm::vec3> gathered;
+    for (;;) {
+        const size_t j = round.next.fetch_add(1);
+        if (j >= round.boxes.size() || failure.failed.load()) return;
+        if (round.boxes[j].empty) continue;
+        try {
+            std::vector<uint32_t> selected;
+            {
+                std::lock_guard lock(round.mutex);
+                selected = selectFor(round, uint32_t(j), first, scale, lane.threads);
+                dir.crossPiece += selected.size();
+            }
+            const CallOptions piece =
+                pieceOptions(call, true, from + width * double(j) / double(round.boxes.size()),
+                             width / double(round.boxes.size()));
+            for (size_t b0 = 0; b0 < selected.size(); b0 += round.maxQueries) {
+                const size_t n = std::min<size_t>(round.maxQueries, selected.size() - b0);
+                const std::vector<uint32_t> batch(selected.begin() + ptrdiff_t(b0),
+                                                  selected.begin() + ptrdiff_t(b0 + n));
+                gathered.resize(n);
+                core::parallelChunks(n, kHostChunk, lane.threads, [&](size_t begin, size_t end, int) {
+                    for (size_t k = begin; k < end; ++k) gathered[k] = qs.points[batch[k]];
+                });
+                Result<HausdorffResult> r = lane.call(gathered, ts.piece(j), piece);
+                if (!r) {
+                    failure.set(r.error());
+                    return;
+                }
+                std::lock_guard lock(round.mutex);
+                addCallTo(dir.shared, r->aToB.counters, &r->timings);
+                mergeBests(dir, *round.pieces, CallQueries{0, &batch}, ts.start[j], r->aNearest, scale,
+                           lane.threads);
+                lane.giveBack(std::move(r->aNearest), PerPoint{});
+            }
+        } catch (const std::bad_alloc&) {
+            failure.set(Error{ErrorCode::kOutOfMemory, "out of host memory at target piece " +
+                                                           std::to_string(j) + " (device lane " +
+                                                           std::to_string(lane.index) + ")"});
+            return;
+        }
+    }
+}
+
+// The direction's result from every query's best pair: the witness (the
+// largest, the smallest input index among ties), the certificate's band,
+// per-point output by input index.
+DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces, Span q, Span t,
+                               bool perPoint, double scale, int threads) {
+    const SpatialPieces::Set& qs = pieces.set(dir.q);
+    const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
+    const size_t n = qs.points.size();
+    std::vector<SettledMaximum> maxima(size_t(core::resolveThreads(threads)));
+    std::vector<uint64_t> at(maxima.size(), 0);
+    core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int w) {
+        SettledMaximum& m = maxima[size_t(w)];
+        for (size_t p = begin; p < end; ++p) {
+            const uint32_t input = qs.input[p];
+            if (dir.d2[p] > m.d2 || (dir.d2[p] == m.d2 && input < m.input)) {
+                m = {dir.d2[p], input};
+                at[size_t(w)] = p;
+            }
+        }
+    });
+    size_t best = 0;
+    for (size_t w = 1; w < maxima.size(); ++w)
+        if (maxima[w].d2 > maxima[best].d2 ||
+            (maxima[w].d2 == maxima[best].d2 && maxima[w].input < maxima[best].input))
+            best = w;
+    const uint64_t w = at[best];
+    DirectionState s = std::move(dir.shared.state);
+    s.witness.distance = dir.distance[w];
+    s.witness.queryIndex = qs.input[w];
+    s.witness.targetIndex = dir.nearest[w];
+    s.witness.queryPoint = glm::dvec3(q[qs.input[w]]);
+    s.witness.targetPoint = glm::dvec3(t[dir.nearest[w]]);
+    s.witnessD2 = dir.d2[w];
+
+    core::DirectionBand& band = s.band;
+    band.present = true;
+    band.slack = dir.shared.slack;
+    band.hf = std::sqrt(double(dir.d2[w]));
+    band.scale = scale;
+    s.reach = band.hf - band.slack;
+    const double lo2 = core::bandThreshold2(double(dir.d2[w]), band.slack);
+    std::vector<std::vector<core::BandQuery>> parts((n + kHostChunk - 1) / kHostChunk);
+    core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t p = begin; p < end; ++p)
+            if (double(dir.d2[p]) >= lo2) parts[begin / kHostChunk].push_back({qs.input[p], dir.nearest[p]});
+    });
+    for (const auto& part : parts) band.queries.insert(band.queries.end(), part.begin(), part.end());
+
+    if (perPoint) {
+        s.perPoint.distance.resize(n);
+        s.perPoint.nearest.resize(n);
+        core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
+            for (size_t p = begin; p < end; ++p) {
+                s.perPoint.distance[qs.input[p]] = dir.distance[p];
+                s.perPoint.nearest[qs.input[p]] = dir.nearest[p];
+            }
+        });
+    }
+    uint32_t queryPieces = 0, targetPieces = 0;
+    for (size_t k = 0; k < pieces.count(); ++k) {
+        queryPieces += qs.size(k) != 0 ? 1 : 0;
+        targetPieces += ts.size(k) != 0 ? 1 : 0;
+    }
+    s.counters.queries = n;
+    s.counters.queryChunks = queryPieces;
+    s.counters.targetTiles = targetPieces;
+    s.counters.crossPieceQueries = dir.crossPiece;
+    s.witness.counters = s.counters;
+    return s;
+}
+
+// The directions whose targets do not fit one call beside a chunk, in
+// pieces ordered in space (`dirs`: null for a direction not in pieces):
+// round one, every piece's queries against its own targets; round two, the
+// open queries against the other pieces that may hold a nearer point.
+std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double scale,
+                                const CallOptions& call, uint64_t perCall, uint64_t maxPiece,
+                                const DirectedCall& directed, const RecycleCall& recycle, int lanes,
+                                int threads) {
+    for (int d = 0; d < 2; ++d) {
+        SpaceDirection* dir = dirs[d];
+        if (dir == nullptr) continue;
+        const size_t n = pieces.set(dir->q).points.size();
+        dir->d2.resize(n);
+        dir->distance.resize(n);
+        dir->nearest.resize(n);
+        core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
+            std::fill(dir->d2.begin() + ptrdiff_t(begin), dir->d2.begin() + ptrdiff_t(end),
+                      std::numeric_limits<float>::infinity());
+            std::fill(dir->distance.begin() + ptrdiff_t(begin), dir->distance.begin() + ptrdiff_t(end), 0.0);
+            std::fill(dir->nearest.begin() + ptrdiff_t(begin), dir->nearest.begin() + ptrdiff_t(end),
+                      UINT32_MAX);
+        });
+    }
+    lanes = int(std::min<size_t>(size_t(std::max(lanes, 1)), pieces.count()));
+    {
+        RoundFailure failure;
+        std::atomic<size_t> next{0};
+        onLanes(lanes, [&](int l) {
+            roundOne(pieces, dirs, scale, call, Lane{l, threads, &directed, &recycle}, next, failure, 0.0,
+                     0.8);
+        });
+        if (failure.error) return failure.error;
+    }
+    for (int d = 0; d < 2; ++d) {
+        SpaceDirection* dir = dirs[d];
+        if (dir == nullptr) continue;
+        RoundTwo round;
+        round.dir = dir;
+        round.pieces = &pieces;
+        round.open = openQueries(*dir, pieces, scale, dir->shared.slack, call.perPointDistances,
+                                 round.maximum, threads);
+        if (round.open.empty()) continue;
+        round.boxes = tileBoxes(pieces.set(1 - dir->q), scale, threads);
+        uint64_t largestTile = 0;
+        for (size_t k = 0; k < pieces.count(); ++k)
+            largestTile = std::max(largestTile, pieces.set(1 - dir->q).size(k));
+        round.maxQueries =
+            std::max<uint64_t>(1, std::min(perCall - std::min(perCall - 1, largestTile), maxPiece));
+        for (const bool first : {true, false}) {
+            RoundFailure failure;
+            round.next = 0;
+            onLanes(lanes, [&](int l) {
+                roundTwo(round, first, scale, call, Lane{l, threads, &directed, &recycle}, failure,
+                         first ? 0.8 : 0.85, first ? 0.05 : 0.15);
+            });
+            if (failure.error) return failure.error;
+        }
+    }
+    return std::nullopt;
+}
+
+// The whole pair within one budget: each direction in chunks (its targets
+// fit one call beside a chunk) or in pieces ordered in space.
+Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOptions& call,
+                                      const MemoryBudget& budget, const DirectedCall& directed,
+                                      const RecycleCall& recycle, const std::function<void()>& release,
+                                      int lanes, int threads) {
+    const Result<DirectionSplit> splitAB = splitDirection(budget, a.size(), b.size(), lanes);
+    if (!splitAB) return splitAB.error();
+    const uint64_t perCall = budget.pointsPerCall();
+    const uint64_t maxPiece = std::min(budget.maxPiecePoints, kMaxCallPoints);
+    const uint64_t tile = std::min(perCall / 2, maxPiece);
+    const bool spaceAB = b.size() > splitAB->targetTile;
+    const bool spaceBA = !call.directedOnly && a.size() > std::min(tile, maxPiece);
+    const double magnitude = std::max(core::largestMagnitude(a, threads), core::largestMagnitude(b, threads));
+    const double slack = core::searchSlack(magnitude * scale);
+
+    std::optional<DirectionState> ab, ba;
+    if (spaceAB || spaceBA) {
+        if (a.size() > UINT32_MAX || b.size() > UINT32_MAX) {
+            return Error{ErrorCode::kInvalidArgument,
+                         "out of core: sets of " + std::to_string(a.size()) + " and " +
+                             std::to_string(b.size()) +
+                             " points; pieces ordered in space take at most 2^32 - 1 points a set"};
+        }
+        // With several lanes, at least two pieces a lane.
+        const uint64_t l2 = 2 * uint64_t(std::max(lanes, 1));
+        PieceLimits limits{tile, tile};
+        if (lanes > 1) {
+            limits.a = std::min(tile, (a.size() + l2 - 1) / l2);
+            limits.b = std::min(tile, (b.size() + l2 - 1) / l2);
+        }
+        const SpatialPieces pieces = SpatialPieces::partition(a, b, scale, limits, threads);
+        SpaceDirection dirAB, dirBA;
+        dirAB.q = 0;
+        dirBA.q = 1;
+        dirAB.shared.slack = dirBA.shared.slack = slack;
+        SpaceDirection* const dirs[2] = {spaceAB ? &dirAB : nullptr, spaceBA ? &dirBA : nullptr};
+        if (auto err =
+                runInSpace(pieces, dirs, scale, call, perCall, maxPiece, directed, recycle, lanes, threads))
+            return *err;
+        if (spaceAB) ab = finishDirection(dirAB, pieces, a, b, call.perPointDistances, scale, threads);
+        if (spaceBA) ba = finishDirection(dirBA, pieces, b, a, call.perPointDistances, scale, threads);
+        if (release) release();
+    }
+    const double width = call.directedOnly ? 1.0 : 0.5;
+    if (!spaceAB) {
+        Result<DirectionState> s =
+            runChunks(a, b, scale, call, splitAB->queryChunk, directed, recycle, lanes, threads, 0.0, width);
+        if (!s) return s.error();
+        ab = std::move(s.value());
+        if (release) release();
+    }
+    if (!call.directedOnly && !spaceBA) {
+        const Result<DirectionSplit> splitBA = splitDirection(budget, b.size(), a.size(), lanes);
+        if (!splitBA) return splitBA.error();
+        Result<DirectionState> s =
+            runChunks(b, a, scale, call, splitBA->queryChunk, directed, recycle, lanes, threads, 0.5, 0.5);
+        if (!s) return s.error();
+        ba = std::move(s.value());
+    }
+
+    HausdorffResult r;
+    r.directedOnly = call.directedOnly;
+    auto material = std::make_shared<detail::ProofMaterial>();
+    material->aToB = ab->band;
+    r.aToB = ab->witness;
+    r.aNearest = std::move(ab->perPoint);
+    r.hausdorff = r.aToB.distance;
+    r.timings = ab->timings;
+    if (!call.directedOnly) {
+        r.bToA = ba->witness;
+        r.bNearest = std::move(ba->perPoint);
+        r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
+        core::addStageTimings(r.timings, ba->timings);
+        material->bToA = ba->band;
+    }
+    // The certificate of the whole from the pieces' bands, on the float sets
+    // the pieces searched: what a backend's own certificate pass is to one
+    // call (the merged witness carries a piece's proof until then). The
+    // result is still in the search frame; the Engine leaves it as every
+    // route's (engine.cpp, leaveFrame: core::restoreOriginal proves it again
+    // from the caller's coordinates when they differ).
+    r.proofMaterial = std::move(material);
+    core::proveFromViews(r, PointView(a), PointView(b), threads);
+    return r;
 }
 
 }  // namespace
@@ -578,41 +826,20 @@ Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, u
 }
 
 Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const CallOptions& call,
-                                        const MemoryBudget& budget, const DirectedCall& directed,
+                                        const MemoryBudget& given, const DirectedCall& directed,
                                         const std::function<void()>& release, int lanes, int threads,
                                         const RecycleCall& recycle) {
-    const double width = call.directedOnly ? 1.0 : 0.5;
-    Result<DirectionState> ab =
-        runDirectionWithin(a, b, scale, call, budget, directed, recycle, release, lanes, threads, 0.0, width);
-    if (!ab) return ab.error();
-    HausdorffResult r;
-    r.directedOnly = call.directedOnly;
-    auto material = std::make_shared<detail::ProofMaterial>();
-    material->aToB = ab->band;
-    r.aToB = ab->witness;
-    r.aNearest = std::move(ab->perPoint);
-    r.hausdorff = r.aToB.distance;
-    r.timings = ab->timings;
-    if (!call.directedOnly) {
+    // The budget halved after each kOutOfMemory (the per-point figure is an
+    // estimate; a device may hold less than it reports).
+    MemoryBudget budget = given;
+    for (;;) {
+        Result<HausdorffResult> r =
+            computeWithin(a, b, scale, call, budget, directed, recycle, release, lanes, threads);
+        if (r || r.error().code != ErrorCode::kOutOfMemory || budget.pointsPerCall() < 4) return r;
         if (release) release();
-        Result<DirectionState> ba = runDirectionWithin(b, a, scale, call, budget, directed, recycle, release,
-                                                       lanes, threads, 0.5, 0.5);
-        if (!ba) return ba.error();
-        r.bToA = ba->witness;
-        r.bNearest = std::move(ba->perPoint);
-        r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
-        core::addStageTimings(r.timings, ba->timings);
-        material->bToA = ba->band;
+        budget.bytes /= 2;
+        budget.source += ", halved after: " + r.error().message;
     }
-    // The certificate of the whole from the pieces' bands, on the float sets
-    // the pieces searched: what a backend's own certificate pass is to one
-    // call (the merged witness carries a piece's proof until then). The
-    // result is still in the search frame; the Engine leaves it as every
-    // route's (engine.cpp, leaveFrame: core::restoreOriginal proves it again
-    // from the caller's coordinates when they differ).
-    r.proofMaterial = std::move(material);
-    core::proveFromViews(r, PointView(a), PointView(b), threads);
-    return r;
 }
 
 }  // namespace rthdist::api

@@ -102,7 +102,7 @@ using DirectedCall =
                                           std::span<const glm::vec3> targets, const CallOptions& call)>;
 // Hands the per-point arrays of a lane's call, once merged, back to that
 // lane's backend for its next call (GpuHausdorff::recyclePerPoint); may be empty.
-using RecycleCall = std::function<void(int lane, PerPoint&& spent)>;
+using RecycleCall = std::function<void(int lane, PerPoint&& a, PerPoint&& b)>;
 
 // H(A,B) (or h(A,B) with call.directedOnly) of float sets searched at the
 // exact power-of-two `scale` (core::exactScale), as a sequence of calls of

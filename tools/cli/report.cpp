@@ -66,7 +66,8 @@ Json countersJson(const Counters& c) {
             {"candidate_pairs", c.candidatePairs},
             {"tail_scanned", c.tailScanned},
             {"query_chunks", c.queryChunks},
-            {"target_tiles", c.targetTiles}};
+            {"target_tiles", c.targetTiles},
+            {"cross_piece_queries", c.crossPieceQueries}};
 }
 
 // One direction; `q`/`t` name the query and target sets ("a"/"b").
@@ -112,6 +113,8 @@ std::string countersText(const Counters& c) {
     if (c.tailScanned > 0) appendf(s, ", tail scanned %llu", (unsigned long long)c.tailScanned);
     if (c.queryChunks > 1 || c.targetTiles > 1)
         appendf(s, ", out of core in %u query chunks x %u target tiles", c.queryChunks, c.targetTiles);
+    if (c.crossPieceQueries > 0)
+        appendf(s, ", %llu queries past their piece", (unsigned long long)c.crossPieceQueries);
     return s;
 }
 

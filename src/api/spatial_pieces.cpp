@@ -1,0 +1,227 @@
+#include "api/spatial_pieces.hpp"
+
+#include <glm/common.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/index_space.hpp"
+#include "core/parallel.hpp"
+
+namespace rthdist::api {
+
+namespace {
+
+using Span = std::span<const glm::vec3>;
+
+// Cells per axis: about 16 points a cell over both sets, 2 to 128 a side
+// (at most 2^21 cells: a Morton code of 7 bits an axis).
+uint32_t cellsPerAxisFor(uint64_t points) {
+    const double side = std::cbrt(double(points) / 16.0);
+    uint32_t cells = 2;
+    while (cells < 128 && double(cells) < side) cells *= 2;
+    return cells;
+}
+
+// Host threads and their input ranges: range t is [t * n / T, (t + 1) * n / T),
+// so that ranks and scatter positions follow input order.
+struct Ranges {
+    size_t n = 0;
+    int count = 1;
+    [[nodiscard]] size_t begin(int t) const { return size_t(uint64_t(n) * uint64_t(t) / uint64_t(count)); }
+};
+
+template <class Fn>
+void forRanges(const Ranges& r, Fn&& fn) {
+    core::parallelChunks(size_t(r.count), 1, r.count, [&](size_t t0, size_t t1, int) {
+        for (size_t t = t0; t < t1; ++t) fn(int(t), r.begin(int(t)), r.begin(int(t) + 1));
+    });
+}
+
+}  // namespace
+
+uint32_t SpatialPieces::axisCell(double v, int axis) const {
+    return core::cellCoord(v, m_lo[axis], m_size[axis], m_cells);
+}
+
+uint32_t SpatialPieces::cellOf(const glm::dvec3& p) const {
+    return core::mortonEncode(axisCell(p.x, 0), axisCell(p.y, 1), axisCell(p.z, 2));
+}
+
+bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) const {
+    uint32_t lo[3], hi[3];
+    uint64_t cells = 1;
+    for (int axis = 0; axis < 3; ++axis) {
+        lo[axis] = axisCell(double(q[axis]) - radius, axis);
+        hi[axis] = axisCell(double(q[axis]) + radius, axis);
+        cells *= hi[axis] - lo[axis] + 1;
+    }
+    if (cells > 64) return false;
+    for (uint32_t z = lo[2]; z <= hi[2]; ++z)
+        for (uint32_t y = lo[1]; y <= hi[1]; ++y)
+            for (uint32_t x = lo[0]; x <= hi[0]; ++x) {
+                const uint32_t owner = m_owner[core::mortonEncode(x, y, z)];
+                if (owner != k && owner != kEmpty) return false;
+            }
+    return true;
+}
+
+SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits limits, int threads) {
+    SpatialPieces out;
+    const Span sets[2] = {a, b};
+    const uint64_t limit[2] = {std::max<uint64_t>(limits.a, 1), std::max<uint64_t>(limits.b, 1)};
+    threads = core::resolveThreads(threads, (a.size() + b.size()) / 65536 + 1);
+
+    // The pair's box, scaled as searched.
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    for (const Span s : sets) {
+        if (s.empty()) continue;
+        std::vector<glm::dvec3> partLo(size_t(threads), glm::dvec3(core::scaled(s[0], scale)));
+        std::vector<glm::dvec3> partHi = partLo;
+        core::parallelChunks(s.size(), size_t(1) << 16, threads, [&](size_t begin, size_t end, int w) {
+            glm::vec3 l = core::scaled(s[begin], scale), h = l;
+            for (size_t i = begin; i < end; ++i) {
+                const glm::vec3 p = core::scaled(s[i], scale);
+                l = glm::min(l, p);
+                h = glm::max(h, p);
+            }
+            partLo[size_t(w)] = glm::min(partLo[size_t(w)], glm::dvec3(l));
+            partHi[size_t(w)] = glm::max(partHi[size_t(w)], glm::dvec3(h));
+        });
+        for (int w = 0; w < threads; ++w) {
+            lo = glm::min(lo, partLo[size_t(w)]);
+            hi = glm::max(hi, partHi[size_t(w)]);
+        }
+    }
+    out.m_cells = cellsPerAxisFor(a.size() + b.size());
+    const uint32_t cellCount = out.m_cells * out.m_cells * out.m_cells;
+    for (int axis = 0; axis < 3; ++axis) {
+        out.m_lo[axis] = lo[axis];
+        const double side = (hi[axis] - lo[axis]) / double(out.m_cells);
+        out.m_size[axis] = side > 0.0 && std::isfinite(side) ? side : 1.0;
+    }
+
+    // Each point's cell (Morton code), and each range's count of every cell.
+    core::UninitVector<uint32_t> key[2];
+    Ranges ranges[2];
+    std::vector<std::vector<uint32_t>> counts[2];
+    for (int s = 0; s < 2; ++s) {
+        const Span points = sets[s];
+        ranges[s] = Ranges{points.size(), core::resolveThreads(threads, points.size() / 65536 + 1)};
+        key[s].resize(points.size());
+        counts[s].assign(size_t(ranges[s].count), std::vector<uint32_t>(cellCount, 0u));
+        forRanges(ranges[s], [&](int t, size_t begin, size_t end) {
+            std::vector<uint32_t>& mine = counts[s][size_t(t)];
+            for (size_t i = begin; i < end; ++i) {
+                const uint32_t c = out.cellOf(glm::dvec3(core::scaled(points[i], scale)));
+                key[s][i] = c;
+                ++mine[c];
+            }
+        });
+    }
+
+    // Cells in Morton order into pieces. A cell past a limit alone is shared:
+    // its points go to `span` pieces of their own by rank in input order.
+    std::vector<uint64_t> total[2] = {std::vector<uint64_t>(cellCount, 0),
+                                      std::vector<uint64_t>(cellCount, 0)};
+    for (int s = 0; s < 2; ++s)
+        for (const std::vector<uint32_t>& c : counts[s])
+            for (uint32_t cell = 0; cell < cellCount; ++cell) total[s][cell] += c[cell];
+    out.m_owner.assign(cellCount, kEmpty);
+    std::vector<uint32_t> firstPiece(cellCount, 0), span(cellCount, 1);
+    uint64_t held[2] = {0, 0};
+    uint32_t pieces = 0;
+    bool open = false;  // the current piece holds a point
+    for (uint32_t cell = 0; cell < cellCount; ++cell) {
+        const uint64_t n[2] = {total[0][cell], total[1][cell]};
+        if (n[0] + n[1] == 0) continue;
+        if (n[0] > limit[0] || n[1] > limit[1]) {
+            if (open) ++pieces;
+            open = false;
+            held[0] = held[1] = 0;
+            const uint64_t m = std::max((n[0] + limit[0] - 1) / limit[0], (n[1] + limit[1] - 1) / limit[1]);
+            out.m_owner[cell] = kShared;
+            firstPiece[cell] = pieces;
+            span[cell] = uint32_t(m);
+            pieces += uint32_t(m);
+            continue;
+        }
+        if (open && (held[0] + n[0] > limit[0] || held[1] + n[1] > limit[1])) {
+            ++pieces;
+            held[0] = held[1] = 0;
+        }
+        open = true;
+        held[0] += n[0];
+        held[1] += n[1];
+        out.m_owner[cell] = pieces;
+        firstPiece[cell] = pieces;
+    }
+    if (open) ++pieces;
+    out.m_pieces = pieces;
+
+    // Each point's piece (its key overwritten), then a stable scatter by piece.
+    for (int s = 0; s < 2; ++s) {
+        const Span points = sets[s];
+        const Ranges& r = ranges[s];
+        // A shared cell's rank base per range: the cell's points in earlier ranges.
+        std::vector<std::vector<uint64_t>> rankBase(size_t(r.count));
+        std::vector<uint32_t> sharedCells;
+        for (uint32_t cell = 0; cell < cellCount; ++cell)
+            if (span[cell] > 1) sharedCells.push_back(cell);
+        for (int t = 0; t < r.count; ++t) rankBase[size_t(t)].resize(sharedCells.size());
+        for (size_t j = 0; j < sharedCells.size(); ++j) {
+            uint64_t before = 0;
+            for (int t = 0; t < r.count; ++t) {
+                rankBase[size_t(t)][j] = before;
+                before += counts[s][size_t(t)][sharedCells[j]];
+            }
+        }
+        std::vector<std::vector<uint64_t>> perPiece(size_t(r.count), std::vector<uint64_t>(pieces, 0));
+        forRanges(r, [&](int t, size_t begin, size_t end) {
+            std::vector<uint64_t>& rank = rankBase[size_t(t)];
+            std::vector<uint64_t>& mine = perPiece[size_t(t)];
+            for (size_t i = begin; i < end; ++i) {
+                const uint32_t cell = key[s][i];
+                uint32_t piece = firstPiece[cell];
+                if (span[cell] > 1) {
+                    const size_t j = size_t(std::lower_bound(sharedCells.begin(), sharedCells.end(), cell) -
+                                            sharedCells.begin());
+                    piece += uint32_t(rank[j]++ * span[cell] / total[s][cell]);
+                }
+                key[s][i] = piece;
+                ++mine[piece];
+            }
+        });
+        Set& set = s == 0 ? out.m_a : out.m_b;
+        set.start.assign(pieces + 1, 0);
+        for (uint32_t k = 0; k < pieces; ++k) {
+            uint64_t n = 0;
+            for (int t = 0; t < r.count; ++t) n += perPiece[size_t(t)][k];
+            set.start[k + 1] = set.start[k] + n;
+        }
+        // perPiece becomes each range's next position in each piece.
+        for (uint32_t k = 0; k < pieces; ++k) {
+            uint64_t at = set.start[k];
+            for (int t = 0; t < r.count; ++t) {
+                const uint64_t n = perPiece[size_t(t)][k];
+                perPiece[size_t(t)][k] = at;
+                at += n;
+            }
+        }
+        set.points.resize(points.size());
+        set.input.resize(points.size());
+        forRanges(r, [&](int t, size_t begin, size_t end) {
+            std::vector<uint64_t>& next = perPiece[size_t(t)];
+            for (size_t i = begin; i < end; ++i) {
+                const uint64_t at = next[key[s][i]]++;
+                set.points[at] = points[i];
+                set.input[at] = uint32_t(i);
+            }
+        });
+        key[s] = {};
+    }
+    return out;
+}
+
+}  // namespace rthdist::api

@@ -1,0 +1,85 @@
+// Pieces of a pair ordered in space, for the out-of-core route (issue 33;
+// design.md §9). Both sets are cut by one grid over the pair's box: cells in
+// Morton order are taken into pieces until a piece would hold more points of
+// a set than its limit, so a piece is a run of neighbouring cells holding
+// points of both sets, and a query meets its nearest targets in its own
+// piece unless it lies near the piece's border. A cell with more points of a
+// set than the limit is split over several pieces by input order (a
+// "shared" cell: such pieces overlap in space; correct, only slower).
+//
+// Each set is gathered piece after piece, in input order within a piece, so
+// that a call on a piece breaks ties as a call on the whole set would (the
+// smaller input index first), and `input` maps a gathered point back.
+//
+// Threading: partition() runs its passes on `threads` threads (0: all); the
+// object is then read-only and may be read from any thread.
+// Memory: per set 16 bytes per point (the gathered copy and its input
+// indices) plus 4 bytes per point while partitioning; the grid at most
+// 2^21 cells (8 bytes each) and 4 bytes per cell and host thread while
+// partitioning.
+// Limits: each set below 2^32 points (the input indices are 32-bit).
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/uninit_vector.hpp"
+
+namespace rthdist::api {
+
+// Points of each set that one piece may hold (>= 1 each).
+struct PieceLimits {
+    uint64_t a = 1;
+    uint64_t b = 1;
+};
+
+class SpatialPieces {
+public:
+    // One set, gathered piece after piece.
+    struct Set {
+        core::UninitVector<glm::vec3> points;  // piece after piece, input order within a piece
+        core::UninitVector<uint32_t> input;    // the input index of each gathered point
+        std::vector<uint64_t> start;           // piece k holds [start[k], start[k + 1])
+        [[nodiscard]] std::span<const glm::vec3> piece(size_t k) const {
+            return {points.data() + start[k], size_t(start[k + 1] - start[k])};
+        }
+        [[nodiscard]] uint64_t size(size_t k) const { return start[k + 1] - start[k]; }
+    };
+
+    // Cuts sets a and b (scaled by the exact power of two `scale` as searched;
+    // each below 2^32 points, at least one point in all) into pieces within
+    // `limits`.
+    [[nodiscard]] static SpatialPieces partition(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                                 double scale, PieceLimits limits, int threads);
+
+    [[nodiscard]] size_t count() const { return m_pieces; }
+    [[nodiscard]] const Set& set(int s) const { return s == 0 ? m_a : m_b; }
+    [[nodiscard]] uint32_t cellsPerAxis() const { return m_cells; }
+
+    // True only when every point of either set whose scaled coordinates lie
+    // within `radius` of q on every axis (q scaled as searched: core::scaled)
+    // belongs to piece k: the cells that box touches hold points of piece k
+    // only, or none. Exact: the cell of a coordinate is a monotone function
+    // of it, computed in double for points and box alike. False for a box of
+    // more than 64 cells.
+    [[nodiscard]] bool boxInPiece(const glm::vec3& q, double radius, uint32_t k) const;
+
+private:
+    static constexpr uint32_t kEmpty = UINT32_MAX;       // a cell without points
+    static constexpr uint32_t kShared = UINT32_MAX - 1;  // a cell split over several pieces
+
+    [[nodiscard]] uint32_t cellOf(const glm::dvec3& p) const;
+    [[nodiscard]] uint32_t axisCell(double v, int axis) const;
+
+    Set m_a, m_b;
+    size_t m_pieces = 0;
+    uint32_t m_cells = 1;  // per axis (a power of two)
+    double m_lo[3] = {0.0, 0.0, 0.0};
+    double m_size[3] = {1.0, 1.0, 1.0};  // a cell's side on each axis
+    std::vector<uint32_t> m_owner;       // per cell (Morton code): its piece, kEmpty or kShared
+};
+
+}  // namespace rthdist::api

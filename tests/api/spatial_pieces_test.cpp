@@ -1,0 +1,113 @@
+// The pieces in space of the out-of-core route (src/api/spatial_pieces.hpp)
+// on the host: every point in exactly one piece, input order within a
+// piece, the limits kept (crowded cells split by input order), and
+// boxInPiece never true for a box that holds a point of another piece.
+#include <gtest/gtest.h>
+
+#include <glm/common.hpp>
+
+#include <algorithm>
+#include <vector>
+
+#include "api/spatial_pieces.hpp"
+#include "common/rng.hpp"
+#include "core/index_space.hpp"
+
+namespace rthdist::test {
+namespace {
+
+using api::PieceLimits;
+using api::SpatialPieces;
+
+std::vector<glm::vec3> cloud(size_t n, uint64_t seed, float spread, glm::vec3 at = glm::vec3(0.0f)) {
+    Rng rng(seed);
+    std::vector<glm::vec3> p(n);
+    for (glm::vec3& v : p)
+        v = at + spread * glm::vec3(float(rng.uniform()), float(rng.uniform()), float(rng.uniform()));
+    return p;
+}
+
+// Every input point once, in input order within its piece, each piece within the limits.
+void expectAPartition(const SpatialPieces& pieces, const std::vector<glm::vec3>* sets[2],
+                      PieceLimits limits) {
+    const uint64_t limit[2] = {limits.a, limits.b};
+    for (int s = 0; s < 2; ++s) {
+        const SpatialPieces::Set& set = pieces.set(s);
+        ASSERT_EQ(set.start.size(), pieces.count() + 1);
+        ASSERT_EQ(set.start.back(), sets[s]->size());
+        std::vector<int> seen(sets[s]->size(), 0);
+        for (size_t k = 0; k < pieces.count(); ++k) {
+            EXPECT_LE(set.size(k), limit[s]) << "set " << s << " piece " << k;
+            for (uint64_t g = set.start[k]; g < set.start[k + 1]; ++g) {
+                const uint32_t i = set.input[g];
+                ASSERT_LT(i, sets[s]->size());
+                ++seen[i];
+                EXPECT_EQ(set.points[g], (*sets[s])[i]);
+                if (g > set.start[k]) EXPECT_LT(set.input[g - 1], i) << "input order within piece " << k;
+            }
+        }
+        EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; })) << "set " << s;
+    }
+}
+
+TEST(SpatialPieces, EveryPointOnceInInputOrderWithinTheLimits) {
+    const std::vector<glm::vec3> a = cloud(5000, 1, 1.0f), b = cloud(3000, 2, 1.0f, glm::vec3(0.3f));
+    const std::vector<glm::vec3>* sets[2] = {&a, &b};
+    for (const PieceLimits limits : {PieceLimits{400, 400}, PieceLimits{5000, 100}, PieceLimits{1, 1}}) {
+        const SpatialPieces pieces = SpatialPieces::partition(a, b, 1.0, limits, 3);
+        expectAPartition(pieces, sets, limits);
+        EXPECT_GE(pieces.count(),
+                  std::max((a.size() + limits.a - 1) / limits.a, (b.size() + limits.b - 1) / limits.b));
+    }
+}
+
+// Points of one cell past the limit (all at one spot, and a crowded cluster
+// beside far strays): split over pieces by input order, each within the limits.
+TEST(SpatialPieces, CrowdedCellsAreSplitByInputOrder) {
+    const std::vector<glm::vec3> same(1000, glm::vec3(0.25f, -3.0f, 7.0f));
+    std::vector<glm::vec3> cluster = cloud(2000, 3, 1e-6f, glm::vec3(5.0f));
+    cluster.push_back(glm::vec3(-3000.0f, 0.0f, 0.0f));
+    cluster.insert(cluster.begin() + 500, glm::vec3(4000.0f, 1.0f, 2.0f));
+    const std::vector<glm::vec3>* sets[2] = {&same, &cluster};
+    const PieceLimits limits{128, 300};
+    const SpatialPieces pieces = SpatialPieces::partition(same, cluster, 1.0, limits, 2);
+    expectAPartition(pieces, sets, limits);
+}
+
+// boxInPiece: whenever it says a box lies in piece k, no point of another
+// piece (of either set) lies in that box; and it does say so for most
+// small boxes around points of a spread cloud.
+TEST(SpatialPieces, BoxInPieceHoldsOnlyThatPiecesPoints) {
+    const std::vector<glm::vec3> a = cloud(4000, 4, 2.0f, glm::vec3(-1.0f)), b = cloud(4000, 5, 2.0f);
+    const double scale = 0.5;  // searched at half size: boxes are in scaled units
+    const SpatialPieces pieces = SpatialPieces::partition(a, b, scale, PieceLimits{500, 500}, 2);
+    std::vector<uint32_t> pieceOf[2];
+    for (int s = 0; s < 2; ++s) {
+        pieceOf[s].resize(pieces.set(s).points.size());
+        for (size_t k = 0; k < pieces.count(); ++k)
+            for (uint64_t g = pieces.set(s).start[k]; g < pieces.set(s).start[k + 1]; ++g)
+                pieceOf[s][pieces.set(s).input[g]] = uint32_t(k);
+    }
+    const std::vector<glm::vec3>* sets[2] = {&a, &b};
+    Rng rng(6);
+    size_t inside = 0, tried = 0;
+    for (size_t i = 0; i < a.size(); i += 7) {
+        const glm::vec3 q = core::scaled(a[i], scale);
+        const double radius = 0.002 * double(rng.index(50));
+        const uint32_t k = pieceOf[0][i];
+        ++tried;
+        if (!pieces.boxInPiece(q, radius, k)) continue;
+        ++inside;
+        for (int s = 0; s < 2; ++s)
+            for (size_t j = 0; j < sets[s]->size(); ++j) {
+                const glm::vec3 p = core::scaled((*sets[s])[j], scale);
+                const bool inBox =
+                    glm::all(glm::lessThanEqual(glm::abs(glm::dvec3(p) - glm::dvec3(q)), glm::dvec3(radius)));
+                if (inBox) ASSERT_EQ(pieceOf[s][j], k) << "set " << s << " point " << j << " query " << i;
+            }
+    }
+    EXPECT_GT(inside, tried / 2);
+}
+
+}  // namespace
+}  // namespace rthdist::test
