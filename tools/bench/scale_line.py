@@ -36,12 +36,19 @@ def main():
         c = counters.get(d)
         if c:
             settled.append(f"{100.0 * c['culled_by_neighbourhood'] / max(1, c['queries']):.1f}%")
+    pieces = []
+    for d in ("a_to_b", "b_to_a"):
+        c = counters.get(d)
+        if c and (c.get("query_chunks", 1) > 1 or c.get("target_tiles", 1) > 1):
+            pieces.append(f"{c['query_chunks']}x{c['target_tiles']}"
+                          f" (+{c.get('cross_piece_queries', 0)} past their piece)")
     v = j.get("verify", {})
     print(f"{case} p{proc} exit {rc}: H {fmt(j.get('hausdorff'))} h(A,B) {fmt(j['a_to_b']['distance'])} "
           f"h(B,A) {fmt((j.get('b_to_a') or {}).get('distance'))} verify {'ok' if v.get('ok') else 'MISMATCH'} "
           f"cpu H {fmt((v.get('cpu') or {}).get('hausdorff'))} | certificate {', '.join(cs) or 'none'} | "
           f"gpu ms {gpu} | wall {j['timings_ms']['wall']:.0f} ms | neighbourhood-settled {'/'.join(settled)} | "
-          f"points {j['points']['a']}x{j['points']['b']}")
+          f"points {j['points']['a']}x{j['points']['b']}"
+          + (f" | pieces {' / '.join(pieces)} host total {j['timings_ms'].get('total', 0):.0f} ms" if pieces else ""))
 
 
 if __name__ == "__main__":
