@@ -76,6 +76,7 @@ py::dict timings(const Timings& t) {
     d["gpu_search"] = t.gpuSearch;
     d["gpu_refine"] = t.gpuRefine;
     d["certificate"] = t.certificate;
+    d["pieces"] = t.pieces;
     d["gpu_certificate"] = t.gpuCertificate;
     return d;
 }

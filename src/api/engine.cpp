@@ -293,8 +293,9 @@ Result<HausdorffResult> runInPieces(Engine::Impl& impl, std::span<const glm::vec
         backend.recyclePerPoint(lane, std::move(a), std::move(b));
     };
     release();
-    Result<HausdorffResult> r = api::computeInPieces(a, b, scale, call, pieces, directed, release,
-                                                     backend.caps().lanes, impl.options.threads, recycle);
+    Result<HausdorffResult> r = api::computeInPieces(
+        a, b, scale, call, pieces, directed, release, backend.caps().lanes, impl.options.threads, recycle,
+        impl.options.tuning && impl.options.tuning->traceSubmits);
     release();  // the pieces' scratch is no use to the next call
     if (!r) return r;
     r->backend = backend.kind();

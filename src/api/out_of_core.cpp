@@ -5,6 +5,7 @@
 #include "core/certificate.hpp"
 #include "core/index_space.hpp"
 #include "core/parallel.hpp"
+#include "core/stopwatch.hpp"
 #include "core/timings.hpp"
 #include "core/uninit_vector.hpp"
 
@@ -13,6 +14,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdio>
 #include <limits>
 #include <mutex>
 #include <new>
@@ -264,16 +266,30 @@ Result<DirectionState> runChunks(Span q, Span t, double scale, const CallOptions
 // ---- Pieces ordered in space (spatial_pieces.hpp) ----------------------
 
 // One direction Q -> T of the pieces in space: every query's best pair so
-// far, by its position in Q's gathered order (searchDist2 of the pair, the
-// distance its call reported, the target's input index), and what the
-// calls add up to.
+// far, by its position in Q's gathered order: the distance its call
+// reported (in double from the pair, as every route reports it; +inf: none
+// yet) and the target's position in T's gathered order. Pairs are compared
+// by that distance, then by the target's input index: the certificate
+// settles the witness in double from the band whatever the order of
+// near-ties, so the result is the one call's.
 struct SpaceDirection {
     int q = 0;  // Q's set in the pieces: 0 (A -> B) or 1 (B -> A)
-    core::UninitVector<float> d2;
     core::UninitVector<double> distance;
     core::UninitVector<uint32_t> nearest;
     SharedDirection shared;
     uint64_t crossPiece = 0;  // queries sent to another piece's targets
+};
+
+// The host's own work between the pieces' calls (Timings::pieces), added
+// up by every lane.
+struct HostClock {
+    std::mutex mutex;
+    double ms = 0.0;
+    void add(core::Clock::time_point since) {
+        const double t = core::msSince(since);
+        std::lock_guard lock(mutex);
+        ms += t;
+    }
 };
 
 // The queries of one call and where they sit in the gathered order: a
@@ -285,27 +301,25 @@ struct CallQueries {
 };
 
 // A call's per-point result merged into the direction's bests: a nearer pair
-// replaces, an equal one only with a smaller target index. Targets: the
-// gathered target piece starting at `tileStart`.
+// replaces, an equal one only with a smaller target input index. Targets:
+// the gathered target piece starting at `tileStart`. Reads the call's
+// arrays and the bests in order; a target's input index only on a tie.
 void mergeBests(SpaceDirection& dir, const SpatialPieces& pieces, const CallQueries& queries,
-                uint64_t tileStart, const PerPoint& pp, double scale, int threads) {
-    const SpatialPieces::Set& qs = pieces.set(dir.q);
+                uint64_t tileStart, const PerPoint& pp, int threads) {
     const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
     const size_t n = pp.nearest.size();
-    core::parallelChunks(n, kHostChunk, core::resolveThreads(threads, n / kHostChunk + 1),
-                         [&](size_t begin, size_t end, int) {
-                             for (size_t k = begin; k < end; ++k) {
-                                 const uint64_t p = queries.at(k);
-                                 const uint64_t g = tileStart + pp.nearest[k];
-                                 const float d2 = searchDist2(qs.points[p], ts.points[g], scale);
-                                 const uint32_t target = ts.input[g];
-                                 if (d2 < dir.d2[p] || (d2 == dir.d2[p] && target < dir.nearest[p])) {
-                                     dir.d2[p] = d2;
-                                     dir.distance[p] = pp.distance[k];
-                                     dir.nearest[p] = target;
-                                 }
-                             }
-                         });
+    core::parallelChunks(
+        n, kHostChunk, core::resolveThreads(threads, n / kHostChunk + 1), [&](size_t begin, size_t end, int) {
+            for (size_t k = begin; k < end; ++k) {
+                const uint64_t p = queries.at(k);
+                const double d = pp.distance[k];
+                const auto g = uint32_t(tileStart + pp.nearest[k]);
+                if (d < dir.distance[p] || (d == dir.distance[p] && ts.input[g] < ts.input[dir.nearest[p]])) {
+                    dir.distance[p] = d;
+                    dir.nearest[p] = g;
+                }
+            }
+        });
 }
 
 void addCallTo(SharedDirection& shared, const Counters& c, const Timings* t) {
@@ -328,17 +342,17 @@ struct RoundFailure {
 
 // Round one: every piece's queries against the same piece's targets, both
 // directions in one call where both are in pieces (`dirs` null where not).
-void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double scale,
-              const CallOptions& call, const Lane& lane, std::atomic<size_t>& next, RoundFailure& failure,
+void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], const CallOptions& call,
+              const Lane& lane, std::atomic<size_t>& next, RoundFailure& failure, HostClock& host,
               double from, double width) {
     const bool both = dirs[0] != nullptr && dirs[1] != nullptr;
+    const int qset = dirs[0] != nullptr ? 0 : 1;
+    const SpatialPieces::Set& qs = pieces.set(qset);
+    const SpatialPieces::Set& ts = pieces.set(1 - qset);
     for (;;) {
         const size_t k = next.fetch_add(1);
         if (k >= pieces.count() || failure.failed.load()) return;
         try {
-            const int qset = dirs[0] != nullptr ? 0 : 1;
-            const SpatialPieces::Set& qs = pieces.set(qset);
-            const SpatialPieces::Set& ts = pieces.set(1 - qset);
             if (qs.size(k) == 0 || ts.size(k) == 0) continue;  // its queries go to other pieces in round two
             CallOptions piece = pieceOptions(call, true, from + width * double(k) / double(pieces.count()),
                                              width / double(pieces.count()));
@@ -348,16 +362,17 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double
                 failure.set(r.error());
                 return;
             }
+            const core::Clock::time_point start = core::Clock::now();
             SpaceDirection& first = *dirs[qset];
             addCallTo(first.shared, r->aToB.counters, &r->timings);
-            mergeBests(first, pieces, CallQueries{qs.start[k]}, ts.start[k], r->aNearest, scale,
-                       lane.threads);
+            mergeBests(first, pieces, CallQueries{qs.start[k]}, ts.start[k], r->aNearest, lane.threads);
             if (both) {
                 addCallTo(dirs[1]->shared, r->bToA.counters, nullptr);
-                mergeBests(*dirs[1], pieces, CallQueries{ts.start[k]}, qs.start[k], r->bNearest, scale,
+                mergeBests(*dirs[1], pieces, CallQueries{ts.start[k]}, qs.start[k], r->bNearest,
                            lane.threads);
             }
             lane.giveBack(std::move(r->aNearest), std::move(r->bNearest));
+            host.add(start);
         } catch (const std::bad_alloc&) {
             failure.set(Error{ErrorCode::kOutOfMemory, "out of host memory in piece " + std::to_string(k) +
                                                            " (device lane " + std::to_string(lane.index) +
@@ -378,24 +393,32 @@ struct OpenQuery {
 // The running maximum of round one's settled queries (design.md §3's early
 // break): a query whose best pair is nearer cannot be the maximum, one as
 // far cannot win the tie when the maximum's query has the smaller input
-// index. Per-point output: nothing is dropped (d2 -1).
+// index. Per-point output: nothing is dropped (distance -1).
 struct SettledMaximum {
-    float d2 = -1.0f;
+    double distance = -1.0;
     uint32_t input = UINT32_MAX;
-    [[nodiscard]] bool drops(float best, uint32_t query) const {
-        return best < d2 || (best == d2 && input < query);
+    uint64_t at = 0;  // its position in the gathered order
+    [[nodiscard]] bool beats(const SettledMaximum& o) const {
+        return distance > o.distance || (distance == o.distance && input < o.input);
+    }
+    [[nodiscard]] bool drops(double best, uint32_t query) const {
+        return best < distance || (best == distance && input < query);
     }
 };
 
 // The target pieces as tiles of round two: each piece's box, scaled as searched.
 struct TileBox {
-    glm::vec3 lo{0.0f}, hi{0.0f};
+    glm::dvec3 lo{0.0}, hi{0.0};
     bool empty = true;
 };
 
-float boxDist2(const glm::vec3& q, const TileBox& box, double scale) {
-    const glm::vec3 qs = core::scaled(q, scale);
-    return squaredLength(glm::max(glm::max(box.lo - qs, qs - box.hi), glm::vec3(0.0f)));
+// A lower bound of the distance from q to any point of the box, squared, in
+// search units (double from float coordinates scaled by a power of two;
+// rounding is monotone).
+double boxGap2(const glm::vec3& q, const TileBox& box, double scale) {
+    const glm::dvec3 qs(core::scaled(q, scale));
+    const glm::dvec3 d = glm::max(glm::max(box.lo - qs, qs - box.hi), glm::dvec3(0.0));
+    return glm::dot(d, d);
 }
 
 std::vector<TileBox> tileBoxes(const SpatialPieces::Set& ts, double scale, int threads) {
@@ -404,30 +427,26 @@ std::vector<TileBox> tileBoxes(const SpatialPieces::Set& ts, double scale, int t
         const Span t = ts.piece(k);
         if (t.empty()) continue;
         const int n = core::resolveThreads(threads, t.size() / kHostChunk + 1);
-        std::vector<TileBox> parts(size_t(n), TileBox{t[0], t[0], false});
+        std::vector<glm::vec3> lo(size_t(n), t[0]), hi(size_t(n), t[0]);
         core::parallelChunks(t.size(), kHostChunk, n, [&](size_t begin, size_t end, int w) {
-            TileBox& part = parts[size_t(w)];
             for (size_t i = begin; i < end; ++i) {
-                part.lo = glm::min(part.lo, t[i]);
-                part.hi = glm::max(part.hi, t[i]);
+                lo[size_t(w)] = glm::min(lo[size_t(w)], t[i]);
+                hi[size_t(w)] = glm::max(hi[size_t(w)], t[i]);
             }
         });
-        TileBox box = parts[0];
-        for (const TileBox& part : parts) {
-            box.lo = glm::min(box.lo, part.lo);
-            box.hi = glm::max(box.hi, part.hi);
+        for (int w = 1; w < n; ++w) {
+            lo[0] = glm::min(lo[0], lo[size_t(w)]);
+            hi[0] = glm::max(hi[0], hi[size_t(w)]);
         }
-        box.lo = core::scaled(box.lo, scale);  // an exact power of two: monotone
-        box.hi = core::scaled(box.hi, scale);
-        boxes[k] = box;
+        boxes[k] = {glm::dvec3(core::scaled(lo[0], scale)), glm::dvec3(core::scaled(hi[0], scale)), false};
     }
     return boxes;
 }
 
 // After round one: the queries that are done (their best pair lies in
 // their own piece and no other piece's point can be as near: the box of
-// their best distance, widened by the certificate's slack and a relative
-// margin, touches cells of their own piece only) and the maximum over
+// their best distance, widened by a relative margin and the certificate's
+// slack, touches cells of their own piece only) and the maximum over
 // them; the others, open.
 std::vector<OpenQuery> openQueries(const SpaceDirection& dir, const SpatialPieces& pieces, double scale,
                                    double slack, bool perPoint, SettledMaximum& maximum, int threads) {
@@ -435,27 +454,27 @@ std::vector<OpenQuery> openQueries(const SpaceDirection& dir, const SpatialPiece
     std::vector<std::vector<OpenQuery>> parts((qs.points.size() + kHostChunk - 1) / kHostChunk);
     std::vector<SettledMaximum> maxima(size_t(core::resolveThreads(threads)));
     core::parallelChunks(qs.points.size(), kHostChunk, threads, [&](size_t begin, size_t end, int w) {
-        uint32_t home =
+        auto home =
             uint32_t(std::upper_bound(qs.start.begin(), qs.start.end(), begin) - qs.start.begin() - 1);
         std::vector<OpenQuery>& open = parts[begin / kHostChunk];
         SettledMaximum& best = maxima[size_t(w)];
         for (size_t p = begin; p < end; ++p) {
             while (p >= qs.start[home + 1]) ++home;
-            const float d2 = dir.d2[p];
-            const double radius = std::sqrt(double(d2)) * (1.0 + 0x1p-12) + slack;
-            if (d2 == std::numeric_limits<float>::infinity() ||
-                !pieces.boxInPiece(core::scaled(qs.points[p], scale), radius, home)) {
+            const double d = dir.distance[p];
+            if (d == std::numeric_limits<double>::infinity() ||
+                !pieces.boxInPiece(core::scaled(qs.points[p], scale), d * scale * (1.0 + 0x1p-12) + slack,
+                                   home)) {
                 open.push_back({uint32_t(p), home, UINT32_MAX});
                 continue;
             }
-            const uint32_t input = qs.input[p];
-            if (d2 > best.d2 || (d2 == best.d2 && input < best.input)) best = {d2, input};
+            const SettledMaximum m{d, qs.input[p], p};
+            if (m.beats(best)) best = m;
         }
     });
     maximum = {};
     if (!perPoint)
         for (const SettledMaximum& m : maxima)
-            if (m.d2 > maximum.d2 || (m.d2 == maximum.d2 && m.input < maximum.input)) maximum = m;
+            if (m.beats(maximum)) maximum = m;
     size_t total = 0;
     for (const auto& part : parts) total += part.size();
     std::vector<OpenQuery> all;
@@ -490,7 +509,7 @@ struct RoundTwo {
 // The open queries that tile j may still improve: not dropped by the early
 // break, neither from j nor sent there first, and no farther from j's box
 // than their best pair (no point of the tile can be nearer, nor tie with a
-// smaller index: the box distance is a lower bound, rounding being monotone).
+// smaller index: the box gap is a lower bound, widened here by 2^-40).
 // `first`: the queries without a pair yet, each to the tile nearest it only.
 std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double scale, int threads) {
     SpaceDirection& dir = *round.dir;
@@ -500,14 +519,14 @@ std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double 
         std::vector<uint32_t>& keep = parts[begin / kHostChunk];
         for (size_t i = begin; i < end; ++i) {
             OpenQuery& o = round.open[i];
-            const float d2 = dir.d2[o.p];
+            const double d = dir.distance[o.p];
             if (first) {
-                if (d2 != std::numeric_limits<float>::infinity()) continue;
+                if (d != std::numeric_limits<double>::infinity()) continue;
                 uint32_t nearest = UINT32_MAX;
-                float gap = std::numeric_limits<float>::infinity();
+                double gap = 0.0;
                 for (uint32_t k = 0; k < round.boxes.size(); ++k) {
                     if (round.boxes[k].empty) continue;
-                    const float g = boxDist2(qs.points[o.p], round.boxes[k], scale);
+                    const double g = boxGap2(qs.points[o.p], round.boxes[k], scale);
                     if (nearest == UINT32_MAX || g < gap) {
                         gap = g;
                         nearest = k;
@@ -518,8 +537,9 @@ std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double 
                 keep.push_back(o.p);
                 continue;
             }
-            if (o.home == j || o.visited == j || round.maximum.drops(d2, qs.input[o.p]) ||
-                boxDist2(qs.points[o.p], round.boxes[j], scale) > d2)
+            const double reach = d * scale;
+            if (o.home == j || o.visited == j || round.maximum.drops(d, qs.input[o.p]) ||
+                boxGap2(qs.points[o.p], round.boxes[j], scale) * (1.0 - 0x1p-40) > reach * reach)
                 continue;
             keep.push_back(o.p);
         }
@@ -530,7 +550,7 @@ std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double 
 // A lane's share of round two: the next tile not yet taken, its selected
 // queries in calls within the budget, merged under the round's lock.
 void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call, const Lane& lane,
-              RoundFailure& failure, double from, double width) {
+              RoundFailure& failure, HostClock& host, double from, double width) {
     SpaceDirection& dir = *round.dir;
     const SpatialPieces::Set& qs = round.pieces->set(dir.q);
     const SpatialPieces::Set& ts = round.pieces->set(1 - dir.q);
@@ -540,16 +560,19 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
         if (j >= round.boxes.size() || failure.failed.load()) return;
         if (round.boxes[j].empty) continue;
         try {
+            core::Clock::time_point start = core::Clock::now();
             std::vector<uint32_t> selected;
             {
                 std::lock_guard lock(round.mutex);
                 selected = selectFor(round, uint32_t(j), first, scale, lane.threads);
                 dir.crossPiece += selected.size();
             }
+            host.add(start);
             const CallOptions piece =
                 pieceOptions(call, true, from + width * double(j) / double(round.boxes.size()),
                              width / double(round.boxes.size()));
             for (size_t b0 = 0; b0 < selected.size(); b0 += round.maxQueries) {
+                start = core::Clock::now();
                 const size_t n = std::min<size_t>(round.maxQueries, selected.size() - b0);
                 const std::vector<uint32_t> batch(selected.begin() + ptrdiff_t(b0),
                                                   selected.begin() + ptrdiff_t(b0 + n));
@@ -557,16 +580,21 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
                 core::parallelChunks(n, kHostChunk, lane.threads, [&](size_t begin, size_t end, int) {
                     for (size_t k = begin; k < end; ++k) gathered[k] = qs.points[batch[k]];
                 });
+                host.add(start);
                 Result<HausdorffResult> r = lane.call(gathered, ts.piece(j), piece);
                 if (!r) {
                     failure.set(r.error());
                     return;
                 }
-                std::lock_guard lock(round.mutex);
-                addCallTo(dir.shared, r->aToB.counters, &r->timings);
-                mergeBests(dir, *round.pieces, CallQueries{0, &batch}, ts.start[j], r->aNearest, scale,
-                           lane.threads);
+                start = core::Clock::now();
+                {
+                    std::lock_guard lock(round.mutex);
+                    addCallTo(dir.shared, r->aToB.counters, &r->timings);
+                    mergeBests(dir, *round.pieces, CallQueries{0, &batch}, ts.start[j], r->aNearest,
+                               lane.threads);
+                }
                 lane.giveBack(std::move(r->aNearest), PerPoint{});
+                host.add(start);
             }
         } catch (const std::bad_alloc&) {
             failure.set(Error{ErrorCode::kOutOfMemory, "out of host memory at target piece " +
@@ -586,42 +614,40 @@ DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces,
     const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
     const size_t n = qs.points.size();
     std::vector<SettledMaximum> maxima(size_t(core::resolveThreads(threads)));
-    std::vector<uint64_t> at(maxima.size(), 0);
     core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int w) {
         SettledMaximum& m = maxima[size_t(w)];
         for (size_t p = begin; p < end; ++p) {
-            const uint32_t input = qs.input[p];
-            if (dir.d2[p] > m.d2 || (dir.d2[p] == m.d2 && input < m.input)) {
-                m = {dir.d2[p], input};
-                at[size_t(w)] = p;
-            }
+            const SettledMaximum here{dir.distance[p], qs.input[p], p};
+            if (here.beats(m)) m = here;
         }
     });
-    size_t best = 0;
-    for (size_t w = 1; w < maxima.size(); ++w)
-        if (maxima[w].d2 > maxima[best].d2 ||
-            (maxima[w].d2 == maxima[best].d2 && maxima[w].input < maxima[best].input))
-            best = w;
-    const uint64_t w = at[best];
+    SettledMaximum top;
+    for (const SettledMaximum& m : maxima)
+        if (m.beats(top)) top = m;
+    const uint64_t w = top.at;
+    const uint32_t target = ts.input[dir.nearest[w]];
     DirectionState s = std::move(dir.shared.state);
     s.witness.distance = dir.distance[w];
     s.witness.queryIndex = qs.input[w];
-    s.witness.targetIndex = dir.nearest[w];
+    s.witness.targetIndex = target;
     s.witness.queryPoint = glm::dvec3(q[qs.input[w]]);
-    s.witness.targetPoint = glm::dvec3(t[dir.nearest[w]]);
-    s.witnessD2 = dir.d2[w];
+    s.witness.targetPoint = glm::dvec3(t[target]);
 
+    // The band: every query whose best pair (a real pair: its distance is an
+    // upper bound of the query's own) reaches the maximum less the slack.
     core::DirectionBand& band = s.band;
     band.present = true;
     band.slack = dir.shared.slack;
-    band.hf = std::sqrt(double(dir.d2[w]));
+    band.hf = dir.distance[w] * scale;
     band.scale = scale;
     s.reach = band.hf - band.slack;
-    const double lo2 = core::bandThreshold2(double(dir.d2[w]), band.slack);
+    const double lo2 = core::bandThreshold2(band.hf * band.hf, band.slack);
     std::vector<std::vector<core::BandQuery>> parts((n + kHostChunk - 1) / kHostChunk);
     core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
-        for (size_t p = begin; p < end; ++p)
-            if (double(dir.d2[p]) >= lo2) parts[begin / kHostChunk].push_back({qs.input[p], dir.nearest[p]});
+        for (size_t p = begin; p < end; ++p) {
+            const double d = dir.distance[p] * scale;
+            if (d * d >= lo2) parts[begin / kHostChunk].push_back({qs.input[p], ts.input[dir.nearest[p]]});
+        }
     });
     for (const auto& part : parts) band.queries.insert(band.queries.end(), part.begin(), part.end());
 
@@ -631,7 +657,7 @@ DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces,
         core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
             for (size_t p = begin; p < end; ++p) {
                 s.perPoint.distance[qs.input[p]] = dir.distance[p];
-                s.perPoint.nearest[qs.input[p]] = dir.nearest[p];
+                s.perPoint.nearest[qs.input[p]] = ts.input[dir.nearest[p]];
             }
         });
     }
@@ -655,28 +681,27 @@ DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces,
 std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double scale,
                                 const CallOptions& call, uint64_t perCall, uint64_t maxPiece,
                                 const DirectedCall& directed, const RecycleCall& recycle, int lanes,
-                                int threads) {
+                                int threads, HostClock& host) {
+    core::Clock::time_point start = core::Clock::now();
     for (int d = 0; d < 2; ++d) {
         SpaceDirection* dir = dirs[d];
         if (dir == nullptr) continue;
         const size_t n = pieces.set(dir->q).points.size();
-        dir->d2.resize(n);
         dir->distance.resize(n);
         dir->nearest.resize(n);
         core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
-            std::fill(dir->d2.begin() + ptrdiff_t(begin), dir->d2.begin() + ptrdiff_t(end),
-                      std::numeric_limits<float>::infinity());
-            std::fill(dir->distance.begin() + ptrdiff_t(begin), dir->distance.begin() + ptrdiff_t(end), 0.0);
-            std::fill(dir->nearest.begin() + ptrdiff_t(begin), dir->nearest.begin() + ptrdiff_t(end),
-                      UINT32_MAX);
+            std::fill(dir->distance.begin() + ptrdiff_t(begin), dir->distance.begin() + ptrdiff_t(end),
+                      std::numeric_limits<double>::infinity());
+            std::fill(dir->nearest.begin() + ptrdiff_t(begin), dir->nearest.begin() + ptrdiff_t(end), 0u);
         });
     }
+    host.add(start);
     lanes = int(std::min<size_t>(size_t(std::max(lanes, 1)), pieces.count()));
     {
         RoundFailure failure;
         std::atomic<size_t> next{0};
         onLanes(lanes, [&](int l) {
-            roundOne(pieces, dirs, scale, call, Lane{l, threads, &directed, &recycle}, next, failure, 0.0,
+            roundOne(pieces, dirs, call, Lane{l, threads, &directed, &recycle}, next, failure, host, 0.0,
                      0.8);
         });
         if (failure.error) return failure.error;
@@ -684,23 +709,28 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
     for (int d = 0; d < 2; ++d) {
         SpaceDirection* dir = dirs[d];
         if (dir == nullptr) continue;
+        start = core::Clock::now();
         RoundTwo round;
         round.dir = dir;
         round.pieces = &pieces;
         round.open = openQueries(*dir, pieces, scale, dir->shared.slack, call.perPointDistances,
                                  round.maximum, threads);
-        if (round.open.empty()) continue;
-        round.boxes = tileBoxes(pieces.set(1 - dir->q), scale, threads);
+        if (round.open.empty()) {
+            host.add(start);
+            continue;
+        }
+        const SpatialPieces::Set& ts = pieces.set(1 - dir->q);
+        round.boxes = tileBoxes(ts, scale, threads);
         uint64_t largestTile = 0;
-        for (size_t k = 0; k < pieces.count(); ++k)
-            largestTile = std::max(largestTile, pieces.set(1 - dir->q).size(k));
+        for (size_t k = 0; k < pieces.count(); ++k) largestTile = std::max(largestTile, ts.size(k));
         round.maxQueries =
             std::max<uint64_t>(1, std::min(perCall - std::min(perCall - 1, largestTile), maxPiece));
+        host.add(start);
         for (const bool first : {true, false}) {
             RoundFailure failure;
             round.next = 0;
             onLanes(lanes, [&](int l) {
-                roundTwo(round, first, scale, call, Lane{l, threads, &directed, &recycle}, failure,
+                roundTwo(round, first, scale, call, Lane{l, threads, &directed, &recycle}, failure, host,
                          first ? 0.8 : 0.85, first ? 0.05 : 0.15);
             });
             if (failure.error) return failure.error;
@@ -714,7 +744,7 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
 Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOptions& call,
                                       const MemoryBudget& budget, const DirectedCall& directed,
                                       const RecycleCall& recycle, const std::function<void()>& release,
-                                      int lanes, int threads) {
+                                      int lanes, int threads, bool trace) {
     const Result<DirectionSplit> splitAB = splitDirection(budget, a.size(), b.size(), lanes);
     if (!splitAB) return splitAB.error();
     const uint64_t perCall = budget.pointsPerCall();
@@ -726,6 +756,8 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
     const double slack = core::searchSlack(magnitude * scale);
 
     std::optional<DirectionState> ab, ba;
+    HostClock host;
+    double partitionMs = 0.0, finishMs = 0.0;
     if (spaceAB || spaceBA) {
         if (a.size() > UINT32_MAX || b.size() > UINT32_MAX) {
             return Error{ErrorCode::kInvalidArgument,
@@ -740,17 +772,28 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
             limits.a = std::min(tile, (a.size() + l2 - 1) / l2);
             limits.b = std::min(tile, (b.size() + l2 - 1) / l2);
         }
+        core::Clock::time_point start = core::Clock::now();
         const SpatialPieces pieces = SpatialPieces::partition(a, b, scale, limits, threads);
+        partitionMs = core::msSince(start);
         SpaceDirection dirAB, dirBA;
         dirAB.q = 0;
         dirBA.q = 1;
         dirAB.shared.slack = dirBA.shared.slack = slack;
         SpaceDirection* const dirs[2] = {spaceAB ? &dirAB : nullptr, spaceBA ? &dirBA : nullptr};
-        if (auto err =
-                runInSpace(pieces, dirs, scale, call, perCall, maxPiece, directed, recycle, lanes, threads))
+        if (auto err = runInSpace(pieces, dirs, scale, call, perCall, maxPiece, directed, recycle, lanes,
+                                  threads, host))
             return *err;
+        start = core::Clock::now();
         if (spaceAB) ab = finishDirection(dirAB, pieces, a, b, call.perPointDistances, scale, threads);
         if (spaceBA) ba = finishDirection(dirBA, pieces, b, a, call.perPointDistances, scale, threads);
+        finishMs = core::msSince(start);
+        if (trace) {
+            std::fprintf(stderr,
+                         "rthdist pieces: %zu in space (%u cells an axis), partition %.1f ms, between calls "
+                         "%.1f ms, results %.1f ms, queries past their piece %llu + %llu\n",
+                         pieces.count(), pieces.cellsPerAxis(), partitionMs, host.ms, finishMs,
+                         (unsigned long long)dirAB.crossPiece, (unsigned long long)dirBA.crossPiece);
+        }
         if (release) release();
     }
     const double width = call.directedOnly ? 1.0 : 0.5;
@@ -792,7 +835,9 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
     // route's (engine.cpp, leaveFrame: core::restoreOriginal proves it again
     // from the caller's coordinates when they differ).
     r.proofMaterial = std::move(material);
+    const core::Clock::time_point proof = core::Clock::now();
     core::proveFromViews(r, PointView(a), PointView(b), threads);
+    r.timings.pieces = partitionMs + host.ms + finishMs + core::msSince(proof);
     return r;
 }
 
@@ -828,13 +873,13 @@ Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, u
 Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const CallOptions& call,
                                         const MemoryBudget& given, const DirectedCall& directed,
                                         const std::function<void()>& release, int lanes, int threads,
-                                        const RecycleCall& recycle) {
+                                        const RecycleCall& recycle, bool trace) {
     // The budget halved after each kOutOfMemory (the per-point figure is an
     // estimate; a device may hold less than it reports).
     MemoryBudget budget = given;
     for (;;) {
         Result<HausdorffResult> r =
-            computeWithin(a, b, scale, call, budget, directed, recycle, release, lanes, threads);
+            computeWithin(a, b, scale, call, budget, directed, recycle, release, lanes, threads, trace);
         if (r || r.error().code != ErrorCode::kOutOfMemory || budget.pointsPerCall() < 4) return r;
         if (release) release();
         budget.bytes /= 2;

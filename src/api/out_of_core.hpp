@@ -121,12 +121,11 @@ using RecycleCall = std::function<void(int lane, PerPoint&& a, PerPoint&& b)>;
 // when that witness's query index is smaller), and witnesses merge by
 // distance, then smallest query index: the result is the one-lane result.
 // `release` is called between directions and after a failure, with no lane
-// running.
-[[nodiscard]] Result<HausdorffResult> computeInPieces(std::span<const glm::vec3> a,
-                                                      std::span<const glm::vec3> b, double scale,
-                                                      const CallOptions& call, const MemoryBudget& budget,
-                                                      const DirectedCall& directed,
-                                                      const std::function<void()>& release, int lanes = 1,
-                                                      int threads = 0, const RecycleCall& recycle = {});
+// running. Timings::pieces: the host's own work of the pieces (partition,
+// merges, selections, the proof); `trace` prints its parts to stderr.
+[[nodiscard]] Result<HausdorffResult> computeInPieces(
+    std::span<const glm::vec3> a, std::span<const glm::vec3> b, double scale, const CallOptions& call,
+    const MemoryBudget& budget, const DirectedCall& directed, const std::function<void()>& release,
+    int lanes = 1, int threads = 0, const RecycleCall& recycle = {}, bool trace = false);
 
 }  // namespace rthdist::api

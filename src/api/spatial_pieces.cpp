@@ -41,8 +41,13 @@ void forRanges(const Ranges& r, Fn&& fn) {
 
 }  // namespace
 
+// (v - lo) * inverse side: a monotone function of v (as is each rounding),
+// the same for points and boxes; clamped to the grid.
 uint32_t SpatialPieces::axisCell(double v, int axis) const {
-    return core::cellCoord(v, m_lo[axis], m_size[axis], m_cells);
+    const double c = (v - m_lo[axis]) * m_inverse[axis];
+    if (!(c > 0.0)) return 0;
+    if (c >= double(m_cells)) return m_cells - 1;
+    return uint32_t(c);
 }
 
 uint32_t SpatialPieces::cellOf(const glm::dvec3& p) const {
@@ -99,7 +104,7 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
     for (int axis = 0; axis < 3; ++axis) {
         out.m_lo[axis] = lo[axis];
         const double side = (hi[axis] - lo[axis]) / double(out.m_cells);
-        out.m_size[axis] = side > 0.0 && std::isfinite(side) ? side : 1.0;
+        out.m_inverse[axis] = side > 0.0 && std::isfinite(1.0 / side) ? 1.0 / side : 1.0;
     }
 
     // Each point's cell (Morton code), and each range's count of every cell.

@@ -191,10 +191,10 @@ std::string jsonReport(const RunReport& report) {
               {"bits_requested", args.options.bits},
               {"directed", r.directedOnly}};
     addDirectedResult(j, r);
-    j["timings_ms"] = {{"load", report.loadMs}, {"setup", t.setup},     {"upload", t.upload},
-                       {"index", t.index},      {"cull", t.cull},       {"search", t.search},
-                       {"refine", t.refine},    {"check", t.check},     {"certificate", t.certificate},
-                       {"total", t.total},      {"wall", report.wallMs}};
+    j["timings_ms"] = {{"load", report.loadMs}, {"setup", t.setup}, {"upload", t.upload},
+                       {"index", t.index},      {"cull", t.cull},   {"search", t.search},
+                       {"refine", t.refine},    {"check", t.check}, {"certificate", t.certificate},
+                       {"pieces", t.pieces},    {"total", t.total}, {"wall", report.wallMs}};
     if (r.backend != Backend::kCpu)  // device time per stage (timestamp queries)
         j["gpu_ms"] = {{"upload", t.gpuUpload}, {"index", t.gpuIndex},   {"cull", t.gpuCull},
                        {"search", t.gpuSearch}, {"refine", t.gpuRefine}, {"certificate", t.gpuCertificate}};
