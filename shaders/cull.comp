@@ -9,12 +9,16 @@
 //   epsilon, as dOut is shrunk) is farther than the running best holds no
 //   nearer point and is skipped;
 // - a crowded cell (more than scanMax points: a split index's cell) is
-//   scanned through its leaves (leaf_first.comp finds the first), each
-//   skipped when its tight box is farther than the running best (float
-//   rounding is monotone: scan_cells.glsl); one of more than leafScanMax
-//   leaves, or any crowded cell of an index without leaves (copies of one
-//   point), contributes what was scanned (its first point at least) and
-//   the query is left to the candidate search;
+//   scanned through its leaf groups (leaf_groups.comp; groupFirst finds the
+//   first), each skipped when its box is farther than the running best, and
+//   the leaves of the others likewise (a group's box holds its leaves' boxes
+//   and float rounding is monotone, so a skipped group's computed distance
+//   is at most each of its leaves', at most each of their points':
+//   scan_cells.glsl); with no best yet, the group nearest to q goes first.
+//   A cell that needs more than cellTests box tests, or any crowded cell of
+//   an index without leaves (copies of one point), contributes what was
+//   scanned (its first point at least) and the query is left to the
+//   candidate search;
 // a minimum of 0 is exact whatever was skipped. A point strictly closer than
 // the running maximum kills the query at once (early break, Taha & Hanbury
 // 2015).
@@ -22,6 +26,55 @@
 #include "scan_cells.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CullPush pc; };
+
+// The leaves of group `g` not farther than the best; false once the cell's
+// box tests (`tests`) pass pc.cellTests.
+bool scanGroup(vec3 q, LeafGroup g, float thr, inout uint tests, inout float best, inout uint bestT,
+               inout bool dead) {
+    uint end = g.firstLeaf + (g.leaves & RTHDIST_GROUP_COUNT);
+    for (uint l = g.firstLeaf; l < end && !dead && best > 0.0; ++l) {
+        if (++tests > pc.cellTests) return false;
+        Cell leaf = cellAt(pc.leaves, l).v;
+        if (boxDist2(q, leaf.lo, leaf.hi) > best) continue;
+        scanCellPoints(q, leaf, pc.targets, thr, best, bestT, dead);  // the refinement's scan of a cell
+    }
+    return true;
+}
+
+// A crowded cell of a split index: its groups, each skipped when its box is
+// farther than the best, and the leaves of the others. With no best yet the
+// group nearest to q is scanned first, so the others meet a small best.
+// false: the cell was not scanned whole (more than pc.cellTests box tests).
+bool scanCrowdedCell(vec3 q, uint key, float thr, inout float best, inout uint bestT, inout bool dead) {
+    const float kInf = uintBitsToFloat(0x7f800000u);
+    uint g0 = uintAt(pc.groupFirst, key).v;
+    uint tests = 0u;
+    uint first = 0xffffffffu;  // the group scanned before the others
+    if (best == kInf) {
+        float nearest = kInf;
+        for (uint g = g0;; ++g) {
+            if (++tests > pc.cellTests) return false;
+            LeafGroup grp = groupAt(pc.groups, g).v;
+            float d2 = boxDist2(q, grp.lo, grp.hi);
+            if (first == 0xffffffffu || d2 < nearest) {
+                nearest = d2;
+                first = g;
+            }
+            if ((grp.leaves & RTHDIST_GROUP_LAST) != 0u) break;
+        }
+        if (!scanGroup(q, groupAt(pc.groups, first).v, thr, tests, best, bestT, dead)) return false;
+    }
+    for (uint g = g0; !dead && best > 0.0; ++g) {
+        LeafGroup grp = groupAt(pc.groups, g).v;
+        if (g != first) {
+            if (++tests > pc.cellTests) return false;
+            if (boxDist2(q, grp.lo, grp.hi) <= best && !scanGroup(q, grp, thr, tests, best, bestT, dead))
+                return false;
+        }
+        if ((grp.leaves & RTHDIST_GROUP_LAST) != 0u) break;
+    }
+    return true;
+}
 
 void main() {
     uint qi = gl_GlobalInvocationID.x;
@@ -59,19 +112,9 @@ void main() {
         uint key = mortonKey(uvec3(cc));
         uint end = uintAt(dense, key).v;
         uint start = key == 0 ? 0u : uintAt(dense, key - 1).v;
-        if (end - start > pc.scanMax && pc.leafFirst != 0ul) {
-            // A crowded cell of a split index: its leaves near q.
-            uint scanned = 0u;
-            for (uint l = uintAt(pc.leafFirst, key).v; l < pc.numLeaves && !dead; ++l) {
-                Cell leaf = cellAt(pc.leaves, l).v;
-                if (leaf.first >= end) break;
-                if (++scanned > pc.leafScanMax) {
-                    complete = false;
-                    break;
-                }
-                if (boxDist2(q, leaf.lo, leaf.hi) > best) continue;
-                scanCellPoints(q, leaf, targets, thr, best, bestT, dead);  // the refinement's scan of a cell
-            }
+        if (end - start > pc.scanMax && pc.groupFirst != 0ul) {
+            // A crowded cell of a split index: its leaf groups near q.
+            if (!scanCrowdedCell(q, key, thr, best, bestT, dead)) complete = false;
             if (!dead && j == 0) thr = deadThreshold(maxPacked, pc.lowerBound2);
             continue;
         }

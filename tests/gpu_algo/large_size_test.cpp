@@ -145,7 +145,7 @@ TEST(LargeSizes, ExactWhenEverySplitIsForcedSmall) {
 // points a set; before the fix its H came out 16 % too large). The
 // neighbourhood pass scanning crowded cells through their leaves settles
 // most of those queries now, so it is held to each crowded cell's first
-// point (setCullLeafScanMax(0)) for the search to meet them; with its leaves
+// point (setCullCellTests(0)) for the search to meet them; with its leaves
 // it settles at least 90 % of the sphere's queries, exactly.
 TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
@@ -164,8 +164,8 @@ TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
         return p;
     };
     cases.push_back(OracleCase{"crowded_sphere_in_unit_box", 32, sphere(3201, 20000), sphere(3202, 20000)});
-    for (uint32_t leaves : {0u, gpu_algo::kCullLeafScanMax}) {
-        (*engine)->setCullLeafScanMax(leaves);
+    for (uint32_t leaves : {0u, gpu_algo::kCullCellTests}) {
+        (*engine)->setCullCellTests(leaves);
         for (uint64_t capacity : {uint64_t(64), uint64_t(2000)}) {
             (*engine)->setMaxPairCapacity(capacity);
             // The sphere (last) always; the density cases sampled under the sanitizers.
