@@ -23,6 +23,7 @@ layout(buffer_reference, std430, buffer_reference_align = 8) buffer Uvec2Ref { u
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer U64Ref { uint64_t v; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer CellRef { Cell v; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer StateRef { QueryState v; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer LeafGroupRef { LeafGroup v; };
 
 Vec4Ref vec4At(uint64_t base, uint i) { return Vec4Ref(base + uint64_t(i) * 16ul); }
 UintRef uintAt(uint64_t base, uint i) { return UintRef(base + uint64_t(i) * 4ul); }
@@ -31,6 +32,7 @@ Uvec2Ref uvec2At(uint64_t base, uint i) { return Uvec2Ref(base + uint64_t(i) * 8
 U64Ref u64At(uint64_t base, uint i) { return U64Ref(base + uint64_t(i) * 8ul); }
 CellRef cellAt(uint64_t base, uint i) { return CellRef(base + uint64_t(i) * 32ul); }
 StateRef stateAt(uint64_t base, uint i) { return StateRef(base + uint64_t(i) * 16ul); }
+LeafGroupRef groupAt(uint64_t base, uint i) { return LeafGroupRef(base + uint64_t(i) * 32ul); }
 
 // The queries the radius in flight searches (set by the host, then by
 // search_advance.comp between the radii of one submission), at most the

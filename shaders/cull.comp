@@ -9,12 +9,16 @@
 //   epsilon, as dOut is shrunk) is farther than the running best holds no
 //   nearer point and is skipped;
 // - a crowded cell (more than scanMax points: a split index's cell) is
-//   scanned through its leaves (leaf_first.comp finds the first), each
-//   skipped when its tight box is farther than the running best (float
-//   rounding is monotone: scan_cells.glsl); one of more than leafScanMax
-//   leaves, or any crowded cell of an index without leaves (copies of one
-//   point), contributes what was scanned (its first point at least) and
-//   the query is left to the candidate search;
+//   scanned through its leaf groups (leaf_groups.comp; groupFirst finds the
+//   first), each skipped when its box is farther than the running best, and
+//   the leaves of the others likewise (a group's box holds its leaves' boxes
+//   and float rounding is monotone, so a skipped group's computed distance
+//   is at most each of its leaves', at most each of their points':
+//   scan_cells.glsl); with no best yet, the cell's first point and then the
+//   group nearest to q go first. A cell that needs more than cellTests box
+//   tests, or any crowded cell of an index without leaves (copies of one
+//   point), contributes what was scanned (its first point at least) and the
+//   query is left to the candidate search;
 // a minimum of 0 is exact whatever was skipped. A point strictly closer than
 // the running maximum kills the query at once (early break, Taha & Hanbury
 // 2015).
@@ -22,6 +26,80 @@
 #include "scan_cells.glsl"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { CullPush pc; };
+
+// The leaves of group `g` not farther than the best; false once the cell's
+// box tests (`tests`) would pass `limit`.
+bool scanGroup(vec3 q, LeafGroup g, float thr, uint limit, inout uint tests, inout float best, inout uint bestT,
+               inout bool dead) {
+    uint end = g.firstLeaf + (g.leaves & RTHDIST_GROUP_COUNT);
+    for (uint l = g.firstLeaf; l < end && !dead && best > 0.0; ++l) {
+        if (tests >= limit) return false;
+        ++tests;
+        Cell leaf = cellAt(pc.leaves, l).v;
+        if (boxDist2(q, leaf.lo, leaf.hi) > best) continue;
+        scanCellPoints(q, leaf, pc.targets, thr, best, bestT, dead);  // the refinement's scan of a cell
+    }
+    return true;
+}
+
+// A crowded cell of a split index (its points from `start`): its groups, each
+// skipped when its box is farther than the best, and the leaves of the
+// others. With no best yet, the cell's first point is measured first (where
+// the running maximum is large, a cluster seen from afar, it kills the query
+// at once), then the group nearest to q (the first whose box holds q) is
+// scanned, so that the others meet a small best. false: the cell was not
+// scanned whole (its groups and leaves need more than pc.cellTests box
+// tests; the nearest group among those tested is still scanned).
+bool scanCrowdedCell(vec3 q, uint key, uint start, float thr, inout float best, inout uint bestT,
+                     inout bool dead) {
+    const float kInf = uintBitsToFloat(0x7f800000u);
+    const uint kNone = 0xffffffffu;
+    uint g0 = uintAt(pc.groupFirst, key).v;
+    uint tests = 0u;
+    uint first = kNone;  // the group scanned before the others
+    if (best == kInf) {
+        vec4 tv = vec4At(pc.targets, start).v;
+        best = dist2(q, tv.xyz);
+        bestT = floatBitsToUint(tv.w);
+        if (best < thr) {
+            dead = true;
+            return true;
+        }
+        float nearest = kInf;
+        bool whole = true;
+        for (uint g = g0;; ++g) {
+            if (tests == pc.cellTests) {
+                whole = false;
+                break;
+            }
+            ++tests;
+            LeafGroup grp = groupAt(pc.groups, g).v;
+            float d2 = boxDist2(q, grp.lo, grp.hi);
+            if (first == kNone || d2 < nearest) {
+                nearest = d2;
+                first = g;
+            }
+            if (d2 == 0.0 || (grp.leaves & RTHDIST_GROUP_LAST) != 0u) break;
+        }
+        if (!whole) {
+            if (first != kNone) scanGroup(q, groupAt(pc.groups, first).v, thr, kNone, tests, best, bestT, dead);
+            return false;
+        }
+        if (!scanGroup(q, groupAt(pc.groups, first).v, thr, pc.cellTests, tests, best, bestT, dead)) return false;
+    }
+    for (uint g = g0; !dead && best > 0.0; ++g) {
+        LeafGroup grp = groupAt(pc.groups, g).v;
+        if (g != first) {
+            if (tests == pc.cellTests) return false;
+            ++tests;
+            if (boxDist2(q, grp.lo, grp.hi) <= best &&
+                !scanGroup(q, grp, thr, pc.cellTests, tests, best, bestT, dead))
+                return false;
+        }
+        if ((grp.leaves & RTHDIST_GROUP_LAST) != 0u) break;
+    }
+    return true;
+}
 
 void main() {
     uint qi = gl_GlobalInvocationID.x;
@@ -59,19 +137,9 @@ void main() {
         uint key = mortonKey(uvec3(cc));
         uint end = uintAt(dense, key).v;
         uint start = key == 0 ? 0u : uintAt(dense, key - 1).v;
-        if (end - start > pc.scanMax && pc.leafFirst != 0ul) {
-            // A crowded cell of a split index: its leaves near q.
-            uint scanned = 0u;
-            for (uint l = uintAt(pc.leafFirst, key).v; l < pc.numLeaves && !dead; ++l) {
-                Cell leaf = cellAt(pc.leaves, l).v;
-                if (leaf.first >= end) break;
-                if (++scanned > pc.leafScanMax) {
-                    complete = false;
-                    break;
-                }
-                if (boxDist2(q, leaf.lo, leaf.hi) > best) continue;
-                scanCellPoints(q, leaf, targets, thr, best, bestT, dead);  // the refinement's scan of a cell
-            }
+        if (end - start > pc.scanMax && pc.groupFirst != 0ul) {
+            // A crowded cell of a split index: its leaf groups near q.
+            if (!scanCrowdedCell(q, key, start, thr, best, bestT, dead)) complete = false;
             if (!dead && j == 0) thr = deadThreshold(maxPacked, pc.lowerBound2);
             continue;
         }

@@ -236,11 +236,12 @@ struct CullPush {
     uint scanMax;       // a cell of more points is not scanned (only its first point):
                         // the query then cannot be settled by this pass
     uint mutant;        // tests only (core/search_mutant.hpp): 1 = skip the query's own cell
-    uint numLeaves;     // leaves of a split index (0: not split)
-    uint64_t leaves;    // Cell[numLeaves] (a split index's cells), 0: not split
-    uint64_t leafFirst; // uint per key: the first leaf of an occupied crowded cell
-    uint leafScanMax;   // a crowded cell of more leaves is not scanned whole
+    uint cellTests;     // box tests (leaf groups and leaves) of one crowded cell at most:
+                        // past them the cell is not scanned whole
     uint pad0;
+    uint64_t leaves;      // Cell[] (a split index's cells), 0: not split
+    uint64_t groupFirst;  // uint per key: the first leaf group of an occupied crowded cell
+    uint64_t groups;      // LeafGroup[]
 };
 
 // leaf_first.comp: the first leaf of each grid cell of a split index.
@@ -250,6 +251,38 @@ struct LeafFirstPush {
     uint64_t leafFirst;   // uint per grid key (out)
     uint numLeaves;
     uint pad0;
+};
+
+// Leaf groups of a split index (leaf_groups.comp): the leaves of each crowded
+// grid cell (more than kCrowdedCell points) in runs of at most groupLeaves,
+// each run's box the union of its leaves' boxes, so that the neighbourhood
+// pass tests a run's box before its leaves'. A cell's groups are
+// consecutive; the last one has RTHDIST_GROUP_LAST set in `leaves`.
+struct LeafGroup {
+    RTHDIST_VEC3 lo;
+    uint firstLeaf;
+    RTHDIST_VEC3 hi;
+    uint leaves;  // leaf count, | RTHDIST_GROUP_LAST on its cell's last group
+};
+#define RTHDIST_GROUP_LAST 0x80000000u
+#define RTHDIST_GROUP_COUNT 0x7fffffffu
+
+// mode 0: a head flag per leaf (the first leaf of every groupLeaves of a
+// crowded cell, counted from its first leaf; firsts = leafFirst); the flags
+// are scanned (exclusive) into group indices; mode 1: the groups; mode 2:
+// firsts[key] = the cell's first group (overwrites leafFirst, which modes 0
+// and 1 read).
+struct LeafGroupPush {
+    uint64_t leaves;      // Cell[numLeaves]
+    uint64_t sortedKeys;  // grid key per sorted point
+    uint64_t dense;       // grid cell ends by key
+    uint64_t firsts;      // uint per grid key: first leaf (modes 0, 1), first group (mode 2 out)
+    uint64_t flags;       // uint[numLeaves]: head flags, then their exclusive scan
+    uint64_t groups;      // LeafGroup[] out (mode 1)
+    uint numLeaves;
+    uint groupLeaves;  // leaves per group at most (>= 1)
+    uint crowded;      // a grid cell of more points has groups (kCrowdedCell)
+    uint mode;
 };
 
 // coarsen.comp: search cells of level j (edge s * 2^j) from those of level
@@ -564,6 +597,7 @@ static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
 static_assert(sizeof(TailScanPush) == 80);
 static_assert(sizeof(SweepPush) == 40);
 static_assert(sizeof(CullPush) <= 128 && sizeof(LeafFirstPush) == 32);
+static_assert(sizeof(LeafGroup) == 32 && offsetof(LeafGroup, leaves) == 28 && sizeof(LeafGroupPush) == 64);
 static_assert(sizeof(CheckPush) == 112 && offsetof(CheckPush, nearestOut) == 88);
 static_assert(sizeof(CertScanPush) == 40);
 static_assert(sizeof(CertWitnessPush) == 64);

@@ -431,7 +431,11 @@ struct GpuHausdorff::State {
 GpuHausdorff::GpuHausdorff(std::unique_ptr<State> state) : m_state(std::move(state)) {}
 GpuHausdorff::~GpuHausdorff() = default;
 
-void GpuHausdorff::setCullLeafScanMax(uint32_t leaves) { m_state->ws.cullLeafScanMax = leaves; }
+void GpuHausdorff::setCullCellTests(uint32_t tests) { m_state->ws.cullCellTests = tests; }
+
+void GpuHausdorff::setLeafGroupLeaves(uint32_t leaves) {
+    m_state->ws.leafGroupLeaves = std::max<uint32_t>(1, leaves);
+}
 
 void GpuHausdorff::setUploadChunks(size_t past, size_t chunk) {
     m_state->ws.chunkedUploadPoints = past;

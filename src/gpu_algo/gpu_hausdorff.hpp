@@ -136,10 +136,16 @@ public:
     // Caps the candidate-pair buffer (default 2^26 pairs); tests shrink it
     // so that queries must retry until their pairs fit.
     void setMaxPairCapacity(uint64_t pairs);
-    // Leaves of a crowded cell the neighbourhood pass scans at most (default
-    // kCullLeafScanMax); tests set 0 (a crowded cell gives its first point
-    // only) so that crowded queries reach the search.
-    void setCullLeafScanMax(uint32_t leaves);
+    // Box tests (leaf groups and leaves) the neighbourhood pass makes in one
+    // crowded cell at most (default kCullCellTests); past them the cell is
+    // left to the search. Tests set 0 (a crowded cell gives its first point
+    // only) so that crowded queries reach the search, or a few so that some
+    // cells are scanned whole and others not.
+    void setCullCellTests(uint32_t tests);
+    // Leaves per leaf group of the split indexes built from now on (default
+    // kLeafGroupLeaves, at least 1); tests use small groups so that cells
+    // hold many.
+    void setLeafGroupLeaves(uint32_t leaves);
     // A host-staged set of more than `past` points goes up through a host
     // buffer of `chunk` points, in halves (defaults kChunkedUploadPoints,
     // kUploadChunkPoints);

@@ -126,16 +126,39 @@ void IndexBuild::splitLeaves(PointIndex& ix) {
     ix.split = true;
     const float edge = std::bit_cast<float>(m_ws.counters().minEdge);
     ix.minEdge = std::isfinite(edge) ? double(edge) : 0.0;
-    // The first leaf of each grid cell, for the neighbourhood pass (its keys:
-    // the grid's, every occupied one written).
-    ix.leafFirst =
-        &m_ws.setBuffer(ix, ix.store->leafFirst, ".leafFirst", VkDeviceSize(1u << (3 * ix.grid.bits)) * 4);
+    // The neighbourhood pass's view of the crowded cells: their leaves in
+    // groups (leaf_groups.comp), and the first group of each cell by grid
+    // key, which first holds the first leaf of each cell (leaf_first.comp).
+    // A crowded cell of L leaves has ceil(L / G) groups, and at most
+    // n / (kCrowdedCell + 1) cells are crowded.
+    const uint32_t groupLeaves = std::max<uint32_t>(1, m_ws.leafGroupLeaves);
+    const VkDeviceSize groupBound = ix.numCells / groupLeaves + n / (kCrowdedCell + 1) + 1;
+    ix.groupFirst =
+        &m_ws.setBuffer(ix, ix.store->groupFirst, ".groupFirst", VkDeviceSize(1u << (3 * ix.grid.bits)) * 4);
+    ix.groups = &m_ws.setBuffer(ix, ix.store->leafGroups, ".leafGroups", groupBound * sizeof(sh::LeafGroup));
+    Buffer& flags = m_ws.grow(m_ws.scratch.leaves.flags, n * 4, "leaf.flags");
     VkCommandBuffer cmd = m_ws.ctx.begin();
-    const sh::LeafFirstPush lp{ix.cells->address(), ix.sortedKeys->address(), ix.leafFirst->address(),
+    const sh::LeafFirstPush lp{ix.cells->address(), ix.sortedKeys->address(), ix.groupFirst->address(),
                                ix.numCells, 0u};
     m_ws.dispatch(cmd, Kernel::kLeafFirst, lp, ix.numCells);
+    m_ws.barrier(cmd);
+    sh::LeafGroupPush gp{ix.cells->address(), ix.sortedKeys->address(),
+                         ix.dense->address(), ix.groupFirst->address(),
+                         flags.address(),     ix.groups->address(),
+                         ix.numCells,         groupLeaves,
+                         kCrowdedCell,        0u};
+    m_ws.dispatch(cmd, Kernel::kLeafGroups, gp, ix.numCells);
+    m_ws.barrier(cmd);
+    m_ws.cmdScan(cmd, flags.address(), ix.numCells, m_ws.scratch.leaves.scanFlags, "leaf.scanFlags");
+    m_ws.barrier(cmd);
+    for (uint32_t mode : {1u, 2u}) {
+        gp.mode = mode;
+        m_ws.dispatch(cmd, Kernel::kLeafGroups, gp, ix.numCells);
+        m_ws.barrier(cmd);
+    }
     cmdCheckIndex(cmd, ix, m_ws.blocks[0]);
     m_ws.ctx.submitAndWait(cmd);
+    m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs();
     verifyIndex(ix, ix.n, m_ws.blocks[0]);
     // A one-shot set's spent ping-pong halves serve the rest of the call
     // (Workspace::spare); a prepared set drops them (SetBuffers::releaseUnused).

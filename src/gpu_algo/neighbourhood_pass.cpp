@@ -58,7 +58,7 @@ void NeighbourhoodPass::cmdCull(VkCommandBuffer cmd, DirectionRun& d) {
     c.active = c.maxCount = c.nextActive = c.cells = 0;
     c.maxPacked = c.pairs = 0;
     c.searchOpen = 0;
-    const bool leaves = d.T.split && m_ws.cullLeafScanMax > 0;
+    const bool leaves = d.T.split && m_ws.cullCellTests > 0;
     sh::CullPush cull{d.Q.sorted->address(),
                       d.T.sorted->address(),
                       d.T.dense->address(),
@@ -71,11 +71,11 @@ void NeighbourhoodPass::cmdCull(VkCommandBuffer cmd, DirectionRun& d) {
                       0u,            // search cells are coarser than the block's cells
                       kCrowdedCell,  // past it: its leaves near the query, or copies of one point
                       m_ws.mutant ? 1u : 0u,
-                      leaves ? d.T.numCells : 0u,
+                      m_ws.cullCellTests,
+                      0u,
                       leaves ? d.T.cells->address() : 0,
-                      leaves ? d.T.leafFirst->address() : 0,
-                      m_ws.cullLeafScanMax,
-                      0u};
+                      leaves ? d.T.groupFirst->address() : 0,
+                      leaves ? d.T.groups->address() : 0};
     m_ws.dispatch(cmd, Kernel::kCull, cull, d.Q.n);
     m_ws.barrier(cmd);
     sh::CompactPush comp{

@@ -31,6 +31,7 @@
 #include "ingest.comp.h"
 #include "ingest_f64.comp.h"
 #include "leaf_first.comp.h"
+#include "leaf_groups.comp.h"
 #include "leaf_keys.comp.h"
 #include "leaf_scatter.comp.h"
 #include "leaf_slots.comp.h"
@@ -103,6 +104,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_sweep_targets_comp, "sweep_targets"},
     {k_spv_leaf_first_comp, "leaf_first"},
     {k_spv_cells_total_comp, "cells_total"},
+    {k_spv_leaf_groups_comp, "leaf_groups"},
     {k_spv_surface_search_rq_comp, "surface_search_rq"},
 }};
 

@@ -51,6 +51,7 @@ enum class Kernel : uint32_t {
     kSweepTargets,   // the search's sweep: few open queries against every target (sweep_targets.comp)
     kLeafFirst,      // a split index's first leaf per grid cell (leaf_first.comp)
     kCellsTotal,     // the number of runs once their heads are scanned (cells_total.comp)
+    kLeafGroups,     // a split index's leaf groups of crowded cells (leaf_groups.comp)
     // The point-to-surface search, ray-query path (surface_search_rq.comp):
     // created by prepareSurfaceSearch only.
     kSurfaceSearchRayQuery,

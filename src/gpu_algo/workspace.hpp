@@ -94,7 +94,8 @@ struct Workspace {
     Buffer hostSmall;                    // the counter blocks (RTHDIST_CTR_*), read-backs after each
     std::array<CounterBlock, 2> blocks;  // blocks[0]: every stage; [1]: a second index build
     uint64_t maxPairCapacity = kMaxPairCapacity;
-    uint32_t cullLeafScanMax = kCullLeafScanMax;        // 0: crowded cells give their first point only
+    uint32_t cullCellTests = kCullCellTests;            // 0: crowded cells give their first point only
+    uint32_t leafGroupLeaves = kLeafGroupLeaves;        // leaves per group of a split index built next
     size_t chunkedUploadPoints = kChunkedUploadPoints;  // a larger host-staged set goes up in chunks
     size_t uploadChunkPoints = kUploadChunkPoints;
     bool mutant = false;  // tests only: core::searchMutant() when the call started

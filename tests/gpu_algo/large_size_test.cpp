@@ -133,6 +133,19 @@ TEST(LargeSizes, ExactWhenEverySplitIsForcedSmall) {
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
+// Issue 32's crowded shape: a noisy sphere (centre (0.5, 0.5, 0.5), radius r,
+// noise sigma per axis) of n points in a unit box whose corners (0, 0, 0) and
+// (1, 1, 1) are points 0 and 1 (tools/bench/scale_gen.cpp's `crowded`).
+std::vector<glm::vec3> crowdedSphere(uint64_t seed, int n, double radius, double noise) {
+    Rng rng(seed);
+    std::vector<glm::vec3> p{{0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}};
+    while (int(p.size()) < n) {
+        const glm::dvec3 sigma(rng.gauss(), rng.gauss(), rng.gauss());
+        p.emplace_back(glm::dvec3(0.5) + radius * rng.direction() + noise * sigma);
+    }
+    return p;
+}
+
 // Issue 32 (wrong H at 300M x 400M and on a 20M crowded sphere): a query
 // whose pairs did not fit the pair buffer at its first radius, or at the first
 // radius of a new search level, was searched again with the cells it lies in
@@ -143,10 +156,10 @@ TEST(LargeSizes, ExactWhenEverySplitIsForcedSmall) {
 // Here the buffer is forced small on crowded inputs: density cases and a
 // small noisy sphere in a unit box whose corners belong to both sets (20k
 // points a set; before the fix its H came out 16 % too large). The
-// neighbourhood pass scanning crowded cells through their leaves settles
-// most of those queries now, so it is held to each crowded cell's first
-// point (setCullLeafScanMax(0)) for the search to meet them; with its leaves
-// it settles at least 90 % of the sphere's queries, exactly.
+// neighbourhood pass scanning crowded cells through their leaf groups
+// settles most of those queries now, so it is held to each crowded cell's
+// first point (setCullCellTests(0)) for the search to meet them; with its
+// leaves it settles at least 90 % of the sphere's queries, exactly.
 TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
     auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
@@ -154,18 +167,10 @@ TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
     std::vector<OracleCase> cases;
     for (const OracleCase& c : makeDensityCases())
         if (c.a.size() + c.b.size() <= 25000 && c.a.size() > 1000 && c.b.size() > 1000) cases.push_back(c);
-    auto sphere = [](uint64_t seed, int n) {
-        Rng rng(seed);
-        std::vector<glm::vec3> p{{0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}};
-        while (int(p.size()) < n) {
-            const glm::dvec3 noise(rng.gauss(), rng.gauss(), rng.gauss());
-            p.emplace_back(glm::dvec3(0.5) + 0.005 * rng.direction() + 2e-6 * noise);
-        }
-        return p;
-    };
-    cases.push_back(OracleCase{"crowded_sphere_in_unit_box", 32, sphere(3201, 20000), sphere(3202, 20000)});
-    for (uint32_t leaves : {0u, gpu_algo::kCullLeafScanMax}) {
-        (*engine)->setCullLeafScanMax(leaves);
+    cases.push_back(OracleCase{"crowded_sphere_in_unit_box", 32, crowdedSphere(3201, 20000, 0.005, 2e-6),
+                               crowdedSphere(3202, 20000, 0.005, 2e-6)});
+    for (uint32_t tests : {0u, gpu_algo::kCullCellTests}) {
+        (*engine)->setCullCellTests(tests);
         for (uint64_t capacity : {uint64_t(64), uint64_t(2000)}) {
             (*engine)->setMaxPairCapacity(capacity);
             // The sphere (last) always; the density cases sampled under the sanitizers.
@@ -174,16 +179,16 @@ TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
             run.push_back(cases.back());
             for (const OracleCase& c : run) {
                 SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed) + " pairs " +
-                             std::to_string(capacity) + " leaves " + std::to_string(leaves));
+                             std::to_string(capacity) + " tests " + std::to_string(tests));
                 auto r = (*engine)->compute(c.a, c.b, Options{});
                 ASSERT_TRUE(r) << r.error().message;
-                std::printf("  %-28s pairs %5llu leaves %4u: H %.9g, settled by the pass %llu / %llu\n",
-                            c.name.c_str(), static_cast<unsigned long long>(capacity), leaves, r->hausdorff,
+                std::printf("  %-28s pairs %5llu tests %4u: H %.9g, settled by the pass %llu / %llu\n",
+                            c.name.c_str(), static_cast<unsigned long long>(capacity), tests, r->hausdorff,
                             static_cast<unsigned long long>(r->aToB.counters.culledByNeighbourhood),
                             static_cast<unsigned long long>(r->aToB.counters.queries));
                 expectMatchesOracle(c, *r);
                 if (c.seed != 32) continue;
-                if (leaves == 0)  // crowded cells' first points only: most queries go to the search
+                if (tests == 0)  // crowded cells' first points only: most queries go to the search
                     EXPECT_LT(r->aToB.counters.culledByNeighbourhood * 2, r->aToB.counters.queries);
                 else  // their leaves near each query: at least 90 % settle without rays
                     EXPECT_GE(r->aToB.counters.culledByNeighbourhood * 10, r->aToB.counters.queries * 9);
@@ -200,6 +205,92 @@ void expectSameValueAndWitnesses(const HausdorffResult& r, const HausdorffResult
     EXPECT_EQ(r.aToB.targetIndex, w.aToB.targetIndex);
     EXPECT_EQ(r.bToA.queryIndex, w.bToA.queryIndex);
     EXPECT_EQ(r.bToA.targetIndex, w.bToA.targetIndex);
+}
+
+// Issue 33: the neighbourhood pass scans a crowded cell through its leaf
+// groups (leaf_groups.comp), each group's box tested before its leaves', at
+// most a number of box tests a cell. Forced small here: groups of 1 and 3
+// leaves (many groups a cell, a cell's last group short) and budgets of a
+// few tests (most crowded cells not scanned whole: the search settles their
+// queries), on crowded inputs that split; exact against the brute force on
+// every combination, and the budget only moves queries between the pass and
+// the search.
+TEST(LargeSizes, LeafGroupsExactUnderForcedLimits) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
+    ASSERT_TRUE(engine) << engine.error().message;
+    std::vector<OracleCase> cases;
+    for (const OracleCase& c : makeDensityCases())
+        if (c.a.size() + c.b.size() <= 25000 && c.a.size() > 1000 && c.b.size() > 1000) cases.push_back(c);
+    cases = sampledCases(cases);
+    cases.push_back(OracleCase{"crowded_sphere_in_unit_box", 33, crowdedSphere(3301, 20000, 0.005, 2e-6),
+                               crowdedSphere(3302, 20000, 0.005, 2e-6)});
+    struct Limits {
+        uint32_t groupLeaves, cellTests;
+    };
+    for (const Limits l : {Limits{1, 6}, Limits{3, 40}, Limits{3, gpu_algo::kCullCellTests}, Limits{32, 20},
+                           Limits{gpu_algo::kLeafGroupLeaves, gpu_algo::kCullCellTests}}) {
+        (*engine)->setLeafGroupLeaves(l.groupLeaves);
+        (*engine)->setCullCellTests(l.cellTests);
+        for (const OracleCase& c : cases) {
+            SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed) + " group " +
+                         std::to_string(l.groupLeaves) + " tests " + std::to_string(l.cellTests));
+            auto r = (*engine)->compute(c.a, c.b, Options{});
+            ASSERT_TRUE(r) << r.error().message;
+            std::printf(
+                "  %-28s group %2u tests %4u: H %.9g, settled by the pass %llu + %llu of %llu + %llu\n",
+                c.name.c_str(), l.groupLeaves, l.cellTests, r->hausdorff,
+                static_cast<unsigned long long>(r->aToB.counters.culledByNeighbourhood),
+                static_cast<unsigned long long>(r->bToA.counters.culledByNeighbourhood),
+                static_cast<unsigned long long>(r->aToB.counters.queries),
+                static_cast<unsigned long long>(r->bToA.counters.queries));
+            expectMatchesOracle(c, *r);
+            if (c.seed != 33) continue;
+            for (const Directed* d : {&r->aToB, &r->bToA}) {
+                if (l.cellTests < 10)  // a few tests: no crowded cell is scanned whole
+                    EXPECT_LT(d->counters.culledByNeighbourhood * 2, d->counters.queries);
+                else if (l.cellTests == gpu_algo::kCullCellTests)  // the default budget: nearly all
+                    EXPECT_GE(d->counters.culledByNeighbourhood * 100, d->counters.queries * 95);
+            }
+        }
+    }
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// Issue 33's case at 1/200 of its size: the crowded sphere of 20M points a
+// set (scale_gen's `crowded`, radius 0.05) had 89 % of its queries settled
+// by the pass; its cells hold up to ~1,700 leaves and the pass gave up on a
+// cell past 1,024. Here 100k points a set on a sphere of radius 0.0035 keep
+// its spacing (~4e-5) and noise (2e-5), so the 8 grid cells around the
+// centre (a grid corner at any bit count; 6 is chosen) hold ~12,500 points
+// and ~1,400-1,540 leaves each, all past the old limit: the
+// old pass settled 2 of 100,000 queries (no cell scanned whole, so nothing
+// raised the running maximum and nothing died). With the leaf groups at
+// least 95 % settle in the pass (100 % on lavapipe), and the value and
+// witnesses are the CPU backend's.
+TEST(LargeSizes, CrowdedSphereSettlesInThePass) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
+    ASSERT_TRUE(engine) << engine.error().message;
+    const std::vector<glm::vec3> a = crowdedSphere(3311, 100000, 0.0035, 2e-5);
+    const std::vector<glm::vec3> b = crowdedSphere(3312, 100000, 0.0035, 2e-5);
+    auto r = (*engine)->compute(a, b, Options{});
+    ASSERT_TRUE(r) << r.error().message;
+    Options cpu;
+    cpu.backend = Backend::kCpu;
+    auto w = hausdorff(a, b, cpu);
+    ASSERT_TRUE(w) << w.error().message;
+    expectSameValueAndWitnesses(*r, *w);
+    for (const Directed* d : {&r->aToB, &r->bToA}) {
+        std::printf("  bits %u, %llu leaves: settled by the pass %llu of %llu\n", d->counters.bits,
+                    static_cast<unsigned long long>(d->counters.occupiedCells),
+                    static_cast<unsigned long long>(d->counters.culledByNeighbourhood),
+                    static_cast<unsigned long long>(d->counters.queries));
+        EXPECT_GT(d->counters.occupiedCells, 8u * 1024u);  // split: past 1,024 leaves a cell
+        EXPECT_GE(d->counters.culledByNeighbourhood * 100, d->counters.queries * 95);
+        EXPECT_TRUE(d->certificate.confirmed);
+    }
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
 // A large set staged by the host goes up in chunks through one reused host
