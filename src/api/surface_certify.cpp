@@ -82,15 +82,16 @@ Nearest bruteNearest(const glm::dvec3& p, const MeshView& surface, int threads) 
 }
 
 // The band by the brute force: the largest nearest distance, the smallest
-// query on a tie (the band is in index order).
+// query on a tie (the band is in index order). q*'s nearest (`known`, of
+// query `knownQuery`) is measured already.
 SurfaceResult bruteBand(const PointView& points, std::span<const uint64_t> band, const MeshView& surface,
-                        int threads) {
+                        int threads, uint64_t knownQuery, const Nearest& known) {
     SurfaceResult r;
     Nearest top;
     uint64_t topQuery = 0;
     bool any = false;
     for (const uint64_t q : band) {
-        const Nearest n = bruteNearest(points.at(q), surface, threads);
+        const Nearest n = q == knownQuery ? known : bruteNearest(points.at(q), surface, threads);
         if (!any || n.distance2 > top.distance2) {
             top = n;
             topQuery = q;
@@ -124,8 +125,8 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
                                                " candidates for " + std::to_string(points.count) + " points"};
     Largest largest;
     const std::vector<double> bound = upperBounds(points, surface, candidate, options.threads, largest);
-    const double lower2 =
-        bruteNearest(points.at(largest.query), surface, options.threads).distance2;  // L^2 <= h^2
+    const Nearest measured = bruteNearest(points.at(largest.query), surface, options.threads);
+    const double lower2 = measured.distance2;  // L^2 <= h^2
 
     // The band, in index order: every query that may reach L.
     std::vector<uint64_t> bandIndex;
@@ -134,7 +135,7 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     }
     Result<SurfaceResult> exact = SurfaceResult{};
     if (bandIndex.size() * surface.triangleCount() <= kBruteWork) {
-        exact = bruteBand(points, bandIndex, surface, options.threads);
+        exact = bruteBand(points, bandIndex, surface, options.threads, largest.query, measured);
     } else {  // the CPU backend's BVH search over the band (its own witness check)
         std::vector<glm::dvec3> band;
         band.reserve(bandIndex.size());
