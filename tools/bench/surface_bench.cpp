@@ -175,6 +175,7 @@ int main(int argc, char** argv) {
                         {"runs", s.runs},
                         {"kept_median_ms", kept.medians()},
                         {"kept_wall_ms_all", kept.wall},
+                        {"kept_total_ms_all", kept.total},
                         {"counters", countersJson(last.directed.counters)},
                         {"one_shot_runs", s.oneShot},
                         {"cpu_reference", reference},
