@@ -45,6 +45,12 @@ SurfaceRadii::SurfaceRadii(double meanSide, double area, uint64_t queries, doubl
     m_first = std::min(std::max({meanSide * 0.5, spacing * 0.5, diagonal * 0x1p-20, 0x1p-24}), m_cover);
 }
 
+std::vector<double> SurfaceRadii::start() const {
+    std::vector<double> radii{m_first};
+    if (m_first < m_cover) radii.push_back(std::min(4.0 * m_first, m_cover));
+    return radii;
+}
+
 std::vector<double> SurfaceRadii::next(double last, uint64_t queries, uint64_t searched,
                                        uint64_t settled) const {
     std::vector<double> radii;
@@ -93,11 +99,12 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     out.stageMs = msSince(t0);
 
     // The first submission: the upload, the first radius (which settles most
-    // queries) and the read-back; then the tail's, while queries are open.
+    // queries), the tail's first and the read-back; then the tail's, while
+    // queries are open.
     t0 = Clock::now();
     VkCommandBuffer cmd = m_ws.ctx.begin();
     cmdUpload(cmd);
-    std::vector<double> batch{radii.first()};
+    std::vector<double> batch = radii.start();
     double settled = -1.0;  // no query is settled before the first radius
     while (!batch.empty()) {
         const std::vector<sh::SurfaceRadiusCount> counts = submitRadii(cmd, batch, settled, out);

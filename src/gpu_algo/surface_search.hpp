@@ -72,6 +72,12 @@ public:
     // triangles; diagonal: of the union's box; all in the search frame.
     SurfaceRadii(double meanSide, double area, uint64_t queries, double diagonal);
     [[nodiscard]] double first() const { return m_first; }
+    // The first submission's radii: first and 4x it (at most cover), as
+    // next() grows a tail: the first radius leaves few queries open (1 of
+    // 35,947 on bunny>res2, 1 of 5,205 on dragon-res4>dragon, 576 of
+    // 437,645 on dragon>res2 on lavapipe, docs/bench/surfaces), and the
+    // second settled them on those rows, so such a call waits once.
+    [[nodiscard]] std::vector<double> start() const;
     [[nodiscard]] double cover() const { return m_cover; }
     // The radii of the next submission after one whose last radius was
     // `last` and searched `searched` of the `queries`, settling `settled`

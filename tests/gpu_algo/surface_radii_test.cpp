@@ -37,6 +37,14 @@ TEST(SurfaceRadii, FirstHasAFloorAndIsAtMostCover) {
     EXPECT_EQ(one.first(), one.cover());
 }
 
+TEST(SurfaceRadii, TheFirstSubmissionHoldsTwoRadii) {
+    EXPECT_EQ(SurfaceRadii(0.1, 1.0, 10000, 2.0).start(), (std::vector<double>{0.05, 0.2}));
+    const SurfaceRadii near(0.1, 1.0, 10000, 0.1);  // 4x first is past cover: cover second
+    EXPECT_EQ(near.start(), (std::vector<double>{0.05, near.cover()}));
+    const SurfaceRadii one(0.01, 100.0, 1, 1.0);  // first is cover: one radius
+    EXPECT_EQ(one.start(), (std::vector<double>{one.cover()}));
+}
+
 TEST(SurfaceRadii, DoublesWhileManyAreOpenAndSettling) {
     const SurfaceRadii r(0.1, 1.0, 1000, 100.0);
     // 1000 searched, 500 settled, 500 open: 2x, two radii.
