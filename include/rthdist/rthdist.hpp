@@ -223,6 +223,11 @@ class Engine;
 // from its VkBuffers.
 struct VulkanDevice;
 struct DevicePointView;
+// Point to surface (rthdist/surface.hpp: include it to call
+// Engine::hausdorffToSurface).
+struct MeshView;
+struct SurfaceCallOptions;
+struct SurfaceResult;
 
 // A point set prepared once on an Engine's device (or, on the CPU backend,
 // in host memory): its frame (origin), exact power-of-two scale, bounds, bit
@@ -326,6 +331,15 @@ public:
     [[nodiscard]] std::vector<Result<HausdorffResult>> computeBatch(std::span<const PreparedSet> sets,
                                                                     std::span<const PairRef> pairs,
                                                                     const CallOptions& call = {});
+
+    // h(points, surface) on this Engine's backend, which keeps its device,
+    // pipelines and buffers between calls: the contract, precision, limits
+    // and routes of hausdorffToSurface (rthdist/surface.hpp, "On a kept
+    // device"), the same results (==). The views are read during the call
+    // only. Like compute, one caller at a time.
+    [[nodiscard]] Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface);
+    [[nodiscard]] Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface,
+                                                           const SurfaceCallOptions& call);
 
     // Hands back a result that is no longer needed: its per-point arrays
     // (aNearest, bNearest) become the next per-point call's on a GPU

@@ -37,8 +37,8 @@
 //   finite. Violations: kInvalidArgument (kBadInput for NaN/Inf), naming
 //   the set, the vertex or the triangle.
 //
-// Backends: Backend::kAuto and kCpu run on the CPU backend (a GPU call
-//   opens its device per call, so auto keeps the CPU). kRayQuery and
+// Backends: Backend::kAuto and kCpu run on the CPU backend (a one-shot GPU
+//   call opens its device per call, so auto keeps the CPU). kRayQuery and
 //   kRtPipeline search on the device (design.md §11, "The GPU backends"):
 //   triangle boxes in a BLAS grown by a radius, each query's nearest
 //   triangle measured by the same rule in float; the directed maximum is
@@ -53,14 +53,29 @@
 //   values come from the CPU backend (kAuto or kCpu), never a GPU backend's
 //   candidates in their place.
 //
+// On a kept device: Engine::hausdorffToSurface (rthdist.hpp) runs the same
+//   call on an Engine's backend, which keeps its device, pipelines, upload
+//   and search buffers and BLAS storage between calls (a one-shot GPU call
+//   creates them all: ~0.35 s on an H200). The route is the Engine's
+//   EngineOptions::backend's as above: kRayQuery and kRtPipeline search on
+//   its device (per-point distances refused, kInvalidArgument), kCpu and
+//   kAuto run the CPU backend (an auto Engine that chose a GPU too, until
+//   the kept route is measured faster than the CPU backend). The results
+//   are those of hausdorffToSurface with the same backend (==); threads are
+//   EngineOptions::threads. Each call uploads its inputs afresh (nothing of
+//   a mesh is kept between calls but the memory); the buffers only grow,
+//   to the largest call's, until the Engine is destroyed.
+//
 // Threading: reentrant; the BVH build and the search (on a GPU backend: the
-//   proof) run on SurfaceOptions::threads threads of the library's worker
-//   pool. The BVH, and so every result, is the same on any thread count.
+//   framing and the proof) run on SurfaceOptions::threads threads of the
+//   library's worker pool. The BVH, and so every result, is the same on
+//   any thread count. An Engine serves one call at a time (as compute).
 // Memory: at most 132 bytes per triangle (its corners in double and at
 //   most one 56-byte BVH node), plus 60 bytes per point with
-//   perPointDistances (SurfacePerPoint). GPU backends: on the device 104 bytes per triangle
-//   and 24 per point (and the BLAS), on the host 36 per triangle and 24
-//   per point more.
+//   perPointDistances (SurfacePerPoint). GPU backends: on the device 104
+//   bytes per triangle and 24 per point (and the BLAS); on the host 36 per
+//   triangle and 16 per point, and host-visible upload and read-back
+//   buffers of 80 per triangle and 24 per point (kept by an Engine).
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -78,16 +93,25 @@
 
 namespace rthdist {
 
-struct SurfaceOptions {
-    Backend backend = Backend::kAuto;  // kAuto or kCpu (above)
-    int threads = 0;                   // 0: every hardware thread
+// What may change from call to call (Engine::hausdorffToSurface).
+struct SurfaceCallOptions {
     // Also return every point's distance, triangle, closest point and
     // barycentric coordinates (SurfaceResult::perPoint; kAuto and kCpu
     // only). Every query then needs its own nearest triangle: the early
     // break against the running maximum is off.
     bool perPointDistances = false;
-    // Read at every chunk of 256 queries: true -> kCancelled.
+    // Read at every chunk of 256 queries (GPU backends: also before and
+    // between the device's submissions): true -> kCancelled. An Engine
+    // stays usable after a cancelled call.
     const std::atomic<bool>* cancel = nullptr;
+};
+
+// The one-shot call's options: the call's, and what an Engine fixes for
+// its life (EngineOptions' backend, threads, deviceIndex, validation).
+struct SurfaceOptions : SurfaceCallOptions {
+    Backend backend =
+        Backend::kAuto;  // above: kAuto or kCpu on the CPU, kRayQuery or kRtPipeline on a device
+    int threads = 0;     // 0: every hardware thread
     // GPU backends: the Vulkan device (listDevices() index; -1: the first
     // that runs the backend) and the validation layer, whose messages are
     // counted (SurfaceResult::validationMessages), as EngineOptions.
@@ -104,9 +128,23 @@ struct SurfaceCounters {
     uint64_t trianglesTested = 0;  // point-triangle evaluations, over all queries
     uint64_t dominated = 0;        // queries stopped early: a triangle nearer than the running maximum
     // GPU backends: the device search and the host's proof.
-    uint32_t radii = 0;  // radii searched on the device
-    uint64_t rays = 0;   // rays cast over all radii
-    uint64_t band = 0;   // queries searched again exactly on the host (the others are proven below h)
+    uint32_t radii = 0;        // radii searched on the device
+    uint64_t rays = 0;         // rays cast over all radii
+    uint32_t submissions = 0;  // command buffers the search submitted and waited for
+    uint64_t band = 0;         // queries searched again exactly on the host (the others are proven below h)
+};
+
+// Where a GPU backend's call went, in milliseconds of host wall clock
+// unless named gpu (all 0 on the CPU backend). searchMs = frame + upload +
+// search + readback + certify, up to the code between them.
+struct SurfaceStages {
+    double frame = 0.0;     // both inputs shifted, scaled and rounded to float (worker pool)
+    double upload = 0.0;    // queries, corners and boxes written to the upload buffer (worker pool)
+    double search = 0.0;    // the device's submissions, waited for: the upload's copies, every
+                            // radius's boxes, BLAS build or refit and rays, the read-back's copy
+    double readback = 0.0;  // every query's candidate triangle taken from the read-back buffer
+    double certify = 0.0;   // the proof in double (the band's exact search included)
+    double gpuBuild = 0.0;  // device time of the boxes and BLAS builds and refits (part of gpuMs)
 };
 
 // h(points, surface) with its witness.
@@ -145,14 +183,18 @@ struct SurfaceResult {
     double buildMs = 0.0;             // the BVH over the triangles
     double searchMs = 0.0;            // every query's nearest triangle (and the witness's check)
     double totalMs = 0.0;             // the whole call, checks included
-    // GPU backends: device setup, the device's search and the host's proof
-    // (buildMs: the device and its pipelines; searchMs: the rest).
+    // GPU backends: buildMs is the device and its pipelines created for a
+    // one-shot call (0 on an Engine, which keeps them); searchMs the rest,
+    // split in `stages`.
+    SurfaceStages stages;
     double gpuMs = 0.0;               // device time of the search
-    uint64_t validationMessages = 0;  // with SurfaceOptions::validation
+    uint64_t validationMessages = 0;  // with SurfaceOptions::validation (an Engine's: over its life)
 };
 
 // h(points, surface): the points' distances to the surface and the largest
-// of them with its witness (contract above).
+// of them with its witness (contract above). On a GPU backend the device
+// is created while the inputs are checked and destroyed with the call;
+// Engine::hausdorffToSurface keeps it.
 [[nodiscard]] RTHDIST_API Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface,
                                                                    const SurfaceOptions& options = {});
 

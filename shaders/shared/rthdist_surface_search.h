@@ -19,23 +19,35 @@ namespace rthdist::shared {
 // are a NaN: no comparison settles it).
 #define RTHDIST_SURFACE_NONE 0xffffffffffffffffUL
 
+// What one radius did, for the host's next step (one per radius of a
+// submission, in host-visible memory): the queries it searched (open
+// before it) and, of those, the ones it settled (best within the radius).
+struct SurfaceRadiusCount {
+    uint searched;
+    uint settled;
+};
+
 struct SurfaceSearchPush {
-    uint64_t queries;   // vec4[numQueries]: the points in the search frame
-    uint64_t corners;   // vec4[3 * triangles]: a, b, c of each triangle in the search frame
-    uint64_t best;      // uint64[numQueries]: the packed nearest triangle so far
-    uint64_t searched;  // uint: queries this radius searched (atomicAdd)
+    uint64_t queries;  // vec4[numQueries]: the points in the search frame
+    uint64_t corners;  // vec4[3 * triangles]: a, b, c of each triangle in the search frame
+    uint64_t best;     // uint64[numQueries]: the packed nearest triangle so far
+    uint64_t counts;   // SurfaceRadiusCount of this radius (atomicAdd)
     uint numQueries;
     float radius;    // triangles whose box lies within it are visited
     float settled2;  // a query whose best is at most this was settled by an earlier radius
+    float settle2;   // a best at most this after this radius settles the query (counted)
     float rayTMax;
     uint slotBase;  // rt-pipeline: first query of this trace (traces are split by the device's limit)
     uint mutant;    // 1: core::searchMutant (tests only): every third triangle is skipped
+    uint pad;
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(SurfaceSearchPush) == 56);
+static_assert(sizeof(SurfaceRadiusCount) == 8);
+static_assert(sizeof(SurfaceSearchPush) == 64);
 static_assert(offsetof(SurfaceSearchPush, numQueries) == 32);
-static_assert(offsetof(SurfaceSearchPush, slotBase) == 48);
+static_assert(offsetof(SurfaceSearchPush, settle2) == 44);
+static_assert(offsetof(SurfaceSearchPush, slotBase) == 52);
 }  // namespace rthdist::shared
 #endif
 #endif

@@ -54,7 +54,8 @@ Result<HausdorffResult> ComputeBackend::computeDeviceViews(const DevicePointView
 }
 
 Result<TriangleCandidates> ComputeBackend::nearestTriangles(std::span<const glm::vec3>,
-                                                            std::span<const glm::vec3>) {
+                                                            std::span<const glm::vec3>,
+                                                            const std::atomic<bool>*) {
     return notOffered("triangle search");
 }
 

@@ -12,6 +12,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -52,9 +53,14 @@ using BackendSetPair = std::pair<const BackendSet*, const BackendSet*>;
 // (api/surface_certify.hpp).
 struct TriangleCandidates {
     std::vector<uint32_t> triangle;
-    uint32_t radii = 0;  // radii searched
-    uint64_t rays = 0;   // rays cast
-    double gpuMs = 0.0;  // device time
+    uint32_t radii = 0;        // radii searched
+    uint64_t rays = 0;         // rays cast
+    uint32_t submissions = 0;  // command buffers submitted and waited for
+    double gpuMs = 0.0;        // device time
+    double gpuBuildMs = 0.0;   // of which the boxes and BLAS builds and refits
+    double stageMs = 0.0;      // host: the upload buffer written
+    double submitMs = 0.0;     // host wall of the submissions (upload copies, radii, read-back copy)
+    double readbackMs = 0.0;   // host: the candidates read back
 };
 
 class ComputeBackend {
@@ -108,9 +114,12 @@ public:
                                                                   int bits, const std::string& name);
 
     // Route::kSurfaceGpu: queries and triangle corners (3 per triangle) in
-    // one float frame, on the first device.
+    // one float frame, on the first device; `cancel` read between
+    // submissions (kCancelled). What it allocates stays for the next call
+    // (releaseScratch frees it).
     [[nodiscard]] virtual Result<TriangleCandidates> nearestTriangles(std::span<const glm::vec3> queries,
-                                                                      std::span<const glm::vec3> corners);
+                                                                      std::span<const glm::vec3> corners,
+                                                                      const std::atomic<bool>* cancel);
 
     // Frees what every lane keeps between one-shot calls (out_of_core.hpp's `release`).
     virtual void releaseScratch() {}

@@ -4,6 +4,7 @@
 // (api/route_planner.hpp) how it runs and runs that route through the
 // backend interface; the frame is entered and left here.
 #include "rthdist/rthdist.hpp"
+#include "rthdist/surface.hpp"
 #include "rthdist/version.hpp"
 #include "rthdist/vulkan_interop.hpp"
 
@@ -22,6 +23,7 @@
 #include "api/device_views.hpp"
 #include "api/out_of_core.hpp"
 #include "api/route_planner.hpp"
+#include "api/surface_engine.hpp"
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
 #include "core/input_limits.hpp"
@@ -399,6 +401,16 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOpti
     Result<CheckedInputs> checked = checkInputs(a, b, m_impl->options.threads);
     if (!checked) return checked.error();
     return computeViews(*m_impl, a, b, *checked, call, t0);
+}
+
+Result<SurfaceResult> Engine::hausdorffToSurface(PointView points, MeshView surface) {
+    return hausdorffToSurface(points, surface, SurfaceCallOptions{});
+}
+
+// Point to surface on the kept backend (api/surface_engine.hpp routes it).
+Result<SurfaceResult> Engine::hausdorffToSurface(PointView points, MeshView surface,
+                                                 const SurfaceCallOptions& call) {
+    return api::surfaceOnEngine(*m_impl->backend, m_impl->options, points, surface, call);
 }
 
 void Engine::recycle(HausdorffResult&& spent) {

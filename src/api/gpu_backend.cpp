@@ -178,10 +178,13 @@ public:
     }
 
     [[nodiscard]] Result<TriangleCandidates> nearestTriangles(std::span<const glm::vec3> queries,
-                                                              std::span<const glm::vec3> corners) override {
-        auto found = gpu().nearestTriangles(queries, corners);
+                                                              std::span<const glm::vec3> corners,
+                                                              const std::atomic<bool>* cancel) override {
+        auto found = gpu().nearestTriangles(queries, corners, cancel);
         if (!found) return found.error();
-        return TriangleCandidates{std::move(found->triangle), found->radii, found->rays, found->gpuMs};
+        return TriangleCandidates{
+            std::move(found->triangle), found->radii,   found->rays,     found->submissions, found->gpuMs,
+            found->gpuBuildMs,          found->stageMs, found->submitMs, found->readbackMs};
     }
 
     void releaseScratch() override {

@@ -102,12 +102,15 @@ struct Plan {
                              const BackendCaps& caps);
 
 // The route of a point set against a triangle surface, chosen before any
-// backend is opened: Backend::kCpu and kAuto take kSurfaceCpu (a GPU call
-// opens a device per call, whose setup outweighs the CPU search at the
-// sizes one call takes for now, so kAuto picks the CPU); a GPU backend the
-// caller named takes kSurfaceGpu, or kRefused (kInvalidArgument) with
-// per-point distances, which only the CPU backend gives: never computed on
-// the CPU in its place.
+// backend is opened (one-shot: `requested` is SurfaceOptions::backend; on an
+// Engine: its EngineOptions::backend, whose device is kept): Backend::kCpu
+// and kAuto take kSurfaceCpu (one-shot, a GPU call opens a device per
+// call, whose setup outweighs the CPU search at the sizes one call takes;
+// an auto Engine that chose a GPU stays on the CPU backend too until the
+// kept route is measured faster than it); a GPU backend the caller named
+// takes kSurfaceGpu, or kRefused (kInvalidArgument) with per-point
+// distances, which only the CPU backend gives: never computed on the CPU in
+// its place.
 [[nodiscard]] Plan planSurfaceRoute(Backend requested, bool perPoint = false);
 
 // The route of two triangle surfaces (surfaceHausdorff, certified bounds):

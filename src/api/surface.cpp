@@ -1,19 +1,24 @@
-// Public entry of the point-to-surface distance (rthdist/surface.hpp):
-// the inputs checked (shape, finite coordinates, triangle indices, the
-// rule's magnitude limit), the route chosen (api::planSurfaceRoute: the CPU
-// backend, or a refusal naming the backend), then the CPU backend's search
+// Public entry of the point-to-surface distance (rthdist/surface.hpp), one-
+// shot and on an Engine (api/surface_engine.hpp): the route chosen
+// (api::planSurfaceRoute: the CPU backend, the device, or a refusal naming
+// the backend), the inputs checked (shape, finite coordinates, triangle
+// indices, the rule's magnitude limit), then the CPU backend's search
 // (cpu/surface_search.hpp), or on a GPU backend the device's search proven
-// on the host (api/surface_gpu.hpp: it opens the backend).
+// on the host (api/surface_gpu.hpp) on the Engine's device or, one-shot, on
+// a device opened while the inputs are checked.
 #include "rthdist/surface.hpp"
 
 #include <glm/common.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <future>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "api/route_planner.hpp"
+#include "api/surface_engine.hpp"
 #include "api/surface_gpu.hpp"
 #include "core/input_frame.hpp"
 #include "core/stopwatch.hpp"
@@ -62,6 +67,41 @@ std::optional<Error> checkTriangles(const MeshView& surface) {
                      " out of range (" + std::to_string(surface.vertices.count) + " vertices)"};
 }
 
+// Every check of a call's inputs, in the order the errors are reported.
+Result<api::SurfaceInputs> checkInputs(const PointView& points, const MeshView& surface, int threads) {
+    if (auto err = core::checkShape(points, "A")) return *err;
+    if (auto err = core::checkShape(surface.vertices, "B")) return *err;
+    if (auto err = checkTriangles(surface)) return *err;
+    Result<core::SetSummary> a = core::summarizeSet(points, "A", threads);
+    if (!a) return a.error();
+    Result<core::SetSummary> b = core::summarizeSet(surface.vertices, "B", threads);
+    if (!b) return b.error();
+    if (auto err = checkMagnitude(a->box, "point set A")) return *err;
+    if (auto err = checkMagnitude(b->box, "point set B")) return *err;
+    return api::SurfaceInputs{*a, *b, std::max(magnitudeOf(a->box), magnitudeOf(b->box))};
+}
+
+// The device of a one-shot GPU call, opened on another thread while the
+// inputs are checked; its milliseconds are the result's buildMs.
+struct OpenedDevice {
+    Result<std::unique_ptr<api::ComputeBackend>> backend = Error{ErrorCode::kInternal, "not opened"};
+    double ms = 0.0;
+};
+
+OpenedDevice openDevice(const SurfaceOptions& options) {
+    const core::Clock::time_point start = core::Clock::now();
+    EngineOptions engine;
+    engine.backend = options.backend;
+    engine.deviceIndex = options.deviceIndex;
+    engine.validation = options.validation;
+    engine.threads = options.threads;
+    engine.tuning = tuningFromEnvironment();
+    OpenedDevice out;
+    out.backend = api::openBackend(engine, nullptr);
+    out.ms = core::msSince(start);
+    return out;
+}
+
 }  // namespace
 
 Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, const SurfaceOptions& options) {
@@ -69,21 +109,45 @@ Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, con
     if (options.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
     const api::Plan plan = api::planSurfaceRoute(options.backend, options.perPointDistances);
     if (plan.route == api::Route::kRefused) return Error{plan.code, plan.reason};
-    if (auto err = core::checkShape(points, "A")) return *err;
-    if (auto err = core::checkShape(surface.vertices, "B")) return *err;
-    if (auto err = checkTriangles(surface)) return *err;
-    Result<core::SetSummary> a = core::summarizeSet(points, "A", options.threads);
-    if (!a) return a.error();
-    Result<core::SetSummary> b = core::summarizeSet(surface.vertices, "B", options.threads);
-    if (!b) return b.error();
-    if (auto err = checkMagnitude(a->box, "point set A")) return *err;
-    if (auto err = checkMagnitude(b->box, "point set B")) return *err;
-    const double magnitude = std::max(magnitudeOf(a->box), magnitudeOf(b->box));
-    Result<SurfaceResult> result = plan.route == api::Route::kSurfaceGpu
-                                       ? api::surfaceOnGpu(points, surface, *a, *b, magnitude, options)
-                                       : cpu::surfaceSearch(points, surface, magnitude, options);
+    std::future<OpenedDevice> opening;
+    if (plan.route == api::Route::kSurfaceGpu)
+        opening = std::async(std::launch::async, [&options] { return openDevice(options); });
+    Result<api::SurfaceInputs> inputs = checkInputs(points, surface, options.threads);
+    if (!inputs) return inputs.error();  // bad input first, even where no device opens
+    Result<SurfaceResult> result = Error{ErrorCode::kInternal, "no route"};
+    if (plan.route == api::Route::kSurfaceGpu) {
+        OpenedDevice device = opening.get();
+        if (!device.backend) return device.backend.error();
+        result = api::surfaceOnGpu(*device.backend.value(), points, surface, *inputs, options);
+        if (result) result->buildMs = device.ms;
+    } else {
+        result = cpu::surfaceSearch(points, surface, inputs->magnitude, options);
+    }
     if (result) result->totalMs = core::msSince(start);
     return result;
 }
 
+namespace api {
+
+Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptions& engine,
+                                      const PointView& points, const MeshView& surface,
+                                      const SurfaceCallOptions& call) {
+    const core::Clock::time_point start = core::Clock::now();
+    SurfaceOptions options;
+    static_cast<SurfaceCallOptions&>(options) = call;
+    options.backend = engine.backend;
+    options.threads = engine.threads;
+    // The Engine's requested backend picks the route (kAuto: the CPU backend).
+    const Plan plan = planSurfaceRoute(engine.backend, call.perPointDistances);
+    if (plan.route == Route::kRefused) return Error{plan.code, plan.reason};
+    Result<SurfaceInputs> inputs = checkInputs(points, surface, options.threads);
+    if (!inputs) return inputs.error();
+    Result<SurfaceResult> result = plan.route == Route::kSurfaceGpu
+                                       ? surfaceOnGpu(backend, points, surface, *inputs, options)
+                                       : cpu::surfaceSearch(points, surface, inputs->magnitude, options);
+    if (result) result->totalMs = core::msSince(start);
+    return result;
+}
+
+}  // namespace api
 }  // namespace rthdist

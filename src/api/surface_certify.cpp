@@ -1,5 +1,7 @@
 #include "api/surface_certify.hpp"
 
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include <cmath>
@@ -52,45 +54,72 @@ std::vector<double> upperBounds(const PointView& points, const MeshView& surface
 // brute force itself (no BVH to build: the usual band of one query).
 constexpr uint64_t kBruteWork = uint64_t(1) << 24;
 
-// q's nearest triangle by every triangle, in index order (the brute force's
-// rule and order: the smallest index on a tie), on the worker pool.
+// q's nearest triangle by the brute force's rule and order (the smallest
+// index on a tie), on the worker pool: every triangle is measured but those
+// whose box lies farther than sqrt(within2) + slack (within2: U(q), at least
+// q's nearest squared distance; infinite: none is skipped). That skip is the
+// CPU backend's BVH pruning (design.md §11: core::closestSlack exceeds every
+// rounding of the rule and of the box distance), applied to each
+// triangle's own box, so the nearest triangle and every triangle tied with
+// it are measured.
 struct Nearest {
     double distance2 = std::numeric_limits<double>::infinity();
     uint32_t triangle = UINT32_MAX;
+    uint64_t tested = 0;  // triangles measured by the rule
 };
 
-Nearest bruteNearest(const glm::dvec3& p, const MeshView& surface, int threads) {
+double pruneBound2(double within2, double slack) {
+    if (!std::isfinite(within2)) return std::numeric_limits<double>::infinity();
+    const double bound = std::sqrt(within2) + slack;
+    return bound * bound;
+}
+
+Nearest bruteNearest(const glm::dvec3& p, const MeshView& surface, int threads, double within2,
+                     double slack) {
     const size_t triangles = surface.triangleCount();
+    const double prune2 = pruneBound2(within2, slack);
     const int workers = core::resolveThreads(threads, (triangles + kChunk - 1) / kChunk);
     std::vector<Nearest> each(static_cast<size_t>(workers));
     core::parallelChunks(triangles, kChunk, workers, [&](size_t begin, size_t end, int thread) {
         Nearest& mine = each[size_t(thread)];
         for (size_t t = begin; t < end; ++t) {
-            const double d2 =
-                core::closestOnTriangle(p, surface.corner(t, 0), surface.corner(t, 1), surface.corner(t, 2))
-                    .distance2;
-            if (d2 < mine.distance2 || (d2 == mine.distance2 && t < mine.triangle))
-                mine = Nearest{d2, uint32_t(t)};
+            const glm::dvec3 a = surface.corner(t, 0), b = surface.corner(t, 1), c = surface.corner(t, 2);
+            const glm::dvec3 lo = glm::min(glm::min(a, b), c), hi = glm::max(glm::max(a, b), c);
+            const glm::dvec3 out = glm::max(glm::max(lo - p, p - hi), glm::dvec3(0.0));
+            if (glm::dot(out, out) > prune2) continue;
+            const double d2 = core::closestOnTriangle(p, a, b, c).distance2;
+            ++mine.tested;
+            if (d2 < mine.distance2 || (d2 == mine.distance2 && t < mine.triangle)) {
+                mine.distance2 = d2;
+                mine.triangle = uint32_t(t);
+            }
         }
     });
     Nearest best;
+    uint64_t tested = 0;
     for (const Nearest& n : each) {
+        tested += n.tested;
         if (n.distance2 < best.distance2 || (n.distance2 == best.distance2 && n.triangle < best.triangle))
             best = n;
     }
+    best.tested = tested;
     return best;
 }
 
 // The band by the brute force: the largest nearest distance, the smallest
-// query on a tie (the band is in index order).
+// query on a tie (the band is in index order). q*'s nearest (`known`, of
+// query `knownQuery`) is measured already.
 SurfaceResult bruteBand(const PointView& points, std::span<const uint64_t> band, const MeshView& surface,
-                        int threads) {
+                        std::span<const double> bound, double slack, int threads, uint64_t knownQuery,
+                        const Nearest& known) {
     SurfaceResult r;
     Nearest top;
-    uint64_t topQuery = 0;
+    uint64_t topQuery = 0, tested = 0;
     bool any = false;
     for (const uint64_t q : band) {
-        const Nearest n = bruteNearest(points.at(q), surface, threads);
+        const Nearest n =
+            q == knownQuery ? known : bruteNearest(points.at(q), surface, threads, bound[q], slack);
+        tested += n.tested;
         if (!any || n.distance2 > top.distance2) {
             top = n;
             topQuery = q;
@@ -107,7 +136,7 @@ SurfaceResult bruteBand(const PointView& points, std::span<const uint64_t> band,
     d.surfacePoint = c.point;
     d.barycentric = c.barycentric;
     d.distance = std::sqrt(c.distance2);
-    d.counters.trianglesTested = band.size() * surface.triangleCount();
+    d.counters.trianglesTested = tested;
     r.hausdorff = d.distance;
     return r;
 }
@@ -124,8 +153,10 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
                                                " candidates for " + std::to_string(points.count) + " points"};
     Largest largest;
     const std::vector<double> bound = upperBounds(points, surface, candidate, options.threads, largest);
-    const double lower2 =
-        bruteNearest(points.at(largest.query), surface, options.threads).distance2;  // L^2 <= h^2
+    const double slack = core::closestSlack(magnitude);
+    const Nearest measured =
+        bruteNearest(points.at(largest.query), surface, options.threads, largest.bound, slack);
+    const double lower2 = measured.distance2;  // L^2 <= h^2
 
     // The band, in index order: every query that may reach L.
     std::vector<uint64_t> bandIndex;
@@ -134,7 +165,7 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     }
     Result<SurfaceResult> exact = SurfaceResult{};
     if (bandIndex.size() * surface.triangleCount() <= kBruteWork) {
-        exact = bruteBand(points, bandIndex, surface, options.threads);
+        exact = bruteBand(points, bandIndex, surface, bound, slack, options.threads, largest.query, measured);
     } else {  // the CPU backend's BVH search over the band (its own witness check)
         std::vector<glm::dvec3> band;
         band.reserve(bandIndex.size());

@@ -7,11 +7,14 @@
 //   1. U(q) = the shared rule in double between q and its candidate
 //      (infinite without one) is at least q's exact nearest distance d(q).
 //   2. q* = the query of largest U (smallest index on a tie) is measured
-//      against every triangle: L = d(q*) <= h.
+//      exactly: L = d(q*) <= h.
 //   3. A query with U(q) < L has d(q) < L <= h: it neither realizes h nor
 //      ties it. The others (the band, U(q) >= L, q* among them) are
-//      measured exactly, in index order: against every triangle while the
-//      band times the triangles is small (the usual band of one query),
+//      measured exactly, in index order: by the brute force over the
+//      triangles while the band times the triangles is small (the usual
+//      band of one query; a triangle whose box lies farther than U(q) plus
+//      the rounding slack of the CPU backend's BVH, core::closestSlack, is
+//      skipped unmeasured: it can hold neither the nearest nor a tie),
 //      else by the CPU backend's BVH search (cpu/surface_search.hpp, its
 //      own proof and witness check); so the answer is h with the brute
 //      force's witness (ties: smallest triangle, smallest query).

@@ -4,10 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <memory>
 #include <vector>
 
-#include "api/backend.hpp"
 #include "api/surface_certify.hpp"
 #include "core/parallel.hpp"
 #include "core/stopwatch.hpp"
@@ -54,41 +52,39 @@ std::vector<glm::vec3> framedCorners(const MeshView& surface, const SearchFrame&
 
 }  // namespace
 
-Result<SurfaceResult> surfaceOnGpu(const PointView& points, const MeshView& surface,
-                                   const core::SetSummary& a, const core::SetSummary& b, double magnitude,
-                                   const SurfaceOptions& options) {
+Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& points, const MeshView& surface,
+                                   const SurfaceInputs& inputs, const SurfaceOptions& options) {
     const core::Clock::time_point start = core::Clock::now();
-    EngineOptions engine;
-    engine.backend = options.backend;
-    engine.deviceIndex = options.deviceIndex;
-    engine.validation = options.validation;
-    engine.threads = options.threads;
-    engine.tuning = tuningFromEnvironment();
-    Result<std::unique_ptr<ComputeBackend>> backend = openBackend(engine, nullptr);
-    if (!backend) return backend.error();
-    ComputeBackend& device = *backend.value();
-    const double setupMs = core::msSince(start);
-
-    const core::Clock::time_point searchStart = core::Clock::now();
-    const SearchFrame frame(a.box, b.box);
+    const SearchFrame frame(inputs.a.box, inputs.b.box);
     const std::vector<glm::vec3> queries = framedPoints(points, frame, options.threads);
     const std::vector<glm::vec3> corners = framedCorners(surface, frame, options.threads);
-    Result<TriangleCandidates> found = device.nearestTriangles(queries, corners);
+    const double frameMs = core::msSince(start);
+    Result<TriangleCandidates> found = device.nearestTriangles(queries, corners, options.cancel);
     if (!found) return found.error();
     if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed))
         return Error{ErrorCode::kCancelled, "the call was cancelled (SurfaceOptions::cancel)"};
 
-    Result<SurfaceResult> result = certifySurface(points, surface, magnitude, found->triangle, options);
+    const core::Clock::time_point certifyStart = core::Clock::now();
+    Result<SurfaceResult> result =
+        certifySurface(points, surface, inputs.magnitude, found->triangle, options);
     if (!result) return result.error();
     SurfaceResult& r = result.value();
     r.backend = device.kind();
     r.device = device.deviceName();
-    r.directed.counters.radii = found->radii;
-    r.directed.counters.rays = found->rays;
-    r.directed.counters.triangles = surface.triangleCount();
+    SurfaceCounters& n = r.directed.counters;
+    n.radii = found->radii;
+    n.rays = found->rays;
+    n.submissions = found->submissions;
+    n.triangles = surface.triangleCount();
+    r.stages.frame = frameMs;
+    r.stages.upload = found->stageMs;
+    r.stages.search = found->submitMs;
+    r.stages.readback = found->readbackMs;
+    r.stages.certify = core::msSince(certifyStart);
+    r.stages.gpuBuild = found->gpuBuildMs;
     r.gpuMs = found->gpuMs;
-    r.buildMs = setupMs;
-    r.searchMs = core::msSince(searchStart);
+    r.buildMs = 0.0;  // the device's setup, the caller's to add (the band's BVH is certify's)
+    r.searchMs = core::msSince(start);
     r.validationMessages = device.validationMessages();
     return result;
 }

@@ -7,15 +7,24 @@
 // caller's coordinates in double.
 #pragma once
 
+#include "api/backend.hpp"
 #include "core/input_frame.hpp"
 #include "rthdist/surface.hpp"
 
 namespace rthdist::api {
 
-// Inputs checked by the caller (api/surface.cpp); a, b: their summaries;
-// magnitude: the largest |coordinate| over both.
-[[nodiscard]] Result<SurfaceResult> surfaceOnGpu(const PointView& points, const MeshView& surface,
-                                                 const core::SetSummary& a, const core::SetSummary& b,
-                                                 double magnitude, const SurfaceOptions& options);
+// What the checks of a point-to-surface call found (api/surface.cpp):
+// both inputs' summaries and the largest |coordinate| over both.
+struct SurfaceInputs {
+    core::SetSummary a, b;
+    double magnitude = 0.0;
+};
+
+// Inputs checked by the caller; `device`: a GPU backend, opened for this
+// call or kept by an Engine (its buffers stay for the next call). Fills
+// every stage of SurfaceResult::stages but setup (the caller's).
+[[nodiscard]] Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& points,
+                                                 const MeshView& surface, const SurfaceInputs& inputs,
+                                                 const SurfaceOptions& options);
 
 }  // namespace rthdist::api

@@ -69,7 +69,8 @@ struct GpuHausdorff::State {
           search(ws, index, refine, check),
           certificate(ws, check),
           deviceIngest(ws, index),
-          smallPairs(ws) {}
+          smallPairs(ws),
+          surface(ws) {}
 
     Workspace ws;
     PerPoint spare;   // recyclePerPoint: the next per-point result's h(A,B) arrays
@@ -85,6 +86,7 @@ struct GpuHausdorff::State {
     CertificatePass certificate;
     DeviceIngest deviceIngest;
     SmallPairScan smallPairs;
+    SurfaceSearch surface;  // kept between calls: its buffers only grow
 
     // The search of a direction that has survivors, then its self-check
     // (in the search's last submission where it folds into it, else one
@@ -461,6 +463,7 @@ void GpuHausdorff::releaseScratch() {
     ws.scratch = Scratch{};
     ws.oneShot = {};
     ws.spare.clear();
+    m_state->surface.release();
     m_state->spare = m_state->spareB = PerPoint{};
     m_state->handedBack = 0;
 }
@@ -613,15 +616,12 @@ const std::string& GpuHausdorff::pipelineCacheStatus() const {
 }
 
 Result<SurfaceCandidates> GpuHausdorff::nearestTriangles(std::span<const glm::vec3> queries,
-                                                         std::span<const glm::vec3> corners) {
+                                                         std::span<const glm::vec3> corners,
+                                                         const std::atomic<bool>* cancel) {
     Timings timings;
     SurfaceCandidates out;
-    auto err = m_state->guarded(timings, [&] {
-        out = SurfaceSearch(m_state->ws).run(queries, corners);
-        // The BLAS of triangles is no point search's: the next call builds its own.
-        m_state->ws.accel.release();
-        m_state->ws.tlasBound = false;
-    });
+    // The BLAS of triangles stays: a point search's first radius builds its own in its storage.
+    auto err = m_state->guarded(timings, [&] { out = m_state->surface.run(queries, corners, cancel); });
     if (err) return *err;
     return out;
 }

@@ -9,59 +9,75 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/parallel.hpp"
 #include "gpu/barriers.hpp"
 #include "gpu/device_limits.hpp"
 #include "gpu_algo/workspace.hpp"
-#include "rthdist_surface_search.h"
 
 namespace rthdist::gpu_algo {
 
 namespace {
 
-// Radii recorded in one submission (each: boxes, refit, rays); the host
-// reads how many queries each searched and stops at the first that searched
-// none.
-constexpr size_t kRadiiPerSubmission = 4;
 constexpr uint32_t kMaxTriangles = uint32_t(1) << 30;  // corner indices 3t + 2 stay in 32 bits
+// At most this share of the queries open, or settled by the last radius:
+// the radius grows 4x (SurfaceRadii::next).
+constexpr uint64_t kTailShare = 16;
+constexpr size_t kStageChunk = size_t(1) << 14;
 
-struct Frame {
+struct Box {
     glm::vec3 lo{std::numeric_limits<float>::infinity()};
     glm::vec3 hi{-std::numeric_limits<float>::infinity()};
     void add(const glm::vec3& p) {
         lo = glm::min(lo, p);
         hi = glm::max(hi, p);
     }
-};
-
-// The radii: from half the mean longest side of the triangles' boxes (a
-// query on or near the surface settles at once), doubling, up to the
-// diagonal of the union of both inputs' boxes, where every grown box holds
-// every query (the last radius settles every query that is left).
-std::vector<double> radiusSchedule(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners) {
-    Frame all;
-    double sides = 0.0;
-    for (size_t t = 0; t + 2 < corners.size(); t += 3) {
-        Frame tri;
-        for (size_t k = 0; k < 3; ++k) tri.add(corners[t + k]);
-        const glm::vec3 e = tri.hi - tri.lo;
-        sides += double(std::max({e.x, e.y, e.z}));
-        all.add(tri.lo);
-        all.add(tri.hi);
+    void add(const Box& b) {
+        lo = glm::min(lo, b.lo);
+        hi = glm::max(hi, b.hi);
     }
-    for (const glm::vec3& q : queries) all.add(q);
-    const double diagonal = glm::length(glm::dvec3(all.hi) - glm::dvec3(all.lo));
-    const double cover = diagonal * (1.0 + 0x1p-10) + 0x1p-24;
-    const double meanSide = sides / double(corners.size() / 3);
-    double r = std::max({meanSide * 0.5, diagonal * 0x1p-20, 0x1p-24});
-    std::vector<double> radii;
-    for (; r < cover; r *= 2.0) radii.push_back(r);
-    radii.push_back(cover);
-    return radii;
-}
+};
 
 }  // namespace
 
-SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners) {
+SurfaceRadii::SurfaceRadii(double meanSide, double area, uint64_t queries, double diagonal) {
+    m_cover = diagonal * (1.0 + 0x1p-10) + 0x1p-24;
+    const double spacing = queries > 0 ? std::sqrt(std::max(area, 0.0) / double(queries)) : 0.0;
+    m_first = std::min(std::max({meanSide * 0.5, spacing * 0.5, diagonal * 0x1p-20, 0x1p-24}), m_cover);
+}
+
+std::vector<double> SurfaceRadii::start() const {
+    std::vector<double> radii{m_first};
+    if (m_first < m_cover) radii.push_back(std::min(4.0 * m_first, m_cover));
+    return radii;
+}
+
+std::vector<double> SurfaceRadii::next(double last, uint64_t queries, uint64_t searched,
+                                       uint64_t settled) const {
+    std::vector<double> radii;
+    const uint64_t open = searched - std::min(settled, searched);
+    if (open == 0 || last >= m_cover) return radii;
+    const bool fast = open * kTailShare <= queries || settled * kTailShare <= searched;
+    const double growth = fast ? 4.0 : 2.0;
+    for (double r = last; radii.size() < kTailRadii && r < m_cover;) {
+        r = std::min(r * growth, m_cover);
+        radii.push_back(r);
+    }
+    return radii;
+}
+
+// Per worker of the staging pass: its share of the radii's statistics.
+struct SurfaceSearch::Stats {
+    Box box;
+    double sides = 0.0, area = 0.0;
+    void add(const Stats& o) {
+        box.add(o.box);
+        sides += o.sides;
+        area += o.area;
+    }
+};
+
+SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners,
+                                     const std::atomic<bool>* cancel) {
     if (corners.empty() || corners.size() % 3 != 0 || corners.size() / 3 >= kMaxTriangles)
         throw gpu::LimitError("the surface search takes 1 to 2^30 - 1 triangles, not " +
                               std::to_string(corners.size() / 3));
@@ -70,95 +86,141 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
                               std::to_string(queries.size()));
     m_queries = uint32_t(queries.size());
     m_triangles = uint32_t(corners.size() / 3);
+    m_built = false;
     m_ws.pipelines.prepareSurfaceSearch(m_ws.pipelineCache.handle());
-    const std::vector<double> radii = radiusSchedule(queries, corners);
-    m_rayTMax = radii.front() * 1e-3;
-    upload(queries, corners);
 
     SurfaceCandidates out;
-    double settled = -1.0;  // no query is settled before the first radius
-    for (size_t first = 0; first < radii.size(); first += kRadiiPerSubmission) {
-        const auto batch =
-            std::span(radii).subspan(first, std::min(kRadiiPerSubmission, radii.size() - first));
-        const std::vector<uint32_t> searched = runRadii(batch, settled, first == 0);
-        out.gpuMs += m_ws.ctx.lastGpuMs();
-        bool done = false;
-        for (uint32_t s : searched) {
-            done = done || s == 0;
-            if (done) break;
-            ++out.radii;
-            out.rays += s;
-        }
-        if (done) break;
-        settled = batch.back();
-    }
+    auto t0 = Clock::now();
+    const Stats stats = stage(queries, corners);
+    const SurfaceRadii radii(stats.sides / double(m_triangles), stats.area, m_queries,
+                             glm::length(glm::dvec3(stats.box.hi) - glm::dvec3(stats.box.lo)));
+    out.firstRadius = radii.first();
+    m_rayTMax = radii.first() * 1e-3;
+    out.stageMs = msSince(t0);
 
-    // Every query's best back to the host: its triangle is the low word.
-    gpu::Buffer& back = m_ws.grow(m_readback, VkDeviceSize(m_queries) * 8, "surface.readback",
-                                  gpu::MemoryKind::kReadback, false);
+    // The first submission: the upload, the first radius (which settles most
+    // queries), the tail's first and the read-back; then the tail's, while
+    // queries are open.
+    t0 = Clock::now();
     VkCommandBuffer cmd = m_ws.ctx.begin();
-    const VkBufferCopy region{0, 0, VkDeviceSize(m_queries) * 8};
-    vkCmdCopyBuffer(cmd, m_best.handle(), back.handle(), 1, &region);
-    gpu::cmdBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                    VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-    m_ws.ctx.submitAndWait(cmd);
-    const auto* packed = static_cast<const uint64_t*>(back.mapped());
-    out.triangle.resize(m_queries);
-    for (uint32_t q = 0; q < m_queries; ++q) {
-        const auto t = uint32_t(packed[q] & 0xffffffffu);
-        out.triangle[q] = t < m_triangles ? t : UINT32_MAX;
+    cmdUpload(cmd);
+    std::vector<double> batch = radii.start();
+    double settled = -1.0;  // no query is settled before the first radius
+    while (!batch.empty()) {
+        const std::vector<sh::SurfaceRadiusCount> counts = submitRadii(cmd, batch, settled, out);
+        sh::SurfaceRadiusCount last{0u, 0u};  // of the last radius that searched a query
+        for (const sh::SurfaceRadiusCount& c : counts) {
+            if (c.searched == 0) break;
+            ++out.radii;
+            out.rays += c.searched;
+            last = c;
+        }
+        if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
+        settled = batch.back();
+        batch = radii.next(settled, m_queries, last.searched, last.settled);
+        if (!batch.empty()) cmd = m_ws.ctx.begin();
     }
+    out.submitMs = msSince(t0);
+
+    // Every query's best, as the last submission copied it: its triangle is the low word.
+    t0 = Clock::now();
+    const auto* packed = static_cast<const uint64_t*>(m_readback.mapped());
+    out.triangle.resize(m_queries);
+    core::parallelChunks(m_queries, kStageChunk * 4, m_ws.threads, [&](size_t begin, size_t end, int) {
+        for (size_t q = begin; q < end; ++q) {
+            const auto t = uint32_t(packed[q] & 0xffffffffu);
+            out.triangle[q] = t < m_triangles ? t : UINT32_MAX;
+        }
+    });
+    out.readbackMs = msSince(t0);
     return out;
 }
 
-void SurfaceSearch::upload(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners) {
+void SurfaceSearch::release() {
+    for (gpu::Buffer* b :
+         {&m_points, &m_corners, &m_boxes, &m_best, &m_aabbs, &m_staging, &m_readback, &m_counts})
+        b->reset();
+}
+
+SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
+                                          std::span<const glm::vec3> corners) {
     const VkDeviceSize pointBytes = VkDeviceSize(m_queries) * 16;
     const VkDeviceSize cornerBytes = VkDeviceSize(m_triangles) * 48;
     const VkDeviceSize boxBytes = VkDeviceSize(m_triangles) * sizeof(sh::Cell);
-    gpu::Buffer& staging = m_ws.grow(m_staging, pointBytes + cornerBytes + boxBytes, "surface.staging",
-                                     gpu::MemoryKind::kHost, false);
+    gpu::Buffer& staging =
+        m_ws.grow(m_staging, pointBytes + cornerBytes + boxBytes, "surface.staging", gpu::MemoryKind::kHost);
+    m_ws.grow(m_points, pointBytes, "surface.queries");
+    m_ws.grow(m_corners, cornerBytes, "surface.corners");
+    m_ws.grow(m_boxes, boxBytes, "surface.boxes");
+    m_ws.grow(m_best, VkDeviceSize(m_queries) * 8, "surface.best");
+    m_ws.grow(m_aabbs, VkDeviceSize(m_triangles) * 24, "surface.aabbs");
+    m_ws.grow(m_readback, VkDeviceSize(m_queries) * 8, "surface.readback", gpu::MemoryKind::kReadback);
+    m_ws.grow(m_counts, SurfaceRadii::kTailRadii * sizeof(sh::SurfaceRadiusCount), "surface.counts",
+              gpu::MemoryKind::kHost, false);
+
     auto* bytes = static_cast<char*>(staging.mapped());
     auto* points = reinterpret_cast<float*>(bytes);
-    for (size_t i = 0; i < queries.size(); ++i) {
-        const float p[4] = {queries[i].x, queries[i].y, queries[i].z, 0.0f};
-        std::memcpy(points + 4 * i, p, sizeof(p));
-    }
     auto* cornerOut = reinterpret_cast<float*>(bytes + pointBytes);
-    auto* boxOut = bytes + pointBytes + cornerBytes;
-    for (uint32_t t = 0; t < m_triangles; ++t) {
-        Frame box;
-        for (size_t k = 0; k < 3; ++k) {
-            const glm::vec3& c = corners[3 * size_t(t) + k];
-            const float p[4] = {c.x, c.y, c.z, 0.0f};
-            std::memcpy(cornerOut + 4 * (3 * size_t(t) + k), p, sizeof(p));
-            box.add(c);
+    char* boxOut = bytes + pointBytes + cornerBytes;
+    const int workers = core::resolveThreads(m_ws.threads, (m_triangles + m_queries) / kStageChunk + 1);
+    std::vector<Stats> each(static_cast<size_t>(workers));
+    core::parallelChunks(m_queries, kStageChunk, workers, [&](size_t begin, size_t end, int thread) {
+        Box box;
+        for (size_t i = begin; i < end; ++i) {
+            const float p[4] = {queries[i].x, queries[i].y, queries[i].z, 0.0f};
+            std::memcpy(points + 4 * i, p, sizeof(p));
+            box.add(queries[i]);
         }
-        const sh::Cell cell{{box.lo.x, box.lo.y, box.lo.z}, t, {box.hi.x, box.hi.y, box.hi.z}, 1u};
-        std::memcpy(boxOut + size_t(t) * sizeof(sh::Cell), &cell, sizeof(cell));
-    }
-    m_ws.grow(m_points, pointBytes, "surface.queries", gpu::MemoryKind::kDevice, false);
-    m_ws.grow(m_corners, cornerBytes, "surface.corners", gpu::MemoryKind::kDevice, false);
-    m_ws.grow(m_boxes, boxBytes, "surface.boxes", gpu::MemoryKind::kDevice, false);
-    m_ws.grow(m_best, VkDeviceSize(m_queries) * 8, "surface.best", gpu::MemoryKind::kDevice, false);
-    m_ws.grow(m_aabbs, VkDeviceSize(m_triangles) * 24, "surface.aabbs", gpu::MemoryKind::kDevice, false);
-    m_ws.grow(m_searched, kRadiiPerSubmission * 4, "surface.searched", gpu::MemoryKind::kHost, false);
+        each[size_t(thread)].box.add(box);
+    });
+    core::parallelChunks(m_triangles, kStageChunk, workers, [&](size_t begin, size_t end, int thread) {
+        Stats mine;
+        for (size_t t = begin; t < end; ++t) {
+            Box tri;
+            for (size_t k = 0; k < 3; ++k) {
+                const glm::vec3& c = corners[3 * t + k];
+                const float p[4] = {c.x, c.y, c.z, 0.0f};
+                std::memcpy(cornerOut + 4 * (3 * t + k), p, sizeof(p));
+                tri.add(c);
+            }
+            const sh::Cell cell{
+                {tri.lo.x, tri.lo.y, tri.lo.z}, uint32_t(t), {tri.hi.x, tri.hi.y, tri.hi.z}, 1u};
+            std::memcpy(boxOut + t * sizeof(sh::Cell), &cell, sizeof(cell));
+            const glm::vec3 e = tri.hi - tri.lo;
+            mine.sides += double(std::max({e.x, e.y, e.z}));
+            const glm::dvec3 a(corners[3 * t]), b(corners[3 * t + 1]), c(corners[3 * t + 2]);
+            mine.area += 0.5 * glm::length(glm::cross(b - a, c - a));
+            mine.box.add(tri);
+        }
+        each[size_t(thread)].add(mine);
+    });
+    Stats all;
+    for (const Stats& s : each) all.add(s);
+    return all;
+}
 
-    VkCommandBuffer cmd = m_ws.ctx.begin();
+void SurfaceSearch::cmdUpload(VkCommandBuffer cmd) {
+    const VkDeviceSize pointBytes = VkDeviceSize(m_queries) * 16;
+    const VkDeviceSize cornerBytes = VkDeviceSize(m_triangles) * 48;
+    const VkDeviceSize boxBytes = VkDeviceSize(m_triangles) * sizeof(sh::Cell);
     const VkBufferCopy toPoints{0, 0, pointBytes};
     const VkBufferCopy toCorners{pointBytes, 0, cornerBytes};
     const VkBufferCopy toBoxes{pointBytes + cornerBytes, 0, boxBytes};
-    vkCmdCopyBuffer(cmd, staging.handle(), m_points.handle(), 1, &toPoints);
-    vkCmdCopyBuffer(cmd, staging.handle(), m_corners.handle(), 1, &toCorners);
-    vkCmdCopyBuffer(cmd, staging.handle(), m_boxes.handle(), 1, &toBoxes);
+    vkCmdCopyBuffer(cmd, m_staging.handle(), m_points.handle(), 1, &toPoints);
+    vkCmdCopyBuffer(cmd, m_staging.handle(), m_corners.handle(), 1, &toCorners);
+    vkCmdCopyBuffer(cmd, m_staging.handle(), m_boxes.handle(), 1, &toBoxes);
     vkCmdFillBuffer(cmd, m_best.handle(), 0, VkDeviceSize(m_queries) * 8, 0xffffffffu);  // none
-    m_ws.ctx.submitAndWait(cmd);
+    gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                     VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
 }
 
-std::vector<uint32_t> SurfaceSearch::runRadii(std::span<const double> radii, double settledBefore,
-                                              bool firstBuild) {
-    auto* searched = static_cast<uint32_t*>(m_searched.mapped());
-    std::fill_n(searched, kRadiiPerSubmission, 0u);
-    VkCommandBuffer cmd = m_ws.ctx.begin();
+std::vector<sh::SurfaceRadiusCount> SurfaceSearch::submitRadii(VkCommandBuffer cmd,
+                                                               std::span<const double> radii,
+                                                               double settledBefore, SurfaceCandidates& out) {
+    auto* counts = static_cast<sh::SurfaceRadiusCount*>(m_counts.mapped());
+    std::fill_n(counts, SurfaceRadii::kTailRadii, sh::SurfaceRadiusCount{0u, 0u});
+    std::vector<std::pair<uint32_t, uint32_t>> buildMarks;
     double settled = settledBefore;
     for (size_t i = 0; i < radii.size(); ++i) {
         // Everything of the radius before (its rays read the BLAS this one refits).
@@ -166,18 +228,29 @@ std::vector<uint32_t> SurfaceSearch::runRadii(std::span<const double> radii, dou
             gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                              VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                              VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+        const uint32_t from = m_ws.ctx.cmdMark(cmd);
         const double settled2 = settled < 0.0 ? -1.0 : settled * settled;
-        cmdRadius(cmd, radii[i], settled2, !(firstBuild && i == 0), m_searched.address() + 4 * i);
+        cmdRadius(cmd, radii[i], settled2, m_built, m_counts.address() + i * sizeof(sh::SurfaceRadiusCount));
+        buildMarks.emplace_back(from, m_ws.ctx.cmdMark(cmd));
+        m_built = true;
         settled = radii[i];
     }
+    // Every query's best for the host (the loop may end after any submission).
+    gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    const VkBufferCopy region{0, 0, VkDeviceSize(m_queries) * 8};
+    vkCmdCopyBuffer(cmd, m_best.handle(), m_readback.handle(), 1, &region);
     gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
     m_ws.ctx.submitAndWait(cmd);
-    return {searched, searched + radii.size()};
+    ++out.submissions;
+    out.gpuMs += m_ws.ctx.lastGpuMs();
+    for (const auto& [from, to] : buildMarks) out.gpuBuildMs += m_ws.ctx.gpuMsBetween(from, to);
+    return {counts, counts + radii.size()};
 }
 
 void SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update,
-                              VkDeviceAddress searched) {
+                              VkDeviceAddress counts) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "surface search");
     const auto r = float(radius);
     // The boxes' slack: rounding at the box's magnitude (grow_boxes.comp).
@@ -195,11 +268,12 @@ void SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled
     sp.queries = m_points.address();
     sp.corners = m_corners.address();
     sp.best = m_best.address();
-    sp.searched = searched;
+    sp.counts = counts;
     sp.numQueries = m_queries;
     sp.radius = r;
     // Rounded down: a query is settled only when its best is within the radius.
     sp.settled2 = settled2 < 0.0 ? -1.0f : std::nextafter(float(settled2), 0.0f);
+    sp.settle2 = std::nextafter(float(radius * radius), 0.0f);
     sp.rayTMax = float(m_rayTMax);
     sp.mutant = m_ws.mutant ? 1u : 0u;
     if (m_ws.rayQuery) {

@@ -2,7 +2,8 @@
 // (the GPU backends: tests/gpu_algo/gpu_surface_test.cpp):
 // float and double inputs of any stride against the brute force over every
 // triangle, and every refusal as an Error value naming the set, the vertex
-// or the triangle.
+// or the triangle; Engine::hausdorffToSurface on an Engine of the CPU
+// backend (kCpu, and kAuto where no RT hardware is) as the free function.
 #include <gtest/gtest.h>
 
 #include <glm/common.hpp>
@@ -15,6 +16,7 @@
 
 #include "common/surface_brute_force.hpp"
 #include "common/surface_cases.hpp"
+#include "rthdist/rthdist.hpp"
 #include "rthdist/surface.hpp"
 
 namespace rthdist {
@@ -39,6 +41,37 @@ TEST(SurfaceApi, AutoAndCpuRunTheCpuBackend) {
         EXPECT_EQ(r->hausdorff, 5.0);  // (8, 4, 3) to the corner edge (4, 4, 0)
         EXPECT_EQ(r->directed.queryIndex, 2u);
         EXPECT_EQ(r->directed.surfacePoint, glm::dvec3(4, 4, 0));
+    }
+}
+
+// An Engine of the CPU backend serves surface calls as the free function
+// does, per-point distances included, call after call.
+TEST(SurfaceApi, AnEngineOfTheCpuBackendEqualsTheFreeFunction) {
+    EngineOptions o;
+    o.backend = Backend::kCpu;
+    Result<Engine> engine = Engine::create(o);
+    ASSERT_TRUE(engine) << engine.error().message;
+    const Small s;
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        const MeshView mesh{PointView(c.vertices), c.indices};
+        SurfaceCallOptions call;
+        call.perPointDistances = true;
+        Result<SurfaceResult> kept = engine->hausdorffToSurface(PointView(c.queries), mesh, call);
+        SurfaceOptions options;
+        options.backend = Backend::kCpu;
+        options.perPointDistances = true;
+        Result<SurfaceResult> once = hausdorffToSurface(PointView(c.queries), mesh, options);
+        ASSERT_TRUE(kept && once) << c.name;
+        EXPECT_EQ(kept->backend, Backend::kCpu) << c.name;
+        EXPECT_EQ(kept->hausdorff, once->hausdorff) << c.name;
+        EXPECT_EQ(kept->directed.queryIndex, once->directed.queryIndex) << c.name;
+        EXPECT_EQ(kept->directed.triangle, once->directed.triangle) << c.name;
+        EXPECT_EQ(kept->perPoint.distance, once->perPoint.distance) << c.name;
+        EXPECT_EQ(kept->perPoint.triangle, once->perPoint.triangle) << c.name;
+        Result<SurfaceResult> small = engine->hausdorffToSurface(PointView(s.points), s.mesh());
+        ASSERT_TRUE(small) << small.error().message;
+        EXPECT_EQ(small->hausdorff, 5.0);
     }
 }
 

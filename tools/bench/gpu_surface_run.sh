@@ -3,12 +3,14 @@
 # (Ubuntu 24.04, 16 cores, NVIDIA H200, python3 with numpy; no Open3D, no CGAL,
 # no MeshLab, no network): every row of tools/bench/surface_peers.py with
 # rthdist's cpu backend (16 threads) and, on the points rows, its rt-pipeline
-# backend, beside surface-cgal (CGAL 5.5: AABB_tree queries on 16 threads;
+# backend one-shot (the CLI: a device per call) and on a kept device
+# (rthdist-surface-bench: one Engine, a warm-up call, then --runs calls of
+# Engine::hausdorffToSurface), beside surface-cgal (CGAL 5.5: AABB_tree queries on 16 threads;
 # bounded-error Hausdorff on one, as CGAL 5.5 has no parallel version of it).
-# Ratios of the points rows are against rthdist-rt-pipeline, of the surfaces
+# Ratios of the points rows are against rthdist-rt-pipeline-kept, of the surfaces
 # rows against rthdist-cpu (--surface both runs on the cpu backend only);
 # rthdist-cpu-1t (one thread) is shown beside CGAL's one-threaded call.
-#   [PYTHON=python3] bash tools/bench/gpu_surface_run.sh BUNDLE OUTDIR [ROWS]
+#   [PYTHON=python3] [RUNS=3] bash tools/bench/gpu_surface_run.sh BUNDLE OUTDIR [ROWS]
 # ROWS: comma-separated row names of surface_peers.py (default: all).
 # Writes OUTDIR/results.json, table.md, log.txt, machine.txt (GPU, cores,
 # which libraries surface-cgal loaded).
@@ -17,7 +19,7 @@
 # release build (cmake --preset release && cmake --build build -j2):
 #   echo /.devrun/ >> .git/info/exclude            # once; .gl/ as docs/gpu.md says
 #   mkdir -p .devrun/surface/lib .devrun/surface/inputs
-#   cp build/rthdist .devrun/surface/
+#   cp build/rthdist build/rthdist-surface-bench .devrun/surface/
 #   # surface-cgal without CGAL's libraries there: CGAL is header-only; GMP and
 #   # MPFR (Debian ships libgmp.a, libmpfr.a), libstdc++ and libgcc linked in
 #   # statically; -frounding-math as CGAL's CMake adds it (interval filters).
@@ -62,4 +64,5 @@ rows=()
 [ -n "$ROWS" ] && rows=(--rows "$ROWS")
 PYTHONUNBUFFERED=1 timeout 580 "${PYTHON:-python3}" "$here/surface_peers.py" --inputs "$B/inputs" --out "$OUT" \
   --rthdist "$B/rthdist" --cgal "$B/surface-cgal" --tools rthdist-cpu,rthdist-cpu-1t,cgal --gpu-backends rt-pipeline \
-  --reference rthdist-rt-pipeline --runs 3 --cap 120 "${rows[@]}" 2>&1 | tee "$OUT/log.txt"
+  --surface-bench "$B/rthdist-surface-bench" --kept-backends rt-pipeline \
+  --reference rthdist-rt-pipeline-kept --runs "${RUNS:-3}" --cap 120 "${rows[@]}" 2>&1 | tee "$OUT/log.txt"

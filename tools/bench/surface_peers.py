@@ -12,6 +12,10 @@ Rows
             or rt-pipeline) against Open3D 0.16 RaycastingScene.compute_distance
             (Embree, float32; max over A's vertices) and surface-cgal points
             (CGAL 5.5 AABB_tree closest_point_and_primitive, double).
+            --kept-backends adds rthdist-<backend>-kept: rthdist-surface-bench
+            (--surface-bench), the same call on one Engine that keeps its
+            device (Engine::hausdorffToSurface): one warm-up call, then
+            --runs calls; compute = each call's total.
   surfaces  H(surface A, surface B): rthdist A B --surface both --tolerance T
             (certified [lower, upper], upper - lower <= T) against surface-cgal
             surfaces (CGAL's bounded_error_symmetric_Hausdorff_distance at the
@@ -137,6 +141,22 @@ def rthdist_tool(args, backend, threads=0):
             value["search_ms"] = j["timings_ms"]["search"]
             value["device"] = j["device"]
         return compute, wall, value
+    return run
+
+
+def kept_tool(args, backend):
+    """rthdist-surface-bench: --runs calls on one Engine after a warm-up call."""
+    def run(row, a, b, tolerance):
+        cmd = [args.surface_bench, a, b, "--backend", backend, "--runs", str(args.runs), "--warmup", "1",
+               "--no-verify"]
+        out, wall = run_process(cmd, args.cap * (args.runs + 2))
+        j = json.loads(out)
+        m = j["kept_median_ms"]
+        value = {"h": j["hausdorff"], "query": j["query"], "triangle": j["triangle"], "device": j["device"],
+                 "setup_ms": j["setup_ms"], "warmup_ms": j["warmup_ms"], "counters": j["counters"],
+                 "stages_ms": {k: m[k] for k in ("frame", "upload", "device", "readback", "certify", "gpu",
+                                                 "gpu_build")}}
+        return j["kept_total_ms_all"], j["kept_wall_ms_all"], value
     return run
 
 
@@ -301,6 +321,9 @@ def main():
     ap.add_argument("--tools", default="rthdist-cpu,open3d,cgal,meshlab")
     ap.add_argument("--gpu-backends", default="", help="rthdist backends for points rows, e.g. ray-query")
     ap.add_argument("--gpu-rows", default="", help="points rows the GPU backends run (default: all points rows)")
+    ap.add_argument("--kept-backends", default="",
+                    help="rthdist backends timed on a kept Engine (rthdist-surface-bench) for points rows")
+    ap.add_argument("--surface-bench", default="build/rthdist-surface-bench")
     ap.add_argument("--reference", default="rthdist-cpu",
                     help="ratios against this rthdist (e.g. rthdist-rt-pipeline); rows it did not run: rthdist-cpu")
     ap.add_argument("--meshlab-samples-per-face", type=int, default=10)
@@ -335,6 +358,7 @@ def main():
         elif name:
             sys.exit("unknown tool " + name)
     gpu = [b for b in args.gpu_backends.split(",") if b]
+    kept = [b for b in args.kept_backends.split(",") if b]
     gpu_rows = set(r for r in args.gpu_rows.split(",") if r)
     wanted = set(r for r in args.rows.split(",") if r)
     rows = [r for r in ROWS if not wanted or r[0] in wanted]
@@ -369,10 +393,16 @@ def main():
         row_tools = [t for t in tools if t.startswith("rthdist") or t in PEERS[kind]]
         if kind == "points":
             row_tools += ["rthdist-" + g for g in gpu if not gpu_rows or name in gpu_rows]
+            row_tools += ["rthdist-" + k + "-kept" for k in kept if not gpu_rows or name in gpu_rows]
         per_tool = {}
         pa, pb = os.path.join(folder, a + ".ply"), os.path.join(folder, b + ".ply")
         for tool in row_tools:
-            run = tools[tool] if tool in tools else rthdist_tool(args, tool[len("rthdist-"):])
+            if tool in tools:
+                run = tools[tool]
+            elif tool.endswith("-kept"):
+                run = kept_tool(args, tool[len("rthdist-"):-len("-kept")])
+            else:
+                run = rthdist_tool(args, tool[len("rthdist-"):])
             try:
                 compute, wall, value = run(row, pa, pb, row.get("tolerance"))
                 per_tool[tool] = {"compute_ms": statistics.median(compute), "wall_ms": statistics.median(wall),

@@ -53,6 +53,7 @@ Json countersJson(const SurfaceCounters& c) {
             {"dominated", c.dominated},
             {"radii", c.radii},
             {"rays", c.rays},
+            {"submissions", c.submissions},
             {"band", c.band}};
 }
 
@@ -90,11 +91,20 @@ std::string jsonReport(const Run& run) {
     j["a_to_b"] = b ? directedJson(r.directed, run.sides) : Json();
     j["b_to_a"] = b ? Json() : directedJson(r.directed, run.sides);
     if (run.stats != nullptr) j["per_point"] = surfaceStatsJson(*run.stats, !b);
+    const SurfaceStages& st = r.stages;
     j["timings_ms"] = {{"load", run.loadMs},
                        {"build", r.buildMs},
                        {"search", r.searchMs},
                        {"total", r.totalMs},
-                       {"wall", run.wallMs}};
+                       {"wall", run.wallMs},
+                       {"stages",
+                        {{"frame", st.frame},
+                         {"upload", st.upload},
+                         {"device", st.search},
+                         {"readback", st.readback},
+                         {"certify", st.certify},
+                         {"gpu", r.gpuMs},
+                         {"gpu_build", st.gpuBuild}}}};
     j["counters"] = {{"a_to_b", b ? countersJson(r.directed.counters) : Json()},
                      {"b_to_a", b ? Json() : countersJson(r.directed.counters)}};
     return jsonText(j) + "\n";
