@@ -283,12 +283,15 @@ struct SpaceDirection {
 // The host's own work between the pieces' calls (Timings::pieces), added
 // up by every lane.
 struct HostClock {
+    enum Part { kRoundOne, kOpen, kRoundTwo, kParts };
     std::mutex mutex;
     double ms = 0.0;
-    void add(core::Clock::time_point since) {
+    double part[kParts] = {0.0, 0.0, 0.0};
+    void add(core::Clock::time_point since, Part p) {
         const double t = core::msSince(since);
         std::lock_guard lock(mutex);
         ms += t;
+        part[p] += t;
     }
 };
 
@@ -322,6 +325,27 @@ void mergeBests(SpaceDirection& dir, const SpatialPieces& pieces, const CallQuer
         });
 }
 
+// Round one's results: every query of the piece gets its first pair (each
+// position is written once in round one, so nothing is compared and the
+// arrays need no pass before it).
+void storeBests(SpaceDirection& dir, uint64_t first, uint64_t tileStart, const PerPoint& pp, int threads) {
+    const size_t n = pp.nearest.size();
+    core::parallelChunks(n, kHostChunk, core::resolveThreads(threads, n / kHostChunk + 1),
+                         [&](size_t begin, size_t end, int) {
+                             for (size_t k = begin; k < end; ++k) {
+                                 dir.distance[first + k] = pp.distance[k];
+                                 dir.nearest[first + k] = uint32_t(tileStart + pp.nearest[k]);
+                             }
+                         });
+}
+
+// Positions [begin, end) without a pair (their piece holds no targets).
+void storeNone(SpaceDirection& dir, uint64_t begin, uint64_t end) {
+    std::fill(dir.distance.begin() + ptrdiff_t(begin), dir.distance.begin() + ptrdiff_t(end),
+              std::numeric_limits<double>::infinity());
+    std::fill(dir.nearest.begin() + ptrdiff_t(begin), dir.nearest.begin() + ptrdiff_t(end), 0u);
+}
+
 void addCallTo(SharedDirection& shared, const Counters& c, const Timings* t) {
     std::lock_guard lock(shared.mutex);
     addCounters(shared.state.counters, c, true);
@@ -353,7 +377,11 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], const 
         const size_t k = next.fetch_add(1);
         if (k >= pieces.count() || failure.failed.load()) return;
         try {
-            if (qs.size(k) == 0 || ts.size(k) == 0) continue;  // its queries go to other pieces in round two
+            if (qs.size(k) == 0 || ts.size(k) == 0) {  // its queries go to other pieces in round two
+                storeNone(*dirs[qset], qs.start[k], qs.start[k + 1]);
+                if (both) storeNone(*dirs[1], ts.start[k], ts.start[k + 1]);
+                continue;
+            }
             CallOptions piece = pieceOptions(call, true, from + width * double(k) / double(pieces.count()),
                                              width / double(pieces.count()));
             piece.directedOnly = !both;
@@ -365,14 +393,13 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], const 
             const core::Clock::time_point start = core::Clock::now();
             SpaceDirection& first = *dirs[qset];
             addCallTo(first.shared, r->aToB.counters, &r->timings);
-            mergeBests(first, pieces, CallQueries{qs.start[k]}, ts.start[k], r->aNearest, lane.threads);
+            storeBests(first, qs.start[k], ts.start[k], r->aNearest, lane.threads);
             if (both) {
                 addCallTo(dirs[1]->shared, r->bToA.counters, nullptr);
-                mergeBests(*dirs[1], pieces, CallQueries{ts.start[k]}, qs.start[k], r->bNearest,
-                           lane.threads);
+                storeBests(*dirs[1], ts.start[k], qs.start[k], r->bNearest, lane.threads);
             }
             lane.giveBack(std::move(r->aNearest), std::move(r->bNearest));
-            host.add(start);
+            host.add(start, HostClock::kRoundOne);
         } catch (const std::bad_alloc&) {
             failure.set(Error{ErrorCode::kOutOfMemory, "out of host memory in piece " + std::to_string(k) +
                                                            " (device lane " + std::to_string(lane.index) +
@@ -567,7 +594,7 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
                 selected = selectFor(round, uint32_t(j), first, scale, lane.threads);
                 dir.crossPiece += selected.size();
             }
-            host.add(start);
+            host.add(start, HostClock::kRoundTwo);
             const CallOptions piece =
                 pieceOptions(call, true, from + width * double(j) / double(round.boxes.size()),
                              width / double(round.boxes.size()));
@@ -580,7 +607,7 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
                 core::parallelChunks(n, kHostChunk, lane.threads, [&](size_t begin, size_t end, int) {
                     for (size_t k = begin; k < end; ++k) gathered[k] = qs.points[batch[k]];
                 });
-                host.add(start);
+                host.add(start, HostClock::kRoundTwo);
                 Result<HausdorffResult> r = lane.call(gathered, ts.piece(j), piece);
                 if (!r) {
                     failure.set(r.error());
@@ -594,7 +621,7 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
                                lane.threads);
                 }
                 lane.giveBack(std::move(r->aNearest), PerPoint{});
-                host.add(start);
+                host.add(start, HostClock::kRoundTwo);
             }
         } catch (const std::bad_alloc&) {
             failure.set(Error{ErrorCode::kOutOfMemory, "out of host memory at target piece " +
@@ -682,20 +709,14 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
                                 const CallOptions& call, uint64_t perCall, uint64_t maxPiece,
                                 const DirectedCall& directed, const RecycleCall& recycle, int lanes,
                                 int threads, HostClock& host) {
-    core::Clock::time_point start = core::Clock::now();
+    // Unwritten: round one writes every position once (storeBests, storeNone).
     for (int d = 0; d < 2; ++d) {
-        SpaceDirection* dir = dirs[d];
-        if (dir == nullptr) continue;
-        const size_t n = pieces.set(dir->q).points.size();
-        dir->distance.resize(n);
-        dir->nearest.resize(n);
-        core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
-            std::fill(dir->distance.begin() + ptrdiff_t(begin), dir->distance.begin() + ptrdiff_t(end),
-                      std::numeric_limits<double>::infinity());
-            std::fill(dir->nearest.begin() + ptrdiff_t(begin), dir->nearest.begin() + ptrdiff_t(end), 0u);
-        });
+        if (dirs[d] == nullptr) continue;
+        const size_t n = pieces.set(dirs[d]->q).points.size();
+        dirs[d]->distance.resize(n);
+        dirs[d]->nearest.resize(n);
     }
-    host.add(start);
+    core::Clock::time_point start;
     lanes = int(std::min<size_t>(size_t(std::max(lanes, 1)), pieces.count()));
     {
         RoundFailure failure;
@@ -716,7 +737,7 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
         round.open = openQueries(*dir, pieces, scale, dir->shared.slack, call.perPointDistances,
                                  round.maximum, threads);
         if (round.open.empty()) {
-            host.add(start);
+            host.add(start, HostClock::kOpen);
             continue;
         }
         const SpatialPieces::Set& ts = pieces.set(1 - dir->q);
@@ -725,7 +746,7 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
         for (size_t k = 0; k < pieces.count(); ++k) largestTile = std::max(largestTile, ts.size(k));
         round.maxQueries =
             std::max<uint64_t>(1, std::min(perCall - std::min(perCall - 1, largestTile), maxPiece));
-        host.add(start);
+        host.add(start, HostClock::kOpen);
         for (const bool first : {true, false}) {
             RoundFailure failure;
             round.next = 0;
@@ -773,7 +794,16 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
             limits.b = std::min(tile, (b.size() + l2 - 1) / l2);
         }
         core::Clock::time_point start = core::Clock::now();
-        const SpatialPieces pieces = SpatialPieces::partition(a, b, scale, limits, threads);
+        std::optional<SpatialPieces> cut;
+        try {
+            cut = SpatialPieces::partition(a, b, scale, limits, threads);
+        } catch (const std::bad_alloc&) {
+            return Error{ErrorCode::kOutOfMemory,
+                         "out of host memory cutting " + std::to_string(a.size()) + " + " +
+                             std::to_string(b.size()) + " points into pieces in space (about " +
+                             std::to_string((a.size() + b.size()) * 20 / 1000000) + " MB beside the inputs)"};
+        }
+        const SpatialPieces& pieces = *cut;
         partitionMs = core::msSince(start);
         SpaceDirection dirAB, dirBA;
         dirAB.q = 0;
@@ -790,9 +820,12 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
         if (trace) {
             std::fprintf(stderr,
                          "rthdist pieces: %zu in space (%u cells an axis), partition %.1f ms, between calls "
-                         "%.1f ms, results %.1f ms, queries past their piece %llu + %llu\n",
-                         pieces.count(), pieces.cellsPerAxis(), partitionMs, host.ms, finishMs,
-                         (unsigned long long)dirAB.crossPiece, (unsigned long long)dirBA.crossPiece);
+                         "%.1f ms (round one %.1f, open queries %.1f, round two %.1f), results %.1f ms, "
+                         "queries past their piece %llu + %llu\n",
+                         pieces.count(), pieces.cellsPerAxis(), partitionMs, host.ms,
+                         host.part[HostClock::kRoundOne], host.part[HostClock::kOpen],
+                         host.part[HostClock::kRoundTwo], finishMs, (unsigned long long)dirAB.crossPiece,
+                         (unsigned long long)dirBA.crossPiece);
         }
         if (release) release();
     }
@@ -880,7 +913,10 @@ Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const Call
     for (;;) {
         Result<HausdorffResult> r =
             computeWithin(a, b, scale, call, budget, directed, recycle, release, lanes, threads, trace);
-        if (r || r.error().code != ErrorCode::kOutOfMemory || budget.pointsPerCall() < 4) return r;
+        // The host's own memory does not grow with a smaller budget.
+        if (r || r.error().code != ErrorCode::kOutOfMemory || budget.pointsPerCall() < 4 ||
+            r.error().message.rfind("out of host memory", 0) == 0)
+            return r;
         if (release) release();
         budget.bytes /= 2;
         budget.source += ", halved after: " + r.error().message;

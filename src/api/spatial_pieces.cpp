@@ -55,6 +55,13 @@ uint32_t SpatialPieces::cellOf(const glm::dvec3& p) const {
 }
 
 bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) const {
+    // Most queries: a box of at most half a cell a side around q lies within
+    // the 3x3x3 cells around q's (each axis's cell moves by at most one), and
+    // q's cell is solid (it and its neighbours hold piece k's points only, or none).
+    if (radius * m_inverse[0] <= 0.5 && radius * m_inverse[1] <= 0.5 && radius * m_inverse[2] <= 0.5) {
+        const uint32_t cell = cellOf(glm::dvec3(q));
+        if (m_solid[cell] != 0 && m_owner[cell] == k) return true;
+    }
     uint32_t lo[3], hi[3];
     uint64_t cells = 1;
     for (int axis = 0; axis < 3; ++axis) {
@@ -164,6 +171,31 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
     }
     if (open) ++pieces;
     out.m_pieces = pieces;
+
+    // Solid cells: a cell of one piece whose neighbours hold that piece's
+    // points only, or none (boxInPiece's first test).
+    out.m_solid.assign(cellCount, 0);
+    const auto side = int(out.m_cells);
+    core::parallelChunks(cellCount, 4096, threads, [&](size_t begin, size_t end, int) {
+        for (size_t cell = begin; cell < end; ++cell) {
+            const uint32_t owner = out.m_owner[cell];
+            if (owner == kEmpty || owner == kShared) continue;
+            int c[3] = {0, 0, 0};
+            for (int bit = 0; bit < 7; ++bit)
+                for (int axis = 0; axis < 3; ++axis) c[axis] |= int((cell >> (3 * bit + axis)) & 1u) << bit;
+            bool solid = true;
+            for (int dz = -1; dz <= 1 && solid; ++dz)
+                for (int dy = -1; dy <= 1 && solid; ++dy)
+                    for (int dx = -1; dx <= 1 && solid; ++dx) {
+                        const int x = c[0] + dx, y = c[1] + dy, z = c[2] + dz;
+                        if (x < 0 || y < 0 || z < 0 || x >= side || y >= side || z >= side) continue;
+                        const uint32_t o =
+                            out.m_owner[core::mortonEncode(uint32_t(x), uint32_t(y), uint32_t(z))];
+                        solid = o == owner || o == kEmpty;
+                    }
+            out.m_solid[cell] = solid ? 1 : 0;
+        }
+    });
 
     // Each point's piece (its key overwritten), then a stable scatter by piece.
     for (int s = 0; s < 2; ++s) {

@@ -79,7 +79,8 @@ private:
     uint32_t m_cells = 1;  // per axis (a power of two)
     double m_lo[3] = {0.0, 0.0, 0.0};
     double m_inverse[3] = {1.0, 1.0, 1.0};  // cells per unit on each axis
-    std::vector<uint32_t> m_owner;          // per cell (Morton code): its piece, kEmpty or kShared
+    std::vector<uint8_t> m_solid;   // per cell: it and its neighbours hold one piece's points, or none
+    std::vector<uint32_t> m_owner;  // per cell (Morton code): its piece, kEmpty or kShared
 };
 
 }  // namespace rthdist::api
