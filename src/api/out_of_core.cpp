@@ -456,10 +456,13 @@ std::vector<TileBox> tileBoxes(const SpatialPieces::Set& ts, double scale, int t
         const int n = core::resolveThreads(threads, t.size() / kHostChunk + 1);
         std::vector<glm::vec3> lo(size_t(n), t[0]), hi(size_t(n), t[0]);
         core::parallelChunks(t.size(), kHostChunk, n, [&](size_t begin, size_t end, int w) {
+            glm::vec3 l = t[begin], h = t[begin];  // kept in registers, not in the shared vectors
             for (size_t i = begin; i < end; ++i) {
-                lo[size_t(w)] = glm::min(lo[size_t(w)], t[i]);
-                hi[size_t(w)] = glm::max(hi[size_t(w)], t[i]);
+                l = glm::min(l, t[i]);
+                h = glm::max(h, t[i]);
             }
+            lo[size_t(w)] = glm::min(lo[size_t(w)], l);
+            hi[size_t(w)] = glm::max(hi[size_t(w)], h);
         });
         for (int w = 1; w < n; ++w) {
             lo[0] = glm::min(lo[0], lo[size_t(w)]);
@@ -484,19 +487,21 @@ std::vector<OpenQuery> openQueries(const SpaceDirection& dir, const SpatialPiece
         auto home =
             uint32_t(std::upper_bound(qs.start.begin(), qs.start.end(), begin) - qs.start.begin() - 1);
         std::vector<OpenQuery>& open = parts[begin / kHostChunk];
-        SettledMaximum& best = maxima[size_t(w)];
+        SettledMaximum best = maxima[size_t(w)];  // a copy: no cache line shared while it runs
         for (size_t p = begin; p < end; ++p) {
             while (p >= qs.start[home + 1]) ++home;
             const double d = dir.distance[p];
+            const double radius = d * scale * (1.0 + 0x1p-12) + slack;
             if (d == std::numeric_limits<double>::infinity() ||
-                !pieces.boxInPiece(core::scaled(qs.points[p], scale), d * scale * (1.0 + 0x1p-12) + slack,
-                                   home)) {
+                (!pieces.solidAround(qs.cell[p], radius) &&
+                 !pieces.boxInPiece(core::scaled(qs.points[p], scale), radius, home))) {
                 open.push_back({uint32_t(p), home, UINT32_MAX});
                 continue;
             }
             const SettledMaximum m{d, qs.input[p], p};
             if (m.beats(best)) best = m;
         }
+        maxima[size_t(w)] = best;
     });
     maximum = {};
     if (!perPoint)
@@ -642,11 +647,12 @@ DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces,
     const size_t n = qs.points.size();
     std::vector<SettledMaximum> maxima(size_t(core::resolveThreads(threads)));
     core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int w) {
-        SettledMaximum& m = maxima[size_t(w)];
+        SettledMaximum m = maxima[size_t(w)];  // a copy: no cache line shared while it runs
         for (size_t p = begin; p < end; ++p) {
             const SettledMaximum here{dir.distance[p], qs.input[p], p};
             if (here.beats(m)) m = here;
         }
+        maxima[size_t(w)] = m;
     });
     SettledMaximum top;
     for (const SettledMaximum& m : maxima)

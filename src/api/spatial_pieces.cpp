@@ -54,14 +54,12 @@ uint32_t SpatialPieces::cellOf(const glm::dvec3& p) const {
     return core::mortonEncode(axisCell(p.x, 0), axisCell(p.y, 1), axisCell(p.z, 2));
 }
 
+bool SpatialPieces::solidAround(uint32_t cell, double radius) const {
+    return radius * m_inverse[0] <= 0.5 && radius * m_inverse[1] <= 0.5 && radius * m_inverse[2] <= 0.5 &&
+           ((m_solid[cell >> 6] >> (cell & 63u)) & 1u) != 0;
+}
+
 bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) const {
-    // Most queries: a box of at most half a cell a side around q lies within
-    // the 3x3x3 cells around q's (each axis's cell moves by at most one), and
-    // q's cell is solid (it and its neighbours hold piece k's points only, or none).
-    if (radius * m_inverse[0] <= 0.5 && radius * m_inverse[1] <= 0.5 && radius * m_inverse[2] <= 0.5) {
-        const uint32_t cell = cellOf(glm::dvec3(q));
-        if (m_solid[cell] != 0 && m_owner[cell] == k) return true;
-    }
     uint32_t lo[3], hi[3];
     uint64_t cells = 1;
     for (int axis = 0; axis < 3; ++axis) {
@@ -174,9 +172,9 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
 
     // Solid cells: a cell of one piece whose neighbours hold that piece's
     // points only, or none (boxInPiece's first test).
-    out.m_solid.assign(cellCount, 0);
+    out.m_solid.assign((cellCount + 63) / 64, 0);
     const auto side = int(out.m_cells);
-    core::parallelChunks(cellCount, 4096, threads, [&](size_t begin, size_t end, int) {
+    core::parallelChunks(cellCount, 4096, threads, [&](size_t begin, size_t end, int) {  // 64 cells a word
         for (size_t cell = begin; cell < end; ++cell) {
             const uint32_t owner = out.m_owner[cell];
             if (owner == kEmpty || owner == kShared) continue;
@@ -193,11 +191,11 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
                             out.m_owner[core::mortonEncode(uint32_t(x), uint32_t(y), uint32_t(z))];
                         solid = o == owner || o == kEmpty;
                     }
-            out.m_solid[cell] = solid ? 1 : 0;
+            if (solid) out.m_solid[cell >> 6] |= uint64_t(1) << (cell & 63u);
         }
     });
 
-    // Each point's piece (its key overwritten), then a stable scatter by piece.
+    // Each point's piece, then a stable scatter by piece.
     for (int s = 0; s < 2; ++s) {
         const Span points = sets[s];
         const Ranges& r = ranges[s];
@@ -214,22 +212,26 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
                 before += counts[s][size_t(t)][sharedCells[j]];
             }
         }
-        std::vector<std::vector<uint64_t>> perPiece(size_t(r.count), std::vector<uint64_t>(pieces, 0));
-        forRanges(r, [&](int t, size_t begin, size_t end) {
-            std::vector<uint64_t>& rank = rankBase[size_t(t)];
-            std::vector<uint64_t>& mine = perPiece[size_t(t)];
-            for (size_t i = begin; i < end; ++i) {
-                const uint32_t cell = key[s][i];
-                uint32_t piece = firstPiece[cell];
-                if (span[cell] > 1) {
-                    const size_t j = size_t(std::lower_bound(sharedCells.begin(), sharedCells.end(), cell) -
-                                            sharedCells.begin());
-                    piece += uint32_t(rank[j]++ * span[cell] / total[s][cell]);
-                }
-                key[s][i] = piece;
-                ++mine[piece];
+        // A point's piece from its cell (and, in a shared cell, its rank
+        // there in input order: the ranges run in order, so the scatter
+        // below finds the same pieces with a fresh copy of the bases).
+        auto pieceOf = [&](uint32_t cell, std::vector<uint64_t>& rank) {
+            uint32_t piece = firstPiece[cell];
+            if (span[cell] > 1) {
+                const auto j = size_t(std::lower_bound(sharedCells.begin(), sharedCells.end(), cell) -
+                                      sharedCells.begin());
+                piece += uint32_t(rank[j]++ * span[cell] / total[s][cell]);
             }
-        });
+            return piece;
+        };
+        std::vector<std::vector<uint64_t>> perPiece(size_t(r.count), std::vector<uint64_t>(pieces, 0));
+        {
+            std::vector<std::vector<uint64_t>> rank = rankBase;
+            forRanges(r, [&](int t, size_t begin, size_t end) {
+                std::vector<uint64_t>& mine = perPiece[size_t(t)];
+                for (size_t i = begin; i < end; ++i) ++mine[pieceOf(key[s][i], rank[size_t(t)])];
+            });
+        }
         Set& set = s == 0 ? out.m_a : out.m_b;
         set.start.assign(pieces + 1, 0);
         for (uint32_t k = 0; k < pieces; ++k) {
@@ -248,12 +250,16 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         }
         set.points.resize(points.size());
         set.input.resize(points.size());
+        set.cell.resize(points.size());
         forRanges(r, [&](int t, size_t begin, size_t end) {
             std::vector<uint64_t>& next = perPiece[size_t(t)];
+            std::vector<uint64_t>& rank = rankBase[size_t(t)];
             for (size_t i = begin; i < end; ++i) {
-                const uint64_t at = next[key[s][i]]++;
+                const uint32_t cell = key[s][i];
+                const uint64_t at = next[pieceOf(cell, rank)]++;
                 set.points[at] = points[i];
                 set.input[at] = uint32_t(i);
+                set.cell[at] = cell;
             }
         });
         key[s] = {};

@@ -13,10 +13,10 @@
 //
 // Threading: partition() runs its passes on `threads` threads (0: all); the
 // object is then read-only and may be read from any thread.
-// Memory: per set 16 bytes per point (the gathered copy and its input
-// indices) plus 4 bytes per point while partitioning; the grid at most
-// 2^21 cells (8 bytes each) and 4 bytes per cell and host thread while
-// partitioning.
+// Memory: per set 20 bytes per point (the gathered copy, its input indices
+// and cells) plus 4 bytes per point while partitioning; the grid at most
+// 2^21 cells (4 bytes and a bit each) and 4 bytes per cell and host thread
+// while partitioning.
 // Limits: each set below 2^32 points (the input indices are 32-bit).
 #pragma once
 
@@ -42,6 +42,7 @@ public:
     struct Set {
         core::UninitVector<glm::vec3> points;  // piece after piece, input order within a piece
         core::UninitVector<uint32_t> input;    // the input index of each gathered point
+        core::UninitVector<uint32_t> cell;     // the grid cell of each (its Morton code)
         std::vector<uint64_t> start;           // piece k holds [start[k], start[k + 1])
         [[nodiscard]] std::span<const glm::vec3> piece(size_t k) const {
             return {points.data() + start[k], size_t(start[k + 1] - start[k])};
@@ -66,6 +67,12 @@ public:
     // of it, computed in double for points and box alike. False for a box of
     // more than 64 cells.
     [[nodiscard]] bool boxInPiece(const glm::vec3& q, double radius, uint32_t k) const;
+    // The same answer, cheaper, for most points of a spread set: true when a
+    // box of `radius` (at most half a cell a side) around a point of `cell`
+    // (Set::cell) stays within the cells around it, and those hold the
+    // points of that cell's piece only, or none (a "solid" cell; each axis's
+    // cell moves by at most one). False says nothing: ask boxInPiece.
+    [[nodiscard]] bool solidAround(uint32_t cell, double radius) const;
 
 private:
     static constexpr uint32_t kEmpty = UINT32_MAX;       // a cell without points
@@ -79,7 +86,7 @@ private:
     uint32_t m_cells = 1;  // per axis (a power of two)
     double m_lo[3] = {0.0, 0.0, 0.0};
     double m_inverse[3] = {1.0, 1.0, 1.0};  // cells per unit on each axis
-    std::vector<uint8_t> m_solid;   // per cell: it and its neighbours hold one piece's points, or none
+    std::vector<uint64_t> m_solid;  // a bit per cell: it and its neighbours hold one piece's points, or none
     std::vector<uint32_t> m_owner;  // per cell (Morton code): its piece, kEmpty or kShared
 };
 

@@ -74,9 +74,9 @@ TEST(SpatialPieces, CrowdedCellsAreSplitByInputOrder) {
     expectAPartition(pieces, sets, limits);
 }
 
-// boxInPiece: whenever it says a box lies in piece k, no point of another
-// piece (of either set) lies in that box; and it does say so for most
-// small boxes around points of a spread cloud.
+// boxInPiece and solidAround: whenever either says a box lies in piece k,
+// no point of another piece (of either set) lies in that box; and they do
+// say so for most small boxes around points of a spread cloud.
 TEST(SpatialPieces, BoxInPieceHoldsOnlyThatPiecesPoints) {
     const std::vector<glm::vec3> a = cloud(4000, 4, 2.0f, glm::vec3(-1.0f)), b = cloud(4000, 5, 2.0f);
     const double scale = 0.5;  // searched at half size: boxes are in scaled units
@@ -90,22 +90,29 @@ TEST(SpatialPieces, BoxInPieceHoldsOnlyThatPiecesPoints) {
     }
     const std::vector<glm::vec3>* sets[2] = {&a, &b};
     Rng rng(6);
-    size_t inside = 0, tried = 0;
+    size_t inside = 0, solid = 0, tried = 0;
+    const SpatialPieces::Set& qs = pieces.set(0);
     for (size_t i = 0; i < a.size(); i += 7) {
         const glm::vec3 q = core::scaled(a[i], scale);
         const double radius = 0.002 * double(rng.index(50));
         const uint32_t k = pieceOf[0][i];
+        uint64_t g = qs.start[k];
+        while (qs.input[g] != i) ++g;
         ++tried;
-        if (!pieces.boxInPiece(q, radius, k)) continue;
-        ++inside;
+        const bool inBoxOfK = pieces.boxInPiece(q, radius, k);
+        const bool solidAroundIt = pieces.solidAround(qs.cell[g], radius);
+        if (!inBoxOfK && !solidAroundIt) continue;
+        inside += inBoxOfK ? 1 : 0;
+        solid += solidAroundIt ? 1 : 0;
         for (int s = 0; s < 2; ++s)
             for (size_t j = 0; j < sets[s]->size(); ++j) {
                 const glm::vec3 p = core::scaled((*sets[s])[j], scale);
-                const bool inBox =
-                    glm::all(glm::lessThanEqual(glm::abs(glm::dvec3(p) - glm::dvec3(q)), glm::dvec3(radius)));
+                const bool inBox = glm::all(glm::lessThanEqual(glm::abs(glm::dvec3(p) - glm::dvec3(q)),
+                                                               glm::dvec3(radius)));
                 if (inBox) ASSERT_EQ(pieceOf[s][j], k) << "set " << s << " point " << j << " query " << i;
             }
     }
+    EXPECT_GT(solid, 0u);
     EXPECT_GT(inside, tried / 2);
 }
 
