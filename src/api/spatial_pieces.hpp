@@ -15,7 +15,7 @@
 // object is then read-only and may be read from any thread.
 // Memory: per set 20 bytes per point (the gathered copy, its input indices
 // and cells) plus 4 bytes per point while partitioning; the grid at most
-// 2^21 cells (4 bytes and a bit each) and 4 bytes per cell and host thread
+// 2^18 cells (4 bytes and a bit each) and 4 bytes per cell and host thread
 // while partitioning.
 // Limits: each set below 2^32 points (the input indices are 32-bit).
 #pragma once
