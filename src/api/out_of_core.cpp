@@ -778,7 +778,7 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
     const uint64_t maxPiece = std::min(budget.maxPiecePoints, kMaxCallPoints);
     const uint64_t tile = std::min(perCall / 2, maxPiece);
     const bool spaceAB = b.size() > splitAB->targetTile;
-    const bool spaceBA = !call.directedOnly && a.size() > std::min(tile, maxPiece);
+    const bool spaceBA = !call.directedOnly && a.size() > tile;
     const double magnitude = std::max(core::largestMagnitude(a, threads), core::largestMagnitude(b, threads));
     const double slack = core::searchSlack(magnitude * scale);
 
