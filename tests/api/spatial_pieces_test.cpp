@@ -107,8 +107,8 @@ TEST(SpatialPieces, BoxInPieceHoldsOnlyThatPiecesPoints) {
         for (int s = 0; s < 2; ++s)
             for (size_t j = 0; j < sets[s]->size(); ++j) {
                 const glm::vec3 p = core::scaled((*sets[s])[j], scale);
-                const bool inBox = glm::all(glm::lessThanEqual(glm::abs(glm::dvec3(p) - glm::dvec3(q)),
-                                                               glm::dvec3(radius)));
+                const bool inBox =
+                    glm::all(glm::lessThanEqual(glm::abs(glm::dvec3(p) - glm::dvec3(q)), glm::dvec3(radius)));
                 if (inBox) ASSERT_EQ(pieceOf[s][j], k) << "set " << s << " point " << j << " query " << i;
             }
     }
