@@ -507,22 +507,7 @@ std::vector<OpenQuery> openQueries(const SpaceDirection& dir, const SpatialPiece
     if (!perPoint)
         for (const SettledMaximum& m : maxima)
             if (m.beats(maximum)) maximum = m;
-    size_t total = 0;
-    for (const auto& part : parts) total += part.size();
-    std::vector<OpenQuery> all;
-    all.reserve(total);
-    for (const auto& part : parts) all.insert(all.end(), part.begin(), part.end());
-    return all;
-}
-
-// Ascending positions gathered by parallel tasks, each task's list in task order.
-std::vector<uint32_t> concatenate(const std::vector<std::vector<uint32_t>>& parts) {
-    size_t total = 0;
-    for (const std::vector<uint32_t>& part : parts) total += part.size();
-    std::vector<uint32_t> all;
-    all.reserve(total);
-    for (const std::vector<uint32_t>& part : parts) all.insert(all.end(), part.begin(), part.end());
-    return all;
+    return core::concatenateParts<std::vector<OpenQuery>>(parts);
 }
 
 // Round two's shared state: the open queries, what they may meet, and the
@@ -576,7 +561,7 @@ std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double 
             keep.push_back(o.p);
         }
     });
-    return concatenate(parts);
+    return core::concatenateParts<std::vector<uint32_t>>(parts);
 }
 
 // A lane's share of round two: the next tile not yet taken, its selected
@@ -682,7 +667,7 @@ DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces,
             if (d * d >= lo2) parts[begin / kHostChunk].push_back({qs.input[p], ts.input[dir.nearest[p]]});
         }
     });
-    for (const auto& part : parts) band.queries.insert(band.queries.end(), part.begin(), part.end());
+    band.queries = core::concatenateParts<std::vector<core::BandQuery>>(parts);
 
     if (perPoint) {
         s.perPoint.distance.resize(n);
@@ -779,9 +764,6 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
     const uint64_t tile = std::min(perCall / 2, maxPiece);
     const bool spaceAB = b.size() > splitAB->targetTile;
     const bool spaceBA = !call.directedOnly && a.size() > tile;
-    const double magnitude = std::max(core::largestMagnitude(a, threads), core::largestMagnitude(b, threads));
-    const double slack = core::searchSlack(magnitude * scale);
-
     std::optional<DirectionState> ab, ba;
     HostClock host;
     double partitionMs = 0.0, finishMs = 0.0;
@@ -814,7 +796,8 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
         SpaceDirection dirAB, dirBA;
         dirAB.q = 0;
         dirBA.q = 1;
-        dirAB.shared.slack = dirBA.shared.slack = slack;
+        dirAB.shared.slack = dirBA.shared.slack = core::searchSlack(
+            std::max(core::largestMagnitude(a, threads), core::largestMagnitude(b, threads)) * scale);
         SpaceDirection* const dirs[2] = {spaceAB ? &dirAB : nullptr, spaceBA ? &dirBA : nullptr};
         if (auto err = runInSpace(pieces, dirs, scale, call, perCall, maxPiece, directed, recycle, lanes,
                                   threads, host))

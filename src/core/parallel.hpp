@@ -55,4 +55,17 @@ void parallelChunks(size_t count, size_t chunk, int threads, Fn&& fn) {
     runOnPool(task);
 }
 
+// The per-task lists of a parallelChunks pass (one list per chunk, each in
+// its chunk's order) joined in chunk order into one `Out` (a std::vector or
+// UninitVector of their element type), allocated once.
+template <class Out, class Parts>
+[[nodiscard]] Out concatenateParts(const Parts& parts) {
+    size_t total = 0;
+    for (const auto& part : parts) total += part.size();
+    Out all;
+    all.reserve(total);
+    for (const auto& part : parts) all.insert(all.end(), part.begin(), part.end());
+    return all;
+}
+
 }  // namespace rthdist::core

@@ -87,12 +87,7 @@ core::UninitVector<uint64_t> decodeBits(std::span<const uint32_t> bits, Dims dim
             }
         }
     });
-    size_t total = 0;
-    for (const auto& s : out) total += s.size();
-    core::UninitVector<uint64_t> joined;
-    joined.reserve(total);
-    for (const auto& s : out) joined.insert(joined.end(), s.begin(), s.end());
-    return joined;
+    return core::concatenateParts<core::UninitVector<uint64_t>>(out);
 }
 
 }  // namespace

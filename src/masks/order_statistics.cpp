@@ -96,8 +96,7 @@ std::pair<double, double> bucketSelect(std::span<const double> values, size_t k,
         }
         inside[b / kChunk] = std::move(in);
     });
-    std::vector<double> gathered;
-    for (const auto& in : inside) gathered.insert(gathered.end(), in.begin(), in.end());
+    std::vector<double> gathered = core::concatenateParts<std::vector<double>>(inside);
     // The values of ranks below .. upTo - 1: k and (unless k is the last) k + 1.
     return nthAndNext(gathered, k - below);
 }

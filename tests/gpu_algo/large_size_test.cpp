@@ -146,6 +146,21 @@ std::vector<glm::vec3> crowdedSphere(uint64_t seed, int n, double radius, double
     return p;
 }
 
+// The crowded inputs of the leaf tests: the density cases of 1,000 to
+// 25,000 points a pair (sampled under the sanitizers) and, last, a noisy
+// sphere of 20k points a set in a unit box whose corners belong to both
+// sets (case seed `seed`, point seeds 100 seed + 1 and + 2).
+std::vector<OracleCase> crowdedCases(uint64_t seed) {
+    std::vector<OracleCase> cases;
+    for (const OracleCase& c : makeDensityCases())
+        if (c.a.size() + c.b.size() <= 25000 && c.a.size() > 1000 && c.b.size() > 1000) cases.push_back(c);
+    cases = sampledCases(cases);
+    cases.push_back(OracleCase{"crowded_sphere_in_unit_box", seed,
+                               crowdedSphere(100 * seed + 1, 20000, 0.005, 2e-6),
+                               crowdedSphere(100 * seed + 2, 20000, 0.005, 2e-6)});
+    return cases;
+}
+
 // Issue 32 (wrong H at 300M x 400M and on a 20M crowded sphere): a query
 // whose pairs did not fit the pair buffer at its first radius, or at the first
 // radius of a new search level, was searched again with the cells it lies in
@@ -164,20 +179,12 @@ TEST(LargeSizes, CrowdedCellsExactWhenPairsOverflow) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
     auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
     ASSERT_TRUE(engine) << engine.error().message;
-    std::vector<OracleCase> cases;
-    for (const OracleCase& c : makeDensityCases())
-        if (c.a.size() + c.b.size() <= 25000 && c.a.size() > 1000 && c.b.size() > 1000) cases.push_back(c);
-    cases.push_back(OracleCase{"crowded_sphere_in_unit_box", 32, crowdedSphere(3201, 20000, 0.005, 2e-6),
-                               crowdedSphere(3202, 20000, 0.005, 2e-6)});
+    const std::vector<OracleCase> cases = crowdedCases(32);
     for (uint32_t tests : {0u, gpu_algo::kCullCellTests}) {
         (*engine)->setCullCellTests(tests);
         for (uint64_t capacity : {uint64_t(64), uint64_t(2000)}) {
             (*engine)->setMaxPairCapacity(capacity);
-            // The sphere (last) always; the density cases sampled under the sanitizers.
-            std::vector<OracleCase> run =
-                sampledCases(std::vector<OracleCase>(cases.begin(), cases.end() - 1));
-            run.push_back(cases.back());
-            for (const OracleCase& c : run) {
+            for (const OracleCase& c : cases) {
                 SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed) + " pairs " +
                              std::to_string(capacity) + " tests " + std::to_string(tests));
                 auto r = (*engine)->compute(c.a, c.b, Options{});
@@ -219,12 +226,7 @@ TEST(LargeSizes, LeafGroupsExactUnderForcedLimits) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
     auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
     ASSERT_TRUE(engine) << engine.error().message;
-    std::vector<OracleCase> cases;
-    for (const OracleCase& c : makeDensityCases())
-        if (c.a.size() + c.b.size() <= 25000 && c.a.size() > 1000 && c.b.size() > 1000) cases.push_back(c);
-    cases = sampledCases(cases);
-    cases.push_back(OracleCase{"crowded_sphere_in_unit_box", 33, crowdedSphere(3301, 20000, 0.005, 2e-6),
-                               crowdedSphere(3302, 20000, 0.005, 2e-6)});
+    const std::vector<OracleCase> cases = crowdedCases(33);
     struct Limits {
         uint32_t groupLeaves, cellTests;
     };
