@@ -59,15 +59,15 @@ _RACE = textwrap.dedent(
 
     backend, dtype = sys.argv[1], np.dtype(sys.argv[2])
     rng = np.random.default_rng(7)
-    a = rng.random((40000, 3)).astype(dtype)
-    b = rng.random((30000, 3)).astype(dtype)
+    a = rng.random((8000, 3)).astype(dtype)
+    b = rng.random((6000, 3)).astype(dtype)
     keep = a.copy()
     stop = False
 
     def writer():  # NaN, inf and huge values in and out of a, as fast as it can
         i = 0
         while not stop:
-            rows = slice(i % 39000, i % 39000 + 1000)
+            rows = slice(i % 7500, i % 7500 + 500)
             a[rows] = (np.nan, np.inf, 1e30)[i % 3]
             a[rows] = keep[rows]
             i += 1

@@ -7,7 +7,7 @@
 # left in build-fuzz/artifacts/<target>/.
 #
 #   tools/fuzz/run.sh                         # every target, 60 s each
-#   RTHDIST_FUZZ_SECONDS=45 tools/fuzz/run.sh # 13 targets in about 5 min on 2 cores (CI: 15 s each)
+#   RTHDIST_FUZZ_SECONDS=45 tools/fuzz/run.sh # 13 targets in about 5 min on 2 cores (CI: 10 s each)
 #   tools/fuzz/run.sh ply gltf                # some targets
 #
 # Targets run side by side, RTHDIST_FUZZ_PARALLEL at a time (default: the
