@@ -113,6 +113,10 @@ struct Counters {
     uint32_t queryChunks = 1;
     uint32_t targetTiles = 1;
     uint64_t crossPieceQueries = 0;
+    // Host views: the targets this direction searched when they were
+    // narrowed to those within reach of its queries (a cluster beside far
+    // strays in the other set: README "Far strays"); 0 when it searched all.
+    uint64_t narrowedTargets = 0;
 };
 
 // The proof of one directed value (README "Exactness"; docs/design.md, "The

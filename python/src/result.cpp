@@ -36,6 +36,7 @@ py::dict counters(const Counters& c) {
     d["query_chunks"] = c.queryChunks;
     d["target_tiles"] = c.targetTiles;
     d["cross_piece_queries"] = c.crossPieceQueries;
+    d["narrowed_targets"] = c.narrowedTargets;
     return d;
 }
 

@@ -8,6 +8,8 @@
 #include "rthdist/version.hpp"
 #include "rthdist/vulkan_interop.hpp"
 
+#include <glm/common.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,6 +23,7 @@
 #include "api/backend.hpp"
 #include "api/certify.hpp"
 #include "api/device_views.hpp"
+#include "api/narrowed_targets.hpp"
 #include "api/out_of_core.hpp"
 #include "api/route_planner.hpp"
 #include "api/surface_engine.hpp"
@@ -320,12 +323,31 @@ Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm:
     return runInPieces(impl, a, b, scale, call, plan.pieces);
 }
 
+Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, const PointView& b,
+                                        const CheckedInputs& checked, const CallOptions& call,
+                                        std::chrono::steady_clock::time_point t0,
+                                        const std::optional<api::NarrowedTargets>& narrowedB,
+                                        const std::optional<api::NarrowedTargets>& narrowedA);
+
 // Host views checked on the host: the frame entered (origin, float copies
-// where needed, the exact scale), the pair run, the frame left.
+// where needed, the exact scale), the pair run, the frame left. A direction
+// whose targets narrow (api/narrowed_targets.hpp) runs alone unless `narrow`
+// is false (the directed calls of computeNarrowed).
 Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, const PointView& b,
                                      const CheckedInputs& checked, const CallOptions& call,
-                                     std::chrono::steady_clock::time_point t0) {
+                                     std::chrono::steady_clock::time_point t0, bool narrow = true) {
     if (auto err = validateCallOptions(call)) return *err;
+    if (narrow) {
+        const int threads = impl.options.threads;
+        std::optional<api::NarrowedTargets> narrowedB = api::narrowTargets(
+            a, checked.a.box, checked.a.floatExact, b, checked.b.box, checked.b.floatExact, threads);
+        std::optional<api::NarrowedTargets> narrowedA;
+        if (!call.directedOnly)
+            narrowedA = api::narrowTargets(b, checked.b.box, checked.b.floatExact, a, checked.a.box,
+                                           checked.a.floatExact, threads);
+        if (narrowedA || narrowedB)
+            return computeNarrowed(impl, a, b, checked, call, t0, narrowedB, narrowedA);
+    }
     const glm::dvec3 origin = core::searchOrigin(checked.a, checked.b);
     if (auto err = core::checkPairFrame(a, checked.a.box, checked.a.floatExact, b, checked.b.box,
                                         checked.b.floatExact, origin))
@@ -336,6 +358,70 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
     return finished(impl, runWithinBudget(impl, fa.span(), fb.span(), scale, call),
                     Frame{origin, a, b, copied}, call, t0);
+}
+
+// A directed result over narrowed targets, in the input's target indices
+// (kept in input order, so the smallest index of a tie is kept too).
+void mapTargetsBack(Directed& d, PerPoint& perPoint, const std::vector<uint64_t>& original) {
+    d.targetIndex = original[d.targetIndex];
+    if (d.certificate.confirmed) d.certificate.nearest = original[d.certificate.nearest];
+    for (uint32_t& n : perPoint.nearest) n = uint32_t(original[n]);
+}
+
+void addTimings(Timings& sum, const Timings& t) {
+    for (auto field : {&Timings::setup, &Timings::upload, &Timings::index, &Timings::cull, &Timings::search,
+                       &Timings::refine, &Timings::check, &Timings::certificate, &Timings::pieces,
+                       &Timings::gpuIndex, &Timings::gpuCull, &Timings::gpuSearch, &Timings::gpuRefine,
+                       &Timings::gpuUpload, &Timings::gpuCertificate})
+        sum.*field += t.*field;
+}
+
+// The two directions as directed calls, a narrowed direction over its kept
+// targets (its own frame), the other over the whole set; results merged
+// back into the input's indices. Per-point arrays are handed back once both
+// directions are done.
+Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, const PointView& b,
+                                        const CheckedInputs& checked, const CallOptions& call,
+                                        std::chrono::steady_clock::time_point t0,
+                                        const std::optional<api::NarrowedTargets>& narrowedB,
+                                        const std::optional<api::NarrowedTargets>& narrowedA) {
+    CallOptions directed = call;
+    directed.directedOnly = true;
+    directed.perPointReady = nullptr;
+    const int threads = impl.options.threads;
+    auto one = [&](const PointView& q, const core::SetSummary& qSummary, const PointView& t,
+                   const core::SetSummary& tSummary,
+                   const std::optional<api::NarrowedTargets>& narrowed) -> Result<HausdorffResult> {
+        if (!narrowed)
+            return computeViews(impl, q, t, CheckedInputs{qSummary, tSummary}, directed, t0, false);
+        Result<core::SetSummary> kept = core::summarizeSet(narrowed->view, "the narrowed targets", threads);
+        if (!kept) return kept.error();
+        Result<HausdorffResult> r =
+            computeViews(impl, q, narrowed->view, CheckedInputs{qSummary, *kept}, directed, t0, false);
+        if (r) {
+            mapTargetsBack(r->aToB, r->aNearest, narrowed->original);
+            r->aToB.counters.narrowedTargets = narrowed->original.size();
+        }
+        return r;
+    };
+    Result<HausdorffResult> r = one(a, checked.a, b, checked.b, narrowedB);
+    if (!r) return r;
+    if (!call.directedOnly) {
+        Result<HausdorffResult> ba = one(b, checked.b, a, checked.a, narrowedA);
+        if (!ba) return ba.error();
+        r->bToA = ba->aToB;
+        r->bNearest = std::move(ba->aNearest);
+        r->directedOnly = false;
+        r->hausdorff = std::max(r->aToB.distance, r->bToA.distance);
+        addTimings(r->timings, ba->timings);
+        r->validationMessages += ba->validationMessages;
+    }
+    r->timings.total = msSince(t0);
+    if (call.perPointReady) {
+        call.perPointReady(0, r->aNearest.nearest);
+        if (!call.directedOnly) call.perPointReady(1, r->bNearest.nearest);
+    }
+    return r;
 }
 
 // Whether two prepared sets can be searched as they are: one frame, within
@@ -371,6 +457,16 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b) {
 
 namespace {
 
+// Whether a direction of the checked pair could narrow (the boxes alone:
+// narrowTargets's first test, before its passes over the targets).
+bool mayNarrow(const CheckedInputs& c, const CallOptions& call) {
+    const bool floatExact = c.a.floatExact && c.b.floatExact;
+    const core::Bounds both{glm::min(c.a.box.lo, c.b.box.lo), glm::max(c.a.box.hi, c.b.box.hi)};
+    const double whole = api::frameMagnitude(both, floatExact);
+    return api::narrowingPays(whole, api::frameMagnitude(c.a.box, floatExact)) ||
+           (!call.directedOnly && api::narrowingPays(whole, api::frameMagnitude(c.b.box, floatExact)));
+}
+
 // Route::kDeviceIngest: a one-shot call on packed float arrays: the device
 // checks, bounds and samples the points; the host only copies them.
 Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
@@ -396,7 +492,16 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOpti
     shape.packedFloat = a.packedFloat() && b.packedFloat();
     const api::Plan plan =
         api::planRoute(shape, call, m_impl->backend->memoryBudget(), m_impl->backend->caps());
-    if (plan.route == api::Route::kDeviceIngest) return computeIngested(*m_impl, a, b, call, t0);
+    if (plan.route == api::Route::kDeviceIngest) {
+        // A small pair's boxes on the host, to look for a narrowed direction
+        // (route_planner.hpp, kNarrowCheckPoints); a bad input is left to the
+        // device's own checks and messages.
+        if (a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call)) {
+            Result<CheckedInputs> checked = checkInputs(a, b, m_impl->options.threads);
+            if (checked && mayNarrow(*checked, call)) return computeViews(*m_impl, a, b, *checked, call, t0);
+        }
+        return computeIngested(*m_impl, a, b, call, t0);
+    }
     if (auto err = validatePerPointSizes(a, b, call)) return *err;
     Result<CheckedInputs> checked = checkInputs(a, b, m_impl->options.threads);
     if (!checked) return checked.error();

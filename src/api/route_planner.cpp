@@ -1,5 +1,6 @@
 #include "api/route_planner.hpp"
 
+#include <cmath>
 #include <string>
 
 namespace rthdist::api {
@@ -117,6 +118,10 @@ Plan planSurfacePairRoute(Backend requested) {
     return refused(ErrorCode::kInvalidArgument,
                    std::string("surface to surface runs on the cpu backend for now (") +
                        backendName(requested) + " requested)");
+}
+
+bool narrowingPays(double wholeMagnitude, double narrowedMagnitude) {
+    return std::ldexp(narrowedMagnitude, kNarrowGainLog2) <= wholeMagnitude;
 }
 
 Plan planFramedCall(uint64_t a, uint64_t b, const CallOptions& call, const MemoryBudget& budget,

@@ -29,6 +29,8 @@
 //       kSurfaceCpu     the CPU backend's triangle BVH (api/surface.cpp); also kAuto
 //       kSurfaceGpu     a GPU backend named by the caller: the device's float search
 //                       over triangle boxes, proven in double on the host (api/surface_gpu.cpp)
+// Host views with a narrowed direction (narrowingPays below) run as two
+// directed calls, each on the routes above.
 // The pieces of kPieces and kSeveralDevices are planned as framed pairs
 // (planFramedCall): a small piece is scanned whole.
 #pragma once
@@ -118,6 +120,18 @@ struct Plan {
 // backend's BVH); a GPU backend is kRefused (kInvalidArgument) for now,
 // never computed on the CPU in its place.
 [[nodiscard]] Plan planSurfacePairRoute(Backend requested);
+
+// Narrowed targets (api/narrowed_targets.hpp), host views: a direction
+// whose targets can be narrowed to those within reach of its queries' box
+// is searched alone, its targets narrowed, in its own frame, when that
+// frame's magnitude (and with it the float search's rounding slack) is at
+// most 2^-kNarrowGainLog2 of the whole pair's; the other direction as it is.
+inline constexpr int kNarrowGainLog2 = 8;
+[[nodiscard]] bool narrowingPays(double wholeMagnitude, double narrowedMagnitude);
+// A kDeviceIngest pair of at most this many points in all takes its boxes on
+// the host (one pass per set) to look for a narrowed direction; larger ones
+// are ingested as they are.
+inline constexpr uint64_t kNarrowCheckPoints = uint64_t(1) << 22;
 
 // The route of a pair already checked and framed on the host (float sets of
 // one frame and scale): kSmallPairScan, kOneCall, kSeveralDevices or kPieces.

@@ -17,6 +17,14 @@ Rows (fixed seeds, both sets written once as float32 binary PLY under --work):
                       both sets (seed 5)
   dragon-far-vertex   Dragon (437,645) vs its decimation res2 (100,250) + the
                       same far vertex 1 km away in both sets
+Issue 33's rows (not run by default: --rows far-..., or --rows extra for all):
+  far-S-one/both      300,000 points per set uniform in an S cube at the origin
+                      (S = 0.1, 1, 10 mm; seeds 6 and 7) + 10 strays 1-10 km
+                      away in random directions in A only (seed 8), or each
+                      set its own (seeds 8 and 9): the far-cluster family
+  crowded-200k/2M     a noisy sphere of radius 0.05 (noise 2e-5) at the
+                      centre of the unit box, the box's corners 0 and 1 in
+                      each set (seeds 10 and 11; scale_gen's "crowded")
 Timing: rthdist-bench (median of --runs timed calls after one warm-up, stage
 medians, the process's own Engine, all hardware threads); cKDTree as in
 peers.py (two trees, two query() calls with workers=-1, builds included,
@@ -45,11 +53,32 @@ from ply_points import read_ply, write_ply  # noqa: E402
 OUTLIER = (1000.0, 1000.0, 1000.0)
 ROWS = ["cluster-200k", "cluster-1M", "cluster-5M", "cauchy-200k", "cauchy-1M", "lidar-fsite8-stray",
         "dragon-far-vertex"]
-SIZES = {"200k": 200_000, "1M": 1_000_000, "5M": 5_000_000}
+FAR_ROWS = ["far-%smm-%s" % (side, where) for side in ("0.1", "1", "10") for where in ("one", "both")]
+EXTRA_ROWS = FAR_ROWS + ["crowded-200k", "crowded-2M"]
+SIZES = {"200k": 200_000, "1M": 1_000_000, "2M": 2_000_000, "5M": 5_000_000}
 
 
 def log(msg):
     print("[density %s] %s" % (time.strftime("%H:%M:%S"), msg), file=sys.stderr, flush=True)
+
+
+FAR_N = 300_000
+
+
+def strays(seed):
+    """10 points 1-10 km from the origin in random directions."""
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(10, 3))
+    return d / np.linalg.norm(d, axis=1, keepdims=True) * rng.uniform(1000.0, 10000.0, (10, 1))
+
+
+def crowded(n, seed):
+    """The scale suite's crowded case (tools/bench/scale_gen.cpp) in NumPy."""
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(n, 3))
+    p = 0.5 + 0.05 * d / np.linalg.norm(d, axis=1, keepdims=True) + 2e-5 * rng.normal(size=(n, 3))
+    p[0], p[1] = 0.0, 1.0
+    return p
 
 
 def make_row(name, data):
@@ -61,6 +90,23 @@ def make_row(name, data):
         far = np.array([OUTLIER])
         return (np.vstack([a, far]).astype(np.float32), np.vstack([b, far]).astype(np.float32),
                 "%d points in a 1 mm cube + one common point 1.7 km away, per set" % n)
+    if name.startswith("far-"):
+        # far-<side>mm-<one|both>: issue 33's far-cluster family (see the docstring).
+        _, side, where = name.split("-")
+        side = float(side[:-2]) * 1e-3
+        a = np.random.default_rng(6).uniform(0.0, side, (FAR_N, 3))
+        b = np.random.default_rng(7).uniform(0.0, side, (FAR_N, 3))
+        a = np.vstack([a, strays(8)])
+        if where == "both":
+            b = np.vstack([b, strays(9)])
+        return (a.astype(np.float32), b.astype(np.float32),
+                "%d points per set in a %g mm cube at the origin + 10 strays 1-10 km away in %s" %
+                (FAR_N, side * 1e3, "A" if where == "one" else "each set (their own)"))
+    if name.startswith("crowded-"):
+        n = SIZES[name.split("-")[1]]
+        a, b = crowded(n, 10), crowded(n, 11)
+        return a.astype(np.float32), b.astype(np.float32), \
+            "%d points per set on a noisy sphere of radius 0.05 in the unit box (its corners in both)" % n
     if name.startswith("cauchy-"):
         n = SIZES[name.split("-")[1]]
         a = np.random.default_rng(3).standard_cauchy((n, 3))
@@ -282,7 +328,8 @@ def main():
     if args.merge:
         results.setdefault("merged_runs", []).append({"backends": args.backends, "tools": args.tools,
                                                       "runs": args.runs, "machine": machine_info(args.bench)})
-    for name in args.rows.split(","):
+    names = [r for x in args.rows.split(",") for r in (EXTRA_ROWS if x == "extra" else [x])]
+    for name in names:
         meta = prepare(name, args.data, args.work)
         a, b = read_ply(meta["a_ply"]).astype(np.float64), read_ply(meta["b_ply"]).astype(np.float64)
         both = np.vstack([a, b])

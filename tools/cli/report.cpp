@@ -67,7 +67,8 @@ Json countersJson(const Counters& c) {
             {"tail_scanned", c.tailScanned},
             {"query_chunks", c.queryChunks},
             {"target_tiles", c.targetTiles},
-            {"cross_piece_queries", c.crossPieceQueries}};
+            {"cross_piece_queries", c.crossPieceQueries},
+            {"narrowed_targets", c.narrowedTargets}};
 }
 
 // One direction; `q`/`t` name the query and target sets ("a"/"b").
@@ -115,6 +116,8 @@ std::string countersText(const Counters& c) {
         appendf(s, ", out of core in %u query chunks x %u target tiles", c.queryChunks, c.targetTiles);
     if (c.crossPieceQueries > 0)
         appendf(s, ", %llu queries past their piece", (unsigned long long)c.crossPieceQueries);
+    if (c.narrowedTargets > 0)
+        appendf(s, ", targets narrowed to %llu", (unsigned long long)c.narrowedTargets);
     return s;
 }
 

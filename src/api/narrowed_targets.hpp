@@ -1,0 +1,55 @@
+// A direction's targets narrowed to those that can be some query's nearest
+// (issue 33's far-cluster family; design.md §13).
+//
+// Why: the float search's rounding slack e (core/certificate.hpp) grows with
+// the largest coordinate of the pair. A dense cluster in one set and a few
+// strays kilometres away in the other make e larger than the cluster's whole
+// extent in the direction whose queries are the cluster alone: no query can
+// be settled within e, every one goes to the rays and the band holds them all.
+// Yet no stray can be such a query's nearest target.
+//
+// The argument: for any query q0 of Q, every query q has
+//   d(q, T) <= |q - q0| + d(q0, T) <= diag(box Q) + d(q0, T) = R,
+// so q's nearest target lies within R of q, hence within R of Q's box. The
+// targets whose distance to Q's box exceeds R are never a nearest target nor
+// tie one: h(Q, T) = h(Q, T'), T' the others, and every query's nearest
+// target in T' is its nearest in T (same distance, same smallest index once
+// T' indices map back in order). R is computed in double and grown by a
+// relative 2^-30 (keeping a target too many costs nothing).
+//
+// The narrowed pair is searched in its own frame (its own origin and scale,
+// core/input_frame.hpp), where the slack scales with the cluster, not the strays.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "core/index_space.hpp"
+#include "rthdist/point_view.hpp"
+
+namespace rthdist::api {
+
+struct NarrowedTargets {
+    std::vector<unsigned char> bytes;  // the kept targets, packed, in the input's scalar type
+    std::vector<uint64_t> original;    // kept position -> index in the input (ascending)
+    PointView view;                    // over `bytes`
+    double radius = 0.0;               // R, grown
+};
+
+// The largest |coordinate| of a box after the frame's origin (zero for
+// float32 coordinates, else the box's centre: core::searchOrigin's rule for
+// one box), as the search would see it.
+[[nodiscard]] double frameMagnitude(const core::Bounds& box, bool floatExact);
+
+// The targets of direction q -> t within R of q's box, when narrowing them
+// leaves a pair whose frame magnitude is at most 2^-kNarrowGainLog2 of the
+// whole pair's (route_planner.hpp, narrowingPays) and drops a target; else
+// nullopt. Boxes and precision from core::summarizeSet; threads as
+// EngineOptions::threads. One pass over t for d(q0, T), one to keep.
+[[nodiscard]] std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bounds& qBox,
+                                                           bool qFloatExact, const PointView& t,
+                                                           const core::Bounds& tBox, bool tFloatExact,
+                                                           int threads);
+
+}  // namespace rthdist::api
