@@ -337,6 +337,10 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
                                      const CheckedInputs& checked, const CallOptions& call,
                                      std::chrono::steady_clock::time_point t0, bool narrow = true) {
     if (auto err = validateCallOptions(call)) return *err;
+    const glm::dvec3 origin = core::searchOrigin(checked.a, checked.b);
+    if (auto err = core::checkPairFrame(a, checked.a.box, checked.a.floatExact, b, checked.b.box,
+                                        checked.b.floatExact, origin))
+        return *err;
     if (narrow) {
         const int threads = impl.options.threads;
         std::optional<api::NarrowedTargets> narrowedB = api::narrowTargets(
@@ -348,10 +352,6 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
         if (narrowedA || narrowedB)
             return computeNarrowed(impl, a, b, checked, call, t0, narrowedB, narrowedA);
     }
-    const glm::dvec3 origin = core::searchOrigin(checked.a, checked.b);
-    if (auto err = core::checkPairFrame(a, checked.a.box, checked.a.floatExact, b, checked.b.box,
-                                        checked.b.floatExact, origin))
-        return *err;
     const core::FloatSet fa(a, origin, impl.options.threads), fb(b, origin, impl.options.threads);
     const double scale = core::exactScale(
         std::max(core::searchMagnitude(checked.a, origin), core::searchMagnitude(checked.b, origin)));
@@ -457,14 +457,20 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b) {
 
 namespace {
 
-// Whether a direction of the checked pair could narrow (the boxes alone:
-// narrowTargets's first test, before its passes over the targets).
-bool mayNarrow(const CheckedInputs& c, const CallOptions& call) {
-    const bool floatExact = c.a.floatExact && c.b.floatExact;
-    const core::Bounds both{glm::min(c.a.box.lo, c.b.box.lo), glm::max(c.a.box.hi, c.b.box.hi)};
-    const double whole = api::frameMagnitude(both, floatExact);
-    return api::narrowingPays(whole, api::frameMagnitude(c.a.box, floatExact)) ||
-           (!call.directedOnly && api::narrowingPays(whole, api::frameMagnitude(c.b.box, floatExact)));
+// A packed float view as the points it holds.
+std::span<const glm::vec3> asVec3(const PointView& v) {
+    return std::span<const glm::vec3>(static_cast<const glm::vec3*>(v.data), v.count);
+}
+
+// Whether a direction of a packed float pair could narrow: its queries'
+// largest |coordinate| (the frame's magnitude of float32 inputs, origin 0)
+// against the pair's; narrowTargets's first test, from one parallel pass
+// per set instead of the host's checks.
+bool mayNarrow(std::span<const glm::vec3> a, std::span<const glm::vec3> b, const CallOptions& call,
+               int threads) {
+    const double ma = core::largestMagnitude(a, threads), mb = core::largestMagnitude(b, threads);
+    const double whole = std::max(ma, mb);
+    return api::narrowingPays(whole, ma) || (!call.directedOnly && api::narrowingPays(whole, mb));
 }
 
 // Route::kDeviceIngest: a one-shot call on packed float arrays: the device
@@ -474,9 +480,6 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
     if (auto err = core::checkShape(a, "A")) return *err;
     if (auto err = core::checkShape(b, "B")) return *err;
     if (auto err = validateCallOptions(call)) return *err;
-    auto asVec3 = [](const PointView& v) {
-        return std::span<const glm::vec3>(static_cast<const glm::vec3*>(v.data), v.count);
-    };
     return finished(impl, impl.backend->computeIngested(asVec3(a), asVec3(b), call),
                     Frame{glm::dvec3(0.0), a, b}, call, t0);
 }
@@ -496,9 +499,11 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOpti
         // A small pair's boxes on the host, to look for a narrowed direction
         // (route_planner.hpp, kNarrowCheckPoints); a bad input is left to the
         // device's own checks and messages.
-        if (a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call)) {
-            Result<CheckedInputs> checked = checkInputs(a, b, m_impl->options.threads);
-            if (checked && mayNarrow(*checked, call)) return computeViews(*m_impl, a, b, *checked, call, t0);
+        const int threads = m_impl->options.threads;
+        if (a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call) &&
+            mayNarrow(asVec3(a), asVec3(b), call, threads)) {
+            Result<CheckedInputs> checked = checkInputs(a, b, threads);
+            if (checked) return computeViews(*m_impl, a, b, *checked, call, t0);
         }
         return computeIngested(*m_impl, a, b, call, t0);
     }

@@ -3,6 +3,10 @@
 # loader: see docs/gpu.md), beside CuPy's KDTree, plus an A/B of the earlier
 # rows of docs/bench/gpu.md against the previous build.
 #   tools/bench/gpu_density_run.sh BUNDLE OUTDIR [ROWS...]
+# ROWS: density.py's names (issue 33's far-* and crowded-* rows included).
+# BEFORE=path: a previous rthdist-bench, run on each row alternated with the
+# new one (3 rounds, lines tagged "build"); AB=0 skips the A/B of the earlier
+# rows of docs/bench/gpu.md at the end.
 # BUNDLE: rthdist, rthdist-bench (new), prev/rthdist-bench (previous build),
 # data/dragon_vrip{,_res2}.ply.gz, ddata/ laid out like ../shared/data
 # (lidar/FSite8_*-utm.ply, stanford/dragon/*.ply.gz).
@@ -26,12 +30,24 @@ for r in "${rows[@]}"; do
   echo "== $r" >> "$OUT/verify.txt"
   timeout 300 "$B/rthdist" "$W/${r}_a.ply" "$W/${r}_b.ply" --backend rt-pipeline --verify >> "$OUT/verify.txt" 2>&1
   echo "exit $?" >> "$OUT/verify.txt"
-  timeout 300 "$B/rthdist-bench" "$W/${r}_a.ply" "$W/${r}_b.ply" --backend rt-pipeline --name "$r" \
-    --runs 7 --warmup 3 --no-verify >> "$OUT/density_rthdist.jsonl" 2>> "$OUT/errors.txt"
+  if [ -n "${BEFORE:-}" ]; then
+    for round in 1 2 3; do
+      for ver in before new; do
+        bin=$B/rthdist-bench; [ $ver = before ] && bin=$BEFORE
+        timeout 300 "$bin" "$W/${r}_a.ply" "$W/${r}_b.ply" --backend rt-pipeline --name "$r" \
+          --runs 7 --warmup 3 --no-verify | sed "s/^{/{\"build\":\"$ver\",\"round\":$round,/" \
+          >> "$OUT/density_rthdist.jsonl" 2>> "$OUT/errors.txt"
+      done
+    done
+  else
+    timeout 300 "$B/rthdist-bench" "$W/${r}_a.ply" "$W/${r}_b.ply" --backend rt-pipeline --name "$r" \
+      --runs 7 --warmup 3 --no-verify >> "$OUT/density_rthdist.jsonl" 2>> "$OUT/errors.txt"
+  fi
 done
 (cd "$here" && timeout 600 python3 gpu_density_peers.py "$W" "${rows[@]}" --runs 5) \
   >> "$OUT/density_peers.jsonl" 2>> "$OUT/errors.txt"
 
+[ "${AB:-1}" = 0 ] && exit 0
 # Earlier rows, previous build vs this one, alternating (3 rounds).
 D=$B/data
 python3 "$here/sample_surface.py" "$D/dragon_vrip.ply.gz" 1000000 1 "$S/s1m_a.ply" &
