@@ -360,12 +360,17 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
                     Frame{origin, a, b, copied}, call, t0);
 }
 
-// A directed result over narrowed targets, in the input's target indices
-// (kept in input order, so the smallest index of a tie is kept too).
+// A directed result over subsets, in the inputs' indices (subsets keep
+// input order, so the smallest index of a tie stays the smallest).
 void mapTargetsBack(Directed& d, PerPoint& perPoint, const std::vector<uint64_t>& original) {
     d.targetIndex = original[d.targetIndex];
     if (d.certificate.confirmed) d.certificate.nearest = original[d.certificate.nearest];
     for (uint32_t& n : perPoint.nearest) n = uint32_t(original[n]);
+}
+
+void mapQueriesBack(Directed& d, const std::vector<uint64_t>& original) {
+    d.queryIndex = original[d.queryIndex];
+    if (d.certificate.confirmed) d.certificate.query = original[d.certificate.query];
 }
 
 void addTimings(Timings& sum, const Timings& t) {
@@ -376,10 +381,28 @@ void addTimings(Timings& sum, const Timings& t) {
         sum.*field += t.*field;
 }
 
+void addCounters(Counters& sum, const Counters& c) {
+    sum.bits = std::max(sum.bits, c.bits);
+    for (auto field : {&Counters::occupiedCells, &Counters::queries, &Counters::culledByNeighbourhood,
+                       &Counters::survivingQueries, &Counters::rays, &Counters::candidatePairs,
+                       &Counters::tailScanned, &Counters::crossPieceQueries})
+        sum.*field += c.*field;
+    sum.iterations += c.iterations;
+}
+
+// Per-point entries of a subset's queries into the whole query set's arrays.
+void scatterPerPoint(PerPoint& whole, const PerPoint& part, const std::vector<uint64_t>& queries) {
+    for (size_t k = 0; k < queries.size(); ++k) {
+        if (!part.nearest.empty()) whole.nearest[queries[k]] = part.nearest[k];
+        if (!part.distance.empty()) whole.distance[queries[k]] = part.distance[k];
+    }
+}
+
 // The two directions as directed calls, a narrowed direction over its kept
-// targets (its own frame), the other over the whole set; results merged
-// back into the input's indices. Per-point arrays are handed back once both
-// directions are done.
+// targets (its own frame; its stray queries, if any, apart against every
+// target), the other over the whole set; results merged back into the
+// input's indices. Per-point arrays are handed back once both directions
+// are done.
 Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, const PointView& b,
                                         const CheckedInputs& checked, const CallOptions& call,
                                         std::chrono::steady_clock::time_point t0,
@@ -389,19 +412,54 @@ Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, 
     directed.directedOnly = true;
     directed.perPointReady = nullptr;
     const int threads = impl.options.threads;
+    auto summary = [threads](const api::PointSubset& s) {
+        return core::summarizeSet(s.view, "a narrowed subset", threads);
+    };
     auto one = [&](const PointView& q, const core::SetSummary& qSummary, const PointView& t,
                    const core::SetSummary& tSummary,
                    const std::optional<api::NarrowedTargets>& narrowed) -> Result<HausdorffResult> {
         if (!narrowed)
             return computeViews(impl, q, t, CheckedInputs{qSummary, tSummary}, directed, t0, false);
-        Result<core::SetSummary> kept = core::summarizeSet(narrowed->view, "the narrowed targets", threads);
+        Result<core::SetSummary> kept = summary(narrowed->targets);
         if (!kept) return kept.error();
+        const bool strays = !narrowed->strays.original.empty();
+        Result<core::SetSummary> coreSummary =
+            strays ? summary(narrowed->core) : Result<core::SetSummary>(qSummary);
+        if (!coreSummary) return coreSummary.error();
         Result<HausdorffResult> r =
-            computeViews(impl, q, narrowed->view, CheckedInputs{qSummary, *kept}, directed, t0, false);
-        if (r) {
-            mapTargetsBack(r->aToB, r->aNearest, narrowed->original);
-            r->aToB.counters.narrowedTargets = narrowed->original.size();
+            computeViews(impl, strays ? narrowed->core.view : q, narrowed->targets.view,
+                         CheckedInputs{*coreSummary, *kept}, directed, t0, false);
+        if (!r) return r;
+        mapTargetsBack(r->aToB, r->aNearest, narrowed->targets.original);
+        r->aToB.counters.narrowedTargets = narrowed->targets.original.size();
+        if (!strays) return r;
+        // The stray queries against every target, in the whole pair's frame.
+        Result<core::SetSummary> straySummary = summary(narrowed->strays);
+        if (!straySummary) return straySummary.error();
+        Result<HausdorffResult> s = computeViews(impl, narrowed->strays.view, t,
+                                                 CheckedInputs{*straySummary, tSummary}, directed, t0, false);
+        if (!s) return s;
+        mapQueriesBack(r->aToB, narrowed->core.original);
+        mapQueriesBack(s->aToB, narrowed->strays.original);
+        if (call.perPointDistances) {
+            PerPoint whole;
+            if (!r->aNearest.nearest.empty()) whole.nearest.resize(q.count);
+            if (!r->aNearest.distance.empty()) whole.distance.resize(q.count);
+            scatterPerPoint(whole, r->aNearest, narrowed->core.original);
+            scatterPerPoint(whole, s->aNearest, narrowed->strays.original);
+            r->aNearest = std::move(whole);
         }
+        // The larger value; on a tie the smaller query index (the brute force's rule).
+        const Directed& c = r->aToB;
+        const Directed& x = s->aToB;
+        Directed winner =
+            x.distance > c.distance || (x.distance == c.distance && x.queryIndex < c.queryIndex) ? x : c;
+        winner.counters = c.counters;
+        addCounters(winner.counters, x.counters);
+        r->aToB = winner;
+        r->hausdorff = winner.distance;
+        addTimings(r->timings, s->timings);
+        r->validationMessages += s->validationMessages;
         return r;
     };
     Result<HausdorffResult> r = one(a, checked.a, b, checked.b, narrowedB);
@@ -470,7 +528,12 @@ bool mayNarrow(std::span<const glm::vec3> a, std::span<const glm::vec3> b, const
                int threads) {
     const double ma = core::largestMagnitude(a, threads), mb = core::largestMagnitude(b, threads);
     const double whole = std::max(ma, mb);
-    return api::narrowingPays(whole, ma) || (!call.directedOnly && api::narrowingPays(whole, mb));
+    // A set's own magnitude, or its sampled core's (strays among its points).
+    auto gains = [whole](std::span<const glm::vec3> q, double m) {
+        return api::narrowingPays(whole, m) ||
+               api::narrowingPays(whole, api::frameMagnitude(api::sampledCore(PointView(q)), true));
+    };
+    return gains(a, ma) || (!call.directedOnly && gains(b, mb));
 }
 
 // Route::kDeviceIngest: a one-shot call on packed float arrays: the device

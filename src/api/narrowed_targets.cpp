@@ -35,6 +35,66 @@ double frameMagnitude(const core::Bounds& box, bool floatExact) {
     return largestAbs(box.lo - origin, box.hi - origin);
 }
 
+namespace {
+
+// The points of `v` at `indices` (ascending), packed in v's scalar type.
+PointSubset subsetOf(const PointView& v, std::vector<uint64_t> indices, int workers) {
+    PointSubset out;
+    out.original = std::move(indices);
+    const size_t pointBytes = 3 * scalarBytes(v.scalar);
+    out.bytes.resize(out.original.size() * pointBytes);
+    core::parallelChunks(out.original.size(), kChunk, workers, [&](size_t begin, size_t end, int) {
+        for (size_t k = begin; k < end; ++k)
+            std::memcpy(out.bytes.data() + k * pointBytes,
+                        static_cast<const unsigned char*>(v.data) + out.original[k] * v.strideBytes,
+                        pointBytes);
+    });
+    out.view =
+        v.scalar == Scalar::kFloat64
+            ? PointView::doubles(reinterpret_cast<const double*>(out.bytes.data()), out.original.size())
+            : PointView::floats(reinterpret_cast<const float*>(out.bytes.data()), out.original.size());
+    return out;
+}
+
+// The indices of v's points for which keep(p) holds, in order.
+template <class Keep>
+std::vector<uint64_t> select(const PointView& v, int workers, const Keep& keep) {
+    const size_t chunks = (v.count + kChunk - 1) / kChunk;
+    std::vector<std::vector<uint64_t>> parts(chunks);
+    core::parallelChunks(v.count, kChunk, workers, [&](size_t begin, size_t end, int) {
+        std::vector<uint64_t>& mine = parts[begin / kChunk];
+        for (size_t i = begin; i < end; ++i)
+            if (keep(v.at(i))) mine.push_back(i);
+    });
+    return core::concatenateParts<std::vector<uint64_t>>(parts);
+}
+
+bool inside(const glm::dvec3& p, const core::Bounds& box) {
+    return glm::all(glm::greaterThanEqual(p, box.lo)) && glm::all(glm::lessThanEqual(p, box.hi));
+}
+
+}  // namespace
+
+core::Bounds sampledCore(const PointView& q) {
+    constexpr size_t kSample = 4096, kDrop = 8;
+    const size_t step = std::max<size_t>(1, q.count / kSample);
+    std::vector<double> axis[3];
+    for (size_t i = 0; i < q.count; i += step) {
+        const glm::dvec3 p = q.at(i);
+        for (int k = 0; k < 3; ++k) axis[k].push_back(p[k]);
+    }
+    core::Bounds box;
+    for (int k = 0; k < 3; ++k) {
+        std::vector<double>& v = axis[k];
+        std::sort(v.begin(), v.end());
+        const size_t drop = v.size() > 4 * kDrop ? kDrop : 0;
+        const double lo = v[drop], hi = v[v.size() - 1 - drop], grow = hi - lo;
+        box.lo[k] = lo - grow;
+        box.hi[k] = hi + grow;
+    }
+    return box;
+}
+
 std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bounds& qBox, bool qFloatExact,
                                              const PointView& t, const core::Bounds& tBox, bool tFloatExact,
                                              int threads) {
@@ -42,54 +102,66 @@ std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bou
     const bool floatExact = qFloatExact && tFloatExact;
     const core::Bounds both{glm::min(qBox.lo, tBox.lo), glm::max(qBox.hi, tBox.hi)};
     const double whole = frameMagnitude(both, floatExact);
-    // The narrowed pair holds Q's box at least: no gain, no pass.
-    if (!narrowingPays(whole, frameMagnitude(qBox, floatExact))) return std::nullopt;
+    const int workers = core::resolveThreads(threads, std::max(q.count, t.count) / kChunk + 1);
+    NarrowedTargets out;
 
-    // d(q0, T) in double over every target.
-    const glm::dvec3 q0 = q.at(0);
-    double nearest2 = std::numeric_limits<double>::infinity();
-    std::mutex merge;
-    const int workers = core::resolveThreads(threads, t.count / kChunk + 1);
-    core::parallelChunks(t.count, kChunk, workers, [&](size_t begin, size_t end, int) {
-        double local = std::numeric_limits<double>::infinity();
-        for (size_t i = begin; i < end; ++i) {
-            const glm::dvec3 d = t.at(i) - q0;
-            local = std::min(local, glm::dot(d, d));
+    // The core: every query when their own box can gain, else those within
+    // a sampled box, when few lie outside it.
+    core::Bounds coreBox = qBox;
+    if (!narrowingPays(whole, frameMagnitude(qBox, floatExact))) {
+        const core::Bounds sampled = sampledCore(q);
+        if (!narrowingPays(whole, frameMagnitude(sampled, floatExact))) return std::nullopt;
+        std::vector<uint64_t> strays =
+            select(q, workers, [&](const glm::dvec3& p) { return !inside(p, sampled); });
+        if (strays.empty() || strays.size() > kMaxStrayQueries || strays.size() == q.count)
+            return std::nullopt;
+        out.core =
+            subsetOf(q, select(q, workers, [&](const glm::dvec3& p) { return inside(p, sampled); }), workers);
+        out.strays = subsetOf(q, std::move(strays), workers);
+        coreBox = core::Bounds{out.core.view.at(0), out.core.view.at(0)};
+        for (size_t i = 1; i < out.core.view.count; ++i) {
+            const glm::dvec3 p = out.core.view.at(i);
+            coreBox.lo = glm::min(coreBox.lo, p);
+            coreBox.hi = glm::max(coreBox.hi, p);
         }
-        const std::lock_guard<std::mutex> lock(merge);
-        nearest2 = std::min(nearest2, local);
-    });
-    const double radius = (glm::length(qBox.hi - qBox.lo) + std::sqrt(nearest2)) * (1.0 + 0x1p-30);
+    }
+    const PointView& coreView = out.strays.original.empty() ? q : out.core.view;
+    // d(p, T) in double over every target.
+    auto nearestDistance = [&](const glm::dvec3& p) {
+        double nearest2 = std::numeric_limits<double>::infinity();
+        std::mutex merge;
+        core::parallelChunks(t.count, kChunk, workers, [&](size_t begin, size_t end, int) {
+            double local = std::numeric_limits<double>::infinity();
+            for (size_t i = begin; i < end; ++i) {
+                const glm::dvec3 d = t.at(i) - p;
+                local = std::min(local, glm::dot(d, d));
+            }
+            const std::lock_guard<std::mutex> lock(merge);
+            nearest2 = std::min(nearest2, local);
+        });
+        return std::sqrt(nearest2);
+    };
+    // A stray query far from every target makes h far larger than the whole
+    // pair's slack (2^-20 of its magnitude): the whole search then settles
+    // the core's queries at once (they cannot raise h), nothing to gain.
+    if (!out.strays.original.empty() &&
+        nearestDistance(out.strays.view.at(0)) >= std::ldexp(whole, kNarrowGainLog2 - 20))
+        return std::nullopt;
+
+    const double radius =
+        (glm::length(coreBox.hi - coreBox.lo) + nearestDistance(coreView.at(0))) * (1.0 + 0x1p-30);
     if (!std::isfinite(radius)) return std::nullopt;
-    const core::Bounds reach{glm::max(qBox.lo - radius, tBox.lo), glm::min(qBox.hi + radius, tBox.hi)};
-    const core::Bounds narrowed{glm::min(qBox.lo, reach.lo), glm::max(qBox.hi, reach.hi)};
+    const core::Bounds reach{glm::max(coreBox.lo - radius, tBox.lo), glm::min(coreBox.hi + radius, tBox.hi)};
+    const core::Bounds narrowed{glm::min(coreBox.lo, reach.lo), glm::max(coreBox.hi, reach.hi)};
     if (!narrowingPays(whole, frameMagnitude(narrowed, floatExact))) return std::nullopt;
 
-    // The targets within R of Q's box, in input order.
+    // The targets within R of the core's box, in input order.
     const double radius2 = radius * radius;
-    const size_t chunks = (t.count + kChunk - 1) / kChunk;
-    std::vector<std::vector<uint64_t>> parts(chunks);
-    core::parallelChunks(t.count, kChunk, workers, [&](size_t begin, size_t end, int) {
-        std::vector<uint64_t>& mine = parts[begin / kChunk];
-        for (size_t i = begin; i < end; ++i)
-            if (boxDistance2(t.at(i), qBox) <= radius2) mine.push_back(i);
-    });
-    NarrowedTargets out;
-    out.original = core::concatenateParts<std::vector<uint64_t>>(parts);
-    if (out.original.empty() || out.original.size() == t.count) return std::nullopt;
+    std::vector<uint64_t> kept =
+        select(t, workers, [&](const glm::dvec3& p) { return boxDistance2(p, coreBox) <= radius2; });
+    if (kept.empty() || kept.size() == t.count) return std::nullopt;
     out.radius = radius;
-    const size_t pointBytes = 3 * scalarBytes(t.scalar);
-    out.bytes.resize(out.original.size() * pointBytes);
-    core::parallelChunks(out.original.size(), kChunk, workers, [&](size_t begin, size_t end, int) {
-        for (size_t k = begin; k < end; ++k)
-            std::memcpy(out.bytes.data() + k * pointBytes,
-                        static_cast<const unsigned char*>(t.data) + out.original[k] * t.strideBytes,
-                        pointBytes);
-    });
-    out.view =
-        t.scalar == Scalar::kFloat64
-            ? PointView::doubles(reinterpret_cast<const double*>(out.bytes.data()), out.original.size())
-            : PointView::floats(reinterpret_cast<const float*>(out.bytes.data()), out.original.size());
+    out.targets = subsetOf(t, std::move(kept), workers);
     return out;
 }
 

@@ -30,23 +30,47 @@
 
 namespace rthdist::api {
 
-struct NarrowedTargets {
-    std::vector<unsigned char> bytes;  // the kept targets, packed, in the input's scalar type
-    std::vector<uint64_t> original;    // kept position -> index in the input (ascending)
-    PointView view;                    // over `bytes`
-    double radius = 0.0;               // R, grown
+// A packed copy of some points of a view, in its scalar type, with their
+// indices in it (ascending).
+struct PointSubset {
+    std::vector<unsigned char> bytes;
+    std::vector<uint64_t> original;  // position -> index in the view
+    PointView view;                  // over `bytes`
 };
+
+struct NarrowedTargets {
+    PointSubset targets;  // within R of the core's box
+    double radius = 0.0;  // R, grown
+    // Queries outside the core (at most kMaxStrayQueries; empty: none, the
+    // core is every query): searched apart against every target. `core`:
+    // the other queries, set only when there are strays.
+    PointSubset core, strays;
+};
+
+// Queries a direction may set apart to narrow the rest (api/narrowed_targets.hpp).
+inline constexpr size_t kMaxStrayQueries = 256;
 
 // The largest |coordinate| of a box after the frame's origin (zero for
 // float32 coordinates, else the box's centre: core::searchOrigin's rule for
 // one box), as the search would see it.
 [[nodiscard]] double frameMagnitude(const core::Bounds& box, bool floatExact);
 
-// The targets of direction q -> t within R of q's box, when narrowing them
-// leaves a pair whose frame magnitude is at most 2^-kNarrowGainLog2 of the
-// whole pair's (route_planner.hpp, narrowingPays) and drops a target; else
-// nullopt. Boxes and precision from core::summarizeSet; threads as
-// EngineOptions::threads. One pass over t for d(q0, T), one to keep.
+// A box around most of q's points (q not empty): a strided sample's box
+// (at most ~4,096 points) without its 8 most extreme values on each side of
+// each axis, grown by its extent on every side (the sample misses the
+// core's own extremes). Where the strays are few, they lie outside it.
+[[nodiscard]] core::Bounds sampledCore(const PointView& q);
+
+// The targets of direction q -> t within R of the queries' core box, when
+// narrowing them leaves a pair whose frame magnitude is at most
+// 2^-kNarrowGainLog2 of the whole pair's (route_planner.hpp, narrowingPays)
+// and drops a target; else nullopt. The core is every query, or, when the
+// queries' own box is too large (strays among them), the queries within a
+// box taken from a sample of them and grown by its extent on every side,
+// when at most kMaxStrayQueries lie outside it: h(Q, T) is then the larger
+// of h(core, narrowed T) and h(strays, T). Boxes and precision from
+// core::summarizeSet; threads as EngineOptions::threads. Passes: one over
+// the queries when they have strays, one over t for d(q0, T), one to keep.
 [[nodiscard]] std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bounds& qBox,
                                                            bool qFloatExact, const PointView& t,
                                                            const core::Bounds& tBox, bool tFloatExact,
