@@ -76,7 +76,7 @@ bool inside(const glm::dvec3& p, const core::Bounds& box) {
 }  // namespace
 
 core::Bounds sampledCore(const PointView& q) {
-    constexpr size_t kSample = 4096, kDrop = 8;
+    constexpr size_t kSample = 1024, kDrop = 8;
     const size_t step = std::max<size_t>(1, q.count / kSample);
     std::vector<double> axis[3];
     for (size_t i = 0; i < q.count; i += step) {
@@ -86,9 +86,11 @@ core::Bounds sampledCore(const PointView& q) {
     core::Bounds box;
     for (int k = 0; k < 3; ++k) {
         std::vector<double>& v = axis[k];
-        std::sort(v.begin(), v.end());
         const size_t drop = v.size() > 4 * kDrop ? kDrop : 0;
-        const double lo = v[drop], hi = v[v.size() - 1 - drop], grow = hi - lo;
+        std::nth_element(v.begin(), v.begin() + ptrdiff_t(drop), v.end());
+        const double lo = v[drop];
+        std::nth_element(v.begin(), v.end() - 1 - ptrdiff_t(drop), v.end());
+        const double hi = v[v.size() - 1 - drop], grow = hi - lo;
         box.lo[k] = lo - grow;
         box.hi[k] = hi + grow;
     }

@@ -56,7 +56,7 @@ inline constexpr size_t kMaxStrayQueries = 256;
 [[nodiscard]] double frameMagnitude(const core::Bounds& box, bool floatExact);
 
 // A box around most of q's points (q not empty): a strided sample's box
-// (at most ~4,096 points) without its 8 most extreme values on each side of
+// (about 1,024 points) without its 8 most extreme values on each side of
 // each axis, grown by its extent on every side (the sample misses the
 // core's own extremes). Where the strays are few, they lie outside it.
 [[nodiscard]] core::Bounds sampledCore(const PointView& q);
