@@ -38,8 +38,9 @@ Result<HausdorffResult> ComputeBackend::scanFramed(int, std::span<const glm::vec
     return notOffered("small-pair scan");
 }
 
-Result<HausdorffResult> ComputeBackend::computeIngested(std::span<const glm::vec3>,
-                                                        std::span<const glm::vec3>, const CallOptions&) {
+Result<HausdorffResult> ComputeBackend::computeIngested(
+    std::span<const glm::vec3>, std::span<const glm::vec3>, const CallOptions&,
+    const std::function<bool(const core::Bounds&, const core::Bounds&)>&) {
     return notOffered("device ingest");
 }
 

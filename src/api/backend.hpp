@@ -14,6 +14,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -85,10 +86,12 @@ public:
                                                              std::span<const glm::vec3> b, double scale,
                                                              const CallOptions& call);
     // Route::kDeviceIngest: packed float arrays in their own coordinates
-    // (origin 0), checked by the device.
-    [[nodiscard]] virtual Result<HausdorffResult> computeIngested(std::span<const glm::vec3> a,
-                                                                  std::span<const glm::vec3> b,
-                                                                  const CallOptions& call);
+    // (origin 0), checked by the device. `leave`, when given, sees both
+    // sets' bounds before any index is built; true ends the call with an
+    // empty result (the engine takes the narrowed route instead).
+    [[nodiscard]] virtual Result<HausdorffResult> computeIngested(
+        std::span<const glm::vec3> a, std::span<const glm::vec3> b, const CallOptions& call,
+        const std::function<bool(const core::Bounds&, const core::Bounds&)>& leave = {});
 
     // A set of floats (before the exact power of two `scale`) indexed once;
     // `floats` must outlive the set; `name` labels its buffers.

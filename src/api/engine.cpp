@@ -520,31 +520,44 @@ std::span<const glm::vec3> asVec3(const PointView& v) {
     return std::span<const glm::vec3>(static_cast<const glm::vec3*>(v.data), v.count);
 }
 
-// Whether a direction of a packed float pair could narrow: its queries'
-// largest |coordinate| (the frame's magnitude of float32 inputs, origin 0)
-// against the pair's; narrowTargets's first test, from one parallel pass
-// per set instead of the host's checks.
-bool mayNarrow(std::span<const glm::vec3> a, std::span<const glm::vec3> b, const CallOptions& call,
-               int threads) {
-    const double ma = core::largestMagnitude(a, threads), mb = core::largestMagnitude(b, threads);
+// Whether a direction of a packed float pair could narrow, from the sets'
+// bounds (as the device ingest found them): a set's own magnitude (origin
+// 0 for float32 inputs), or its sampled core's (strays among its points),
+// against the pair's; narrowTargets's first test.
+bool mayNarrow(const core::Bounds& boxA, const core::Bounds& boxB, const PointView& a, const PointView& b,
+               const CallOptions& call) {
+    const double ma = core::largestMagnitude(boxA), mb = core::largestMagnitude(boxB);
     const double whole = std::max(ma, mb);
-    // A set's own magnitude, or its sampled core's (strays among its points).
-    auto gains = [whole](std::span<const glm::vec3> q, double m) {
+    auto gains = [whole](const PointView& q, double m) {
         return api::narrowingPays(whole, m) ||
-               api::narrowingPays(whole, api::frameMagnitude(api::sampledCore(PointView(q)), true));
+               api::narrowingPays(whole, api::frameMagnitude(api::sampledCore(q, 256), true));
     };
     return gains(a, ma) || (!call.directedOnly && gains(b, mb));
 }
 
 // Route::kDeviceIngest: a one-shot call on packed float arrays: the device
 // checks, bounds and samples the points; the host only copies them.
+// Pairs of at most kNarrowCheckPoints points in all look at the device's
+// bounds for a narrowed direction (route_planner.hpp): the device stops
+// before its indexes, and the pair goes the host views' way.
 Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
                                         const CallOptions& call, std::chrono::steady_clock::time_point t0) {
     if (auto err = core::checkShape(a, "A")) return *err;
     if (auto err = core::checkShape(b, "B")) return *err;
     if (auto err = validateCallOptions(call)) return *err;
-    return finished(impl, impl.backend->computeIngested(asVec3(a), asVec3(b), call),
-                    Frame{glm::dvec3(0.0), a, b}, call, t0);
+    bool narrow = false;
+    std::function<bool(const core::Bounds&, const core::Bounds&)> leave;
+    if (a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call))
+        leave = [&](const core::Bounds& boxA, const core::Bounds& boxB) {
+            return narrow = mayNarrow(boxA, boxB, a, b, call);
+        };
+    Result<HausdorffResult> r = impl.backend->computeIngested(asVec3(a), asVec3(b), call, leave);
+    if (narrow) {
+        Result<CheckedInputs> checked = checkInputs(a, b, impl.options.threads);
+        if (!checked) return checked.error();
+        return computeViews(impl, a, b, *checked, call, t0);
+    }
+    return finished(impl, std::move(r), Frame{glm::dvec3(0.0), a, b}, call, t0);
 }
 
 }  // namespace
@@ -558,18 +571,7 @@ Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOpti
     shape.packedFloat = a.packedFloat() && b.packedFloat();
     const api::Plan plan =
         api::planRoute(shape, call, m_impl->backend->memoryBudget(), m_impl->backend->caps());
-    if (plan.route == api::Route::kDeviceIngest) {
-        // A small pair's boxes on the host, to look for a narrowed direction
-        // (route_planner.hpp, kNarrowCheckPoints); a bad input is left to the
-        // device's own checks and messages.
-        const int threads = m_impl->options.threads;
-        if (a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call) &&
-            mayNarrow(asVec3(a), asVec3(b), call, threads)) {
-            Result<CheckedInputs> checked = checkInputs(a, b, threads);
-            if (checked) return computeViews(*m_impl, a, b, *checked, call, t0);
-        }
-        return computeIngested(*m_impl, a, b, call, t0);
-    }
+    if (plan.route == api::Route::kDeviceIngest) return computeIngested(*m_impl, a, b, call, t0);
     if (auto err = validatePerPointSizes(a, b, call)) return *err;
     Result<CheckedInputs> checked = checkInputs(a, b, m_impl->options.threads);
     if (!checked) return checked.error();

@@ -137,10 +137,10 @@ public:
                                                      const CallOptions& call) override {
         return gpu(lane).scanWhole(a, b, scale, call);
     }
-    [[nodiscard]] Result<HausdorffResult> computeIngested(std::span<const glm::vec3> a,
-                                                          std::span<const glm::vec3> b,
-                                                          const CallOptions& call) override {
-        return gpu().computePacked(a, b, call);
+    [[nodiscard]] Result<HausdorffResult> computeIngested(
+        std::span<const glm::vec3> a, std::span<const glm::vec3> b, const CallOptions& call,
+        const std::function<bool(const core::Bounds&, const core::Bounds&)>& leave) override {
+        return gpu().computePacked(a, b, call, leave);
     }
 
     [[nodiscard]] Result<std::shared_ptr<BackendSet>> prepare(std::span<const glm::vec3> floats, double scale,

@@ -75,9 +75,9 @@ bool inside(const glm::dvec3& p, const core::Bounds& box) {
 
 }  // namespace
 
-core::Bounds sampledCore(const PointView& q) {
-    constexpr size_t kSample = 1024, kDrop = 8;
-    const size_t step = std::max<size_t>(1, q.count / kSample);
+core::Bounds sampledCore(const PointView& q, size_t samples) {
+    constexpr size_t kDrop = 8;
+    const size_t step = std::max<size_t>(1, q.count / std::max<size_t>(samples, 1));
     std::vector<double> axis[3];
     for (size_t i = 0; i < q.count; i += step) {
         const glm::dvec3 p = q.at(i);

@@ -56,10 +56,10 @@ inline constexpr size_t kMaxStrayQueries = 256;
 [[nodiscard]] double frameMagnitude(const core::Bounds& box, bool floatExact);
 
 // A box around most of q's points (q not empty): a strided sample's box
-// (about 1,024 points) without its 8 most extreme values on each side of
+// (about `samples` points) without its 8 most extreme values on each side of
 // each axis, grown by its extent on every side (the sample misses the
 // core's own extremes). Where the strays are few, they lie outside it.
-[[nodiscard]] core::Bounds sampledCore(const PointView& q);
+[[nodiscard]] core::Bounds sampledCore(const PointView& q, size_t samples = 1024);
 
 // The targets of direction q -> t within R of the queries' core box, when
 // narrowing them leaves a pair whose frame magnitude is at most

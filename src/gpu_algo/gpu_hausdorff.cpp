@@ -128,10 +128,13 @@ struct GpuHausdorff::State {
     // bounds, chooses both grids (DeviceIngest::chooseGrids: one more
     // submission for the probe of the automatic bit count), and a last
     // submission builds both indexes.
-    // Returns false, having done nothing else, when the sets need the exact
-    // power-of-two scale (index_space.hpp), which the host path applies.
-    bool ingestPair(DeviceSet& da, DeviceSet& db, std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                    const CallOptions& options) {
+    // kHostPath, having done nothing else, when the sets need the exact
+    // power-of-two scale (index_space.hpp), which the host path applies;
+    // kLeft when `leave` took the bounds and ended the call.
+    enum class Ingested { kIndexed, kHostPath, kLeft };
+    Ingested ingestPair(DeviceSet& da, DeviceSet& db, std::span<const glm::vec3> a,
+                        std::span<const glm::vec3> b, const CallOptions& options,
+                        const std::function<bool(const core::Bounds&, const core::Bounds&)>& leave) {
         const auto t0 = Clock::now();
         std::array<DeviceSet*, 2> sets = {&da, &db};
         std::array<std::span<const glm::vec3>, 2> inputs = {a, b};
@@ -157,12 +160,13 @@ struct GpuHausdorff::State {
         ws.timings->gpuIndex += ws.ctx.lastGpuMs() - uploadMs;
         for (size_t k = 0; k < 2; ++k) index.finishIngest(sets[k]->ix, ws.blocks[k]);
         const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
-        if (exactScale(magnitude) != 1.0) return false;
+        if (exactScale(magnitude) != 1.0) return Ingested::kHostPath;
+        if (leave && leave(da.ix.bounds, db.ix.bounds)) return Ingested::kLeft;
         const auto t1 = Clock::now();
         deviceIngest.chooseGrids(indexes, options.bits);
         ws.timings->index += msSince(t1);
         index.buildIndexes(std::array{&da.ix, &db.ix}, /*uploaded=*/true);
-        return true;
+        return Ingested::kIndexed;
     }
 
     // One-shot H of two float sets through the host path: each staged by
@@ -510,14 +514,16 @@ Result<HausdorffResult> GpuHausdorff::computeIndexed(std::span<const glm::vec3> 
     return res;
 }
 
-Result<HausdorffResult> GpuHausdorff::computePacked(std::span<const glm::vec3> a,
-                                                    std::span<const glm::vec3> b,
-                                                    const CallOptions& options) {
+Result<HausdorffResult> GpuHausdorff::computePacked(
+    std::span<const glm::vec3> a, std::span<const glm::vec3> b, const CallOptions& options,
+    const std::function<bool(const core::Bounds&, const core::Bounds&)>& leave) {
     State& st = *m_state;
     HausdorffResult res = st.emptyResult(options);
     auto err = st.guarded(res.timings, [&] {
         DeviceSet da, db;
-        if (!st.ingestPair(da, db, a, b, options)) {
+        const State::Ingested ingested = st.ingestPair(da, db, a, b, options, leave);
+        if (ingested == State::Ingested::kLeft) return;
+        if (ingested == State::Ingested::kHostPath) {
             // Coordinates past 2^40 or below 2^-40: the host path scales them.
             const double magnitude = std::max(largestMagnitude(da.ix.bounds), largestMagnitude(db.ix.bounds));
             st.hostPair(a, b, exactScale(magnitude), options, res);

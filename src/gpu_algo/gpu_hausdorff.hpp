@@ -16,6 +16,7 @@
 // buffers and the acceleration structures of its device).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -70,9 +71,12 @@ public:
     // point), bounds and the bit count's sample come from the device. The
     // caller has checked only the views' shape (count, pointer). For sets
     // that ingests() accepts.
-    [[nodiscard]] Result<HausdorffResult> computePacked(std::span<const glm::vec3> a,
-                                                        std::span<const glm::vec3> b,
-                                                        const CallOptions& options);
+    // `leave`, when given, sees both sets' bounds once the device has them
+    // (before any index is built); true ends the call there, with an empty
+    // result (the caller takes another route: api/narrowed_targets.hpp).
+    [[nodiscard]] Result<HausdorffResult> computePacked(
+        std::span<const glm::vec3> a, std::span<const glm::vec3> b, const CallOptions& options,
+        const std::function<bool(const core::Bounds&, const core::Bounds&)>& leave = {});
     // The points (both sets together) computePacked takes: both indexed in
     // one submission, each with scratch of its own (2^25).
     [[nodiscard]] static uint64_t ingestPoints();
