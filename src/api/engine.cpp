@@ -537,26 +537,30 @@ bool mayNarrow(const core::Bounds& boxA, const core::Bounds& boxB, const PointVi
 
 // Route::kDeviceIngest: a one-shot call on packed float arrays: the device
 // checks, bounds and samples the points; the host only copies them.
-// Pairs of at most kNarrowCheckPoints points in all look at the device's
-// bounds for a narrowed direction (route_planner.hpp): the device stops
-// before its indexes, and the pair goes the host views' way.
+// Pairs of at most kNarrowCheckPoints points in all look for a narrowed
+// direction from the device's bounds (route_planner.hpp): when one narrows,
+// the device stops before its indexes and the directions run narrowed
+// (packed float32 views: their summaries are the device's bounds, float-exact).
 Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
                                         const CallOptions& call, std::chrono::steady_clock::time_point t0) {
     if (auto err = core::checkShape(a, "A")) return *err;
     if (auto err = core::checkShape(b, "B")) return *err;
     if (auto err = validateCallOptions(call)) return *err;
-    bool narrow = false;
+    std::optional<api::NarrowedTargets> narrowedA, narrowedB;
+    std::optional<CheckedInputs> checked;
     std::function<bool(const core::Bounds&, const core::Bounds&)> leave;
     if (a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call))
         leave = [&](const core::Bounds& boxA, const core::Bounds& boxB) {
-            return narrow = mayNarrow(boxA, boxB, a, b, call);
+            if (!mayNarrow(boxA, boxB, a, b, call)) return false;
+            const int threads = impl.options.threads;
+            narrowedB = api::narrowTargets(a, boxA, true, b, boxB, true, threads);
+            if (!call.directedOnly) narrowedA = api::narrowTargets(b, boxB, true, a, boxA, true, threads);
+            if (!narrowedA && !narrowedB) return false;
+            checked = CheckedInputs{core::SetSummary{boxA, true}, core::SetSummary{boxB, true}};
+            return true;
         };
     Result<HausdorffResult> r = impl.backend->computeIngested(asVec3(a), asVec3(b), call, leave);
-    if (narrow) {
-        Result<CheckedInputs> checked = checkInputs(a, b, impl.options.threads);
-        if (!checked) return checked.error();
-        return computeViews(impl, a, b, *checked, call, t0);
-    }
+    if (checked) return computeNarrowed(impl, a, b, *checked, call, t0, narrowedB, narrowedA);
     return finished(impl, std::move(r), Frame{glm::dvec3(0.0), a, b}, call, t0);
 }
 
