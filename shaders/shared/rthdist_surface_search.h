@@ -1,10 +1,10 @@
 // Shared between C++ (src/gpu_algo/surface_search.cpp) and GLSL
 // (surface_search*.r*, surface_search_rq.comp, surface_tail.comp): the push
 // constants of the point-to-surface search (design.md §11). One procedural
-// AABB per triangle, grown by the radius; each query keeps its nearest triangle so
-// far as one packed word (float bits of the squared distance << 32 |
-// triangle), lowered with atomicMin: the smaller distance wins, then the
-// smaller triangle. The device's answer is a candidate only: the host
+// AABB per triangle, grown by the radius; each query keeps its nearest
+// triangle so far as one packed word (float bits of the squared distance
+// << 32 | triangle), lowered with atomicMin: the smaller distance wins, then
+// the smaller triangle. The device's answer is a candidate only: the host
 // proves the value in double (api/surface_certify.hpp).
 #ifndef RTHDIST_SURFACE_SEARCH_H
 #define RTHDIST_SURFACE_SEARCH_H
