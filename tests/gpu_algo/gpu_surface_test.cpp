@@ -547,6 +547,26 @@ TEST(GpuSurfaceTail, FindsTheNearestTriangleOfEveryOpenQuery) {
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
+// The device's group and ray limits forced down: the radii's traces and
+// the tail's dispatch are split into many, and still cover every query.
+TEST(GpuSurfaceTail, SplitDispatchesCoverEveryQuery) {
+    RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx);
+    gpu::DeviceLimits limits = ctx->limits();
+    limits.maxGroupsX = 3;
+    limits.maxRayDispatch = 5;
+    ctx->setLimits(limits);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
+    ASSERT_TRUE(engine) << engine.error().message;
+    for (const FramedCase& c : tailCases()) {
+        if (c.name != "far_copy" && c.name != "far_outliers") continue;
+        Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
+        ASSERT_TRUE(found) << c.name << ": " << found.error().message;
+        expectNearest(c, *found, false);
+        EXPECT_GT(found->tailQueries, 0u) << c.name;
+    }
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
 // Queries on the surface settle at the first radius: no tail.
 TEST(GpuSurfaceTail, DoesNotRunWhereTheRadiiSettleEveryQuery) {
     RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx);
