@@ -407,7 +407,7 @@ std::vector<FramedCase> tailCases() {
     cases.push_back({"far_sphere_copy", ball, moved(ball, across)});
     // Slivers, points and duplicates in the far surface.
     const std::vector<glm::vec3> odd = soup(low, 0.35f, 400, 8, true);
-    cases.push_back({"far_degenerate_copy", odd, moved(far, across)});
+    cases.push_back({"far_degenerate_copy", odd, moved(odd, across)});
     // Queries on and near the surface, and far outliers in the frame's corners.
     FramedCase outliers{"far_outliers", soup(glm::vec3(0.0f), 0.5f, 400, 9, true), {}};
     std::mt19937 rng(10);
