@@ -142,7 +142,8 @@ struct SurfaceStages {
     double frame = 0.0;      // both inputs shifted, scaled and rounded to float (worker pool)
     double upload = 0.0;     // queries, corners and boxes written to the upload buffer (worker pool)
     double search = 0.0;     // the device's submissions, waited for: the upload's copies, every
-                             // radius's boxes, BLAS build or refit and rays, the read-back's copy
+                             // radius's boxes, BLAS build or refit and rays, the read-back's copy;
+                             // where queries are left open, the tail (tree built, descent, copies)
     double readback = 0.0;   // every query's candidate triangle taken from the read-back buffer
     double certify = 0.0;    // the proof in double (the band's exact search included)
     double gpuBuild = 0.0;   // device time of the boxes and BLAS builds and refits (part of gpuMs)
