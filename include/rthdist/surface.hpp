@@ -131,6 +131,7 @@ struct SurfaceCounters {
     uint32_t radii = 0;        // radii searched on the device
     uint64_t rays = 0;         // rays cast over all radii
     uint32_t submissions = 0;  // command buffers the search submitted and waited for
+    uint64_t tailQueries = 0;  // queries the radii left open, searched by the device's tree descent
     uint64_t band = 0;         // queries searched again exactly on the host (the others are proven below h)
 };
 
@@ -138,13 +139,16 @@ struct SurfaceCounters {
 // unless named gpu (all 0 on the CPU backend). searchMs = frame + upload +
 // search + readback + certify, up to the code between them.
 struct SurfaceStages {
-    double frame = 0.0;     // both inputs shifted, scaled and rounded to float (worker pool)
-    double upload = 0.0;    // queries, corners and boxes written to the upload buffer (worker pool)
-    double search = 0.0;    // the device's submissions, waited for: the upload's copies, every
-                            // radius's boxes, BLAS build or refit and rays, the read-back's copy
-    double readback = 0.0;  // every query's candidate triangle taken from the read-back buffer
-    double certify = 0.0;   // the proof in double (the band's exact search included)
-    double gpuBuild = 0.0;  // device time of the boxes and BLAS builds and refits (part of gpuMs)
+    double frame = 0.0;      // both inputs shifted, scaled and rounded to float (worker pool)
+    double upload = 0.0;     // queries, corners and boxes written to the upload buffer (worker pool)
+    double search = 0.0;     // the device's submissions, waited for: the upload's copies, every
+                             // radius's boxes, BLAS build or refit and rays, the read-back's copy;
+                             // where queries are left open, the tail (tree built, descent, copies)
+    double readback = 0.0;   // every query's candidate triangle taken from the read-back buffer
+    double certify = 0.0;    // the proof in double (the band's exact search included)
+    double gpuBuild = 0.0;   // device time of the boxes and BLAS builds and refits (part of gpuMs)
+    double tailBuild = 0.0;  // the tail's tree of the triangles built on the host (part of search)
+    double gpuTail = 0.0;    // device time of the tail's tree descent and its copies (part of gpuMs)
 };
 
 // h(points, surface) with its witness.

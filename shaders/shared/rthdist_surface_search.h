@@ -1,10 +1,10 @@
 // Shared between C++ (src/gpu_algo/surface_search.cpp) and GLSL
-// (surface_search*.r*, surface_search_rq.comp): the push constants of the
-// point-to-surface search (design.md §11). One procedural AABB per
-// triangle, grown by the radius; each query keeps its nearest triangle so
-// far as one packed word (float bits of the squared distance << 32 |
-// triangle), lowered with atomicMin: the smaller distance wins, then the
-// smaller triangle. The device's answer is a candidate only: the host
+// (surface_search*.r*, surface_search_rq.comp, surface_tail.comp): the push
+// constants of the point-to-surface search (design.md §11). One procedural
+// AABB per triangle, grown by the radius; each query keeps its nearest
+// triangle so far as one packed word (float bits of the squared distance
+// << 32 | triangle), lowered with atomicMin: the smaller distance wins, then
+// the smaller triangle. The device's answer is a candidate only: the host
 // proves the value in double (api/surface_certify.hpp).
 #ifndef RTHDIST_SURFACE_SEARCH_H
 #define RTHDIST_SURFACE_SEARCH_H
@@ -42,7 +42,30 @@ struct SurfaceSearchPush {
     uint pad;
 };
 
+// The tail (surface_tail.comp): every query the radii left open descends
+// the float BVH of the triangles (gpu_algo/surface_tree.hpp) nearest-first,
+// measuring each triangle of a leaf it reaches by the rays' own test
+// (surface_visit.glsl, which reads `corners` and `mutant` of this block).
+#define RTHDIST_SURFACE_TAIL_STACK 32  // at least the tree's levels less one (kSurfaceTreeMaxLevels)
+
+struct SurfaceTailPush {
+    uint64_t queries;  // vec4[numQueries]: the points in the search frame
+    uint64_t corners;  // vec4[3 * triangles]: a, b, c of each triangle in the search frame
+    uint64_t best;     // uint64[numQueries]: the packed nearest triangle so far, lowered in place
+    uint64_t nodes;    // Cell[]: the tree, root first (surface_tree.hpp)
+    uint64_t order;    // uint[triangles]: sorted position -> triangle
+    uint64_t counts;   // uint: the queries the tail searched (atomicAdd)
+    uint numQueries;
+    float settled2;  // a query whose best is at most this was settled by the radii
+    uint mutant;     // 1: core::searchMutant (tests only): every third triangle is skipped
+    uint pad;
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(SurfaceTailPush) == 64);
+static_assert(offsetof(SurfaceTailPush, counts) == 40);
+static_assert(offsetof(SurfaceTailPush, numQueries) == 48);
+static_assert(offsetof(SurfaceTailPush, mutant) == 56);
 static_assert(sizeof(SurfaceRadiusCount) == 8);
 static_assert(sizeof(SurfaceSearchPush) == 64);
 static_assert(offsetof(SurfaceSearchPush, numQueries) == 32);

@@ -62,6 +62,9 @@ struct TriangleCandidates {
     double stageMs = 0.0;      // host: the upload buffer written
     double submitMs = 0.0;     // host wall of the submissions (upload copies, radii, read-back copy)
     double readbackMs = 0.0;   // host: the candidates read back
+    uint64_t tailQueries = 0;  // queries the tail's tree descent searched (left open by the radii)
+    double tailBuildMs = 0.0;  // host: the tail's tree built and written (part of submitMs)
+    double tailGpuMs = 0.0;    // device time of the tail (part of gpuMs)
 };
 
 class ComputeBackend {

@@ -182,9 +182,18 @@ public:
                                                               const std::atomic<bool>* cancel) override {
         auto found = gpu().nearestTriangles(queries, corners, cancel);
         if (!found) return found.error();
-        return TriangleCandidates{
-            std::move(found->triangle), found->radii,   found->rays,     found->submissions, found->gpuMs,
-            found->gpuBuildMs,          found->stageMs, found->submitMs, found->readbackMs};
+        return TriangleCandidates{std::move(found->triangle),
+                                  found->radii,
+                                  found->rays,
+                                  found->submissions,
+                                  found->gpuMs,
+                                  found->gpuBuildMs,
+                                  found->stageMs,
+                                  found->submitMs,
+                                  found->readbackMs,
+                                  found->tailQueries,
+                                  found->tailBuildMs,
+                                  found->tailGpuMs};
     }
 
     void releaseScratch() override {

@@ -75,6 +75,7 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
     n.radii = found->radii;
     n.rays = found->rays;
     n.submissions = found->submissions;
+    n.tailQueries = found->tailQueries;
     n.triangles = surface.triangleCount();
     r.stages.frame = frameMs;
     r.stages.upload = found->stageMs;
@@ -82,6 +83,8 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
     r.stages.readback = found->readbackMs;
     r.stages.certify = core::msSince(certifyStart);
     r.stages.gpuBuild = found->gpuBuildMs;
+    r.stages.tailBuild = found->tailBuildMs;
+    r.stages.gpuTail = found->tailGpuMs;
     r.gpuMs = found->gpuMs;
     r.buildMs = 0.0;  // the device's setup, the caller's to add (the band's BVH is certify's)
     r.searchMs = core::msSince(start);

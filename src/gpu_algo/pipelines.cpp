@@ -54,6 +54,7 @@
 #include "surface_search.rgen.h"
 #include "surface_search.rint.h"
 #include "surface_search_rq.comp.h"
+#include "surface_tail.comp.h"
 
 namespace rthdist::gpu {
 
@@ -106,6 +107,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
     {k_spv_cells_total_comp, "cells_total"},
     {k_spv_leaf_groups_comp, "leaf_groups"},
     {k_spv_surface_search_rq_comp, "surface_search_rq"},
+    {k_spv_surface_tail_comp, "surface_tail"},
 }};
 
 }  // namespace
@@ -160,7 +162,8 @@ void Pipelines::createLayout() {
 void Pipelines::createComputePipelines(VkPipelineCache cache) {
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !m_rayQuery) continue;
-        if (Kernel(k) == Kernel::kSurfaceSearchRayQuery) continue;  // prepareSurfaceSearch
+        if (Kernel(k) == Kernel::kSurfaceSearchRayQuery || Kernel(k) == Kernel::kSurfaceTail)
+            continue;  // prepareSurfaceSearch
         // Float64 SPIR-V is valid only on a device with shaderFloat64 enabled.
         if ((Kernel(k) == Kernel::kIngestF64 || Kernel(k) == Kernel::kProbeLevels) && !m_ctx.shaderFloat64())
             continue;
@@ -307,6 +310,11 @@ void Pipelines::cmdTraceRaysIndirect(VkCommandBuffer cmd, const void* push, uint
 }
 
 void Pipelines::prepareSurfaceSearch(VkPipelineCache cache) {
+    const auto tail = size_t(Kernel::kSurfaceTail);
+    if (!m_compute[tail])
+        m_compute[tail] =
+            createComputePipeline(m_ctx, kComputeSpirv[tail].code, m_layout.get(), cache,
+                                  VK_PIPELINE_CREATE_DISPATCH_BASE_BIT, kComputeSpirv[tail].name);
     const auto k = size_t(Kernel::kSurfaceSearchRayQuery);
     if (m_rayQuery && !m_compute[k]) {
         m_compute[k] = createComputePipeline(m_ctx, kComputeSpirv[k].code, m_layout.get(), cache,

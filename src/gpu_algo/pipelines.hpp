@@ -55,6 +55,9 @@ enum class Kernel : uint32_t {
     // The point-to-surface search, ray-query path (surface_search_rq.comp):
     // created by prepareSurfaceSearch only.
     kSurfaceSearchRayQuery,
+    // The point-to-surface search's tail, on both paths (surface_tail.comp):
+    // created by prepareSurfaceSearch only.
+    kSurfaceTail,
     kCount
 };
 
@@ -83,10 +86,11 @@ public:
                               VkDeviceAddress args) const;
     [[nodiscard]] bool tracesIndirect() const;
 
-    // The point-to-surface search's pipeline (design.md §11), created on
-    // first use so that point calls never compile it: the ray-query kernel
+    // The point-to-surface search's pipelines (design.md §11), created on
+    // first use so that point calls never compile them: the ray-query kernel
     // (Kernel::kSurfaceSearchRayQuery), or the ray-tracing pipeline of
-    // surface_search.rgen/rint and its shader binding table.
+    // surface_search.rgen/rint and its shader binding table; and the tail's
+    // kernel (Kernel::kSurfaceTail) on both.
     void prepareSurfaceSearch(VkPipelineCache cache);
     // One surface-search ray-generation invocation per index in [0, width).
     void cmdTraceSurfaceRays(VkCommandBuffer cmd, const void* push, uint32_t pushSize, uint32_t width) const;

@@ -12,6 +12,7 @@
 #include "core/parallel.hpp"
 #include "gpu/barriers.hpp"
 #include "gpu/device_limits.hpp"
+#include "gpu_algo/surface_tree.hpp"
 #include "gpu_algo/workspace.hpp"
 
 namespace rthdist::gpu_algo {
@@ -19,9 +20,6 @@ namespace rthdist::gpu_algo {
 namespace {
 
 constexpr uint32_t kMaxTriangles = uint32_t(1) << 30;  // corner indices 3t + 2 stay in 32 bits
-// At most this share of the queries open, or settled by the last radius:
-// the radius grows 4x (SurfaceRadii::next).
-constexpr uint64_t kTailShare = 16;
 constexpr size_t kStageChunk = size_t(1) << 14;
 
 struct Box {
@@ -48,20 +46,6 @@ SurfaceRadii::SurfaceRadii(double meanSide, double area, uint64_t queries, doubl
 std::vector<double> SurfaceRadii::start() const {
     std::vector<double> radii{m_first};
     if (m_first < m_cover) radii.push_back(std::min(4.0 * m_first, m_cover));
-    return radii;
-}
-
-std::vector<double> SurfaceRadii::next(double last, uint64_t queries, uint64_t searched,
-                                       uint64_t settled) const {
-    std::vector<double> radii;
-    const uint64_t open = searched - std::min(settled, searched);
-    if (open == 0 || last >= m_cover) return radii;
-    const bool fast = open * kTailShare <= queries || settled * kTailShare <= searched;
-    const double growth = fast ? 4.0 : 2.0;
-    for (double r = last; radii.size() < kTailRadii && r < m_cover;) {
-        r = std::min(r * growth, m_cover);
-        radii.push_back(r);
-    }
     return radii;
 }
 
@@ -98,27 +82,24 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     m_rayTMax = radii.first() * 1e-3;
     out.stageMs = msSince(t0);
 
-    // The first submission: the upload, the first radius (which settles most
-    // queries), the tail's first and the read-back; then the tail's, while
-    // queries are open.
+    // The first submission: the upload, the radii (the first settles most
+    // queries) and the read-back; then the tail's, where queries are open.
     t0 = Clock::now();
+    std::fill_n(static_cast<uint32_t*>(m_counts.mapped()), 2 * SurfaceRadii::kStartRadii + 1, 0u);
     VkCommandBuffer cmd = m_ws.ctx.begin();
     cmdUpload(cmd);
-    std::vector<double> batch = radii.start();
-    double settled = -1.0;  // no query is settled before the first radius
-    while (!batch.empty()) {
-        const std::vector<sh::SurfaceRadiusCount> counts = submitRadii(cmd, batch, settled, out);
-        sh::SurfaceRadiusCount last{0u, 0u};  // of the last radius that searched a query
-        for (const sh::SurfaceRadiusCount& c : counts) {
-            if (c.searched == 0) break;
-            ++out.radii;
-            out.rays += c.searched;
-            last = c;
-        }
+    const std::vector<double> start = radii.start();
+    uint64_t open = 0;  // after the last radius that searched a query
+    for (const sh::SurfaceRadiusCount& c : submitRadii(cmd, start, out)) {
+        open = c.searched - std::min(c.settled, c.searched);
+        if (c.searched == 0) break;
+        ++out.radii;
+        out.rays += c.searched;
+    }
+    if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
+    if (open > 0) {
+        submitTail(corners, start.back(), out);
         if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
-        settled = batch.back();
-        batch = radii.next(settled, m_queries, last.searched, last.settled);
-        if (!batch.empty()) cmd = m_ws.ctx.begin();
     }
     out.submitMs = msSince(t0);
 
@@ -137,8 +118,8 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
 }
 
 void SurfaceSearch::release() {
-    for (gpu::Buffer* b :
-         {&m_points, &m_corners, &m_boxes, &m_best, &m_aabbs, &m_staging, &m_readback, &m_counts})
+    for (gpu::Buffer* b : {&m_points, &m_corners, &m_boxes, &m_best, &m_aabbs, &m_staging, &m_readback,
+                           &m_counts, &m_nodes, &m_order})
         b->reset();
 }
 
@@ -155,7 +136,8 @@ SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
     m_ws.grow(m_best, VkDeviceSize(m_queries) * 8, "surface.best");
     m_ws.grow(m_aabbs, VkDeviceSize(m_triangles) * 24, "surface.aabbs");
     m_ws.grow(m_readback, VkDeviceSize(m_queries) * 8, "surface.readback", gpu::MemoryKind::kReadback);
-    m_ws.grow(m_counts, SurfaceRadii::kTailRadii * sizeof(sh::SurfaceRadiusCount), "surface.counts",
+    // Each radius's counts, then the tail's (one uint).
+    m_ws.grow(m_counts, SurfaceRadii::kStartRadii * sizeof(sh::SurfaceRadiusCount) + 4, "surface.counts",
               gpu::MemoryKind::kHost, false);
 
     auto* bytes = static_cast<char*>(staging.mapped());
@@ -217,11 +199,11 @@ void SurfaceSearch::cmdUpload(VkCommandBuffer cmd) {
 
 std::vector<sh::SurfaceRadiusCount> SurfaceSearch::submitRadii(VkCommandBuffer cmd,
                                                                std::span<const double> radii,
-                                                               double settledBefore, SurfaceCandidates& out) {
-    auto* counts = static_cast<sh::SurfaceRadiusCount*>(m_counts.mapped());
-    std::fill_n(counts, SurfaceRadii::kTailRadii, sh::SurfaceRadiusCount{0u, 0u});
+                                                               SurfaceCandidates& out) {
+    if (radii.size() > SurfaceRadii::kStartRadii) throw std::logic_error("more radii than counts");
+    const auto* counts = static_cast<const sh::SurfaceRadiusCount*>(m_counts.mapped());
     std::vector<std::pair<uint32_t, uint32_t>> buildMarks;
-    double settled = settledBefore;
+    double settled = -1.0;  // no query is settled before the first radius
     for (size_t i = 0; i < radii.size(); ++i) {
         // Everything of the radius before (its rays read the BLAS this one refits).
         if (i > 0)
@@ -235,18 +217,70 @@ std::vector<sh::SurfaceRadiusCount> SurfaceSearch::submitRadii(VkCommandBuffer c
         m_built = true;
         settled = radii[i];
     }
-    // Every query's best for the host (the loop may end after any submission).
+    // Every query's best for the host (the tail may not follow).
+    cmdReadBack(cmd);
+    m_ws.ctx.submitAndWait(cmd);
+    ++out.submissions;
+    out.gpuMs += m_ws.ctx.lastGpuMs();
+    for (const auto& [from, to] : buildMarks) out.gpuBuildMs += m_ws.ctx.gpuMsBetween(from, to);
+    return {counts, counts + radii.size()};
+}
+
+void SurfaceSearch::cmdReadBack(VkCommandBuffer cmd) {
     gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                      VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
     const VkBufferCopy region{0, 0, VkDeviceSize(m_queries) * 8};
     vkCmdCopyBuffer(cmd, m_best.handle(), m_readback.handle(), 1, &region);
     gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+}
+
+void SurfaceSearch::submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out) {
+    // The tree, written to the upload buffer (the radii's submission has
+    // finished with what it held): nodes, then the order.
+    auto t0 = Clock::now();
+    const SurfaceTree tree = buildSurfaceTree(corners, m_ws.threads);
+    const VkDeviceSize nodeBytes = VkDeviceSize(tree.nodes.size()) * sizeof(sh::Cell);
+    const VkDeviceSize orderBytes = VkDeviceSize(tree.order.size()) * sizeof(uint32_t);
+    gpu::Buffer& staging =
+        m_ws.grow(m_staging, nodeBytes + orderBytes, "surface.staging", gpu::MemoryKind::kHost);
+    m_ws.grow(m_nodes, nodeBytes, "surface.nodes");
+    m_ws.grow(m_order, orderBytes, "surface.order");
+    auto* bytes = static_cast<char*>(staging.mapped());
+    std::memcpy(bytes, tree.nodes.data(), nodeBytes);
+    std::memcpy(bytes + nodeBytes, tree.order.data(), orderBytes);
+    out.tailBuildMs = msSince(t0);
+
+    VkCommandBuffer cmd = m_ws.ctx.begin();
+    {
+        const gpu::ScopedLabel label(m_ws.ctx, cmd, "surface tail");
+        const VkBufferCopy toNodes{0, 0, nodeBytes};
+        const VkBufferCopy toOrder{nodeBytes, 0, orderBytes};
+        vkCmdCopyBuffer(cmd, m_staging.handle(), m_nodes.handle(), 1, &toNodes);
+        vkCmdCopyBuffer(cmd, m_staging.handle(), m_order.handle(), 1, &toOrder);
+        gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        sh::SurfaceTailPush tp{};
+        tp.queries = m_points.address();
+        tp.corners = m_corners.address();
+        tp.best = m_best.address();
+        tp.nodes = m_nodes.address();
+        tp.order = m_order.address();
+        tp.counts = m_counts.address() + SurfaceRadii::kStartRadii * sizeof(sh::SurfaceRadiusCount);
+        tp.numQueries = m_queries;
+        // The radii's settle2 of the last radius: the queries open after it.
+        tp.settled2 = std::nextafter(float(settled * settled), 0.0f);
+        tp.mutant = m_ws.mutant ? 1u : 0u;
+        m_ws.dispatch(cmd, Kernel::kSurfaceTail, tp, m_queries);
+    }
+    cmdReadBack(cmd);
     m_ws.ctx.submitAndWait(cmd);
     ++out.submissions;
-    out.gpuMs += m_ws.ctx.lastGpuMs();
-    for (const auto& [from, to] : buildMarks) out.gpuBuildMs += m_ws.ctx.gpuMsBetween(from, to);
-    return {counts, counts + radii.size()};
+    out.tailGpuMs = m_ws.ctx.lastGpuMs();
+    out.gpuMs += out.tailGpuMs;
+    out.tailQueries = static_cast<const uint32_t*>(
+        m_counts.mapped())[SurfaceRadii::kStartRadii * sizeof(sh::SurfaceRadiusCount) / sizeof(uint32_t)];
 }
 
 void SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update,

@@ -1,20 +1,28 @@
 // The point-to-surface search on the device (issue 34; design.md §11): the
 // RT-HDIST scheme of the point search (candidate_search.hpp) with triangles
-// for targets. One procedural AABB per triangle in a BLAS, its box grown by
-// a radius R (refitted as R grows); one ray of tiny length per query not
-// yet settled (ray query, or the ray-tracing pipeline of
+// for targets, then a tree descent for the queries it leaves open.
+//   The radii: one procedural AABB per triangle in a BLAS, its box grown by
+// a radius R (refitted for the second radius); one ray of tiny length per
+// query not yet settled (ray query, or the ray-tracing pipeline of
 // surface_search.rgen/rint), and every triangle whose grown box the ray
 // starts in is measured by the shared rule
 // (shaders/shared/rthdist_point_triangle.h) in float, the query keeping
 // its nearest. A query whose nearest lies within R is settled (a nearer
 // triangle's box lies within R too, so it was visited: up to float
-// rounding); the others go on with a larger R, up to a radius that covers
-// the union of both inputs' boxes, where every query meets every triangle.
+// rounding). One submission holds the radii of SurfaceRadii::start, which
+// settle nearly every query of inputs near each other.
+//   The tail: a query farther than the last radius (inputs apart, far
+// outliers) would need larger radii, where each ray sits in thousands of
+// overlapping grown boxes. Instead, when any query is open, the host builds
+// the float BVH of the triangles (surface_tree.hpp) and one more submission
+// runs surface_tail.comp: every open query descends it nearest-first from
+// the best the rays found, by the same per-triangle test, so it ends with
+// what a visit of every triangle would give.
 //
 // The answer is a candidate, not a value: each query's nearest triangle
 // (or none). The caller proves the directed maximum in double on the host
 // (api/surface_certify.hpp), so a rounding or a miss here costs host work,
-// never a wrong value; the radii (SurfaceRadii) decide cost only.
+// never a wrong value; the radii and the tree decide cost only.
 //
 // Kept between calls (one per GpuHausdorff): its buffers only grow, and the
 // BLAS storage is the workspace's (a later point search rebuilds it).
@@ -46,46 +54,38 @@ struct SurfaceCandidates {
     double stageMs = 0.0;            // host: the inputs written to the upload buffer, the radii's statistics
     double submitMs = 0.0;           // host wall: recording, submitting and waiting for the submissions
     double readbackMs = 0.0;         // host: the candidates taken from the read-back buffer
+    // The tail (0 where the radii settled every query):
+    uint64_t tailQueries = 0;  // queries that descended the tree on the device
+    double tailBuildMs = 0.0;  // host: the tree built and written to the upload buffer (part of submitMs)
+    double tailGpuMs = 0.0;    // device time of the tail's submission (part of gpuMs)
 };
 
 // The radii of one search (host only; tests/gpu_algo/surface_radii_test.cpp).
 // None decides a value (the host proves it); they set how many queries the
-// first pass settles and how many BLAS refits the rest costs.
+// radii settle and how many the tail's tree descent is left with.
 //   first: the larger of half the mean longest side of the triangles' boxes
 //     (a query on or near the surface settles at once) and half the mean
 //     spacing of the queries over the surface, sqrt(area / queries): at that
-//     radius a query meets about 0.8 F / Q triangles, so the first pass
+//     radius a query meets about 0.8 F / Q triangles, so the first radius
 //     measures O(F + Q) triangles however few the queries are, and a sparse
 //     query set (a coarse mesh's vertices against a fine one) settles in one
 //     pass instead of a refit of every triangle per doubling.
-//   next: after a submission, the radius doubles while its last radius
-//     settled a fair share of what it searched and many queries are open;
-//     it grows 4x when at most 1/16 of the queries are open (few rays: the
-//     BLAS refits are the cost) or when the last radius settled at most
-//     1/16 of its queries (far below their distances: inputs far apart).
-//     The last radius is `cover`, the diagonal of the union of both
-//     inputs' boxes (grown for rounding), where every grown box holds every
-//     query.
+//   cover: the diagonal of the union of both inputs' boxes (grown for
+//     rounding), where every grown box holds every query.
 class SurfaceRadii {
 public:
     // meanSide: of the triangles' boxes' longest sides; area: of the
     // triangles; diagonal: of the union's box; all in the search frame.
     SurfaceRadii(double meanSide, double area, uint64_t queries, double diagonal);
     [[nodiscard]] double first() const { return m_first; }
-    // The first submission's radii: first and 4x it (at most cover), as
-    // next() grows a tail: the first radius leaves few queries open (1 of
+    // The one submission's radii: first and 4x it (at most cover). The
+    // first radius leaves few queries open on inputs near each other (1 of
     // 35,947 on bunny>res2, 1 of 5,205 on dragon-res4>dragon, 576 of
     // 437,645 on dragon>res2 on lavapipe, docs/bench/surfaces), and the
-    // second settled them on those rows, so such a call waits once.
+    // second settles most of those; the tail takes the rest.
     [[nodiscard]] std::vector<double> start() const;
     [[nodiscard]] double cover() const { return m_cover; }
-    // The radii of the next submission after one whose last radius was
-    // `last` and searched `searched` of the `queries`, settling `settled`
-    // of them (empty when none is left open or `last` is the cover radius):
-    // up to kTailRadii, the last of them at most cover.
-    [[nodiscard]] std::vector<double> next(double last, uint64_t queries, uint64_t searched,
-                                           uint64_t settled) const;
-    static constexpr size_t kTailRadii = 2;
+    static constexpr size_t kStartRadii = 2;  // at most, in start()
 
 private:
     double m_first = 0.0, m_cover = 0.0;
@@ -98,8 +98,9 @@ public:
     // queries: the points in the search frame; corners: a, b, c of every
     // triangle in the same frame (3 per triangle). Fewer than 2^30
     // triangles and 2^32 queries; a BLAS past the device's
-    // maxPrimitiveCount throws gpu::LimitError. `cancel` is read between
-    // submissions (true: throws CallCancelled). Vulkan failures throw.
+    // maxPrimitiveCount throws gpu::LimitError. One submission of the
+    // radii, then one of the tail where a query is open. `cancel` is read
+    // after each (true: throws CallCancelled). Vulkan failures throw.
     [[nodiscard]] SurfaceCandidates run(std::span<const glm::vec3> queries,
                                         std::span<const glm::vec3> corners,
                                         const std::atomic<bool>* cancel = nullptr);
@@ -118,14 +119,21 @@ private:
     // rays), then every query's best copied for the host. Returns what each
     // radius did.
     std::vector<sh::SurfaceRadiusCount> submitRadii(VkCommandBuffer cmd, std::span<const double> radii,
-                                                    double settledBefore, SurfaceCandidates& out);
+                                                    SurfaceCandidates& out);
     void cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update, VkDeviceAddress counts);
+    // The tail's submission for the queries the radii left open (their best
+    // farther than `settled`): the tree built on the host and uploaded, the
+    // descent, every query's best copied for the host.
+    void submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out);
+    // Every query's best copied to the read-back buffer for the host.
+    void cmdReadBack(VkCommandBuffer cmd);
 
     Workspace& m_ws;
     uint32_t m_queries = 0, m_triangles = 0;
     double m_rayTMax = 0.0;
     bool m_built = false;  // the BLAS of this call is built (the next radius refits it)
     gpu::Buffer m_points, m_corners, m_boxes, m_best, m_aabbs, m_staging, m_readback, m_counts;
+    gpu::Buffer m_nodes, m_order;  // the tail's tree (surface_tree.hpp)
 };
 
 }  // namespace rthdist::gpu_algo

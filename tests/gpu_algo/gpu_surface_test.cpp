@@ -7,19 +7,29 @@
 // inputs; the validation layer on and silent. The kept-device route
 // (Engine::hausdorffToSurface): one Engine serving calls of growing and
 // shrinking sizes equals the brute force and a one-shot call, a cancelled
-// call leaves it usable, per-point distances stay refused.
+// call leaves it usable, per-point distances stay refused. The tail (the
+// tree descent of the queries the radii leave open, surface_tail.comp):
+// every query's candidate against the brute force's nearest triangle,
+// directly on the device search (GpuHausdorff::nearestTriangles), on far
+// copies, far outliers and degenerate far triangles, with and without the
+// mutant.
 #include <gtest/gtest.h>
 
 #include <glm/geometric.hpp>
 
 #include <atomic>
 #include <cstdio>
+#include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "common/surface_brute_force.hpp"
 #include "common/surface_cases.hpp"
+#include "core/point_triangle.hpp"
 #include "core/search_mutant.hpp"
+#include "gpu/context.hpp"
+#include "gpu_algo/gpu_hausdorff.hpp"
 #include "gpu_algo/gpu_test_support.hpp"
 #include "rthdist/surface.hpp"
 
@@ -69,15 +79,16 @@ void expectBruteForce(const test::SurfaceCase& c, Backend backend, const Result<
     // one submission per radius at most (the first holds the upload too).
     EXPECT_GE(n.radii, 1u) << c.name;
     EXPECT_GE(n.rays, c.queries.size()) << c.name;
-    EXPECT_GE(n.submissions, 1u) << c.name;
-    EXPECT_LE(n.submissions, n.radii) << c.name;
+    // One submission for the radii, one more for the tail where it ran.
+    EXPECT_EQ(n.submissions, n.tailQueries > 0 ? 2u : 1u) << c.name;
+    EXPECT_LE(n.tailQueries, c.queries.size()) << c.name;
     // The proof searched the witness again, at least.
     EXPECT_GE(n.band, 1u) << c.name;
     EXPECT_LE(n.band, c.queries.size()) << c.name;
     EXPECT_EQ(r->validationMessages, 0u) << c.name;
-    std::printf("  h %.17g: %u radii, %llu rays, %u submissions, band %llu\n", r->hausdorff, n.radii,
-                static_cast<unsigned long long>(n.rays), n.submissions,
-                static_cast<unsigned long long>(n.band));
+    std::printf("  h %.17g: %u radii, %llu rays, %u submissions, tail %llu, band %llu\n", r->hausdorff,
+                n.radii, static_cast<unsigned long long>(n.rays), n.submissions,
+                static_cast<unsigned long long>(n.tailQueries), static_cast<unsigned long long>(n.band));
 }
 
 void expectBruteForce(const test::SurfaceCase& c, Backend backend) {
@@ -234,6 +245,7 @@ TEST(GpuSurfaceEngine, RepeatedCallsOfGrowingAndShrinkingSizesMatchAFreshDevice)
         EXPECT_EQ(kept->directed.surfacePoint, fresh->directed.surfacePoint) << c.name;
         EXPECT_EQ(kept->directed.counters.radii, fresh->directed.counters.radii) << c.name;
         EXPECT_EQ(kept->directed.counters.rays, fresh->directed.counters.rays) << c.name;
+        EXPECT_EQ(kept->directed.counters.tailQueries, fresh->directed.counters.tailQueries) << c.name;
         EXPECT_EQ(kept->directed.counters.band, fresh->directed.counters.band) << c.name;
     }
 }
@@ -313,6 +325,308 @@ TEST(GpuSurfaceEngine, BadInputIsReportedAndTheEngineServesOn) {
     test::SurfaceCase good = c;
     good.queries = points;
     expectBruteForce(good, backend, engine->hausdorffToSurface(PointView(points), meshOf(good)));
+}
+
+}  // namespace
+}  // namespace rthdist
+
+namespace rthdist {
+namespace {
+
+// The tail's inputs as the device search takes them: float, in the search
+// frame (|coordinate| <= 1), 3 corners per triangle.
+struct FramedCase {
+    std::string name;
+    std::vector<glm::vec3> corners;
+    std::vector<glm::vec3> queries;
+};
+
+// Small triangles in a ball around `centre`, no two sharing a corner (a
+// query's nearest is one triangle, not a shared vertex's fan). Degenerate:
+// every 7th a sliver (its corners on a line), every 11th a point, every 5th
+// an exact copy of the triangle before (ties go to the smaller index).
+std::vector<glm::vec3> soup(glm::vec3 centre, float radius, size_t triangles, uint32_t seed,
+                            bool degenerate) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), side(-0.03f, 0.03f);
+    std::vector<glm::vec3> corners;
+    while (corners.size() < 3 * triangles) {
+        const size_t t = corners.size() / 3;
+        glm::vec3 a;
+        do {
+            a = glm::vec3(unit(rng), unit(rng), unit(rng));
+        } while (glm::length(a) > 1.0f);
+        a = centre + radius * a;
+        const glm::vec3 b = a + glm::vec3(side(rng), side(rng), side(rng));
+        const glm::vec3 c = a + glm::vec3(side(rng), side(rng), side(rng));
+        if (degenerate && t % 5 == 4) {
+            for (int k = 0; k < 3; ++k) corners.push_back(corners[corners.size() - 3]);
+        } else if (degenerate && t % 11 == 10) {
+            corners.insert(corners.end(), {a, a, a});
+        } else if (degenerate && t % 7 == 6) {
+            corners.insert(corners.end(), {a, b, a + 0.25f * (b - a)});
+        } else {
+            corners.insert(corners.end(), {a, b, c});
+        }
+    }
+    return corners;
+}
+
+// A closed UV sphere (the poles' triangles have two equal corners).
+std::vector<glm::vec3> sphere(glm::vec3 centre, float radius, int rings, int sectors) {
+    auto at = [&](int i, int j) {
+        const double theta = 3.14159265358979 * double(i) / rings,
+                     phi = 6.28318530717959 * double(j) / sectors;
+        // A bump per sector: no symmetry to tie the far queries' nearest.
+        const double r = radius * (1.0 + 0.05 * std::sin(3.0 * phi + double(i)));
+        return centre + glm::vec3(glm::dvec3(r * std::sin(theta) * std::cos(phi),
+                                             r * std::sin(theta) * std::sin(phi), r * std::cos(theta)));
+    };
+    std::vector<glm::vec3> corners;
+    for (int i = 0; i < rings; ++i) {
+        for (int j = 0; j < sectors; ++j) {
+            corners.insert(corners.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+            corners.insert(corners.end(), {at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+    }
+    return corners;
+}
+
+std::vector<glm::vec3> moved(std::vector<glm::vec3> points, glm::vec3 by) {
+    for (glm::vec3& p : points) p += by;
+    return points;
+}
+
+std::vector<FramedCase> tailCases() {
+    std::vector<FramedCase> cases;
+    const glm::vec3 low(-0.55f), across(1.0f);
+    // A surface's translated copy far away: its corners for queries.
+    const std::vector<glm::vec3> far = soup(low, 0.35f, 400, 7, false);
+    cases.push_back({"far_copy", far, moved(far, across)});
+    const std::vector<glm::vec3> ball = sphere(low, 0.3f, 12, 16);
+    cases.push_back({"far_sphere_copy", ball, moved(ball, across)});
+    // Slivers, points and duplicates in the far surface.
+    const std::vector<glm::vec3> odd = soup(low, 0.35f, 400, 8, true);
+    cases.push_back({"far_degenerate_copy", odd, moved(odd, across)});
+    // Queries on and near the surface, and far outliers in the frame's corners.
+    FramedCase outliers{"far_outliers", soup(glm::vec3(0.0f), 0.5f, 400, 9, true), {}};
+    std::mt19937 rng(10);
+    std::uniform_real_distribution<float> tiny(-0.002f, 0.002f);
+    for (size_t i = 0; i < outliers.corners.size(); i += 2)
+        outliers.queries.push_back(outliers.corners[i] + glm::vec3(tiny(rng), tiny(rng), tiny(rng)));
+    for (int i = 0; i < 8; ++i)
+        outliers.queries.emplace_back(i & 1 ? 0.97f : -0.97f, i & 2 ? 0.95f : -0.96f, i & 4 ? 0.98f : -0.9f);
+    cases.push_back(outliers);
+    // A sheet of separate triangles and a query far above each one's centre,
+    // at nearly one height: each query's nearest is the triangle below it,
+    // and every other is farther (a search that misses it shows in the band).
+    FramedCase sheet{"far_sheet", {}, {}};
+    for (int i = 0; i < 20; ++i) {
+        for (int j = 0; j < 20; ++j) {
+            const glm::vec3 a(-0.8f + 0.08f * float(i), -0.8f + 0.08f * float(j), -0.3f);
+            const glm::vec3 b = a + glm::vec3(0.03f, 0.005f * float(j % 3), 0.0f);
+            const glm::vec3 c = a + glm::vec3(0.01f * float(i % 2), 0.03f, 0.0f);
+            sheet.corners.insert(sheet.corners.end(), {a, b, c});
+            const float height = 0.6f - 1e-5f * float(20 * i + j);  // one farthest query
+            sheet.queries.push_back((a + b + c) / 3.0f + glm::vec3(0.0f, 0.0f, height));
+        }
+    }
+    cases.push_back(sheet);
+    return cases;
+}
+
+// Every query against every triangle in double: the nearest (smallest
+// index on a tie) and the nearest of the triangles that are not copies of
+// it (its margin).
+struct BruteNearest {
+    double d2 = std::numeric_limits<double>::infinity();
+    uint32_t triangle = UINT32_MAX;
+    double other2 = std::numeric_limits<double>::infinity();
+};
+
+double distance2(const glm::vec3& q, std::span<const glm::vec3> corners, uint32_t t) {
+    return core::closestOnTriangle(glm::dvec3(q), glm::dvec3(corners[3 * size_t(t)]),
+                                   glm::dvec3(corners[3 * size_t(t) + 1]),
+                                   glm::dvec3(corners[3 * size_t(t) + 2]))
+        .distance2;
+}
+
+BruteNearest bruteNearest(const glm::vec3& q, std::span<const glm::vec3> corners) {
+    BruteNearest n;
+    const auto triangles = uint32_t(corners.size() / 3);
+    for (uint32_t t = 0; t < triangles; ++t) {
+        const double d2 = distance2(q, corners, t);
+        if (d2 < n.d2) {
+            n.d2 = d2;
+            n.triangle = t;
+        }
+    }
+    auto same = [&](uint32_t t) {
+        for (size_t k = 0; k < 3; ++k) {
+            if (corners[3 * size_t(t) + k] != corners[3 * size_t(n.triangle) + k]) return false;
+        }
+        return true;
+    };
+    for (uint32_t t = 0; t < triangles; ++t) {
+        if (!same(t)) n.other2 = std::min(n.other2, distance2(q, corners, t));
+    }
+    return n;
+}
+
+std::unique_ptr<gpu::Context> surfaceContext(std::string& whyNot) {
+    auto ctx = gpu::Context::create(test::backendUnderTest(), -1, true);
+    if (!ctx) {
+        whyNot = ctx.error().message;
+        return nullptr;
+    }
+    return std::move(ctx.value());
+}
+
+#define RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx) \
+    std::string rthdist_why_;                \
+    auto ctx = surfaceContext(rthdist_why_); \
+    if (!ctx) GTEST_SKIP() << "no device for this backend: " << rthdist_why_
+
+// What the device search returned for a case, against the brute force.
+struct TailCheck {
+    size_t clear = 0;  // queries whose nearest is clear of every other triangle's distance
+    size_t missedThirds =
+        0;  // of those, ones whose nearest is a third triangle that the search did not return
+};
+
+// Each candidate is as near as the nearest up to float rounding, and is
+// the nearest where the margin is clear. With `mutant` (every third
+// triangle skipped): never a third triangle, the nearest of the others.
+TailCheck expectNearest(const FramedCase& c, const gpu_algo::SurfaceCandidates& found, bool mutant) {
+    TailCheck check;
+    EXPECT_EQ(found.triangle.size(), c.queries.size()) << c.name;
+    for (size_t i = 0; i < c.queries.size() && i < found.triangle.size(); ++i) {
+        const BruteNearest want = bruteNearest(c.queries[i], c.corners);
+        const uint32_t got = found.triangle[i];
+        const bool clear = want.other2 - want.d2 > 1e-3 * want.other2;
+        if (got >= c.corners.size() / 3) {
+            ADD_FAILURE() << c.name << " query " << i << ": no triangle";
+            continue;
+        }
+        if (mutant) {
+            EXPECT_NE(got % 3, 0u) << c.name << " query " << i;
+            if (clear && want.triangle % 3 == 0) ++check.missedThirds;
+            if (clear && want.triangle % 3 != 0) EXPECT_EQ(got, want.triangle) << c.name << " query " << i;
+            continue;
+        }
+        EXPECT_LE(distance2(c.queries[i], c.corners, got), want.d2 * (1.0 + 1e-5) + 1e-12)
+            << c.name << " query " << i << ": triangle " << got << " for " << want.triangle;
+        if (clear) {
+            ++check.clear;
+            EXPECT_EQ(got, want.triangle) << c.name << " query " << i;
+        }
+    }
+    return check;
+}
+
+// The queries the radii leave open (far copies, outliers, degenerate far
+// triangles) go through the tail, which finds each one's nearest triangle.
+TEST(GpuSurfaceTail, FindsTheNearestTriangleOfEveryOpenQuery) {
+    RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
+    ASSERT_TRUE(engine) << engine.error().message;
+    for (const FramedCase& c : tailCases()) {
+        Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
+        ASSERT_TRUE(found) << c.name << ": " << found.error().message;
+        const TailCheck check = expectNearest(c, *found, false);
+        std::printf("%s: %zu triangles, %zu queries, %u radii, tail %llu, %zu clear\n", c.name.c_str(),
+                    c.corners.size() / 3, c.queries.size(), found->radii,
+                    static_cast<unsigned long long>(found->tailQueries), check.clear);
+        EXPECT_GT(found->tailQueries, 0u) << c.name;
+        EXPECT_LE(found->tailQueries, c.queries.size()) << c.name;
+        EXPECT_EQ(found->submissions, 2u) << c.name;
+        // The copies of disjoint triangles have clear nearest triangles:
+        // the index check above is not vacuous.
+        if (c.name != "far_sphere_copy") EXPECT_GT(check.clear, c.queries.size() / 2) << c.name;
+    }
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// The device's group and ray limits forced down: the radii's traces and
+// the tail's dispatch are split into many, and still cover every query.
+TEST(GpuSurfaceTail, SplitDispatchesCoverEveryQuery) {
+    RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx);
+    gpu::DeviceLimits limits = ctx->limits();
+    limits.maxGroupsX = 3;
+    limits.maxRayDispatch = 5;
+    ctx->setLimits(limits);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
+    ASSERT_TRUE(engine) << engine.error().message;
+    for (const FramedCase& c : tailCases()) {
+        if (c.name != "far_copy" && c.name != "far_outliers") continue;
+        Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
+        ASSERT_TRUE(found) << c.name << ": " << found.error().message;
+        expectNearest(c, *found, false);
+        EXPECT_GT(found->tailQueries, 0u) << c.name;
+    }
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// Queries on the surface settle at the first radius: no tail.
+TEST(GpuSurfaceTail, DoesNotRunWhereTheRadiiSettleEveryQuery) {
+    RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
+    ASSERT_TRUE(engine) << engine.error().message;
+    const std::vector<glm::vec3> corners = soup(glm::vec3(0.1f), 0.6f, 400, 12, true);
+    const FramedCase c{"near", corners, corners};
+    Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
+    ASSERT_TRUE(found) << found.error().message;
+    expectNearest(c, *found, false);
+    EXPECT_EQ(found->tailQueries, 0u);
+    EXPECT_EQ(found->submissions, 1u);
+    EXPECT_EQ(found->tailBuildMs, 0.0);
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// The tail honours the mutant (a search that misses every third
+// triangle): a query whose nearest is such a triangle gets another, and
+// the others still get theirs; through the API the proof catches it.
+TEST(GpuSurfaceTail, AMissingTailIsCaughtByTheProof) {
+    RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
+    ASSERT_TRUE(engine) << engine.error().message;
+    struct Mutant {
+        Mutant() { core::searchMutant() = true; }
+        ~Mutant() { core::searchMutant() = false; }
+    };
+    const Backend backend = test::backendUnderTest();
+    uint64_t clean = 0, missing = 0, missedThirds = 0;
+    for (const FramedCase& c : tailCases()) {
+        test::SurfaceCase api{c.name, 0, {}, {}, {}};
+        for (size_t i = 0; i < c.corners.size(); ++i) {
+            api.vertices.emplace_back(c.corners[i]);
+            api.indices.push_back(uint32_t(i));
+        }
+        for (const glm::vec3& q : c.queries) api.queries.emplace_back(q);
+        const Result<SurfaceResult> right = onDevice(api, backend);
+        expectBruteForce(api, backend, right);
+        ASSERT_TRUE(right);
+        EXPECT_GT(right->directed.counters.tailQueries, 0u) << c.name;
+        clean += right->directed.counters.band;
+
+        const Mutant mutant;
+        Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
+        ASSERT_TRUE(found) << c.name << ": " << found.error().message;
+        EXPECT_GT(found->tailQueries, 0u) << c.name;
+        missedThirds += expectNearest(c, *found, true).missedThirds;
+        const Result<SurfaceResult> wrong = onDevice(api, backend);
+        expectBruteForce(api, backend, wrong);
+        ASSERT_TRUE(wrong);
+        missing += wrong->directed.counters.band;
+    }
+    // The missed triangles showed: queries lost their nearest, and the
+    // proof searched more queries again.
+    std::printf("band %llu with the mutant, %llu without; %llu nearest triangles missed\n",
+                static_cast<unsigned long long>(missing), static_cast<unsigned long long>(clean),
+                static_cast<unsigned long long>(missedThirds));
+    EXPECT_GT(missedThirds, 0u);
+    EXPECT_GT(missing, clean);
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
 }  // namespace

@@ -8,7 +8,8 @@
 // One Engine is created (setup_ms); its first --warmup calls are timed apart
 // (warmup_ms: the first call also compiles what the driver compiles on first
 // use), then --runs calls give the medians of every stage (SurfaceResult:
-// total, search, frame, upload, device, readback, certify, gpu, gpu_build)
+// total, search, frame, upload, device, readback, certify, gpu, gpu_build,
+// tail_build, gpu_tail)
 // and the wall clock of the call. --one-shot N more calls of the free
 // function (a device per call) give one_shot medians (total, build = the
 // device and its pipelines). --no-verify skips the CPU backend's call that
@@ -49,7 +50,8 @@ struct Settings {
 
 // The series of one kind of call: every stage's milliseconds per call.
 struct Series {
-    std::vector<double> wall, total, build, search, frame, upload, device, readback, certify, gpu, gpuBuild;
+    std::vector<double> wall, total, build, search, frame, upload, device, readback, certify, gpu, gpuBuild,
+        tailBuild, gpuTail;
 
     void add(const SurfaceResult& r, double wallMs) {
         wall.push_back(wallMs);
@@ -63,18 +65,23 @@ struct Series {
         certify.push_back(r.stages.certify);
         gpu.push_back(r.gpuMs);
         gpuBuild.push_back(r.stages.gpuBuild);
+        tailBuild.push_back(r.stages.tailBuild);
+        gpuTail.push_back(r.stages.gpuTail);
     }
     [[nodiscard]] nlohmann::json medians() const {
-        return {{"wall", median(wall)},     {"total", median(total)},       {"build", median(build)},
-                {"search", median(search)}, {"frame", median(frame)},       {"upload", median(upload)},
-                {"device", median(device)}, {"readback", median(readback)}, {"certify", median(certify)},
-                {"gpu", median(gpu)},       {"gpu_build", median(gpuBuild)}};
+        return {
+            {"wall", median(wall)},       {"total", median(total)},        {"build", median(build)},
+            {"search", median(search)},   {"frame", median(frame)},        {"upload", median(upload)},
+            {"device", median(device)},   {"readback", median(readback)},  {"certify", median(certify)},
+            {"gpu", median(gpu)},         {"gpu_build", median(gpuBuild)}, {"tail_build", median(tailBuild)},
+            {"gpu_tail", median(gpuTail)}};
     }
 };
 
 nlohmann::json countersJson(const rthdist::SurfaceCounters& c) {
     return {{"queries", c.queries}, {"triangles", c.triangles},     {"radii", c.radii},
-            {"rays", c.rays},       {"submissions", c.submissions}, {"band", c.band}};
+            {"rays", c.rays},       {"submissions", c.submissions}, {"tail_queries", c.tailQueries},
+            {"band", c.band}};
 }
 
 int fail(const std::string& what, const rthdist::Error& e) {

@@ -54,6 +54,7 @@ Json countersJson(const SurfaceCounters& c) {
             {"radii", c.radii},
             {"rays", c.rays},
             {"submissions", c.submissions},
+            {"tail_queries", c.tailQueries},
             {"band", c.band}};
 }
 
@@ -104,7 +105,9 @@ std::string jsonReport(const Run& run) {
                          {"readback", st.readback},
                          {"certify", st.certify},
                          {"gpu", r.gpuMs},
-                         {"gpu_build", st.gpuBuild}}}};
+                         {"gpu_build", st.gpuBuild},
+                         {"tail_build", st.tailBuild},
+                         {"gpu_tail", st.gpuTail}}}};
     j["counters"] = {{"a_to_b", b ? countersJson(r.directed.counters) : Json()},
                      {"b_to_a", b ? Json() : countersJson(r.directed.counters)}};
     return jsonText(j) + "\n";
