@@ -107,27 +107,6 @@ std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bou
     const int workers = core::resolveThreads(threads, std::max(q.count, t.count) / kChunk + 1);
     NarrowedTargets out;
 
-    // The core: every query when their own box can gain, else those within
-    // a sampled box, when few lie outside it.
-    core::Bounds coreBox = qBox;
-    if (!narrowingPays(whole, frameMagnitude(qBox, floatExact))) {
-        const core::Bounds sampled = sampledCore(q);
-        if (!narrowingPays(whole, frameMagnitude(sampled, floatExact))) return std::nullopt;
-        std::vector<uint64_t> strays =
-            select(q, workers, [&](const glm::dvec3& p) { return !inside(p, sampled); });
-        if (strays.empty() || strays.size() > kMaxStrayQueries || strays.size() == q.count)
-            return std::nullopt;
-        out.core =
-            subsetOf(q, select(q, workers, [&](const glm::dvec3& p) { return inside(p, sampled); }), workers);
-        out.strays = subsetOf(q, std::move(strays), workers);
-        coreBox = core::Bounds{out.core.view.at(0), out.core.view.at(0)};
-        for (size_t i = 1; i < out.core.view.count; ++i) {
-            const glm::dvec3 p = out.core.view.at(i);
-            coreBox.lo = glm::min(coreBox.lo, p);
-            coreBox.hi = glm::max(coreBox.hi, p);
-        }
-    }
-    const PointView& coreView = out.strays.original.empty() ? q : out.core.view;
     // d(p, T) in double over every target.
     auto nearestDistance = [&](const glm::dvec3& p) {
         double nearest2 = std::numeric_limits<double>::infinity();
@@ -143,12 +122,41 @@ std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bou
         });
         return std::sqrt(nearest2);
     };
-    // A stray query far from every target makes h far larger than the whole
-    // pair's slack (2^-20 of its magnitude): the whole search then settles
-    // the core's queries at once (they cannot raise h), nothing to gain.
-    if (!out.strays.original.empty() &&
-        nearestDistance(out.strays.view.at(0)) >= std::ldexp(whole, kNarrowGainLog2 - 20))
-        return std::nullopt;
+
+    // The core: every query when their own box can gain, else those within
+    // a sampled box, when few lie outside it.
+    core::Bounds coreBox = qBox;
+    if (!narrowingPays(whole, frameMagnitude(qBox, floatExact))) {
+        const core::Bounds sampled = sampledCore(q);
+        if (!narrowingPays(whole, frameMagnitude(sampled, floatExact))) return std::nullopt;
+        std::vector<uint64_t> strays =
+            select(q, workers, [&](const glm::dvec3& p) { return !inside(p, sampled); });
+        if (strays.empty() || strays.size() > kMaxStrayQueries || strays.size() == q.count)
+            return std::nullopt;
+        // A stray query far from every target makes h far larger than the
+        // whole pair's slack (2^-20 of its magnitude): the whole search then
+        // settles the core's queries at once (they cannot raise h), nothing
+        // to gain. Checked before any copy.
+        if (nearestDistance(q.at(strays.front())) >= std::ldexp(whole, kNarrowGainLog2 - 20))
+            return std::nullopt;
+        std::vector<uint64_t> core;
+        core.reserve(q.count - strays.size());
+        for (uint64_t i = 0, k = 0; i < q.count; ++i) {
+            if (k < strays.size() && strays[k] == i)
+                ++k;
+            else
+                core.push_back(i);
+        }
+        out.core = subsetOf(q, std::move(core), workers);
+        out.strays = subsetOf(q, std::move(strays), workers);
+        coreBox = core::Bounds{out.core.view.at(0), out.core.view.at(0)};
+        for (size_t i = 1; i < out.core.view.count; ++i) {
+            const glm::dvec3 p = out.core.view.at(i);
+            coreBox.lo = glm::min(coreBox.lo, p);
+            coreBox.hi = glm::max(coreBox.hi, p);
+        }
+    }
+    const PointView& coreView = out.strays.original.empty() ? q : out.core.view;
 
     const double radius =
         (glm::length(coreBox.hi - coreBox.lo) + nearestDistance(coreView.at(0))) * (1.0 + 0x1p-30);

@@ -6,7 +6,7 @@
 # ROWS: density.py's names (issue 33's far-* and crowded-* rows included).
 # BEFORE=path: a previous rthdist-bench, run on each row alternated with the
 # new one (3 rounds, lines tagged "build"); AB=0 skips the A/B of the earlier
-# rows of docs/bench/gpu.md at the end.
+# rows of docs/bench/gpu.md at the end; PEERS=0 skips CuPy.
 # BUNDLE: rthdist, rthdist-bench (new), prev/rthdist-bench (previous build),
 # data/dragon_vrip{,_res2}.ply.gz, ddata/ laid out like ../shared/data
 # (lidar/FSite8_*-utm.ply, stanford/dragon/*.ply.gz).
@@ -44,7 +44,7 @@ for r in "${rows[@]}"; do
       --runs 7 --warmup 3 --no-verify >> "$OUT/density_rthdist.jsonl" 2>> "$OUT/errors.txt"
   fi
 done
-(cd "$here" && timeout 600 python3 gpu_density_peers.py "$W" "${rows[@]}" --runs 5) \
+[ "${PEERS:-1}" = 0 ] || (cd "$here" && timeout 600 python3 gpu_density_peers.py "$W" "${rows[@]}" --runs 5) \
   >> "$OUT/density_peers.jsonl" 2>> "$OUT/errors.txt"
 
 [ "${AB:-1}" = 0 ] && exit 0
