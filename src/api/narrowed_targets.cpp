@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "api/route_planner.hpp"
+#include "core/certificate.hpp"
 #include "core/parallel.hpp"
 
 namespace rthdist::api {
@@ -74,6 +75,51 @@ bool inside(const glm::dvec3& p, const core::Bounds& box) {
 }
 
 }  // namespace
+
+Directed strayQueries(const PointSubset& strays, const PointView& t, PerPoint* perPoint, int threads) {
+    const size_t n = strays.view.count;
+    std::vector<core::BandNearest> nearest(n);
+    std::vector<glm::dvec3> q(n);
+    for (size_t k = 0; k < n; ++k) {
+        nearest[k].query = k;
+        q[k] = strays.view.at(k);
+    }
+    std::mutex merge;
+    const int workers = core::resolveThreads(threads, t.count / kChunk + 1);
+    core::parallelChunks(t.count, kChunk, workers, [&](size_t begin, size_t end, int) {
+        std::vector<core::BandNearest> local(n);
+        for (size_t i = begin; i < end; ++i) {
+            const glm::dvec3 p = t.at(i);
+            for (size_t k = 0; k < n; ++k) local[k].offer(i, core::exactDistance(q[k], p));
+        }
+        const std::lock_guard<std::mutex> lock(merge);
+        for (size_t k = 0; k < n; ++k) nearest[k].offer(local[k].target, local[k].distance);
+    });
+    size_t win = 0;  // the largest distance, the smaller position on a tie
+    for (size_t k = 1; k < n; ++k)
+        if (nearest[k].distance > nearest[win].distance) win = k;
+    Directed d;
+    d.distance = nearest[win].distance;
+    d.queryIndex = win;
+    d.targetIndex = nearest[win].target;
+    d.queryPoint = q[win];
+    d.targetPoint = t.at(d.targetIndex);
+    d.counters.queries = n;
+    d.certificate.confirmed = true;
+    d.certificate.query = d.queryIndex;
+    d.certificate.nearest = d.targetIndex;
+    d.certificate.distance = d.distance;
+    d.certificate.band = n;
+    if (perPoint != nullptr) {
+        perPoint->nearest.resize(n);
+        perPoint->distance.resize(n);
+        for (size_t k = 0; k < n; ++k) {
+            perPoint->nearest[k] = uint32_t(nearest[k].target);
+            perPoint->distance[k] = nearest[k].distance;
+        }
+    }
+    return d;
+}
 
 core::Bounds sampledCore(const PointView& q, size_t samples) {
     constexpr size_t kDrop = 8;

@@ -27,6 +27,7 @@
 
 #include "core/index_space.hpp"
 #include "rthdist/point_view.hpp"
+#include "rthdist/rthdist.hpp"
 
 namespace rthdist::api {
 
@@ -50,6 +51,15 @@ struct NarrowedTargets {
 // Queries a direction may set apart to narrow the rest (api/narrowed_targets.hpp).
 inline constexpr size_t kMaxStrayQueries = 256;
 
+// The stray queries' exact answer, a brute force in double on the host over
+// every target (at most kMaxStrayQueries queries): the directed value with
+// its witness (ties: the smaller query, then the smaller target; positions
+// in `strays`, input indices of t), its certificate (the brute force is
+// exact: confirmed, every stray in the band) and, when `perPoint`, each
+// stray's nearest target and distance. threads as EngineOptions::threads.
+[[nodiscard]] Directed strayQueries(const PointSubset& strays, const PointView& t, PerPoint* perPoint,
+                                    int threads);
+
 // The largest |coordinate| of a box after the frame's origin (zero for
 // float32 coordinates, else the box's centre: core::searchOrigin's rule for
 // one box), as the search would see it.
@@ -68,7 +78,7 @@ inline constexpr size_t kMaxStrayQueries = 256;
 // queries' own box is too large (strays among them), the queries within a
 // box taken from a sample of them and grown by its extent on every side,
 // when at most kMaxStrayQueries lie outside it: h(Q, T) is then the larger
-// of h(core, narrowed T) and h(strays, T). Boxes and precision from
+// of h(core, narrowed T) and h(strays, T), the latter by strayQueries. Boxes and precision from
 // core::summarizeSet; threads as EngineOptions::threads. Passes: one over
 // the queries when they have strays, one over t for d(q0, T), one to keep.
 [[nodiscard]] std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bounds& qBox,
