@@ -3,8 +3,8 @@
 #include <glm/common.hpp>
 
 #include <algorithm>
-#include <limits>
 
+#include "core/float_box.hpp"
 #include "core/index_space.hpp"
 #include "core/parallel.hpp"
 #include "cpu/key_sort.hpp"
@@ -18,7 +18,6 @@ namespace {
 constexpr uint32_t kRefineCells = 1024;      // cells per axis of a refinement key (10 bits)
 constexpr uint32_t kParallelRun = 1u << 16;  // runs this long are refined with all threads
 constexpr uint64_t kIndexMask = 0xffffffffull;
-constexpr float kInf = std::numeric_limits<float>::infinity();
 
 struct Run {
     uint32_t first = 0, end = 0;
@@ -65,17 +64,7 @@ std::vector<Run> collectRunsInParallel(std::span<const uint64_t> values, int thr
     return all;
 }
 
-struct Box {
-    glm::vec3 lo{kInf}, hi{-kInf};
-    void add(const glm::vec3& p) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
-    void add(const Box& b) {
-        lo = glm::min(lo, b.lo);
-        hi = glm::max(hi, b.hi);
-    }
-};
+using Box = core::FloatBox;
 
 // The run's entries before it is permuted: input index and coordinates.
 struct RunCopy {

@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <stdexcept>
 
+#include "core/float_box.hpp"
 #include "core/parallel.hpp"
 #include "gpu/barriers.hpp"
 #include "gpu/device_limits.hpp"
@@ -22,18 +22,7 @@ namespace {
 constexpr uint32_t kMaxTriangles = uint32_t(1) << 30;  // corner indices 3t + 2 stay in 32 bits
 constexpr size_t kStageChunk = size_t(1) << 14;
 
-struct Box {
-    glm::vec3 lo{std::numeric_limits<float>::infinity()};
-    glm::vec3 hi{-std::numeric_limits<float>::infinity()};
-    void add(const glm::vec3& p) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
-    void add(const Box& b) {
-        lo = glm::min(lo, b.lo);
-        hi = glm::max(hi, b.hi);
-    }
-};
+using Box = core::FloatBox;
 
 }  // namespace
 

@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
+#include "core/float_box.hpp"
 #include "core/parallel.hpp"
 #include "rthdist_morton.h"
 
@@ -21,18 +21,7 @@ constexpr uint32_t kMortonBits = 30;  // 10 per axis
 constexpr uint32_t kRadixBits = 10;   // three passes over the codes
 constexpr uint32_t kBuckets = uint32_t(1) << kRadixBits;
 
-struct Box {
-    glm::vec3 lo{std::numeric_limits<float>::infinity()};
-    glm::vec3 hi{-std::numeric_limits<float>::infinity()};
-    void add(const glm::vec3& p) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
-    void add(const Box& b) {
-        lo = glm::min(lo, b.lo);
-        hi = glm::max(hi, b.hi);
-    }
-};
+using Box = core::FloatBox;
 
 Box triangleBox(std::span<const glm::vec3> corners, size_t t) {
     Box b;

@@ -11,10 +11,10 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
-#include <limits>
 #include <random>
 #include <vector>
 
+#include "core/float_box.hpp"
 #include "gpu_algo/surface_tree.hpp"
 
 namespace rthdist::gpu_algo {
@@ -22,14 +22,7 @@ namespace {
 
 namespace sh = rthdist::shared;
 
-struct Box {
-    glm::vec3 lo{std::numeric_limits<float>::infinity()};
-    glm::vec3 hi{-std::numeric_limits<float>::infinity()};
-    void add(const glm::vec3& p) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
-};
+using Box = core::FloatBox;
 
 Box boxOf(const sh::Cell& c) { return {{c.lo.x, c.lo.y, c.lo.z}, {c.hi.x, c.hi.y, c.hi.z}}; }
 
