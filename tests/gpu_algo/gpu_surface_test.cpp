@@ -29,6 +29,7 @@
 #include "core/point_triangle.hpp"
 #include "core/search_mutant.hpp"
 #include "gpu/context.hpp"
+#include "gpu_algo/gpu_context_support.hpp"
 #include "gpu_algo/gpu_hausdorff.hpp"
 #include "gpu_algo/gpu_test_support.hpp"
 #include "rthdist/surface.hpp"
@@ -473,20 +474,6 @@ BruteNearest bruteNearest(const glm::vec3& q, std::span<const glm::vec3> corners
     return n;
 }
 
-std::unique_ptr<gpu::Context> surfaceContext(std::string& whyNot) {
-    auto ctx = gpu::Context::create(test::backendUnderTest(), -1, true);
-    if (!ctx) {
-        whyNot = ctx.error().message;
-        return nullptr;
-    }
-    return std::move(ctx.value());
-}
-
-#define RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx) \
-    std::string rthdist_why_;                \
-    auto ctx = surfaceContext(rthdist_why_); \
-    if (!ctx) GTEST_SKIP() << "no device for this backend: " << rthdist_why_
-
 // What the device search returned for a case, against the brute force.
 struct TailCheck {
     size_t clear = 0;  // queries whose nearest is clear of every other triangle's distance
@@ -527,7 +514,7 @@ TailCheck expectNearest(const FramedCase& c, const gpu_algo::SurfaceCandidates& 
 // The queries the radii leave open (far copies, outliers, degenerate far
 // triangles) go through the tail, which finds each one's nearest triangle.
 TEST(GpuSurfaceTail, FindsTheNearestTriangleOfEveryOpenQuery) {
-    RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx);
+    RTHDIST_REQUIRE_CONTEXT(ctx);
     auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
     ASSERT_TRUE(engine) << engine.error().message;
     for (const FramedCase& c : tailCases()) {
@@ -550,7 +537,7 @@ TEST(GpuSurfaceTail, FindsTheNearestTriangleOfEveryOpenQuery) {
 // The device's group and ray limits forced down: the radii's traces and
 // the tail's dispatch are split into many, and still cover every query.
 TEST(GpuSurfaceTail, SplitDispatchesCoverEveryQuery) {
-    RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx);
+    RTHDIST_REQUIRE_CONTEXT(ctx);
     gpu::DeviceLimits limits = ctx->limits();
     limits.maxGroupsX = 3;
     limits.maxRayDispatch = 5;
@@ -569,7 +556,7 @@ TEST(GpuSurfaceTail, SplitDispatchesCoverEveryQuery) {
 
 // Queries on the surface settle at the first radius: no tail.
 TEST(GpuSurfaceTail, DoesNotRunWhereTheRadiiSettleEveryQuery) {
-    RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx);
+    RTHDIST_REQUIRE_CONTEXT(ctx);
     auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
     ASSERT_TRUE(engine) << engine.error().message;
     const std::vector<glm::vec3> corners = soup(glm::vec3(0.1f), 0.6f, 400, 12, true);
@@ -587,7 +574,7 @@ TEST(GpuSurfaceTail, DoesNotRunWhereTheRadiiSettleEveryQuery) {
 // triangle): a query whose nearest is such a triangle gets another, and
 // the others still get theirs; through the API the proof catches it.
 TEST(GpuSurfaceTail, AMissingTailIsCaughtByTheProof) {
-    RTHDIST_REQUIRE_SURFACE_CONTEXT(ctx);
+    RTHDIST_REQUIRE_CONTEXT(ctx);
     auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
     ASSERT_TRUE(engine) << engine.error().message;
     struct Mutant {

@@ -23,24 +23,11 @@
 #include "gpu/vk_struct.hpp"
 #include "gpu_algo/gpu_hausdorff.hpp"
 #include "gpu_algo/point_index.hpp"
+#include "gpu_context_support.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {
 namespace {
-
-std::unique_ptr<gpu::Context> makeContext(std::string& whyNot) {
-    auto ctx = gpu::Context::create(backendUnderTest(), -1, true);
-    if (!ctx) {
-        whyNot = ctx.error().message;
-        return nullptr;
-    }
-    return std::move(ctx.value());
-}
-
-#define RTHDIST_REQUIRE_CONTEXT(ctx)      \
-    std::string rthdist_why_;             \
-    auto ctx = makeContext(rthdist_why_); \
-    if (!ctx) GTEST_SKIP() << "no device for this backend: " << rthdist_why_
 
 // Runs address_probe.comp once for `index` and returns the 7 addresses.
 std::vector<uint64_t> probeAddresses(gpu::Context& ctx, uint64_t base, uint32_t index) {
