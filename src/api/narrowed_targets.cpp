@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <mutex>
 
 #include "api/route_planner.hpp"
 #include "core/certificate.hpp"
@@ -17,11 +16,6 @@ namespace rthdist::api {
 namespace {
 
 constexpr size_t kChunk = size_t(1) << 16;
-
-double largestAbs(const glm::dvec3& lo, const glm::dvec3& hi) {
-    const glm::dvec3 m = glm::max(glm::abs(lo), glm::abs(hi));
-    return std::max({m.x, m.y, m.z});
-}
 
 // Squared distance from p to the box (0 inside).
 double boxDistance2(const glm::dvec3& p, const core::Bounds& box) {
@@ -33,7 +27,7 @@ double boxDistance2(const glm::dvec3& p, const core::Bounds& box) {
 
 double frameMagnitude(const core::Bounds& box, bool floatExact) {
     const glm::dvec3 origin = floatExact ? glm::dvec3(0.0) : (box.lo + box.hi) * 0.5;
-    return largestAbs(box.lo - origin, box.hi - origin);
+    return core::largestMagnitude(core::Bounds{box.lo - origin, box.hi - origin});
 }
 
 namespace {
@@ -70,6 +64,17 @@ std::vector<uint64_t> select(const PointView& v, int workers, const Keep& keep) 
     return core::concatenateParts<std::vector<uint64_t>>(parts);
 }
 
+core::PointAt pointsOf(const PointView& v) {
+    return [v](uint64_t i) { return v.at(i); };
+}
+
+// d(v[i], T) in double over every target (core::hostBruteForce).
+double nearestDistance(const PointView& v, uint64_t i, const PointView& t, int threads) {
+    core::BandNearest b{i};
+    (void)core::hostBruteForce(pointsOf(v), pointsOf(t), t.count, threads)(std::span(&b, 1));
+    return b.distance;
+}
+
 bool inside(const glm::dvec3& p, const core::Bounds& box) {
     return glm::all(glm::greaterThanEqual(p, box.lo)) && glm::all(glm::lessThanEqual(p, box.hi));
 }
@@ -84,17 +89,7 @@ Directed strayQueries(const PointSubset& strays, const PointView& t, PerPoint* p
         nearest[k].query = k;
         q[k] = strays.view.at(k);
     }
-    std::mutex merge;
-    const int workers = core::resolveThreads(threads, t.count / kChunk + 1);
-    core::parallelChunks(t.count, kChunk, workers, [&](size_t begin, size_t end, int) {
-        std::vector<core::BandNearest> local(n);
-        for (size_t i = begin; i < end; ++i) {
-            const glm::dvec3 p = t.at(i);
-            for (size_t k = 0; k < n; ++k) local[k].offer(i, core::exactDistance(q[k], p));
-        }
-        const std::lock_guard<std::mutex> lock(merge);
-        for (size_t k = 0; k < n; ++k) nearest[k].offer(local[k].target, local[k].distance);
-    });
+    (void)core::hostBruteForce(pointsOf(strays.view), pointsOf(t), t.count, threads)(nearest);
     size_t win = 0;  // the largest distance, the smaller position on a tie
     for (size_t k = 1; k < n; ++k)
         if (nearest[k].distance > nearest[win].distance) win = k;
@@ -153,22 +148,6 @@ std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bou
     const int workers = core::resolveThreads(threads, std::max(q.count, t.count) / kChunk + 1);
     NarrowedTargets out;
 
-    // d(p, T) in double over every target.
-    auto nearestDistance = [&](const glm::dvec3& p) {
-        double nearest2 = std::numeric_limits<double>::infinity();
-        std::mutex merge;
-        core::parallelChunks(t.count, kChunk, workers, [&](size_t begin, size_t end, int) {
-            double local = std::numeric_limits<double>::infinity();
-            for (size_t i = begin; i < end; ++i) {
-                const glm::dvec3 d = t.at(i) - p;
-                local = std::min(local, glm::dot(d, d));
-            }
-            const std::lock_guard<std::mutex> lock(merge);
-            nearest2 = std::min(nearest2, local);
-        });
-        return std::sqrt(nearest2);
-    };
-
     // The core: every query when their own box can gain, else those within
     // a sampled box, when few lie outside it.
     core::Bounds coreBox = qBox;
@@ -183,7 +162,7 @@ std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bou
         // whole pair's slack (2^-20 of its magnitude): the whole search then
         // settles the core's queries at once (they cannot raise h), nothing
         // to gain. Checked before any copy.
-        if (nearestDistance(q.at(strays.front())) >= std::ldexp(whole, kNarrowGainLog2 - 20))
+        if (nearestDistance(q, strays.front(), t, threads) >= std::ldexp(whole, kNarrowGainLog2 - 20))
             return std::nullopt;
         std::vector<uint64_t> core;
         core.reserve(q.count - strays.size());
@@ -205,7 +184,7 @@ std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bou
     const PointView& coreView = out.strays.original.empty() ? q : out.core.view;
 
     const double radius =
-        (glm::length(coreBox.hi - coreBox.lo) + nearestDistance(coreView.at(0))) * (1.0 + 0x1p-30);
+        (glm::length(coreBox.hi - coreBox.lo) + nearestDistance(coreView, 0, t, threads)) * (1.0 + 0x1p-30);
     if (!std::isfinite(radius)) return std::nullopt;
     const core::Bounds reach{glm::max(coreBox.lo - radius, tBox.lo), glm::min(coreBox.hi + radius, tBox.hi)};
     const core::Bounds narrowed{glm::min(coreBox.lo, reach.lo), glm::max(coreBox.hi, reach.hi)};
