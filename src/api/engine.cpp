@@ -32,6 +32,7 @@
 #include "core/input_limits.hpp"
 #include "core/stopwatch.hpp"
 #include "core/thread_pool.hpp"
+#include "core/timings.hpp"
 
 namespace rthdist {
 
@@ -373,23 +374,6 @@ void mapQueriesBack(Directed& d, const std::vector<uint64_t>& original) {
     if (d.certificate.confirmed) d.certificate.query = original[d.certificate.query];
 }
 
-void addTimings(Timings& sum, const Timings& t) {
-    for (auto field : {&Timings::setup, &Timings::upload, &Timings::index, &Timings::cull, &Timings::search,
-                       &Timings::refine, &Timings::check, &Timings::certificate, &Timings::pieces,
-                       &Timings::gpuIndex, &Timings::gpuCull, &Timings::gpuSearch, &Timings::gpuRefine,
-                       &Timings::gpuUpload, &Timings::gpuCertificate})
-        sum.*field += t.*field;
-}
-
-void addCounters(Counters& sum, const Counters& c) {
-    sum.bits = std::max(sum.bits, c.bits);
-    for (auto field : {&Counters::occupiedCells, &Counters::queries, &Counters::culledByNeighbourhood,
-                       &Counters::survivingQueries, &Counters::rays, &Counters::candidatePairs,
-                       &Counters::tailScanned, &Counters::crossPieceQueries})
-        sum.*field += c.*field;
-    sum.iterations += c.iterations;
-}
-
 // Per-point entries of a subset's queries into the whole query set's arrays.
 void scatterPerPoint(PerPoint& whole, const PerPoint& part, const std::vector<uint64_t>& queries) {
     for (size_t k = 0; k < queries.size(); ++k) {
@@ -456,7 +440,7 @@ Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, 
         Directed winner =
             x.distance > c.distance || (x.distance == c.distance && x.queryIndex < c.queryIndex) ? x : c;
         winner.counters = c.counters;
-        addCounters(winner.counters, x.counters);
+        winner.counters.queries += x.counters.queries;  // the strays' brute force counts only its queries
         r->aToB = winner;
         r->hausdorff = winner.distance;
         return r;
@@ -470,7 +454,8 @@ Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, 
         r->bNearest = std::move(ba->aNearest);
         r->directedOnly = false;
         r->hausdorff = std::max(r->aToB.distance, r->bToA.distance);
-        addTimings(r->timings, ba->timings);
+        core::addStageTimings(r->timings, ba->timings);  // setup: the first call's alone
+        r->timings.pieces += ba->timings.pieces;
         r->validationMessages += ba->validationMessages;
     }
     r->timings.total = msSince(t0);
