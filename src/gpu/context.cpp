@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "gpu/barriers.hpp"
+#include "gpu/process_instance.hpp"
 #include "gpu/vk_struct.hpp"
 
 namespace rthdist::gpu {
@@ -43,26 +44,6 @@ void throwVulkanError(VkResult result, const char* expr, const char* file, int l
 }
 
 namespace {
-
-bool instanceHasExtension(const char* name) {
-    uint32_t n = 0;
-    vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr);
-    std::vector<VkExtensionProperties> exts(n);
-    vkEnumerateInstanceExtensionProperties(nullptr, &n, exts.data());
-    for (uint32_t i = 0; i < n; ++i)
-        if (std::strcmp(exts[i].extensionName, name) == 0) return true;
-    return false;
-}
-
-bool hasValidationLayer() {
-    uint32_t n = 0;
-    vkEnumerateInstanceLayerProperties(&n, nullptr);
-    std::vector<VkLayerProperties> props(n);
-    vkEnumerateInstanceLayerProperties(&n, props.data());
-    for (uint32_t i = 0; i < n; ++i)
-        if (std::strcmp(props[i].layerName, "VK_LAYER_KHRONOS_validation") == 0) return true;
-    return false;
-}
 
 const char* typeName(VkPhysicalDeviceType t) {
     switch (t) {
@@ -134,39 +115,6 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBit
     return VK_FALSE;
 }
 
-// An instance of Vulkan 1.3, with the validation layer when asked for, and
-// VK_EXT_debug_utils with validation or Tuning::debugLabels (names and labels
-// for GPU captures without validation; off by default: on the H100 they cost
-// ~0.1 ms per prepared set and ~0.15 ms per batched pair).
-Result<UniqueInstance> makeInstance(bool validation, bool debugLabels) {
-    VkApplicationInfo app = vkStruct<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);
-    app.pApplicationName = "rthdist";
-    app.apiVersion = VK_API_VERSION_1_3;
-    std::vector<const char*> layers, exts;
-    if (validation) {
-        if (!hasValidationLayer())
-            return Error{ErrorCode::kNoDevice,
-                         "validation requested but VK_LAYER_KHRONOS_validation is not installed "
-                         "(Debian: vulkan-validationlayers)"};
-        layers.push_back("VK_LAYER_KHRONOS_validation");
-    }
-    if (validation || (debugLabels && instanceHasExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME)))
-        exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-    VkInstanceCreateInfo ci = vkStruct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
-    ci.pApplicationInfo = &app;
-    ci.enabledLayerCount = uint32_t(layers.size());
-    ci.ppEnabledLayerNames = layers.data();
-    ci.enabledExtensionCount = uint32_t(exts.size());
-    ci.ppEnabledExtensionNames = exts.data();
-    VkInstance instance = VK_NULL_HANDLE;
-    VkResult r = vkCreateInstance(&ci, nullptr, &instance);
-    if (r != VK_SUCCESS)
-        return Error{ErrorCode::kNoDevice,
-                     std::string("no Vulkan driver could be loaded (vkCreateInstance: ") + vkResultName(r) +
-                         "); install a Vulkan ICD, e.g. Mesa lavapipe"};
-    return UniqueInstance(instance, {});
-}
-
 std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
     uint32_t n = 0;
     vkEnumeratePhysicalDevices(instance, &n, nullptr);
@@ -216,11 +164,11 @@ std::optional<Choice> chooseDevice(const std::vector<VkPhysicalDevice>& pds,
 }  // namespace
 
 Result<std::vector<DeviceInfo>> describeDevices() {
-    auto instance = makeInstance(false, false);
+    Result<ProcessInstance*> instance = instanceFor(false, false);
     if (!instance) return instance.error();
     std::vector<DeviceInfo> out;
     int i = 0;
-    for (VkPhysicalDevice pd : physicalDevices(instance->get())) out.push_back(describeDevice(pd, i++));
+    for (VkPhysicalDevice pd : physicalDevices((*instance)->handle)) out.push_back(describeDevice(pd, i++));
     return out;
 }
 
@@ -240,7 +188,7 @@ Result<std::unique_ptr<Context>> Context::create(std::span<const DeviceRequireme
     ctx->m_tuning = tuning;
     try {
         if (std::optional<Error> err = ctx->createInstance(validation)) return *err;
-        const std::vector<VkPhysicalDevice> pds = physicalDevices(ctx->m_instance.get());
+        const std::vector<VkPhysicalDevice> pds = physicalDevices(ctx->m_instanceHandle);
         if (pds.empty()) return Error{ErrorCode::kNoDevice, "no Vulkan physical device found"};
         std::string reasons;
         const std::optional<Choice> choice = chooseDevice(pds, alternatives, deviceIndex, reasons);
@@ -265,15 +213,16 @@ Result<std::unique_ptr<Context>> Context::create(std::span<const DeviceRequireme
 }
 
 std::optional<Error> Context::createInstance(bool validation) {
-    Result<UniqueInstance> instance = makeInstance(validation, m_tuning.debugLabels);
+    Result<ProcessInstance*> instance = instanceFor(validation, m_tuning.debugLabels);
     if (!instance) return instance.error();
-    m_instance = std::move(instance.value());
-    m_instanceHandle = m_instance.get();
+    m_process = *instance;
+    m_processMessagesBefore = m_process->messages.load();
+    m_instanceHandle = m_process->handle;
     // Null where the instance has no VK_EXT_debug_utils: the helpers then do nothing.
-    m_setObjectName = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
-        vkGetInstanceProcAddr(m_instanceHandle, "vkSetDebugUtilsObjectNameEXT"));
-    if (!validation) return std::nullopt;
-    return createMessenger();
+    if (m_process->debugUtils)
+        m_setObjectName = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+            vkGetInstanceProcAddr(m_instanceHandle, "vkSetDebugUtilsObjectNameEXT"));
+    return std::nullopt;
 }
 
 std::optional<Error> Context::createMessenger() {

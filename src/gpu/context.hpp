@@ -1,8 +1,9 @@
-// Vulkan instance, device selection and the single compute queue of an Engine
-// or of the splat renderer. Device selection is headless, takes its
-// requirements as data (gpu/device_requirements.hpp) and records why every
-// rejected device was rejected (vk-bootstrap's habit). Every handle it creates
-// is owned (gpu/unique_handle.hpp): a failure midway releases what exists.
+// Device selection and the single compute queue of an Engine or of the splat
+// renderer, on the process's Vulkan instance (gpu/process_instance.hpp) or an
+// embedder's. Device selection is headless, takes its requirements as data
+// (gpu/device_requirements.hpp) and records why every rejected device was
+// rejected (vk-bootstrap's habit). Every handle it creates is owned
+// (gpu/unique_handle.hpp): a failure midway releases what exists.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -19,6 +20,7 @@
 
 #include "gpu/device_limits.hpp"
 #include "gpu/device_requirements.hpp"
+#include "gpu/process_instance.hpp"
 #include "gpu/unique_handle.hpp"
 #include "gpu/vk_check.hpp"
 #include "rthdist/rthdist.hpp"
@@ -74,6 +76,8 @@ public:
     Context(const Context&) = delete;
     Context& operator=(const Context&) = delete;
 
+    // The process's instance (gpu/process_instance.hpp) or the embedder's.
+    [[nodiscard]] VkInstance instance() const { return m_instanceHandle; }
     [[nodiscard]] VkDevice device() const { return m_deviceHandle; }
     [[nodiscard]] VkPhysicalDevice physicalDevice() const { return m_physical; }
     [[nodiscard]] VkQueue queue() const { return m_queue; }
@@ -97,7 +101,13 @@ public:
     // value than the device's would be unsafe).
     [[nodiscard]] const DeviceLimits& limits() const { return m_limits; }
     void setLimits(const DeviceLimits& limits) { m_limits = limits; }
-    [[nodiscard]] uint64_t validationMessageCount() const { return m_validationMessages.load(); }
+    // Validation messages since this Context was made: its borrowed
+    // instance's messenger's, or the process instance's (which Contexts
+    // alive at the same time share: gpu/process_instance.hpp).
+    [[nodiscard]] uint64_t validationMessageCount() const {
+        return m_validationMessages.load() +
+               (m_process != nullptr ? m_process->messages.load() - m_processMessagesBefore : 0);
+    }
     [[nodiscard]] uint32_t memoryTypeIndex(uint32_t typeBits, VkMemoryPropertyFlags wanted) const;
     [[nodiscard]] float timestampPeriodNs() const { return m_timestampPeriod; }
     // VK_EXT_external_memory_host is on (host arrays can be imported in
@@ -145,7 +155,7 @@ private:
     Context() = default;
     // The steps of create(), in order.
     [[nodiscard]] std::optional<Error> createInstance(bool validation);
-    // The messenger that counts validation messages on m_instanceHandle.
+    // The messenger that counts validation messages on a borrowed instance.
     [[nodiscard]] std::optional<Error> createMessenger();
     // borrow(): the handles checked and adopted, the debug-utils entry points.
     [[nodiscard]] std::optional<Error> adopt(const VulkanDevice& handles, const DeviceRequirements& req,
@@ -157,7 +167,9 @@ private:
     void createCommandObjects();
 
     // Declared in creation order: destroyed in reverse, children first.
-    UniqueInstance m_instance;  // empty when borrowed
+    // The process's instance (kept for the process), or null when borrowed.
+    ProcessInstance* m_process = nullptr;
+    uint64_t m_processMessagesBefore = 0;
     VkInstance m_instanceHandle = VK_NULL_HANDLE;
     UniqueMessenger m_messenger;
     PFN_vkSetDebugUtilsObjectNameEXT m_setObjectName = nullptr;

@@ -111,13 +111,13 @@ using UniqueMessenger =
     Unique<VkDebugUtilsMessengerEXT,
            LoadedDeleter<VkInstance, VkDebugUtilsMessengerEXT, PFN_vkDestroyDebugUtilsMessengerEXT>>;
 
-// The roots, instance and device. Context waits for the device to be idle
+// The root, the device (the instance is the process's:
+// gpu/process_instance.hpp). Context waits for the device to be idle
 // before anything goes, and declares them first so they go last.
 template <typename Handle, void (*Destroy)(Handle, const VkAllocationCallbacks*)>
 struct RootDeleter {
     void operator()(Handle h) const noexcept { Destroy(h, nullptr); }
 };
-using UniqueInstance = Unique<VkInstance, RootDeleter<VkInstance, vkDestroyInstance>>;
 using UniqueDevice = Unique<VkDevice, RootDeleter<VkDevice, vkDestroyDevice>>;
 
 // Calls create(device, &info, nullptr, &handle) (a vkCreateXxx of the
