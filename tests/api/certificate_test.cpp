@@ -64,13 +64,14 @@ TEST(Certificate, EveryResultCarriesAConfirmedProof) {
 // The mutant drops candidates: some directions come out wrong, the
 // certificate fails for them and the Engine recomputes them on the CPU
 // backend; every value is exact all the same. The mutant misses in the
-// rays' refinement only, so the sweep and the tail scan, which a GPU's
-// schedule prefers for the sampled cases' few open queries (on the H200 no
-// direction reached the rays), are off: open queries go to the rays on any
-// device.
+// rays' refinement only, so the small-pair scan (an H200 scans every
+// sampled case whole: no index, no rays), the sweep and the tail scan, which
+// a GPU's schedule prefers for the sampled cases' few open queries, are off:
+// open queries go to the rays on any device.
 TEST(Certificate, MutantSearchIsCaughtAndRecomputed) {
     EngineOptions options = engineUnderTest();
     Tuning raysOnly;
+    raysOnly.smallPairWork = 0;
     raysOnly.sweepWork = 0;
     raysOnly.tailScanWork = 0;
     raysOnly.tailScanStartWork = 0;
