@@ -12,8 +12,12 @@
 # BUNDLE holds rthdist and rthdist-scale-gen. Cases: tools/bench/scale_cases.sh
 # (default: all but torus-1000x1000, which needs ~24 GB of disk and a long
 # CPU check).
-# Environment: PROCS (default 2), EXTRA (more rthdist options, e.g. "--memory-budget 20000"),
-# SCRATCH (where the inputs go; default /tmp/rthdist-scale).
+# Environment: PROCS (default 2), VERIFY (default 1; 0: no --verify, for the
+# CLI's wall time alone: the CPU check costs 10-45 s a case), BEFORE (a
+# previous build's rthdist: each process of the new one is preceded by one of
+# it on the same inputs, files and lines tagged "before"), EXTRA (more
+# rthdist options, e.g. "--memory-budget 20000"), SCRATCH (where the inputs
+# go; default /tmp/rthdist-scale).
 set -uo pipefail
 B=$(cd "${1:?bundle dir}" && pwd)
 OUT=${2:?out dir}
@@ -37,13 +41,21 @@ for c in "${cases[@]}"; do
   for p in $(seq 1 "$PROCS"); do
     # Read once before the first process: every process reads from the page cache.
     [ "$p" = 1 ] && cat "${files[@]}" > /dev/null
-    t0=$(date +%s%N)
-    # shellcheck disable=SC2086
-    "$B/rthdist" --json --verify --quiet --backend rt-pipeline ${EXTRA:-} "${files[@]}" \
-      > "$OUT/$c.$p.json" 2> "$OUT/$c.$p.err"
-    rc=$?
-    echo "$c process $p: exit $rc in $(( ($(date +%s%N) - t0) / 1000000 )) ms" >> "$OUT/log.txt"
-    python3 "$here/scale_line.py" "$c" "$p" "$rc" "$OUT/$c.$p.json" "$OUT/$c.$p.err" | tee -a "$OUT/lines.txt"
+    verify=--verify
+    [ "${VERIFY:-1}" = 0 ] && verify=
+    builds=(new)
+    [ -n "${BEFORE:-}" ] && builds=(before new)
+    for build in "${builds[@]}"; do
+      bin=$B/rthdist name=$c
+      [ "$build" = before ] && bin=$BEFORE name=$c.before
+      t0=$(date +%s%N)
+      # shellcheck disable=SC2086
+      "$bin" --json $verify --quiet --backend rt-pipeline ${EXTRA:-} "${files[@]}" \
+        > "$OUT/$name.$p.json" 2> "$OUT/$name.$p.err"
+      rc=$?
+      echo "$name process $p: exit $rc in $(( ($(date +%s%N) - t0) / 1000000 )) ms" >> "$OUT/log.txt"
+      python3 "$here/scale_line.py" "$name" "$p" "$rc" "$OUT/$name.$p.json" "$OUT/$name.$p.err" | tee -a "$OUT/lines.txt"
+    done
   done
   rm -f "${files[@]}"
 done

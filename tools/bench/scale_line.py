@@ -42,11 +42,15 @@ def main():
         if c and (c.get("query_chunks", 1) > 1 or c.get("target_tiles", 1) > 1):
             pieces.append(f"{c['query_chunks']}x{c['target_tiles']}"
                           f" (+{c.get('cross_piece_queries', 0)} past their piece)")
-    v = j.get("verify", {})
+    v = j.get("verify")
+    checked = "off" if v is None else ("ok" if v.get("ok") else "MISMATCH")
+    v = v or {}
+    t = j["timings_ms"]
+    host = " ".join(f"{k} {t.get(k, 0):.0f}" for k in ("load", "setup", "upload", "index", "cull", "total"))
     print(f"{case} p{proc} exit {rc}: H {fmt(j.get('hausdorff'))} h(A,B) {fmt(j['a_to_b']['distance'])} "
-          f"h(B,A) {fmt((j.get('b_to_a') or {}).get('distance'))} verify {'ok' if v.get('ok') else 'MISMATCH'} "
+          f"h(B,A) {fmt((j.get('b_to_a') or {}).get('distance'))} verify {checked} "
           f"cpu H {fmt((v.get('cpu') or {}).get('hausdorff'))} | certificate {', '.join(cs) or 'none'} | "
-          f"gpu ms {gpu} | wall {j['timings_ms']['wall']:.0f} ms | neighbourhood-settled {'/'.join(settled)} | "
+          f"gpu ms {gpu} | host ms {host} | wall {j['timings_ms']['wall']:.0f} ms | neighbourhood-settled {'/'.join(settled)} | "
           f"points {j['points']['a']}x{j['points']['b']}"
           + (f" | pieces {' / '.join(pieces)} host total {j['timings_ms'].get('total', 0):.0f} ms" if pieces else ""))
 
