@@ -375,6 +375,9 @@ TEST(CliCpu, VerifyAgrees) {
     ASSERT_TRUE(j.contains("verify"));
     EXPECT_TRUE(j["verify"]["ok"].get<bool>());
     EXPECT_EQ(j["verify"]["cpu"]["hausdorff"].get<double>(), j["hausdorff"].get<double>());
+    // The CPU check's own call time, beside this call's (both positive: each searched).
+    EXPECT_GT(j["verify"]["cpu"]["total_ms"].get<double>(), 0.0);
+    EXPECT_GT(j["timings_ms"]["total"].get<double>(), 0.0);
 }
 
 TEST(CliCpu, ThreadCountDoesNotChangeTheResult) {

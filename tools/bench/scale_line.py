@@ -49,7 +49,7 @@ def main():
     host = " ".join(f"{k} {t.get(k, 0):.0f}" for k in ("load", "setup", "upload", "index", "cull", "total"))
     print(f"{case} p{proc} exit {rc}: H {fmt(j.get('hausdorff'))} h(A,B) {fmt(j['a_to_b']['distance'])} "
           f"h(B,A) {fmt((j.get('b_to_a') or {}).get('distance'))} verify {checked} "
-          f"cpu H {fmt((v.get('cpu') or {}).get('hausdorff'))} | certificate {', '.join(cs) or 'none'} | "
+          f"cpu H {fmt((v.get('cpu') or {}).get('hausdorff'))} in {(v.get('cpu') or {}).get('total_ms', 0) / 1000:.1f} s | certificate {', '.join(cs) or 'none'} | "
           f"gpu ms {gpu} | host ms {host} | wall {j['timings_ms']['wall']:.0f} ms | neighbourhood-settled {'/'.join(settled)} | "
           f"points {j['points']['a']}x{j['points']['b']}"
           + (f" | pieces {' / '.join(pieces)} host total {j['timings_ms'].get('total', 0):.0f} ms" if pieces else ""))
