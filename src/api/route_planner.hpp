@@ -29,8 +29,9 @@
 //       kSurfaceCpu     the CPU backend's triangle BVH (api/surface.cpp); also kAuto
 //       kSurfaceGpu     a GPU backend named by the caller: the device's float search
 //                       over triangle boxes, proven in double on the host (api/surface_gpu.cpp)
-// Host views with a narrowed direction (narrowingPays below) run as two
-// directed calls, each on the routes above.
+// Host views that narrow (narrowingPays below, api/narrowed_targets.hpp) run
+// as one call on both sets' cores or as two directed calls, each on the
+// routes above.
 // The pieces of kPieces and kSeveralDevices are planned as framed pairs
 // (planFramedCall): a small piece is scanned whole.
 #pragma once
@@ -128,9 +129,8 @@ struct Plan {
 // most 2^-kNarrowGainLog2 of the whole pair's; the other direction as it is.
 inline constexpr int kNarrowGainLog2 = 8;
 [[nodiscard]] bool narrowingPays(double wholeMagnitude, double narrowedMagnitude);
-// A kDeviceIngest pair of at most this many points in all takes its boxes on
-// the host (one pass per set) to look for a narrowed direction; larger ones
-// are ingested as they are.
+// A kDeviceIngest pair of at most this many points in all looks for narrowed
+// targets from the ingest's own bounds; larger ones are ingested as they are.
 inline constexpr uint64_t kNarrowCheckPoints = uint64_t(1) << 22;
 
 // The route of a pair already checked and framed on the host (float sets of
