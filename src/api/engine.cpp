@@ -531,7 +531,9 @@ bool mayNarrow(const core::Bounds& boxA, const core::Bounds& boxB, const PointVi
 // Route::kDeviceIngest: a one-shot call on packed float arrays: the device
 // checks, bounds and samples the points; the host only copies them.
 // Pairs of at most kNarrowCheckPoints points in all look for narrowed
-// targets from the device's bounds (route_planner.hpp): when the pair
+// targets (route_planner.hpp): from boxes the host takes first where the
+// backend says so (BackendCaps::narrowOnHost; the device then ingests only
+// pairs that do not narrow), else from the device's bounds: when the pair
 // narrows, the device stops before its indexes, its upload thrown away
 // (its wall reported as upload). Packed float32 views: float-exact summaries.
 Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
@@ -543,8 +545,17 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
     std::optional<CheckedInputs> checked;
     double narrowingMs = 0.0;  // looking for it (Timings::pieces), whether it narrows or not
     std::function<bool(const core::Bounds&, const core::Bounds&)> leave;
+    const bool check = a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call);
     const int threads = impl.options.threads;
-    if (a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call))
+    if (check && impl.backend->caps().narrowOnHost) {
+        // The boxes on the host first; bad points are left to the ingest to report.
+        const auto start = core::Clock::now();
+        Result<CheckedInputs> boxes = checkInputs(a, b, threads);
+        if (boxes && mayNarrow(boxes->a.box, boxes->b.box, a, b, call))
+            narrowed = api::narrowPair(a, boxes->a, b, boxes->b, call.directedOnly, threads);
+        narrowingMs = core::msSince(start);
+        if (narrowed) return computeNarrowed(impl, a, b, *boxes, call, t0, *narrowed, narrowingMs);
+    } else if (check) {
         leave = [&](const core::Bounds& boxA, const core::Bounds& boxB) {
             if (!mayNarrow(boxA, boxB, a, b, call)) return false;
             const auto start = core::Clock::now();
@@ -555,6 +566,7 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
             checked = boxes;
             return true;
         };
+    }
     const auto ingestStart = core::Clock::now();
     Result<HausdorffResult> r = impl.backend->computeIngested(asVec3(a), asVec3(b), call, leave);
     const double ingestMs = core::msSince(ingestStart) - narrowingMs;

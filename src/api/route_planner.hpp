@@ -86,6 +86,10 @@ struct BackendCaps {
     bool piecesOnOutOfMemory = false;
     // Why the backend reads no device views; empty when it does.
     std::string noDeviceViews;
+    // A kDeviceIngest pair of at most kNarrowCheckPoints looks for narrowed
+    // targets from boxes taken on the host before the ingest, not from the
+    // ingest's own (Tuning::narrowHostBounds).
+    bool narrowOnHost = false;
 };
 
 struct Plan {
@@ -130,7 +134,9 @@ struct Plan {
 inline constexpr int kNarrowGainLog2 = 8;
 [[nodiscard]] bool narrowingPays(double wholeMagnitude, double narrowedMagnitude);
 // A kDeviceIngest pair of at most this many points in all looks for narrowed
-// targets from the ingest's own bounds; larger ones are ingested as they are.
+// targets, from boxes taken on the host (one pass per set) before the
+// ingest or from the ingest's own (BackendCaps::narrowOnHost); larger ones
+// are ingested as they are.
 inline constexpr uint64_t kNarrowCheckPoints = uint64_t(1) << 22;
 
 // The route of a pair already checked and framed on the host (float sets of

@@ -266,26 +266,30 @@ TEST(NarrowedTargets, TiesBetweenTheCoreAndAStrayTakeTheSmallerQueryIndex) {
 }
 
 // Pairs of the device ingest (packed float32, no small-pair scan) look for
-// narrowing from the device's bounds, then leave the ingest: the same exact
-// answers as the host views' route.
-TEST(NarrowedTargets, DeviceIngestNarrowsFromItsBounds) {
+// narrowing from the host's boxes or from the device's, which it then
+// leaves (Tuning::narrowHostBounds): the same exact answers either way.
+TEST(NarrowedTargets, DeviceIngestNarrowsFromEitherBoxes) {
     std::vector<glm::vec3> a = farCluster(3000, 1e-3f, 0, 101), b = farCluster(2800, 1e-3f, 0, 102);
     const glm::vec3 far(0.0f, 1700.0f, 0.0f);
     a.push_back(far);
     b.push_back(far);
     const std::vector<glm::vec3> one = farCluster(2600, 1e-3f, 5, 103), c = farCluster(2700, 1e-3f, 0, 104);
-    EngineOptions options = test::engineUnderTest();
-    options.tuning = Tuning{};
-    options.tuning->smallPairWork = 0;
-    RTHDIST_REQUIRE_ENGINE(engine, options);
-    for (auto [q, t] : {std::pair{a, b}, std::pair{one, c}, std::pair{c, one}}) {
-        for (bool perPoint : {false, true}) {
-            CallOptions call;
-            call.perPointDistances = perPoint;
-            Result<HausdorffResult> r = engine->compute(q, t, call);
-            ASSERT_TRUE(r) << r.error().message;
-            expectExact(*r, q, t, perPoint);
-            EXPECT_GT(r->aToB.counters.narrowedTargets + r->bToA.counters.narrowedTargets, 0u);
+    for (bool hostBounds : {false, true}) {
+        SCOPED_TRACE(hostBounds ? "host bounds" : "device bounds");
+        EngineOptions options = test::engineUnderTest();
+        options.tuning = Tuning{};
+        options.tuning->smallPairWork = 0;
+        options.tuning->narrowHostBounds = hostBounds;
+        RTHDIST_REQUIRE_ENGINE(engine, options);
+        for (auto [q, t] : {std::pair{a, b}, std::pair{one, c}, std::pair{c, one}}) {
+            for (bool perPoint : {false, true}) {
+                CallOptions call;
+                call.perPointDistances = perPoint;
+                Result<HausdorffResult> r = engine->compute(q, t, call);
+                ASSERT_TRUE(r) << r.error().message;
+                expectExact(*r, q, t, perPoint);
+                EXPECT_GT(r->aToB.counters.narrowedTargets + r->bToA.counters.narrowedTargets, 0u);
+            }
         }
     }
 }
