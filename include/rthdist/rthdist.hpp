@@ -166,7 +166,9 @@ struct Timings {
     double certificate = 0.0;  // the certificate's brute force and proof in double (wall;
                                // also inside `check`/`total`)
     double pieces = 0.0;       // out of core: the host's own work of the pieces (cutting the
-                               // sets in space, merging the calls' results, the proof); wall
+                               // sets in space, merging the calls' results, the proof); narrowed
+                               // targets (README "Far strays"): looking for them, the cores and
+                               // kept targets, the strays' brute force, the merge; wall
     double total = 0.0;        // the whole compute() call, device setup excluded
     // Device time per stage from Vulkan timestamp queries (GPU backends only;
     // 0 on the CPU backend). The wall-clock fields above include submission,

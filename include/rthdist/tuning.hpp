@@ -45,6 +45,15 @@ struct Tuning {
     // copying them: off by default, on the H200 pinning cost more than the
     // copy it saves (docs/bench/prepared). RTHDIST_HOST_IMPORT=1.
     bool hostImport = false;
+    // A packed float32 pair of at most 2^22 points in all (the device
+    // ingest's) takes its boxes on the host, one pass per set, to look for
+    // narrowed targets before the device ingests it; else from the ingest's
+    // own bounds, whose upload a pair that narrows then throws away. Default:
+    // on a CPU device (lavapipe: the ingest is host work as well, about 55 of
+    // cluster-1M's 590-650 ms on 2 cores), off on a GPU (where the ingest is
+    // cheap and the pass would cost every pair that does not narrow).
+    // RTHDIST_NARROW_HOST_BOUNDS (0: off, else on).
+    std::optional<bool> narrowHostBounds;
     // Debug names and labels on Vulkan objects and command buffers without
     // validation, for GPU captures (~0.1 ms per prepared set on an H100).
     // RTHDIST_DEBUG_LABELS (set and not 0).

@@ -30,6 +30,7 @@
 #include "core/index_space.hpp"
 #include "core/input_frame.hpp"
 #include "core/input_limits.hpp"
+#include "core/parallel.hpp"
 #include "core/stopwatch.hpp"
 #include "core/thread_pool.hpp"
 #include "core/timings.hpp"
@@ -327,13 +328,12 @@ Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm:
 Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, const PointView& b,
                                         const CheckedInputs& checked, const CallOptions& call,
                                         std::chrono::steady_clock::time_point t0,
-                                        const std::optional<api::NarrowedTargets>& narrowedB,
-                                        const std::optional<api::NarrowedTargets>& narrowedA);
+                                        const api::PairNarrowing& narrowed, double narrowingMs);
 
 // Host views checked on the host: the frame entered (origin, float copies
-// where needed, the exact scale), the pair run, the frame left. A direction
-// whose targets narrow (api/narrowed_targets.hpp) runs alone unless `narrow`
-// is false (the directed calls of computeNarrowed).
+// where needed, the exact scale), the pair run, the frame left. A pair that
+// narrows (api/narrowed_targets.hpp) runs as computeNarrowed says unless
+// `narrow` is false (the calls of computeNarrowed).
 Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, const PointView& b,
                                      const CheckedInputs& checked, const CallOptions& call,
                                      std::chrono::steady_clock::time_point t0, bool narrow = true) {
@@ -342,122 +342,131 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     if (auto err = core::checkPairFrame(a, checked.a.box, checked.a.floatExact, b, checked.b.box,
                                         checked.b.floatExact, origin))
         return *err;
+    double narrowingMs = 0.0;  // looking for it (Timings::pieces), whether it narrows or not
     if (narrow) {
-        const int threads = impl.options.threads;
-        std::optional<api::NarrowedTargets> narrowedB = api::narrowTargets(
-            a, checked.a.box, checked.a.floatExact, b, checked.b.box, checked.b.floatExact, threads);
-        std::optional<api::NarrowedTargets> narrowedA;
-        if (!call.directedOnly)
-            narrowedA = api::narrowTargets(b, checked.b.box, checked.b.floatExact, a, checked.a.box,
-                                           checked.a.floatExact, threads);
-        if (narrowedA || narrowedB)
-            return computeNarrowed(impl, a, b, checked, call, t0, narrowedB, narrowedA);
+        const auto narrowStart = core::Clock::now();
+        std::optional<api::PairNarrowing> narrowed =
+            api::narrowPair(a, checked.a, b, checked.b, call.directedOnly, impl.options.threads);
+        narrowingMs = core::msSince(narrowStart);
+        if (narrowed) return computeNarrowed(impl, a, b, checked, call, t0, *narrowed, narrowingMs);
     }
     const core::FloatSet fa(a, origin, impl.options.threads), fb(b, origin, impl.options.threads);
     const double scale = core::exactScale(
         std::max(core::searchMagnitude(checked.a, origin), core::searchMagnitude(checked.b, origin)));
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
-    return finished(impl, runWithinBudget(impl, fa.span(), fb.span(), scale, call),
-                    Frame{origin, a, b, copied}, call, t0);
+    Result<HausdorffResult> r = finished(impl, runWithinBudget(impl, fa.span(), fb.span(), scale, call),
+                                         Frame{origin, a, b, copied}, call, t0);
+    if (r) r->timings.pieces += narrowingMs;
+    return r;
 }
 
-// A directed result over subsets, in the inputs' indices (subsets keep
-// input order, so the smallest index of a tie stays the smallest).
-void mapTargetsBack(Directed& d, PerPoint& perPoint, const std::vector<uint64_t>& original) {
-    d.targetIndex = original[d.targetIndex];
-    if (d.certificate.confirmed) d.certificate.nearest = original[d.certificate.nearest];
-    for (uint32_t& n : perPoint.nearest) n = uint32_t(original[n]);
-}
-
-void mapQueriesBack(Directed& d, const std::vector<uint64_t>& original) {
-    d.queryIndex = original[d.queryIndex];
-    if (d.certificate.confirmed) d.certificate.query = original[d.certificate.query];
-}
-
-// Per-point entries of a subset's queries into the whole query set's arrays.
-void scatterPerPoint(PerPoint& whole, const PerPoint& part, const std::vector<uint64_t>& queries) {
-    for (size_t k = 0; k < queries.size(); ++k) {
-        if (!part.nearest.empty()) whole.nearest[queries[k]] = part.nearest[k];
-        if (!part.distance.empty()) whole.distance[queries[k]] = part.distance[k];
+// A direction searched over subsets (queries `core` of q, targets `targets`
+// of t), back in the inputs' indices (subsets keep input order, so the
+// smallest index of a tie stays the smallest), with its stray queries
+// against every target merged in: the larger value, on a tie the smaller
+// query index (the brute force's rule); per-point entries scattered back in
+// query order.
+void mergeDirection(Directed& d, PerPoint& perPoint, const api::PointSubset& core,
+                    const api::PointSubset& strays, const api::PointSubset& targets, const PointView& q,
+                    const PointView& t, const CallOptions& call, int threads) {
+    constexpr size_t kChunk = size_t(1) << 16;
+    if (!targets.whole()) {
+        d.targetIndex = targets.indexOf(d.targetIndex);
+        if (d.certificate.confirmed) d.certificate.nearest = targets.indexOf(d.certificate.nearest);
+        std::vector<uint32_t>& nearest = perPoint.nearest;
+        core::parallelChunks(nearest.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
+            for (size_t k = begin; k < end; ++k) nearest[k] = uint32_t(targets.indexOf(nearest[k]));
+        });
+        d.counters.narrowedTargets = targets.view.count;
     }
+    if (core.whole()) return;
+    // The stray queries against every target: a brute force in double on
+    // the host (a few queries; exact without a certificate).
+    PerPoint strayPoints;
+    Directed x = api::strayQueries(strays, t, call.perPointDistances ? &strayPoints : nullptr, threads);
+    if (!call.perPointDistances || call.perPointNearestOnly) strayPoints.distance.clear();
+    d.queryIndex = core.indexOf(d.queryIndex);
+    if (d.certificate.confirmed) d.certificate.query = core.indexOf(d.certificate.query);
+    x.queryIndex = strays.indexOf(x.queryIndex);
+    x.certificate.query = x.queryIndex;
+    if (call.perPointDistances) {
+        PerPoint whole;
+        if (!perPoint.nearest.empty()) whole.nearest.resize(q.count);
+        if (!perPoint.distance.empty()) whole.distance.resize(q.count);
+        core::parallelChunks(core.view.count, kChunk, threads, [&](size_t begin, size_t end, int) {
+            core.forIndices(begin, end, [&](uint64_t k, uint64_t i) {
+                if (!perPoint.nearest.empty()) whole.nearest[i] = perPoint.nearest[k];
+                if (!perPoint.distance.empty()) whole.distance[i] = perPoint.distance[k];
+            });
+        });
+        for (size_t k = 0; k < strays.view.count; ++k) {
+            if (!whole.nearest.empty()) whole.nearest[strays.listed[k]] = strayPoints.nearest[k];
+            if (!whole.distance.empty()) whole.distance[strays.listed[k]] = strayPoints.distance[k];
+        }
+        perPoint = std::move(whole);
+    }
+    Directed winner =
+        x.distance > d.distance || (x.distance == d.distance && x.queryIndex < d.queryIndex) ? x : d;
+    winner.counters = d.counters;
+    winner.counters.queries += x.counters.queries;  // the strays' brute force counts only its queries
+    d = winner;
 }
 
-// The two directions as directed calls, a narrowed direction over its kept
-// targets (its own frame; its stray queries, if any, apart against every
-// target), the other over the whole set; results merged back into the
-// input's indices. Per-point arrays are handed back once both directions
-// are done.
+// A narrowed pair: one call on both cores (api::JointCores), or the two
+// directions as directed calls, a narrowed direction over its kept targets
+// (its own frame), the other over the whole set; each set's stray queries
+// apart against every target; results merged back into the input's indices.
+// Per-point arrays are handed back once both directions are done. The
+// narrowing's host work (narrowingMs, the merges, the strays) is
+// Timings::pieces.
 Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, const PointView& b,
                                         const CheckedInputs& checked, const CallOptions& call,
                                         std::chrono::steady_clock::time_point t0,
-                                        const std::optional<api::NarrowedTargets>& narrowedB,
-                                        const std::optional<api::NarrowedTargets>& narrowedA) {
-    CallOptions directed = call;
-    directed.directedOnly = true;
-    directed.perPointReady = nullptr;
+                                        const api::PairNarrowing& narrowed, double narrowingMs) {
     const int threads = impl.options.threads;
-    auto summary = [threads](const api::PointSubset& s) {
-        return core::summarizeSet(s.view, "a narrowed subset", threads);
-    };
-    auto one = [&](const PointView& q, const core::SetSummary& qSummary, const PointView& t,
-                   const core::SetSummary& tSummary,
-                   const std::optional<api::NarrowedTargets>& narrowed) -> Result<HausdorffResult> {
-        if (!narrowed)
-            return computeViews(impl, q, t, CheckedInputs{qSummary, tSummary}, directed, t0, false);
-        Result<core::SetSummary> kept = summary(narrowed->targets);
-        if (!kept) return kept.error();
-        const bool strays = !narrowed->strays.original.empty();
-        Result<core::SetSummary> coreSummary =
-            strays ? summary(narrowed->core) : Result<core::SetSummary>(qSummary);
-        if (!coreSummary) return coreSummary.error();
-        Result<HausdorffResult> r =
-            computeViews(impl, strays ? narrowed->core.view : q, narrowed->targets.view,
-                         CheckedInputs{*coreSummary, *kept}, directed, t0, false);
+    CallOptions sub = call;
+    sub.perPointReady = nullptr;
+    Result<HausdorffResult> r = Error{ErrorCode::kInternal, "narrowed pair not run"};
+    if (narrowed.joint) {
+        const api::JointCores& j = *narrowed.joint;
+        r = computeViews(impl, j.coreA.view, j.coreB.view, CheckedInputs{j.summaryA, j.summaryB}, sub, t0,
+                         false);
         if (!r) return r;
-        mapTargetsBack(r->aToB, r->aNearest, narrowed->targets.original);
-        r->aToB.counters.narrowedTargets = narrowed->targets.original.size();
-        if (!strays) return r;
-        // The stray queries against every target: a brute force in double
-        // on the host (a few queries; exact without a certificate).
-        const auto strayStart = core::Clock::now();
-        PerPoint strayPoints;
-        Directed x = api::strayQueries(narrowed->strays, t, call.perPointDistances ? &strayPoints : nullptr,
-                                       impl.options.threads);
-        if (!call.perPointDistances || call.perPointNearestOnly) strayPoints.distance.clear();
-        mapQueriesBack(r->aToB, narrowed->core.original);
-        mapQueriesBack(x, narrowed->strays.original);
-        if (call.perPointDistances) {
-            PerPoint whole;
-            if (!r->aNearest.nearest.empty()) whole.nearest.resize(q.count);
-            if (!r->aNearest.distance.empty()) whole.distance.resize(q.count);
-            scatterPerPoint(whole, r->aNearest, narrowed->core.original);
-            scatterPerPoint(whole, strayPoints, narrowed->strays.original);
-            r->aNearest = std::move(whole);
+        const auto mergeStart = core::Clock::now();
+        mergeDirection(r->aToB, r->aNearest, j.coreA, j.straysA, j.coreB, a, b, call, threads);
+        if (!call.directedOnly)
+            mergeDirection(r->bToA, r->bNearest, j.coreB, j.straysB, j.coreA, b, a, call, threads);
+        narrowingMs += core::msSince(mergeStart);
+    } else {
+        sub.directedOnly = true;
+        auto one = [&](const PointView& q, const core::SetSummary& qSummary, const PointView& t,
+                       const core::SetSummary& tSummary,
+                       const std::optional<api::NarrowedTargets>& n) -> Result<HausdorffResult> {
+            if (!n) return computeViews(impl, q, t, CheckedInputs{qSummary, tSummary}, sub, t0, false);
+            Result<HausdorffResult> d =
+                computeViews(impl, n->core.view, n->targets.view,
+                             CheckedInputs{n->coreSummary, n->targetsSummary}, sub, t0, false);
+            if (!d) return d;
+            const auto mergeStart = core::Clock::now();
+            mergeDirection(d->aToB, d->aNearest, n->core, n->strays, n->targets, q, t, call, threads);
+            narrowingMs += core::msSince(mergeStart);
+            return d;
+        };
+        r = one(a, checked.a, b, checked.b, narrowed.targetsB);
+        if (!r) return r;
+        if (!call.directedOnly) {
+            Result<HausdorffResult> ba = one(b, checked.b, a, checked.a, narrowed.targetsA);
+            if (!ba) return ba.error();
+            r->bToA = ba->aToB;
+            r->bNearest = std::move(ba->aNearest);
+            r->directedOnly = false;
+            core::addStageTimings(r->timings, ba->timings);  // setup: the first call's alone
+            r->timings.pieces += ba->timings.pieces;
+            r->validationMessages += ba->validationMessages;
         }
-        r->timings.certificate += msSince(strayStart);
-        // The larger value; on a tie the smaller query index (the brute force's rule).
-        const Directed& c = r->aToB;
-        Directed winner =
-            x.distance > c.distance || (x.distance == c.distance && x.queryIndex < c.queryIndex) ? x : c;
-        winner.counters = c.counters;
-        winner.counters.queries += x.counters.queries;  // the strays' brute force counts only its queries
-        r->aToB = winner;
-        r->hausdorff = winner.distance;
-        return r;
-    };
-    Result<HausdorffResult> r = one(a, checked.a, b, checked.b, narrowedB);
-    if (!r) return r;
-    if (!call.directedOnly) {
-        Result<HausdorffResult> ba = one(b, checked.b, a, checked.a, narrowedA);
-        if (!ba) return ba.error();
-        r->bToA = ba->aToB;
-        r->bNearest = std::move(ba->aNearest);
-        r->directedOnly = false;
-        r->hausdorff = std::max(r->aToB.distance, r->bToA.distance);
-        core::addStageTimings(r->timings, ba->timings);  // setup: the first call's alone
-        r->timings.pieces += ba->timings.pieces;
-        r->validationMessages += ba->validationMessages;
     }
+    r->hausdorff = call.directedOnly ? r->aToB.distance : std::max(r->aToB.distance, r->bToA.distance);
+    r->timings.pieces += narrowingMs;
     r->timings.total = msSince(t0);
     if (call.perPointReady) {
         call.perPointReady(0, r->aNearest.nearest);
@@ -521,30 +530,58 @@ bool mayNarrow(const core::Bounds& boxA, const core::Bounds& boxB, const PointVi
 
 // Route::kDeviceIngest: a one-shot call on packed float arrays: the device
 // checks, bounds and samples the points; the host only copies them.
-// Pairs of at most kNarrowCheckPoints points in all look for a narrowed
-// direction from the device's bounds (route_planner.hpp): when one narrows,
-// the device stops before its indexes and the directions run narrowed
-// (packed float32 views: their summaries are the device's bounds, float-exact).
+// Pairs of at most kNarrowCheckPoints points in all look for narrowed
+// targets (route_planner.hpp): from boxes the host takes first where the
+// backend says so (BackendCaps::narrowOnHost; the device then ingests only
+// pairs that do not narrow), else from the device's bounds: when the pair
+// narrows, the device stops before its indexes, its upload thrown away
+// (its wall reported as upload). Packed float32 views: float-exact summaries.
 Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
                                         const CallOptions& call, std::chrono::steady_clock::time_point t0) {
     if (auto err = core::checkShape(a, "A")) return *err;
     if (auto err = core::checkShape(b, "B")) return *err;
     if (auto err = validateCallOptions(call)) return *err;
-    std::optional<api::NarrowedTargets> narrowedA, narrowedB;
+    std::optional<api::PairNarrowing> narrowed;
     std::optional<CheckedInputs> checked;
+    double narrowingMs = 0.0;  // looking for it (Timings::pieces), whether it narrows or not
     std::function<bool(const core::Bounds&, const core::Bounds&)> leave;
-    if (a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call))
+    const bool check = a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call);
+    const int threads = impl.options.threads;
+    if (check && impl.backend->caps().narrowOnHost) {
+        // The boxes on the host first; bad points are left to the ingest to report.
+        const auto start = core::Clock::now();
+        Result<CheckedInputs> boxes = checkInputs(a, b, threads);
+        if (boxes && mayNarrow(boxes->a.box, boxes->b.box, a, b, call))
+            narrowed = api::narrowPair(a, boxes->a, b, boxes->b, call.directedOnly, threads);
+        narrowingMs = core::msSince(start);
+        if (narrowed) return computeNarrowed(impl, a, b, *boxes, call, t0, *narrowed, narrowingMs);
+    } else if (check) {
         leave = [&](const core::Bounds& boxA, const core::Bounds& boxB) {
             if (!mayNarrow(boxA, boxB, a, b, call)) return false;
-            const int threads = impl.options.threads;
-            narrowedB = api::narrowTargets(a, boxA, true, b, boxB, true, threads);
-            if (!call.directedOnly) narrowedA = api::narrowTargets(b, boxB, true, a, boxA, true, threads);
-            if (!narrowedA && !narrowedB) return false;
-            checked = CheckedInputs{core::SetSummary{boxA, true}, core::SetSummary{boxB, true}};
+            const auto start = core::Clock::now();
+            const CheckedInputs boxes{core::SetSummary{boxA, true}, core::SetSummary{boxB, true}};
+            narrowed = api::narrowPair(a, boxes.a, b, boxes.b, call.directedOnly, threads);
+            narrowingMs = core::msSince(start);
+            if (!narrowed) return false;
+            checked = boxes;
             return true;
         };
+    }
+    const auto ingestStart = core::Clock::now();
     Result<HausdorffResult> r = impl.backend->computeIngested(asVec3(a), asVec3(b), call, leave);
-    if (checked) return computeNarrowed(impl, a, b, *checked, call, t0, narrowedB, narrowedA);
+    const double ingestMs = core::msSince(ingestStart) - narrowingMs;
+    if (checked) {
+        if (!r) return r;
+        Result<HausdorffResult> n = computeNarrowed(impl, a, b, *checked, call, t0, *narrowed, narrowingMs);
+        if (!n) return n;
+        // The ingest the narrowed calls replaced, thrown away: its wall as
+        // upload (its bounds included), its device times as they were.
+        n->timings.upload += ingestMs;
+        n->timings.gpuUpload += r->timings.gpuUpload;
+        n->timings.gpuIndex += r->timings.gpuIndex;
+        return n;
+    }
+    if (r) r->timings.pieces += narrowingMs;
     return finished(impl, std::move(r), Frame{glm::dvec3(0.0), a, b}, call, t0);
 }
 

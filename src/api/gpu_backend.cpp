@@ -97,6 +97,7 @@ public:
         caps.ingestPoints = gpu_algo::GpuHausdorff::ingestPoints();
         caps.lanes = int(m_lanes.size());
         caps.piecesOnOutOfMemory = m_options.memoryBudget == 0;
+        caps.narrowOnHost = m_options.tuning->narrowHostBounds.value_or(first().context->cpuDevice());
         if (!first().context->borrowed())
             caps.noDeviceViews =
                 "device views (DevicePointView) need an Engine created on your VkDevice "

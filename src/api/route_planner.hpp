@@ -29,8 +29,9 @@
 //       kSurfaceCpu     the CPU backend's triangle BVH (api/surface.cpp); also kAuto
 //       kSurfaceGpu     a GPU backend named by the caller: the device's float search
 //                       over triangle boxes, proven in double on the host (api/surface_gpu.cpp)
-// Host views with a narrowed direction (narrowingPays below) run as two
-// directed calls, each on the routes above.
+// Host views that narrow (narrowingPays below, api/narrowed_targets.hpp) run
+// as one call on both sets' cores or as two directed calls, each on the
+// routes above.
 // The pieces of kPieces and kSeveralDevices are planned as framed pairs
 // (planFramedCall): a small piece is scanned whole.
 #pragma once
@@ -85,6 +86,10 @@ struct BackendCaps {
     bool piecesOnOutOfMemory = false;
     // Why the backend reads no device views; empty when it does.
     std::string noDeviceViews;
+    // A kDeviceIngest pair of at most kNarrowCheckPoints looks for narrowed
+    // targets from boxes taken on the host before the ingest, not from the
+    // ingest's own (Tuning::narrowHostBounds).
+    bool narrowOnHost = false;
 };
 
 struct Plan {
@@ -128,8 +133,9 @@ struct Plan {
 // most 2^-kNarrowGainLog2 of the whole pair's; the other direction as it is.
 inline constexpr int kNarrowGainLog2 = 8;
 [[nodiscard]] bool narrowingPays(double wholeMagnitude, double narrowedMagnitude);
-// A kDeviceIngest pair of at most this many points in all takes its boxes on
-// the host (one pass per set) to look for a narrowed direction; larger ones
+// A kDeviceIngest pair of at most this many points in all looks for narrowed
+// targets, from boxes taken on the host (one pass per set) before the
+// ingest or from the ingest's own (BackendCaps::narrowOnHost); larger ones
 // are ingested as they are.
 inline constexpr uint64_t kNarrowCheckPoints = uint64_t(1) << 22;
 

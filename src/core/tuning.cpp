@@ -41,6 +41,8 @@ Tuning tuningFromEnvironment() {
     t.tailScanStartWork = number("RTHDIST_TAIL_SCAN_START");
     t.sweepWork = number("RTHDIST_SWEEP_WORK");
     t.hostImport = text("RTHDIST_HOST_IMPORT") == "1";
+    if (const char* v = std::getenv("RTHDIST_NARROW_HOST_BOUNDS"))
+        t.narrowHostBounds = std::string_view(v) != "0";
     const std::string labels = text("RTHDIST_DEBUG_LABELS");
     t.debugLabels = !labels.empty() && labels != "0";
     t.traceSubmits = std::getenv("RTHDIST_SUBMIT_TRACE") != nullptr;

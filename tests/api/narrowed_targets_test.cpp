@@ -145,16 +145,153 @@ TEST(NarrowedTargets, CommonStraysAreSetApartAndTheRestNarrowed) {
     EXPECT_EQ(r->hausdorff, r->aToB.distance);
 }
 
+// How the pair narrows on the host (api::narrowPair over the sets' own
+// boxes): nullopt, one call on both cores (joint) or directions apart.
+std::optional<api::PairNarrowing> narrowing(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                                            bool directedOnly = false) {
+    return api::narrowPair(a, core::SetSummary{core::boundsOf(a), true}, b,
+                           core::SetSummary{core::boundsOf(b), true}, directedOnly, 2);
+}
+
 // Strays of their own in both sets: h is kilometres, far above the slack,
-// so the whole search settles the clusters at once; nothing narrows.
+// so the whole search settles the clusters at once; nothing narrows (found
+// from both sets' splits, without a pass over the other set).
 TEST(NarrowedTargets, StraysInBothSetsSearchEveryTarget) {
     RTHDIST_REQUIRE_TEST_ENGINE(engine);
     const std::vector<glm::vec3> a = farCluster(2000, 1e-3f, 3, 31), b = farCluster(2000, 1e-3f, 3, 32);
+    EXPECT_FALSE(narrowing(a, b));
     Result<HausdorffResult> r = engine->compute(a, b);
     ASSERT_TRUE(r) << r.error().message;
     expectExact(*r, a, b, false);
     EXPECT_EQ(r->aToB.counters.narrowedTargets, 0u);
     EXPECT_EQ(r->bToA.counters.narrowedTargets, 0u);
+}
+
+// The joint call with strays in one set (of their own: B -> A narrows,
+// A's strays go to the brute force) and in both (common ones), and
+// directed (A's strays of their own: nothing narrows): the host's choice,
+// then the values, witnesses and per-point entries against the brute force.
+TEST(NarrowedTargets, OneCallOnTheCoresWithStraysInOneSetOrBoth) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    const std::vector<glm::vec3> one = farCluster(2500, 1e-3f, 4, 71),
+                                 cluster = farCluster(2400, 1e-3f, 0, 72);
+    std::vector<glm::vec3> common = farCluster(2300, 1e-3f, 0, 73);
+    const std::vector<glm::vec3> far = farCluster(0, 1e-3f, 2, 74);
+    common.insert(common.begin(), far.begin(), far.end());  // strays first, last: the core is a run
+    std::vector<glm::vec3> withFar = cluster;               // of the set (amid them: CommonStrays...)
+    withFar.insert(withFar.end(), far.begin(), far.end());
+    for (auto [a, b, directedJoint] : {std::tuple{one, cluster, false}, std::tuple{cluster, one, true},
+                                       std::tuple{common, withFar, true}}) {
+        SCOPED_TRACE(testing::Message() << a.size() << " x " << b.size());
+        ASSERT_TRUE(narrowing(a, b) && narrowing(a, b)->joint);
+        CallOptions perPoint;
+        perPoint.perPointDistances = true;
+        Result<HausdorffResult> r = engine->compute(a, b, perPoint);
+        ASSERT_TRUE(r) << r.error().message;
+        expectExact(*r, a, b, true);
+        CallOptions directed;
+        directed.directedOnly = true;
+        EXPECT_EQ(narrowing(a, b, true) && narrowing(a, b, true)->joint, directedJoint);
+        EXPECT_EQ(narrowing(a, b, true).has_value(), directedJoint);
+        r = engine->compute(a, b, directed);
+        ASSERT_TRUE(r) << r.error().message;
+        expectExact(*r, a, b, false);
+        EXPECT_TRUE(r->directedOnly);
+    }
+}
+
+// Strays of B near A's core (within its reach, outside B's own sampled core):
+// they can be A's nearest targets, so the directions run apart (each its
+// own kept targets, B's strays among A's) and still match the brute force.
+TEST(NarrowedTargets, StraysWithinTheOtherCoresReachRunTheDirectionsApart) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    std::vector<glm::vec3> a = farCluster(3000, 1e-2f, 0, 81);  // a 10 mm cube
+    std::vector<glm::vec3> b = farCluster(2000, 1e-3f, 0, 82);  // a 1 mm cube ...
+    for (auto& p : b) p += glm::vec3(4.5e-3f);                  // ... at its centre
+    for (glm::vec3 near : {glm::vec3(1e-3f), glm::vec3(9e-3f), glm::vec3(1e-3f, 9e-3f, 5e-3f)})
+        b.push_back(near);                     // B's strays within A's cube
+    const glm::vec3 far(1700.0f, 0.0f, 0.0f);  // and a common far point
+    a.push_back(far);
+    b.push_back(far);
+    const std::optional<api::PairNarrowing> n = narrowing(a, b);
+    ASSERT_TRUE(n);
+    EXPECT_FALSE(n->joint);
+    ASSERT_TRUE(n->targetsA && n->targetsB);
+    EXPECT_EQ(n->targetsB->strays.view.count, 1u);  // A's far point
+    EXPECT_EQ(n->targetsA->strays.view.count, 4u);  // B's near ones and the far point
+    for (bool perPoint : {false, true}) {
+        CallOptions call;
+        call.perPointDistances = perPoint;
+        Result<HausdorffResult> r = engine->compute(a, b, call);
+        ASSERT_TRUE(r) << r.error().message;
+        expectExact(*r, a, b, perPoint);
+        EXPECT_EQ(r->aToB.counters.narrowedTargets, b.size() - 1);  // B but the far point
+        EXPECT_GT(r->bToA.counters.narrowedTargets, 0u);
+        EXPECT_LT(r->bToA.counters.narrowedTargets, a.size() - 1);  // A's points near B's core
+    }
+}
+
+// Ties between the core's answer and a stray's: the stray and its nearest
+// target are the core's witness pair moved by 2048 along x (coordinates on
+// a 2^-12 grid in x, so the move is exact in float32 and the distances are
+// the same double). The larger value, on a tie the smaller query index:
+// the core's witness when the stray comes after it, the stray at index 0.
+TEST(NarrowedTargets, TiesBetweenTheCoreAndAStrayTakeTheSmallerQueryIndex) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    std::vector<glm::vec3> a = farCluster(1500, 1e-2f, 0, 91), b = farCluster(1400, 1e-2f, 0, 92);
+    for (auto* set : {&a, &b})
+        for (auto& p : *set) p.x = std::round(p.x * 4096.0f) / 4096.0f;
+    const oracle::DirectedExact base = oracle::bruteForceDirected(a, b);
+    const glm::vec3 move(2048.0f, 0.0f, 0.0f);
+    const glm::vec3 stray = a[base.queryIndex] + move, twin = b[base.targetIndex] + move;
+    ASSERT_EQ(stray - move, a[base.queryIndex]);  // exact moves
+    ASSERT_EQ(twin - move, b[base.targetIndex]);
+    b.push_back(twin);
+    for (bool first : {false, true}) {
+        SCOPED_TRACE(first ? "stray first" : "stray last");
+        std::vector<glm::vec3> q = a;
+        q.insert(first ? q.begin() : q.end(), stray);
+        const oracle::DirectedExact want = oracle::bruteForceDirected(q, b);
+        ASSERT_EQ(want.distance, base.distance);  // the tie is there
+        EXPECT_EQ(want.queryIndex, first ? 0u : base.queryIndex);
+        ASSERT_TRUE(narrowing(q, b) && narrowing(q, b)->joint);
+        for (bool perPoint : {false, true}) {
+            CallOptions call;
+            call.perPointDistances = perPoint;
+            Result<HausdorffResult> r = engine->compute(q, b, call);
+            ASSERT_TRUE(r) << r.error().message;
+            expectExact(*r, q, b, perPoint);
+        }
+    }
+}
+
+// Pairs of the device ingest (packed float32, no small-pair scan) look for
+// narrowing from the host's boxes or from the device's, which it then
+// leaves (Tuning::narrowHostBounds): the same exact answers either way.
+TEST(NarrowedTargets, DeviceIngestNarrowsFromEitherBoxes) {
+    std::vector<glm::vec3> a = farCluster(3000, 1e-3f, 0, 101), b = farCluster(2800, 1e-3f, 0, 102);
+    const glm::vec3 far(0.0f, 1700.0f, 0.0f);
+    a.push_back(far);
+    b.push_back(far);
+    const std::vector<glm::vec3> one = farCluster(2600, 1e-3f, 5, 103), c = farCluster(2700, 1e-3f, 0, 104);
+    for (bool hostBounds : {false, true}) {
+        SCOPED_TRACE(hostBounds ? "host bounds" : "device bounds");
+        EngineOptions options = test::engineUnderTest();
+        options.tuning = Tuning{};
+        options.tuning->smallPairWork = 0;
+        options.tuning->narrowHostBounds = hostBounds;
+        RTHDIST_REQUIRE_ENGINE(engine, options);
+        for (auto [q, t] : {std::pair{a, b}, std::pair{one, c}, std::pair{c, one}}) {
+            for (bool perPoint : {false, true}) {
+                CallOptions call;
+                call.perPointDistances = perPoint;
+                Result<HausdorffResult> r = engine->compute(q, t, call);
+                ASSERT_TRUE(r) << r.error().message;
+                expectExact(*r, q, t, perPoint);
+                EXPECT_GT(r->aToB.counters.narrowedTargets + r->bToA.counters.narrowedTargets, 0u);
+            }
+        }
+    }
 }
 
 // The narrowing alone (host): the kept targets are exactly those within R of
@@ -174,11 +311,59 @@ TEST(NarrowTargets, KeepsEveryTargetWithinReachInOrder) {
             glm::max(glm::max(glm::dvec3(qBox.lo) - p, p - glm::dvec3(qBox.hi)), glm::dvec3(0.0));
         if (std::sqrt(glm::dot(d, d)) <= n->radius) want.push_back(i);
     }
-    EXPECT_EQ(n->targets.original, want);
-    EXPECT_TRUE(n->strays.original.empty());
+    EXPECT_EQ(n->targets.listed, want);
+    EXPECT_TRUE(n->strays.listed.empty());
     ASSERT_EQ(n->targets.view.count, want.size());
     for (size_t k = 0; k < want.size(); ++k) EXPECT_EQ(n->targets.view.at(k), glm::dvec3(t[want[k]]));
     EXPECT_EQ(want.size(), 800u + 4u);  // the strays are dropped, the cluster kept
+}
+
+// The kept-target test reads float32 targets against float boxes first
+// (outside the reach's box: dropped; inside a box within reach: kept), the
+// rest in double: the kept set is the double test's, also for targets a
+// float step either side of the reach (faces, edges and corners of it).
+TEST(NarrowTargets, FloatBoxesKeepWhatTheDoubleTestKeeps) {
+    const std::vector<glm::vec3> q = farCluster(500, 1e-3f, 0, 111);
+    const core::Bounds qBox = core::boundsOf(q);
+    const double radius = glm::length(qBox.hi - qBox.lo) * (1.0 + 0x1p-30);  // d(q0, T) = 0 below
+    std::vector<glm::vec3> t = {q[0], glm::vec3(1700.0f, 0.0f, 0.0f)};
+    std::mt19937_64 rng(112);
+    std::uniform_int_distribution<int> side(-1, 1);
+    std::normal_distribution<double> g(0.0, 1.0);
+    while (t.size() < 20000) {
+        // A point at distance `radius` from the box: beyond a face, an edge or a corner.
+        const glm::ivec3 s(side(rng), side(rng), side(rng));
+        if (s == glm::ivec3(0)) continue;
+        glm::dvec3 dir(std::abs(g(rng)), std::abs(g(rng)), std::abs(g(rng)));
+        glm::dvec3 p;
+        for (int k = 0; k < 3; ++k) dir[k] = s[k] == 0 ? 0.0 : dir[k];
+        dir = glm::normalize(dir) * radius;
+        for (int k = 0; k < 3; ++k)
+            p[k] = s[k] < 0   ? qBox.lo[k] - dir[k]
+                   : s[k] > 0 ? qBox.hi[k] + dir[k]
+                              : qBox.lo[k] + (qBox.hi[k] - qBox.lo[k]) * std::abs(g(rng)) / 4.0;
+        const glm::vec3 f(p);
+        t.push_back(f);
+        for (int k = 0; k < 3; ++k)
+            for (float to : {-1.0f, 1.0f}) {
+                glm::vec3 n = f;
+                n[k] = std::nextafter(n[k], to);
+                t.push_back(n);
+            }
+    }
+    const std::optional<api::NarrowedTargets> n =
+        api::narrowTargets(q, qBox, true, t, core::boundsOf(t), true, 2);
+    ASSERT_TRUE(n);
+    EXPECT_EQ(n->radius, radius);
+    std::vector<uint64_t> want;
+    for (size_t i = 0; i < t.size(); ++i) {
+        const glm::dvec3 p(t[i]);
+        const glm::dvec3 d = glm::max(glm::max(qBox.lo - p, p - qBox.hi), glm::dvec3(0.0));
+        if (glm::dot(d, d) <= radius * radius) want.push_back(i);
+    }
+    EXPECT_GT(want.size(), 1000u);
+    EXPECT_LT(want.size(), t.size() - 1000);
+    EXPECT_EQ(n->targets.listed, want);
 }
 
 TEST(NarrowTargets, NothingNarrowsWithoutGain) {
