@@ -149,6 +149,7 @@ struct SurfaceStages {
     double gpuBuild = 0.0;   // device time of the boxes and BLAS builds and refits (part of gpuMs)
     double tailBuild = 0.0;  // the tail's tree of the triangles built on the host (part of search)
     double gpuTail = 0.0;    // device time of the tail's tree descent and its copies (part of gpuMs)
+    double tailHost = 0.0;   // the open queries measured exactly on the host instead (part of certify)
 };
 
 // h(points, surface) with its witness.
