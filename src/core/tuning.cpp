@@ -40,6 +40,7 @@ Tuning tuningFromEnvironment() {
     t.tailScanWork = number("RTHDIST_TAIL_SCAN_WORK");
     t.tailScanStartWork = number("RTHDIST_TAIL_SCAN_START");
     t.sweepWork = number("RTHDIST_SWEEP_WORK");
+    t.surfaceHostWork = number("RTHDIST_SURFACE_HOST_WORK");
     t.hostImport = text("RTHDIST_HOST_IMPORT") == "1";
     const std::string labels = text("RTHDIST_DEBUG_LABELS");
     t.debugLabels = !labels.empty() && labels != "0";
