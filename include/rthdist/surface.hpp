@@ -131,8 +131,15 @@ struct SurfaceCounters {
     uint32_t radii = 0;        // radii searched on the device
     uint64_t rays = 0;         // rays cast over all radii
     uint32_t submissions = 0;  // command buffers the search submitted and waited for
-    uint64_t tailQueries = 0;  // queries the radii left open, searched by the device's tree descent
-    uint64_t band = 0;         // queries searched again exactly on the host (the others are proven below h)
+    // The queries the radii left open (design.md §11, "The tail") go one of
+    // two ways: many descend the device's tree of the triangles (the tail),
+    // a few (open queries x triangles at most Tuning::surfaceHostWork) are
+    // measured exactly on the host instead (no tree, one submission).
+    uint64_t tailQueries = 0;      // queries searched by the device's tree descent
+    uint64_t tailHostQueries = 0;  // queries measured exactly on the host instead (the proof's brute force)
+    uint32_t tailTreeReused = 0;   // 1: the descent's tree was the call before's (same corners), not built
+    // Queries searched again exactly on the host (the others are proven below h).
+    uint64_t band = 0;
 };
 
 // Where a GPU backend's call went, in milliseconds of host wall clock
@@ -149,6 +156,7 @@ struct SurfaceStages {
     double gpuBuild = 0.0;   // device time of the boxes and BLAS builds and refits (part of gpuMs)
     double tailBuild = 0.0;  // the tail's tree of the triangles built on the host (part of search)
     double gpuTail = 0.0;    // device time of the tail's tree descent and its copies (part of gpuMs)
+    double tailHost = 0.0;   // the open queries measured exactly on the host instead (part of certify)
 };
 
 // h(points, surface) with its witness.

@@ -41,6 +41,12 @@ struct Tuning {
     // takes over while open queries x targets is at most this (0: never).
     // RTHDIST_SWEEP_WORK.
     std::optional<uint64_t> sweepWork;
+    // Point to surface on a GPU backend: the queries the radii leave open
+    // are measured exactly on the host (no tree, no second submission)
+    // while open queries x triangles is at most this (default 2^19 per
+    // host thread); past it they descend the tail's tree on the device (0:
+    // always the tree). RTHDIST_SURFACE_HOST_WORK.
+    std::optional<uint64_t> surfaceHostWork;
     // Read host arrays in place (VK_EXT_external_memory_host) instead of
     // copying them: off by default, on the H200 pinning cost more than the
     // copy it saves (docs/bench/prepared). RTHDIST_HOST_IMPORT=1.

@@ -62,9 +62,13 @@ struct TriangleCandidates {
     double stageMs = 0.0;      // host: the upload buffer written
     double submitMs = 0.0;     // host wall of the submissions (upload copies, radii, read-back copy)
     double readbackMs = 0.0;   // host: the candidates read back
-    uint64_t tailQueries = 0;  // queries the tail's tree descent searched (left open by the radii)
-    double tailBuildMs = 0.0;  // host: the tail's tree built and written (part of submitMs)
-    double tailGpuMs = 0.0;    // device time of the tail (part of gpuMs)
+    // Queries the radii left open, where few: no tail searched them; the
+    // caller measures them exactly (api/surface_certify.hpp). In index order.
+    std::vector<uint32_t> open;
+    uint64_t tailQueries = 0;     // queries the tail's tree descent searched (left open by the radii)
+    bool tailTreeReused = false;  // the tail's tree was the call before's (the same corners)
+    double tailBuildMs = 0.0;     // host: the tail's tree built and written (part of submitMs)
+    double tailGpuMs = 0.0;       // device time of the tail (part of gpuMs)
 };
 
 class ComputeBackend {

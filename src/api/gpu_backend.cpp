@@ -192,7 +192,9 @@ public:
                                   found->stageMs,
                                   found->submitMs,
                                   found->readbackMs,
+                                  std::move(found->open),
                                   found->tailQueries,
+                                  found->tailTreeReused,
                                   found->tailBuildMs,
                                   found->tailGpuMs};
     }

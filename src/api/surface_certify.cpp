@@ -4,6 +4,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -25,22 +26,25 @@ struct Largest {
     uint64_t query = 0;
 };
 
+// The rule in double between query q and triangle t: infinite for none.
+double measure2(const PointView& points, const MeshView& surface, uint64_t q, uint32_t t) {
+    if (t >= surface.triangleCount()) return std::numeric_limits<double>::infinity();
+    return core::closestOnTriangle(points.at(q), surface.corner(t, 0), surface.corner(t, 1),
+                                   surface.corner(t, 2))
+        .distance2;
+}
+
 // U(q) of every query: the rule in double against its candidate (an upper
 // bound of its nearest distance), infinite without one.
 std::vector<double> upperBounds(const PointView& points, const MeshView& surface,
                                 std::span<const uint32_t> candidate, int threads, Largest& largest) {
     std::vector<double> bound(points.count);
-    const size_t triangles = surface.triangleCount();
     const int workers = core::resolveThreads(threads, (points.count + kChunk - 1) / kChunk);
     std::vector<Largest> each(static_cast<size_t>(workers));
     core::parallelChunks(points.count, kChunk, workers, [&](size_t begin, size_t end, int thread) {
         Largest& mine = each[size_t(thread)];
         for (size_t q = begin; q < end; ++q) {
-            const uint32_t t = candidate[q];
-            bound[q] = t < triangles ? core::closestOnTriangle(points.at(q), surface.corner(t, 0),
-                                                               surface.corner(t, 1), surface.corner(t, 2))
-                                           .distance2
-                                     : std::numeric_limits<double>::infinity();
+            bound[q] = measure2(points, surface, q, candidate[q]);
             if (bound[q] > mine.bound) mine = Largest{bound[q], q};
         }
     });
@@ -54,18 +58,19 @@ std::vector<double> upperBounds(const PointView& points, const MeshView& surface
 // brute force itself (no BVH to build: the usual band of one query).
 constexpr uint64_t kBruteWork = uint64_t(1) << 24;
 
-// q's nearest triangle by the brute force's rule and order (the smallest
-// index on a tie), on the worker pool: every triangle is measured but those
-// whose box lies farther than sqrt(within2) + slack (within2: U(q), at least
-// q's nearest squared distance; infinite: none is skipped). That skip is the
-// CPU backend's BVH pruning (design.md §11: core::closestSlack exceeds every
-// rounding of the rule and of the box distance), applied to each
-// triangle's own box, so the nearest triangle and every triangle tied with
-// it are measured.
+// A query's nearest triangle by the brute force's rule and order (the
+// smallest index on a tie).
 struct Nearest {
     double distance2 = std::numeric_limits<double>::infinity();
     uint32_t triangle = UINT32_MAX;
     uint64_t tested = 0;  // triangles measured by the rule
+    // Takes triangle t at d2 if nearer (ties: the smaller index).
+    void offer(double d2, uint32_t t) {
+        if (d2 < distance2 || (d2 == distance2 && t < triangle)) {
+            distance2 = d2;
+            triangle = t;
+        }
+    }
 };
 
 double pruneBound2(double within2, double slack) {
@@ -74,52 +79,115 @@ double pruneBound2(double within2, double slack) {
     return bound * bound;
 }
 
-Nearest bruteNearest(const glm::dvec3& p, const MeshView& surface, int threads, double within2,
-                     double slack) {
-    const size_t triangles = surface.triangleCount();
-    const double prune2 = pruneBound2(within2, slack);
+// One query's brute force in one thread: the query, its pruning bound (the
+// square of sqrt(b) + slack below) and its nearest so far.
+struct Probe {
+    glm::dvec3 p{0.0};
+    double prune2 = std::numeric_limits<double>::infinity();
+    Nearest best;
+
+    // Triangle t (corners a, b, c; box lo-hi): skipped when its box lies
+    // past the bound, else measured by the rule (and the bound tightened).
+    void visit(size_t t, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& lo,
+               const glm::dvec3& hi, double slack) {
+        const glm::dvec3 out = glm::max(glm::max(lo - p, p - hi), glm::dvec3(0.0));
+        if (glm::dot(out, out) > prune2) return;
+        const double d2 = core::closestOnTriangle(p, a, b, c).distance2;
+        ++best.tested;
+        if (d2 < best.distance2) prune2 = std::min(prune2, pruneBound2(d2, slack));
+        best.offer(d2, uint32_t(t));
+    }
+};
+
+// Each query's nearest triangle (`queries`: indices into points) in one
+// pass over the triangles on the worker pool: every triangle is measured
+// but those whose box lies farther than sqrt(b) + slack, b the smaller of
+// the query's within2 (at least its nearest squared distance: U(q), or
+// infinite) and the nearest the thread has measured for it so far (a real
+// triangle's: at least the nearest too). That skip is the CPU backend's
+// BVH pruning (design.md §11: core::closestSlack exceeds every rounding of
+// the rule and of the box distance), applied to each triangle's own box,
+// so the nearest triangle and every triangle tied with it are measured.
+std::vector<Nearest> bruteNearest(const PointView& points, std::span<const uint64_t> queries,
+                                  const MeshView& surface, int threads, std::span<const double> within2,
+                                  double slack) {
+    const size_t k = queries.size(), triangles = surface.triangleCount();
+    if (k == 0) return {};
     const int workers = core::resolveThreads(threads, (triangles + kChunk - 1) / kChunk);
-    std::vector<Nearest> each(static_cast<size_t>(workers));
+    std::vector<Probe> each(size_t(workers) * k);  // each thread's k probes
+    for (size_t w = 0; w < size_t(workers); ++w) {
+        for (size_t i = 0; i < k; ++i) {
+            each[w * k + i].p = points.at(queries[i]);
+            each[w * k + i].prune2 = pruneBound2(within2[i], slack);
+        }
+    }
     core::parallelChunks(triangles, kChunk, workers, [&](size_t begin, size_t end, int thread) {
-        Nearest& mine = each[size_t(thread)];
-        for (size_t t = begin; t < end; ++t) {
-            const glm::dvec3 a = surface.corner(t, 0), b = surface.corner(t, 1), c = surface.corner(t, 2);
-            const glm::dvec3 lo = glm::min(glm::min(a, b), c), hi = glm::max(glm::max(a, b), c);
-            const glm::dvec3 out = glm::max(glm::max(lo - p, p - hi), glm::dvec3(0.0));
-            if (glm::dot(out, out) > prune2) continue;
-            const double d2 = core::closestOnTriangle(p, a, b, c).distance2;
-            ++mine.tested;
-            if (d2 < mine.distance2 || (d2 == mine.distance2 && t < mine.triangle)) {
-                mine.distance2 = d2;
-                mine.triangle = uint32_t(t);
+        Probe* mine = &each[size_t(thread) * k];
+        auto pass = [&](Probe* probes, size_t count) {
+            for (size_t t = begin; t < end; ++t) {
+                const glm::dvec3 a = surface.corner(t, 0), b = surface.corner(t, 1), c = surface.corner(t, 2);
+                const glm::dvec3 lo = glm::min(glm::min(a, b), c), hi = glm::max(glm::max(a, b), c);
+                for (size_t i = 0; i < count; ++i) probes[i].visit(t, a, b, c, lo, hi, slack);
             }
+        };
+        if (k == 1) {  // the usual single query: its probe in registers
+            Probe one = mine[0];
+            pass(&one, 1);
+            mine[0] = one;
+        } else {
+            pass(mine, k);
         }
     });
-    Nearest best;
-    uint64_t tested = 0;
-    for (const Nearest& n : each) {
-        tested += n.tested;
-        if (n.distance2 < best.distance2 || (n.distance2 == best.distance2 && n.triangle < best.triangle))
-            best = n;
+    std::vector<Nearest> best(k);
+    for (size_t w = 0; w < size_t(workers); ++w) {
+        for (size_t i = 0; i < k; ++i) {
+            const Nearest& n = each[w * k + i].best;
+            best[i].tested += n.tested;
+            if (n.triangle != UINT32_MAX) best[i].offer(n.distance2, n.triangle);
+        }
     }
-    best.tested = tested;
     return best;
 }
 
+// Queries measured exactly already (by bruteNearest), by query index.
+using Known = std::vector<std::pair<uint64_t, Nearest>>;  // sorted by query
+
+// Where q is, or would go, in `known`.
+Known::const_iterator placeOf(const Known& known, uint64_t q) {
+    return std::lower_bound(known.begin(), known.end(), q,
+                            [](const Known::value_type& e, uint64_t v) { return e.first < v; });
+}
+
+const Nearest* knownOf(const Known& known, uint64_t q) {
+    const auto it = placeOf(known, q);
+    return it != known.end() && it->first == q ? &it->second : nullptr;
+}
+
 // The band by the brute force: the largest nearest distance, the smallest
-// query on a tie (the band is in index order). q*'s nearest (`known`, of
-// query `knownQuery`) is measured already.
+// query on a tie (the band is in index order). The queries of `known` are
+// measured already; the others in one pass over the triangles.
+// trianglesTested: the rule's evaluations of that pass and of `known`.
 SurfaceResult bruteBand(const PointView& points, std::span<const uint64_t> band, const MeshView& surface,
-                        std::span<const double> bound, double slack, int threads, uint64_t knownQuery,
-                        const Nearest& known) {
+                        std::span<const double> bound, double slack, int threads, const Known& known) {
+    std::vector<uint64_t> rest;
+    std::vector<double> restBound;
+    for (const uint64_t q : band) {
+        if (knownOf(known, q) == nullptr) {
+            rest.push_back(q);
+            restBound.push_back(bound[q]);
+        }
+    }
+    const std::vector<Nearest> measured = bruteNearest(points, rest, surface, threads, restBound, slack);
     SurfaceResult r;
     Nearest top;
     uint64_t topQuery = 0, tested = 0;
     bool any = false;
+    size_t next = 0;  // into rest and measured (both in band order)
+    for (const Nearest& n : measured) tested += n.tested;
+    for (const auto& [q, n] : known) tested += n.tested;
     for (const uint64_t q : band) {
-        const Nearest n =
-            q == knownQuery ? known : bruteNearest(points.at(q), surface, threads, bound[q], slack);
-        tested += n.tested;
+        const Nearest* k = knownOf(known, q);
+        const Nearest& n = k != nullptr ? *k : measured[next++];
         if (!any || n.distance2 > top.distance2) {
             top = n;
             topQuery = q;
@@ -141,31 +209,75 @@ SurfaceResult bruteBand(const PointView& points, std::span<const uint64_t> band,
     return r;
 }
 
+// The band, in index order: every query whose U may reach L (a function of
+// its own: inlined in certifySurface, this loop ran 3x slower on 2 cores).
+std::vector<uint64_t> bandOf(std::span<const double> bound, double lower2) {
+    std::vector<uint64_t> band;
+    for (size_t q = 0; q < bound.size(); ++q) {
+        if (bound[q] >= lower2) band.push_back(q);
+    }
+    return band;
+}
+
 }  // namespace
 
 Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface, double magnitude,
-                                     std::span<const uint32_t> candidate, const SurfaceOptions& options) {
+                                     std::span<const uint32_t> candidate, const SurfaceOptions& options,
+                                     std::span<const uint32_t> open) {
     if (options.perPointDistances)
         return Error{ErrorCode::kInvalidArgument,
                      "the proof of a surface search gives no per-point distances"};
     if (candidate.size() != points.count)
         return Error{ErrorCode::kInternal, "surface proof: " + std::to_string(candidate.size()) +
                                                " candidates for " + std::to_string(points.count) + " points"};
+    const double slack = core::closestSlack(magnitude);
+    const size_t triangles = surface.triangleCount();
+
+    // The open queries first, exactly (their candidates' U as the first
+    // bound); each then takes its nearest triangle for its candidate, so its
+    // U below is its exact nearest distance.
+    const core::Clock::time_point openStart = core::Clock::now();
+    Known known;
+    std::vector<uint32_t> settledCandidate;
+    if (!open.empty()) {
+        std::vector<uint64_t> openQueries;
+        std::vector<double> within2;
+        for (const uint32_t q : open) {
+            if (q >= points.count || (!openQueries.empty() && q <= openQueries.back())) {
+                return Error{ErrorCode::kInternal,
+                             "surface proof: open query " + std::to_string(q) + " out of range or order"};
+            }
+            openQueries.push_back(q);
+            within2.push_back(measure2(points, surface, q, candidate[q]));
+        }
+        const std::vector<Nearest> nearest =
+            bruteNearest(points, openQueries, surface, options.threads, within2, slack);
+        settledCandidate.assign(candidate.begin(), candidate.end());
+        for (size_t i = 0; i < openQueries.size(); ++i) {
+            known.emplace_back(openQueries[i], nearest[i]);
+            settledCandidate[openQueries[i]] = nearest[i].triangle;
+        }
+        candidate = settledCandidate;
+    }
+    const double openMs = open.empty() ? 0.0 : core::msSince(openStart);
+
     Largest largest;
     const std::vector<double> bound = upperBounds(points, surface, candidate, options.threads, largest);
-    const double slack = core::closestSlack(magnitude);
-    const Nearest measured =
-        bruteNearest(points.at(largest.query), surface, options.threads, largest.bound, slack);
+    Nearest measured;  // q*'s nearest, exactly
+    if (const Nearest* k = knownOf(known, largest.query)) {
+        measured = *k;
+    } else {
+        const double within2[1] = {largest.bound};
+        const uint64_t query[1] = {largest.query};
+        measured = bruteNearest(points, query, surface, options.threads, within2, slack)[0];
+        known.insert(placeOf(known, largest.query), {largest.query, measured});
+    }
     const double lower2 = measured.distance2;  // L^2 <= h^2
 
-    // The band, in index order: every query that may reach L.
-    std::vector<uint64_t> bandIndex;
-    for (size_t q = 0; q < points.count; ++q) {
-        if (bound[q] >= lower2) bandIndex.push_back(q);
-    }
+    const std::vector<uint64_t> bandIndex = bandOf(bound, lower2);
     Result<SurfaceResult> exact = SurfaceResult{};
-    if (bandIndex.size() * surface.triangleCount() <= kBruteWork) {
-        exact = bruteBand(points, bandIndex, surface, bound, slack, options.threads, largest.query, measured);
+    if (bandIndex.size() * triangles <= kBruteWork) {
+        exact = bruteBand(points, bandIndex, surface, bound, slack, options.threads, known);
     } else {  // the CPU backend's BVH search over the band (its own witness check)
         std::vector<glm::dvec3> band;
         band.reserve(bandIndex.size());
@@ -182,6 +294,7 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     }
     d.counters.queries = points.count;
     d.counters.band = bandIndex.size();
+    exact->stages.tailHost = openMs;
     return exact;
 }
 

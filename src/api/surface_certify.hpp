@@ -33,9 +33,16 @@ namespace rthdist::api {
 // one triangle index per point, UINT32_MAX (or any index past the last
 // triangle) for none; magnitude: the largest |coordinate| over both
 // (core::closestSlack). perPointDistances is not offered (kInvalidArgument).
-// SurfaceResult::directed.counters.band: the queries searched exactly.
+// open (increasing query indices): queries the search left unsettled
+// (gpu_algo::SurfaceCandidates::open), measured exactly first by the same
+// brute force (pruned by their candidate's U), then taking their nearest
+// triangle for candidate: their U is then exact, and the proof runs as
+// above (a measured query found again is not measured twice).
+// SurfaceResult::directed.counters.band: the queries searched exactly in 3.;
+// stages.tailHost: the open queries' brute force.
 [[nodiscard]] Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface,
                                                    double magnitude, std::span<const uint32_t> candidate,
-                                                   const SurfaceOptions& options);
+                                                   const SurfaceOptions& options,
+                                                   std::span<const uint32_t> open = {});
 
 }  // namespace rthdist::api

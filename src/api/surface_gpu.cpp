@@ -66,7 +66,7 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
 
     const core::Clock::time_point certifyStart = core::Clock::now();
     Result<SurfaceResult> result =
-        certifySurface(points, surface, inputs.magnitude, found->triangle, options);
+        certifySurface(points, surface, inputs.magnitude, found->triangle, options, found->open);
     if (!result) return result.error();
     SurfaceResult& r = result.value();
     r.backend = device.kind();
@@ -76,6 +76,8 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
     n.rays = found->rays;
     n.submissions = found->submissions;
     n.tailQueries = found->tailQueries;
+    n.tailHostQueries = found->open.size();
+    n.tailTreeReused = found->tailTreeReused ? 1u : 0u;
     n.triangles = surface.triangleCount();
     r.stages.frame = frameMs;
     r.stages.upload = found->stageMs;

@@ -3,8 +3,9 @@
 // Both inputs are shifted by the centre of their union's box, scaled by a
 // power of two (|coordinate| <= 1) and rounded to float; the backend's
 // device search (gpu_algo/surface_search.hpp) gives each query a nearest
-// triangle; api/surface_certify.hpp proves the directed maximum from the
-// caller's coordinates in double.
+// triangle (a few far queries it hands back open); api/surface_certify.hpp
+// measures those exactly and proves the directed maximum from the caller's
+// coordinates in double.
 #pragma once
 
 #include "api/backend.hpp"

@@ -179,9 +179,11 @@ public:
 
     // The point-to-surface search (surface_search.hpp): every query's
     // nearest triangle as the device found it, a candidate the caller proves
-    // in double. queries and corners (3 per triangle) in one float frame;
-    // `cancel` read between submissions (kCancelled). Its buffers and the
-    // BLAS storage stay for the next call (releaseScratch frees them).
+    // in double (a few open queries handed back for the caller to measure:
+    // SurfaceCandidates::open). queries and corners (3 per triangle) in one
+    // float frame; `cancel` read between submissions (kCancelled). Its
+    // buffers, the tail's tree and the BLAS storage stay for the next call
+    // (releaseScratch frees them).
     [[nodiscard]] Result<SurfaceCandidates> nearestTriangles(std::span<const glm::vec3> queries,
                                                              std::span<const glm::vec3> corners,
                                                              const std::atomic<bool>* cancel = nullptr);

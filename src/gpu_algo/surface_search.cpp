@@ -24,12 +24,37 @@ constexpr size_t kStageChunk = size_t(1) << 14;
 
 using Box = core::FloatBox;
 
+// One triangle's share of the corners' fingerprint (SurfaceSearch keeps the
+// tail's tree while it is the same): its nine float corners' bits and its
+// index, mixed. The fingerprint is the sum of the shares, so it is the same
+// whatever the threads.
+uint64_t fingerprintOf(const glm::vec3* corners, uint32_t triangle) {
+    uint32_t w[10];
+    std::memcpy(w, corners, 9 * sizeof(float));
+    w[9] = triangle;
+    uint64_t h = 0x9e3779b97f4a7c15ULL;
+    for (int i = 0; i < 10; i += 2) {
+        h = (h ^ (uint64_t(w[i]) | uint64_t(w[i + 1]) << 32)) * 0xff51afd7ed558ccdULL;
+        h ^= h >> 32;
+    }
+    return h;
+}
+
 }  // namespace
 
 SurfaceRadii::SurfaceRadii(double meanSide, double area, uint64_t queries, double diagonal) {
     m_cover = diagonal * (1.0 + 0x1p-10) + 0x1p-24;
     const double spacing = queries > 0 ? std::sqrt(std::max(area, 0.0) / double(queries)) : 0.0;
     m_first = std::min(std::max({meanSide * 0.5, spacing * 0.5, diagonal * 0x1p-20, 0x1p-24}), m_cover);
+}
+
+uint64_t surfaceHostWork(const Tuning& tuning, int threads) {
+    return tuning.surfaceHostWork.value_or(kSurfaceHostWorkPerThread *
+                                           uint64_t(core::resolveThreads(threads)));
+}
+
+bool openQueriesToHost(uint64_t open, uint64_t triangles, uint64_t hostWork) {
+    return open > 0 && triangles > 0 && open <= hostWork / triangles;
 }
 
 std::vector<double> SurfaceRadii::start() const {
@@ -42,10 +67,12 @@ std::vector<double> SurfaceRadii::start() const {
 struct SurfaceSearch::Stats {
     Box box;
     double sides = 0.0, area = 0.0;
+    uint64_t fingerprint = 0;  // of the corners (fingerprintOf, summed)
     void add(const Stats& o) {
         box.add(o.box);
         sides += o.sides;
         area += o.area;
+        fingerprint += o.fingerprint;
     }
 };
 
@@ -86,22 +113,38 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
         out.rays += c.searched;
     }
     if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
-    if (open > 0) {
-        submitTail(corners, start.back(), out);
+    // A few open queries go back to the host (measured exactly there), the
+    // others descend the tail's tree.
+    const bool toHost = openQueriesToHost(open, m_triangles, surfaceHostWork(m_ws.tuning, m_ws.threads));
+    if (open > 0 && !toHost) {
+        submitTail(corners, stats.fingerprint, start.back(), out);
         if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
     }
     out.submitMs = msSince(t0);
 
-    // Every query's best, as the last submission copied it: its triangle is the low word.
+    // Every query's best, as the last submission copied it: its triangle is
+    // the low word; where the open queries go back, a query is open as the
+    // rays' shader tells (its best not within the last radius, or none).
     t0 = Clock::now();
     const auto* packed = static_cast<const uint64_t*>(m_readback.mapped());
+    const float settled2 = std::nextafter(float(start.back() * start.back()), 0.0f);
+    const size_t chunk = kStageChunk * 4;
+    std::vector<std::vector<uint32_t>> openParts(toHost ? (m_queries + chunk - 1) / chunk : 0);
     out.triangle.resize(m_queries);
-    core::parallelChunks(m_queries, kStageChunk * 4, m_ws.threads, [&](size_t begin, size_t end, int) {
+    core::parallelChunks(m_queries, chunk, m_ws.threads, [&](size_t begin, size_t end, int) {
         for (size_t q = begin; q < end; ++q) {
             const auto t = uint32_t(packed[q] & 0xffffffffu);
             out.triangle[q] = t < m_triangles ? t : UINT32_MAX;
         }
+        if (!toHost) return;
+        for (size_t q = begin; q < end; ++q) {
+            float d2 = 0.0f;
+            const auto bits = uint32_t(packed[q] >> 32);
+            std::memcpy(&d2, &bits, sizeof(d2));
+            if (!(d2 <= settled2)) openParts[begin / chunk].push_back(uint32_t(q));
+        }
     });
+    out.open = core::concatenateParts<std::vector<uint32_t>>(openParts);
     out.readbackMs = msSince(t0);
     return out;
 }
@@ -110,6 +153,7 @@ void SurfaceSearch::release() {
     for (gpu::Buffer* b : {&m_points, &m_corners, &m_boxes, &m_best, &m_aabbs, &m_staging, &m_readback,
                            &m_counts, &m_nodes, &m_order})
         b->reset();
+    m_treeTriangles = 0;
 }
 
 SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
@@ -162,6 +206,7 @@ SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
             const glm::dvec3 a(corners[3 * t]), b(corners[3 * t + 1]), c(corners[3 * t + 2]);
             mine.area += 0.5 * glm::length(glm::cross(b - a, c - a));
             mine.box.add(tri);
+            mine.fingerprint += fingerprintOf(&corners[3 * t], uint32_t(t));
         }
         each[size_t(thread)].add(mine);
     });
@@ -224,32 +269,44 @@ void SurfaceSearch::cmdReadBack(VkCommandBuffer cmd) {
                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
 }
 
-void SurfaceSearch::submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out) {
-    // The tree, written to the upload buffer (the radii's submission has
+void SurfaceSearch::submitTail(std::span<const glm::vec3> corners, uint64_t fingerprint, double settled,
+                               SurfaceCandidates& out) {
+    // The tree of the call before where the corners are the same; else
+    // built and written to the upload buffer (the radii's submission has
     // finished with what it held): nodes, then the order.
-    auto t0 = Clock::now();
-    const SurfaceTree tree = buildSurfaceTree(corners, m_ws.threads);
-    const VkDeviceSize nodeBytes = VkDeviceSize(tree.nodes.size()) * sizeof(sh::Cell);
-    const VkDeviceSize orderBytes = VkDeviceSize(tree.order.size()) * sizeof(uint32_t);
-    gpu::Buffer& staging =
-        m_ws.grow(m_staging, nodeBytes + orderBytes, "surface.staging", gpu::MemoryKind::kHost);
-    m_ws.grow(m_nodes, nodeBytes, "surface.nodes");
-    m_ws.grow(m_order, orderBytes, "surface.order");
-    auto* bytes = static_cast<char*>(staging.mapped());
-    std::memcpy(bytes, tree.nodes.data(), nodeBytes);
-    std::memcpy(bytes + nodeBytes, tree.order.data(), orderBytes);
-    out.tailBuildMs = msSince(t0);
+    const bool kept = m_treeTriangles == m_triangles && m_treeFingerprint == fingerprint;
+    VkDeviceSize nodeBytes = 0, orderBytes = 0;
+    if (!kept) {
+        auto t0 = Clock::now();
+        m_treeTriangles = 0;  // m_nodes and m_order hold no tree until the submission below is done
+        const SurfaceTree tree = buildSurfaceTree(corners, m_ws.threads);
+        nodeBytes = VkDeviceSize(tree.nodes.size()) * sizeof(sh::Cell);
+        orderBytes = VkDeviceSize(tree.order.size()) * sizeof(uint32_t);
+        gpu::Buffer& staging =
+            m_ws.grow(m_staging, nodeBytes + orderBytes, "surface.staging", gpu::MemoryKind::kHost);
+        m_ws.grow(m_nodes, nodeBytes, "surface.nodes");
+        m_ws.grow(m_order, orderBytes, "surface.order");
+        auto* bytes = static_cast<char*>(staging.mapped());
+        std::memcpy(bytes, tree.nodes.data(), nodeBytes);
+        std::memcpy(bytes + nodeBytes, tree.order.data(), orderBytes);
+        out.tailBuildMs = msSince(t0);
+    }
+    out.tailTreeReused = kept;
 
     VkCommandBuffer cmd = m_ws.ctx.begin();
     {
         const gpu::ScopedLabel label(m_ws.ctx, cmd, "surface tail");
-        const VkBufferCopy toNodes{0, 0, nodeBytes};
-        const VkBufferCopy toOrder{nodeBytes, 0, orderBytes};
-        vkCmdCopyBuffer(cmd, m_staging.handle(), m_nodes.handle(), 1, &toNodes);
-        vkCmdCopyBuffer(cmd, m_staging.handle(), m_order.handle(), 1, &toOrder);
-        gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        if (!kept) {
+            const VkBufferCopy toNodes{0, 0, nodeBytes};
+            const VkBufferCopy toOrder{nodeBytes, 0, orderBytes};
+            vkCmdCopyBuffer(cmd, m_staging.handle(), m_nodes.handle(), 1, &toNodes);
+            vkCmdCopyBuffer(cmd, m_staging.handle(), m_order.handle(), 1, &toOrder);
+            // (A kept tree's copies were made visible to compute reads by
+            // this barrier in the submission that made them.)
+            gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                             VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                             VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        }
         sh::SurfaceTailPush tp{};
         tp.queries = m_points.address();
         tp.corners = m_corners.address();
@@ -265,6 +322,10 @@ void SurfaceSearch::submitTail(std::span<const glm::vec3> corners, double settle
     }
     cmdReadBack(cmd);
     m_ws.ctx.submitAndWait(cmd);
+    if (!kept) {
+        m_treeTriangles = m_triangles;
+        m_treeFingerprint = fingerprint;
+    }
     ++out.submissions;
     out.tailGpuMs = m_ws.ctx.lastGpuMs();
     out.gpuMs += out.tailGpuMs;

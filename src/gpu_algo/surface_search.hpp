@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "gpu/buffer.hpp"
+#include "rthdist/tuning.hpp"
 #include "rthdist_surface_search.h"
 
 namespace rthdist::gpu_algo {
@@ -54,11 +55,36 @@ struct SurfaceCandidates {
     double stageMs = 0.0;            // host: the inputs written to the upload buffer, the radii's statistics
     double submitMs = 0.0;           // host wall: recording, submitting and waiting for the submissions
     double readbackMs = 0.0;         // host: the candidates taken from the read-back buffer
-    // The tail (0 where the radii settled every query):
-    uint64_t tailQueries = 0;  // queries that descended the tree on the device
-    double tailBuildMs = 0.0;  // host: the tree built and written to the upload buffer (part of submitMs)
-    double tailGpuMs = 0.0;    // device time of the tail's submission (part of gpuMs)
+    // The queries the radii left open, where they were few (open x
+    // triangles at most Tuning::surfaceHostWork): no tail ran; their
+    // `triangle` is the rays' best (or none), and the caller measures them
+    // exactly. In index order.
+    std::vector<uint32_t> open;
+    // The tail (0 where it did not run):
+    uint64_t tailQueries = 0;     // queries that descended the tree on the device
+    bool tailTreeReused = false;  // the tree of the call before (the same corners): not built
+    double tailBuildMs = 0.0;     // host: the tree built and written to the upload buffer (part of submitMs)
+    double tailGpuMs = 0.0;       // device time of the tail's submission (part of gpuMs)
 };
+
+// Where the queries the radii leave open go (host only; tests/gpu_algo/
+// surface_radii_test.cpp): back to the host, whose proof measures them
+// exactly (SurfaceCandidates::open), while open queries x triangles is at
+// most the host work, else down the tail's tree on the device. Measured on
+// 2 cores (docs/bench/surfaces, session 7): the host's brute force costs
+// ~3 ns per query and triangle on one thread (a box test each: one pass
+// over the triangles for all of them, on the worker pool); the tree's build
+// ~30 ns per triangle (2 ms for the bunny's 69,451 triangles on one thread,
+// little of it parallel at that size), then a second submission; on the
+// H200 the tail added ~4.8 ms of host time with 8 open queries (session
+// 6). So the host takes ~2^19 pairs per host thread (~1.6 ms): 15 open
+// queries of the bunny on 2 threads, 120 on 16.
+inline constexpr uint64_t kSurfaceHostWorkPerThread = uint64_t(1) << 19;
+// Tuning::surfaceHostWork, else kSurfaceHostWorkPerThread x the host's
+// threads (threads: EngineOptions::threads, 0: every hardware thread).
+[[nodiscard]] uint64_t surfaceHostWork(const Tuning& tuning, int threads);
+// True when `open` queries of `triangles` go to the host under `hostWork`.
+[[nodiscard]] bool openQueriesToHost(uint64_t open, uint64_t triangles, uint64_t hostWork);
 
 // The radii of one search (host only; tests/gpu_algo/surface_radii_test.cpp).
 // None decides a value (the host proves it); they set how many queries the
@@ -111,7 +137,8 @@ private:
     struct Stats;
     // The queries, corners and the triangles' tight boxes (search cells of
     // one triangle each) written to the upload buffer on the worker pool,
-    // with the statistics of the radii; the device buffers grown.
+    // with the statistics of the radii and the corners' fingerprint; the
+    // device buffers grown.
     Stats stage(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners);
     // The upload buffer's copies and every query's best set to none.
     void cmdUpload(VkCommandBuffer cmd);
@@ -122,9 +149,11 @@ private:
                                                     SurfaceCandidates& out);
     void cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update, VkDeviceAddress counts);
     // The tail's submission for the queries the radii left open (their best
-    // farther than `settled`): the tree built on the host and uploaded, the
-    // descent, every query's best copied for the host.
-    void submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out);
+    // farther than `settled`): the tree built on the host and uploaded
+    // (unless the one kept from the call before is of the same corners:
+    // `fingerprint`), the descent, every query's best copied for the host.
+    void submitTail(std::span<const glm::vec3> corners, uint64_t fingerprint, double settled,
+                    SurfaceCandidates& out);
     // Every query's best copied to the read-back buffer for the host.
     void cmdReadBack(VkCommandBuffer cmd);
 
@@ -134,6 +163,12 @@ private:
     bool m_built = false;  // the BLAS of this call is built (the next radius refits it)
     gpu::Buffer m_points, m_corners, m_boxes, m_best, m_aabbs, m_staging, m_readback, m_counts;
     gpu::Buffer m_nodes, m_order;  // the tail's tree (surface_tree.hpp)
+    // Of which corners m_nodes and m_order hold the tree (0 triangles: none).
+    // Equal counts keep every index of a kept tree in range; a fingerprint
+    // that matches other corners (a 64-bit collision) would only give worse
+    // candidates, which the host's proof measures like any.
+    uint32_t m_treeTriangles = 0;
+    uint64_t m_treeFingerprint = 0;
 };
 
 }  // namespace rthdist::gpu_algo

@@ -2,7 +2,9 @@
 // (api/surface_certify.hpp, design.md §11 "The GPU backends"), on the host:
 // whatever the candidates (each query's true nearest, none, the wrong
 // triangle, a random one), the value and witness equal (==) the brute
-// force over every triangle; good candidates keep the band small.
+// force over every triangle; good candidates keep the band small. Queries
+// the search left open are measured exactly first: their candidates then
+// do not matter, not even to the band.
 #include <gtest/gtest.h>
 
 #include <glm/common.hpp>
@@ -11,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "api/surface_certify.hpp"
@@ -29,9 +32,17 @@ double magnitude(const test::SurfaceCase& c) {
     return m;
 }
 
-Result<SurfaceResult> certify(const test::SurfaceCase& c, const std::vector<uint32_t>& candidate) {
+Result<SurfaceResult> certify(const test::SurfaceCase& c, const std::vector<uint32_t>& candidate,
+                              const std::vector<uint32_t>& open = {}) {
     return api::certifySurface(PointView(c.queries), MeshView{PointView(c.vertices), c.indices}, magnitude(c),
-                               candidate, SurfaceOptions{});
+                               candidate, SurfaceOptions{}, open);
+}
+
+// The queries at h: the band of exact candidates.
+size_t queriesAtMax(const oracle::SurfaceDirectedExact& want) {
+    size_t atMax = 0;
+    for (const oracle::SurfaceNearest& n : want.perQuery) atMax += std::sqrt(n.distance2) == want.distance;
+    return atMax;
 }
 
 void expectExact(const test::SurfaceCase& c, const Result<SurfaceResult>& r,
@@ -63,12 +74,7 @@ TEST(SurfaceCertify, AnyCandidatesGiveTheBruteForce) {
         const Result<SurfaceResult> exact = certify(c, nearest);
         expectExact(c, exact, want, "nearest");
         // The band is the queries at h: the witness and its ties.
-        if (exact) {
-            size_t atMax = 0;
-            for (const oracle::SurfaceNearest& n : want.perQuery)
-                atMax += std::sqrt(n.distance2) == want.distance;
-            EXPECT_EQ(exact->directed.counters.band, atMax) << c.name;
-        }
+        if (exact) EXPECT_EQ(exact->directed.counters.band, queriesAtMax(want)) << c.name;
         expectExact(c, certify(c, none), want, "none");
         expectExact(c, certify(c, shiftedByOne), want, "the next triangle");
         expectExact(c, certify(c, random), want, "random");
@@ -99,6 +105,79 @@ TEST(SurfaceCertify, ALargeBandTakesTheBvhSearch) {
     ASSERT_TRUE(large);
     EXPECT_EQ(large->directed.counters.band, c.queries.size());
     EXPECT_GT(large->directed.counters.bvhNodes, 0u);
+}
+
+// Open queries (the search's `open`: every third query and the witness,
+// with no candidate, the next triangle or a random one) are measured
+// exactly before the bounds: the brute force's answer, the band of exact
+// candidates (the queries at h), and each open query's triangles counted.
+// Without them open, the queries with no candidate join the band.
+TEST(SurfaceCertify, OpenQueriesAreMeasuredExactlyFirst) {
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        std::printf("%s: seed %llu, %zu triangles, %zu queries\n", c.name.c_str(),
+                    static_cast<unsigned long long>(c.seed), c.indices.size() / 3, c.queries.size());
+        const oracle::SurfaceDirectedExact want = oracle::bruteForceSurface(c.queries, c.vertices, c.indices);
+        const auto triangles = uint32_t(c.indices.size() / 3);
+        std::vector<uint32_t> candidate(c.queries.size()), open;
+        test::Rng rng(c.seed);
+        size_t none = 0;
+        for (size_t q = 0; q < c.queries.size(); ++q) {
+            candidate[q] = want.perQuery[q].triangle;
+            if (q % 3 != 0 && q != want.queryIndex) continue;
+            open.push_back(uint32_t(q));
+            switch (open.size() % 3) {
+                case 0:
+                    candidate[q] = UINT32_MAX;
+                    ++none;
+                    break;
+                case 1: candidate[q] = (candidate[q] + 1) % triangles; break;
+                default: candidate[q] = uint32_t(rng.uniform(0.0, double(triangles))) % triangles;
+            }
+        }
+        const Result<SurfaceResult> measured = certify(c, candidate, open);
+        expectExact(c, measured, want, "open");
+        ASSERT_TRUE(measured);
+        EXPECT_EQ(measured->directed.counters.band, queriesAtMax(want)) << c.name;
+        EXPECT_GE(measured->directed.counters.trianglesTested, open.size()) << c.name;
+        const Result<SurfaceResult> bounded = certify(c, candidate);
+        expectExact(c, bounded, want, "not open");
+        ASSERT_TRUE(bounded);
+        EXPECT_GE(bounded->directed.counters.band, none) << c.name;
+    }
+}
+
+// Every query open with no candidate: each is measured exactly first, so
+// the band is the queries at h and needs no BVH (ALargeBandTakesTheBvhSearch
+// below: the same queries not open).
+TEST(SurfaceCertify, EveryQueryOpenNeedsNoBvh) {
+    test::SurfaceCase c = test::heightField(3438, 32, 16.0);
+    test::Rng rng(3438);
+    for (int i = 0; i < 600; ++i)
+        c.queries.emplace_back(rng.uniform(-1, 17), rng.uniform(-1, 17), rng.uniform(-4, 4));
+    const oracle::SurfaceDirectedExact want = oracle::bruteForceSurface(c.queries, c.vertices, c.indices);
+    const std::vector<uint32_t> none(c.queries.size(), UINT32_MAX);
+    std::vector<uint32_t> all(c.queries.size());
+    for (size_t q = 0; q < all.size(); ++q) all[q] = uint32_t(q);
+    const Result<SurfaceResult> r = certify(c, none, all);
+    expectExact(c, r, want, "every query open");
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->directed.counters.band, queriesAtMax(want));
+    EXPECT_EQ(r->directed.counters.bvhNodes, 0u);
+}
+
+// An open list out of range or out of order is the caller's bug: kInternal.
+TEST(SurfaceCertify, OpenQueriesOutOfRangeOrOrderAreErrors) {
+    test::SurfaceCase c = test::heightField(3439, 4, 1.0);
+    c.queries = {{0.5, 0.5, 1.0}, {0.25, 0.5, -1.0}, {0.75, 0.25, 0.5}};
+    const std::vector<uint32_t> none(c.queries.size(), UINT32_MAX);
+    for (const std::vector<uint32_t>& open :
+         {std::vector<uint32_t>{3}, std::vector<uint32_t>{1, 0}, std::vector<uint32_t>{1, 1}}) {
+        const Result<SurfaceResult> r = certify(c, none, open);
+        ASSERT_FALSE(r);
+        EXPECT_EQ(r.error().code, ErrorCode::kInternal);
+        EXPECT_NE(r.error().message.find("open query"), std::string::npos) << r.error().message;
+    }
 }
 
 TEST(SurfaceCertify, PerPointAndWrongSizesAreErrors) {

@@ -8,15 +8,20 @@
 // (Engine::hausdorffToSurface): one Engine serving calls of growing and
 // shrinking sizes equals the brute force and a one-shot call, a cancelled
 // call leaves it usable, per-point distances stay refused. The tail (the
-// tree descent of the queries the radii leave open, surface_tail.comp):
-// every query's candidate against the brute force's nearest triangle,
-// directly on the device search (GpuHausdorff::nearestTriangles), on far
-// copies, far outliers and degenerate far triangles, with and without the
-// mutant.
+// tree descent of the queries the radii leave open, surface_tail.comp,
+// forced by Tuning::surfaceHostWork = 0): every query's candidate against
+// the brute force's nearest triangle, directly on the device search
+// (GpuHausdorff::nearestTriangles), on far copies, far outliers and
+// degenerate far triangles, with and without the mutant; its tree kept
+// between an Engine's calls only while the corners are the same. The
+// other way of the open queries (a few: back to the host, whose proof
+// measures them exactly): the open list is the queries the radii left
+// open, and the answers are the brute force's, also with the mutant.
 #include <gtest/gtest.h>
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <limits>
@@ -80,16 +85,23 @@ void expectBruteForce(const test::SurfaceCase& c, Backend backend, const Result<
     // one submission per radius at most (the first holds the upload too).
     EXPECT_GE(n.radii, 1u) << c.name;
     EXPECT_GE(n.rays, c.queries.size()) << c.name;
-    // One submission for the radii, one more for the tail where it ran.
+    // One submission for the radii, one more for the tail where it ran;
+    // the open queries go one way, the tree or the host, not both.
     EXPECT_EQ(n.submissions, n.tailQueries > 0 ? 2u : 1u) << c.name;
     EXPECT_LE(n.tailQueries, c.queries.size()) << c.name;
+    EXPECT_LE(n.tailHostQueries, c.queries.size()) << c.name;
+    EXPECT_FALSE(n.tailQueries > 0 && n.tailHostQueries > 0) << c.name;
+    if (n.tailQueries == 0) EXPECT_EQ(n.tailTreeReused, 0u) << c.name;
+    if (n.tailHostQueries == 0) EXPECT_EQ(r->stages.tailHost, 0.0) << c.name;
     // The proof searched the witness again, at least.
     EXPECT_GE(n.band, 1u) << c.name;
     EXPECT_LE(n.band, c.queries.size()) << c.name;
     EXPECT_EQ(r->validationMessages, 0u) << c.name;
-    std::printf("  h %.17g: %u radii, %llu rays, %u submissions, tail %llu, band %llu\n", r->hausdorff,
-                n.radii, static_cast<unsigned long long>(n.rays), n.submissions,
-                static_cast<unsigned long long>(n.tailQueries), static_cast<unsigned long long>(n.band));
+    std::printf(
+        "  h %.17g: %u radii, %llu rays, %u submissions, tail %llu (tree kept %u), host %llu, band %llu\n",
+        r->hausdorff, n.radii, static_cast<unsigned long long>(n.rays), n.submissions,
+        static_cast<unsigned long long>(n.tailQueries), n.tailTreeReused,
+        static_cast<unsigned long long>(n.tailHostQueries), static_cast<unsigned long long>(n.band));
 }
 
 void expectBruteForce(const test::SurfaceCase& c, Backend backend) {
@@ -247,6 +259,9 @@ TEST(GpuSurfaceEngine, RepeatedCallsOfGrowingAndShrinkingSizesMatchAFreshDevice)
         EXPECT_EQ(kept->directed.counters.radii, fresh->directed.counters.radii) << c.name;
         EXPECT_EQ(kept->directed.counters.rays, fresh->directed.counters.rays) << c.name;
         EXPECT_EQ(kept->directed.counters.tailQueries, fresh->directed.counters.tailQueries) << c.name;
+        EXPECT_EQ(kept->directed.counters.tailHostQueries, fresh->directed.counters.tailHostQueries)
+            << c.name;
+        EXPECT_EQ(fresh->directed.counters.tailTreeReused, 0u) << c.name << ": a one-shot call keeps no tree";
         EXPECT_EQ(kept->directed.counters.band, fresh->directed.counters.band) << c.name;
     }
 }
@@ -436,6 +451,36 @@ std::vector<FramedCase> tailCases() {
     return cases;
 }
 
+// The tail's tests' tuning: open queries x triangles up to `hostWork` go
+// back to the host, the others descend the tail's tree.
+constexpr uint64_t kAlwaysTree = 0, kAlwaysHost = UINT64_MAX;
+
+Tuning tailTuning(uint64_t hostWork) {
+    Tuning t = *test::gpuOptions().tuning;
+    t.surfaceHostWork = hostWork;
+    return t;
+}
+
+// A kept device (validation on) whose open queries go one way.
+Result<Engine> tunedSurfaceEngine(Backend backend, uint64_t hostWork) {
+    EngineOptions o;
+    o.backend = backend;
+    o.validation = true;
+    o.tuning = tailTuning(hostWork);
+    return Engine::create(o);
+}
+
+// A framed case as the API takes it (every corner its own vertex).
+test::SurfaceCase apiCase(const FramedCase& c) {
+    test::SurfaceCase api{c.name, 0, {}, {}, {}};
+    for (size_t i = 0; i < c.corners.size(); ++i) {
+        api.vertices.emplace_back(c.corners[i]);
+        api.indices.push_back(uint32_t(i));
+    }
+    for (const glm::vec3& q : c.queries) api.queries.emplace_back(q);
+    return api;
+}
+
 // Every query against every triangle in double: the nearest (smallest
 // index on a tie) and the nearest of the triangles that are not copies of
 // it (its margin).
@@ -484,10 +529,13 @@ struct TailCheck {
 // Each candidate is as near as the nearest up to float rounding, and is
 // the nearest where the margin is clear. With `mutant` (every third
 // triangle skipped): never a third triangle, the nearest of the others.
+// The queries handed back open (found.open) are the host's to measure:
+// not checked here.
 TailCheck expectNearest(const FramedCase& c, const gpu_algo::SurfaceCandidates& found, bool mutant) {
     TailCheck check;
     EXPECT_EQ(found.triangle.size(), c.queries.size()) << c.name;
     for (size_t i = 0; i < c.queries.size() && i < found.triangle.size(); ++i) {
+        if (std::binary_search(found.open.begin(), found.open.end(), uint32_t(i))) continue;
         const BruteNearest want = bruteNearest(c.queries[i], c.corners);
         const uint32_t got = found.triangle[i];
         const bool clear = want.other2 - want.d2 > 1e-3 * want.other2;
@@ -515,7 +563,7 @@ TailCheck expectNearest(const FramedCase& c, const gpu_algo::SurfaceCandidates& 
 // triangles) go through the tail, which finds each one's nearest triangle.
 TEST(GpuSurfaceTail, FindsTheNearestTriangleOfEveryOpenQuery) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, tailTuning(kAlwaysTree));
     ASSERT_TRUE(engine) << engine.error().message;
     for (const FramedCase& c : tailCases()) {
         Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
@@ -526,6 +574,7 @@ TEST(GpuSurfaceTail, FindsTheNearestTriangleOfEveryOpenQuery) {
                     static_cast<unsigned long long>(found->tailQueries), check.clear);
         EXPECT_GT(found->tailQueries, 0u) << c.name;
         EXPECT_LE(found->tailQueries, c.queries.size()) << c.name;
+        EXPECT_TRUE(found->open.empty()) << c.name;
         EXPECT_EQ(found->submissions, 2u) << c.name;
         // The copies of disjoint triangles have clear nearest triangles:
         // the index check above is not vacuous.
@@ -542,7 +591,7 @@ TEST(GpuSurfaceTail, SplitDispatchesCoverEveryQuery) {
     limits.maxGroupsX = 3;
     limits.maxRayDispatch = 5;
     ctx->setLimits(limits);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, tailTuning(kAlwaysTree));
     ASSERT_TRUE(engine) << engine.error().message;
     for (const FramedCase& c : tailCases()) {
         if (c.name != "far_copy" && c.name != "far_outliers") continue;
@@ -554,19 +603,23 @@ TEST(GpuSurfaceTail, SplitDispatchesCoverEveryQuery) {
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
-// Queries on the surface settle at the first radius: no tail.
+// Queries on the surface settle at the first radius: no tail, nothing
+// handed back open, whichever way open queries would go.
 TEST(GpuSurfaceTail, DoesNotRunWhereTheRadiiSettleEveryQuery) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
-    ASSERT_TRUE(engine) << engine.error().message;
-    const std::vector<glm::vec3> corners = soup(glm::vec3(0.1f), 0.6f, 400, 12, true);
-    const FramedCase c{"near", corners, corners};
-    Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
-    ASSERT_TRUE(found) << found.error().message;
-    expectNearest(c, *found, false);
-    EXPECT_EQ(found->tailQueries, 0u);
-    EXPECT_EQ(found->submissions, 1u);
-    EXPECT_EQ(found->tailBuildMs, 0.0);
+    for (const uint64_t hostWork : {kAlwaysTree, kAlwaysHost}) {
+        auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, tailTuning(hostWork));
+        ASSERT_TRUE(engine) << engine.error().message;
+        const std::vector<glm::vec3> corners = soup(glm::vec3(0.1f), 0.6f, 400, 12, true);
+        const FramedCase c{"near", corners, corners};
+        Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
+        ASSERT_TRUE(found) << found.error().message;
+        expectNearest(c, *found, false);
+        EXPECT_EQ(found->tailQueries, 0u);
+        EXPECT_TRUE(found->open.empty());
+        EXPECT_EQ(found->submissions, 1u);
+        EXPECT_EQ(found->tailBuildMs, 0.0);
+    }
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
@@ -575,22 +628,19 @@ TEST(GpuSurfaceTail, DoesNotRunWhereTheRadiiSettleEveryQuery) {
 // the others still get theirs; through the API the proof catches it.
 TEST(GpuSurfaceTail, AMissingTailIsCaughtByTheProof) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *test::gpuOptions().tuning);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, tailTuning(kAlwaysTree));
     ASSERT_TRUE(engine) << engine.error().message;
     struct Mutant {
         Mutant() { core::searchMutant() = true; }
         ~Mutant() { core::searchMutant() = false; }
     };
     const Backend backend = test::backendUnderTest();
+    Result<Engine> tree = tunedSurfaceEngine(backend, kAlwaysTree);
+    ASSERT_TRUE(tree) << tree.error().message;
     uint64_t clean = 0, missing = 0, missedThirds = 0;
     for (const FramedCase& c : tailCases()) {
-        test::SurfaceCase api{c.name, 0, {}, {}, {}};
-        for (size_t i = 0; i < c.corners.size(); ++i) {
-            api.vertices.emplace_back(c.corners[i]);
-            api.indices.push_back(uint32_t(i));
-        }
-        for (const glm::vec3& q : c.queries) api.queries.emplace_back(q);
-        const Result<SurfaceResult> right = onDevice(api, backend);
+        const test::SurfaceCase api = apiCase(c);
+        const Result<SurfaceResult> right = tree->hausdorffToSurface(PointView(api.queries), meshOf(api));
         expectBruteForce(api, backend, right);
         ASSERT_TRUE(right);
         EXPECT_GT(right->directed.counters.tailQueries, 0u) << c.name;
@@ -601,9 +651,10 @@ TEST(GpuSurfaceTail, AMissingTailIsCaughtByTheProof) {
         ASSERT_TRUE(found) << c.name << ": " << found.error().message;
         EXPECT_GT(found->tailQueries, 0u) << c.name;
         missedThirds += expectNearest(c, *found, true).missedThirds;
-        const Result<SurfaceResult> wrong = onDevice(api, backend);
+        const Result<SurfaceResult> wrong = tree->hausdorffToSurface(PointView(api.queries), meshOf(api));
         expectBruteForce(api, backend, wrong);
         ASSERT_TRUE(wrong);
+        EXPECT_GT(wrong->directed.counters.tailQueries, 0u) << c.name;
         missing += wrong->directed.counters.band;
     }
     // The missed triangles showed: queries lost their nearest, and the
@@ -614,6 +665,125 @@ TEST(GpuSurfaceTail, AMissingTailIsCaughtByTheProof) {
     EXPECT_GT(missedThirds, 0u);
     EXPECT_GT(missing, clean);
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// A kept Engine keeps the tail's tree while the triangles' float corners
+// are the same (their count and fingerprint): the same inputs again
+// descend it without building it; other corners (one vertex moved, one
+// triangle fewer) build their own, after which the first inputs build
+// theirs again; a point call between (its own BLAS in the shared storage)
+// leaves the tree. Every answer is the brute force's.
+TEST(GpuSurfaceTail, AKeptEngineReusesTheTreeOnlyForTheSameCorners) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    Result<Engine> engine = tunedSurfaceEngine(backend, kAlwaysTree);
+    ASSERT_TRUE(engine) << engine.error().message;
+    const test::SurfaceCase same = apiCase(tailCases().front());
+    test::SurfaceCase moved = same;
+    moved.name += "_moved_vertex";
+    moved.vertices[7].y += 1e-3;
+    test::SurfaceCase fewer = same;
+    fewer.name += "_one_triangle_fewer";
+    fewer.indices.resize(fewer.indices.size() - 3);
+    auto call = [&](const test::SurfaceCase& c, uint32_t reused) {
+        const Result<SurfaceResult> r = engine->hausdorffToSurface(PointView(c.queries), meshOf(c));
+        expectBruteForce(c, backend, r);
+        if (!r) return;
+        EXPECT_GT(r->directed.counters.tailQueries, 0u) << c.name;
+        EXPECT_EQ(r->directed.counters.tailTreeReused, reused) << c.name;
+        if (reused != 0) EXPECT_EQ(r->stages.tailBuild, 0.0) << c.name;
+    };
+    call(same, 0);
+    call(same, 1);
+    call(moved, 0);
+    call(moved, 1);
+    call(same, 0);
+    call(fewer, 0);
+    call(same, 0);
+    CallOptions points;
+    points.directedOnly = true;
+    const Result<HausdorffResult> between =
+        engine->compute(PointView(same.queries), PointView(same.vertices), points);
+    ASSERT_TRUE(between) << between.error().message;
+    call(same, 1);
+}
+
+// Where few queries are open (here always: Tuning::surfaceHostWork at its
+// largest), the device hands them back instead of descending the tree: one
+// submission, no tree. The list is the queries the tail would search (its
+// count on the same inputs), in index order; each keeps the rays' best or
+// none; the other queries have their nearest triangles.
+TEST(GpuSurfaceHost, HandsBackTheQueriesTheRadiiLeaveOpen) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    auto host = gpu_algo::GpuHausdorff::create(*ctx, "", 0, tailTuning(kAlwaysHost));
+    ASSERT_TRUE(host) << host.error().message;
+    auto tree = gpu_algo::GpuHausdorff::create(*ctx, "", 0, tailTuning(kAlwaysTree));
+    ASSERT_TRUE(tree) << tree.error().message;
+    for (const FramedCase& c : tailCases()) {
+        Result<gpu_algo::SurfaceCandidates> found = (*host)->nearestTriangles(c.queries, c.corners);
+        ASSERT_TRUE(found) << c.name << ": " << found.error().message;
+        Result<gpu_algo::SurfaceCandidates> descended = (*tree)->nearestTriangles(c.queries, c.corners);
+        ASSERT_TRUE(descended) << c.name << ": " << descended.error().message;
+        expectNearest(c, *found, false);
+        std::printf("%s: %zu queries, %zu open\n", c.name.c_str(), c.queries.size(), found->open.size());
+        EXPECT_FALSE(found->open.empty()) << c.name;
+        EXPECT_EQ(found->open.size(), descended->tailQueries) << c.name;
+        EXPECT_TRUE(std::adjacent_find(found->open.begin(), found->open.end(), std::greater_equal<>()) ==
+                    found->open.end())
+            << c.name << ": not in index order";
+        for (const uint32_t q : found->open) {
+            ASSERT_LT(q, c.queries.size()) << c.name;
+            const uint32_t t = found->triangle[q];
+            EXPECT_TRUE(t == UINT32_MAX || t < c.corners.size() / 3) << c.name << " query " << q;
+        }
+        EXPECT_EQ(found->tailQueries, 0u) << c.name;
+        EXPECT_FALSE(found->tailTreeReused) << c.name;
+        EXPECT_EQ(found->submissions, 1u) << c.name;
+        EXPECT_EQ(found->tailBuildMs, 0.0) << c.name;
+        EXPECT_EQ(found->tailGpuMs, 0.0) << c.name;
+    }
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// Through the API the queries handed back are measured exactly by the
+// host's proof: the brute force's answer on every tail case, one
+// submission, no tree, as many host queries as the tree's descent
+// searches, a band no larger than the descent's (their candidates are
+// their nearest triangles); with the mutant too (the device misses
+// triangles, the host's brute force does not).
+TEST(GpuSurfaceHost, OpenQueriesAreMeasuredExactlyOnTheHost) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    Result<Engine> host = tunedSurfaceEngine(backend, kAlwaysHost);
+    ASSERT_TRUE(host) << host.error().message;
+    Result<Engine> tree = tunedSurfaceEngine(backend, kAlwaysTree);
+    ASSERT_TRUE(tree) << tree.error().message;
+    for (const FramedCase& f : tailCases()) {
+        const test::SurfaceCase c = apiCase(f);
+        const Result<SurfaceResult> settled = host->hausdorffToSurface(PointView(c.queries), meshOf(c));
+        expectBruteForce(c, backend, settled);
+        const Result<SurfaceResult> descended = tree->hausdorffToSurface(PointView(c.queries), meshOf(c));
+        expectBruteForce(c, backend, descended);
+        ASSERT_TRUE(settled && descended);
+        const SurfaceCounters& n = settled->directed.counters;
+        EXPECT_GT(n.tailHostQueries, 0u) << c.name;
+        EXPECT_EQ(n.tailHostQueries, descended->directed.counters.tailQueries) << c.name;
+        EXPECT_EQ(n.tailQueries, 0u) << c.name;
+        EXPECT_EQ(n.submissions, 1u) << c.name;
+        EXPECT_EQ(settled->stages.tailBuild, 0.0) << c.name;
+        EXPECT_EQ(settled->stages.gpuTail, 0.0) << c.name;
+        EXPECT_GT(settled->stages.tailHost, 0.0) << c.name;
+        EXPECT_GE(n.trianglesTested, n.tailHostQueries) << c.name;
+        EXPECT_LE(n.band, descended->directed.counters.band) << c.name;
+
+        struct Mutant {
+            Mutant() { core::searchMutant() = true; }
+            ~Mutant() { core::searchMutant() = false; }
+        };
+        const Mutant mutant;
+        const Result<SurfaceResult> missing = host->hausdorffToSurface(PointView(c.queries), meshOf(c));
+        expectBruteForce(c, backend, missing);
+        ASSERT_TRUE(missing);
+        EXPECT_GT(missing->directed.counters.tailHostQueries, 0u) << c.name;
+    }
 }
 
 }  // namespace

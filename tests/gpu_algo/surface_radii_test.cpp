@@ -2,8 +2,10 @@
 // SurfaceRadii) on the host, no device: the first radius from the
 // triangles' sides and the queries' spacing, the one submission's radii
 // (first, 4x it, at most the cover radius). The queries they leave open go
-// to the tail's tree descent (surface_tree_test.cpp, gpu_surface_test.cpp).
-// None decides a value (the host proves it); these pin the cost.
+// back to the host while few (openQueriesToHost: open x triangles at most
+// the host work), else to the tail's tree descent (surface_tree_test.cpp,
+// gpu_surface_test.cpp). None decides a value (the host proves it); these
+// pin the cost.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -46,6 +48,31 @@ TEST(SurfaceRadii, TheFirstSubmissionHoldsTwoRadii) {
     EXPECT_EQ(one.start(), (std::vector<double>{one.cover()}));
     for (const SurfaceRadii& r : {near, one, SurfaceRadii(0.1, 1.0, 10000, 2.0)})
         EXPECT_LE(r.start().size(), SurfaceRadii::kStartRadii);
+}
+
+// The host work: Tuning::surfaceHostWork where set, else 2^19 per host
+// thread; open queries go to the host while open x triangles is at most it.
+TEST(SurfaceRadii, FewOpenQueriesGoToTheHost) {
+    EXPECT_EQ(surfaceHostWork(Tuning{}, 2), 2 * kSurfaceHostWorkPerThread);
+    EXPECT_EQ(surfaceHostWork(Tuning{}, 16), 16 * kSurfaceHostWorkPerThread);
+    Tuning tuned;
+    tuned.surfaceHostWork = 12345;
+    EXPECT_EQ(surfaceHostWork(tuned, 16), 12345u);
+    tuned.surfaceHostWork = 0;
+    EXPECT_EQ(surfaceHostWork(tuned, 16), 0u);
+    // The bunny's 69,451 triangles on 2 threads: 15 open queries go back, 16 do not.
+    const uint64_t twoThreads = surfaceHostWork(Tuning{}, 2);
+    EXPECT_TRUE(openQueriesToHost(8, 69451, twoThreads));
+    EXPECT_TRUE(openQueriesToHost(15, 69451, twoThreads));
+    EXPECT_FALSE(openQueriesToHost(16, 69451, twoThreads));
+    EXPECT_TRUE(openQueriesToHost(15 * 69451, 1, 15 * 69451));  // the bound itself
+    EXPECT_FALSE(openQueriesToHost(15 * 69451 + 1, 1, 15 * 69451));
+    // None open: nothing to hand back; no host work: always the tree.
+    EXPECT_FALSE(openQueriesToHost(0, 69451, twoThreads));
+    EXPECT_FALSE(openQueriesToHost(1, 1, 0));
+    // Past 64 bits of queries x triangles: the division keeps it exact.
+    EXPECT_TRUE(openQueriesToHost(1, uint64_t(1) << 40, UINT64_MAX));
+    EXPECT_FALSE(openQueriesToHost(uint64_t(1) << 40, uint64_t(1) << 40, UINT64_MAX));
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 // (warmup_ms: the first call also compiles what the driver compiles on first
 // use), then --runs calls give the medians of every stage (SurfaceResult:
 // total, search, frame, upload, device, readback, certify, gpu, gpu_build,
-// tail_build, gpu_tail)
+// tail_build, gpu_tail, tail_host)
 // and the wall clock of the call. --one-shot N more calls of the free
 // function (a device per call) give one_shot medians (total, build = the
 // device and its pipelines). --no-verify skips the CPU backend's call that
@@ -51,7 +51,7 @@ struct Settings {
 // The series of one kind of call: every stage's milliseconds per call.
 struct Series {
     std::vector<double> wall, total, build, search, frame, upload, device, readback, certify, gpu, gpuBuild,
-        tailBuild, gpuTail;
+        tailBuild, gpuTail, tailHost;
 
     void add(const SurfaceResult& r, double wallMs) {
         wall.push_back(wallMs);
@@ -67,20 +67,27 @@ struct Series {
         gpuBuild.push_back(r.stages.gpuBuild);
         tailBuild.push_back(r.stages.tailBuild);
         gpuTail.push_back(r.stages.gpuTail);
+        tailHost.push_back(r.stages.tailHost);
     }
     [[nodiscard]] nlohmann::json medians() const {
         return {
-            {"wall", median(wall)},       {"total", median(total)},        {"build", median(build)},
-            {"search", median(search)},   {"frame", median(frame)},        {"upload", median(upload)},
-            {"device", median(device)},   {"readback", median(readback)},  {"certify", median(certify)},
-            {"gpu", median(gpu)},         {"gpu_build", median(gpuBuild)}, {"tail_build", median(tailBuild)},
-            {"gpu_tail", median(gpuTail)}};
+            {"wall", median(wall)},        {"total", median(total)},        {"build", median(build)},
+            {"search", median(search)},    {"frame", median(frame)},        {"upload", median(upload)},
+            {"device", median(device)},    {"readback", median(readback)},  {"certify", median(certify)},
+            {"gpu", median(gpu)},          {"gpu_build", median(gpuBuild)}, {"tail_build", median(tailBuild)},
+            {"gpu_tail", median(gpuTail)}, {"tail_host", median(tailHost)}};
     }
 };
 
 nlohmann::json countersJson(const rthdist::SurfaceCounters& c) {
-    return {{"queries", c.queries}, {"triangles", c.triangles},     {"radii", c.radii},
-            {"rays", c.rays},       {"submissions", c.submissions}, {"tail_queries", c.tailQueries},
+    return {{"queries", c.queries},
+            {"triangles", c.triangles},
+            {"radii", c.radii},
+            {"rays", c.rays},
+            {"submissions", c.submissions},
+            {"tail_queries", c.tailQueries},
+            {"tail_host_queries", c.tailHostQueries},
+            {"tail_tree_reused", c.tailTreeReused},
             {"band", c.band}};
 }
 

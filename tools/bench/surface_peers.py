@@ -155,7 +155,7 @@ def kept_tool(args, backend):
         value = {"h": j["hausdorff"], "query": j["query"], "triangle": j["triangle"], "device": j["device"],
                  "setup_ms": j["setup_ms"], "warmup_ms": j["warmup_ms"], "counters": j["counters"],
                  "stages_ms": {k: m[k] for k in ("frame", "upload", "device", "readback", "certify", "gpu",
-                                                 "gpu_build")}}
+                                                 "gpu_build", "tail_build", "gpu_tail", "tail_host") if k in m}}
         return j["kept_total_ms_all"], j["kept_wall_ms_all"], value
     return run
 

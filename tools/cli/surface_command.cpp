@@ -55,6 +55,8 @@ Json countersJson(const SurfaceCounters& c) {
             {"rays", c.rays},
             {"submissions", c.submissions},
             {"tail_queries", c.tailQueries},
+            {"tail_host_queries", c.tailHostQueries},
+            {"tail_tree_reused", c.tailTreeReused},
             {"band", c.band}};
 }
 
@@ -107,7 +109,8 @@ std::string jsonReport(const Run& run) {
                          {"gpu", r.gpuMs},
                          {"gpu_build", st.gpuBuild},
                          {"tail_build", st.tailBuild},
-                         {"gpu_tail", st.gpuTail}}}};
+                         {"gpu_tail", st.gpuTail},
+                         {"tail_host", st.tailHost}}}};
     j["counters"] = {{"a_to_b", b ? countersJson(r.directed.counters) : Json()},
                      {"b_to_a", b ? Json() : countersJson(r.directed.counters)}};
     return jsonText(j) + "\n";
