@@ -26,6 +26,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -519,6 +520,13 @@ BruteNearest bruteNearest(const glm::vec3& q, std::span<const glm::vec3> corners
     return n;
 }
 
+// Triangles t and u have the same corners in the same order (exact copies).
+bool sameCorners(std::span<const glm::vec3> corners, uint32_t t, uint32_t u) {
+    for (size_t k = 0; k < 3; ++k)
+        if (corners[3 * size_t(t) + k] != corners[3 * size_t(u) + k]) return false;
+    return true;
+}
+
 // What the device search returned for a case, against the brute force.
 struct TailCheck {
     size_t clear = 0;  // queries whose nearest is clear of every other triangle's distance
@@ -552,8 +560,13 @@ TailCheck expectNearest(const FramedCase& c, const gpu_algo::SurfaceCandidates& 
         EXPECT_LE(distance2(c.queries[i], c.corners, got), want.d2 * (1.0 + 1e-5) + 1e-12)
             << c.name << " query " << i << ": triangle " << got << " for " << want.triangle;
         if (clear) {
+            // The nearest, or an exact copy of it: among copies the device's
+            // candidate may be any (the H200 reached a later copy first and
+            // skipped the earlier ones by its float box test, design.md §11;
+            // the proved result takes the first: GpuSurfaceTies).
             ++check.clear;
-            EXPECT_EQ(got, want.triangle) << c.name << " query " << i;
+            EXPECT_TRUE(got == want.triangle || sameCorners(c.corners, got, want.triangle))
+                << c.name << " query " << i << ": triangle " << got << " for " << want.triangle;
         }
     }
     return check;
