@@ -13,11 +13,18 @@
 // settle nearly every query of inputs near each other.
 //   The tail: a query farther than the last radius (inputs apart, far
 // outliers) would need larger radii, where each ray sits in thousands of
-// overlapping grown boxes. Instead, when any query is open, the host builds
-// the float BVH of the triangles (surface_tree.hpp) and one more submission
-// runs surface_tail.comp: every open query descends it nearest-first from
-// the best the rays found, by the same per-triangle test, so it ends with
-// what a visit of every triangle would give.
+// overlapping grown boxes. Instead, when many queries are open, the host
+// builds the float BVH of the triangles (surface_tree.hpp) and one more
+// submission runs surface_tail.comp: every open query descends it
+// nearest-first from the best the rays found, by the same per-triangle
+// test, so it ends with what a visit of every triangle would give. The
+// tree stays on the device for the next call, which descends it without a
+// build while the triangles' float corners are the same (their count and a
+// fingerprint, taken only where the tree is wanted). A few open queries
+// (open x triangles at most the host work, surfaceHostWork) are handed
+// back instead (SurfaceCandidates::open): the caller's proof measures them
+// exactly on the host, which costs less than the tree's build and a second
+// submission.
 //
 // The answer is a candidate, not a value: each query's nearest triangle
 // (or none). The caller proves the directed maximum in double on the host
@@ -137,8 +144,7 @@ private:
     struct Stats;
     // The queries, corners and the triangles' tight boxes (search cells of
     // one triangle each) written to the upload buffer on the worker pool,
-    // with the statistics of the radii and the corners' fingerprint; the
-    // device buffers grown.
+    // with the statistics of the radii; the device buffers grown.
     Stats stage(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners);
     // The upload buffer's copies and every query's best set to none.
     void cmdUpload(VkCommandBuffer cmd);
@@ -151,9 +157,9 @@ private:
     // The tail's submission for the queries the radii left open (their best
     // farther than `settled`): the tree built on the host and uploaded
     // (unless the one kept from the call before is of the same corners:
-    // `fingerprint`), the descent, every query's best copied for the host.
-    void submitTail(std::span<const glm::vec3> corners, uint64_t fingerprint, double settled,
-                    SurfaceCandidates& out);
+    // their count and fingerprint), the descent, every query's best copied
+    // for the host.
+    void submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out);
     // Every query's best copied to the read-back buffer for the host.
     void cmdReadBack(VkCommandBuffer cmd);
 
