@@ -311,6 +311,7 @@ std::optional<NarrowedTargets> narrowWith(const PointView& q, const CoreSplit& s
                                           const core::Bounds& tBox, const std::optional<CoreSplit>& tSplit,
                                           double whole, bool floatExact, int threads) {
     if (t.count < 2) return std::nullopt;
+    if (double(split.strays.size()) * double(t.count) > double(kMaxApartStrayWork)) return std::nullopt;
     const int workers = core::resolveThreads(threads, std::max(q.count, t.count) / kChunk + 1);
     // A stray query far from every target makes h far larger than the
     // whole pair's slack (2^-20 of its magnitude): the whole search then

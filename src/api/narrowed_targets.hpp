@@ -65,6 +65,12 @@ inline constexpr size_t kMaxStrayQueries = 256;
 // set's strays of its own leave its direction whole.
 inline constexpr uint64_t kMaxJointStrayWork = uint64_t(1) << 28;
 
+// The same bound for a direction narrowed apart: its strays against every
+// target (strays x targets) at most; past it the direction is searched whole
+// (exact all the same), so that a few hundred strays of a set against
+// billions of targets never become a host brute force of minutes.
+inline constexpr uint64_t kMaxApartStrayWork = uint64_t(1) << 30;
+
 // A set split into its core and at most kMaxStrayQueries strays.
 struct CoreSplit {
     core::SetSummary core;         // the core's box (exact) and precision
