@@ -105,16 +105,6 @@ DeviceInfo describeDevice(VkPhysicalDevice pd, int index) {
     return info;
 }
 
-VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                              VkDebugUtilsMessageTypeFlagsEXT,
-                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
-    if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
-        static_cast<Context*>(user)->countValidationMessage();
-        std::fprintf(stderr, "rthdist: validation: %s\n", data->pMessage);
-    }
-    return VK_FALSE;
-}
-
 std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
     uint32_t n = 0;
     vkEnumeratePhysicalDevices(instance, &n, nullptr);
@@ -233,15 +223,7 @@ std::optional<Error> Context::createMessenger() {
         vkGetInstanceProcAddr(inst, "vkDestroyDebugUtilsMessengerEXT"));
     if (!createFn || !destroyMessenger)
         return Error{ErrorCode::kNoDevice, "validation requested but VK_EXT_debug_utils has no messenger"};
-    VkDebugUtilsMessengerCreateInfoEXT mi =
-        vkStruct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
-    mi.messageSeverity =
-        VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                     VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    mi.pfnUserCallback = onDebugMessage;
-    mi.pUserData = this;
+    const VkDebugUtilsMessengerCreateInfoEXT mi = validationMessengerInfo(&m_validationMessages);
     VkDebugUtilsMessengerEXT messenger;
     RTHDIST_VK_CHECK(createFn(inst, &mi, nullptr, &messenger));
     m_messenger = UniqueMessenger(messenger, {inst, destroyMessenger});

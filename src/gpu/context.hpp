@@ -135,8 +135,6 @@ public:
     [[nodiscard]] bool tracingSubmits() const { return m_traceSubmits; }
     static constexpr uint32_t kTimestampSlots = 40;
 
-    void countValidationMessage() { ++m_validationMessages; }
-
     // Debug utilities (VK_EXT_debug_utils, enabled with validation, or with
     // Tuning::debugLabels, RTHDIST_DEBUG_LABELS=1, for GPU captures). Without it
     // they do nothing, so callers never test for it.

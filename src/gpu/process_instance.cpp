@@ -39,9 +39,9 @@ bool hasValidationLayer() {
 
 VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                               VkDebugUtilsMessageTypeFlagsEXT,
-                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* count) {
     if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
-        ++static_cast<ProcessInstance*>(user)->messages;
+        ++*static_cast<std::atomic<uint64_t>*>(count);
         std::fprintf(stderr, "rthdist: validation: %s\n", data->pMessage);
     }
     return VK_FALSE;
@@ -54,15 +54,7 @@ std::optional<Error> addMessenger(ProcessInstance& instance) {
         vkGetInstanceProcAddr(instance.handle, "vkCreateDebugUtilsMessengerEXT"));
     if (!create)
         return Error{ErrorCode::kNoDevice, "validation requested but VK_EXT_debug_utils has no messenger"};
-    VkDebugUtilsMessengerCreateInfoEXT mi =
-        vkStruct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
-    mi.messageSeverity =
-        VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                     VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    mi.pfnUserCallback = onDebugMessage;
-    mi.pUserData = &instance;
+    const VkDebugUtilsMessengerCreateInfoEXT mi = validationMessengerInfo(&instance.messages);
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
     const VkResult r = create(instance.handle, &mi, nullptr, &messenger);
     if (r != VK_SUCCESS)
@@ -106,6 +98,19 @@ Result<ProcessInstance*> makeInstance(bool validation, bool debugUtils) {
 }
 
 }  // namespace
+
+VkDebugUtilsMessengerCreateInfoEXT validationMessengerInfo(std::atomic<uint64_t>* count) {
+    VkDebugUtilsMessengerCreateInfoEXT mi =
+        vkStruct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
+    mi.messageSeverity =
+        VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                     VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    mi.pfnUserCallback = onDebugMessage;
+    mi.pUserData = count;
+    return mi;
+}
 
 Result<ProcessInstance*> instanceFor(bool validation, bool debugLabels) {
     static std::mutex mutex;

@@ -36,6 +36,11 @@ struct ProcessInstance {
     std::atomic<uint64_t> messages{0};
 };
 
+// A messenger's create info that prints validation warnings and errors to
+// stderr and counts them in *count (the process's instances', and a
+// borrowed instance's when a Context asks for validation on it).
+[[nodiscard]] VkDebugUtilsMessengerCreateInfoEXT validationMessengerInfo(std::atomic<uint64_t>* count);
+
 // The process's instance of Vulkan 1.3 with the validation layer when asked
 // for (kNoDevice when it is not installed), and VK_EXT_debug_utils with
 // validation or `debugLabels` where the loader has it. kNoDevice when no
