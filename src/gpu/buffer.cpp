@@ -28,10 +28,18 @@ uint32_t memoryTypeFor(const Context& ctx, uint32_t typeBits, MemoryKind kind) {
     return type;
 }
 
-// Device-address memory for `req`; a failure names the device's limits.
-UniqueMemory allocateMemory(const Context& ctx, const VkMemoryRequirements& req, uint32_t type) {
+// Device-address memory for `req`, dedicated to `buffer` (Vulkan 1.1 core):
+// every Buffer owns its memory anyway, and NVIDIA's driver 580 allocates and
+// frees a dedicated allocation ~20x faster (H200: 16 GiB in 18 ms and 17 ms
+// against 430 and 446 ms; the same fill speed after, reading zeros: design.md
+// §9). A failure names the device's limits.
+UniqueMemory allocateMemory(const Context& ctx, const VkMemoryRequirements& req, uint32_t type,
+                            VkBuffer buffer) {
+    VkMemoryDedicatedAllocateInfo dedicated =
+        vkStruct<VkMemoryDedicatedAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO);
+    dedicated.buffer = buffer;
     VkMemoryAllocateFlagsInfo flags =
-        vkStruct<VkMemoryAllocateFlagsInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
+        vkStruct<VkMemoryAllocateFlagsInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO, &dedicated);
     flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
     VkMemoryAllocateInfo ai = vkStruct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags);
     ai.allocationSize = req.size;
@@ -63,7 +71,7 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
     const VkBuffer buffer = m_buffer.get();
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(d, buffer, &req);
-    m_memory = allocateMemory(ctx, req, memoryTypeFor(ctx, req.memoryTypeBits, kind));
+    m_memory = allocateMemory(ctx, req, memoryTypeFor(ctx, req.memoryTypeBits, kind), buffer);
     RTHDIST_VK_CHECK(vkBindBufferMemory(d, buffer, m_memory.get(), 0));
     if (kind != MemoryKind::kDevice)
         RTHDIST_VK_CHECK(vkMapMemory(d, m_memory.get(), 0, VK_WHOLE_SIZE, 0, &m_mapped));
