@@ -18,7 +18,8 @@
 namespace rthdist::api {
 namespace {
 
-constexpr size_t kChunk = 4096;
+// The smallest chunk of the passes measuring the rule (~50 ns a pair).
+constexpr size_t kMinChunk = 256;
 
 // The largest bound of one thread's chunks, the smallest index on a tie.
 struct Largest {
@@ -39,9 +40,10 @@ double measure2(const PointView& points, const MeshView& surface, uint64_t q, ui
 std::vector<double> upperBounds(const PointView& points, const MeshView& surface,
                                 std::span<const uint32_t> candidate, int threads, Largest& largest) {
     std::vector<double> bound(points.count);
-    const int workers = core::resolveThreads(threads, (points.count + kChunk - 1) / kChunk);
+    const size_t chunk = core::balancedChunk(points.count, threads, kMinChunk, 4096);
+    const int workers = core::resolveThreads(threads, (points.count + chunk - 1) / chunk);
     std::vector<Largest> each(static_cast<size_t>(workers));
-    core::parallelChunks(points.count, kChunk, workers, [&](size_t begin, size_t end, int thread) {
+    core::parallelChunks(points.count, chunk, workers, [&](size_t begin, size_t end, int thread) {
         Largest& mine = each[size_t(thread)];
         for (size_t q = begin; q < end; ++q) {
             bound[q] = measure2(points, surface, q, candidate[q]);
@@ -113,7 +115,8 @@ std::vector<Nearest> bruteNearest(const PointView& points, std::span<const uint6
                                   double slack) {
     const size_t k = queries.size(), triangles = surface.triangleCount();
     if (k == 0) return {};
-    const int workers = core::resolveThreads(threads, (triangles + kChunk - 1) / kChunk);
+    const size_t chunk = core::balancedChunk(triangles, threads, kMinChunk, 4096);
+    const int workers = core::resolveThreads(threads, (triangles + chunk - 1) / chunk);
     std::vector<Probe> each(size_t(workers) * k);  // each thread's k probes
     for (size_t w = 0; w < size_t(workers); ++w) {
         for (size_t i = 0; i < k; ++i) {
@@ -121,7 +124,7 @@ std::vector<Nearest> bruteNearest(const PointView& points, std::span<const uint6
             each[w * k + i].prune2 = pruneBound2(within2[i], slack);
         }
     }
-    core::parallelChunks(triangles, kChunk, workers, [&](size_t begin, size_t end, int thread) {
+    core::parallelChunks(triangles, chunk, workers, [&](size_t begin, size_t end, int thread) {
         Probe* mine = &each[size_t(thread) * k];
         auto pass = [&](Probe* probes, size_t count) {
             for (size_t t = begin; t < end; ++t) {

@@ -34,19 +34,23 @@ struct SearchFrame {
 
 std::vector<glm::vec3> framedPoints(const PointView& points, const SearchFrame& frame, int threads) {
     std::vector<glm::vec3> out(points.count);
-    core::parallelChunks(points.count, 1 << 16, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) out[i] = frame(points.at(i));
-    });
+    core::parallelChunks(points.count, core::balancedChunk(points.count, threads), threads,
+                         [&](size_t begin, size_t end, int) {
+                             for (size_t i = begin; i < end; ++i) out[i] = frame(points.at(i));
+                         });
     return out;
 }
 
 std::vector<glm::vec3> framedCorners(const MeshView& surface, const SearchFrame& frame, int threads) {
     std::vector<glm::vec3> out(3 * surface.triangleCount());
-    core::parallelChunks(surface.triangleCount(), 1 << 16, threads, [&](size_t begin, size_t end, int) {
-        for (size_t t = begin; t < end; ++t) {
-            for (int k = 0; k < 3; ++k) out[3 * t + size_t(k)] = frame(surface.corner(t, k));
-        }
-    });
+    const size_t triangles = surface.triangleCount();
+    core::parallelChunks(triangles, core::balancedChunk(triangles, threads, 1 << 10), threads,
+                         [&](size_t begin, size_t end, int) {
+                             for (size_t t = begin; t < end; ++t) {
+                                 for (int k = 0; k < 3; ++k)
+                                     out[3 * t + size_t(k)] = frame(surface.corner(t, k));
+                             }
+                         });
     return out;
 }
 

@@ -98,9 +98,10 @@ std::optional<Error> checkShape(const PointView& points, const char* name) {
 Result<SetSummary> summarizeSet(const PointView& points, const char* name, int threads) {
     if (auto err = checkShape(points, name)) return *err;
     const char* base = static_cast<const char*>(points.data);
-    threads = core::resolveThreads(threads, points.count / kChunk + 1);
+    const size_t chunk = core::balancedChunk(points.count, threads, size_t(1) << 12, kChunk);
+    threads = core::resolveThreads(threads, points.count / chunk + 1);
     std::vector<ChunkSummary> parts(static_cast<size_t>(threads));
-    core::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int t) {
+    core::parallelChunks(points.count, chunk, threads, [&](size_t begin, size_t end, int t) {
         merge(parts[size_t(t)], points.scalar == Scalar::kFloat64
                                     ? summarizeChunk<double>(base, points.strideBytes, begin, end)
                                     : summarizeChunk<float>(base, points.strideBytes, begin, end));
@@ -144,8 +145,9 @@ double searchMagnitude(const SetSummary& set, const glm::dvec3& origin) {
 
 std::vector<glm::vec3> roundedCopy(const PointView& points, const glm::dvec3& origin, int threads) {
     std::vector<glm::vec3> out(points.count);
-    threads = core::resolveThreads(threads, points.count / kChunk + 1);
-    core::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int) {
+    const size_t chunk = core::balancedChunk(points.count, threads, size_t(1) << 12, kChunk);
+    threads = core::resolveThreads(threads, points.count / chunk + 1);
+    core::parallelChunks(points.count, chunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) out[i] = glm::vec3(points.at(i) - origin);
     });
     return out;

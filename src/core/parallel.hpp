@@ -21,6 +21,17 @@ namespace rthdist::core {
     return t;
 }
 
+// A chunk size for a pass over `count` light elements on `threads` threads
+// (0: all): about four chunks a thread, at least `minimum` elements a chunk
+// (a chunk's scheduling costs ~1 us) and at most `maximum`. A fixed large
+// chunk leaves a small call's pass (36k points in 1<<16 chunks) on one
+// thread of sixteen.
+[[nodiscard]] inline size_t balancedChunk(size_t count, int threads, size_t minimum = size_t(1) << 11,
+                                          size_t maximum = size_t(1) << 16) {
+    const size_t wanted = count / (4 * size_t(resolveThreads(threads))) + 1;
+    return std::clamp(wanted, minimum, std::max(minimum, maximum));
+}
+
 // Calls fn(chunkBegin, chunkEnd, threadIndex) once for each chunk of [0, count)
 // of `chunk` elements (the last one shorter), pulled dynamically by up to
 // resolveThreads(threads, chunks) workers: the caller is worker 0, the others

@@ -144,7 +144,7 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     t0 = Clock::now();
     const auto* packed = static_cast<const uint64_t*>(m_readback.mapped());
     const float settled2 = std::nextafter(float(start.back() * start.back()), 0.0f);
-    const size_t chunk = kStageChunk * 4;
+    const size_t chunk = core::balancedChunk(m_queries, m_ws.threads);
     std::vector<std::vector<uint32_t>> openParts(toHost ? (m_queries + chunk - 1) / chunk : 0);
     out.triangle.resize(m_queries);
     core::parallelChunks(m_queries, chunk, m_ws.threads, [&](size_t begin, size_t end, int) {
@@ -192,9 +192,12 @@ SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
     auto* points = reinterpret_cast<float*>(bytes);
     auto* cornerOut = reinterpret_cast<float*>(bytes + pointBytes);
     char* boxOut = bytes + pointBytes + cornerBytes;
-    const int workers = core::resolveThreads(m_ws.threads, (m_triangles + m_queries) / kStageChunk + 1);
+    const size_t queryChunk = core::balancedChunk(m_queries, m_ws.threads);
+    const size_t triangleChunk = core::balancedChunk(m_triangles, m_ws.threads, size_t(1) << 10);
+    const int workers =
+        core::resolveThreads(m_ws.threads, m_queries / queryChunk + m_triangles / triangleChunk + 1);
     std::vector<Stats> each(static_cast<size_t>(workers));
-    core::parallelChunks(m_queries, kStageChunk, workers, [&](size_t begin, size_t end, int thread) {
+    core::parallelChunks(m_queries, queryChunk, workers, [&](size_t begin, size_t end, int thread) {
         Box box;
         for (size_t i = begin; i < end; ++i) {
             const float p[4] = {queries[i].x, queries[i].y, queries[i].z, 0.0f};
@@ -203,7 +206,7 @@ SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
         }
         each[size_t(thread)].box.add(box);
     });
-    core::parallelChunks(m_triangles, kStageChunk, workers, [&](size_t begin, size_t end, int thread) {
+    core::parallelChunks(m_triangles, triangleChunk, workers, [&](size_t begin, size_t end, int thread) {
         Stats mine;
         for (size_t t = begin; t < end; ++t) {
             Box tri;
@@ -260,8 +263,9 @@ std::vector<sh::SurfaceRadiusCount> SurfaceSearch::submitRadii(VkCommandBuffer c
                              VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
         const uint32_t from = m_ws.ctx.cmdMark(cmd);
         const double settled2 = settled < 0.0 ? -1.0 : settled * settled;
-        cmdRadius(cmd, radii[i], settled2, m_built, m_counts.address() + i * sizeof(sh::SurfaceRadiusCount));
-        buildMarks.emplace_back(from, m_ws.ctx.cmdMark(cmd));
+        const uint32_t built = cmdRadius(cmd, radii[i], settled2, m_built,
+                                         m_counts.address() + i * sizeof(sh::SurfaceRadiusCount));
+        buildMarks.emplace_back(from, built);
         m_built = true;
         settled = radii[i];
     }
@@ -347,8 +351,8 @@ void SurfaceSearch::submitTail(std::span<const glm::vec3> corners, double settle
         m_counts.mapped())[SurfaceRadii::kStartRadii * sizeof(sh::SurfaceRadiusCount) / sizeof(uint32_t)];
 }
 
-void SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update,
-                              VkDeviceAddress counts) {
+uint32_t SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update,
+                                  VkDeviceAddress counts) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "surface search");
     const auto r = float(radius);
     // The boxes' slack: rounding at the box's magnitude (grow_boxes.comp).
@@ -362,6 +366,7 @@ void SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled
         m_ws.pipelines.bindTlas(m_ws.accel.tlas());
         m_ws.tlasBound = true;
     }
+    const uint32_t built = m_ws.ctx.cmdMark(cmd);
     sh::SurfaceSearchPush sp{};
     sp.queries = m_points.address();
     sp.corners = m_corners.address();
@@ -376,7 +381,7 @@ void SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled
     sp.mutant = m_ws.mutant ? 1u : 0u;
     if (m_ws.rayQuery) {
         m_ws.dispatch(cmd, Kernel::kSurfaceSearchRayQuery, sp, m_queries);
-        return;
+        return built;
     }
     const uint64_t chunk = std::max<uint64_t>(1, m_ws.ctx.limits().maxRayDispatch);
     for (uint64_t first = 0; first < m_queries; first += chunk) {
@@ -384,6 +389,7 @@ void SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled
         m_ws.pipelines.cmdTraceSurfaceRays(cmd, &sp, sizeof(sp),
                                            uint32_t(std::min<uint64_t>(chunk, m_queries - first)));
     }
+    return built;
 }
 
 }  // namespace rthdist::gpu_algo

@@ -153,7 +153,10 @@ private:
     // radius did.
     std::vector<sh::SurfaceRadiusCount> submitRadii(VkCommandBuffer cmd, std::span<const double> radii,
                                                     SurfaceCandidates& out);
-    void cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update, VkDeviceAddress counts);
+    // One radius: the boxes grown, the BLAS built or refit, the rays. Returns
+    // the timestamp mark after the builds (the stage split of gpuBuildMs).
+    uint32_t cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update,
+                       VkDeviceAddress counts);
     // The tail's submission for the queries the radii left open (their best
     // farther than `settled`): the tree built on the host and uploaded
     // (unless the one kept from the call before is of the same corners:

@@ -136,6 +136,18 @@ TEST(ParallelChunks, OneThreadRunsInlineOnTheCaller) {
     EXPECT_EQ(poolWorkerCount(), workers);
 }
 
+// balancedChunk: ~four chunks a thread between its bounds, so a small pass
+// still spreads over the threads and a large one keeps large chunks.
+TEST(BalancedChunk, FourChunksAThreadWithinTheBounds) {
+    EXPECT_EQ(balancedChunk(36000, 16, 256, 4096), 36000u / 64 + 1);  // 64 chunks for 16 threads
+    EXPECT_EQ(balancedChunk(36000, 16), size_t(1) << 11);             // the default floor
+    EXPECT_EQ(balancedChunk(100, 16, 256, 4096), 256u);               // never below the floor
+    EXPECT_EQ(balancedChunk(size_t(1) << 30, 16), size_t(1) << 16);   // nor past the ceiling
+    EXPECT_EQ(balancedChunk(1000, 2, 8, 1 << 20), 1000u / 8 + 1);
+    // A ceiling below the floor gives the floor.
+    EXPECT_EQ(balancedChunk(size_t(1) << 30, 4, 512, 64), 512u);
+}
+
 // Three levels of calls, each fn starting the next: each level counts its
 // elements, and every call must complete however busy the pool is.
 TEST(ParallelChunks, NestedCallsComplete) {
