@@ -815,8 +815,7 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
         SpaceDirection dirAB, dirBA;
         dirAB.q = 0;
         dirBA.q = 1;
-        dirAB.shared.slack = dirBA.shared.slack = core::searchSlack(
-            std::max(core::largestMagnitude(a, threads), core::largestMagnitude(b, threads)) * scale);
+        dirAB.shared.slack = dirBA.shared.slack = core::searchSlack(pieces.largestMagnitude() * scale);
         SpaceDirection* const dirs[2] = {spaceAB ? &dirAB : nullptr, spaceBA ? &dirBA : nullptr};
         if (auto err = runInSpace(pieces, dirs, scale, call, perCall, maxPiece, directed, recycle, lanes,
                                   threads, host))

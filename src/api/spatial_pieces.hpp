@@ -59,6 +59,9 @@ public:
     [[nodiscard]] size_t count() const { return m_pieces; }
     [[nodiscard]] const Set& set(int s) const { return s == 0 ? m_a : m_b; }
     [[nodiscard]] uint32_t cellsPerAxis() const { return m_cells; }
+    // The largest magnitude of a coordinate of either set as given (not
+    // scaled): core::largestMagnitude of both, found in the partition's pass.
+    [[nodiscard]] double largestMagnitude() const { return m_magnitude; }
 
     // True only when every point of either set whose scaled coordinates lie
     // within `radius` of q on every axis (q scaled as searched: core::scaled)
@@ -84,6 +87,7 @@ private:
     Set m_a, m_b;
     size_t m_pieces = 0;
     uint32_t m_cells = 1;  // per axis (a power of two)
+    double m_magnitude = 0.0;
     double m_lo[3] = {0.0, 0.0, 0.0};
     double m_inverse[3] = {1.0, 1.0, 1.0};  // cells per unit on each axis
     std::vector<uint64_t> m_solid;  // a bit per cell: it and its neighbours hold one piece's points, or none
