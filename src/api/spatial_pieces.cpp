@@ -70,11 +70,6 @@ uint32_t SpatialPieces::cellOf(const glm::dvec3& p) const {
     return core::mortonEncode(axisCell(p.x, 0), axisCell(p.y, 1), axisCell(p.z, 2));
 }
 
-bool SpatialPieces::solidAround(uint32_t cell, double radius) const {
-    return radius * m_inverse[0] <= 0.5 && radius * m_inverse[1] <= 0.5 && radius * m_inverse[2] <= 0.5 &&
-           ((m_solid[cell >> 6] >> (cell & 63u)) & 1u) != 0;
-}
-
 bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) const {
     uint32_t lo[3], hi[3];
     uint64_t cells = 1;

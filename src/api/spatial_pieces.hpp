@@ -75,7 +75,11 @@ public:
     // (Set::cell) stays within the cells around it, and those hold the
     // points of that cell's piece only, or none (a "solid" cell; each axis's
     // cell moves by at most one). False says nothing: ask boxInPiece.
-    [[nodiscard]] bool solidAround(uint32_t cell, double radius) const;
+    // Inline: asked once for every query after round one.
+    [[nodiscard]] bool solidAround(uint32_t cell, double radius) const {
+        return radius * m_inverse[0] <= 0.5 && radius * m_inverse[1] <= 0.5 && radius * m_inverse[2] <= 0.5 &&
+               ((m_solid[cell >> 6] >> (cell & 63u)) & 1u) != 0;
+    }
 
 private:
     static constexpr uint32_t kEmpty = UINT32_MAX;       // a cell without points
