@@ -134,6 +134,21 @@ CallOptions pieceOptions(const CallOptions& call, bool perPoint, double from, do
     return piece;
 }
 
+// A call of the pieces in space: per-point nearest targets only. The host
+// computes each pair's distance itself as it merges (pairDistance: the
+// distance every backend reports, core::exactDistance of the pair as given),
+// so the call neither computes nor writes a distance per query.
+CallOptions spaceOptions(const CallOptions& call, double from, double width) {
+    CallOptions piece = pieceOptions(call, true, from, width);
+    piece.perPointNearestOnly = true;
+    return piece;
+}
+
+// A per-point pair's distance as the backends report it (PerPoint::distance).
+double pairDistance(const glm::vec3& q, const glm::vec3& t) {
+    return core::exactDistance(glm::dvec3(q), glm::dvec3(t));
+}
+
 // Where a lane's calls go: its device (the DirectedCall's lane argument),
 // the host threads of its passes, and whether its calls report progress
 // (lane 0, the calling thread, only).
@@ -304,10 +319,10 @@ struct CallQueries {
 };
 
 // A call's per-point result merged into the direction's bests: a nearer pair
-// replaces, an equal one only with a smaller target input index. Targets:
-// the gathered target piece starting at `tileStart`. Reads the call's
-// arrays and the bests in order; a target's input index only on a tie.
-void mergeBests(SpaceDirection& dir, const SpatialPieces& pieces, const CallQueries& queries,
+// replaces, an equal one only with a smaller target input index. Queries:
+// the call's, `points` (gathered); targets: the gathered target piece
+// starting at `tileStart`. A target's input index is read only on a tie.
+void mergeBests(SpaceDirection& dir, const SpatialPieces& pieces, const CallQueries& queries, Span points,
                 uint64_t tileStart, const PerPoint& pp, int threads) {
     const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
     const size_t n = pp.nearest.size();
@@ -315,8 +330,8 @@ void mergeBests(SpaceDirection& dir, const SpatialPieces& pieces, const CallQuer
         n, kHostChunk, core::resolveThreads(threads, n / kHostChunk + 1), [&](size_t begin, size_t end, int) {
             for (size_t k = begin; k < end; ++k) {
                 const uint64_t p = queries.at(k);
-                const double d = pp.distance[k];
                 const auto g = uint32_t(tileStart + pp.nearest[k]);
+                const double d = pairDistance(points[k], ts.points[g]);
                 if (d < dir.distance[p] || (d == dir.distance[p] && ts.input[g] < ts.input[dir.nearest[p]])) {
                     dir.distance[p] = d;
                     dir.nearest[p] = g;
@@ -325,16 +340,20 @@ void mergeBests(SpaceDirection& dir, const SpatialPieces& pieces, const CallQuer
         });
 }
 
-// Round one's results: every query of the piece gets its first pair (each
-// position is written once in round one, so nothing is compared and the
-// arrays need no pass before it).
-void storeBests(SpaceDirection& dir, uint64_t first, uint64_t tileStart, const PerPoint& pp, int threads) {
+// Round one's results for piece k: every query of the piece gets its first
+// pair, its distance computed here (each position is written once in round
+// one, so nothing is compared and the arrays need no pass before it).
+void storeBests(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, const PerPoint& pp, int threads) {
+    const SpatialPieces::Set& qs = pieces.set(dir.q);
+    const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
+    const uint64_t first = qs.start[k], tileStart = ts.start[k];
     const size_t n = pp.nearest.size();
     core::parallelChunks(n, kHostChunk, core::resolveThreads(threads, n / kHostChunk + 1),
                          [&](size_t begin, size_t end, int) {
-                             for (size_t k = begin; k < end; ++k) {
-                                 dir.distance[first + k] = pp.distance[k];
-                                 dir.nearest[first + k] = uint32_t(tileStart + pp.nearest[k]);
+                             for (size_t i = begin; i < end; ++i) {
+                                 const auto g = uint32_t(tileStart + pp.nearest[i]);
+                                 dir.distance[first + i] = pairDistance(qs.points[first + i], ts.points[g]);
+                                 dir.nearest[first + i] = g;
                              }
                          });
 }
@@ -382,7 +401,7 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], const 
                 if (both) storeNone(*dirs[1], ts.start[k], ts.start[k + 1]);
                 continue;
             }
-            CallOptions piece = pieceOptions(call, true, from + width * double(k) / double(pieces.count()),
+            CallOptions piece = spaceOptions(call, from + width * double(k) / double(pieces.count()),
                                              width / double(pieces.count()));
             piece.directedOnly = !both;
             Result<HausdorffResult> r = lane.call(qs.piece(k), ts.piece(k), piece);
@@ -393,10 +412,10 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], const 
             const core::Clock::time_point start = core::Clock::now();
             SpaceDirection& first = *dirs[qset];
             addCallTo(first.shared, r->aToB.counters, &r->timings);
-            storeBests(first, qs.start[k], ts.start[k], r->aNearest, lane.threads);
+            storeBests(first, pieces, k, r->aNearest, lane.threads);
             if (both) {
                 addCallTo(dirs[1]->shared, r->bToA.counters, nullptr);
-                storeBests(*dirs[1], ts.start[k], qs.start[k], r->bNearest, lane.threads);
+                storeBests(*dirs[1], pieces, k, r->bNearest, lane.threads);
             }
             lane.giveBack(std::move(r->aNearest), std::move(r->bNearest));
             host.add(start, HostClock::kRoundOne);
@@ -586,7 +605,7 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
             }
             host.add(start, HostClock::kRoundTwo);
             const CallOptions piece =
-                pieceOptions(call, true, from + width * double(j) / double(round.boxes.size()),
+                spaceOptions(call, from + width * double(j) / double(round.boxes.size()),
                              width / double(round.boxes.size()));
             for (size_t b0 = 0; b0 < selected.size(); b0 += round.maxQueries) {
                 start = core::Clock::now();
@@ -607,7 +626,7 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
                 {
                     std::lock_guard lock(round.mutex);
                     addCallTo(dir.shared, r->aToB.counters, &r->timings);
-                    mergeBests(dir, *round.pieces, CallQueries{0, &batch}, ts.start[j], r->aNearest,
+                    mergeBests(dir, *round.pieces, CallQueries{0, &batch}, gathered, ts.start[j], r->aNearest,
                                lane.threads);
                 }
                 lane.giveBack(std::move(r->aNearest), PerPoint{});
@@ -796,8 +815,7 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
         SpaceDirection dirAB, dirBA;
         dirAB.q = 0;
         dirBA.q = 1;
-        dirAB.shared.slack = dirBA.shared.slack = core::searchSlack(
-            std::max(core::largestMagnitude(a, threads), core::largestMagnitude(b, threads)) * scale);
+        dirAB.shared.slack = dirBA.shared.slack = core::searchSlack(pieces.largestMagnitude() * scale);
         SpaceDirection* const dirs[2] = {spaceAB ? &dirAB : nullptr, spaceBA ? &dirBA : nullptr};
         if (auto err = runInSpace(pieces, dirs, scale, call, perCall, maxPiece, directed, recycle, lanes,
                                   threads, host))

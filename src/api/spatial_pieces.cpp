@@ -42,6 +42,19 @@ void forRanges(const Ranges& r, Fn&& fn) {
     });
 }
 
+// A shared cell's points by rank in input order over its `span` pieces:
+// rank r (of `total`) goes to piece floor(r * span / total) of the cell's.
+uint32_t pieceOfRank(uint64_t rank, uint64_t span, uint64_t total) { return uint32_t(rank * span / total); }
+
+// The ranks [begin, end) that pieceOfRank sends to piece m of the cell's:
+// floor(r * span / total) >= m exactly when r >= ceil(m * total / span).
+struct PieceRanks {
+    uint64_t begin = 0, end = 0;
+};
+PieceRanks pieceRanks(uint64_t m, uint64_t span, uint64_t total) {
+    return {(m * total + span - 1) / span, ((m + 1) * total + span - 1) / span};
+}
+
 }  // namespace
 
 // (v - lo) * inverse side: a monotone function of v (as is each rounding),
@@ -55,11 +68,6 @@ uint32_t SpatialPieces::axisCell(double v, int axis) const {
 
 uint32_t SpatialPieces::cellOf(const glm::dvec3& p) const {
     return core::mortonEncode(axisCell(p.x, 0), axisCell(p.y, 1), axisCell(p.z, 2));
-}
-
-bool SpatialPieces::solidAround(uint32_t cell, double radius) const {
-    return radius * m_inverse[0] <= 0.5 && radius * m_inverse[1] <= 0.5 && radius * m_inverse[2] <= 0.5 &&
-           ((m_solid[cell >> 6] >> (cell & 63u)) & 1u) != 0;
 }
 
 bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) const {
@@ -92,19 +100,24 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         if (s.empty()) continue;
         std::vector<glm::dvec3> partLo(size_t(threads), glm::dvec3(core::scaled(s[0], scale)));
         std::vector<glm::dvec3> partHi = partLo;
+        std::vector<float> partMagnitude(size_t(threads), 0.0f);
         core::parallelChunks(s.size(), size_t(1) << 16, threads, [&](size_t begin, size_t end, int w) {
             glm::vec3 l = core::scaled(s[begin], scale), h = l;
+            float m = partMagnitude[size_t(w)];  // as core::largestMagnitude, in the same pass
             for (size_t i = begin; i < end; ++i) {
                 const glm::vec3 p = core::scaled(s[i], scale);
                 l = glm::min(l, p);
                 h = glm::max(h, p);
+                m = std::max({m, std::abs(s[i].x), std::abs(s[i].y), std::abs(s[i].z)});
             }
             partLo[size_t(w)] = glm::min(partLo[size_t(w)], glm::dvec3(l));
             partHi[size_t(w)] = glm::max(partHi[size_t(w)], glm::dvec3(h));
+            partMagnitude[size_t(w)] = m;
         });
         for (int w = 0; w < threads; ++w) {
             lo = glm::min(lo, partLo[size_t(w)]);
             hi = glm::max(hi, partHi[size_t(w)]);
+            out.m_magnitude = std::max(out.m_magnitude, double(partMagnitude[size_t(w)]));
         }
     }
     out.m_cells = cellsPerAxisFor(a.size() + b.size());
@@ -223,18 +236,31 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
             if (span[cell] > 1) {
                 const auto j = size_t(std::lower_bound(sharedCells.begin(), sharedCells.end(), cell) -
                                       sharedCells.begin());
-                piece += uint32_t(rank[j]++ * span[cell] / total[s][cell]);
+                piece += pieceOfRank(rank[j]++, span[cell], total[s][cell]);
             }
             return piece;
         };
+        // Each range's count of every piece, from its counts of the cells: a
+        // cell's points go to its piece, a shared cell's ranks [base, base +
+        // count) to the pieces whose rank intervals (pieceRanks) they meet.
         std::vector<std::vector<uint64_t>> perPiece(size_t(r.count), std::vector<uint64_t>(pieces, 0));
-        {
-            std::vector<std::vector<uint64_t>> rank = rankBase;
-            forRanges(r, [&](int t, size_t begin, size_t end) {
-                std::vector<uint64_t>& mine = perPiece[size_t(t)];
-                for (size_t i = begin; i < end; ++i) ++mine[pieceOf(key[s][i], rank[size_t(t)])];
-            });
-        }
+        forRanges(r, [&](int t, size_t, size_t) {
+            std::vector<uint64_t>& mine = perPiece[size_t(t)];
+            const std::vector<uint32_t>& cells = counts[s][size_t(t)];
+            for (uint32_t cell = 0; cell < cellCount; ++cell)
+                if (span[cell] == 1 && cells[cell] != 0) mine[firstPiece[cell]] += cells[cell];
+            for (size_t j = 0; j < sharedCells.size(); ++j) {
+                const uint32_t cell = sharedCells[j];
+                const uint64_t lo = rankBase[size_t(t)][j], hi = lo + cells[cell];
+                if (lo == hi) continue;
+                const uint32_t last = pieceOfRank(hi - 1, span[cell], total[s][cell]);
+                for (uint32_t m = pieceOfRank(lo, span[cell], total[s][cell]); m <= last; ++m) {
+                    const PieceRanks ranks = pieceRanks(m, span[cell], total[s][cell]);
+                    const uint64_t from = std::max(lo, ranks.begin), to = std::min(hi, ranks.end);
+                    if (from < to) mine[firstPiece[cell] + m] += to - from;
+                }
+            }
+        });
         Set& set = s == 0 ? out.m_a : out.m_b;
         set.start.assign(pieces + 1, 0);
         for (uint32_t k = 0; k < pieces; ++k) {

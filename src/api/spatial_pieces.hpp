@@ -59,6 +59,9 @@ public:
     [[nodiscard]] size_t count() const { return m_pieces; }
     [[nodiscard]] const Set& set(int s) const { return s == 0 ? m_a : m_b; }
     [[nodiscard]] uint32_t cellsPerAxis() const { return m_cells; }
+    // The largest magnitude of a coordinate of either set as given (not
+    // scaled): core::largestMagnitude of both, found in the partition's pass.
+    [[nodiscard]] double largestMagnitude() const { return m_magnitude; }
 
     // True only when every point of either set whose scaled coordinates lie
     // within `radius` of q on every axis (q scaled as searched: core::scaled)
@@ -72,7 +75,11 @@ public:
     // (Set::cell) stays within the cells around it, and those hold the
     // points of that cell's piece only, or none (a "solid" cell; each axis's
     // cell moves by at most one). False says nothing: ask boxInPiece.
-    [[nodiscard]] bool solidAround(uint32_t cell, double radius) const;
+    // Inline: asked once for every query after round one.
+    [[nodiscard]] bool solidAround(uint32_t cell, double radius) const {
+        return radius * m_inverse[0] <= 0.5 && radius * m_inverse[1] <= 0.5 && radius * m_inverse[2] <= 0.5 &&
+               ((m_solid[cell >> 6] >> (cell & 63u)) & 1u) != 0;
+    }
 
 private:
     static constexpr uint32_t kEmpty = UINT32_MAX;       // a cell without points
@@ -84,6 +91,7 @@ private:
     Set m_a, m_b;
     size_t m_pieces = 0;
     uint32_t m_cells = 1;  // per axis (a power of two)
+    double m_magnitude = 0.0;
     double m_lo[3] = {0.0, 0.0, 0.0};
     double m_inverse[3] = {1.0, 1.0, 1.0};  // cells per unit on each axis
     std::vector<uint64_t> m_solid;  // a bit per cell: it and its neighbours hold one piece's points, or none

@@ -74,6 +74,36 @@ TEST(SpatialPieces, CrowdedCellsAreSplitByInputOrder) {
     expectAPartition(pieces, sets, limits);
 }
 
+// Sets of several host ranges (65,536 points a range and more) with crowded
+// cells split over pieces: the same pieces, in the same order, on one
+// thread as on four (a range's share of a crowded cell's pieces is found
+// from its counts, its points' ranks continue the earlier ranges'), and the
+// largest magnitude is core::largestMagnitude's of both sets.
+TEST(SpatialPieces, SeveralRangesCutAsOne) {
+    std::vector<glm::vec3> a = cloud(200000, 5, 2.0f, glm::vec3(-1.0f));
+    for (size_t i = 0; i < a.size(); i += 3) a[i] = glm::vec3(0.5f, 0.25f, -0.75f);  // one crowded cell
+    std::vector<glm::vec3> b = cloud(150000, 6, 1e-7f, glm::vec3(0.2f));             // another
+    b.push_back(glm::vec3(-40.0f, 3.0f, 9.0f));
+    const std::vector<glm::vec3>* sets[2] = {&a, &b};
+    for (const PieceLimits limits : {PieceLimits{7001, 9999}, PieceLimits{50000, 3}}) {
+        const SpatialPieces one = SpatialPieces::partition(a, b, 0.5, limits, 1);
+        const SpatialPieces four = SpatialPieces::partition(a, b, 0.5, limits, 4);
+        expectAPartition(four, sets, limits);
+        ASSERT_EQ(one.count(), four.count());
+        for (int s = 0; s < 2; ++s) {
+            EXPECT_EQ(one.set(s).start, four.set(s).start) << "set " << s;
+            EXPECT_TRUE(
+                std::equal(one.set(s).input.begin(), one.set(s).input.end(), four.set(s).input.begin()))
+                << "set " << s;
+            EXPECT_TRUE(std::equal(one.set(s).cell.begin(), one.set(s).cell.end(), four.set(s).cell.begin()))
+                << "set " << s;
+        }
+        EXPECT_EQ(four.largestMagnitude(),
+                  std::max(core::largestMagnitude(a, 1), core::largestMagnitude(b, 1)));
+        EXPECT_EQ(four.largestMagnitude(), 40.0);
+    }
+}
+
 // boxInPiece and solidAround: whenever either says a box lies in piece k,
 // no point of another piece (of either set) lies in that box; and they do
 // say so for most small boxes around points of a spread cloud.
