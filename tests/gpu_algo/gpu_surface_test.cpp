@@ -554,7 +554,10 @@ TailCheck expectNearest(const FramedCase& c, const gpu_algo::SurfaceCandidates& 
         if (mutant) {
             EXPECT_NE(got % 3, 0u) << c.name << " query " << i;
             if (clear && want.triangle % 3 == 0) ++check.missedThirds;
-            if (clear && want.triangle % 3 != 0) EXPECT_EQ(got, want.triangle) << c.name << " query " << i;
+            // (An exact copy of the nearest may stand for it, as below.)
+            if (clear && want.triangle % 3 != 0)
+                EXPECT_TRUE(got == want.triangle || sameCorners(c.corners, got, want.triangle))
+                    << c.name << " query " << i << ": triangle " << got << " for " << want.triangle;
             continue;
         }
         EXPECT_LE(distance2(c.queries[i], c.corners, got), want.d2 * (1.0 + 1e-5) + 1e-12)
