@@ -25,6 +25,7 @@
 #include "api/out_of_core.hpp"
 #include "api/route_planner.hpp"
 #include "core/input_frame.hpp"
+#include "core/uninit_vector.hpp"
 #include "rthdist/rthdist.hpp"
 #include "rthdist/vulkan_interop.hpp"
 
@@ -53,7 +54,7 @@ using BackendSetPair = std::pair<const BackendSet*, const BackendSet*>;
 // (UINT32_MAX: none), a candidate the caller proves in double
 // (api/surface_certify.hpp).
 struct TriangleCandidates {
-    std::vector<uint32_t> triangle;
+    core::UninitVector<uint32_t> triangle;
     uint32_t radii = 0;        // radii searched
     uint64_t rays = 0;         // rays cast
     uint32_t submissions = 0;  // command buffers submitted and waited for

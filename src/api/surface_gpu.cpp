@@ -9,6 +9,7 @@
 #include "api/surface_certify.hpp"
 #include "core/parallel.hpp"
 #include "core/stopwatch.hpp"
+#include "core/uninit_vector.hpp"
 
 namespace rthdist::api {
 namespace {
@@ -32,8 +33,9 @@ struct SearchFrame {
     [[nodiscard]] glm::vec3 operator()(const glm::dvec3& p) const { return glm::vec3((p - origin) * scale); }
 };
 
-std::vector<glm::vec3> framedPoints(const PointView& points, const SearchFrame& frame, int threads) {
-    std::vector<glm::vec3> out(points.count);
+// (UninitVector: first touched by the workers, its block reused by the next call.)
+core::UninitVector<glm::vec3> framedPoints(const PointView& points, const SearchFrame& frame, int threads) {
+    core::UninitVector<glm::vec3> out(points.count);
     core::parallelChunks(points.count, core::balancedChunk(points.count, threads), threads,
                          [&](size_t begin, size_t end, int) {
                              for (size_t i = begin; i < end; ++i) out[i] = frame(points.at(i));
@@ -41,8 +43,8 @@ std::vector<glm::vec3> framedPoints(const PointView& points, const SearchFrame& 
     return out;
 }
 
-std::vector<glm::vec3> framedCorners(const MeshView& surface, const SearchFrame& frame, int threads) {
-    std::vector<glm::vec3> out(3 * surface.triangleCount());
+core::UninitVector<glm::vec3> framedCorners(const MeshView& surface, const SearchFrame& frame, int threads) {
+    core::UninitVector<glm::vec3> out(3 * surface.triangleCount());
     const size_t triangles = surface.triangleCount();
     core::parallelChunks(triangles, core::balancedChunk(triangles, threads, 1 << 10), threads,
                          [&](size_t begin, size_t end, int) {
@@ -60,8 +62,8 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
                                    const SurfaceInputs& inputs, const SurfaceOptions& options) {
     const core::Clock::time_point start = core::Clock::now();
     const SearchFrame frame(inputs.a.box, inputs.b.box);
-    const std::vector<glm::vec3> queries = framedPoints(points, frame, options.threads);
-    const std::vector<glm::vec3> corners = framedCorners(surface, frame, options.threads);
+    const core::UninitVector<glm::vec3> queries = framedPoints(points, frame, options.threads);
+    const core::UninitVector<glm::vec3> corners = framedCorners(surface, frame, options.threads);
     const double frameMs = core::msSince(start);
     Result<TriangleCandidates> found = device.nearestTriangles(queries, corners, options.cancel);
     if (!found) return found.error();
