@@ -45,7 +45,7 @@ BruteForce hostBruteForce(const PointAt& query, const PointAt& target, uint64_t 
 }
 
 DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, const PointAt& target,
-                             const BruteForce& bruteForce) {
+                             const BruteForce& bruteForce, size_t firstBatch) {
     DirectedProof p;
     p.band = band.queries.size();
     if (!band.failure.empty()) {
@@ -89,6 +89,7 @@ DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, co
         have = true;
     };
     size_t i = 0;
+    size_t batchSize = std::clamp<size_t>(firstBatch, 1, kBruteForceBatch);
     while (i < order.size()) {
         // A query whose bound does not exceed the largest exact distance so
         // far cannot raise it (nor win a tie: its index is larger, or it ties
@@ -106,7 +107,7 @@ DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, co
             continue;
         }
         std::vector<BandNearest> batch;
-        for (size_t j = i; j < order.size() && batch.size() < kBruteForceBatch; ++j) {
+        for (size_t j = i; j < order.size() && batch.size() < batchSize; ++j) {
             if (!settles(order[j].upper)) break;
             if (candidatesOf(order[j].query) != nullptr) break;
             BandNearest b{order[j].query};
@@ -119,6 +120,7 @@ DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, co
             return p;
         }
         p.bruteForced += batch.size();
+        batchSize = std::min(2 * batchSize, kBruteForceBatch);
         for (const BandNearest& b : batch) {
             if (b.target == std::numeric_limits<uint64_t>::max()) {
                 p.failure = "band query " + std::to_string(b.query) + " found no target in its brute force";
@@ -177,7 +179,9 @@ void proveFromViews(HausdorffResult& r, const PointView& a, const PointView& b, 
         if (!band.present) return;
         const PointAt query = [&q](uint64_t i) { return q.at(i); };
         const PointAt target = [&t](uint64_t i) { return t.at(i); };
-        applyProof(d, proveDirection(band, query, target, hostBruteForce(query, target, t.size(), threads)),
+        applyProof(d,
+                   proveDirection(band, query, target, hostBruteForce(query, target, t.size(), threads),
+                                  kHostFirstBatch),
                    query, target, &pp);
     };
     one(r.aToB, r.aNearest, r.proofMaterial->aToB, a, b);

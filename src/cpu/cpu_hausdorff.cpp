@@ -287,6 +287,7 @@ struct DirectedOutput {
     bool lostQuery = false;
     bool cancelled = false;  // CallOptions::cancel was set: the output is incomplete
     double indexMs = 0.0, cullMs = 0.0, searchMs = 0.0, refineMs = 0.0;
+    double certificateMs = 0.0;  // proveDirection: the band settled in double (after refine)
 };
 
 // Stage boundaries of one direction as fractions of it (search dominates).
@@ -531,12 +532,15 @@ core::DirectionBand bandOf(const Direction& d, std::vector<core::BandQuery> quer
 // coordinates; HausdorffResult::proofMaterial keeps the band for a proof
 // from the caller's): out.directed takes the proof's witness when it holds.
 void proveDirection(const Direction& d, DirectedOutput& out, PerPoint* perPoint = nullptr) {
+    const auto start = Clock::now();
     const core::PointAt query = [&d](uint64_t i) { return glm::dvec3(d.queries[i]); };
     const core::PointAt target = [&d](uint64_t i) { return glm::dvec3(d.targets[i]); };
     const core::DirectedProof proof = core::proveDirection(
-        out.band, query, target, core::hostBruteForce(query, target, d.targets.size(), d.threads));
+        out.band, query, target, core::hostBruteForce(query, target, d.targets.size(), d.threads),
+        core::kHostFirstBatch);
     core::applyProof(out.directed, proof, query, target, perPoint);
     if (!proof.proven) out.band.failure = proof.failure;
+    out.certificateMs = msSince(start);
 }
 
 // Every query's exact float nearest neighbour. A query equal to the previous
@@ -851,6 +855,7 @@ std::optional<Error> runDirection(const CpuSet& q, const CpuSet& t, int threads,
     timings.cull += o.cullMs;
     timings.search += o.searchMs;
     timings.refine += o.refineMs;
+    timings.certificate += o.certificateMs;
     if (o.cancelled) return Error{ErrorCode::kCancelled, "the call was cancelled (CallOptions::cancel)"};
     if (o.lostQuery) return Error{ErrorCode::kInternal, "CPU backend: a query found no target"};
     into = o.directed;
