@@ -79,6 +79,40 @@ struct CentreBefore {
     }
 };
 
+// Reorders items[0, count) so that the first `half` are the smaller by
+// CentreBefore<Axis>. A large range is first cut by a histogram of its
+// centres over [lo, hi] (about 16 items a bin, at most kMaxBins; a bin is a non-decreasing
+// function of the centre, so every item of a lower bin is smaller than every
+// item of a higher one): the items below the bin that holds position `half`
+// go first, that bin's next, and only that bin is ordered by nth_element.
+// Two passes and a small selection instead of introselect's passes over the
+// whole range (perf: nth_element was 41 % of a 871k-triangle build).
+template <int Axis>
+void selectHalf(BuildItem* items, uint32_t count, uint32_t half, float lo, float hi) {
+    constexpr uint32_t kSmallRange = 128;
+    constexpr uint32_t kMaxBins = 256;
+    const float width = hi - lo;
+    if (count <= kSmallRange || !(width > 0.0f) || !std::isfinite(width)) {
+        std::nth_element(items, items + half, items + count, CentreBefore<Axis>{});
+        return;
+    }
+    // About 16 items a bin, at most kMaxBins.
+    const uint32_t bins = std::min(kMaxBins, count / 16);
+    const float toBin = float(bins) / width;
+    const auto binOf = [&](const BuildItem& item) {
+        const float b = (item.centre[Axis] - lo) * toBin;
+        return b < float(bins - 1) ? uint32_t(b) : bins - 1;  // b >= 0: lo is the minimum
+    };
+    std::array<uint32_t, kMaxBins> histogram{};
+    for (uint32_t i = 0; i < count; ++i) ++histogram[binOf(items[i])];
+    uint32_t median = 0, below = 0;
+    while (below + histogram[median] <= half) below += histogram[median++];
+    BuildItem* const end = items + count;
+    BuildItem* const from = std::partition(items, end, [&](const BuildItem& x) { return binOf(x) < median; });
+    BuildItem* const to = std::partition(from, end, [&](const BuildItem& x) { return binOf(x) == median; });
+    std::nth_element(from, items + half, to, CentreBefore<Axis>{});
+}
+
 // Reorders items[0, count) so that the first count / 2 are the smaller by
 // (centre along the longest axis of the centres' spread, triangle index),
 // and returns count / 2. The order is strict and total, so the halves
@@ -93,9 +127,9 @@ uint32_t splitAtMedian(BuildItem* items, uint32_t count) {
     const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
     const uint32_t half = count / 2;
     switch (axis) {
-        case 0: std::nth_element(items, items + half, items + count, CentreBefore<0>{}); break;
-        case 1: std::nth_element(items, items + half, items + count, CentreBefore<1>{}); break;
-        default: std::nth_element(items, items + half, items + count, CentreBefore<2>{}); break;
+        case 0: selectHalf<0>(items, count, half, cLo.x, cHi.x); break;
+        case 1: selectHalf<1>(items, count, half, cLo.y, cHi.y); break;
+        default: selectHalf<2>(items, count, half, cLo.z, cHi.z); break;
     }
     return half;
 }
