@@ -34,8 +34,8 @@ double pruneBound2(double best2, double slack) {
 // with a double centre; any order of the items gives a correct tree, and
 // rounding only makes more ties, which the index breaks).
 struct BuildItem {
-    glm::vec3 centre{0.0f};
-    uint32_t triangle = 0;
+    glm::vec3 centre;
+    uint32_t triangle;
 };
 static_assert(sizeof(BuildItem) == 16);
 
@@ -148,7 +148,7 @@ struct PendingNode {
 TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     const auto n = uint32_t(mesh.triangleCount());
     threads = core::resolveThreads(threads, n / kSubtreeTriangles);
-    std::vector<BuildItem> items(n);
+    core::UninitVector<BuildItem> items(n);  // every item written below
     core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
         for (size_t t = begin; t < end; ++t) {
             const glm::dvec3 c0 = mesh.corner(t, 0), c1 = mesh.corner(t, 1), c2 = mesh.corner(t, 2);

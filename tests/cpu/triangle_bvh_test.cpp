@@ -104,8 +104,8 @@ bool boxHolds(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& inne
 // Walks the tree from the root and checks every invariant the query relies on.
 void expectTreeInvariants(const RandomMesh& m, const cpu::TriangleBvh& bvh) {
     const size_t n = m.triangleCount();
-    const std::vector<cpu::TriangleBvh::Node>& nodes = bvh.nodes();
-    const std::vector<uint32_t>& order = bvh.triangleOrder();
+    const auto& nodes = bvh.nodes();
+    const auto& order = bvh.triangleOrder();
     ASSERT_EQ(order.size(), n) << m.name;
     ASSERT_FALSE(nodes.empty()) << m.name;
     std::vector<int> nodeSeen(nodes.size(), 0), triangleSeen(n, 0), positionSeen(n, 0);
