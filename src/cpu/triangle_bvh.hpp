@@ -1,11 +1,13 @@
 // A bounding-volume hierarchy over triangles, in double, for the exact
 // nearest-triangle query of the point-to-surface search (design.md §11).
 //
-// Built top-down by median splits of the triangles' box centres along the
-// longest axis of their spread (leaves of at most kLeafTriangles), so the
-// tree is balanced (depth <= log2(n) + 2) whatever the input, duplicate and
-// degenerate triangles included. Each split keeps the half of smaller
-// (centre, triangle index), a strict total order, so the tree is one
+// Built top-down by median splits of the triangles' box centres (rounded
+// to float) along the longest axis of their spread (leaves of at most
+// kLeafTriangles), so the tree is balanced (depth <= log2(n) + 2) whatever
+// the input, duplicate and degenerate triangles included. Each split keeps
+// the half of smaller (centre, triangle index), a strict total order, found
+// by a histogram of the centres and a selection in the median's bin only,
+// so the tree is one
 // function of the mesh: the same nodes, boxes and triangle order on any
 // number of threads. The build runs on the worker pool: the top levels
 // level by level (the nodes of a level in parallel), then the subtrees
