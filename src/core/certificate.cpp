@@ -172,6 +172,11 @@ void applyProof(Directed& d, const DirectedProof& proof, const PointAt& query, c
     d.certificate.distance = proof.distance;
 }
 
+DirectedProof proveOnHost(const DirectionBand& band, const PointAt& query, const PointAt& target, uint64_t n,
+                          int threads) {
+    return proveDirection(band, query, target, hostBruteForce(query, target, n, threads), kHostFirstBatch);
+}
+
 void proveFromViews(HausdorffResult& r, const PointView& a, const PointView& b, int threads) {
     if (!r.proofMaterial) return;
     auto one = [threads](Directed& d, PerPoint& pp, const DirectionBand& band, const PointView& q,
@@ -179,10 +184,7 @@ void proveFromViews(HausdorffResult& r, const PointView& a, const PointView& b, 
         if (!band.present) return;
         const PointAt query = [&q](uint64_t i) { return q.at(i); };
         const PointAt target = [&t](uint64_t i) { return t.at(i); };
-        applyProof(d,
-                   proveDirection(band, query, target, hostBruteForce(query, target, t.size(), threads),
-                                  kHostFirstBatch),
-                   query, target, &pp);
+        applyProof(d, proveOnHost(band, query, target, t.size(), threads), query, target, &pp);
     };
     one(r.aToB, r.aNearest, r.proofMaterial->aToB, a, b);
     if (!r.directedOnly) one(r.bToA, r.bNearest, r.proofMaterial->bToA, b, a);

@@ -137,6 +137,12 @@ inline constexpr size_t kHostFirstBatch = 1;
 // `threads` threads (EngineOptions::threads), for proveDirection.
 [[nodiscard]] BruteForce hostBruteForce(const PointAt& query, const PointAt& target, uint64_t n, int threads);
 
+// proveDirection with the host's brute force over the n targets on
+// `threads` threads, its batches from kHostFirstBatch: what every proof on
+// the host runs (the CPU backend's, proveFromViews).
+[[nodiscard]] DirectedProof proveOnHost(const DirectionBand& band, const PointAt& query,
+                                        const PointAt& target, uint64_t n, int threads);
+
 // Each direction of `r` whose backend left a band (r.proofMaterial) proven
 // again from the caller's coordinates `a` and `b` (the band's indices are
 // theirs): the witness, value and certificate from that proof, or the
