@@ -13,9 +13,8 @@ namespace {
 // The witness alone: its nearest target in double over every target.
 bool witnessHolds(Directed& d, const PointView& q, const PointView& t, int threads) {
     const core::PointAt query = [&q](uint64_t i) { return q.at(i); };
-    const core::PointAt target = [&t](uint64_t i) { return t.at(i); };
     core::BandNearest nearest{d.queryIndex};
-    if (!core::hostBruteForce(query, target, t.size(), threads)(std::span(&nearest, 1))) return false;
+    if (!core::hostBruteForce(query, t, threads)(std::span(&nearest, 1))) return false;
     if (!(nearest.distance == d.distance)) return false;
     d.certificate = Certificate{};
     d.certificate.confirmed = true;

@@ -8,6 +8,7 @@
 
 #include "core/index_space.hpp"
 #include "core/parallel.hpp"
+#include "core/stopwatch.hpp"
 
 namespace rthdist::api {
 
@@ -94,6 +95,12 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
     const uint64_t limit[2] = {std::max<uint64_t>(limits.a, 1), std::max<uint64_t>(limits.b, 1)};
     threads = core::resolveThreads(threads, (a.size() + b.size()) / 65536 + 1);
 
+    core::Clock::time_point pass = core::Clock::now();
+    auto lap = [&pass](double& into) {
+        into = core::msSince(pass);
+        pass = core::Clock::now();
+    };
+
     // The pair's box, scaled as searched.
     glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
     for (const Span s : sets) {
@@ -120,6 +127,7 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
             out.m_magnitude = std::max(out.m_magnitude, double(partMagnitude[size_t(w)]));
         }
     }
+    lap(out.m_times.box);
     out.m_cells = cellsPerAxisFor(a.size() + b.size());
     const uint32_t cellCount = out.m_cells * out.m_cells * out.m_cells;
     for (int axis = 0; axis < 3; ++axis) {
@@ -146,6 +154,8 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
             }
         });
     }
+
+    lap(out.m_times.keys);
 
     // Cells in Morton order into pieces. A cell past a limit alone is shared:
     // its points go to `span` pieces of their own by rank in input order.
@@ -210,6 +220,8 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
             if (solid) out.m_solid[cell >> 6] |= uint64_t(1) << (cell & 63u);
         }
     });
+
+    lap(out.m_times.plan);
 
     // Each point's piece, then a stable scatter by piece.
     for (int s = 0; s < 2; ++s) {
@@ -293,6 +305,7 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         });
         key[s] = {};
     }
+    lap(out.m_times.scatter);
     return out;
 }
 

@@ -56,6 +56,12 @@ public:
     [[nodiscard]] static SpatialPieces partition(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                  double scale, PieceLimits limits, int threads);
 
+    // The partition's passes, ms (for RTHDIST_SUBMIT_TRACE's pieces line).
+    struct PassTimes {
+        double box = 0.0, keys = 0.0, plan = 0.0, scatter = 0.0;
+    };
+    [[nodiscard]] const PassTimes& passTimes() const { return m_times; }
+
     [[nodiscard]] size_t count() const { return m_pieces; }
     [[nodiscard]] const Set& set(int s) const { return s == 0 ? m_a : m_b; }
     [[nodiscard]] uint32_t cellsPerAxis() const { return m_cells; }
@@ -89,6 +95,7 @@ private:
     [[nodiscard]] uint32_t axisCell(double v, int axis) const;
 
     Set m_a, m_b;
+    PassTimes m_times;
     size_t m_pieces = 0;
     uint32_t m_cells = 1;  // per axis (a power of two)
     double m_magnitude = 0.0;

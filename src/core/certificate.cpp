@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <mutex>
 
 #include "core/parallel.hpp"
@@ -37,6 +38,53 @@ BruteForce hostBruteForce(const PointAt& query, const PointAt& target, uint64_t 
                 const glm::dvec3 p = target(t);
                 for (size_t k = 0; k < q.size(); ++k) local[k].offer(t, exactDistance(q[k], p));
             }
+            const std::lock_guard<std::mutex> lock(merge);
+            for (size_t k = 0; k < band.size(); ++k) band[k].offer(local[k].target, local[k].distance);
+        });
+        return true;
+    };
+}
+
+namespace {
+
+// One chunk [begin, end) of a view's targets against the queries `q`, into
+// `local` (one per query, fresh for the chunk): see hostBruteForce's view form.
+template <class T>
+void scanChunk(const char* base, size_t stride, size_t begin, size_t end, const std::vector<glm::dvec3>& q,
+               std::vector<BandNearest>& local) {
+    std::vector<double> best2(q.size(), std::numeric_limits<double>::infinity());
+    for (size_t t = begin; t < end; ++t) {
+        T v[3];
+        std::memcpy(v, base + t * stride, sizeof(v));
+        const glm::dvec3 p(v[0], v[1], v[2]);
+        for (size_t k = 0; k < q.size(); ++k) {
+            const glm::dvec3 d = q[k] - p;  // as exactDistance
+            const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+            if (!(d2 < best2[k])) continue;
+            local[k].offer(t, std::sqrt(d2));
+            if (local[k].target == t) best2[k] = d2;
+        }
+    }
+}
+
+}  // namespace
+
+BruteForce hostBruteForce(const PointAt& query, const PointView& targets, int threads) {
+    return [query, targets, threads](std::span<BandNearest> band) {
+        if (band.empty()) return true;
+        std::vector<glm::dvec3> q(band.size());
+        for (size_t k = 0; k < band.size(); ++k) q[k] = query(band[k].query);
+        std::mutex merge;
+        constexpr size_t kChunk = size_t(1) << 15;
+        const size_t n = targets.size();
+        const int workers = resolveThreads(threads, n / kChunk + 1);
+        const auto* base = static_cast<const char*>(targets.data);
+        parallelChunks(n, kChunk, workers, [&](size_t begin, size_t end, int) {
+            std::vector<BandNearest> local(band.size());
+            if (targets.scalar == Scalar::kFloat64)
+                scanChunk<double>(base, targets.strideBytes, begin, end, q, local);
+            else
+                scanChunk<float>(base, targets.strideBytes, begin, end, q, local);
             const std::lock_guard<std::mutex> lock(merge);
             for (size_t k = 0; k < band.size(); ++k) band[k].offer(local[k].target, local[k].distance);
         });
@@ -172,9 +220,10 @@ void applyProof(Directed& d, const DirectedProof& proof, const PointAt& query, c
     d.certificate.distance = proof.distance;
 }
 
-DirectedProof proveOnHost(const DirectionBand& band, const PointAt& query, const PointAt& target, uint64_t n,
+DirectedProof proveOnHost(const DirectionBand& band, const PointAt& query, const PointView& targets,
                           int threads) {
-    return proveDirection(band, query, target, hostBruteForce(query, target, n, threads), kHostFirstBatch);
+    const PointAt target = [&targets](uint64_t i) { return targets.at(i); };
+    return proveDirection(band, query, target, hostBruteForce(query, targets, threads), kHostFirstBatch);
 }
 
 void proveFromViews(HausdorffResult& r, const PointView& a, const PointView& b, int threads) {
@@ -184,7 +233,7 @@ void proveFromViews(HausdorffResult& r, const PointView& a, const PointView& b, 
         if (!band.present) return;
         const PointAt query = [&q](uint64_t i) { return q.at(i); };
         const PointAt target = [&t](uint64_t i) { return t.at(i); };
-        applyProof(d, proveOnHost(band, query, target, t.size(), threads), query, target, &pp);
+        applyProof(d, proveOnHost(band, query, t, threads), query, target, &pp);
     };
     one(r.aToB, r.aNearest, r.proofMaterial->aToB, a, b);
     if (!r.directedOnly) one(r.bToA, r.bNearest, r.proofMaterial->bToA, b, a);

@@ -136,12 +136,19 @@ inline constexpr size_t kHostFirstBatch = 1;
 // A host brute force over `targets` (n points, coordinates by `target`) on
 // `threads` threads (EngineOptions::threads), for proveDirection.
 [[nodiscard]] BruteForce hostBruteForce(const PointAt& query, const PointAt& target, uint64_t n, int threads);
+// The same answer over the points of a view, read where they lie: each
+// pair's squared distance is compared with the chunk's nearest so far and
+// its square root taken only when it is smaller (the root is monotone and a
+// chunk is scanned in rising index order, so a pair skipped could neither be
+// nearer nor win a tie). ~1 ns a target and query on one core where the
+// PointAt form costs several: at 1B targets a pass is what the proof costs.
+[[nodiscard]] BruteForce hostBruteForce(const PointAt& query, const PointView& targets, int threads);
 
-// proveDirection with the host's brute force over the n targets on
+// proveDirection with the host's brute force over the view's targets on
 // `threads` threads, its batches from kHostFirstBatch: what every proof on
 // the host runs (the CPU backend's, proveFromViews).
 [[nodiscard]] DirectedProof proveOnHost(const DirectionBand& band, const PointAt& query,
-                                        const PointAt& target, uint64_t n, int threads);
+                                        const PointView& targets, int threads);
 
 // Each direction of `r` whose backend left a band (r.proofMaterial) proven
 // again from the caller's coordinates `a` and `b` (the band's indices are

@@ -535,7 +535,7 @@ void proveDirection(const Direction& d, DirectedOutput& out, PerPoint* perPoint 
     const auto start = Clock::now();
     const core::PointAt query = [&d](uint64_t i) { return glm::dvec3(d.queries[i]); };
     const core::PointAt target = [&d](uint64_t i) { return glm::dvec3(d.targets[i]); };
-    const core::DirectedProof proof = core::proveOnHost(out.band, query, target, d.targets.size(), d.threads);
+    const core::DirectedProof proof = core::proveOnHost(out.band, query, PointView(d.targets), d.threads);
     core::applyProof(out.directed, proof, query, target, perPoint);
     if (!proof.proven) out.band.failure = proof.failure;
     out.certificateMs = msSince(start);

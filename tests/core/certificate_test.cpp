@@ -158,4 +158,46 @@ TEST(ProveDirection, AMaximumNoQueryReachesFailsTheProof) {
 }
 
 }  // namespace
+// The view form of the host brute force (it skips the square root of a pair
+// no nearer than the chunk's best) answers as the PointAt form on float and
+// double views with a stride, ties included: targets on a coarse grid put
+// many at the same distance from a grid query, and the smaller index wins.
+TEST(HostBruteForce, TheViewFormAnswersAsThePointAtFormTiesIncluded) {
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<int> cell(-4, 4);
+    const size_t n = 100000;      // several chunks of the parallel scan
+    std::vector<float> packed;    // x, y, z, padding: a 16-byte stride
+    std::vector<double> doubles;  // x, y, z
+    std::vector<glm::dvec3> points;
+    for (size_t i = 0; i < n; ++i) {
+        const glm::dvec3 p(cell(rng) * 0.25, cell(rng) * 0.25, cell(rng) * 0.25);
+        points.push_back(p);
+        packed.insert(packed.end(), {float(p.x), float(p.y), float(p.z), 0.0f});
+        doubles.insert(doubles.end(), {p.x, p.y, p.z});
+    }
+    const std::vector<glm::dvec3> queries = {
+        {0.0, 0.0, 0.0}, {0.125, 0.125, 0.0}, {3.0, -2.0, 1.0}, {0.1, 0.2, 0.3}, {-1.0, -1.0, -1.0}};
+    const PointAt query = [&queries](uint64_t i) { return queries[i]; };
+    const PointAt target = [&points](uint64_t i) { return points[i]; };
+    auto run = [&](const BruteForce& bf) {
+        std::vector<BandNearest> band(queries.size());
+        for (size_t k = 0; k < band.size(); ++k) band[k].query = k;
+        EXPECT_TRUE(bf(band));
+        return band;
+    };
+    const std::vector<BandNearest> want = run(hostBruteForce(query, target, n, 3));
+    for (const PointView& view :
+         {PointView::floats(packed.data(), n, 16), PointView::doubles(doubles.data(), n)}) {
+        const std::vector<BandNearest> got = run(hostBruteForce(query, view, 3));
+        for (size_t k = 0; k < queries.size(); ++k) {
+            EXPECT_EQ(got[k].target, want[k].target) << "query " << k;
+            EXPECT_EQ(got[k].distance, want[k].distance) << "query " << k;
+        }
+    }
+    // A tie really is decided by index here: the origin's nearest is one of many at distance 0.
+    EXPECT_EQ(want[0].distance, 0.0);
+    EXPECT_EQ(want[0].target,
+              size_t(std::find(points.begin(), points.end(), glm::dvec3(0.0)) - points.begin()));
+}
+
 }  // namespace rthdist::core
