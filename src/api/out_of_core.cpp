@@ -458,66 +458,11 @@ struct RoundFailure {
     }
 };
 
-// A piece's call result whose verdicts (settlePiece) run on a thread of
-// their own while the lane's next call runs: the host's pass over a piece's
-// queries overlaps the device's work on the next piece. Its per-point arrays
-// go back to the lane (RecycleCall) from the lane's thread, after the join,
-// never while a call of the lane runs.
-class SettleBeside {
-public:
-    SettleBeside() = default;
-    SettleBeside(const SettleBeside&) = delete;
-    SettleBeside& operator=(const SettleBeside&) = delete;
-    ~SettleBeside() { join(); }
-
-    // Starts piece k's verdicts from `r` (the call's result).
-    void start(HausdorffResult&& r, size_t k, const SpatialPieces& pieces, SpaceDirection* const dirs[2],
-               double scale, const Lane& lane, HostClock& host) {
-        m_result = std::move(r);
-        m_k = k;
-        m_thread = std::thread([this, &pieces, dirs, scale, &lane, &host] {
-            const core::Clock::time_point start = core::Clock::now();
-            try {
-                const bool both = dirs[0] != nullptr && dirs[1] != nullptr;
-                SpaceDirection& first = dirs[0] != nullptr ? *dirs[0] : *dirs[1];
-                addCallTo(first.shared, m_result.aToB.counters, &m_result.timings);
-                settlePiece(first, pieces, m_k, m_result.aNearest, scale, lane.threads);
-                if (both) {
-                    addCallTo(dirs[1]->shared, m_result.bToA.counters, nullptr);
-                    settlePiece(*dirs[1], pieces, m_k, m_result.bNearest, scale, lane.threads);
-                }
-            } catch (const std::bad_alloc&) {
-                m_outOfMemory = true;
-            }
-            host.add(start, HostClock::kRoundOne);
-        });
-    }
-
-    // Waits for the verdicts running (if any) and gives their arrays back;
-    // an error when they ran out of host memory.
-    std::optional<Error> finish(const Lane& lane) {
-        if (!m_thread.joinable()) return std::nullopt;
-        join();
-        lane.giveBack(std::move(m_result.aNearest), std::move(m_result.bNearest));
-        m_result = HausdorffResult{};
-        if (!m_outOfMemory) return std::nullopt;
-        return Error{ErrorCode::kOutOfMemory, "out of host memory in piece " + std::to_string(m_k) +
-                                                  " (device lane " + std::to_string(lane.index) + ")"};
-    }
-
-private:
-    void join() {
-        if (m_thread.joinable()) m_thread.join();
-    }
-    std::thread m_thread;
-    HausdorffResult m_result;
-    size_t m_k = 0;
-    bool m_outOfMemory = false;
-};
-
 // Round one: every piece's queries against the same piece's targets, both
-// directions in one call where both are in pieces (`dirs` null where not);
-// each call's verdicts beside the lane's next call (SettleBeside).
+// directions in one call where both are in pieces (`dirs` null where not).
+// (The verdicts were tried on a thread of their own beside the lane's next
+// call: on the H200 machine the call's upload then took as long as the
+// verdicts saved, both bound by the host's memory.)
 void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double scale,
               const CallOptions& call, const Lane& lane, std::atomic<size_t>& next, RoundFailure& failure,
               HostClock& host, double from, double width) {
@@ -525,10 +470,9 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double
     const int qset = dirs[0] != nullptr ? 0 : 1;
     const SpatialPieces::Set& qs = pieces.set(qset);
     const SpatialPieces::Set& ts = pieces.set(1 - qset);
-    SettleBeside beside;
     for (;;) {
         const size_t k = next.fetch_add(1);
-        if (k >= pieces.count() || failure.failed.load()) break;
+        if (k >= pieces.count() || failure.failed.load()) return;
         try {
             if (qs.size(k) == 0 || ts.size(k) == 0) {  // its queries go to other pieces in round two
                 openAll(*dirs[qset], pieces, k);
@@ -539,23 +483,27 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double
                                              width / double(pieces.count()));
             piece.directedOnly = !both;
             Result<HausdorffResult> r = lane.call(qs.piece(k), ts.piece(k), piece);
-            if (std::optional<Error> err = beside.finish(lane)) {
-                failure.set(*err);
-                break;
-            }
             if (!r) {
                 failure.set(r.error());
-                break;
+                return;
             }
-            beside.start(std::move(*r), k, pieces, dirs, scale, lane, host);
+            const core::Clock::time_point start = core::Clock::now();
+            SpaceDirection& first = *dirs[qset];
+            addCallTo(first.shared, r->aToB.counters, &r->timings);
+            settlePiece(first, pieces, k, r->aNearest, scale, lane.threads);
+            if (both) {
+                addCallTo(dirs[1]->shared, r->bToA.counters, nullptr);
+                settlePiece(*dirs[1], pieces, k, r->bNearest, scale, lane.threads);
+            }
+            lane.giveBack(std::move(r->aNearest), std::move(r->bNearest));
+            host.add(start, HostClock::kRoundOne);
         } catch (const std::bad_alloc&) {
             failure.set(Error{ErrorCode::kOutOfMemory, "out of host memory in piece " + std::to_string(k) +
                                                            " (device lane " + std::to_string(lane.index) +
                                                            ")"});
-            break;
+            return;
         }
     }
-    if (std::optional<Error> err = beside.finish(lane)) failure.set(*err);
 }
 
 // The target pieces as tiles of round two: each piece's box, scaled as searched.
