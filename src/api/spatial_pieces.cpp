@@ -61,9 +61,12 @@ PieceRanks pieceRanks(uint64_t m, uint64_t span, uint64_t total) {
 // (v - lo) * inverse side: a monotone function of v (as is each rounding),
 // the same for points and boxes; clamped to the grid.
 uint32_t SpatialPieces::axisCell(double v, int axis) const {
-    const double c = (v - m_lo[axis]) * m_inverse[axis];
-    if (!(c > 0.0)) return 0;
-    if (c >= double(m_cells)) return m_cells - 1;
+    // Clamped without branches (NaN to 0, as `c > 0` is false for it), so
+    // that the keys' pass vectorizes: the same cells as before for every v.
+    double c = (v - m_lo[axis]) * m_inverse[axis];
+    c = c > 0.0 ? c : 0.0;
+    const double top = double(m_cells - 1);
+    c = c < top ? c : top;
     return uint32_t(c);
 }
 
@@ -147,10 +150,15 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         counts[s].assign(size_t(ranges[s].count), std::vector<uint32_t>(cellCount, 0u));
         forRanges(ranges[s], [&](int t, size_t begin, size_t end) {
             std::vector<uint32_t>& mine = counts[s][size_t(t)];
-            for (size_t i = begin; i < end; ++i) {
-                const uint32_t c = out.cellOf(glm::dvec3(core::scaled(points[i], scale)));
-                key[s][i] = c;
-                ++mine[c];
+            uint32_t* keys = key[s].data();
+            // In runs: the keys first (a loop without branches or stores
+            // that alias, which the compiler vectorizes), then their counts.
+            constexpr size_t kRun = 1024;
+            for (size_t r0 = begin; r0 < end; r0 += kRun) {
+                const size_t r1 = std::min(end, r0 + kRun);
+                for (size_t i = r0; i < r1; ++i)
+                    keys[i] = out.cellOf(glm::dvec3(core::scaled(points[i], scale)));
+                for (size_t i = r0; i < r1; ++i) ++mine[keys[i]];
             }
         });
     }
@@ -243,14 +251,14 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         // A point's piece from its cell (and, in a shared cell, its rank
         // there in input order: the ranges run in order, so the scatter
         // below finds the same pieces with a fresh copy of the bases).
+        // The owner table answers for every cell but a shared one (one
+        // lookup a point, not two).
         auto pieceOf = [&](uint32_t cell, std::vector<uint64_t>& rank) {
-            uint32_t piece = firstPiece[cell];
-            if (span[cell] > 1) {
-                const auto j = size_t(std::lower_bound(sharedCells.begin(), sharedCells.end(), cell) -
-                                      sharedCells.begin());
-                piece += pieceOfRank(rank[j]++, span[cell], total[s][cell]);
-            }
-            return piece;
+            const uint32_t owner = out.m_owner[cell];
+            if (owner != kShared) return owner;
+            const auto j =
+                size_t(std::lower_bound(sharedCells.begin(), sharedCells.end(), cell) - sharedCells.begin());
+            return firstPiece[cell] + pieceOfRank(rank[j]++, span[cell], total[s][cell]);
         };
         // Each range's count of every piece, from its counts of the cells: a
         // cell's points go to its piece, a shared cell's ranks [base, base +
