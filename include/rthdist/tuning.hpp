@@ -47,6 +47,12 @@ struct Tuning {
     // host thread); past it they descend the tail's tree on the device (0:
     // always the tree). RTHDIST_SURFACE_HOST_WORK.
     std::optional<uint64_t> surfaceHostWork;
+    // Point to surface on a GPU backend: true, every query descends the
+    // tail's tree from none in one submission (no radii, no BLAS); false,
+    // the radii first; unset, the radii unless the triangles are at most
+    // 4,096 or the queries at most 1,024 (gpu_algo::descendOnly).
+    // RTHDIST_SURFACE_DESCEND=0|1.
+    std::optional<bool> surfaceDescend;
     // Read host arrays in place (VK_EXT_external_memory_host) instead of
     // copying them: off by default, on the H200 pinning cost more than the
     // copy it saves (docs/bench/prepared). RTHDIST_HOST_IMPORT=1.

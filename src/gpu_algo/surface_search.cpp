@@ -70,6 +70,10 @@ uint64_t surfaceHostWork(const Tuning& tuning, int threads) {
                                            uint64_t(core::resolveThreads(threads)));
 }
 
+bool descendOnly(const Tuning& tuning, uint64_t queries, uint64_t triangles) {
+    return tuning.surfaceDescend.value_or(triangles <= kDescendTriangles || queries <= kDescendQueries);
+}
+
 bool openQueriesToHost(uint64_t open, uint64_t triangles, uint64_t hostWork) {
     return open > 0 && triangles > 0 && open <= hostWork / triangles;
 }
@@ -91,6 +95,15 @@ struct SurfaceSearch::Stats {
     }
 };
 
+// The tail's tree of one call (tailTree): kept from the call before, or built.
+struct SurfaceSearch::TailTree {
+    bool kept = false;
+    uint64_t fingerprint = 0;
+    SurfaceTree tree;  // empty where kept
+    VkDeviceSize nodeBytes = 0, orderBytes = 0;
+    [[nodiscard]] VkDeviceSize bytes() const { return nodeBytes + orderBytes; }
+};
+
 SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners,
                                      const std::atomic<bool>* cancel) {
     if (corners.empty() || corners.size() % 3 != 0 || corners.size() / 3 >= kMaxTriangles)
@@ -105,6 +118,40 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     m_ws.pipelines.prepareSurfaceSearch(m_ws.pipelineCache.handle());
 
     SurfaceCandidates out;
+    if (descendOnly(m_ws.tuning, m_queries, m_triangles)) {
+        // The tree first, so that the upload buffer holds the inputs and it
+        // for one submission: the upload, every query's descent from none.
+        auto t0 = Clock::now();
+        const TailTree tree = tailTree(corners, out);
+        const Stats stats = stage(queries, corners, tree.bytes());
+        stageTail(tree, inputBytes());
+        out.firstRadius = SurfaceRadii(stats.sides / double(m_triangles), stats.area, m_queries,
+                                       glm::length(glm::dvec3(stats.box.hi) - glm::dvec3(stats.box.lo)))
+                              .first();
+        out.stageMs = msSince(t0) - out.tailBuildMs;
+        t0 = Clock::now();
+        std::fill_n(static_cast<uint32_t*>(m_counts.mapped()), 2 * SurfaceRadii::kStartRadii + 1, 0u);
+        VkCommandBuffer cmd = m_ws.ctx.begin();
+        cmdUpload(cmd);
+        cmdTail(cmd, tree, inputBytes(), 0.0);
+        cmdReadBack(cmd);
+        m_ws.ctx.submitAndWait(cmd);
+        finishTail(tree, out);
+        if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
+        out.submitMs = msSince(t0) + out.tailBuildMs;  // the tree's build is part of it, as after the radii
+        t0 = Clock::now();
+        const auto* packed = static_cast<const uint64_t*>(m_readback.mapped());
+        out.triangle.resize(m_queries);
+        core::parallelChunks(m_queries, core::balancedChunk(m_queries, m_ws.threads), m_ws.threads,
+                             [&](size_t begin, size_t end, int) {
+                                 for (size_t q = begin; q < end; ++q) {
+                                     const auto t = uint32_t(packed[q] & 0xffffffffu);
+                                     out.triangle[q] = t < m_triangles ? t : UINT32_MAX;
+                                 }
+                             });
+        out.readbackMs = msSince(t0);
+        return out;
+    }
     auto t0 = Clock::now();
     const Stats stats = stage(queries, corners);
     const SurfaceRadii radii(stats.sides / double(m_triangles), stats.area, m_queries,
@@ -171,13 +218,17 @@ void SurfaceSearch::release() {
     m_treeTriangles = 0;
 }
 
+VkDeviceSize SurfaceSearch::inputBytes() const {
+    return VkDeviceSize(m_queries) * 16 + VkDeviceSize(m_triangles) * (48 + sizeof(sh::Cell));
+}
+
 SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
-                                          std::span<const glm::vec3> corners) {
+                                          std::span<const glm::vec3> corners, VkDeviceSize extra) {
     const VkDeviceSize pointBytes = VkDeviceSize(m_queries) * 16;
     const VkDeviceSize cornerBytes = VkDeviceSize(m_triangles) * 48;
     const VkDeviceSize boxBytes = VkDeviceSize(m_triangles) * sizeof(sh::Cell);
     gpu::Buffer& staging =
-        m_ws.grow(m_staging, pointBytes + cornerBytes + boxBytes, "surface.staging", gpu::MemoryKind::kHost);
+        m_ws.grow(m_staging, inputBytes() + extra, "surface.staging", gpu::MemoryKind::kHost);
     m_ws.grow(m_points, pointBytes, "surface.queries");
     m_ws.grow(m_corners, cornerBytes, "surface.corners");
     m_ws.grow(m_boxes, boxBytes, "surface.boxes");
@@ -287,68 +338,83 @@ void SurfaceSearch::cmdReadBack(VkCommandBuffer cmd) {
                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
 }
 
-void SurfaceSearch::submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out) {
-    // The tree of the call before where the corners are the same; else
-    // built and written to the upload buffer (the radii's submission has
-    // finished with what it held): nodes, then the order.
-    const uint64_t fingerprint = fingerprintOf(corners, m_ws.threads);
-    const bool kept = m_treeTriangles == m_triangles && m_treeFingerprint == fingerprint;
-    VkDeviceSize nodeBytes = 0, orderBytes = 0;
-    if (!kept) {
-        auto t0 = Clock::now();
-        m_treeTriangles = 0;  // m_nodes and m_order hold no tree until the submission below is done
-        const SurfaceTree tree = buildSurfaceTree(corners, m_ws.threads);
-        nodeBytes = VkDeviceSize(tree.nodes.size()) * sizeof(sh::Cell);
-        orderBytes = VkDeviceSize(tree.order.size()) * sizeof(uint32_t);
-        gpu::Buffer& staging =
-            m_ws.grow(m_staging, nodeBytes + orderBytes, "surface.staging", gpu::MemoryKind::kHost);
-        m_ws.grow(m_nodes, nodeBytes, "surface.nodes");
-        m_ws.grow(m_order, orderBytes, "surface.order");
-        auto* bytes = static_cast<char*>(staging.mapped());
-        std::memcpy(bytes, tree.nodes.data(), nodeBytes);
-        std::memcpy(bytes + nodeBytes, tree.order.data(), orderBytes);
-        out.tailBuildMs = msSince(t0);
-    }
-    out.tailTreeReused = kept;
+SurfaceSearch::TailTree SurfaceSearch::tailTree(std::span<const glm::vec3> corners, SurfaceCandidates& out) {
+    TailTree t;
+    t.fingerprint = fingerprintOf(corners, m_ws.threads);
+    t.kept = m_treeTriangles == m_triangles && m_treeFingerprint == t.fingerprint;
+    out.tailTreeReused = t.kept;
+    if (t.kept) return t;
+    const auto t0 = Clock::now();
+    m_treeTriangles = 0;  // m_nodes and m_order hold no tree until the tail's submission is done
+    t.tree = buildSurfaceTree(corners, m_ws.threads);
+    t.nodeBytes = VkDeviceSize(t.tree.nodes.size()) * sizeof(sh::Cell);
+    t.orderBytes = VkDeviceSize(t.tree.order.size()) * sizeof(uint32_t);
+    m_ws.grow(m_nodes, t.nodeBytes, "surface.nodes");
+    m_ws.grow(m_order, t.orderBytes, "surface.order");
+    out.tailBuildMs = msSince(t0);
+    return t;
+}
 
-    VkCommandBuffer cmd = m_ws.ctx.begin();
-    {
-        const gpu::ScopedLabel label(m_ws.ctx, cmd, "surface tail");
-        if (!kept) {
-            const VkBufferCopy toNodes{0, 0, nodeBytes};
-            const VkBufferCopy toOrder{nodeBytes, 0, orderBytes};
-            vkCmdCopyBuffer(cmd, m_staging.handle(), m_nodes.handle(), 1, &toNodes);
-            vkCmdCopyBuffer(cmd, m_staging.handle(), m_order.handle(), 1, &toOrder);
-            // (A kept tree's copies were made visible to compute reads by
-            // this barrier in the submission that made them.)
-            gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                             VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                             VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-        }
-        sh::SurfaceTailPush tp{};
-        tp.queries = m_points.address();
-        tp.corners = m_corners.address();
-        tp.best = m_best.address();
-        tp.nodes = m_nodes.address();
-        tp.order = m_order.address();
-        tp.counts = m_counts.address() + SurfaceRadii::kStartRadii * sizeof(sh::SurfaceRadiusCount);
-        tp.numQueries = m_queries;
-        // The radii's settle2 of the last radius: the queries open after it.
-        tp.settled2 = std::nextafter(float(settled * settled), 0.0f);
-        tp.mutant = m_ws.mutant ? 1u : 0u;
-        m_ws.dispatch(cmd, Kernel::kSurfaceTail, tp, m_queries);
+void SurfaceSearch::stageTail(const TailTree& tree, VkDeviceSize at) {
+    if (tree.kept) return;
+    gpu::Buffer& staging =
+        at == 0 ? m_ws.grow(m_staging, tree.bytes(), "surface.staging", gpu::MemoryKind::kHost) : m_staging;
+    if (staging.size() < at + tree.bytes())
+        throw std::logic_error("the upload buffer holds no room for the tree");
+    auto* bytes = static_cast<char*>(staging.mapped()) + at;
+    std::memcpy(bytes, tree.tree.nodes.data(), tree.nodeBytes);
+    std::memcpy(bytes + tree.nodeBytes, tree.tree.order.data(), tree.orderBytes);
+}
+
+void SurfaceSearch::cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceSize at, double settled) {
+    const gpu::ScopedLabel label(m_ws.ctx, cmd, "surface tail");
+    if (!tree.kept) {
+        const VkBufferCopy toNodes{at, 0, tree.nodeBytes};
+        const VkBufferCopy toOrder{at + tree.nodeBytes, 0, tree.orderBytes};
+        vkCmdCopyBuffer(cmd, m_staging.handle(), m_nodes.handle(), 1, &toNodes);
+        vkCmdCopyBuffer(cmd, m_staging.handle(), m_order.handle(), 1, &toOrder);
+        // (A kept tree's copies were made visible to compute reads by
+        // this barrier in the submission that made them.)
+        gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     }
-    cmdReadBack(cmd);
-    m_ws.ctx.submitAndWait(cmd);
-    if (!kept) {
+    sh::SurfaceTailPush tp{};
+    tp.queries = m_points.address();
+    tp.corners = m_corners.address();
+    tp.best = m_best.address();
+    tp.nodes = m_nodes.address();
+    tp.order = m_order.address();
+    tp.counts = m_counts.address() + SurfaceRadii::kStartRadii * sizeof(sh::SurfaceRadiusCount);
+    tp.numQueries = m_queries;
+    // The radii's settle2 of the last radius: the queries open after it
+    // (settled 0: every query, a best of none compares false).
+    tp.settled2 = std::nextafter(float(settled * settled), 0.0f);
+    tp.mutant = m_ws.mutant ? 1u : 0u;
+    m_ws.dispatch(cmd, Kernel::kSurfaceTail, tp, m_queries);
+}
+
+void SurfaceSearch::finishTail(const TailTree& tree, SurfaceCandidates& out) {
+    if (!tree.kept) {
         m_treeTriangles = m_triangles;
-        m_treeFingerprint = fingerprint;
+        m_treeFingerprint = tree.fingerprint;
     }
     ++out.submissions;
     out.tailGpuMs = m_ws.ctx.lastGpuMs();
     out.gpuMs += out.tailGpuMs;
     out.tailQueries = static_cast<const uint32_t*>(
         m_counts.mapped())[SurfaceRadii::kStartRadii * sizeof(sh::SurfaceRadiusCount) / sizeof(uint32_t)];
+}
+
+void SurfaceSearch::submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out) {
+    // (The radii's submission has finished with what the upload buffer held.)
+    const TailTree tree = tailTree(corners, out);
+    stageTail(tree, 0);
+    VkCommandBuffer cmd = m_ws.ctx.begin();
+    cmdTail(cmd, tree, 0, settled);
+    cmdReadBack(cmd);
+    m_ws.ctx.submitAndWait(cmd);
+    finishTail(tree, out);
 }
 
 uint32_t SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update,

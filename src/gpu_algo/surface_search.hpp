@@ -94,6 +94,20 @@ inline constexpr uint64_t kSurfaceHostWorkPerThread = uint64_t(1) << 19;
 // True when `open` queries of `triangles` go to the host under `hostWork`.
 [[nodiscard]] bool openQueriesToHost(uint64_t open, uint64_t triangles, uint64_t hostWork);
 
+// Where a call skips the radii and every query descends the tail's tree
+// from none (host only; tests/gpu_algo/surface_radii_test.cpp): a few
+// triangles (at most kDescendTriangles: the radii's BLAS builds, refit and
+// TLAS builds cost more than the tree's build and descent; on the H200
+// they were 0.29 ms of bunny>res4's 0.60 ms of device time for 948
+// triangles, session 8), or a few queries (at most kDescendQueries: that
+// many rays, each in ~100 grown boxes of a fine mesh, keep the GPU nearly
+// idle; bunny-res4>bunny's 453 took 3.2 ms of rays). The descent ends with
+// what a visit of every triangle would give, as after the radii.
+inline constexpr uint64_t kDescendTriangles = 4096;
+inline constexpr uint64_t kDescendQueries = 1024;
+// Tuning::surfaceDescend decides where it is set.
+[[nodiscard]] bool descendOnly(const Tuning& tuning, uint64_t queries, uint64_t triangles);
+
 // The radii of one search (host only; tests/gpu_algo/surface_radii_test.cpp).
 // None decides a value (the host proves it); they set how many queries the
 // radii settle and how many the tail's tree descent is left with.
@@ -133,7 +147,8 @@ public:
     // triangle in the same frame (3 per triangle). Fewer than 2^30
     // triangles and 2^32 queries; a BLAS past the device's
     // maxPrimitiveCount throws gpu::LimitError. One submission of the
-    // radii, then one of the tail where a query is open. `cancel` is read
+    // radii, then one of the tail where a query is open; where descendOnly,
+    // one submission of the upload and the tail for every query. `cancel` is read
     // after each (true: throws CallCancelled). Vulkan failures throw.
     [[nodiscard]] SurfaceCandidates run(std::span<const glm::vec3> queries,
                                         std::span<const glm::vec3> corners,
@@ -146,7 +161,11 @@ private:
     // The queries, corners and the triangles' tight boxes (search cells of
     // one triangle each) written to the upload buffer on the worker pool,
     // with the statistics of the radii; the device buffers grown.
-    Stats stage(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners);
+    // `extra`: bytes of the upload buffer kept after the inputs (the tail's
+    // tree, where descendOnly); the inputs' bytes are inputBytes().
+    Stats stage(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners,
+                VkDeviceSize extra = 0);
+    [[nodiscard]] VkDeviceSize inputBytes() const;
     // The upload buffer's copies and every query's best set to none.
     void cmdUpload(VkCommandBuffer cmd);
     // One submission: its radii (each: grown boxes, BLAS build or refit,
@@ -158,11 +177,22 @@ private:
     // the timestamp mark after the builds (the stage split of gpuBuildMs).
     uint32_t cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update,
                        VkDeviceAddress counts);
+    // The tail's tree for this call's corners: the one kept from the call
+    // before where the corners are the same (their count and fingerprint),
+    // else built on the host (its device buffers grown).
+    struct TailTree;
+    TailTree tailTree(std::span<const glm::vec3> corners, SurfaceCandidates& out);
+    // A built tree written to the upload buffer at byte `at` (grown when
+    // `at` is 0; else stage() kept the room).
+    void stageTail(const TailTree& tree, VkDeviceSize at);
+    // The tree's copies from the upload buffer (a built one) and the
+    // descent of every query whose best is farther than `settled`.
+    void cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceSize at, double settled);
+    // After the tail's submission: the tree kept, the tail's counts.
+    void finishTail(const TailTree& tree, SurfaceCandidates& out);
     // The tail's submission for the queries the radii left open (their best
-    // farther than `settled`): the tree built on the host and uploaded
-    // (unless the one kept from the call before is of the same corners:
-    // their count and fingerprint), the descent, every query's best copied
-    // for the host.
+    // farther than `settled`): tailTree, the descent, every query's best
+    // copied for the host.
     void submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out);
     // Every query's best copied to the read-back buffer for the host.
     void cmdReadBack(VkCommandBuffer cmd);

@@ -24,7 +24,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -38,6 +40,7 @@
 #include "gpu_algo/gpu_context_support.hpp"
 #include "gpu_algo/gpu_hausdorff.hpp"
 #include "gpu_algo/gpu_test_support.hpp"
+#include "gpu_algo/surface_search.hpp"
 #include "rthdist/surface.hpp"
 
 namespace rthdist {
@@ -65,8 +68,23 @@ Result<SurfaceResult> onDevice(const test::SurfaceCase& c, Backend backend) {
 
 MeshView meshOf(const test::SurfaceCase& c) { return MeshView{PointView(c.vertices), c.indices}; }
 
+// This binary's cases test the radii (RTHDIST_SURFACE_DESCEND=0 for every
+// call that reads the environment); the descent of every query without
+// them has its own suite (GpuSurfaceDescend), on engines tuned for it.
+class RadiiFirst : public ::testing::Environment {
+public:
+    void SetUp() override { setenv("RTHDIST_SURFACE_DESCEND", "0", 1); }
+};
+[[maybe_unused]] ::testing::Environment* const kRadiiFirst =
+    ::testing::AddGlobalTestEnvironment(new RadiiFirst);
+
+// How a call searched: the radii first (then the tail or the host for the
+// queries they leave open), or every query down the tail's tree.
+enum class Path { kRadii, kDescend };
+
 // r (of case c on `backend`) against the brute force over every triangle.
-void expectBruteForce(const test::SurfaceCase& c, Backend backend, const Result<SurfaceResult>& r) {
+void expectBruteForce(const test::SurfaceCase& c, Backend backend, const Result<SurfaceResult>& r,
+                      Path path = Path::kRadii) {
     std::printf("%s: seed %llu, %zu triangles, %zu queries\n", c.name.c_str(),
                 static_cast<unsigned long long>(c.seed), c.indices.size() / 3, c.queries.size());
     const oracle::SurfaceDirectedExact want = oracle::bruteForceSurface(c.queries, c.vertices, c.indices);
@@ -82,13 +100,24 @@ void expectBruteForce(const test::SurfaceCase& c, Backend backend, const Result<
     const SurfaceCounters& n = r->directed.counters;
     EXPECT_EQ(n.queries, c.queries.size()) << c.name;
     EXPECT_EQ(n.triangles, c.indices.size() / 3) << c.name;
-    // The device searched: at least one radius, a ray per query at the first,
-    // one submission per radius at most (the first holds the upload too).
-    EXPECT_GE(n.radii, 1u) << c.name;
-    EXPECT_GE(n.rays, c.queries.size()) << c.name;
-    // One submission for the radii, one more for the tail where it ran;
-    // the open queries go one way, the tree or the host, not both.
-    EXPECT_EQ(n.submissions, n.tailQueries > 0 ? 2u : 1u) << c.name;
+    if (path == Path::kDescend) {
+        // One submission (the upload and the descent), every query down
+        // the tree, no radius, no ray, nothing for the host's tail.
+        EXPECT_EQ(n.radii, 0u) << c.name;
+        EXPECT_EQ(n.rays, 0u) << c.name;
+        EXPECT_EQ(n.submissions, 1u) << c.name;
+        EXPECT_EQ(n.tailQueries, c.queries.size()) << c.name;
+        EXPECT_EQ(n.tailHostQueries, 0u) << c.name;
+    } else {
+        // The device searched: at least one radius, a ray per query at the
+        // first, one submission per radius at most (the first holds the
+        // upload too).
+        EXPECT_GE(n.radii, 1u) << c.name;
+        EXPECT_GE(n.rays, c.queries.size()) << c.name;
+        // One submission for the radii, one more for the tail where it ran;
+        // the open queries go one way, the tree or the host, not both.
+        EXPECT_EQ(n.submissions, n.tailQueries > 0 ? 2u : 1u) << c.name;
+    }
     EXPECT_LE(n.tailQueries, c.queries.size()) << c.name;
     EXPECT_LE(n.tailHostQueries, c.queries.size()) << c.name;
     EXPECT_FALSE(n.tailQueries > 0 && n.tailHostQueries > 0) << c.name;
@@ -803,4 +832,79 @@ TEST(GpuSurfaceHost, OpenQueriesAreMeasuredExactlyOnTheHost) {
 }
 
 }  // namespace
+// ---- Every query down the tail's tree (Tuning::surfaceDescend) ----------
+
+Result<Engine> descendEngine(Backend backend, std::optional<bool> descend) {
+    EngineOptions o;
+    o.backend = backend;
+    o.validation = true;
+    o.tuning = *test::gpuOptions().tuning;
+    o.tuning->surfaceDescend = descend;
+    return Engine::create(o);
+}
+
+// Forced: every case's value, witness and nearest triangle are the brute
+// force's, from one submission without radii.
+TEST(GpuSurfaceDescend, EveryCaseMatchesTheBruteForce) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    Result<Engine> engine = descendEngine(backend, true);
+    ASSERT_TRUE(engine) << engine.error().message;
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        expectBruteForce(c, backend, engine->hausdorffToSurface(PointView(c.queries), meshOf(c)),
+                         Path::kDescend);
+    }
+}
+
+// The rule (surfaceDescend unset): a mesh of at most 4,096 triangles, or at
+// most 1,024 queries, descends; more of both takes the radii. The same
+// values either way.
+TEST(GpuSurfaceDescend, TheRuleDescendsForFewTrianglesOrFewQueries) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    Result<Engine> engine = descendEngine(backend, std::nullopt);
+    ASSERT_TRUE(engine) << engine.error().message;
+    auto withQueries = [](test::SurfaceCase c, int queries) {
+        for (int i = 0; i < queries; ++i) {
+            const double u = double(i % 40) / 40.0, v = double(i / 40 % 40) / 40.0;
+            c.queries.emplace_back(0.3 + 9.4 * u, 0.3 + 9.4 * v, (i % 7) * 0.5 - 1.5 + 1e-3 * (i / 1600));
+        }
+        return c;
+    };
+    const test::SurfaceCase small = withQueries(test::heightField(71, 20, 10.0), 2000);  // 800 triangles
+    const test::SurfaceCase fine = withQueries(test::heightField(72, 50, 10.0), 2000);   // 5,000 triangles
+    const test::SurfaceCase sparse = withQueries(test::heightField(73, 50, 10.0), 600);  // 600 queries
+    ASSERT_LE(small.indices.size() / 3, gpu_algo::kDescendTriangles);
+    ASSERT_GT(fine.indices.size() / 3, gpu_algo::kDescendTriangles);
+    expectBruteForce(small, backend, engine->hausdorffToSurface(PointView(small.queries), meshOf(small)),
+                     Path::kDescend);
+    expectBruteForce(fine, backend, engine->hausdorffToSurface(PointView(fine.queries), meshOf(fine)),
+                     Path::kRadii);
+    expectBruteForce(sparse, backend, engine->hausdorffToSurface(PointView(sparse.queries), meshOf(sparse)),
+                     Path::kDescend);
+}
+
+// A kept engine descends the tree of the call before where the corners are
+// the same, and builds it again where they are not.
+TEST(GpuSurfaceDescend, AKeptEngineReusesTheTreeOnlyForTheSameCorners) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    Result<Engine> engine = descendEngine(backend, true);
+    ASSERT_TRUE(engine) << engine.error().message;
+    const test::SurfaceCase same = apiCase(tailCases().front());
+    test::SurfaceCase moved = same;
+    moved.name += "_moved_vertex";
+    moved.vertices[7].y += 1e-3;
+    auto call = [&](const test::SurfaceCase& c, uint32_t reused) {
+        const Result<SurfaceResult> r = engine->hausdorffToSurface(PointView(c.queries), meshOf(c));
+        expectBruteForce(c, backend, r, Path::kDescend);
+        if (!r) return;
+        EXPECT_EQ(r->directed.counters.tailTreeReused, reused) << c.name;
+        if (reused != 0) EXPECT_EQ(r->stages.tailBuild, 0.0) << c.name;
+    };
+    call(same, 0);
+    call(same, 1);
+    call(moved, 0);
+    call(same, 0);
+    call(same, 1);
+}
+
 }  // namespace rthdist

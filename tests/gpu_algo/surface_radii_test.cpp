@@ -76,4 +76,24 @@ TEST(SurfaceRadii, FewOpenQueriesGoToTheHost) {
 }
 
 }  // namespace
+// Every query down the tree without radii: where Tuning::surfaceDescend
+// says so, else for at most kDescendTriangles triangles or at most
+// kDescendQueries queries (bunny>res4's 948 triangles, bunny-res4>bunny's
+// 453 queries; not dragon>res4's 437,645 x 11,102).
+TEST(SurfaceRadii, FewTrianglesOrFewQueriesDescendOnly) {
+    const Tuning rule;
+    EXPECT_TRUE(descendOnly(rule, 35947, 948));
+    EXPECT_TRUE(descendOnly(rule, 453, 69451));
+    EXPECT_FALSE(descendOnly(rule, 437645, 11102));
+    EXPECT_TRUE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles));
+    EXPECT_FALSE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles + 1));
+    EXPECT_TRUE(descendOnly(rule, kDescendQueries, kDescendTriangles + 1));
+    Tuning forced;
+    forced.surfaceDescend = true;
+    EXPECT_TRUE(descendOnly(forced, 437645, 11102));
+    forced.surfaceDescend = false;
+    EXPECT_FALSE(descendOnly(forced, 35947, 948));
+    EXPECT_FALSE(descendOnly(forced, 1, 1));
+}
+
 }  // namespace rthdist::gpu_algo
