@@ -13,6 +13,12 @@
 // malloc returned such blocks to the system after each call (its mmap and
 // trim thresholds) and the next call faulted them in again: ~4,000 page
 // faults and 60 % of a Dragon-vs-res2 call on the CPU backend.
+// kLargeBlock is 1 MiB (was 4 MiB): a one-shot call's mid-size arrays (a
+// 52,000-triangle BVH's 3.7 MB of corners and 1.5 MB of nodes) were most
+// of its build in 4 KiB faults on a VM; huge pages took the CLI's
+// armadillo-dec>armadillo from 27.3 to 18.1 ms and Dragon vs res2 from
+// 73-75 to 49-67 ms on 2 cores (docs/bench/surfaces, session 9), at the
+// cost of up to 1 MiB of rounding per block of 1-4 MiB.
 //
 // Contract: only for trivially copyable element types whose every element is
 // written before it is read. Not under AddressSanitizer: there every block
@@ -51,7 +57,7 @@ inline constexpr bool kMapLargeBlocks = true;
 #endif
 
 inline constexpr size_t kMappedBlock = size_t(64) << 10;  // bytes; smaller blocks from operator new
-inline constexpr size_t kLargeBlock = size_t(4) << 20;    // and larger: huge pages, whole 2 MiB
+inline constexpr size_t kLargeBlock = size_t(1) << 20;    // and larger: huge pages, whole 2 MiB
 inline constexpr size_t kCachedBytes = size_t(256) << 20;
 inline constexpr size_t kCachedBlocks = 128;
 
