@@ -50,7 +50,8 @@ struct Tuning {
     // Point to surface on a GPU backend: true, every query descends the
     // tail's tree from none in one submission (no radii, no BLAS); false,
     // the radii first; unset, the radii unless the triangles are at most
-    // 4,096 or the queries at most 1,024 (gpu_algo::descendOnly).
+    // 4,096 (and the queries at most 2^20) or the queries at most 1,024
+    // (gpu_algo::descendOnly).
     // RTHDIST_SURFACE_DESCEND=0|1.
     std::optional<bool> surfaceDescend;
     // Read host arrays in place (VK_EXT_external_memory_host) instead of

@@ -71,7 +71,8 @@ uint64_t surfaceHostWork(const Tuning& tuning, int threads) {
 }
 
 bool descendOnly(const Tuning& tuning, uint64_t queries, uint64_t triangles) {
-    return tuning.surfaceDescend.value_or(triangles <= kDescendTriangles || queries <= kDescendQueries);
+    return tuning.surfaceDescend.value_or(
+        (triangles <= kDescendTriangles && queries <= kDescendMostQueries) || queries <= kDescendQueries);
 }
 
 bool openQueriesToHost(uint64_t open, uint64_t triangles, uint64_t hostWork) {

@@ -102,9 +102,13 @@ inline constexpr uint64_t kSurfaceHostWorkPerThread = uint64_t(1) << 19;
 // triangles, session 8), or a few queries (at most kDescendQueries: that
 // many rays, each in ~100 grown boxes of a fine mesh, keep the GPU nearly
 // idle; bunny-res4>bunny's 453 took 3.2 ms of rays). The descent ends with
-// what a visit of every triangle would give, as after the radii.
+// what a visit of every triangle would give, as after the radii. The few
+// triangles' side is bounded by kDescendMostQueries (2^20): past it the
+// radii stay, as measured at scale (the descent was measured up to 36k
+// queries; each query of the tail also counts itself on one atomic).
 inline constexpr uint64_t kDescendTriangles = 4096;
 inline constexpr uint64_t kDescendQueries = 1024;
+inline constexpr uint64_t kDescendMostQueries = uint64_t(1) << 20;
 // Tuning::surfaceDescend decides where it is set.
 [[nodiscard]] bool descendOnly(const Tuning& tuning, uint64_t queries, uint64_t triangles);
 

@@ -79,7 +79,8 @@ TEST(SurfaceRadii, FewOpenQueriesGoToTheHost) {
 // Every query down the tree without radii: where Tuning::surfaceDescend
 // says so, else for at most kDescendTriangles triangles or at most
 // kDescendQueries queries (bunny>res4's 948 triangles, bunny-res4>bunny's
-// 453 queries; not dragon>res4's 437,645 x 11,102).
+// 453 queries; not dragon>res4's 437,645 x 11,102), the few triangles' side
+// up to kDescendMostQueries queries.
 TEST(SurfaceRadii, FewTrianglesOrFewQueriesDescendOnly) {
     const Tuning rule;
     EXPECT_TRUE(descendOnly(rule, 35947, 948));
@@ -88,6 +89,9 @@ TEST(SurfaceRadii, FewTrianglesOrFewQueriesDescendOnly) {
     EXPECT_TRUE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles));
     EXPECT_FALSE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles + 1));
     EXPECT_TRUE(descendOnly(rule, kDescendQueries, kDescendTriangles + 1));
+    // Few triangles but past 2^20 queries: the radii, as at scale.
+    EXPECT_TRUE(descendOnly(rule, kDescendMostQueries, 948));
+    EXPECT_FALSE(descendOnly(rule, kDescendMostQueries + 1, 948));
     Tuning forced;
     forced.surfaceDescend = true;
     EXPECT_TRUE(descendOnly(forced, 437645, 11102));
