@@ -24,8 +24,16 @@ double bandThreshold2(double hf2, double slack) {
     return lo * lo * (1.0 - kSlackPerMagnitude);
 }
 
-BruteForce hostBruteForce(const PointAt& query, const PointAt& target, uint64_t n, int threads) {
-    return [query, target, n, threads](std::span<BandNearest> band) {
+namespace {
+
+// A host brute force over n targets: the band's queries gathered once, the
+// targets cut into chunks on the pool, scan(begin, end, q, local) filling
+// each chunk's nearest per query (`local`, fresh), merged under a lock
+// (BandNearest::offer breaks ties by the smaller index, so the order of
+// the merges does not matter).
+template <class Scan>
+BruteForce bruteForceBy(const PointAt& query, uint64_t n, int threads, Scan scan) {
+    return [query, n, threads, scan](std::span<BandNearest> band) {
         if (band.empty()) return true;
         std::vector<glm::dvec3> q(band.size());
         for (size_t k = 0; k < band.size(); ++k) q[k] = query(band[k].query);
@@ -34,10 +42,7 @@ BruteForce hostBruteForce(const PointAt& query, const PointAt& target, uint64_t 
         const int workers = resolveThreads(threads, n / kChunk + 1);
         parallelChunks(n, kChunk, workers, [&](size_t begin, size_t end, int) {
             std::vector<BandNearest> local(band.size());
-            for (size_t t = begin; t < end; ++t) {
-                const glm::dvec3 p = target(t);
-                for (size_t k = 0; k < q.size(); ++k) local[k].offer(t, exactDistance(q[k], p));
-            }
+            scan(begin, end, q, local);
             const std::lock_guard<std::mutex> lock(merge);
             for (size_t k = 0; k < band.size(); ++k) band[k].offer(local[k].target, local[k].distance);
         });
@@ -45,10 +50,8 @@ BruteForce hostBruteForce(const PointAt& query, const PointAt& target, uint64_t 
     };
 }
 
-namespace {
-
 // One chunk [begin, end) of a view's targets against the queries `q`, into
-// `local` (one per query, fresh for the chunk): see hostBruteForce's view form.
+// `local`: see hostBruteForce's view form.
 template <class T>
 void scanChunk(const char* base, size_t stride, size_t begin, size_t end, const std::vector<glm::dvec3>& q,
                std::vector<BandNearest>& local) {
@@ -69,27 +72,28 @@ void scanChunk(const char* base, size_t stride, size_t begin, size_t end, const 
 
 }  // namespace
 
+BruteForce hostBruteForce(const PointAt& query, const PointAt& target, uint64_t n, int threads) {
+    return bruteForceBy(query, n, threads,
+                        [target](size_t begin, size_t end, const std::vector<glm::dvec3>& q,
+                                 std::vector<BandNearest>& local) {
+                            for (size_t t = begin; t < end; ++t) {
+                                const glm::dvec3 p = target(t);
+                                for (size_t k = 0; k < q.size(); ++k)
+                                    local[k].offer(t, exactDistance(q[k], p));
+                            }
+                        });
+}
+
 BruteForce hostBruteForce(const PointAt& query, const PointView& targets, int threads) {
-    return [query, targets, threads](std::span<BandNearest> band) {
-        if (band.empty()) return true;
-        std::vector<glm::dvec3> q(band.size());
-        for (size_t k = 0; k < band.size(); ++k) q[k] = query(band[k].query);
-        std::mutex merge;
-        constexpr size_t kChunk = size_t(1) << 15;
-        const size_t n = targets.size();
-        const int workers = resolveThreads(threads, n / kChunk + 1);
-        const auto* base = static_cast<const char*>(targets.data);
-        parallelChunks(n, kChunk, workers, [&](size_t begin, size_t end, int) {
-            std::vector<BandNearest> local(band.size());
-            if (targets.scalar == Scalar::kFloat64)
-                scanChunk<double>(base, targets.strideBytes, begin, end, q, local);
-            else
-                scanChunk<float>(base, targets.strideBytes, begin, end, q, local);
-            const std::lock_guard<std::mutex> lock(merge);
-            for (size_t k = 0; k < band.size(); ++k) band[k].offer(local[k].target, local[k].distance);
-        });
-        return true;
-    };
+    return bruteForceBy(query, targets.size(), threads,
+                        [targets](size_t begin, size_t end, const std::vector<glm::dvec3>& q,
+                                  std::vector<BandNearest>& local) {
+                            const auto* base = static_cast<const char*>(targets.data);
+                            if (targets.scalar == Scalar::kFloat64)
+                                scanChunk<double>(base, targets.strideBytes, begin, end, q, local);
+                            else
+                                scanChunk<float>(base, targets.strideBytes, begin, end, q, local);
+                        });
 }
 
 DirectedProof proveDirection(const DirectionBand& band, const PointAt& query, const PointAt& target,

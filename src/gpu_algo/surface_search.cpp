@@ -100,7 +100,7 @@ struct SurfaceSearch::Stats {
 struct SurfaceSearch::TailTree {
     bool kept = false;
     uint64_t fingerprint = 0;
-    SurfaceTree tree;  // empty where kept
+    SurfaceTree tree;  // empty where kept (or where no tail is wanted: nothing to stage)
     VkDeviceSize nodeBytes = 0, orderBytes = 0;
     [[nodiscard]] VkDeviceSize bytes() const { return nodeBytes + orderBytes; }
 };
@@ -119,72 +119,52 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     m_ws.pipelines.prepareSurfaceSearch(m_ws.pipelineCache.handle());
 
     SurfaceCandidates out;
-    if (descendOnly(m_ws.tuning, m_queries, m_triangles)) {
-        // The tree first, so that the upload buffer holds the inputs and it
-        // for one submission: the upload, every query's descent from none.
-        auto t0 = Clock::now();
-        const TailTree tree = tailTree(corners, out);
-        const Stats stats = stage(queries, corners, tree.bytes());
-        stageTail(tree, inputBytes());
-        out.firstRadius = SurfaceRadii(stats.sides / double(m_triangles), stats.area, m_queries,
-                                       glm::length(glm::dvec3(stats.box.hi) - glm::dvec3(stats.box.lo)))
-                              .first();
-        out.stageMs = msSince(t0) - out.tailBuildMs;
-        t0 = Clock::now();
-        std::fill_n(static_cast<uint32_t*>(m_counts.mapped()), 2 * SurfaceRadii::kStartRadii + 1, 0u);
-        VkCommandBuffer cmd = m_ws.ctx.begin();
-        cmdUpload(cmd);
-        cmdTail(cmd, tree, inputBytes(), 0.0);
-        cmdReadBack(cmd);
-        m_ws.ctx.submitAndWait(cmd);
-        finishTail(tree, out);
-        if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
-        out.submitMs = msSince(t0) + out.tailBuildMs;  // the tree's build is part of it, as after the radii
-        t0 = Clock::now();
-        const auto* packed = static_cast<const uint64_t*>(m_readback.mapped());
-        out.triangle.resize(m_queries);
-        core::parallelChunks(m_queries, core::balancedChunk(m_queries, m_ws.threads), m_ws.threads,
-                             [&](size_t begin, size_t end, int) {
-                                 for (size_t q = begin; q < end; ++q) {
-                                     const auto t = uint32_t(packed[q] & 0xffffffffu);
-                                     out.triangle[q] = t < m_triangles ? t : UINT32_MAX;
-                                 }
-                             });
-        out.readbackMs = msSince(t0);
-        return out;
-    }
+    // Descending only (descendOnly): the tree first, so that the upload
+    // buffer holds the inputs and it for one submission.
+    const bool descend = descendOnly(m_ws.tuning, m_queries, m_triangles);
     auto t0 = Clock::now();
-    const Stats stats = stage(queries, corners);
+    const TailTree tree = descend ? tailTree(corners, out) : TailTree{};
+    const Stats stats = stage(queries, corners, tree.bytes());
+    if (descend) stageTail(tree, inputBytes());
     const SurfaceRadii radii(stats.sides / double(m_triangles), stats.area, m_queries,
                              glm::length(glm::dvec3(stats.box.hi) - glm::dvec3(stats.box.lo)));
     out.firstRadius = radii.first();
     m_rayTMax = radii.first() * 1e-3;
-    out.stageMs = msSince(t0);
+    out.stageMs = msSince(t0) - out.tailBuildMs;  // the tree's build is part of submitMs, as after the radii
 
-    // The first submission: the upload, the radii (the first settles most
-    // queries) and the read-back; then the tail's, where queries are open.
+    // The first submission: the upload, then the radii (the first settles
+    // most queries) and the read-back, and the tail's where queries are
+    // open; or, descending only, every query's descent from none.
     t0 = Clock::now();
     std::fill_n(static_cast<uint32_t*>(m_counts.mapped()), 2 * SurfaceRadii::kStartRadii + 1, 0u);
     VkCommandBuffer cmd = m_ws.ctx.begin();
     cmdUpload(cmd);
     const std::vector<double> start = radii.start();
-    uint64_t open = 0;  // after the last radius that searched a query
-    for (const sh::SurfaceRadiusCount& c : submitRadii(cmd, start, out)) {
-        open = c.searched - std::min(c.settled, c.searched);
-        if (c.searched == 0) break;
-        ++out.radii;
-        out.rays += c.searched;
-    }
-    if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
-    // A few open queries go back to the host (measured exactly there), the
-    // others descend the tail's tree.
-    const bool toHost =
-        open > 0 && openQueriesToHost(open, m_triangles, surfaceHostWork(m_ws.tuning, m_ws.threads));
-    if (open > 0 && !toHost) {
-        submitTail(corners, start.back(), out);
+    bool toHost = false;
+    if (descend) {
+        cmdTail(cmd, tree, inputBytes(), 0.0);
+        cmdReadBack(cmd);
+        m_ws.ctx.submitAndWait(cmd);
+        finishTail(tree, out);
         if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
+    } else {
+        uint64_t open = 0;  // after the last radius that searched a query
+        for (const sh::SurfaceRadiusCount& c : submitRadii(cmd, start, out)) {
+            open = c.searched - std::min(c.settled, c.searched);
+            if (c.searched == 0) break;
+            ++out.radii;
+            out.rays += c.searched;
+        }
+        if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
+        // A few open queries go back to the host (measured exactly there),
+        // the others descend the tail's tree.
+        toHost = open > 0 && openQueriesToHost(open, m_triangles, surfaceHostWork(m_ws.tuning, m_ws.threads));
+        if (open > 0 && !toHost) {
+            submitTail(corners, start.back(), out);
+            if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
+        }
     }
-    out.submitMs = msSince(t0);
+    out.submitMs = msSince(t0) + (descend ? out.tailBuildMs : 0.0);
 
     // Every query's best, as the last submission copied it: its triangle is
     // the low word; where the open queries go back, a query is open as the

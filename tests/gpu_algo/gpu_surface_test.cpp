@@ -491,13 +491,18 @@ Tuning tailTuning(uint64_t hostWork) {
     return t;
 }
 
-// A kept device (validation on) whose open queries go one way.
-Result<Engine> tunedSurfaceEngine(Backend backend, uint64_t hostWork) {
+// A kept device (validation on) with `tuning`.
+Result<Engine> surfaceEngine(Backend backend, const Tuning& tuning) {
     EngineOptions o;
     o.backend = backend;
     o.validation = true;
-    o.tuning = tailTuning(hostWork);
+    o.tuning = tuning;
     return Engine::create(o);
+}
+
+// A kept device whose open queries go one way.
+Result<Engine> tunedSurfaceEngine(Backend backend, uint64_t hostWork) {
+    return surfaceEngine(backend, tailTuning(hostWork));
 }
 
 // A framed case as the API takes it (every corner its own vertex).
@@ -717,11 +722,8 @@ TEST(GpuSurfaceTail, AMissingTailIsCaughtByTheProof) {
 // descend it without building it; other corners (one vertex moved, one
 // triangle fewer) build their own, after which the first inputs build
 // theirs again; a point call between (its own BLAS in the shared storage)
-// leaves the tree. Every answer is the brute force's.
-TEST(GpuSurfaceTail, AKeptEngineReusesTheTreeOnlyForTheSameCorners) {
-    RTHDIST_REQUIRE_SURFACE_DEVICE();
-    Result<Engine> engine = tunedSurfaceEngine(backend, kAlwaysTree);
-    ASSERT_TRUE(engine) << engine.error().message;
+// leaves the tree. Every answer is the brute force's, searched by `path`.
+void expectTreeKeptOnlyForTheSameCorners(Engine& engine, Backend backend, Path path) {
     const test::SurfaceCase same = apiCase(tailCases().front());
     test::SurfaceCase moved = same;
     moved.name += "_moved_vertex";
@@ -730,8 +732,8 @@ TEST(GpuSurfaceTail, AKeptEngineReusesTheTreeOnlyForTheSameCorners) {
     fewer.name += "_one_triangle_fewer";
     fewer.indices.resize(fewer.indices.size() - 3);
     auto call = [&](const test::SurfaceCase& c, uint32_t reused) {
-        const Result<SurfaceResult> r = engine->hausdorffToSurface(PointView(c.queries), meshOf(c));
-        expectBruteForce(c, backend, r);
+        const Result<SurfaceResult> r = engine.hausdorffToSurface(PointView(c.queries), meshOf(c));
+        expectBruteForce(c, backend, r, path);
         if (!r) return;
         EXPECT_GT(r->directed.counters.tailQueries, 0u) << c.name;
         EXPECT_EQ(r->directed.counters.tailTreeReused, reused) << c.name;
@@ -747,9 +749,16 @@ TEST(GpuSurfaceTail, AKeptEngineReusesTheTreeOnlyForTheSameCorners) {
     CallOptions points;
     points.directedOnly = true;
     const Result<HausdorffResult> between =
-        engine->compute(PointView(same.queries), PointView(same.vertices), points);
+        engine.compute(PointView(same.queries), PointView(same.vertices), points);
     ASSERT_TRUE(between) << between.error().message;
     call(same, 1);
+}
+
+TEST(GpuSurfaceTail, AKeptEngineReusesTheTreeOnlyForTheSameCorners) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    Result<Engine> engine = tunedSurfaceEngine(backend, kAlwaysTree);
+    ASSERT_TRUE(engine) << engine.error().message;
+    expectTreeKeptOnlyForTheSameCorners(*engine, backend, Path::kRadii);
 }
 
 // Where few queries are open (here always: Tuning::surfaceHostWork at its
@@ -831,16 +840,12 @@ TEST(GpuSurfaceHost, OpenQueriesAreMeasuredExactlyOnTheHost) {
     }
 }
 
-}  // namespace
 // ---- Every query down the tail's tree (Tuning::surfaceDescend) ----------
 
 Result<Engine> descendEngine(Backend backend, std::optional<bool> descend) {
-    EngineOptions o;
-    o.backend = backend;
-    o.validation = true;
-    o.tuning = *test::gpuOptions().tuning;
-    o.tuning->surfaceDescend = descend;
-    return Engine::create(o);
+    Tuning t = *test::gpuOptions().tuning;
+    t.surfaceDescend = descend;
+    return surfaceEngine(backend, t);
 }
 
 // Forced: every case's value, witness and nearest triangle are the brute
@@ -884,27 +889,13 @@ TEST(GpuSurfaceDescend, TheRuleDescendsForFewTrianglesOrFewQueries) {
 }
 
 // A kept engine descends the tree of the call before where the corners are
-// the same, and builds it again where they are not.
+// the same, and builds it again where they are not, as after the radii.
 TEST(GpuSurfaceDescend, AKeptEngineReusesTheTreeOnlyForTheSameCorners) {
     RTHDIST_REQUIRE_SURFACE_DEVICE();
     Result<Engine> engine = descendEngine(backend, true);
     ASSERT_TRUE(engine) << engine.error().message;
-    const test::SurfaceCase same = apiCase(tailCases().front());
-    test::SurfaceCase moved = same;
-    moved.name += "_moved_vertex";
-    moved.vertices[7].y += 1e-3;
-    auto call = [&](const test::SurfaceCase& c, uint32_t reused) {
-        const Result<SurfaceResult> r = engine->hausdorffToSurface(PointView(c.queries), meshOf(c));
-        expectBruteForce(c, backend, r, Path::kDescend);
-        if (!r) return;
-        EXPECT_EQ(r->directed.counters.tailTreeReused, reused) << c.name;
-        if (reused != 0) EXPECT_EQ(r->stages.tailBuild, 0.0) << c.name;
-    };
-    call(same, 0);
-    call(same, 1);
-    call(moved, 0);
-    call(same, 0);
-    call(same, 1);
+    expectTreeKeptOnlyForTheSameCorners(*engine, backend, Path::kDescend);
 }
 
+}  // namespace
 }  // namespace rthdist
