@@ -15,9 +15,19 @@
 namespace rthdist::cpu {
 namespace {
 
-double boxDistance2(const glm::dvec3& p, const glm::dvec3& lo, const glm::dvec3& hi) {
-    const glm::dvec3 d = glm::max(glm::max(lo - p, p - hi), glm::dvec3(0.0));
+double boxDistance2(const glm::dvec3& p, const glm::vec3& lo, const glm::vec3& hi) {
+    const glm::dvec3 d = glm::max(glm::max(glm::dvec3(lo) - p, p - glm::dvec3(hi)), glm::dvec3(0.0));
     return glm::dot(d, d);
+}
+
+// The nearest float at or below v (FLT_MAX for v past it) and at or above.
+float floatAtOrBelow(double v) {
+    const float f = float(v);
+    return double(f) > v ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+float floatAtOrAbove(double v) {
+    const float f = float(v);
+    return double(f) < v ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
 }
 
 // The squared distance a box must exceed to be skipped: (best + slack)^2,
@@ -79,24 +89,59 @@ struct CentreBefore {
     }
 };
 
-// Reorders items[0, count) so that the first `half` are the smaller by
-// CentreBefore<Axis>. A large range is first cut by a histogram of its
-// centres over [lo, hi] (about 16 items a bin, at most kMaxBins; a bin is a non-decreasing
-// function of the centre, so every item of a lower bin is smaller than every
-// item of a higher one): the items below the bin that holds position `half`
-// go first, that bin's next, and only that bin is ordered by nth_element.
-// Two passes and a small selection instead of introselect's passes over the
-// whole range (perf: nth_element was 41 % of a 871k-triangle build).
+// The box of a set of build items' centres (float: min and max are exact,
+// so it is the same whatever the order the items are added in).
+struct CentreBounds {
+    glm::vec3 lo{std::numeric_limits<float>::infinity()};
+    glm::vec3 hi{-std::numeric_limits<float>::infinity()};
+    void add(const glm::vec3& c) {
+        lo = glm::min(lo, c);
+        hi = glm::max(hi, c);
+    }
+    void add(const CentreBounds& b) {
+        lo = glm::min(lo, b.lo);
+        hi = glm::max(hi, b.hi);
+    }
+};
+
+CentreBounds boundsOf(const BuildItem* items, uint32_t count) {
+    CentreBounds b;
+    for (uint32_t i = 0; i < count; ++i) b.add(items[i].centre);
+    return b;
+}
+
+// A node's split: the first `half` items (by CentreBefore along the axis)
+// go left, the rest right; the halves' centre boxes; `moved`: the halves
+// were written to the other buffer (else reordered in place).
+struct Split {
+    uint32_t half = 0;
+    CentreBounds left, right;
+    bool moved = false;
+};
+
+// Splits src[0, count) at count / 2 along Axis. A large range is cut by a
+// histogram of its centres over the node's [lo, hi] along the axis (about
+// 16 items a bin, at most kMaxBins; a bin is a non-decreasing function of
+// the centre, so every item of a lower bin is smaller than every item of a
+// higher one): one pass writes the items below the median's bin, the bin's,
+// and those above into dst (three cursors, no branch on the item), adding
+// each to its half's box, and only the median's bin is ordered by
+// nth_element. Two passes a level, each read once (perf: the selection was
+// most of the build). A small or flat range is selected in place.
 template <int Axis>
-void selectHalf(BuildItem* items, uint32_t count, uint32_t half, float lo, float hi) {
+Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBounds& bounds) {
     constexpr uint32_t kSmallRange = 128;
     constexpr uint32_t kMaxBins = 256;
-    const float width = hi - lo;
+    Split s;
+    s.half = count / 2;
+    const float lo = bounds.lo[Axis];
+    const float width = bounds.hi[Axis] - lo;
     if (count <= kSmallRange || !(width > 0.0f) || !std::isfinite(width)) {
-        std::nth_element(items, items + half, items + count, CentreBefore<Axis>{});
-        return;
+        std::nth_element(src, src + s.half, src + count, CentreBefore<Axis>{});
+        s.left = boundsOf(src, s.half);
+        s.right = boundsOf(src + s.half, count - s.half);
+        return s;
     }
-    // About 16 items a bin, at most kMaxBins.
     const uint32_t bins = std::min(kMaxBins, count / 16);
     const float toBin = float(bins) / width;
     const auto binOf = [&](const BuildItem& item) {
@@ -104,133 +149,188 @@ void selectHalf(BuildItem* items, uint32_t count, uint32_t half, float lo, float
         return b < float(bins - 1) ? uint32_t(b) : bins - 1;  // b >= 0: lo is the minimum
     };
     std::array<uint32_t, kMaxBins> histogram{};
-    for (uint32_t i = 0; i < count; ++i) ++histogram[binOf(items[i])];
+    for (uint32_t i = 0; i < count; ++i) ++histogram[binOf(src[i])];
     uint32_t median = 0, below = 0;
-    while (below + histogram[median] <= half) below += histogram[median++];
-    BuildItem* const end = items + count;
-    BuildItem* const from = std::partition(items, end, [&](const BuildItem& x) { return binOf(x) < median; });
-    BuildItem* const to = std::partition(from, end, [&](const BuildItem& x) { return binOf(x) == median; });
-    std::nth_element(from, items + half, to, CentreBefore<Axis>{});
-}
-
-// Reorders items[0, count) so that the first count / 2 are the smaller by
-// (centre along the longest axis of the centres' spread, triangle index),
-// and returns count / 2. The order is strict and total, so the halves
-// depend only on the set of items, never on their order or on the thread.
-uint32_t splitAtMedian(BuildItem* items, uint32_t count) {
-    glm::vec3 cLo(std::numeric_limits<float>::infinity()), cHi(-cLo);
+    while (below + histogram[median] <= s.half) below += histogram[median++];
+    const uint32_t inMedian = histogram[median];
+    std::array<uint32_t, 3> cursor{0, below, below + inMedian};
+    std::array<CentreBounds, 3> side;  // below, the median's bin (unused), above
     for (uint32_t i = 0; i < count; ++i) {
-        cLo = glm::min(cLo, items[i].centre);
-        cHi = glm::max(cHi, items[i].centre);
+        const BuildItem item = src[i];
+        const uint32_t bin = binOf(item);
+        const uint32_t k = uint32_t(bin >= median) + uint32_t(bin > median);
+        dst[cursor[k]++] = item;
+        side[k].add(item.centre);
     }
-    const glm::dvec3 spread = glm::dvec3(cHi) - glm::dvec3(cLo);
-    const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
-    const uint32_t half = count / 2;
-    switch (axis) {
-        case 0: selectHalf<0>(items, count, half, cLo.x, cHi.x); break;
-        case 1: selectHalf<1>(items, count, half, cLo.y, cHi.y); break;
-        default: selectHalf<2>(items, count, half, cLo.z, cHi.z); break;
-    }
-    return half;
+    std::nth_element(dst + below, dst + s.half, dst + below + inMedian, CentreBefore<Axis>{});
+    s.left = side[0];
+    s.left.add(boundsOf(dst + below, s.half - below));
+    s.right = side[2];
+    s.right.add(boundsOf(dst + s.half, below + inMedian - s.half));
+    s.moved = true;
+    return s;
 }
 
-// One node still to build: node `at` over items [first, first + count),
-// its descendants at [base, base + descendantCount(count)).
+// Splits at count / 2 along the longest axis of the centres' spread. The
+// order is strict and total, so the halves depend only on the set of items,
+// never on their order or on the thread.
+Split splitAtMedian(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBounds& bounds) {
+    const glm::dvec3 spread = glm::dvec3(bounds.hi) - glm::dvec3(bounds.lo);
+    const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
+    switch (axis) {
+        case 0: return splitAlong<0>(src, dst, count, bounds);
+        case 1: return splitAlong<1>(src, dst, count, bounds);
+        default: return splitAlong<2>(src, dst, count, bounds);
+    }
+}
+
+// One node still to build: node `at` over the items [first, first + count)
+// of buffer `buffer`, whose centres lie in `bounds`; its descendants at
+// [base, base + descendantCount(count)).
 struct PendingNode {
     uint32_t at = 0;
     uint32_t first = 0;
     uint32_t count = 0;
     uint32_t base = 0;
+    CentreBounds bounds;
+    uint32_t buffer = 0;
 };
 
 }  // namespace
 
+// The build in three passes: the splits (which triangles each leaf holds),
+// then every triangle's corners written once, in input order, to its place
+// in BVH order (a scattered write instead of a random read through the
+// index array), then the boxes from the leaves up.
 TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     const auto n = uint32_t(mesh.triangleCount());
     threads = core::resolveThreads(threads, n / kSubtreeTriangles);
-    core::UninitVector<BuildItem> items(n);  // every item written below
+    m_nodes.resize(1 + size_t(descendantCount(n)));
+    m_corners.resize(3 * size_t(n));
+    m_original.resize(n);
+    if (n == 0) {
+        m_nodes[0] = Node{glm::vec3(std::numeric_limits<float>::infinity()),
+                          glm::vec3(-std::numeric_limits<float>::infinity()), 0, 0};
+        return;
+    }
+    // Two buffers of build items (a level's splits read one and write the
+    // other) in the corners' memory, 32 of its 72 bytes a triangle: the items
+    // are spent before the corners pass writes there. Fresh memory is what a
+    // one-shot build pays most for on a VM (~2.5 ms a MiB on first touch,
+    // docs/bench/surfaces session 10), and no block of its own is faulted in.
+    static_assert(2 * sizeof(BuildItem) <= 3 * sizeof(glm::dvec3) && alignof(BuildItem) <= alignof(glm::dvec3));
+    BuildItem* const items = reinterpret_cast<BuildItem*>(m_corners.data());
+    BuildItem* const buffers[2] = {items, items + n};
+    const size_t chunks = (size_t(n) + kSubtreeTriangles - 1) / kSubtreeTriangles;
+    std::vector<CentreBounds> chunkBounds(chunks);
     core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
+        CentreBounds b;
         for (size_t t = begin; t < end; ++t) {
             const glm::dvec3 c0 = mesh.corner(t, 0), c1 = mesh.corner(t, 1), c2 = mesh.corner(t, 2);
             items[t] = {glm::vec3((glm::min(glm::min(c0, c1), c2) + glm::max(glm::max(c0, c1), c2)) * 0.5),
                         uint32_t(t)};
+            b.add(items[t].centre);
         }
+        chunkBounds[begin / kSubtreeTriangles] = b;
     });
-    m_nodes.resize(1 + size_t(descendantCount(n)));
-    m_corners.resize(3 * size_t(n));
-    m_original.resize(n);
+    PendingNode root{0, 0, n, 1, {}, 0};
+    for (const CentreBounds& b : chunkBounds) root.bounds.add(b);
 
-    // A leaf's triangles in BVH order, their corners, and its box.
+    core::UninitVector<uint32_t> placeOf(n);  // triangle -> its BVH position
+    // A leaf: its triangles' BVH order (their corners and box come later).
     const auto makeLeaf = [&](const PendingNode& p) {
-        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+        const BuildItem* from = buffers[p.buffer];
         for (uint32_t i = p.first; i < p.first + p.count; ++i) {
-            const uint32_t t = items[i].triangle;
+            const uint32_t t = from[i].triangle;
             m_original[i] = t;
-            for (int k = 0; k < 3; ++k) {
-                const glm::dvec3 c = mesh.corner(t, k);
-                m_corners[3 * size_t(i) + size_t(k)] = c;
-                lo = glm::min(lo, c);
-                hi = glm::max(hi, c);
-            }
+            placeOf[t] = i;
         }
-        m_nodes[p.at] = Node{lo, hi, p.first, p.count};
+        m_nodes[p.at].first = p.first;
+        m_nodes[p.at].count = p.count;
     };
-    // Node p.at becomes inner over [first, first + half) and the rest; its
-    // children are the first two of its descendants, then the left's
-    // descendants, then the right's.
-    const auto children = [&](const PendingNode& p, uint32_t half) {
+    // Node p becomes inner; its children are the first two of its
+    // descendants, then the left's descendants, then the right's.
+    const auto split = [&](const PendingNode& p) {
+        const Split s = splitAtMedian(buffers[p.buffer] + p.first, buffers[1 - p.buffer] + p.first, p.count,
+                                      p.bounds);
         m_nodes[p.at].first = p.base;
         m_nodes[p.at].count = 0;
+        const uint32_t buffer = s.moved ? 1 - p.buffer : p.buffer;
         return std::array<PendingNode, 2>{
-            PendingNode{p.base, p.first, half, p.base + 2},
-            PendingNode{p.base + 1, p.first + half, p.count - half, p.base + 2 + descendantCount(half)}};
+            PendingNode{p.base, p.first, s.half, p.base + 2, s.left, buffer},
+            PendingNode{p.base + 1, p.first + s.half, p.count - s.half, p.base + 2 + descendantCount(s.half),
+                        s.right, buffer}};
     };
-    const auto unionOfChildren = [&](uint32_t at) {
-        Node& node = m_nodes[at];
-        const Node& l = m_nodes[node.first];
-        const Node& r = m_nodes[node.first + 1];
-        node.lo = glm::min(l.lo, r.lo);
-        node.hi = glm::max(l.hi, r.hi);
-    };
-    // A whole subtree on this thread, depth first.
-    const auto buildSubtree = [&](const PendingNode& root) {
+    // A whole subtree's splits on this thread, depth first.
+    const auto splitSubtree = [&](const PendingNode& top) {
         const auto recurse = [&](const auto& self, const PendingNode& p) -> void {
             if (p.count <= kLeafTriangles) {
                 makeLeaf(p);
                 return;
             }
-            const std::array<PendingNode, 2> c = children(p, splitAtMedian(&items[p.first], p.count));
-            self(self, c[0]);
-            self(self, c[1]);
-            unionOfChildren(p.at);
+            for (const PendingNode& c : split(p)) self(self, c);
         };
-        recurse(recurse, root);
+        recurse(recurse, top);
     };
 
     // The top levels one level at a time, the nodes of a level in parallel;
-    // then the subtrees below them as parallel tasks; then the boxes of the
-    // top levels from the bottom up.
-    std::vector<PendingNode> level{PendingNode{0, 0, n, 1}};
+    // then the subtrees below them as parallel tasks.
+    std::vector<PendingNode> level{root};
     std::vector<uint32_t> topInner;  // parents before their children
     while (threads > 1 && level.size() < kSubtreesPerThread * size_t(threads) &&
            level.front().count > kSubtreeTriangles) {
-        std::vector<uint32_t> half(level.size());
+        std::vector<std::array<PendingNode, 2>> halves(level.size());
         core::parallelChunks(level.size(), 1, threads, [&](size_t begin, size_t end, int) {
-            for (size_t i = begin; i < end; ++i)
-                half[i] = splitAtMedian(&items[level[i].first], level[i].count);
+            for (size_t i = begin; i < end; ++i) halves[i] = split(level[i]);
         });
         std::vector<PendingNode> next;
         next.reserve(2 * level.size());
         for (size_t i = 0; i < level.size(); ++i) {
             topInner.push_back(level[i].at);
-            for (const PendingNode& c : children(level[i], half[i])) next.push_back(c);
+            next.insert(next.end(), halves[i].begin(), halves[i].end());
         }
         level = std::move(next);
     }
     core::parallelChunks(level.size(), 1, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) buildSubtree(level[i]);
+        for (size_t i = begin; i < end; ++i) splitSubtree(level[i]);
     });
-    for (auto it = topInner.rbegin(); it != topInner.rend(); ++it) unionOfChildren(*it);
+
+    // The corners, each triangle's in input order to its BVH place.
+    core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
+        for (size_t t = begin; t < end; ++t) {
+            glm::dvec3* to = &m_corners[3 * size_t(placeOf[t])];
+            for (int k = 0; k < 3; ++k) to[k] = mesh.corner(t, k);
+        }
+    });
+
+    // The boxes: a node's children come after it, so each subtree's nodes in
+    // reverse order meet the children first; then the top levels.
+    const auto boxOf = [&](uint32_t at) {
+        Node& node = m_nodes[at];
+        if (node.count > 0) {
+            const glm::dvec3* c = &m_corners[3 * size_t(node.first)];
+            glm::dvec3 lo = c[0], hi = c[0];
+            for (uint32_t k = 1; k < 3 * node.count; ++k) {
+                lo = glm::min(lo, c[k]);
+                hi = glm::max(hi, c[k]);
+            }
+            node.lo = glm::vec3(floatAtOrBelow(lo.x), floatAtOrBelow(lo.y), floatAtOrBelow(lo.z));
+            node.hi = glm::vec3(floatAtOrAbove(hi.x), floatAtOrAbove(hi.y), floatAtOrAbove(hi.z));
+            return;
+        }
+        const Node& l = m_nodes[node.first];
+        const Node& r = m_nodes[node.first + 1];
+        node.lo = glm::min(l.lo, r.lo);
+        node.hi = glm::max(l.hi, r.hi);
+    };
+    core::parallelChunks(level.size(), 1, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) {
+            const PendingNode& p = level[i];
+            for (uint32_t at = p.base + descendantCount(p.count); at-- > p.base;) boxOf(at);
+            boxOf(p.at);
+        }
+    });
+    for (auto it = topInner.rbegin(); it != topInner.rend(); ++it) boxOf(*it);
 }
 
 NearestTriangle TriangleBvh::nearest(const glm::dvec3& p, double slack, double stopBelow2) const {

@@ -72,11 +72,16 @@ public:
 
     // Every field written by the build (no initializers: the arrays are
     // UninitVector, first touched by the build's workers).
+    // 32 bytes: the box in float, rounded outward (it holds every triangle
+    // below; a coordinate past float's range widens it to FLT_MAX or
+    // infinity, still holding them), so the nodes take 57 % of the memory
+    // of a box in double, which a one-shot call faults in fresh.
     struct Node {
-        glm::dvec3 lo, hi;  // the union of the boxes of the triangles below
-        uint32_t first;     // leaf: first triangle (BVH order); inner: left child (right = first + 1)
-        uint32_t count;     // leaf: triangles; inner: 0
+        glm::vec3 lo, hi;  // leaf: the union of its triangles' boxes rounded outward; inner: of its children's
+        uint32_t first;    // leaf: first triangle (BVH order); inner: left child (right = first + 1)
+        uint32_t count;    // leaf: triangles; inner: 0
     };
+    static_assert(sizeof(Node) == 32);
     // For tests and diagnostics: node 0 is the root; a node's children come
     // after it. triangleOrder()[i]: the triangle at BVH position i.
     [[nodiscard]] const core::UninitVector<Node>& nodes() const { return m_nodes; }
@@ -84,7 +89,7 @@ public:
 
 private:
     // UninitVector: no pass zeroes them first, and a kept Engine's next call
-    // reuses their blocks (core/uninit_vector.hpp): 91 MB for 871k triangles.
+    // reuses their blocks (core/uninit_vector.hpp): 77 MB for 871k triangles.
     core::UninitVector<Node> m_nodes;
     core::UninitVector<glm::dvec3> m_corners;  // 3 per triangle, in BVH order
     core::UninitVector<uint32_t> m_original;   // BVH order -> triangle index

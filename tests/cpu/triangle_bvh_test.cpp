@@ -141,9 +141,13 @@ void expectTreeInvariants(const RandomMesh& m, const cpu::TriangleBvh& bvh) {
                 lo = glm::min(lo, tLo);
                 hi = glm::max(hi, tHi);
             }
-            if (node.count > 0) {  // the tightest box: the union of its triangles'
-                EXPECT_EQ(node.lo, lo) << m.name;
-                EXPECT_EQ(node.hi, hi) << m.name;
+            if (node.count > 0) {  // the tightest float box around the union of its triangles'
+                for (int k = 0; k < 3; ++k) {
+                    EXPECT_LE(double(node.lo[k]), lo[k]) << m.name;
+                    EXPECT_GT(double(std::nextafter(node.lo[k], INFINITY)), lo[k]) << m.name;
+                    EXPECT_GE(double(node.hi[k]), hi[k]) << m.name;
+                    EXPECT_LT(double(std::nextafter(node.hi[k], -INFINITY)), hi[k]) << m.name;
+                }
             }
             continue;
         }
@@ -233,6 +237,36 @@ TEST(TriangleBvh, NearestEqualsTheBruteForceOnRandomMeshes) {
             EXPECT_EQ(got.distance2, want.distance2) << m.name;
             EXPECT_EQ(got.triangle, want.triangle) << m.name << ": the smallest index on a tie";
             EXPECT_EQ(got.point, want.point) << m.name;
+        }
+    }
+}
+
+// Coordinates float cannot hold (the boxes are float, rounded outward):
+// doubles between floats, a georeferenced offset, magnitudes past float's
+// range and in its subnormal range. The tree's invariants hold and every
+// answer equals the brute force.
+TEST(TriangleBvh, FloatBoxesHoldWhatFloatCannot) {
+    struct Frame {
+        double scale, offset;
+    };
+    for (const Frame f : {Frame{1.0, 0.0}, Frame{1.0, 6.4e6}, Frame{1e45, 0.0}, Frame{1e45, -1e46},
+                          Frame{1e-42, 0.0}}) {
+        RandomMesh m = randomMesh(77, 3000);
+        const std::vector<glm::dvec3> lattice = queries(m, 78, 150);
+        test::Rng rng(79);
+        const auto place = [&](const glm::dvec3& v) { return v * f.scale + f.offset; };
+        for (glm::dvec3& v : m.vertices)
+            v = place(v + glm::dvec3(rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3)));
+        m.name += ", x " + std::to_string(f.scale) + " + " + std::to_string(f.offset);
+        const cpu::TriangleBvh bvh(m.view(), 2);
+        expectTreeInvariants(m, bvh);
+        const double magnitude = std::abs(f.offset) + 20.0 * f.scale;
+        for (const glm::dvec3& q : lattice) {
+            const glm::dvec3 p = place(q);
+            const oracle::SurfaceNearest want = oracle::bruteNearestTriangle(p, m.vertices, m.indices);
+            const cpu::NearestTriangle got = bvh.nearest(p, core::closestSlack(magnitude));
+            EXPECT_EQ(got.distance2, want.distance2) << m.name;
+            EXPECT_EQ(got.triangle, want.triangle) << m.name;
         }
     }
 }
