@@ -38,6 +38,14 @@
 # repository root:
 #   bash tools/bench/gpu_surface_run.sh .devrun/surface $OUT
 # About 3-6 minutes of device time (the CGAL surfaces rows dominate).
+# TOOLS overrides the peers and CPU columns (default rthdist-cpu,rthdist-cpu-1t,cgal);
+# ONESHOT=rt-pipeline adds one-shot calls in one process (rthdist-rt-pipeline-oneshot).
+# Open3D there: Debian 12's python3.11, numpy and python3-open3d with the
+# libraries they load (not libc or libstdc++: the machine's newer ones serve),
+# unpacked into a folder with a run.sh that sets LD_LIBRARY_PATH, PYTHONHOME
+# and PYTHONPATH (~44 MB as tar.xz, carried in two parts beside the bundle:
+# docs/bench/surfaces, session 10); then OPEN3D_PYTHON=that/run.sh (Open3D's
+# worker only) and TOOLS=...,open3d.
 set -uo pipefail
 B=$(cd "${1:?bundle dir}" && pwd); OUT=${2:?out dir}; ROWS=${3:-}
 here=$(cd "$(dirname "$0")" && pwd)
@@ -63,6 +71,7 @@ export LD_LIBRARY_PATH=$B/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 rows=()
 [ -n "$ROWS" ] && rows=(--rows "$ROWS")
 PYTHONUNBUFFERED=1 timeout 580 "${PYTHON:-python3}" "$here/surface_peers.py" --inputs "$B/inputs" --out "$OUT" \
-  --rthdist "$B/rthdist" --cgal "$B/surface-cgal" --tools rthdist-cpu,rthdist-cpu-1t,cgal --gpu-backends rt-pipeline \
-  --surface-bench "$B/rthdist-surface-bench" --kept-backends rt-pipeline \
+  --rthdist "$B/rthdist" --cgal "$B/surface-cgal" --tools "${TOOLS:-rthdist-cpu,rthdist-cpu-1t,cgal}" \
+  --gpu-backends rt-pipeline --surface-bench "$B/rthdist-surface-bench" --kept-backends rt-pipeline \
+  --oneshot-backends "${ONESHOT:-}" --open3d-python "${OPEN3D_PYTHON:-}" \
   --reference rthdist-rt-pipeline-kept --runs "${RUNS:-3}" --cap 120 "${rows[@]}" 2>&1 | tee "$OUT/log.txt"

@@ -12,6 +12,9 @@ Rows
             or rt-pipeline) against Open3D 0.16 RaycastingScene.compute_distance
             (Embree, float32; max over A's vertices) and surface-cgal points
             (CGAL 5.5 AABB_tree closest_point_and_primitive, double).
+            --oneshot-backends adds rthdist-<backend>-oneshot: the same
+            bench's --one-shot calls (the free function, a BVH built each
+            call, as Open3D builds its scene each run) in one process.
             --kept-backends adds rthdist-<backend>-kept: rthdist-surface-bench
             (--surface-bench), the same call on one Engine that keeps its
             device (Engine::hausdorffToSurface): one warm-up call, then
@@ -160,10 +163,27 @@ def kept_tool(args, backend):
     return run
 
 
+def oneshot_tool(args, backend):
+    """rthdist-surface-bench --one-shot: --runs calls of the free function
+    hausdorffToSurface in one process (each builds its BVH and, on a GPU
+    backend, opens its device), as Open3D's runs build a scene each in one
+    Python process; one Engine call before them warms the process."""
+    def run(row, a, b, tolerance):
+        cmd = [args.surface_bench, a, b, "--backend", backend, "--runs", "1", "--warmup", "0",
+               "--one-shot", str(args.runs), "--no-verify"]
+        out, wall = run_process(cmd, args.cap * (args.runs + 2))
+        j = json.loads(out)
+        m = j["one_shot_median_ms"]
+        value = {"h": j["hausdorff"], "query": j["query"], "triangle": j["triangle"], "device": j["device"],
+                 "build_ms": m["build"], "search_ms": m["search"]}
+        return j["one_shot_total_ms_all"], j["one_shot_wall_ms_all"], value
+    return run
+
+
 def open3d_tool(args):
     def run(row, a, b, tolerance):
-        out, wall = run_process([sys.executable, os.path.abspath(__file__), "--open3d-worker", a, b,
-                                 str(args.runs)], args.cap * args.runs)
+        out, wall = run_process([args.open3d_python or sys.executable, os.path.abspath(__file__),
+                                 "--open3d-worker", a, b, str(args.runs)], args.cap * args.runs)
         j = json.loads(out)
         return j["ms"], [1000.0 * wall / args.runs] * args.runs, {"h": j["h"], "query": j["query"]}
     return run
@@ -323,6 +343,12 @@ def main():
     ap.add_argument("--gpu-rows", default="", help="points rows the GPU backends run (default: all points rows)")
     ap.add_argument("--kept-backends", default="",
                     help="rthdist backends timed on a kept Engine (rthdist-surface-bench) for points rows")
+    ap.add_argument("--oneshot-backends", default="",
+                    help="rthdist backends timed as one-shot calls in one process (rthdist-surface-bench "
+                         "--one-shot) for points rows: rthdist-<backend>-oneshot")
+    ap.add_argument("--open3d-python", default="",
+                    help="the Python that runs Open3D's worker (default: this one), e.g. a carried "
+                         "interpreter's wrapper on a machine without Open3D")
     ap.add_argument("--surface-bench", default="build/rthdist-surface-bench")
     ap.add_argument("--reference", default="rthdist-cpu",
                     help="ratios against this rthdist (e.g. rthdist-rt-pipeline); rows it did not run: rthdist-cpu")
@@ -359,6 +385,7 @@ def main():
             sys.exit("unknown tool " + name)
     gpu = [b for b in args.gpu_backends.split(",") if b]
     kept = [b for b in args.kept_backends.split(",") if b]
+    oneshot = [b for b in args.oneshot_backends.split(",") if b]
     gpu_rows = set(r for r in args.gpu_rows.split(",") if r)
     wanted = set(r for r in args.rows.split(",") if r)
     rows = [r for r in ROWS if not wanted or r[0] in wanted]
@@ -394,6 +421,7 @@ def main():
         if kind == "points":
             row_tools += ["rthdist-" + g for g in gpu if not gpu_rows or name in gpu_rows]
             row_tools += ["rthdist-" + k + "-kept" for k in kept if not gpu_rows or name in gpu_rows]
+            row_tools += ["rthdist-" + k + "-oneshot" for k in oneshot]
         per_tool = {}
         pa, pb = os.path.join(folder, a + ".ply"), os.path.join(folder, b + ".ply")
         for tool in row_tools:
@@ -401,6 +429,8 @@ def main():
                 run = tools[tool]
             elif tool.endswith("-kept"):
                 run = kept_tool(args, tool[len("rthdist-"):-len("-kept")])
+            elif tool.endswith("-oneshot"):
+                run = oneshot_tool(args, tool[len("rthdist-"):-len("-oneshot")])
             else:
                 run = rthdist_tool(args, tool[len("rthdist-"):])
             try:
