@@ -41,18 +41,34 @@ void raiseMax(std::atomic<uint64_t>& bits, double value) {
     }
 }
 
-// The witness's nearest triangle by every triangle, in index order.
-NearestTriangle bruteNearest(const glm::dvec3& p, const MeshView& surface) {
+// The witness's nearest triangle by every triangle: chunks of the triangles
+// on the worker pool, each in index order, joined by the smaller squared
+// distance and then the smaller index, so the answer is the serial loop's
+// (the first triangle at the smallest distance) on any thread count. One
+// thread took ~20 ms of a 16-core call against the Dragon's 871k triangles.
+NearestTriangle bruteNearest(const glm::dvec3& p, const MeshView& surface, int threads) {
+    constexpr size_t kTriangleChunk = size_t(1) << 14;
+    const size_t n = surface.triangleCount();
+    const size_t chunks = (n + kTriangleChunk - 1) / kTriangleChunk;
+    std::vector<NearestTriangle> each(chunks);
+    core::parallelChunks(n, kTriangleChunk, threads, [&](size_t begin, size_t end, int) {
+        NearestTriangle best;
+        best.distance2 = std::numeric_limits<double>::infinity();
+        for (size_t t = begin; t < end; ++t) {
+            const core::TriangleClosest r =
+                core::closestOnTriangle(p, surface.corner(t, 0), surface.corner(t, 1), surface.corner(t, 2));
+            if (r.distance2 < best.distance2) {
+                best.distance2 = r.distance2;
+                best.triangle = uint32_t(t);
+                best.point = r.point;
+            }
+        }
+        each[begin / kTriangleChunk] = best;
+    });
     NearestTriangle best;
     best.distance2 = std::numeric_limits<double>::infinity();
-    for (size_t t = 0; t < surface.triangleCount(); ++t) {
-        const core::TriangleClosest r =
-            core::closestOnTriangle(p, surface.corner(t, 0), surface.corner(t, 1), surface.corner(t, 2));
-        if (r.distance2 < best.distance2) {
-            best.distance2 = r.distance2;
-            best.triangle = uint32_t(t);
-            best.point = r.point;
-        }
+    for (const NearestTriangle& c : each) {  // chunk order = index order: strict < keeps the first
+        if (c.distance2 < best.distance2) best = c;
     }
     return best;
 }
@@ -124,7 +140,7 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
     if (!overall.any) return Error{ErrorCode::kInternal, "surface search: no query was settled"};
 
     const glm::dvec3 q = points.at(overall.query);
-    const NearestTriangle check = bruteNearest(q, surface);
+    const NearestTriangle check = bruteNearest(q, surface, options.threads);
     if (check.distance2 != overall.hit.distance2 || check.triangle != overall.hit.triangle) {
         return Error{ErrorCode::kInternal,
                      "surface search: the witness query " + std::to_string(overall.query) +
