@@ -119,6 +119,13 @@ struct Split {
     bool moved = false;
 };
 
+// Items a split takes on several threads (from this many), in chunks of
+// kSplitChunk: fixed chunks, so the items land where one thread puts them.
+constexpr uint32_t kParallelSplit = uint32_t(1) << 16;
+constexpr uint32_t kSplitChunk = uint32_t(1) << 14;
+constexpr uint32_t kMaxBins = 256;
+using Histogram = std::array<uint32_t, kMaxBins>;
+
 // Splits src[0, count) at count / 2 along Axis. A large range is cut by a
 // histogram of its centres over the node's [lo, hi] along the axis (about
 // 16 items a bin, at most kMaxBins; a bin is a non-decreasing function of
@@ -127,11 +134,14 @@ struct Split {
 // and those above into dst (three cursors, no branch on the item), adding
 // each to its half's box, and only the median's bin is ordered by
 // nth_element. Two passes a level, each read once (perf: the selection was
-// most of the build). A small or flat range is selected in place.
+// most of the build). A small or flat range is selected in place. From
+// kParallelSplit items and with threads > 1 both passes run on the worker
+// pool in fixed chunks: each chunk's histogram, then each chunk's first
+// place in each part from them, so every item lands where one thread's
+// stable pass puts it and the tree is the same on any thread count.
 template <int Axis>
-Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBounds& bounds) {
+Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBounds& bounds, int threads) {
     constexpr uint32_t kSmallRange = 128;
-    constexpr uint32_t kMaxBins = 256;
     Split s;
     s.half = count / 2;
     const float lo = bounds.lo[Axis];
@@ -148,24 +158,71 @@ Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBou
         const float b = (item.centre[Axis] - lo) * toBin;
         return b < float(bins - 1) ? uint32_t(b) : bins - 1;  // b >= 0: lo is the minimum
     };
-    std::array<uint32_t, kMaxBins> histogram{};
-    for (uint32_t i = 0; i < count; ++i) ++histogram[binOf(src[i])];
+    const auto countBins = [&](Histogram& h, size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) ++h[binOf(src[i])];
+    };
     uint32_t median = 0, below = 0;
-    while (below + histogram[median] <= s.half) below += histogram[median++];
-    const uint32_t inMedian = histogram[median];
-    std::array<uint32_t, 3> cursor{0, below, below + inMedian};
-    std::array<CentreBounds, 3> side;  // below, the median's bin (unused), above
-    for (uint32_t i = 0; i < count; ++i) {
-        const BuildItem item = src[i];
-        const uint32_t bin = binOf(item);
-        const uint32_t k = uint32_t(bin >= median) + uint32_t(bin > median);
-        dst[cursor[k]++] = item;
-        side[k].add(item.centre);
+    const auto findMedian = [&](const Histogram& histogram) {
+        while (below + histogram[median] <= s.half) below += histogram[median++];
+    };
+    // One pass writes each item to its part through three cursors (no branch
+    // on the item) and grows its half's centre box.
+    const auto scatter = [&](std::array<uint32_t, 3> at, std::array<CentreBounds, 3>& side, size_t begin,
+                             size_t end) {
+        for (size_t i = begin; i < end; ++i) {
+            const BuildItem item = src[i];
+            const uint32_t bin = binOf(item);
+            const uint32_t k = uint32_t(bin >= median) + uint32_t(bin > median);
+            dst[at[k]++] = item;
+            side[k].add(item.centre);
+        }
+    };
+    uint32_t inMedian = 0;
+    if (threads <= 1 || count < kParallelSplit) {
+        Histogram histogram{};
+        countBins(histogram, 0, count);
+        findMedian(histogram);
+        inMedian = histogram[median];
+        std::array<CentreBounds, 3> side;  // below, the median's bin (unused), above
+        scatter({0, below, below + inMedian}, side, 0, count);
+        s.left = side[0];
+        s.right = side[2];
+    } else {
+        const uint32_t chunks = (count + kSplitChunk - 1) / kSplitChunk;
+        std::vector<Histogram> local(chunks);
+        core::parallelChunks(count, kSplitChunk, threads, [&](size_t begin, size_t end, int) {
+            Histogram& h = local[begin / kSplitChunk];
+            h.fill(0);
+            countBins(h, begin, end);
+        });
+        Histogram histogram{};
+        for (const Histogram& h : local)
+            for (uint32_t b = 0; b < bins; ++b) histogram[b] += h[b];
+        findMedian(histogram);
+        inMedian = histogram[median];
+        // Each chunk's first place in each part: below, the median's bin, above.
+        std::vector<std::array<uint32_t, 3>> first(chunks);
+        std::array<uint32_t, 3> cursor{0, below, below + inMedian};
+        for (uint32_t c = 0; c < chunks; ++c) {
+            first[c] = cursor;
+            uint32_t under = 0;
+            for (uint32_t b = 0; b < median; ++b) under += local[c][b];
+            const uint32_t size = std::min(kSplitChunk, count - c * kSplitChunk);
+            cursor[0] += under;
+            cursor[1] += local[c][median];
+            cursor[2] += size - under - local[c][median];
+        }
+        std::vector<std::array<CentreBounds, 3>> sides(chunks);
+        core::parallelChunks(count, kSplitChunk, threads, [&](size_t begin, size_t end, int) {
+            scatter(first[begin / kSplitChunk], sides[begin / kSplitChunk], begin, end);
+        });
+        for (const std::array<CentreBounds, 3>& side : sides) {
+            s.left.add(side[0]);
+            s.right.add(side[2]);
+        }
     }
     std::nth_element(dst + below, dst + s.half, dst + below + inMedian, CentreBefore<Axis>{});
-    s.left = side[0];
     s.left.add(boundsOf(dst + below, s.half - below));
-    s.right = side[2];
     s.right.add(boundsOf(dst + s.half, below + inMedian - s.half));
     s.moved = true;
     return s;
@@ -174,13 +231,13 @@ Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBou
 // Splits at count / 2 along the longest axis of the centres' spread. The
 // order is strict and total, so the halves depend only on the set of items,
 // never on their order or on the thread.
-Split splitAtMedian(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBounds& bounds) {
+Split splitAtMedian(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBounds& bounds, int threads) {
     const glm::dvec3 spread = glm::dvec3(bounds.hi) - glm::dvec3(bounds.lo);
     const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
     switch (axis) {
-        case 0: return splitAlong<0>(src, dst, count, bounds);
-        case 1: return splitAlong<1>(src, dst, count, bounds);
-        default: return splitAlong<2>(src, dst, count, bounds);
+        case 0: return splitAlong<0>(src, dst, count, bounds, threads);
+        case 1: return splitAlong<1>(src, dst, count, bounds, threads);
+        default: return splitAlong<2>(src, dst, count, bounds, threads);
     }
 }
 
@@ -250,9 +307,9 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     };
     // Node p becomes inner; its children are the first two of its
     // descendants, then the left's descendants, then the right's.
-    const auto split = [&](const PendingNode& p) {
+    const auto split = [&](const PendingNode& p, int splitThreads) {
         const Split s = splitAtMedian(buffers[p.buffer] + p.first, buffers[1 - p.buffer] + p.first, p.count,
-                                      p.bounds);
+                                      p.bounds, splitThreads);
         m_nodes[p.at].first = p.base;
         m_nodes[p.at].count = 0;
         const uint32_t buffer = s.moved ? 1 - p.buffer : p.buffer;
@@ -268,7 +325,7 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
                 makeLeaf(p);
                 return;
             }
-            for (const PendingNode& c : split(p)) self(self, c);
+            for (const PendingNode& c : split(p, 1)) self(self, c);
         };
         recurse(recurse, top);
     };
@@ -279,9 +336,12 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     std::vector<uint32_t> topInner;  // parents before their children
     while (threads > 1 && level.size() < kSubtreesPerThread * size_t(threads) &&
            level.front().count > kSubtreeTriangles) {
+        // A level of fewer nodes than threads shares them out: each node's
+        // split on threads / nodes of them (the root's on all).
         std::vector<std::array<PendingNode, 2>> halves(level.size());
+        const int each = std::max(1, threads / int(level.size()));
         core::parallelChunks(level.size(), 1, threads, [&](size_t begin, size_t end, int) {
-            for (size_t i = begin; i < end; ++i) halves[i] = split(level[i]);
+            for (size_t i = begin; i < end; ++i) halves[i] = split(level[i], each);
         });
         std::vector<PendingNode> next;
         next.reserve(2 * level.size());

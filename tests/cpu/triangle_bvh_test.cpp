@@ -178,9 +178,10 @@ double slack() { return core::closestSlack(20.0); }
 std::vector<RandomMesh> meshes() {
     std::vector<RandomMesh> all;
     // Small sizes around the leaf size and its doubles; then sizes whose top
-    // levels the build splits in parallel.
+    // levels the build splits in parallel (from 2^16 items a split runs on
+    // several threads itself: the root of 65537, the top two levels of 140000).
     uint64_t seed = 1;
-    for (size_t n : {1, 2, 3, 4, 5, 7, 8, 9, 16, 17, 100, 4097, 30000, 65537})
+    for (size_t n : {1, 2, 3, 4, 5, 7, 8, 9, 16, 17, 100, 4097, 30000, 65537, 140000})
         all.push_back(randomMesh(seed++, n));
     all.push_back(duplicateMesh(20000));
     return all;
