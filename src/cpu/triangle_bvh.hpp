@@ -1,5 +1,6 @@
-// A bounding-volume hierarchy over triangles, in double, for the exact
-// nearest-triangle query of the point-to-surface search (design.md §11).
+// A bounding-volume hierarchy over triangles (corners in double, node boxes
+// in float rounded outward), for the exact nearest-triangle query of the
+// point-to-surface search (design.md §11).
 //
 // Built top-down by median splits of the triangles' box centres (rounded
 // to float) along the longest axis of their spread (leaves of at most
@@ -10,8 +11,10 @@
 // so the tree is one
 // function of the mesh: the same nodes, boxes and triangle order on any
 // number of threads. The build runs on the worker pool: the top levels
-// level by level (the nodes of a level in parallel), then the subtrees
-// below them as parallel tasks, each on one thread.
+// level by level (the nodes of a level in parallel, a split of 2^16 items or
+// more itself on several threads in fixed chunks), then the subtrees below
+// them as parallel tasks, each on one thread; then the corners, each
+// triangle's written once to its place, and the boxes from the leaves up.
 //
 // The query visits the nearer child first and skips a box only when its
 // distance exceeds the best distance so far by more than
@@ -19,12 +22,13 @@
 // index on a tie) is never skipped, so the answer equals a brute force over
 // every triangle. That holds for any tree shape: it only needs each node's
 // box to contain the boxes of the triangles below it (min and max are exact,
-// and the rounded box distance only shrinks as a box grows), and a tie
+// rounding to float goes outward, and the rounded box distance only shrinks
+// as a box grows), and a tie
 // between triangles is settled by their index, not by the order of the
 // visit.
 //
-// Layout for a later GPU path: the boxes are the triangles' own (the
-// procedural AABBs of a BLAS would be the same), and the measure is the
+// Layout for a later GPU path: the leaves' boxes hold the triangles' own
+// (the procedural AABBs of a BLAS would be the same), and the measure is the
 // shared rule (shaders/shared/rthdist_point_triangle.h).
 #pragma once
 
