@@ -263,7 +263,13 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     const auto n = uint32_t(mesh.triangleCount());
     threads = core::resolveThreads(threads, n / kSubtreeTriangles);
     m_nodes.resize(1 + size_t(descendantCount(n)));
-    m_corners.resize(3 * size_t(n));
+    // Float corners for a float mesh (its coordinates, exactly: the rule
+    // reads them as doubles), half the memory of double ones.
+    m_floatCorners = mesh.vertices.scalar == Scalar::kFloat32;
+    if (m_floatCorners)
+        m_cornersF.resize(3 * size_t(n));
+    else
+        m_corners.resize(3 * size_t(n));
     m_original.resize(n);
     if (n == 0) {
         m_nodes[0] = Node{glm::vec3(std::numeric_limits<float>::infinity()),
@@ -275,8 +281,9 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     // are spent before the corners pass writes there. Fresh memory is what a
     // one-shot build pays most for on a VM (~2.5 ms a MiB on first touch,
     // docs/bench/surfaces session 10), and no block of its own is faulted in.
-    static_assert(2 * sizeof(BuildItem) <= 3 * sizeof(glm::dvec3) && alignof(BuildItem) <= alignof(glm::dvec3));
-    BuildItem* const items = reinterpret_cast<BuildItem*>(m_corners.data());
+    static_assert(2 * sizeof(BuildItem) <= 3 * sizeof(glm::vec3) && alignof(BuildItem) <= alignof(glm::vec3));
+    BuildItem* const items = m_floatCorners ? reinterpret_cast<BuildItem*>(m_cornersF.data())
+                                            : reinterpret_cast<BuildItem*>(m_corners.data());
     BuildItem* const buffers[2] = {items, items + n};
     const size_t chunks = (size_t(n) + kSubtreeTriangles - 1) / kSubtreeTriangles;
     std::vector<CentreBounds> chunkBounds(chunks);
@@ -358,8 +365,13 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     // The corners, each triangle's in input order to its BVH place.
     core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
         for (size_t t = begin; t < end; ++t) {
-            glm::dvec3* to = &m_corners[3 * size_t(placeOf[t])];
-            for (int k = 0; k < 3; ++k) to[k] = mesh.corner(t, k);
+            const size_t at = 3 * size_t(placeOf[t]);
+            for (int k = 0; k < 3; ++k) {
+                if (m_floatCorners)
+                    m_cornersF[at + size_t(k)] = glm::vec3(mesh.corner(t, k));  // exact: a float's value
+                else
+                    m_corners[at + size_t(k)] = mesh.corner(t, k);
+            }
         }
     });
 
@@ -368,11 +380,11 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     const auto boxOf = [&](uint32_t at) {
         Node& node = m_nodes[at];
         if (node.count > 0) {
-            const glm::dvec3* c = &m_corners[3 * size_t(node.first)];
-            glm::dvec3 lo = c[0], hi = c[0];
+            const size_t first = 3 * size_t(node.first);
+            glm::dvec3 lo = cornerAt(first), hi = lo;
             for (uint32_t k = 1; k < 3 * node.count; ++k) {
-                lo = glm::min(lo, c[k]);
-                hi = glm::max(hi, c[k]);
+                lo = glm::min(lo, cornerAt(first + k));
+                hi = glm::max(hi, cornerAt(first + k));
             }
             node.lo = glm::vec3(floatAtOrBelow(lo.x), floatAtOrBelow(lo.y), floatAtOrBelow(lo.z));
             node.hi = glm::vec3(floatAtOrAbove(hi.x), floatAtOrAbove(hi.y), floatAtOrAbove(hi.z));
@@ -394,6 +406,13 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
 }
 
 NearestTriangle TriangleBvh::nearest(const glm::dvec3& p, double slack, double stopBelow2) const {
+    return m_floatCorners ? nearestIn(m_cornersF.data(), p, slack, stopBelow2)
+                          : nearestIn(m_corners.data(), p, slack, stopBelow2);
+}
+
+template <class Corner>
+NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& p, double slack,
+                                       double stopBelow2) const {
     NearestTriangle best;
     best.distance2 = std::numeric_limits<double>::infinity();
     double bound2 = best.distance2;
@@ -412,8 +431,9 @@ NearestTriangle TriangleBvh::nearest(const glm::dvec3& p, double slack, double s
         const Node& node = m_nodes[e.node];
         if (node.count > 0) {
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-                const glm::dvec3* c = &m_corners[3 * size_t(i)];
-                const core::TriangleClosest r = core::closestOnTriangle(p, c[0], c[1], c[2]);
+                const Corner* c = &corners[3 * size_t(i)];
+                const core::TriangleClosest r =
+                    core::closestOnTriangle(p, glm::dvec3(c[0]), glm::dvec3(c[1]), glm::dvec3(c[2]));
                 ++best.trianglesTested;
                 const uint32_t t = m_original[i];
                 if (r.distance2 < best.distance2 || (r.distance2 == best.distance2 && t < best.triangle)) {
@@ -447,6 +467,7 @@ NearestTriangle TriangleBvh::nearest(const glm::dvec3& p, double slack, double s
 
 size_t TriangleBvh::hostBytes() const {
     return m_nodes.capacity() * sizeof(Node) + m_corners.capacity() * sizeof(glm::dvec3) +
+           m_cornersF.capacity() * sizeof(glm::vec3) +
            m_original.capacity() * sizeof(uint32_t);
 }
 

@@ -1,4 +1,4 @@
-// A bounding-volume hierarchy over triangles (corners in double, node boxes
+// A bounding-volume hierarchy over triangles (corners in the mesh's float or double, node boxes
 // in float rounded outward), for the exact nearest-triangle query of the
 // point-to-surface search (design.md §11).
 //
@@ -59,7 +59,8 @@ struct NearestTriangle {
 class TriangleBvh {
 public:
     // The mesh's triangles (indices checked by the caller, coordinates
-    // finite), copied in double. threads: of the worker pool for the build
+    // finite), copied: in float for a float mesh (exactly its values), else in
+    // double. threads: of the worker pool for the build
     // (core::resolveThreads: 0 = every hardware thread); the tree does not
     // depend on it.
     explicit TriangleBvh(const MeshView& mesh, int threads = 1);
@@ -93,9 +94,21 @@ public:
 
 private:
     // UninitVector: no pass zeroes them first, and a kept Engine's next call
-    // reuses their blocks (core/uninit_vector.hpp): 77 MB for 871k triangles.
+    // reuses their blocks (core/uninit_vector.hpp): 83 MB for 871k triangles
+    // in double, 52 MB in float.
     core::UninitVector<Node> m_nodes;
-    core::UninitVector<glm::dvec3> m_corners;  // 3 per triangle, in BVH order
+    // The corners, 3 per triangle in BVH order: in float for a float mesh
+    // (m_cornersF), else in double; the other array stays empty.
+    core::UninitVector<glm::dvec3> m_corners;
+    core::UninitVector<glm::vec3> m_cornersF;
+    bool m_floatCorners = false;
+
+    [[nodiscard]] glm::dvec3 cornerAt(size_t k) const {
+        return m_floatCorners ? glm::dvec3(m_cornersF[k]) : m_corners[k];
+    }
+    template <class Corner>
+    [[nodiscard]] NearestTriangle nearestIn(const Corner* corners, const glm::dvec3& p, double slack,
+                                            double stopBelow2) const;
     core::UninitVector<uint32_t> m_original;   // BVH order -> triangle index
 };
 

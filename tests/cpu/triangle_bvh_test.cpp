@@ -272,5 +272,43 @@ TEST(TriangleBvh, FloatBoxesHoldWhatFloatCannot) {
     }
 }
 
+// A float mesh keeps its corners in float (half the memory): the same tree
+// and the same answers as the same values given in double, and the brute
+// force's.
+TEST(TriangleBvh, FloatMeshAnswersAsTheSameValuesInDouble) {
+    for (const size_t triangles : {size_t(5000), size_t(70000)}) {
+        const RandomMesh m = randomMesh(91 + triangles, triangles);
+        test::Rng rng(93);
+        std::vector<glm::vec3> fv;
+        for (const glm::dvec3& v : m.vertices)  // off the lattice, rounded to float once
+            fv.emplace_back(v + glm::dvec3(rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1)));
+        const std::vector<glm::dvec3> dv(fv.begin(), fv.end());  // the same values
+        const cpu::TriangleBvh f(MeshView{PointView(fv), m.indices}, 2);
+        const cpu::TriangleBvh d(MeshView{PointView(dv), m.indices}, 2);
+        EXPECT_LT(f.hostBytes(), d.hostBytes()) << m.name;
+        ASSERT_EQ(f.nodeCount(), d.nodeCount()) << m.name;
+        EXPECT_EQ(f.triangleOrder(), d.triangleOrder()) << m.name;
+        for (size_t i = 0; i < f.nodeCount(); ++i) {
+            const cpu::TriangleBvh::Node &a = f.nodes()[i], &b = d.nodes()[i];
+            ASSERT_TRUE(a.lo == b.lo && a.hi == b.hi && a.first == b.first && a.count == b.count)
+                << m.name << ": node " << i;
+        }
+        const RandomMesh same{m.name, dv, m.indices};
+        for (const glm::dvec3& p : queries(same, 94, 200)) {
+            const cpu::NearestTriangle x = f.nearest(p, slack());
+            const cpu::NearestTriangle y = d.nearest(p, slack());
+            EXPECT_EQ(x.distance2, y.distance2) << m.name;
+            EXPECT_EQ(x.triangle, y.triangle) << m.name;
+            EXPECT_EQ(x.point, y.point) << m.name;
+            EXPECT_EQ(x.barycentric, y.barycentric) << m.name;
+            if (triangles <= 5000) {
+                const oracle::SurfaceNearest want = oracle::bruteNearestTriangle(p, dv, m.indices);
+                EXPECT_EQ(x.distance2, want.distance2) << m.name;
+                EXPECT_EQ(x.triangle, want.triangle) << m.name;
+            }
+        }
+    }
+}
+
 }  // namespace
 }  // namespace rthdist
