@@ -320,10 +320,9 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
         m_nodes[p.at].first = p.base;
         m_nodes[p.at].count = 0;
         const uint32_t buffer = s.moved ? 1 - p.buffer : p.buffer;
-        return std::array<PendingNode, 2>{
-            PendingNode{p.base, p.first, s.half, p.base + 2, s.left, buffer},
-            PendingNode{p.base + 1, p.first + s.half, p.count - s.half, p.base + 2 + descendantCount(s.half),
-                        s.right, buffer}};
+        return std::array<PendingNode, 2>{PendingNode{p.base, p.first, s.half, p.base + 2, s.left, buffer},
+                                          PendingNode{p.base + 1, p.first + s.half, p.count - s.half,
+                                                      p.base + 2 + descendantCount(s.half), s.right, buffer}};
     };
     // A whole subtree's splits on this thread, depth first.
     const auto splitSubtree = [&](const PendingNode& top) {
@@ -467,8 +466,7 @@ NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& 
 
 size_t TriangleBvh::hostBytes() const {
     return m_nodes.capacity() * sizeof(Node) + m_corners.capacity() * sizeof(glm::dvec3) +
-           m_cornersF.capacity() * sizeof(glm::vec3) +
-           m_original.capacity() * sizeof(uint32_t);
+           m_cornersF.capacity() * sizeof(glm::vec3) + m_original.capacity() * sizeof(uint32_t);
 }
 
 }  // namespace rthdist::cpu

@@ -82,9 +82,10 @@ public:
     // infinity, still holding them), so the nodes take 57 % of the memory
     // of a box in double, which a one-shot call faults in fresh.
     struct Node {
-        glm::vec3 lo, hi;  // leaf: the union of its triangles' boxes rounded outward; inner: of its children's
-        uint32_t first;    // leaf: first triangle (BVH order); inner: left child (right = first + 1)
-        uint32_t count;    // leaf: triangles; inner: 0
+        glm::vec3 lo,
+            hi;          // leaf: the union of its triangles' boxes rounded outward; inner: of its children's
+        uint32_t first;  // leaf: first triangle (BVH order); inner: left child (right = first + 1)
+        uint32_t count;  // leaf: triangles; inner: 0
     };
     static_assert(sizeof(Node) == 32);
     // For tests and diagnostics: node 0 is the root; a node's children come
@@ -109,7 +110,7 @@ private:
     template <class Corner>
     [[nodiscard]] NearestTriangle nearestIn(const Corner* corners, const glm::dvec3& p, double slack,
                                             double stopBelow2) const;
-    core::UninitVector<uint32_t> m_original;   // BVH order -> triangle index
+    core::UninitVector<uint32_t> m_original;  // BVH order -> triangle index
 };
 
 }  // namespace rthdist::cpu

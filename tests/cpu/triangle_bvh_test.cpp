@@ -250,14 +250,15 @@ TEST(TriangleBvh, FloatBoxesHoldWhatFloatCannot) {
     struct Frame {
         double scale, offset;
     };
-    for (const Frame f : {Frame{1.0, 0.0}, Frame{1.0, 6.4e6}, Frame{1e45, 0.0}, Frame{1e45, -1e46},
-                          Frame{1e-42, 0.0}}) {
+    for (const Frame f :
+         {Frame{1.0, 0.0}, Frame{1.0, 6.4e6}, Frame{1e45, 0.0}, Frame{1e45, -1e46}, Frame{1e-42, 0.0}}) {
         RandomMesh m = randomMesh(77, 3000);
         const std::vector<glm::dvec3> lattice = queries(m, 78, 150);
         test::Rng rng(79);
         const auto place = [&](const glm::dvec3& v) { return v * f.scale + f.offset; };
         for (glm::dvec3& v : m.vertices)
-            v = place(v + glm::dvec3(rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3)));
+            v = place(
+                v + glm::dvec3(rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3)));
         m.name += ", x " + std::to_string(f.scale) + " + " + std::to_string(f.offset);
         const cpu::TriangleBvh bvh(m.view(), 2);
         expectTreeInvariants(m, bvh);
@@ -281,7 +282,8 @@ TEST(TriangleBvh, FloatMeshAnswersAsTheSameValuesInDouble) {
         test::Rng rng(93);
         std::vector<glm::vec3> fv;
         for (const glm::dvec3& v : m.vertices)  // off the lattice, rounded to float once
-            fv.emplace_back(v + glm::dvec3(rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1)));
+            fv.emplace_back(
+                v + glm::dvec3(rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1)));
         const std::vector<glm::dvec3> dv(fv.begin(), fv.end());  // the same values
         const cpu::TriangleBvh f(MeshView{PointView(fv), m.indices}, 2);
         const cpu::TriangleBvh d(MeshView{PointView(dv), m.indices}, 2);
