@@ -62,16 +62,23 @@
 //   kAuto run the CPU backend (an auto Engine that chose a GPU too, until
 //   the kept route is measured faster than the CPU backend). The results
 //   are those of hausdorffToSurface with the same backend (==); threads are
-//   EngineOptions::threads. Each call uploads its inputs afresh (nothing of
-//   a mesh is kept between calls but the memory); the buffers only grow,
-//   to the largest call's, until the Engine is destroyed.
+//   EngineOptions::threads. On the CPU backend an Engine keeps its last
+//   mesh's BVH with a copy of that mesh (24 bytes a vertex, 12 a
+//   triangle): a call whose mesh equals it, compared exactly (every
+//   vertex's value bit for bit, every index; float or double alike),
+//   searches the kept tree (SurfaceCounters::tailTreeReused = 1, buildMs the
+//   comparison's), any other builds and keeps a new one. A GPU backend
+//   uploads its inputs afresh and keeps its tail's tree for the same
+//   corners; its buffers only grow, to the largest call's, until the
+//   Engine is destroyed.
 //
 // Threading: reentrant; the BVH build and the search (on a GPU backend: the
 //   framing and the proof) run on SurfaceOptions::threads threads of the
 //   library's worker pool. The BVH, and so every result, is the same on
 //   any thread count. An Engine serves one call at a time (as compute).
-// Memory: at most 132 bytes per triangle (its corners in double and at
-//   most one 56-byte BVH node), plus 60 bytes per point with
+// Memory: at most 112 bytes per triangle (its corners, 72 bytes in double
+//   or 36 in float for a float mesh; at most one 32-byte BVH node; its
+//   index, twice during the build), plus 60 bytes per point with
 //   perPointDistances (SurfacePerPoint). GPU backends: on the device 104
 //   bytes per triangle and 24 per point (and the BLAS); on the host 36 per
 //   triangle and 16 per point, and host-visible upload and read-back
@@ -137,7 +144,9 @@ struct SurfaceCounters {
     // measured exactly on the host instead (no tree, one submission).
     uint64_t tailQueries = 0;      // queries searched by the device's tree descent
     uint64_t tailHostQueries = 0;  // queries measured exactly on the host instead (the proof's brute force)
-    uint32_t tailTreeReused = 0;   // 1: the descent's tree was the call before's (same corners), not built
+    // 1: the tree was the call before's, not built: a GPU backend's descent
+    // tree (same corners), or an Engine's CPU-backend BVH (the same mesh).
+    uint32_t tailTreeReused = 0;
     // Queries searched again exactly on the host (the others are proven below h).
     uint64_t band = 0;
 };

@@ -103,6 +103,7 @@ struct Engine::Impl {
     std::shared_ptr<api::ComputeBackend> backend;
     double setupMs = 0.0;
     uint64_t preparedCount = 0;
+    cpu::KeptSurfaceTree surfaceTree;  // the CPU route's last mesh and its BVH
 };
 
 struct PreparedSet::Impl {
@@ -610,7 +611,8 @@ Result<SurfaceResult> Engine::hausdorffToSurface(PointView points, MeshView surf
 // Point to surface on the kept backend (api/surface_engine.hpp routes it).
 Result<SurfaceResult> Engine::hausdorffToSurface(PointView points, MeshView surface,
                                                  const SurfaceCallOptions& call) {
-    return api::surfaceOnEngine(*m_impl->backend, m_impl->options, points, surface, call);
+    return api::surfaceOnEngine(*m_impl->backend, m_impl->options, m_impl->surfaceTree, points, surface,
+                                call);
 }
 
 void Engine::recycle(HausdorffResult&& spent) {

@@ -130,8 +130,8 @@ Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, con
 namespace api {
 
 Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptions& engine,
-                                      const PointView& points, const MeshView& surface,
-                                      const SurfaceCallOptions& call) {
+                                      cpu::KeptSurfaceTree& kept, const PointView& points,
+                                      const MeshView& surface, const SurfaceCallOptions& call) {
     const core::Clock::time_point start = core::Clock::now();
     SurfaceOptions options;
     static_cast<SurfaceCallOptions&>(options) = call;
@@ -142,10 +142,20 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
     if (plan.route == Route::kRefused) return Error{plan.code, plan.reason};
     Result<SurfaceInputs> inputs = checkInputs(points, surface, options.threads);
     if (!inputs) return inputs.error();
-    Result<SurfaceResult> result = plan.route == Route::kSurfaceGpu
-                                       ? surfaceOnGpu(backend, points, surface, *inputs, options)
-                                       : cpu::surfaceSearch(points, surface, inputs->magnitude, options);
-    if (result) result->totalMs = core::msSince(start);
+    if (plan.route == Route::kSurfaceGpu) {
+        Result<SurfaceResult> result = surfaceOnGpu(backend, points, surface, *inputs, options);
+        if (result) result->totalMs = core::msSince(start);
+        return result;
+    }
+    const core::Clock::time_point treeStart = core::Clock::now();
+    bool reused = false;
+    const cpu::TriangleBvh& tree = kept.treeFor(surface, options.threads, reused);
+    const double treeMs = core::msSince(treeStart);
+    Result<SurfaceResult> result = cpu::surfaceSearch(points, surface, inputs->magnitude, options, tree);
+    if (!result) return result;
+    result->buildMs = treeMs;  // the tree's build, or the comparison that kept it
+    result->directed.counters.tailTreeReused = reused ? 1 : 0;
+    result->totalMs = core::msSince(start);
     return result;
 }
 

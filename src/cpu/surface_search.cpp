@@ -92,11 +92,22 @@ NearestTriangle bruteNearest(const glm::dvec3& p, const MeshView& surface, doubl
 Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& surface, double magnitude,
                                     const SurfaceOptions& options) {
     const core::Clock::time_point start = core::Clock::now();
+    const TriangleBvh bvh(surface, options.threads);
+    const double buildMs = core::msSince(start);
+    Result<SurfaceResult> result = surfaceSearch(points, surface, magnitude, options, bvh);
+    if (result) {
+        result->buildMs = buildMs;
+        result->totalMs = core::msSince(start);
+    }
+    return result;
+}
+
+Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& surface, double magnitude,
+                                    const SurfaceOptions& options, const TriangleBvh& bvh) {
+    const core::Clock::time_point start = core::Clock::now();
     SurfaceResult result;
     result.backend = Backend::kCpu;
     result.device = "cpu";
-    const TriangleBvh bvh(surface, options.threads);
-    result.buildMs = core::msSince(start);
 
     const core::Clock::time_point searchStart = core::Clock::now();
     const double slack = core::closestSlack(magnitude);

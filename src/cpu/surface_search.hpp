@@ -5,6 +5,7 @@
 // witness query checked against every triangle.
 #pragma once
 
+#include "cpu/triangle_bvh.hpp"
 #include "rthdist/surface.hpp"
 
 namespace rthdist::cpu {
@@ -14,5 +15,11 @@ namespace rthdist::cpu {
 // both (the pruning's slack, core::closestSlack).
 [[nodiscard]] Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& surface,
                                                   double magnitude, const SurfaceOptions& options);
+
+// The same search over a tree already built over `surface`'s triangles (an
+// Engine's kept tree, cpu/kept_surface_tree.hpp); buildMs is left 0.
+[[nodiscard]] Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& surface,
+                                                  double magnitude, const SurfaceOptions& options,
+                                                  const TriangleBvh& bvh);
 
 }  // namespace rthdist::cpu

@@ -75,6 +75,59 @@ TEST(SurfaceApi, AnEngineOfTheCpuBackendEqualsTheFreeFunction) {
     }
 }
 
+// An Engine of the CPU backend keeps its last mesh's BVH: the same mesh
+// again (the same values from another array, or given in float) reuses it,
+// and any change (a vertex moved by one ulp, an index, a vertex more)
+// builds a new one; every answer is the free function's (==).
+TEST(SurfaceApi, AnEngineOfTheCpuBackendKeepsItsTreeForTheSameMeshOnly) {
+    EngineOptions o;
+    o.backend = Backend::kCpu;
+    Result<Engine> engine = Engine::create(o);
+    ASSERT_TRUE(engine) << engine.error().message;
+    const std::vector<test::SurfaceCase> cases = test::makeSurfaceCases();
+    const auto withQueries = std::find_if(cases.begin(), cases.end(), [](const test::SurfaceCase& c) {
+        return !c.queries.empty() && c.indices.size() >= 6;
+    });
+    ASSERT_NE(withQueries, cases.end());
+    const test::SurfaceCase& c = *withQueries;
+    const auto call = [&](const MeshView& mesh, uint32_t wantReused, const char* step) {
+        SurfaceCallOptions perPoint;
+        perPoint.perPointDistances = true;
+        Result<SurfaceResult> kept = engine->hausdorffToSurface(PointView(c.queries), mesh, perPoint);
+        SurfaceOptions options;
+        options.backend = Backend::kCpu;
+        options.perPointDistances = true;
+        Result<SurfaceResult> once = hausdorffToSurface(PointView(c.queries), mesh, options);
+        ASSERT_TRUE(kept && once) << c.name << ": " << step;
+        EXPECT_EQ(kept->directed.counters.tailTreeReused, wantReused) << c.name << ": " << step;
+        EXPECT_EQ(kept->hausdorff, once->hausdorff) << c.name << ": " << step;
+        EXPECT_EQ(kept->directed.queryIndex, once->directed.queryIndex) << c.name << ": " << step;
+        EXPECT_EQ(kept->directed.triangle, once->directed.triangle) << c.name << ": " << step;
+        EXPECT_EQ(kept->directed.surfacePoint, once->directed.surfacePoint) << c.name << ": " << step;
+        EXPECT_EQ(kept->perPoint.distance, once->perPoint.distance) << c.name << ": " << step;
+        EXPECT_EQ(kept->perPoint.triangle, once->perPoint.triangle) << c.name << ": " << step;
+    };
+    std::vector<glm::dvec3> vertices = c.vertices;
+    std::vector<uint32_t> indices = c.indices;
+    call(MeshView{PointView(vertices), indices}, 0, "first");
+    call(MeshView{PointView(vertices), indices}, 1, "same arrays");
+    const std::vector<glm::dvec3> copy = vertices;
+    const std::vector<uint32_t> copyIndices = indices;
+    call(MeshView{PointView(copy), copyIndices}, 1, "same values, other arrays");
+    vertices[1].x = std::nextafter(vertices[1].x, 1e300);
+    call(MeshView{PointView(vertices), indices}, 0, "a vertex one ulp away");
+    call(MeshView{PointView(vertices), indices}, 1, "that mesh again");
+    std::swap(indices[0], indices[1]);
+    call(MeshView{PointView(vertices), indices}, 0, "two indices swapped");
+    vertices.push_back(vertices.back());
+    call(MeshView{PointView(vertices), indices}, 0, "a vertex more");
+    std::vector<glm::vec3> floats;
+    for (const glm::dvec3& v : copy) floats.emplace_back(v);
+    std::vector<glm::dvec3> fromFloats(floats.begin(), floats.end());
+    call(MeshView{PointView(fromFloats), copyIndices}, 0, "rounded to float, in double");
+    call(MeshView{PointView(floats), copyIndices}, 1, "the same values in float");
+}
+
 // Per-point distances come from the CPU backend only: a GPU backend the
 // caller named is refused before any device is opened, never replaced.
 TEST(SurfaceApi, PerPointOnAGpuBackendIsRefusedNotReplaced) {
