@@ -277,10 +277,11 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
         return;
     }
     // Two buffers of build items (a level's splits read one and write the
-    // other) in the corners' memory, 32 of its 72 bytes a triangle: the items
-    // are spent before the corners pass writes there. Fresh memory is what a
-    // one-shot build pays most for on a VM (~2.5 ms a MiB on first touch,
-    // docs/bench/surfaces session 10), and no block of its own is faulted in.
+    // other) in the corners' memory, 32 of its 36 (float) or 72 (double)
+    // bytes a triangle: the items are spent before the corners pass writes
+    // there. Fresh memory is what a one-shot build pays most for on a VM
+    // (~2.3 ms a MiB on first touch, docs/bench/surfaces session 10), and no
+    // block of its own is faulted in.
     static_assert(2 * sizeof(BuildItem) <= 3 * sizeof(glm::vec3) && alignof(BuildItem) <= alignof(glm::vec3));
     BuildItem* const items = m_floatCorners ? reinterpret_cast<BuildItem*>(m_cornersF.data())
                                             : reinterpret_cast<BuildItem*>(m_corners.data());
