@@ -9,6 +9,7 @@
 #include <limits>
 #include <utility>
 
+#include "core/float_box.hpp"
 #include "core/parallel.hpp"
 #include "core/point_triangle.hpp"
 
@@ -89,23 +90,10 @@ struct CentreBefore {
     }
 };
 
-// The box of a set of build items' centres (float: min and max are exact,
-// so it is the same whatever the order the items are added in).
-struct CentreBounds {
-    glm::vec3 lo{std::numeric_limits<float>::infinity()};
-    glm::vec3 hi{-std::numeric_limits<float>::infinity()};
-    void add(const glm::vec3& c) {
-        lo = glm::min(lo, c);
-        hi = glm::max(hi, c);
-    }
-    void add(const CentreBounds& b) {
-        lo = glm::min(lo, b.lo);
-        hi = glm::max(hi, b.hi);
-    }
-};
-
-CentreBounds boundsOf(const BuildItem* items, uint32_t count) {
-    CentreBounds b;
+// The box of build items' centres (min and max are exact: the same box
+// whatever the order the items are added in).
+core::FloatBox boundsOf(const BuildItem* items, uint32_t count) {
+    core::FloatBox b;
     for (uint32_t i = 0; i < count; ++i) b.add(items[i].centre);
     return b;
 }
@@ -115,7 +103,7 @@ CentreBounds boundsOf(const BuildItem* items, uint32_t count) {
 // were written to the other buffer (else reordered in place).
 struct Split {
     uint32_t half = 0;
-    CentreBounds left, right;
+    core::FloatBox left, right;
     bool moved = false;
 };
 
@@ -140,7 +128,7 @@ using Histogram = std::array<uint32_t, kMaxBins>;
 // place in each part from them, so every item lands where one thread's
 // stable pass puts it and the tree is the same on any thread count.
 template <int Axis>
-Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBounds& bounds, int threads) {
+Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const core::FloatBox& bounds, int threads) {
     constexpr uint32_t kSmallRange = 128;
     Split s;
     s.half = count / 2;
@@ -167,7 +155,7 @@ Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBou
     };
     // One pass writes each item to its part through three cursors (no branch
     // on the item) and grows its half's centre box.
-    const auto scatter = [&](std::array<uint32_t, 3> at, std::array<CentreBounds, 3>& side, size_t begin,
+    const auto scatter = [&](std::array<uint32_t, 3> at, std::array<core::FloatBox, 3>& side, size_t begin,
                              size_t end) {
         for (size_t i = begin; i < end; ++i) {
             const BuildItem item = src[i];
@@ -183,7 +171,7 @@ Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBou
         countBins(histogram, 0, count);
         findMedian(histogram);
         inMedian = histogram[median];
-        std::array<CentreBounds, 3> side;  // below, the median's bin (unused), above
+        std::array<core::FloatBox, 3> side;  // below, the median's bin (unused), above
         scatter({0, below, below + inMedian}, side, 0, count);
         s.left = side[0];
         s.right = side[2];
@@ -212,11 +200,11 @@ Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBou
             cursor[1] += local[c][median];
             cursor[2] += size - under - local[c][median];
         }
-        std::vector<std::array<CentreBounds, 3>> sides(chunks);
+        std::vector<std::array<core::FloatBox, 3>> sides(chunks);
         core::parallelChunks(count, kSplitChunk, threads, [&](size_t begin, size_t end, int) {
             scatter(first[begin / kSplitChunk], sides[begin / kSplitChunk], begin, end);
         });
-        for (const std::array<CentreBounds, 3>& side : sides) {
+        for (const std::array<core::FloatBox, 3>& side : sides) {
             s.left.add(side[0]);
             s.right.add(side[2]);
         }
@@ -231,7 +219,8 @@ Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBou
 // Splits at count / 2 along the longest axis of the centres' spread. The
 // order is strict and total, so the halves depend only on the set of items,
 // never on their order or on the thread.
-Split splitAtMedian(BuildItem* src, BuildItem* dst, uint32_t count, const CentreBounds& bounds, int threads) {
+Split splitAtMedian(BuildItem* src, BuildItem* dst, uint32_t count, const core::FloatBox& bounds,
+                    int threads) {
     const glm::dvec3 spread = glm::dvec3(bounds.hi) - glm::dvec3(bounds.lo);
     const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
     switch (axis) {
@@ -249,7 +238,7 @@ struct PendingNode {
     uint32_t first = 0;
     uint32_t count = 0;
     uint32_t base = 0;
-    CentreBounds bounds;
+    core::FloatBox bounds;
     uint32_t buffer = 0;
 };
 
@@ -287,9 +276,9 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
                                             : reinterpret_cast<BuildItem*>(m_corners.data());
     BuildItem* const buffers[2] = {items, items + n};
     const size_t chunks = (size_t(n) + kSubtreeTriangles - 1) / kSubtreeTriangles;
-    std::vector<CentreBounds> chunkBounds(chunks);
+    std::vector<core::FloatBox> chunkBounds(chunks);
     core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
-        CentreBounds b;
+        core::FloatBox b;
         for (size_t t = begin; t < end; ++t) {
             const glm::dvec3 c0 = mesh.corner(t, 0), c1 = mesh.corner(t, 1), c2 = mesh.corner(t, 2);
             items[t] = {glm::vec3((glm::min(glm::min(c0, c1), c2) + glm::max(glm::max(c0, c1), c2)) * 0.5),
@@ -299,7 +288,7 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
         chunkBounds[begin / kSubtreeTriangles] = b;
     });
     PendingNode root{0, 0, n, 1, {}, 0};
-    for (const CentreBounds& b : chunkBounds) root.bounds.add(b);
+    for (const core::FloatBox& b : chunkBounds) root.bounds.add(b);
 
     core::UninitVector<uint32_t> placeOf(n);  // triangle -> its BVH position
     // A leaf: its triangles' BVH order (their corners and box come later).
