@@ -12,6 +12,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "common/surface_brute_force.hpp"
@@ -44,6 +46,28 @@ TEST(SurfaceApi, AutoAndCpuRunTheCpuBackend) {
     }
 }
 
+// The call on `engine` and the free function on the CPU backend, both with
+// per-point distances: the same answers (==). Returns the Engine's result.
+std::optional<SurfaceResult> engineEqualsFreeFunction(Engine& engine, const std::vector<glm::dvec3>& queries,
+                                                      const MeshView& mesh, const std::string& where) {
+    SurfaceCallOptions call;
+    call.perPointDistances = true;
+    Result<SurfaceResult> kept = engine.hausdorffToSurface(PointView(queries), mesh, call);
+    SurfaceOptions options;
+    options.backend = Backend::kCpu;
+    options.perPointDistances = true;
+    Result<SurfaceResult> once = hausdorffToSurface(PointView(queries), mesh, options);
+    EXPECT_TRUE(kept && once) << where;
+    if (!kept || !once) return std::nullopt;
+    EXPECT_EQ(kept->hausdorff, once->hausdorff) << where;
+    EXPECT_EQ(kept->directed.queryIndex, once->directed.queryIndex) << where;
+    EXPECT_EQ(kept->directed.triangle, once->directed.triangle) << where;
+    EXPECT_EQ(kept->directed.surfacePoint, once->directed.surfacePoint) << where;
+    EXPECT_EQ(kept->perPoint.distance, once->perPoint.distance) << where;
+    EXPECT_EQ(kept->perPoint.triangle, once->perPoint.triangle) << where;
+    return *kept;
+}
+
 // An Engine of the CPU backend serves surface calls as the free function
 // does, per-point distances included, call after call.
 TEST(SurfaceApi, AnEngineOfTheCpuBackendEqualsTheFreeFunction) {
@@ -54,21 +78,10 @@ TEST(SurfaceApi, AnEngineOfTheCpuBackendEqualsTheFreeFunction) {
     const Small s;
     for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
         if (c.queries.empty()) continue;
-        const MeshView mesh{PointView(c.vertices), c.indices};
-        SurfaceCallOptions call;
-        call.perPointDistances = true;
-        Result<SurfaceResult> kept = engine->hausdorffToSurface(PointView(c.queries), mesh, call);
-        SurfaceOptions options;
-        options.backend = Backend::kCpu;
-        options.perPointDistances = true;
-        Result<SurfaceResult> once = hausdorffToSurface(PointView(c.queries), mesh, options);
-        ASSERT_TRUE(kept && once) << c.name;
+        const std::optional<SurfaceResult> kept =
+            engineEqualsFreeFunction(*engine, c.queries, MeshView{PointView(c.vertices), c.indices}, c.name);
+        ASSERT_TRUE(kept) << c.name;
         EXPECT_EQ(kept->backend, Backend::kCpu) << c.name;
-        EXPECT_EQ(kept->hausdorff, once->hausdorff) << c.name;
-        EXPECT_EQ(kept->directed.queryIndex, once->directed.queryIndex) << c.name;
-        EXPECT_EQ(kept->directed.triangle, once->directed.triangle) << c.name;
-        EXPECT_EQ(kept->perPoint.distance, once->perPoint.distance) << c.name;
-        EXPECT_EQ(kept->perPoint.triangle, once->perPoint.triangle) << c.name;
         Result<SurfaceResult> small = engine->hausdorffToSurface(PointView(s.points), s.mesh());
         ASSERT_TRUE(small) << small.error().message;
         EXPECT_EQ(small->hausdorff, 5.0);
@@ -91,21 +104,10 @@ TEST(SurfaceApi, AnEngineOfTheCpuBackendKeepsItsTreeForTheSameMeshOnly) {
     ASSERT_NE(withQueries, cases.end());
     const test::SurfaceCase& c = *withQueries;
     const auto call = [&](const MeshView& mesh, uint32_t wantReused, const char* step) {
-        SurfaceCallOptions perPoint;
-        perPoint.perPointDistances = true;
-        Result<SurfaceResult> kept = engine->hausdorffToSurface(PointView(c.queries), mesh, perPoint);
-        SurfaceOptions options;
-        options.backend = Backend::kCpu;
-        options.perPointDistances = true;
-        Result<SurfaceResult> once = hausdorffToSurface(PointView(c.queries), mesh, options);
-        ASSERT_TRUE(kept && once) << c.name << ": " << step;
+        const std::optional<SurfaceResult> kept =
+            engineEqualsFreeFunction(*engine, c.queries, mesh, c.name + ": " + step);
+        ASSERT_TRUE(kept) << c.name << ": " << step;
         EXPECT_EQ(kept->directed.counters.tailTreeReused, wantReused) << c.name << ": " << step;
-        EXPECT_EQ(kept->hausdorff, once->hausdorff) << c.name << ": " << step;
-        EXPECT_EQ(kept->directed.queryIndex, once->directed.queryIndex) << c.name << ": " << step;
-        EXPECT_EQ(kept->directed.triangle, once->directed.triangle) << c.name << ": " << step;
-        EXPECT_EQ(kept->directed.surfacePoint, once->directed.surfacePoint) << c.name << ": " << step;
-        EXPECT_EQ(kept->perPoint.distance, once->perPoint.distance) << c.name << ": " << step;
-        EXPECT_EQ(kept->perPoint.triangle, once->perPoint.triangle) << c.name << ": " << step;
     };
     std::vector<glm::dvec3> vertices = c.vertices;
     std::vector<uint32_t> indices = c.indices;
