@@ -13,6 +13,7 @@
 #include "api/route_planner.hpp"
 #include "core/certificate.hpp"
 #include "core/parallel.hpp"
+#include "core/point_triangle.hpp"
 
 namespace rthdist::api {
 namespace {
@@ -22,8 +23,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Squared distance from p to the box (0 inside).
 double boxDistance2(const glm::dvec3& p, const core::Bounds& box) {
-    const glm::dvec3 d = glm::max(glm::max(box.lo - p, p - box.hi), glm::dvec3(0.0));
-    return glm::dot(d, d);
+    return core::boxDistance2(p, box.lo, box.hi);
 }
 
 // Point i of a view of scalar S (float or double), in double.

@@ -93,8 +93,7 @@ struct Probe {
     // past the bound, else measured by the rule (and the bound tightened).
     void visit(size_t t, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& lo,
                const glm::dvec3& hi, double slack) {
-        const glm::dvec3 out = glm::max(glm::max(lo - p, p - hi), glm::dvec3(0.0));
-        if (glm::dot(out, out) > prune2) return;
+        if (core::boxDistance2(p, lo, hi) > prune2) return;
         const double d2 = core::closestOnTriangle(p, a, b, c).distance2;
         ++best.tested;
         if (d2 < best.distance2) prune2 = std::min(prune2, pruneBound2(d2, slack));

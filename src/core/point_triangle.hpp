@@ -5,6 +5,8 @@
 // brute force get the same bits for the same inputs.
 #pragma once
 
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 namespace rthdist::core {
@@ -28,5 +30,13 @@ struct TriangleClosest {
 // whose computed distance exceeds best + slack holds no triangle that
 // measures below best.
 [[nodiscard]] double closestSlack(double magnitude);
+
+// The squared distance from p to the box [lo, hi] (0 inside): the pruning
+// tests' point-to-box distance, the one closestSlack covers (every search
+// and brute force that skips boxes uses this one).
+[[nodiscard]] inline double boxDistance2(const glm::dvec3& p, const glm::dvec3& lo, const glm::dvec3& hi) {
+    const glm::dvec3 d = glm::max(glm::max(lo - p, p - hi), glm::dvec3(0.0));
+    return glm::dot(d, d);
+}
 
 }  // namespace rthdist::core

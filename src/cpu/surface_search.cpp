@@ -67,9 +67,8 @@ NearestTriangle bruteNearest(const glm::dvec3& p, const MeshView& surface, doubl
         best.distance2 = std::numeric_limits<double>::infinity();
         for (size_t t = begin; t < end; ++t) {
             const glm::dvec3 a = surface.corner(t, 0), b = surface.corner(t, 1), c = surface.corner(t, 2);
-            const glm::dvec3 out = glm::max(
-                glm::max(glm::min(glm::min(a, b), c) - p, p - glm::max(glm::max(a, b), c)), glm::dvec3(0.0));
-            if (glm::dot(out, out) > bound2) continue;
+            if (core::boxDistance2(p, glm::min(glm::min(a, b), c), glm::max(glm::max(a, b), c)) > bound2)
+                continue;
             const core::TriangleClosest r = core::closestOnTriangle(p, a, b, c);
             if (r.distance2 < best.distance2) {
                 best.distance2 = r.distance2;

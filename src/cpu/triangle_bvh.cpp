@@ -16,9 +16,9 @@
 namespace rthdist::cpu {
 namespace {
 
+// A node's float box, read in double.
 double boxDistance2(const glm::dvec3& p, const glm::vec3& lo, const glm::vec3& hi) {
-    const glm::dvec3 d = glm::max(glm::max(glm::dvec3(lo) - p, p - glm::dvec3(hi)), glm::dvec3(0.0));
-    return glm::dot(d, d);
+    return core::boxDistance2(p, glm::dvec3(lo), glm::dvec3(hi));
 }
 
 // The nearest float at or below v (FLT_MAX for v past it) and at or above.
