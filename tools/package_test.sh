@@ -7,7 +7,11 @@
 #   2. with pkg-config (g++ -std=c++20 $(pkg-config --cflags --libs rthdist)).
 # The shared libraries must export rthdist's public API only, and README.md's
 # C++ example must be the consumer's main.cpp.
-# RTHDIST_JOBS sets the build parallelism (default 2).
+# RTHDIST_JOBS sets the build parallelism (default 2). RTHDIST_PKG_STATIC_FROM
+# names an existing Release build of the default options (static; e.g. the
+# release preset's build/, as .ci/run has just built it) to install the static
+# package from instead of building build-pkg-static/: the same library, one
+# build fewer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=${RTHDIST_JOBS:-2}
@@ -27,11 +31,20 @@ for kind in static shared; do
   build=build-pkg-$kind
   shared=OFF
   [[ $kind == shared ]] && shared=ON
-  # RTHDIST_MPI=OFF: rthdist_mpi is not part of the package (nothing installs
-  # it), so a static library build would compile it for nothing.
-  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DBUILD_SHARED_LIBS=$shared \
-    -DRTHDIST_BUILD_TESTS=OFF -DRTHDIST_BUILD_TOOLS=OFF -DRTHDIST_MPI=OFF > "$work/configure-$kind.log" 2>&1 ||
-    { cat "$work/configure-$kind.log"; exit 1; }
+  if [[ $kind == static && -n ${RTHDIST_PKG_STATIC_FROM:-} ]]; then
+    build=$RTHDIST_PKG_STATIC_FROM
+    cache=$build/CMakeCache.txt
+    # Only a Release build with static libraries is the package a user builds by default.
+    grep -q '^CMAKE_BUILD_TYPE:STRING=Release$' "$cache" && ! grep -q '^BUILD_SHARED_LIBS:BOOL=ON$' "$cache" ||
+      { echo "RTHDIST_PKG_STATIC_FROM=$build: not a static Release build ($cache)"; exit 1; }
+    echo "-- installing from $build (built already)"
+  else
+    # RTHDIST_MPI=OFF: rthdist_mpi is not part of the package (nothing installs
+    # it), so a static library build would compile it for nothing.
+    cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DBUILD_SHARED_LIBS=$shared \
+      -DRTHDIST_BUILD_TESTS=OFF -DRTHDIST_BUILD_TOOLS=OFF -DRTHDIST_MPI=OFF > "$work/configure-$kind.log" 2>&1 ||
+      { cat "$work/configure-$kind.log"; exit 1; }
+  fi
   cmake --build "$build" -j "$jobs"
   prefix=$work/$kind
   cmake --install "$build" --prefix "$prefix" > /dev/null

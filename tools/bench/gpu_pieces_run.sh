@@ -11,7 +11,8 @@
 # budget case, default 3), BEFORE (processes of the before build, default 1),
 # VERIFY (1: one more after process with --verify, default 1), BIG (1: also
 # the 1B x 1B torus, default 1), BIG_RUNS (default 2), DEVICES (e.g. "0,1":
-# the 1B x 1B also on these devices), SCRATCH (default /tmp/rthdist-scale).
+# the budget case and the 1B x 1B also on these devices), SCRATCH (default
+# /tmp/rthdist-scale).
 set -uo pipefail
 B=$(cd "${1:?bundle dir}" && pwd)
 OUT=${2:?out dir}
@@ -40,6 +41,7 @@ run "torus one call (after)" rthdist
 for r in $(seq 1 "${RUNS:-3}"); do
   [ "$r" -le "${BEFORE:-1}" ] && run "torus budget 22400 (before)" rthdist-pieces-before --memory-budget 22400
   run "torus budget 22400 (after)" rthdist --memory-budget 22400
+  [ -n "${DEVICES:-}" ] && run "torus budget 22400 (after, devices $DEVICES)" rthdist --memory-budget 22400 --devices "$DEVICES"
 done
 [ "${VERIFY:-1}" = 1 ] && run "torus budget 22400 (after, --verify)" rthdist --memory-budget 22400 --verify
 rm -f "${files[@]}"
