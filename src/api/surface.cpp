@@ -151,7 +151,8 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
     bool reused = false;
     const cpu::TriangleBvh& tree = kept.treeFor(surface, options.threads, reused);
     const double treeMs = core::msSince(treeStart);
-    Result<SurfaceResult> result = cpu::surfaceSearch(points, surface, inputs->magnitude, options, tree);
+    Result<SurfaceResult> result =
+        cpu::surfaceSearch(points, surface, inputs->magnitude, options, tree, &kept.blocks());
     if (!result) return result;
     result->buildMs = treeMs;  // the tree's build, or the comparison that kept it
     result->directed.counters.tailTreeReused = reused ? 1 : 0;

@@ -35,12 +35,14 @@ const TriangleBvh& KeptSurfaceTree::treeFor(const MeshView& surface, int threads
     kept = sameMesh(surface, threads);
     if (kept) return *m_tree;
     m_tree.reset();  // its memory back before the next one is built
+    m_blocks = TriangleBlocks();
     m_vertices.resize(surface.vertices.count);
     core::parallelChunks(m_vertices.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) m_vertices[i] = surface.vertices.at(i);
     });
     m_indices.assign(surface.indices.begin(), surface.indices.end());
     m_tree.emplace(surface, threads);
+    m_blocks = TriangleBlocks(surface, threads);
     return *m_tree;
 }
 

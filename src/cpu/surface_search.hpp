@@ -5,6 +5,7 @@
 // witness query checked against every triangle.
 #pragma once
 
+#include "cpu/triangle_blocks.hpp"
 #include "cpu/triangle_bvh.hpp"
 #include "rthdist/surface.hpp"
 
@@ -18,8 +19,10 @@ namespace rthdist::cpu {
 
 // The same search over a tree already built over `surface`'s triangles (an
 // Engine's kept tree, cpu/kept_surface_tree.hpp); buildMs is left 0.
+// `blocks` (may be null): the runs of the same mesh, for the witness check
+// (the same answer, cpu/triangle_blocks.hpp).
 [[nodiscard]] Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& surface,
                                                   double magnitude, const SurfaceOptions& options,
-                                                  const TriangleBvh& bvh);
+                                                  const TriangleBvh& bvh, const TriangleBlocks* blocks = nullptr);
 
 }  // namespace rthdist::cpu

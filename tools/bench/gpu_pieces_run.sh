@@ -11,8 +11,11 @@
 # budget case, default 3), BEFORE (processes of the before build, default 1),
 # VERIFY (1: one more after process with --verify, default 1), BIG (1: also
 # the 1B x 1B torus, default 1), BIG_RUNS (default 2), DEVICES (e.g. "0,1":
-# the budget case and the 1B x 1B also on these devices), SCRATCH (default
-# /tmp/rthdist-scale).
+# the budget case and the 1B x 1B also on these devices), ALT_ENV (e.g.
+# "RTHDIST_HOST_IMPORT=1": every process of the after build is followed by
+# one with these variables set, labelled "+ALT_ENV"), TRACE (1: every
+# process with RTHDIST_SUBMIT_TRACE=1, its stderr kept beside its JSON),
+# SCRATCH (default /tmp/rthdist-scale).
 set -uo pipefail
 B=$(cd "${1:?bundle dir}" && pwd)
 OUT=${2:?out dir}
@@ -23,16 +26,26 @@ source "$here/scale_cases.sh"
 { nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader 2>/dev/null; nproc; } > "$OUT/machine.txt"
 cat "$OUT/machine.txt"
 n=0
-run() {  # run LABEL BIN ARGS... : one process, one line
-  local label=$1 bin=$2
-  shift 2
+trace=()
+[ "${TRACE:-0}" = 1 ] && trace=(RTHDIST_SUBMIT_TRACE=1)
+run1() {  # run1 LABEL BIN ENV ARGS... : one process, one line
+  local label=$1 bin=$2 extra=$3
+  shift 3
   n=$((n + 1))
   local t0
   t0=$(date +%s%N)
-  "$B/$bin" --json --quiet --backend rt-pipeline "$@" "${files[@]}" > "$OUT/$n.json" 2> "$OUT/$n.err"
+  # shellcheck disable=SC2086  # extra: variable assignments, one word each
+  env "${trace[@]}" $extra "$B/$bin" --json --quiet --backend rt-pipeline "$@" "${files[@]}" > "$OUT/$n.json" 2> "$OUT/$n.err"
   local rc=$?
   echo "$label: exit $rc in $(( ($(date +%s%N) - t0) / 1000000 )) ms"
   python3 "$here/scale_line.py" "$label" "$n" "$rc" "$OUT/$n.json" "$OUT/$n.err"
+}
+run() {  # run LABEL BIN ARGS... : one process (and one with ALT_ENV for the after build)
+  local label=$1 bin=$2
+  shift 2
+  run1 "$label" "$bin" "" "$@"
+  [ -n "${ALT_ENV:-}" ] && [ "$bin" = rthdist ] && run1 "$label +$ALT_ENV" "$bin" "$ALT_ENV" "$@"
+  return 0
 }
 scale_specs torus-300x400
 scale_files "$B" "$S"
