@@ -9,8 +9,8 @@
 // Threading: one call at a time (an Engine's contract); the comparison and
 // the build run on `threads` threads of the worker pool.
 // Memory: the tree (TriangleBvh::hostBytes), its runs (under a byte a
-// triangle) and the copy, 24 bytes a vertex and 12 a triangle, until a different mesh replaces them or the Engine is
-// destroyed.
+// triangle) and the copy, 24 bytes a vertex and 12 a triangle, until a
+// different mesh replaces them or the Engine is destroyed.
 #pragma once
 
 #include <glm/vec3.hpp>

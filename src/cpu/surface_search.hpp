@@ -23,6 +23,7 @@ namespace rthdist::cpu {
 // (the same answer, cpu/triangle_blocks.hpp).
 [[nodiscard]] Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& surface,
                                                   double magnitude, const SurfaceOptions& options,
-                                                  const TriangleBvh& bvh, const TriangleBlocks* blocks = nullptr);
+                                                  const TriangleBvh& bvh,
+                                                  const TriangleBlocks* blocks = nullptr);
 
 }  // namespace rthdist::cpu
