@@ -11,6 +11,7 @@
 #include <glm/common.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <future>
 #include <memory>
@@ -21,6 +22,7 @@
 #include "api/surface_engine.hpp"
 #include "api/surface_gpu.hpp"
 #include "core/input_frame.hpp"
+#include "core/parallel.hpp"
 #include "core/stopwatch.hpp"
 #include "cpu/surface_search.hpp"
 
@@ -44,7 +46,7 @@ std::optional<Error> checkMagnitude(const core::Bounds& box, const char* name) {
                                                   " is past the point-to-surface limit of 2^250 (~1.8e75)"};
 }
 
-std::optional<Error> checkTriangles(const MeshView& surface) {
+std::optional<Error> checkTriangles(const MeshView& surface, int threads) {
     if (surface.indices.size() % 3 != 0) {
         return Error{ErrorCode::kInvalidArgument,
                      "surface B: " + std::to_string(surface.indices.size()) +
@@ -58,23 +60,42 @@ std::optional<Error> checkTriangles(const MeshView& surface) {
                          std::to_string(surface.triangleCount()) + " triangles of " +
                          std::to_string(surface.vertices.count) + " vertices"};
     }
-    const auto it = std::find_if(surface.indices.begin(), surface.indices.end(),
-                                 [&](uint32_t v) { return v >= surface.vertices.count; });
-    if (it == surface.indices.end()) return std::nullopt;
-    const auto at = size_t(it - surface.indices.begin());
-    return Error{ErrorCode::kInvalidArgument,
-                 "surface B: triangle " + std::to_string(at / 3) + ": vertex index " + std::to_string(*it) +
-                     " out of range (" + std::to_string(surface.vertices.count) + " vertices)"};
+    // The first index out of range (the error names the first bad triangle),
+    // chunks on the worker pool: a chunk past a bad one found already stops.
+    const size_t n = surface.indices.size();
+    std::atomic<size_t> first{n};
+    core::parallelChunks(n, size_t(1) << 16, threads, [&](size_t begin, size_t end, int) {
+        if (begin >= first.load(std::memory_order_relaxed)) return;
+        for (size_t i = begin; i < end; ++i) {
+            if (surface.indices[i] < surface.vertices.count) continue;
+            size_t seen = first.load(std::memory_order_relaxed);
+            while (i < seen && !first.compare_exchange_weak(seen, i, std::memory_order_relaxed)) {
+            }
+            return;
+        }
+    });
+    const size_t at = first.load();
+    if (at == n) return std::nullopt;
+    return Error{ErrorCode::kInvalidArgument, "surface B: triangle " + std::to_string(at / 3) +
+                                                  ": vertex index " + std::to_string(surface.indices[at]) +
+                                                  " out of range (" + std::to_string(surface.vertices.count) +
+                                                  " vertices)"};
 }
 
 // Every check of a call's inputs, in the order the errors are reported.
-Result<api::SurfaceInputs> checkInputs(const PointView& points, const MeshView& surface, int threads) {
+// `keptB`: the summary of a mesh equal to one checked before (an Engine's
+// kept mesh, bit for bit): its triangles and vertices are not read again.
+Result<api::SurfaceInputs> checkInputs(const PointView& points, const MeshView& surface, int threads,
+                                       const core::SetSummary* keptB = nullptr) {
     if (auto err = core::checkShape(points, "A")) return *err;
     if (auto err = core::checkShape(surface.vertices, "B")) return *err;
-    if (auto err = checkTriangles(surface)) return *err;
+    if (keptB == nullptr) {
+        if (auto err = checkTriangles(surface, threads)) return *err;
+    }
     Result<core::SetSummary> a = core::summarizeSet(points, "A", threads);
     if (!a) return a.error();
-    Result<core::SetSummary> b = core::summarizeSet(surface.vertices, "B", threads);
+    Result<core::SetSummary> b = keptB != nullptr ? Result<core::SetSummary>(*keptB)
+                                                  : core::summarizeSet(surface.vertices, "B", threads);
     if (!b) return b.error();
     if (auto err = checkMagnitude(a->box, "point set A")) return *err;
     if (auto err = checkMagnitude(b->box, "point set B")) return *err;
@@ -140,17 +161,25 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
     // The Engine's requested backend picks the route (kAuto: the CPU backend).
     const Plan plan = planSurfaceRoute(engine.backend, call.perPointDistances);
     if (plan.route == Route::kRefused) return Error{plan.code, plan.reason};
-    Result<SurfaceInputs> inputs = checkInputs(points, surface, options.threads);
-    if (!inputs) return inputs.error();
     if (plan.route == Route::kSurfaceGpu) {
+        Result<SurfaceInputs> inputs = checkInputs(points, surface, options.threads);
+        if (!inputs) return inputs.error();
         Result<SurfaceResult> result = surfaceOnGpu(backend, points, surface, *inputs, options);
         if (result) result->totalMs = core::msSince(start);
         return result;
     }
+    // The CPU route: a mesh equal to the kept one (compared once the views
+    // are readable) is neither checked nor built again.
     const core::Clock::time_point treeStart = core::Clock::now();
-    bool reused = false;
-    const cpu::TriangleBvh& tree = kept.treeFor(surface, options.threads, reused);
-    const double treeMs = core::msSince(treeStart);
+    const bool reused = !core::checkShape(points, "A") && !core::checkShape(surface.vertices, "B") &&
+                        kept.holds(surface, options.threads);
+    double treeMs = core::msSince(treeStart);
+    Result<SurfaceInputs> inputs =
+        checkInputs(points, surface, options.threads, reused ? &kept.summary() : nullptr);
+    if (!inputs) return inputs.error();
+    const core::Clock::time_point buildStart = core::Clock::now();
+    const cpu::TriangleBvh& tree = reused ? kept.tree() : kept.keep(surface, inputs->b, options.threads);
+    treeMs += core::msSince(buildStart);
     Result<SurfaceResult> result =
         cpu::surfaceSearch(points, surface, inputs->magnitude, options, tree, &kept.blocks());
     if (!result) return result;

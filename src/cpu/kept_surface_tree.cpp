@@ -12,7 +12,7 @@ constexpr size_t kChunk = size_t(1) << 16;
 
 }  // namespace
 
-bool KeptSurfaceTree::sameMesh(const MeshView& surface, int threads) const {
+bool KeptSurfaceTree::holds(const MeshView& surface, int threads) const {
     if (!m_tree || surface.vertices.count != m_vertices.size() || surface.indices.size() != m_indices.size())
         return false;
     std::atomic<bool> differ{false};
@@ -31,9 +31,8 @@ bool KeptSurfaceTree::sameMesh(const MeshView& surface, int threads) const {
     return !differ.load();
 }
 
-const TriangleBvh& KeptSurfaceTree::treeFor(const MeshView& surface, int threads, bool& kept) {
-    kept = sameMesh(surface, threads);
-    if (kept) return *m_tree;
+const TriangleBvh& KeptSurfaceTree::keep(const MeshView& surface, const core::SetSummary& summary,
+                                         int threads) {
     m_tree.reset();  // its memory back before the next one is built
     m_blocks = TriangleBlocks();
     m_vertices.resize(surface.vertices.count);
@@ -43,6 +42,7 @@ const TriangleBvh& KeptSurfaceTree::treeFor(const MeshView& surface, int threads
     m_indices.assign(surface.indices.begin(), surface.indices.end());
     m_tree.emplace(surface, threads);
     m_blocks = TriangleBlocks(surface, threads);
+    m_summary = summary;
     return *m_tree;
 }
 

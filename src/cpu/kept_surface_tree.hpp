@@ -19,6 +19,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/input_frame.hpp"
 #include "cpu/triangle_blocks.hpp"
 #include "cpu/triangle_bvh.hpp"
 #include "rthdist/mesh.hpp"
@@ -27,20 +28,27 @@ namespace rthdist::cpu {
 
 class KeptSurfaceTree {
 public:
-    // The tree over `surface` (checked by the caller): the kept one when the
-    // mesh equals the last one's (kept = true), else one built now and kept.
-    [[nodiscard]] const TriangleBvh& treeFor(const MeshView& surface, int threads, bool& kept);
-    // The same mesh's runs (cpu/triangle_blocks.hpp), for the witness check:
-    // built with the tree, valid while it is.
+    // Whether a tree is kept for a mesh equal to `surface` (its shape checked
+    // by the caller: the view readable), bit for bit: one pass over it.
+    [[nodiscard]] bool holds(const MeshView& surface, int threads) const;
+    // Builds and keeps the tree over `surface` (checked by the caller: every
+    // index in range, every coordinate finite), replacing any kept one;
+    // `summary`: its vertices' checked summary, kept beside it.
+    const TriangleBvh& keep(const MeshView& surface, const core::SetSummary& summary, int threads);
+
+    // The kept tree and, built with it, the mesh's runs (cpu/triangle_blocks.hpp,
+    // for the witness check) and its vertices' summary as checked when kept:
+    // valid while holds() of the mesh searched.
+    [[nodiscard]] const TriangleBvh& tree() const { return *m_tree; }
     [[nodiscard]] const TriangleBlocks& blocks() const { return m_blocks; }
+    [[nodiscard]] const core::SetSummary& summary() const { return m_summary; }
 
 private:
-    [[nodiscard]] bool sameMesh(const MeshView& surface, int threads) const;
-
     std::vector<glm::dvec3> m_vertices;  // the kept tree's mesh, bit for bit
     std::vector<uint32_t> m_indices;
     std::optional<TriangleBvh> m_tree;
     TriangleBlocks m_blocks;
+    core::SetSummary m_summary;
 };
 
 }  // namespace rthdist::cpu

@@ -247,6 +247,62 @@ TEST(SurfaceApi, IndexOutOfRangeNamesTheTriangle) {
     EXPECT_EQ(r.error().message, "surface B: triangle 1: vertex index 9 out of range (4 vertices)");
 }
 
+// The index check runs in chunks on the worker pool: the error names the
+// first bad triangle however many chunks hold one and however many threads.
+TEST(SurfaceApi, TheFirstIndexOutOfRangeIsNamedOnAnyThreadCount) {
+    Small s;
+    while (s.indices.size() < 3 * 50000) s.indices.insert(s.indices.end(), {0, 1, 2});  // 150,000 indices
+    s.indices[3 * 45000 + 2] = 7;
+    s.indices[3 * 30000 + 1] = 5;
+    s.indices[3 * 40000] = 6;
+    for (const int threads : {1, 2, 5}) {
+        SurfaceOptions options;
+        options.threads = threads;
+        Result<SurfaceResult> r = hausdorffToSurface(PointView(s.points), s.mesh(), options);
+        ASSERT_FALSE(r) << threads << " threads";
+        EXPECT_EQ(r.error().message, "surface B: triangle 30000: vertex index 5 out of range (4 vertices)")
+            << threads << " threads";
+    }
+}
+
+// An Engine's kept mesh spares the next call with the same mesh its checks
+// (api/surface.cpp); any other mesh is checked whole, and a call that fails
+// its checks keeps nothing: the kept mesh is still the one kept.
+TEST(SurfaceApi, AnEngineChecksEveryMeshButTheOneItKeeps) {
+    EngineOptions o;
+    o.backend = Backend::kCpu;
+    Result<Engine> engine = Engine::create(o);
+    ASSERT_TRUE(engine) << engine.error().message;
+    Small s;
+    Result<SurfaceResult> first = engine->hausdorffToSurface(PointView(s.points), s.mesh());
+    ASSERT_TRUE(first) << first.error().message;
+    EXPECT_EQ(first->directed.counters.tailTreeReused, 0u);
+
+    Small bad = s;
+    bad.indices[4] = 9;
+    Result<SurfaceResult> r = engine->hausdorffToSurface(PointView(bad.points), bad.mesh());
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().message, "surface B: triangle 1: vertex index 9 out of range (4 vertices)");
+    Small infinite = s;
+    infinite.vertices[3].z = std::numeric_limits<double>::infinity();
+    r = engine->hausdorffToSurface(PointView(infinite.points), infinite.mesh());
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+
+    std::vector<glm::dvec3> nan = s.points;
+    nan[1].y = std::numeric_limits<double>::quiet_NaN();
+    r = engine->hausdorffToSurface(PointView(nan), s.mesh());  // the kept mesh, bad points
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(r.error().message.find("A"), std::string::npos) << r.error().message;
+
+    Result<SurfaceResult> again = engine->hausdorffToSurface(PointView(s.points), s.mesh());
+    ASSERT_TRUE(again) << again.error().message;
+    EXPECT_EQ(again->directed.counters.tailTreeReused, 1u);
+    EXPECT_EQ(again->hausdorff, first->hausdorff);
+    EXPECT_EQ(again->directed.queryIndex, first->directed.queryIndex);
+}
+
 TEST(SurfaceApi, IndicesNotInTriplesAreRefused) {
     Small s;
     s.indices.pop_back();
