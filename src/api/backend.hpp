@@ -55,6 +55,8 @@ using BackendSetPair = std::pair<const BackendSet*, const BackendSet*>;
 // (api/surface_certify.hpp).
 struct TriangleCandidates {
     core::UninitVector<uint32_t> triangle;
+    core::UninitVector<float>
+        distance2;             // the device's squared distance to `triangle` (search frame), +inf for none
     uint32_t radii = 0;        // radii searched
     uint64_t rays = 0;         // rays cast
     uint32_t submissions = 0;  // command buffers submitted and waited for

@@ -184,6 +184,7 @@ public:
         auto found = gpu().nearestTriangles(queries, corners, cancel);
         if (!found) return found.error();
         return TriangleCandidates{std::move(found->triangle),
+                                  std::move(found->distance2),
                                   found->radii,
                                   found->rays,
                                   found->submissions,

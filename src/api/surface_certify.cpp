@@ -227,11 +227,83 @@ std::vector<uint64_t> bandOf(std::span<const double> bound, double lower2, int t
     return core::concatenateParts<std::vector<uint64_t>>(parts);
 }
 
+// The device's own distances (searched2: squared, in the search frame,
+// where coordinates are (v - origin) * scale, |v'| <= 1) bound each U(q):
+// |sqrt(U(q)) - sqrt(searched2[q]) / scale| <= kSearchedReach / scale.
+// Why: the frame's rounding moves each float coordinate by at most 2^-25
+// (a distance by at most 2 * sqrt(3) * 2^-25); the float rule's closest
+// point lies within ~20 u_f of the float triangle (a convex combination or
+// a clamped segment point, as in double: design.md §11, u_f = 2^-24) and
+// its distance rounds by a few u_f (a division to 2.5 ulp); the double
+// rule's own error is ~2^-40 of that. Together below 2^-18; 2^-16 leaves a
+// factor 4. The bound is checked on a sample of each call (q* and
+// kSearchedSamples queries spread over the indices): any sampled query
+// outside it, or a distance that is not a number, and the proof measures
+// every U(q) instead (upperBounds), trusting nothing of the device's.
+constexpr double kSearchedReach = 0x1p-16;
+constexpr size_t kSearchedSamples = 64;
+
+// Where a query's U(q) may reach L (sqrt(lower2)): a query the device left
+// without a candidate, measured on the host (open), or whose distance is
+// not a number always may; else when its distance plus the reach is not
+// below sqrt(L).
+struct SearchedBound {
+    std::span<const float> searched2;
+    double scale = 1.0;
+    double reach = 0.0;                             // kSearchedReach / scale
+    [[nodiscard]] double upper(uint64_t q) const {  // an upper bound of sqrt(U(q)), or +inf
+        const float d2 = searched2[q];
+        if (!(d2 >= 0.0f) || std::isinf(d2)) return std::numeric_limits<double>::infinity();
+        return std::sqrt(double(d2)) / scale + reach;
+    }
+};
+
+// The query of the largest device distance (one without a number first:
+// no candidate), the smallest index on a tie: the worker pool in chunks.
+uint64_t searchedTop(std::span<const float> searched2, int threads) {
+    const auto key = [](float d2) { return d2 >= 0.0f ? d2 : std::numeric_limits<float>::infinity(); };
+    const size_t n = searched2.size(), chunk = core::balancedChunk(n, threads);
+    std::vector<uint64_t> tops((n + chunk - 1) / chunk);
+    core::parallelChunks(n, chunk, threads, [&](size_t begin, size_t end, int) {
+        uint64_t top = begin;
+        for (size_t q = begin + 1; q < end; ++q)
+            if (key(searched2[q]) > key(searched2[top])) top = q;
+        tops[begin / chunk] = top;
+    });
+    uint64_t top = tops.front();
+    for (const uint64_t t : tops)
+        if (key(searched2[t]) > key(searched2[top])) top = t;  // chunk order: strict > keeps the first
+    return top;
+}
+
+// The band from the device's distances: every query whose bound reaches
+// sqrt(lower2) is measured (U(q) in double against its candidate, into
+// `bound`), and kept where U(q) >= lower2; the others have U(q) < L
+// (SearchedBound). Index order, the worker pool chunk by chunk.
+std::vector<uint64_t> bandBySearched(const PointView& points, const MeshView& surface,
+                                     std::span<const uint32_t> candidate, const SearchedBound& searched,
+                                     const Known& known, double lower2, int threads, double* bound) {
+    const double floor = std::sqrt(lower2);
+    const size_t n = points.count;
+    const size_t chunk = core::balancedChunk(n, threads);
+    std::vector<std::vector<uint64_t>> parts((n + chunk - 1) / chunk);
+    core::parallelChunks(n, chunk, threads, [&](size_t begin, size_t end, int) {
+        std::vector<uint64_t>& mine = parts[begin / chunk];
+        for (size_t q = begin; q < end; ++q) {
+            if (searched.upper(q) < floor && knownOf(known, q) == nullptr) continue;
+            bound[q] = measure2(points, surface, q, candidate[q]);
+            if (bound[q] >= lower2) mine.push_back(q);
+        }
+    });
+    return core::concatenateParts<std::vector<uint64_t>>(parts);
+}
+
 }  // namespace
 
 Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface, double magnitude,
                                      std::span<const uint32_t> candidate, const SurfaceOptions& options,
-                                     std::span<const uint32_t> open) {
+                                     std::span<const uint32_t> open, std::span<const float> searched2,
+                                     double searchScale) {
     if (options.perPointDistances)
         return Error{ErrorCode::kInvalidArgument,
                      "the proof of a surface search gives no per-point distances"};
@@ -269,9 +341,40 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     }
     const double openMs = open.empty() ? 0.0 : core::msSince(openStart);
 
+    // With the device's distances (and their sample agreeing), q* is the
+    // query of the largest one and only the queries they do not rule out
+    // are measured; else every U(q) is, q* the largest.
+    // (The open queries' distances are their exact nearest ones now, in the
+    // frame's units: q* is chosen among the queries by what is known of them.)
+    std::vector<float> openAdjusted;
+    if (!known.empty() && searched2.size() == points.count) {
+        openAdjusted.assign(searched2.begin(), searched2.end());
+        for (const auto& [q, n] : known) openAdjusted[q] = float(n.distance2 * searchScale * searchScale);
+        searched2 = openAdjusted;
+    }
+    const SearchedBound searched{searched2, searchScale, kSearchedReach / searchScale};
+    bool bySearched = searched2.size() == points.count && searchScale > 0.0 && std::isfinite(searched.reach);
     Largest largest;
-    const core::UninitVector<double> bound =
-        upperBounds(points, surface, candidate, options.threads, largest);
+    core::UninitVector<double> bound;
+    if (bySearched) {
+        bound = core::UninitVector<double>(points.count);  // written where measured
+        const uint64_t top = searchedTop(searched2, options.threads);
+        largest = Largest{measure2(points, surface, top, candidate[top]), top};
+        bound[top] = largest.bound;
+        const uint64_t step = std::max<uint64_t>(1, points.count / kSearchedSamples);
+        for (uint64_t q = 0; q < points.count && bySearched; q += step) {
+            if (knownOf(known, q) != nullptr || std::isinf(searched.upper(q)))
+                continue;  // measured, or no bound
+            const double u = std::sqrt(measure2(points, surface, q, candidate[q]));
+            const double d = std::sqrt(double(searched2[q])) / searchScale;
+            bySearched = std::abs(u - d) <= searched.reach;
+        }
+        const double u = std::sqrt(largest.bound);
+        if (!std::isinf(searched.upper(top)) && knownOf(known, top) == nullptr &&
+            !(std::abs(u - std::sqrt(double(searched2[top])) / searchScale) <= searched.reach))
+            bySearched = false;
+    }
+    if (!bySearched) bound = upperBounds(points, surface, candidate, options.threads, largest);
     Nearest measured;  // q*'s nearest, exactly
     if (const Nearest* k = knownOf(known, largest.query)) {
         measured = *k;
@@ -283,7 +386,10 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     }
     const double lower2 = measured.distance2;  // L^2 <= h^2
 
-    const std::vector<uint64_t> bandIndex = bandOf(bound, lower2, options.threads);
+    const std::vector<uint64_t> bandIndex = bySearched
+                                                ? bandBySearched(points, surface, candidate, searched, known,
+                                                                 lower2, options.threads, bound.data())
+                                                : bandOf(bound, lower2, options.threads);
     Result<SurfaceResult> exact = SurfaceResult{};
     if (bandIndex.size() * triangles <= kBruteWork) {
         exact = bruteBand(points, bandIndex, surface, bound, slack, options.threads, known);

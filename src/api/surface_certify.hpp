@@ -40,9 +40,17 @@ namespace rthdist::api {
 // above (a measured query found again is not measured twice).
 // SurfaceResult::directed.counters.band: the queries searched exactly in 3.;
 // stages.tailHost: the open queries' brute force.
+// searched2 (may be empty): the device's squared distance of each query to
+// its candidate in the search frame, whose scale is `searchScale` (a power of
+// two): the proof then measures U(q) only where that distance (plus a
+// rounding reach, checked on a sample of the call) does not rule it out
+// (surface_certify.cpp, kSearchedReach; design.md §11). The answer is the
+// same either way.
 [[nodiscard]] Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface,
                                                    double magnitude, std::span<const uint32_t> candidate,
                                                    const SurfaceOptions& options,
-                                                   std::span<const uint32_t> open = {});
+                                                   std::span<const uint32_t> open = {},
+                                                   std::span<const float> searched2 = {},
+                                                   double searchScale = 0.0);
 
 }  // namespace rthdist::api

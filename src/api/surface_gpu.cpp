@@ -71,8 +71,8 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
         return Error{ErrorCode::kCancelled, "the call was cancelled (SurfaceOptions::cancel)"};
 
     const core::Clock::time_point certifyStart = core::Clock::now();
-    Result<SurfaceResult> result =
-        certifySurface(points, surface, inputs.magnitude, found->triangle, options, found->open);
+    Result<SurfaceResult> result = certifySurface(points, surface, inputs.magnitude, found->triangle, options,
+                                                  found->open, found->distance2, frame.scale);
     if (!result) return result.error();
     SurfaceResult& r = result.value();
     r.backend = device.kind();

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 #include "core/float_box.hpp"
@@ -175,15 +176,17 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     const size_t chunk = core::balancedChunk(m_queries, m_ws.threads);
     std::vector<std::vector<uint32_t>> openParts(toHost ? (m_queries + chunk - 1) / chunk : 0);
     out.triangle.resize(m_queries);
+    out.distance2.resize(m_queries);
     core::parallelChunks(m_queries, chunk, m_ws.threads, [&](size_t begin, size_t end, int) {
         for (size_t q = begin; q < end; ++q) {
             const uint64_t best = packed[q];
             const auto t = uint32_t(best & 0xffffffffu);
-            out.triangle[q] = t < m_triangles ? t : UINT32_MAX;
-            if (!toHost) continue;
             float d2 = 0.0f;
             const auto bits = uint32_t(best >> 32);
             std::memcpy(&d2, &bits, sizeof(d2));
+            out.triangle[q] = t < m_triangles ? t : UINT32_MAX;
+            out.distance2[q] = t < m_triangles ? d2 : std::numeric_limits<float>::infinity();
+            if (!toHost) continue;
             if (!(d2 <= settled2)) openParts[begin / chunk].push_back(uint32_t(q));
         }
     });

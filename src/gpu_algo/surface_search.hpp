@@ -54,15 +54,18 @@ struct Workspace;
 
 struct SurfaceCandidates {
     core::UninitVector<uint32_t> triangle;  // per query: its nearest triangle found, UINT32_MAX for none
-    uint32_t radii = 0;                     // radii that searched a query
-    uint64_t rays = 0;                      // rays cast over all radii
-    uint32_t submissions = 0;               // command buffers submitted (each waited for)
-    double firstRadius = 0.0;               // in the search frame (|coordinate| <= 1)
-    double gpuMs = 0.0;                     // device time of the submissions
-    double gpuBuildMs = 0.0;                // of which the triangles' boxes and BLAS builds and refits
-    double stageMs = 0.0;     // host: the inputs written to the upload buffer, the radii's statistics
-    double submitMs = 0.0;    // host wall: recording, submitting and waiting for the submissions
-    double readbackMs = 0.0;  // host: the candidates taken from the read-back buffer
+    // Per query: the squared distance the device measured to `triangle`
+    // (the shared rule in float, in the search frame), +inf for none.
+    core::UninitVector<float> distance2;
+    uint32_t radii = 0;        // radii that searched a query
+    uint64_t rays = 0;         // rays cast over all radii
+    uint32_t submissions = 0;  // command buffers submitted (each waited for)
+    double firstRadius = 0.0;  // in the search frame (|coordinate| <= 1)
+    double gpuMs = 0.0;        // device time of the submissions
+    double gpuBuildMs = 0.0;   // of which the triangles' boxes and BLAS builds and refits
+    double stageMs = 0.0;      // host: the inputs written to the upload buffer, the radii's statistics
+    double submitMs = 0.0;     // host wall: recording, submitting and waiting for the submissions
+    double readbackMs = 0.0;   // host: the candidates taken from the read-back buffer
     // The queries the radii left open, where they were few (open x
     // triangles at most Tuning::surfaceHostWork): no tail ran; their
     // `triangle` is the rays' best (or none), and the caller measures them

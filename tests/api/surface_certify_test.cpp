@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "api/surface_certify.hpp"
@@ -81,6 +82,55 @@ TEST(SurfaceCertify, AnyCandidatesGiveTheBruteForce) {
         // An index past the last triangle is none.
         std::vector<uint32_t> past(c.queries.size(), triangles);
         expectExact(c, certify(c, past), want, "past the last");
+    }
+}
+
+// The device's distances (api/surface_certify.hpp, searched2): where they
+// are the candidates' distances in the search frame, the proof measures
+// only the queries they do not rule out, and the answer is the brute
+// force's; distances that disagree with the candidates on the proof's
+// sample (here: all zero, or all scaled by 4) are not used, and the answer
+// is the brute force's all the same.
+TEST(SurfaceCertify, TheDevicesDistancesGiveTheSameAnswer) {
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        const oracle::SurfaceDirectedExact want = oracle::bruteForceSurface(c.queries, c.vertices, c.indices);
+        // The search frame of api/surface_gpu.cpp: a power of two bringing
+        // every coordinate about the union box's centre to at most 1.
+        glm::dvec3 lo(INFINITY), hi(-INFINITY);
+        for (const auto* set : {&c.vertices, &c.queries})
+            for (const glm::dvec3& v : *set) {
+                lo = glm::min(lo, v);
+                hi = glm::max(hi, v);
+            }
+        const glm::dvec3 half = (hi - lo) * 0.5;
+        int exponent = 0;
+        std::frexp(std::max({half.x, half.y, half.z, 0x1p-1000}), &exponent);
+        const double scale = std::ldexp(1.0, -exponent);
+        const auto triangles = uint32_t(c.indices.size() / 3);
+        std::vector<uint32_t> candidate(c.queries.size());
+        std::vector<float> searched(c.queries.size()), zero(c.queries.size(), 0.0f), far(c.queries.size());
+        test::Rng rng(c.seed + 1);
+        for (size_t q = 0; q < c.queries.size(); ++q) {
+            // The nearest triangle for most, another for every fifth query.
+            candidate[q] = q % 5 == 0 ? uint32_t(rng.uniform(0.0, double(triangles))) % triangles
+                                      : want.perQuery[q].triangle;
+            const std::vector<glm::dvec3> query{c.queries[q]};
+            const size_t t = 3 * size_t(candidate[q]);
+            const std::vector<uint32_t> one{c.indices[t], c.indices[t + 1], c.indices[t + 2]};
+            const double u2 = oracle::bruteForceSurface(query, c.vertices, one).perQuery[0].distance2;
+            searched[q] = float(u2 * scale * scale);
+            far[q] = 16.0f * searched[q] + 1.0f;
+        }
+        const MeshView mesh{PointView(c.vertices), c.indices};
+        for (const auto& [name, distances] :
+             {std::pair<const char*, const std::vector<float>*>{"device", &searched},
+              {"zero", &zero},
+              {"too far", &far}}) {
+            const Result<SurfaceResult> r = api::certifySurface(
+                PointView(c.queries), mesh, magnitude(c), candidate, SurfaceOptions{}, {}, *distances, scale);
+            expectExact(c, r, want, name);
+        }
     }
 }
 
