@@ -374,7 +374,10 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
             !(std::abs(u - std::sqrt(double(searched2[top])) / searchScale) <= searched.reach))
             bySearched = false;
     }
-    if (!bySearched) bound = upperBounds(points, surface, candidate, options.threads, largest);
+    if (!bySearched) {
+        largest = Largest{};
+        bound = upperBounds(points, surface, candidate, options.threads, largest);
+    }
     Nearest measured;  // q*'s nearest, exactly
     if (const Nearest* k = knownOf(known, largest.query)) {
         measured = *k;
