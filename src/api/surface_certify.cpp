@@ -256,6 +256,13 @@ struct SearchedBound {
         if (!(d2 >= 0.0f) || std::isinf(d2)) return std::numeric_limits<double>::infinity();
         return std::sqrt(double(d2)) / scale + reach;
     }
+    // Whether the device's distance of q agrees with U(q) = u2 within the
+    // reach (the sample's check); true where it gives no bound (none, not a
+    // number), which the proof never uses to skip a query.
+    [[nodiscard]] bool agrees(uint64_t q, double u2) const {
+        if (std::isinf(upper(q))) return true;
+        return std::abs(std::sqrt(u2) - std::sqrt(double(searched2[q])) / scale) <= reach;
+    }
 };
 
 // The query of the largest device distance (one without a number first:
@@ -363,16 +370,10 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
         bound[top] = largest.bound;
         const uint64_t step = std::max<uint64_t>(1, points.count / kSearchedSamples);
         for (uint64_t q = 0; q < points.count && bySearched; q += step) {
-            if (knownOf(known, q) != nullptr || std::isinf(searched.upper(q)))
-                continue;  // measured, or no bound
-            const double u = std::sqrt(measure2(points, surface, q, candidate[q]));
-            const double d = std::sqrt(double(searched2[q])) / searchScale;
-            bySearched = std::abs(u - d) <= searched.reach;
+            if (knownOf(known, q) != nullptr) continue;  // measured exactly already
+            bySearched = searched.agrees(q, measure2(points, surface, q, candidate[q]));
         }
-        const double u = std::sqrt(largest.bound);
-        if (!std::isinf(searched.upper(top)) && knownOf(known, top) == nullptr &&
-            !(std::abs(u - std::sqrt(double(searched2[top])) / searchScale) <= searched.reach))
-            bySearched = false;
+        if (knownOf(known, top) == nullptr) bySearched = bySearched && searched.agrees(top, largest.bound);
     }
     if (!bySearched) {
         largest = Largest{};
