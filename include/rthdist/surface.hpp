@@ -220,7 +220,7 @@ struct SurfaceResult {
                                                                    const SurfaceOptions& options = {});
 
 // ---------------------------------------------------------------------------
-// Surface to surface (issue 34, phase 2: the CPU backend)
+// Surface to surface (issue 34: the CPU backend and both GPU backends)
 //
 // Contract
 //   H(SA, SB) = max(h(SA, SB), h(SB, SA)) between the surfaces of two meshes,
@@ -268,14 +268,31 @@ struct SurfaceResult {
 //   memory: 40 bytes each, plus 16 per open patch); a call that would need
 //   more is kOutOfMemory naming the bounds reached and the limit.
 //
-// Backends and threading as hausdorffToSurface (kAuto, kCpu; GPU backends
-//   refused). Deterministic: the same bounds and witnesses whatever the
-//   thread count (the rounds are batches; ties go to the smaller index).
+// Backends and threading as hausdorffToSurface: kAuto and kCpu run each
+//   round's batch on the CPU backend's BVH (every sample's distance exact);
+//   kRayQuery and kRtPipeline on the device's float search of
+//   hausdorffToSurface (one device opened for the call, both directions on
+//   it): each sample's distance is the rule in double to the triangle the
+//   device found (an upper bound of its exact distance, which the patches'
+//   bounds need), each batch's maximum is proven exactly on the host (the
+//   lower bound's witness), so the bounds are certified alike; they may
+//   differ from the CPU backend's within the tolerance (the same lower
+//   bound where the same samples are queried). A GPU backend's tolerance
+//   must be at least 2^-14 of the largest coordinate of the box of both
+//   meshes around its centre, rounded up to a power of two (at most
+//   ~6.1e-5 of the box's diagonal, below the default), else
+//   kInvalidArgument naming that floor: a sample's distance may exceed its
+//   exact one by the float search's reach. Deterministic on each backend:
+//   the same bounds and witnesses whatever the thread count (the rounds are
+//   batches; ties go to the smaller index).
 struct SurfaceBoundsOptions {
-    Backend backend = Backend::kAuto;  // kAuto or kCpu
+    Backend backend = Backend::kAuto;  // kAuto or kCpu on the CPU, kRayQuery or kRtPipeline on a device
     int threads = 0;                   // 0: every hardware thread
-    double tolerance = 0.0;            // absolute; 0: 1e-4 of the bounding diagonal
-    bool directedOnly = false;         // h(SA, SB) alone
+    // GPU backends: the Vulkan device and the validation layer, as SurfaceOptions.
+    int deviceIndex = -1;
+    bool validation = false;
+    double tolerance = 0.0;     // absolute; 0: 1e-4 of the bounding diagonal
+    bool directedOnly = false;  // h(SA, SB) alone
     uint64_t maxQueries = uint64_t(1) << 26;
     // Read at every chunk of queries: true -> kCancelled.
     const std::atomic<bool>* cancel = nullptr;
@@ -310,11 +327,13 @@ struct SurfaceBoundsResult {
     SurfaceBoundsDirected aToB;       // h(SA, SB)
     SurfaceBoundsDirected bToA;       // h(SB, SA); zeros with directedOnly
     bool directed = false;            // directedOnly: bounds are h(SA, SB)'s
-    Backend backend = Backend::kCpu;
-    std::string device;     // "cpu"
-    double buildMs = 0.0;   // the BVHs
-    double searchMs = 0.0;  // the rounds
+    Backend backend = Backend::kCpu;  // the backend that ran
+    std::string device;               // "cpu", or the device's name
+    double buildMs = 0.0;             // the BVHs (GPU backends: the device opened, the corners framed)
+    double searchMs = 0.0;            // the rounds
     double totalMs = 0.0;
+    double gpuMs = 0.0;               // GPU backends: device time of every batch's search
+    uint64_t validationMessages = 0;  // with SurfaceBoundsOptions::validation
 };
 
 // Certified bounds on H(surface a, surface b) (contract above).

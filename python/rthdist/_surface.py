@@ -63,7 +63,13 @@ def surface_hausdorff(vertices_a, faces_a, vertices_b, faces_b, *, tolerance=0.0
     meshes' box), tolerance, slack, directed, a_to_b and b_to_a (None with
     directed=True), each with its own bounds and the witness of its lower
     bound: from_point on from_triangle, its closest point to_point on
-    `triangle` of the other surface, and distance. design.md §12.
+    `triangle` of the other surface, and distance; backend and device, the
+    ones that ran. backend: "auto" or "cpu" (the CPU backend's BVH), or
+    "ray-query" / "rt-pipeline" (each round's queries on a Vulkan device,
+    each round's maximum proven on the host: bounds certified alike; the
+    tolerance must then be at least 2^-14 of the meshes' largest coordinate
+    around the centre of their box, rounded up to a power of two, else
+    ValueError naming that floor). design.md §12.
     """
     va, fa = _mesh(vertices_a, faces_a, "surface a")
     vb, fb = _mesh(vertices_b, faces_b, "surface b")

@@ -144,6 +144,8 @@ py::dict surfaceToSurface(const py::array& va, const py::array& fa, const py::ar
     out["tolerance"] = s.tolerance;
     out["slack"] = s.slack;
     out["directed"] = s.directed;
+    out["backend"] = backendName(s.backend);
+    out["device"] = s.device;
     out["a_to_b"] = directedDict(s.aToB);
     out["b_to_a"] = s.directed ? py::object(py::none()) : py::object(directedDict(s.bToA));
     return out;

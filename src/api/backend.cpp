@@ -4,6 +4,9 @@
 
 #include <string>
 
+#include "core/stopwatch.hpp"
+#include "rthdist/tuning.hpp"
+
 namespace rthdist::api {
 
 namespace {
@@ -86,6 +89,20 @@ Result<std::unique_ptr<ComputeBackend>> openBackend(const EngineOptions& options
         return makeCpuBackend(options);
     }
     return makeGpuBackend(options, nullptr);
+}
+
+OneShotBackend openOneShot(Backend backend, int deviceIndex, bool validation, int threads) {
+    const core::Clock::time_point start = core::Clock::now();
+    EngineOptions engine;
+    engine.backend = backend;
+    engine.deviceIndex = deviceIndex;
+    engine.validation = validation;
+    engine.threads = threads;
+    engine.tuning = tuningFromEnvironment();
+    OneShotBackend out;
+    out.backend = openBackend(engine, nullptr);
+    out.ms = core::msSince(start);
+    return out;
 }
 
 }  // namespace rthdist::api

@@ -151,6 +151,16 @@ public:
 [[nodiscard]] Result<std::unique_ptr<ComputeBackend>> openBackend(const EngineOptions& options,
                                                                   const VulkanDevice* borrowed);
 
+// The backend of a one-shot surface call (hausdorffToSurface,
+// surfaceHausdorff on a GPU backend): an Engine's options from the call's,
+// the tuning from the environment, opened by openBackend; `ms` the time it
+// took (the result's buildMs). Any thread.
+struct OneShotBackend {
+    Result<std::unique_ptr<ComputeBackend>> backend = Error{ErrorCode::kInternal, "not opened"};
+    double ms = 0.0;
+};
+[[nodiscard]] OneShotBackend openOneShot(Backend backend, int deviceIndex, bool validation, int threads);
+
 [[nodiscard]] std::unique_ptr<ComputeBackend> makeCpuBackend(const EngineOptions& options);
 [[nodiscard]] Result<std::unique_ptr<ComputeBackend>> makeGpuBackend(const EngineOptions& options,
                                                                      const VulkanDevice* borrowed);

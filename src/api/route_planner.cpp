@@ -115,9 +115,7 @@ Plan planSurfaceRoute(Backend requested, bool perPoint) {
 
 Plan planSurfacePairRoute(Backend requested) {
     if (requested == Backend::kCpu || requested == Backend::kAuto) return routed(Route::kSurfaceCpu);
-    return refused(ErrorCode::kInvalidArgument,
-                   std::string("surface to surface runs on the cpu backend for now (") +
-                       backendName(requested) + " requested)");
+    return routed(Route::kSurfaceGpu);
 }
 
 bool narrowingPays(double wholeMagnitude, double narrowedMagnitude) {

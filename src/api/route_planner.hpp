@@ -24,7 +24,8 @@
 //   device views (Engine::compute(DevicePointView, ...)):
 //       kRefused        a backend that reads no device views, or past the budget
 //       kDeviceViews    ingested and searched on the device
-//   a point set against a triangle surface (hausdorffToSurface, planSurfaceRoute):
+//   a point set against a triangle surface (hausdorffToSurface, planSurfaceRoute),
+//   and two surfaces (surfaceHausdorff, planSurfacePairRoute: the same routes, no refusal):
 //       kRefused        per-point distances on a GPU backend (the CPU backend gives them)
 //       kSurfaceCpu     the CPU backend's triangle BVH (api/surface.cpp); also kAuto
 //       kSurfaceGpu     a GPU backend named by the caller: the device's float search
@@ -122,8 +123,9 @@ struct Plan {
 
 // The route of two triangle surfaces (surfaceHausdorff, certified bounds):
 // kSurfaceCpu for kCpu and kAuto (the refinement's batches run on the CPU
-// backend's BVH); a GPU backend is kRefused (kInvalidArgument) for now,
-// never computed on the CPU in its place.
+// backend's BVH); kSurfaceGpu for a GPU backend the caller named (the
+// batches on the device's search, each batch's maximum proven on the host:
+// api/surface_pair_gpu.hpp), never computed on the CPU in its place.
 [[nodiscard]] Plan planSurfacePairRoute(Backend requested);
 
 // Narrowed targets (api/narrowed_targets.hpp), host views: a direction

@@ -102,27 +102,6 @@ Result<api::SurfaceInputs> checkInputs(const PointView& points, const MeshView& 
     return api::SurfaceInputs{*a, *b, std::max(magnitudeOf(a->box), magnitudeOf(b->box))};
 }
 
-// The device of a one-shot GPU call, opened on another thread while the
-// inputs are checked; its milliseconds are the result's buildMs.
-struct OpenedDevice {
-    Result<std::unique_ptr<api::ComputeBackend>> backend = Error{ErrorCode::kInternal, "not opened"};
-    double ms = 0.0;
-};
-
-OpenedDevice openDevice(const SurfaceOptions& options) {
-    const core::Clock::time_point start = core::Clock::now();
-    EngineOptions engine;
-    engine.backend = options.backend;
-    engine.deviceIndex = options.deviceIndex;
-    engine.validation = options.validation;
-    engine.threads = options.threads;
-    engine.tuning = tuningFromEnvironment();
-    OpenedDevice out;
-    out.backend = api::openBackend(engine, nullptr);
-    out.ms = core::msSince(start);
-    return out;
-}
-
 }  // namespace
 
 Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, const SurfaceOptions& options) {
@@ -130,14 +109,18 @@ Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, con
     if (options.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
     const api::Plan plan = api::planSurfaceRoute(options.backend, options.perPointDistances);
     if (plan.route == api::Route::kRefused) return Error{plan.code, plan.reason};
-    std::future<OpenedDevice> opening;
+    // A GPU call's device opens on another thread while the inputs are checked.
+    std::future<api::OneShotBackend> opening;
     if (plan.route == api::Route::kSurfaceGpu)
-        opening = std::async(std::launch::async, [&options] { return openDevice(options); });
+        opening = std::async(std::launch::async, [&options] {
+            return api::openOneShot(options.backend, options.deviceIndex, options.validation,
+                                    options.threads);
+        });
     Result<api::SurfaceInputs> inputs = checkInputs(points, surface, options.threads);
     if (!inputs) return inputs.error();  // bad input first, even where no device opens
     Result<SurfaceResult> result = Error{ErrorCode::kInternal, "no route"};
     if (plan.route == api::Route::kSurfaceGpu) {
-        OpenedDevice device = opening.get();
+        api::OneShotBackend device = opening.get();
         if (!device.backend) return device.backend.error();
         result = api::surfaceOnGpu(*device.backend.value(), points, surface, *inputs, options);
         if (result) result->buildMs = device.ms;

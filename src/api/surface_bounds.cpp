@@ -4,19 +4,25 @@
 // (api::planSurfaceRoute, as for point to surface), both meshes shifted to
 // a frame centred on their common box (design.md §12: the slack then scales
 // with the meshes' extent, not their distance from the origin), the
-// tolerance resolved and checked against its floor, then the CPU backend's
-// refinement (cpu/surface_bounds.hpp) and the witnesses shifted back.
+// tolerance resolved and checked against its floor (and a GPU backend's),
+// then the refinement (cpu/surface_bounds.hpp) with each direction's batch
+// search: the CPU backend's BVH, or the device's search proven on the host
+// (api/surface_pair_gpu.hpp) on a device opened while the meshes are
+// checked; the witnesses shifted back.
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <future>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "api/route_planner.hpp"
+#include "api/surface_pair_gpu.hpp"
 #include "core/input_frame.hpp"
 #include "core/point_triangle.hpp"
 #include "core/stopwatch.hpp"
@@ -100,6 +106,18 @@ Result<double> resolveTolerance(double requested, double diagonal, double slack)
             " of these meshes (4 x 2^-40 of their largest coordinate around the centre of their box)"};
 }
 
+// A GPU backend's floor (kGpuPairFloor in the search frame's units).
+std::optional<Error> checkGpuFloor(double tolerance, const api::SearchFrame& frame, Backend backend) {
+    const double floor = api::kGpuPairFloor / frame.scale;
+    if (tolerance >= floor) return std::nullopt;
+    return Error{ErrorCode::kInvalidArgument,
+                 "tolerance " + number(tolerance) + " is below the " + backendName(backend) +
+                     " backend's floor " + number(floor) +
+                     " for these meshes (2^-14 of the largest coordinate of their box around its centre, "
+                     "rounded up to a power of two: the float search's reach); the cpu backend reaches 4 x "
+                     "2^-40 of it"};
+}
+
 void shiftBack(SurfaceBoundsDirected& d, const glm::dvec3& origin) {
     d.fromPoint += origin;
     d.toPoint += origin;
@@ -112,6 +130,14 @@ Result<SurfaceBoundsResult> surfaceHausdorff(MeshView a, MeshView b, const Surfa
     if (options.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
     const api::Plan plan = api::planSurfacePairRoute(options.backend);
     if (plan.route == api::Route::kRefused) return Error{plan.code, plan.reason};
+    const bool gpu = plan.route == api::Route::kSurfaceGpu;
+    // A GPU call's device opens on another thread while the meshes are checked.
+    std::future<api::OneShotBackend> opening;
+    if (gpu)
+        opening = std::async(std::launch::async, [&options] {
+            return api::openOneShot(options.backend, options.deviceIndex, options.validation,
+                                    options.threads);
+        });
     Result<core::SetSummary> sa = checkMesh(a, "A", options.threads);
     if (!sa) return sa.error();
     Result<core::SetSummary> sb = checkMesh(b, "B", options.threads);
@@ -120,18 +146,56 @@ Result<SurfaceBoundsResult> surfaceHausdorff(MeshView a, MeshView b, const Surfa
     const glm::dvec3 lo = glm::min(sa->box.lo, sb->box.lo), hi = glm::max(sa->box.hi, sb->box.hi);
     const glm::dvec3 origin = (lo * 0.5) + (hi * 0.5);  // halves first: no overflow near the limit
     const std::vector<glm::dvec3> va = shifted(a, origin), vb = shifted(b, origin);
-    const double magnitude = std::max(magnitudeOf({lo - origin, hi - origin}), 0.0);
+    const core::Bounds work{lo - origin, hi - origin};
+    const double magnitude = std::max(magnitudeOf(work), 0.0);
     const double slack = core::closestSlack(magnitude);
     Result<double> tolerance = resolveTolerance(options.tolerance, glm::distance(lo, hi), slack);
     if (!tolerance) return tolerance.error();
+    const api::SearchFrame frame(work, work);
+    if (gpu) {
+        if (auto err = checkGpuFloor(*tolerance, frame, options.backend)) return *err;
+    }
 
     const MeshView wa{PointView(va), a.indices}, wb{PointView(vb), b.indices};
-    Result<SurfaceBoundsResult> result = cpu::surfaceBounds(wa, wb, *tolerance, slack, options);
+    std::unique_ptr<cpu::SampleSearch> aToB, bToA;
+    api::OneShotBackend device;
+    if (gpu) device = opening.get();
+    if (gpu && !device.backend) return device.backend.error();
+    const core::Clock::time_point buildStart = core::Clock::now();
+    if (gpu) {
+        api::ComputeBackend& backend = *device.backend.value();
+        aToB = std::make_unique<api::DeviceSampleSearch>(backend, wb, frame, magnitude, options.threads,
+                                                         options.cancel);
+        if (!options.directedOnly)
+            bToA = std::make_unique<api::DeviceSampleSearch>(backend, wa, frame, magnitude, options.threads,
+                                                             options.cancel);
+    } else {
+        aToB = std::make_unique<cpu::BvhSampleSearch>(wb, slack, options.threads, options.cancel);
+        if (!options.directedOnly)
+            bToA = std::make_unique<cpu::BvhSampleSearch>(wa, slack, options.threads, options.cancel);
+    }
+    const double buildMs = core::msSince(buildStart);
+    Result<SurfaceBoundsResult> result =
+        cpu::surfaceBounds(wa, wb, *tolerance, slack, options, *aToB, bToA.get());
     if (!result) return result;
     result->tolerance = *tolerance;
     result->origin = origin;
     shiftBack(result->aToB, origin);
     if (!options.directedOnly) shiftBack(result->bToA, origin);
+    if (gpu) {
+        api::ComputeBackend& backend = *device.backend.value();
+        result->backend = backend.kind();
+        result->device = backend.deviceName();
+        result->buildMs = device.ms + buildMs;  // the device's setup and the corners framed
+        for (const std::unique_ptr<cpu::SampleSearch>* s : {&aToB, &bToA}) {
+            if (*s) result->gpuMs += static_cast<const api::DeviceSampleSearch&>(**s).gpuMs();
+        }
+        result->validationMessages = backend.validationMessages();
+    } else {
+        result->backend = Backend::kCpu;
+        result->device = "cpu";
+        result->buildMs = buildMs;  // both BVHs
+    }
     result->totalMs = core::msSince(start);
     return result;
 }

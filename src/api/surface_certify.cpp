@@ -310,7 +310,7 @@ std::vector<uint64_t> bandBySearched(const PointView& points, const MeshView& su
 Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface, double magnitude,
                                      std::span<const uint32_t> candidate, const SurfaceOptions& options,
                                      std::span<const uint32_t> open, std::span<const float> searched2,
-                                     double searchScale) {
+                                     double searchScale, std::vector<uint32_t>* openNearest) {
     if (options.perPointDistances)
         return Error{ErrorCode::kInvalidArgument,
                      "the proof of a surface search gives no per-point distances"};
@@ -324,6 +324,7 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     // bound); each then takes its nearest triangle for its candidate, so its
     // U below is its exact nearest distance.
     const core::Clock::time_point openStart = core::Clock::now();
+    if (openNearest != nullptr) openNearest->clear();
     Known known;
     std::vector<uint32_t> settledCandidate;
     if (!open.empty()) {
@@ -343,6 +344,7 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
         for (size_t i = 0; i < openQueries.size(); ++i) {
             known.emplace_back(openQueries[i], nearest[i]);
             settledCandidate[openQueries[i]] = nearest[i].triangle;
+            if (openNearest != nullptr) openNearest->push_back(nearest[i].triangle);
         }
         candidate = settledCandidate;
     }

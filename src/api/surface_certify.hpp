@@ -24,6 +24,7 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "rthdist/surface.hpp"
 
@@ -46,11 +47,11 @@ namespace rthdist::api {
 // rounding reach, checked on a sample of the call) does not rule it out
 // (surface_certify.cpp, kSearchedReach; design.md §11). The answer is the
 // same either way.
-[[nodiscard]] Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface,
-                                                   double magnitude, std::span<const uint32_t> candidate,
-                                                   const SurfaceOptions& options,
-                                                   std::span<const uint32_t> open = {},
-                                                   std::span<const float> searched2 = {},
-                                                   double searchScale = 0.0);
+// openNearest (may be null): the open queries' exact nearest triangles, in
+// the order of `open` (the brute force's: the smallest index on a tie).
+[[nodiscard]] Result<SurfaceResult> certifySurface(
+    const PointView& points, const MeshView& surface, double magnitude, std::span<const uint32_t> candidate,
+    const SurfaceOptions& options, std::span<const uint32_t> open = {}, std::span<const float> searched2 = {},
+    double searchScale = 0.0, std::vector<uint32_t>* openNearest = nullptr);
 
 }  // namespace rthdist::api

@@ -12,26 +12,16 @@
 #include "core/uninit_vector.hpp"
 
 namespace rthdist::api {
-namespace {
 
-// The device's frame: the centre of the union's box, then a power of two
-// that brings every coordinate to at most 1 in magnitude (the rule's
-// degree-4 products stay far from float's range at any input scale).
-struct SearchFrame {
-    glm::dvec3 origin{0.0};
-    double scale = 1.0;
-
-    SearchFrame(const core::Bounds& a, const core::Bounds& b) {
-        const glm::dvec3 lo = glm::min(a.lo, b.lo), hi = glm::max(a.hi, b.hi);
-        origin = (lo + hi) * 0.5;
-        const glm::dvec3 half = glm::max(hi - origin, origin - lo);
-        const double m = std::max({half.x, half.y, half.z});
-        int exponent = 0;
-        if (m > 0.0 && std::isfinite(m)) std::frexp(m, &exponent);  // m < 2^exponent
-        scale = std::ldexp(1.0, -exponent);
-    }
-    [[nodiscard]] glm::vec3 operator()(const glm::dvec3& p) const { return glm::vec3((p - origin) * scale); }
-};
+SearchFrame::SearchFrame(const core::Bounds& a, const core::Bounds& b) {
+    const glm::dvec3 lo = glm::min(a.lo, b.lo), hi = glm::max(a.hi, b.hi);
+    origin = (lo + hi) * 0.5;
+    const glm::dvec3 half = glm::max(hi - origin, origin - lo);
+    const double m = std::max({half.x, half.y, half.z});
+    int exponent = 0;
+    if (m > 0.0 && std::isfinite(m)) std::frexp(m, &exponent);  // m < 2^exponent
+    scale = std::ldexp(1.0, -exponent);
+}
 
 // (UninitVector: first touched by the workers, its block reused by the next call.)
 core::UninitVector<glm::vec3> framedPoints(const PointView& points, const SearchFrame& frame, int threads) {
@@ -55,8 +45,6 @@ core::UninitVector<glm::vec3> framedCorners(const MeshView& surface, const Searc
                          });
     return out;
 }
-
-}  // namespace
 
 Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& points, const MeshView& surface,
                                    const SurfaceInputs& inputs, const SurfaceOptions& options) {

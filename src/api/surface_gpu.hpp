@@ -8,11 +8,33 @@
 // coordinates in double.
 #pragma once
 
+#include <glm/vec3.hpp>
+
 #include "api/backend.hpp"
 #include "core/input_frame.hpp"
+#include "core/uninit_vector.hpp"
 #include "rthdist/surface.hpp"
 
 namespace rthdist::api {
+
+// The device's frame: the centre of the union of two boxes, then a power
+// of two that brings every coordinate in them to at most 1 in magnitude
+// (the rule's degree-4 products stay far from float's range at any input
+// scale). A point is (p - origin) * scale, rounded to float.
+struct SearchFrame {
+    glm::dvec3 origin{0.0};
+    double scale = 1.0;
+
+    SearchFrame(const core::Bounds& a, const core::Bounds& b);
+    [[nodiscard]] glm::vec3 operator()(const glm::dvec3& p) const { return glm::vec3((p - origin) * scale); }
+};
+
+// The points, or the triangles' corners (3 per triangle, in index order),
+// in the frame, on the worker pool (threads as EngineOptions::threads).
+[[nodiscard]] core::UninitVector<glm::vec3> framedPoints(const PointView& points, const SearchFrame& frame,
+                                                         int threads);
+[[nodiscard]] core::UninitVector<glm::vec3> framedCorners(const MeshView& surface, const SearchFrame& frame,
+                                                          int threads);
 
 // What the checks of a point-to-surface call found (api/surface.cpp):
 // both inputs' summaries and the largest |coordinate| over both.

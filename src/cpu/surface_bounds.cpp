@@ -16,7 +16,6 @@
 #include "core/parallel.hpp"
 #include "core/point_triangle.hpp"
 #include "core/stopwatch.hpp"
-#include "cpu/triangle_bvh.hpp"
 
 namespace rthdist::cpu {
 namespace {
@@ -48,11 +47,13 @@ struct Patch {
 struct Direction {
     const MeshView* from = nullptr;
     const MeshView* to = nullptr;
-    std::optional<TriangleBvh> bvh;  // over `to`
+    SampleSearch* search = nullptr;  // over `to`
     std::vector<Sample> samples;
     size_t evaluated = 0;  // samples [evaluated, size) still need their query
     std::vector<Patch> work;
-    uint32_t best = kNone;  // the sample of the largest d (the smallest index on a tie)
+    // The sample of the largest exact d (the smallest index on a tie): each
+    // batch's proven maximum (SampleSearch), the others' d being upper bounds.
+    uint32_t best = kNone;
     double maxSettled = -std::numeric_limits<double>::infinity();  // largest bound of a settled patch
     SurfaceBoundsCounters counters;
 
@@ -79,27 +80,27 @@ void seed(Direction& dir) {
     }
 }
 
-// The new samples' nearest triangles, on the worker pool; false when cancelled.
-bool evaluate(Direction& dir, double slack, const SurfaceBoundsOptions& options) {
+// The new samples' nearest triangles in one batch (SampleSearch): each
+// sample's d an upper bound of its exact distance (exact on the CPU
+// backend), the batch's proven maximum a candidate for the lower bound.
+std::optional<Error> evaluate(Direction& dir) {
     const size_t begin = dir.evaluated, count = dir.samples.size() - begin;
-    std::atomic<bool> cancelled{false};
-    core::parallelChunks(count, kChunk, options.threads, [&](size_t lo, size_t hi, int) {
-        if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) {
-            cancelled.store(true, std::memory_order_relaxed);
-            return;
-        }
-        for (size_t i = begin + lo; i < begin + hi; ++i) {
-            const NearestTriangle hit = dir.bvh->nearest(dir.samples[i].p, slack);
-            dir.samples[i].d = std::sqrt(hit.distance2);
-            dir.samples[i].nearest = hit.triangle;
-        }
-    });
-    dir.counters.queries += count;
-    for (size_t i = begin; i < dir.samples.size(); ++i) {
-        if (dir.best == kNone || dir.samples[i].d > dir.samples[dir.best].d) dir.best = uint32_t(i);
+    if (count == 0) return std::nullopt;
+    std::vector<glm::dvec3> points(count);
+    std::vector<double> distance(count);
+    std::vector<uint32_t> nearest(count);
+    for (size_t i = 0; i < count; ++i) points[i] = dir.samples[begin + i].p;
+    Result<size_t> top = dir.search->search(points, distance, nearest);
+    if (!top) return top.error();
+    for (size_t i = 0; i < count; ++i) {
+        dir.samples[begin + i].d = distance[i];
+        dir.samples[begin + i].nearest = nearest[i];
     }
+    dir.counters.queries += count;
+    const auto proven = uint32_t(begin + *top);
+    if (dir.best == kNone || dir.samples[proven].d > dir.samples[dir.best].d) dir.best = proven;
     dir.evaluated = dir.samples.size();
-    return !cancelled.load();
+    return std::nullopt;
 }
 
 double distanceTo(const glm::dvec3& p, const MeshView& to, uint32_t t) {
@@ -264,8 +265,7 @@ Error tooManyQueries(const Refinement& r, double openBound) {
 
 std::optional<Error> Refinement::round() {
     for (Direction& d : dirs) {
-        if (!evaluate(d, slack, *options))
-            return Error{ErrorCode::kCancelled, "the call was cancelled (SurfaceBoundsOptions::cancel)"};
+        if (std::optional<Error> err = evaluate(d)) return err;
     }
     // Settled: the bound plus its slack cannot pass lower - slack + tolerance.
     const double threshold = lower() + tolerance - 2.0 * slack;
@@ -289,8 +289,10 @@ std::optional<Error> Refinement::round() {
 }  // namespace
 
 Result<SurfaceBoundsResult> surfaceBounds(const MeshView& a, const MeshView& b, double tolerance,
-                                          double slack, const SurfaceBoundsOptions& options) {
-    const core::Clock::time_point start = core::Clock::now();
+                                          double slack, const SurfaceBoundsOptions& options,
+                                          SampleSearch& aToB, SampleSearch* bToA) {
+    if (!options.directedOnly && bToA == nullptr)
+        return Error{ErrorCode::kInternal, "surface to surface: no search for the direction B -> A"};
     Refinement r;
     r.tolerance = tolerance;
     r.slack = slack;
@@ -298,16 +300,14 @@ Result<SurfaceBoundsResult> surfaceBounds(const MeshView& a, const MeshView& b, 
     r.dirs.resize(options.directedOnly ? 1 : 2);
     r.dirs[0].from = &a;
     r.dirs[0].to = &b;
+    r.dirs[0].search = &aToB;
     if (!options.directedOnly) {
         r.dirs[1].from = &b;
         r.dirs[1].to = &a;
+        r.dirs[1].search = bToA;
     }
-    for (Direction& d : r.dirs) {
-        d.bvh.emplace(*d.to, options.threads);
-        seed(d);
-    }
+    for (Direction& d : r.dirs) seed(d);
     SurfaceBoundsResult result;
-    result.buildMs = core::msSince(start);
     const core::Clock::time_point searchStart = core::Clock::now();
     while (r.open()) {
         if (std::optional<Error> err = r.round()) return *err;
@@ -319,8 +319,6 @@ Result<SurfaceBoundsResult> surfaceBounds(const MeshView& a, const MeshView& b, 
     result.lower = std::max(result.aToB.lower, result.bToA.lower);
     result.upper = std::max(result.aToB.upper, result.bToA.upper);
     result.slack = slack;
-    result.backend = Backend::kCpu;
-    result.device = "cpu";
     return result;
 }
 

@@ -256,17 +256,12 @@ TEST(RoutePlanner, SurfacesRunOnTheBackendNamed) {
     }
 }
 
-TEST(RoutePlanner, SurfacePairsRunOnTheCpuBackend) {
+TEST(RoutePlanner, SurfacePairsRunOnTheBackendNamed) {
     EXPECT_EQ(planSurfacePairRoute(Backend::kCpu).route, Route::kSurfaceCpu);
     EXPECT_EQ(planSurfacePairRoute(Backend::kAuto).route, Route::kSurfaceCpu);
-    for (Backend gpu : {Backend::kRayQuery, Backend::kRtPipeline}) {
-        // Refused, never replaced by the CPU.
-        const Plan plan = planSurfacePairRoute(gpu);
-        EXPECT_EQ(plan.route, Route::kRefused);
-        EXPECT_EQ(plan.code, ErrorCode::kInvalidArgument);
-        EXPECT_NE(plan.reason.find("runs on the cpu backend for now"), std::string::npos) << plan.reason;
-        EXPECT_NE(plan.reason.find(backendName(gpu)), std::string::npos) << plan.reason;
-    }
+    // A GPU backend the caller named runs on the device, never on the CPU in its place.
+    for (Backend gpu : {Backend::kRayQuery, Backend::kRtPipeline})
+        EXPECT_EQ(planSurfacePairRoute(gpu).route, Route::kSurfaceGpu);
 }
 
 TEST(RoutePlanner, EveryRouteHasAName) {

@@ -19,81 +19,25 @@
 #include <map>
 #include <vector>
 
-#include "common/surface_cases.hpp"
+#include "common/surface_pair_cases.hpp"
 #include "rthdist/surface.hpp"
 
 namespace rthdist {
 namespace {
 
-struct Mesh {
-    std::vector<glm::dvec3> vertices;
-    std::vector<uint32_t> indices;
-    [[nodiscard]] MeshView view() const { return MeshView{PointView(vertices), indices}; }
-};
-
-Mesh fromCase(const test::SurfaceCase& c) { return Mesh{c.vertices, c.indices}; }
-
-Mesh translated(Mesh m, const glm::dvec3& by) {
-    for (glm::dvec3& v : m.vertices) v += by;
-    return m;
-}
-
-Mesh scaled(Mesh m, double s) {
-    for (glm::dvec3& v : m.vertices) v *= s;
-    return m;
-}
-
-// An icosahedron subdivided `levels` times, every vertex projected onto the
-// unit sphere: a convex polytope whose vertices lie on the sphere (up to
-// one rounding).
-Mesh icosphere(int levels) {
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    Mesh m;
-    for (const glm::dvec3& v :
-         {glm::dvec3(-1, t, 0), glm::dvec3(1, t, 0), glm::dvec3(-1, -t, 0), glm::dvec3(1, -t, 0),
-          glm::dvec3(0, -1, t), glm::dvec3(0, 1, t), glm::dvec3(0, -1, -t), glm::dvec3(0, 1, -t),
-          glm::dvec3(t, 0, -1), glm::dvec3(t, 0, 1), glm::dvec3(-t, 0, -1), glm::dvec3(-t, 0, 1)})
-        m.vertices.push_back(glm::normalize(v));
-    m.indices = {0, 11, 5,  0, 5,  1, 0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
-                 4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3,  9,  4, 3,  4,  2, 3, 2, 6, 3,
-                 6, 8,  3,  8, 9,  4, 9, 5, 2, 4, 11, 6,  2, 10, 8,  6, 7, 9, 8, 1};
-    for (int level = 0; level < levels; ++level) {
-        std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
-        auto middle = [&](uint32_t a, uint32_t b) {
-            const auto key = std::minmax(a, b);
-            const auto [it, inserted] = mid.try_emplace(key, uint32_t(m.vertices.size()));
-            if (inserted) m.vertices.push_back(glm::normalize(m.vertices[a] + m.vertices[b]));
-            return it->second;
-        };
-        std::vector<uint32_t> next;
-        for (size_t i = 0; i < m.indices.size(); i += 3) {
-            const uint32_t a = m.indices[i], b = m.indices[i + 1], c = m.indices[i + 2];
-            const uint32_t ab = middle(a, b), bc = middle(b, c), ca = middle(c, a);
-            next.insert(next.end(), {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca});
-        }
-        m.indices = std::move(next);
-    }
-    return m;
-}
+using Mesh = test::PairMesh;
+using test::checkAgainstSampling;
+using test::expectBrackets;
+using test::fromCase;
+using test::icosphere;
+using test::scaled;
+using test::translated;
 
 Result<SurfaceBoundsResult> bounds(const Mesh& a, const Mesh& b, double tolerance, bool directed = false) {
     SurfaceBoundsOptions options;
     options.tolerance = tolerance;
     options.directedOnly = directed;
     return surfaceHausdorff(a.view(), b.view(), options);
-}
-
-// lower <= known <= upper and upper - lower <= tolerance; `known` within
-// `known_error` (the rounding of the test's own construction).
-void expectBrackets(const SurfaceBoundsResult& r, double known, double knownError = 0.0) {
-    std::printf("bounds [%.17g, %.17g] width %.3g, tolerance %.3g, known %.17g, queries %llu + %llu\n",
-                r.lower, r.upper, r.upper - r.lower, r.tolerance, known,
-                static_cast<unsigned long long>(r.aToB.counters.queries),
-                static_cast<unsigned long long>(r.bToA.counters.queries));
-    EXPECT_LE(r.lower, known + knownError);
-    EXPECT_GE(r.upper, known - knownError);
-    EXPECT_LE(r.upper - r.lower, r.tolerance);
-    EXPECT_LE(r.lower, r.upper);
 }
 
 TEST(SurfaceBounds, TriangleAndItsParallelOffsetCopy) {
@@ -172,50 +116,6 @@ TEST(SurfaceBounds, DirectedOnlyHoldsItsOwnWidth) {
     EXPECT_EQ(r->bToA.counters.queries, 0u);
 }
 
-// Every point of A's triangles at barycentric coordinates (i, j, n - i - j) / n.
-std::vector<glm::dvec3> denseSamples(const Mesh& m, int n) {
-    std::vector<glm::dvec3> points;
-    for (size_t t = 0; t < m.indices.size(); t += 3) {
-        const glm::dvec3 &p = m.vertices[m.indices[t]], &q = m.vertices[m.indices[t + 1]],
-                         &s = m.vertices[m.indices[t + 2]];
-        for (int i = 0; i <= n; ++i)
-            for (int j = 0; i + j <= n; ++j)
-                points.push_back((p * double(n - i - j) + q * double(i) + s * double(j)) / double(n));
-    }
-    return points;
-}
-
-double longestEdge(const Mesh& m) {
-    double e = 0.0;
-    for (size_t t = 0; t < m.indices.size(); t += 3) {
-        for (int k = 0; k < 3; ++k)
-            e = std::max(e, glm::distance(m.vertices[m.indices[t + size_t(k)]],
-                                          m.vertices[m.indices[t + size_t(k + 1) % 3]]));
-    }
-    return e;
-}
-
-// Dense exact sampling, independent of the refinement: h(A, B) >= the
-// largest sampled distance (a lower bound), and <= it plus 2/3 of the
-// longest edge of the sampling grid (the Lipschitz bound, an upper bound).
-void checkAgainstSampling(const Mesh& a, const Mesh& b, const SurfaceBoundsDirected& d) {
-    const int n = 24;
-    const std::vector<glm::dvec3> samples = denseSamples(a, n);
-    SurfaceOptions options;
-    Result<SurfaceResult> sampled = hausdorffToSurface(PointView(samples), b.view(), options);
-    ASSERT_TRUE(sampled) << sampled.error().message;
-    const double sampledUpper = sampled->hausdorff + longestEdge(a) / n * (2.0 / 3.0) * (1 + 1e-12);
-    std::printf("sampled %.17g (upper %.17g), bounds [%.17g, %.17g]\n", sampled->hausdorff, sampledUpper,
-                d.lower, d.upper);
-    EXPECT_LE(sampled->hausdorff, d.upper);
-    EXPECT_LE(d.lower, sampledUpper);
-    // The witness realizes the lower bound: its own exact distance.
-    Result<SurfaceResult> w = hausdorffToSurface(PointView(std::vector<glm::dvec3>{d.fromPoint}), b.view());
-    ASSERT_TRUE(w) << w.error().message;
-    EXPECT_NEAR(w->hausdorff, d.distance, 1e-12);
-    EXPECT_NEAR(glm::distance(d.fromPoint, d.toPoint), d.distance, 1e-12);
-}
-
 TEST(SurfaceBounds, HeightFieldsAgainstDenseSampling) {
     for (uint64_t seed : {3470u, 3471u, 3472u}) {
         const Mesh a = fromCase(test::heightField(seed, 7, 5.0));
@@ -286,11 +186,6 @@ TEST(SurfaceBounds, RefusalsAreErrors) {
         EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
         EXPECT_NE(r.error().message.find("tolerance"), std::string::npos) << r.error().message;
     }
-    SurfaceBoundsOptions options;
-    options.backend = Backend::kRayQuery;
-    r = surfaceHausdorff(a.view(), a.view(), options);
-    ASSERT_FALSE(r);
-    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
 }
 
 TEST(SurfaceBounds, QueryLimitIsOutOfMemoryWithTheBoundsReached) {

@@ -2,10 +2,14 @@
 // lavapipe (design.md §11, "The GPU backends"): a georeferenced OBJ height
 // field and points around it, the JSON's directed value and witness against
 // the brute force over every triangle (tests/common) with ==, the
-// validation layer silent; per-point outputs refused (exit 2). Never
-// skipped: without a device the runs fail (CI must have lavapipe).
+// validation layer silent; per-point outputs refused (exit 2). `--surface
+// both` on each GPU backend: the bounds bracket a closed form (a triangle
+// and its parallel offset copy) within --tolerance and meet the cpu
+// backend's; a tolerance below the GPU floor is a usage error naming it.
+// Never skipped: without a device the runs fail (CI must have lavapipe).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -69,6 +73,39 @@ TEST_F(CliSurfaceGpu, PointsToSurfaceMatchTheBruteForceOnEveryGpuBackend) {
         else
             EXPECT_GE(c["rays"].get<uint64_t>(), m_points.size()) << backend;
         EXPECT_GE(c["band"].get<uint64_t>(), 1u) << backend;
+    }
+}
+
+TEST_F(CliSurfaceGpu, SurfaceToSurfaceOnEveryGpuBackend) {
+    const std::string a = m_dir.write("a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const std::string b = m_dir.write("b.obj", "v 0 0 0.25\nv 1 0 0.25\nv 0 1 0.25\nf 1 2 3\n");
+    const CliRun cpu =
+        runCli({a, b, "--surface", "both", "--backend", "cpu", "--tolerance", "1e-3", "--json"});
+    ASSERT_EQ(cpu.exitCode, 0) << cpu;
+    const Json c = Json::parse(cpu.out);
+    for (const char* backend : {"ray-query", "rt-pipeline"}) {
+        const CliRun run = runCli({a, b, "--surface", "both", "--backend", backend, "--tolerance", "1e-3",
+                                   "--json", "--validation"});
+        ASSERT_EQ(run.exitCode, 0) << run;
+        const Json j = Json::parse(run.out);
+        EXPECT_EQ(j["backend"], backend);
+        EXPECT_EQ(j["mode"], "surface-to-surface");
+        EXPECT_EQ(j["validation_messages"].get<uint64_t>(), 0u) << backend;
+        const double lower = j["bounds"][0].get<double>(), upper = j["bounds"][1].get<double>();
+        EXPECT_LE(lower, 0.25) << backend;
+        EXPECT_GE(upper, 0.25) << backend;
+        EXPECT_LE(upper - lower, 1e-3) << backend;
+        EXPECT_LE(std::max(lower, c["bounds"][0].get<double>()),
+                  std::min(upper, c["bounds"][1].get<double>()));
+        EXPECT_EQ(j["a_to_b"]["distance"].get<double>(), 0.25) << backend;
+        // Below the float search's floor (2^-14 of the box's largest
+        // coordinate around its centre, 0.5 here, rounded up to a power of
+        // two: 2^-14): refused, named.
+        const CliRun low = runCli({a, b, "--surface", "both", "--backend", backend, "--tolerance", "2e-5"});
+        EXPECT_EQ(low.exitCode, 2) << low;
+        EXPECT_NE(low.err.find("below the " + std::string(backend) + " backend's floor 6.103515625e-05"),
+                  std::string::npos)
+            << low;
     }
 }
 

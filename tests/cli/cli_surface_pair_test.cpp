@@ -4,8 +4,8 @@
 // JSON's bounds bracketing it within --tolerance, both witnesses' keys,
 // --directed, the summary line; the refusals: --tolerance malformed, out
 // of range, below the meshes' rounding floor or without --surface both,
-// a GPU backend (exit 2 naming the option); a side without faces (exit 3
-// naming the file).
+// per-point outputs (exit 2 naming the option); a side without faces (exit
+// 3 naming the file). The GPU backends: cli_surface_gpu_test.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -107,12 +107,10 @@ TEST_F(CliSurfacePair, BadTolerancesAreUsageErrorsNamingTheOption) {
     EXPECT_EQ(run.exitCode, 2) << run;
 }
 
-TEST_F(CliSurfacePair, GpuBackendAndPerPointAreRefused) {
-    CliRun run = runCli({m_a, m_b, "--surface", "both", "--backend", "ray-query"});
+TEST_F(CliSurfacePair, PerPointIsRefused) {
+    const CliRun run = runCli({m_a, m_b, "--surface", "both", "--per-point"});
     EXPECT_EQ(run.exitCode, 2) << run;
-    EXPECT_NE(run.err.find("runs on the cpu backend for now"), std::string::npos) << run;
-    run = runCli({m_a, m_b, "--surface", "both", "--per-point"});
-    EXPECT_EQ(run.exitCode, 2) << run;
+    EXPECT_NE(run.err.find("not per-point distances"), std::string::npos) << run;
 }
 
 TEST_F(CliSurfacePair, SideWithoutFacesIsBadInputNamingTheFile) {

@@ -130,6 +130,20 @@ def test_triangle_and_its_offset_copy():
     assert d["directed"] and d["b_to_a"] is None
 
 
+@pytest.mark.parametrize("gpu", ["ray-query", "rt-pipeline"])
+def test_surface_to_surface_on_a_gpu_backend(gpu):
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float64)
+    f = np.array([[0, 1, 2]], dtype=np.int32)
+    r = rthdist.surface_hausdorff(v, f, v + [0, 0, 0.25], f, tolerance=1e-3, backend=gpu)
+    lower, upper = r["bounds"]
+    assert r["backend"] == gpu
+    assert lower <= 0.25 <= upper and upper - lower <= 1e-3
+    assert r["a_to_b"]["distance"] == 0.25
+    # Below the float search's floor (2^-14 here): a ValueError naming it.
+    with pytest.raises(ValueError, match="floor 6.103515625e-05"):
+        rthdist.surface_hausdorff(v, f, v + [0, 0, 0.25], f, tolerance=1e-5, backend=gpu)
+
+
 def test_square_split_both_ways_is_zero():
     other = np.array([[0, 1, 3], [1, 2, 3]], dtype=np.uint32)
     r = rthdist.surface_hausdorff(SQUARE_V, SQUARE_F, SQUARE_V, other, tolerance=1e-3)

@@ -141,11 +141,12 @@ Options:
                       distances (cpu backend: auto picks it), their files
                       named for that side alone (--surface b: PREFIX_a.*);
                       both: certified bounds [lower, upper] on H between the
-                      surfaces of both meshes (--directed: h(A, B)); the cpu
-                      backend (auto picks it)
+                      surfaces of both meshes (--directed: h(A, B)), on the
+                      cpu backend (auto picks it) or a GPU backend
   --tolerance T       --surface both: the largest width upper - lower, a
                       finite distance > 0 (default 1e-4 of the diagonal of
-                      both meshes' box; at least ~4e-12 of their extent)
+                      both meshes' box; at least ~4e-12 of their extent on
+                      the cpu backend, ~6e-5 of their diagonal on a GPU one)
   --eval LIST         reconstruction evaluation, A the reconstruction and B the
                       ground truth: accuracy (A -> B) and completeness (B -> A)
                       mean and median, Chamfer, precision, recall and F-score
@@ -355,9 +356,10 @@ void addPerPointOptions(CommandLine& line, CliArgs& out) {
     }
 }
 
-// --surface reports the directed value alone (on the cpu backend, or on
-// one device of a GPU backend), with per-point outputs on the cpu backend
-// for a|b: the options it cannot honour are refused, never ignored.
+// --surface reports the directed value alone (a|b) or certified bounds
+// (both), on the cpu backend or on one device of a GPU backend, with
+// per-point outputs on the cpu backend for a|b: the options it cannot
+// honour are refused, never ignored.
 std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
     if (out.tolerance > 0.0 && out.surface != "both")
         return usageError(
@@ -379,9 +381,6 @@ std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
         return usageError("option '--surface' proves its value itself: --verify has nothing to compare");
     if (!out.options.devices.empty() || out.allDevices)
         return usageError("option '--surface' runs on one device: --devices spreads work over GPUs");
-    if (out.surface == "both" &&
-        (out.options.backend == Backend::kRayQuery || out.options.backend == Backend::kRtPipeline))
-        return usageError("option '--surface both': surface to surface runs on the cpu backend for now");
     return std::nullopt;
 }
 

@@ -87,14 +87,12 @@ std::string jsonReport(const Run& run) {
               {"bounds", Json::array({r.lower, r.upper})},
               {"tolerance", r.tolerance},
               {"slack", r.slack},
-              {"origin", pointJson(r.origin)}};
+              {"origin", pointJson(r.origin)},
+              {"validation_messages", r.validationMessages}};
     j["a_to_b"] = directedJson(r.aToB, "a", "b");
     j["b_to_a"] = r.directed ? Json() : directedJson(r.bToA, "b", "a");
-    j["timings_ms"] = {{"load", run.loadMs},
-                       {"build", r.buildMs},
-                       {"search", r.searchMs},
-                       {"total", r.totalMs},
-                       {"wall", run.wallMs}};
+    j["timings_ms"] = {{"load", run.loadMs}, {"build", r.buildMs}, {"search", r.searchMs},
+                       {"total", r.totalMs}, {"wall", run.wallMs}, {"gpu", r.gpuMs}};
     j["counters"] = {{"a_to_b", countersJson(r.aToB.counters)},
                      {"b_to_a", r.directed ? Json() : countersJson(r.bToA.counters)}};
     return jsonText(j) + "\n";
@@ -152,6 +150,8 @@ int surfacePairCommand(const CliArgs& args) {
     SurfaceBoundsOptions options;
     options.backend = args.options.backend;
     options.threads = args.options.threads;
+    options.deviceIndex = args.options.deviceIndex;
+    options.validation = args.options.validation;
     options.tolerance = args.tolerance;
     options.directedOnly = args.options.directedOnly;
     Result<SurfaceBoundsResult> result = surfaceHausdorff(a->view(), b->view(), options);
