@@ -329,9 +329,10 @@ struct SurfaceBoundsResult {
     bool directed = false;            // directedOnly: bounds are h(SA, SB)'s
     Backend backend = Backend::kCpu;  // the backend that ran
     std::string device;               // "cpu", or the device's name
-    double buildMs = 0.0;             // the BVHs (GPU backends: the device opened, the corners framed)
+    double buildMs = 0.0;             // the BVHs (GPU backends: every triangle's corners framed)
     double searchMs = 0.0;            // the rounds
-    double totalMs = 0.0;
+    double totalMs = 0.0;             // the whole call (GPU backends: setupMs included)
+    double setupMs = 0.0;             // GPU backends: the device opened for the call (beside the checks)
     double gpuMs = 0.0;               // GPU backends: device time of every batch's search
     uint64_t validationMessages = 0;  // with SurfaceBoundsOptions::validation
 };
