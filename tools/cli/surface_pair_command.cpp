@@ -92,7 +92,8 @@ std::string jsonReport(const Run& run) {
     j["a_to_b"] = directedJson(r.aToB, "a", "b");
     j["b_to_a"] = r.directed ? Json() : directedJson(r.bToA, "b", "a");
     j["timings_ms"] = {{"load", run.loadMs}, {"build", r.buildMs}, {"search", r.searchMs},
-                       {"total", r.totalMs}, {"wall", run.wallMs}, {"gpu", r.gpuMs}};
+                       {"total", r.totalMs}, {"wall", run.wallMs}, {"setup", r.setupMs},
+                       {"gpu", r.gpuMs}};
     j["counters"] = {{"a_to_b", countersJson(r.aToB.counters)},
                      {"b_to_a", r.directed ? Json() : countersJson(r.bToA.counters)}};
     return jsonText(j) + "\n";
