@@ -22,6 +22,7 @@
 #include "api/surface_engine.hpp"
 #include "api/surface_gpu.hpp"
 #include "core/input_frame.hpp"
+#include "core/mesh_checks.hpp"
 #include "core/parallel.hpp"
 #include "core/stopwatch.hpp"
 #include "cpu/surface_search.hpp"
@@ -46,42 +47,6 @@ std::optional<Error> checkMagnitude(const core::Bounds& box, const char* name) {
                                                   " is past the point-to-surface limit of 2^250 (~1.8e75)"};
 }
 
-std::optional<Error> checkTriangles(const MeshView& surface, int threads) {
-    if (surface.indices.size() % 3 != 0) {
-        return Error{ErrorCode::kInvalidArgument,
-                     "surface B: " + std::to_string(surface.indices.size()) +
-                         " indices are not a whole number of triangles (3 each)"};
-    }
-    if (surface.triangleCount() == 0)
-        return Error{ErrorCode::kInvalidArgument, "surface B has no triangles: the distance is undefined"};
-    if (surface.triangleCount() > UINT32_MAX || surface.vertices.count > UINT32_MAX) {
-        return Error{ErrorCode::kInvalidArgument,
-                     "surface B: at most 2^32 - 1 triangles and vertices (32-bit indices), not " +
-                         std::to_string(surface.triangleCount()) + " triangles of " +
-                         std::to_string(surface.vertices.count) + " vertices"};
-    }
-    // The first index out of range (the error names the first bad triangle),
-    // chunks on the worker pool: a chunk past a bad one found already stops.
-    const size_t n = surface.indices.size();
-    std::atomic<size_t> first{n};
-    core::parallelChunks(n, size_t(1) << 16, threads, [&](size_t begin, size_t end, int) {
-        if (begin >= first.load(std::memory_order_relaxed)) return;
-        for (size_t i = begin; i < end; ++i) {
-            if (surface.indices[i] < surface.vertices.count) continue;
-            size_t seen = first.load(std::memory_order_relaxed);
-            while (i < seen && !first.compare_exchange_weak(seen, i, std::memory_order_relaxed)) {
-            }
-            return;
-        }
-    });
-    const size_t at = first.load();
-    if (at == n) return std::nullopt;
-    return Error{ErrorCode::kInvalidArgument, "surface B: triangle " + std::to_string(at / 3) +
-                                                  ": vertex index " + std::to_string(surface.indices[at]) +
-                                                  " out of range (" + std::to_string(surface.vertices.count) +
-                                                  " vertices)"};
-}
-
 // Every check of a call's inputs, in the order the errors are reported.
 // `keptB`: the summary of a mesh equal to one checked before (an Engine's
 // kept mesh, bit for bit): its triangles and vertices are not read again.
@@ -90,7 +55,7 @@ Result<api::SurfaceInputs> checkInputs(const PointView& points, const MeshView& 
     if (auto err = core::checkShape(points, "A")) return *err;
     if (auto err = core::checkShape(surface.vertices, "B")) return *err;
     if (keptB == nullptr) {
-        if (auto err = checkTriangles(surface, threads)) return *err;
+        if (auto err = core::checkTriangles(surface, "surface B", threads)) return *err;
     }
     Result<core::SetSummary> a = core::summarizeSet(points, "A", threads);
     if (!a) return a.error();

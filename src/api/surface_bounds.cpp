@@ -24,6 +24,8 @@
 #include "api/route_planner.hpp"
 #include "api/surface_pair_gpu.hpp"
 #include "core/input_frame.hpp"
+#include "core/mesh_checks.hpp"
+#include "core/parallel.hpp"
 #include "core/point_triangle.hpp"
 #include "core/stopwatch.hpp"
 #include "cpu/surface_bounds.hpp"
@@ -48,34 +50,11 @@ double magnitudeOf(const core::Bounds& box) {
     return std::max({m.x, m.y, m.z});
 }
 
-std::optional<Error> checkTriangles(const MeshView& mesh, const std::string& name) {
-    if (mesh.indices.size() % 3 != 0) {
-        return Error{ErrorCode::kInvalidArgument,
-                     name + ": " + std::to_string(mesh.indices.size()) +
-                         " indices are not a whole number of triangles (3 each)"};
-    }
-    if (mesh.triangleCount() == 0)
-        return Error{ErrorCode::kInvalidArgument, name + " has no triangles: the distance is undefined"};
-    if (mesh.triangleCount() > UINT32_MAX || mesh.vertices.count > UINT32_MAX) {
-        return Error{ErrorCode::kInvalidArgument, name + ": at most 2^32 - 1 triangles and vertices, not " +
-                                                      std::to_string(mesh.triangleCount()) +
-                                                      " triangles of " + std::to_string(mesh.vertices.count) +
-                                                      " vertices"};
-    }
-    const auto it = std::find_if(mesh.indices.begin(), mesh.indices.end(),
-                                 [&](uint32_t v) { return v >= mesh.vertices.count; });
-    if (it == mesh.indices.end()) return std::nullopt;
-    const auto at = size_t(it - mesh.indices.begin());
-    return Error{ErrorCode::kInvalidArgument,
-                 name + ": triangle " + std::to_string(at / 3) + ": vertex index " + std::to_string(*it) +
-                     " out of range (" + std::to_string(mesh.vertices.count) + " vertices)"};
-}
-
 // The mesh checked and summarized (its box), or the error naming it.
 Result<core::SetSummary> checkMesh(const MeshView& mesh, const char* set, int threads) {
     const std::string name = std::string("surface ") + set;
     if (auto err = core::checkShape(mesh.vertices, set)) return *err;
-    if (auto err = checkTriangles(mesh, name)) return *err;
+    if (auto err = core::checkTriangles(mesh, name, threads)) return *err;
     Result<core::SetSummary> s = core::summarizeSet(mesh.vertices, set, threads);
     if (!s) return s.error();
     if (magnitudeOf(s->box) > kMaxMagnitude) {
@@ -86,10 +65,13 @@ Result<core::SetSummary> checkMesh(const MeshView& mesh, const char* set, int th
     return s;
 }
 
-// The mesh's vertices in the work frame: p - origin, in double.
-std::vector<glm::dvec3> shifted(const MeshView& mesh, const glm::dvec3& origin) {
+// The mesh's vertices in the work frame: p - origin, in double (worker pool).
+std::vector<glm::dvec3> shifted(const MeshView& mesh, const glm::dvec3& origin, int threads) {
     std::vector<glm::dvec3> v(mesh.vertices.count);
-    for (size_t i = 0; i < v.size(); ++i) v[i] = mesh.vertices.at(i) - origin;
+    core::parallelChunks(v.size(), core::balancedChunk(v.size(), threads), threads,
+                         [&](size_t begin, size_t end, int) {
+                             for (size_t i = begin; i < end; ++i) v[i] = mesh.vertices.at(i) - origin;
+                         });
     return v;
 }
 
@@ -145,7 +127,8 @@ Result<SurfaceBoundsResult> surfaceHausdorff(MeshView a, MeshView b, const Surfa
 
     const glm::dvec3 lo = glm::min(sa->box.lo, sb->box.lo), hi = glm::max(sa->box.hi, sb->box.hi);
     const glm::dvec3 origin = (lo * 0.5) + (hi * 0.5);  // halves first: no overflow near the limit
-    const std::vector<glm::dvec3> va = shifted(a, origin), vb = shifted(b, origin);
+    const std::vector<glm::dvec3> va = shifted(a, origin, options.threads),
+                                  vb = shifted(b, origin, options.threads);
     const core::Bounds work{lo - origin, hi - origin};
     const double magnitude = std::max(magnitudeOf(work), 0.0);
     const double slack = core::closestSlack(magnitude);
