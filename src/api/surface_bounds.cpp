@@ -153,9 +153,16 @@ Result<SurfaceBoundsResult> surfaceHausdorff(MeshView a, MeshView b, const Surfa
             bToA = std::make_unique<api::DeviceSampleSearch>(backend, wa, frame, magnitude, options.threads,
                                                              options.cancel);
     } else {
-        aToB = std::make_unique<cpu::BvhSampleSearch>(wb, slack, options.threads, options.cancel);
+        // Both trees at once (a small mesh's build runs on one thread; a
+        // large one's share the worker pool).
+        std::future<std::unique_ptr<cpu::SampleSearch>> other;
         if (!options.directedOnly)
-            bToA = std::make_unique<cpu::BvhSampleSearch>(wa, slack, options.threads, options.cancel);
+            other = std::async(std::launch::async, [&] {
+                return std::unique_ptr<cpu::SampleSearch>(
+                    std::make_unique<cpu::BvhSampleSearch>(wa, slack, options.threads, options.cancel));
+            });
+        aToB = std::make_unique<cpu::BvhSampleSearch>(wb, slack, options.threads, options.cancel);
+        if (other.valid()) bToA = other.get();
     }
     const double buildMs = core::msSince(buildStart);
     Result<SurfaceBoundsResult> result =
