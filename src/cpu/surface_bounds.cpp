@@ -236,6 +236,7 @@ struct Refinement {
     std::vector<Direction> dirs;
     double tolerance = 0.0, slack = 0.0;
     const SurfaceBoundsOptions* options = nullptr;
+    size_t roundsRun = 0;
 
     [[nodiscard]] double lower() const {
         double l = 0.0;
@@ -264,8 +265,12 @@ Error tooManyQueries(const Refinement& r, double openBound) {
 }
 
 std::optional<Error> Refinement::round() {
-    for (Direction& d : dirs) {
-        if (std::optional<Error> err = evaluate(d)) return err;
+    // Each direction's batch (neither reads the other's); the order turns
+    // every round, so that a GPU search meets the same mesh twice in a row
+    // at each turn (its device keeps the last mesh's descent tree).
+    const bool turn = (roundsRun++ % 2) == 1;
+    for (size_t k = 0; k < dirs.size(); ++k) {
+        if (std::optional<Error> err = evaluate(dirs[turn ? dirs.size() - 1 - k : k])) return err;
     }
     // Settled: the bound plus its slack cannot pass lower - slack + tolerance.
     const double threshold = lower() + tolerance - 2.0 * slack;
