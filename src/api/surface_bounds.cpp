@@ -154,15 +154,16 @@ Result<SurfaceBoundsResult> surfaceHausdorff(MeshView a, MeshView b, const Surfa
                                                              options.cancel);
     } else {
         // Both trees at once (a small mesh's build runs on one thread; a
-        // large one's share the worker pool).
-        std::future<std::unique_ptr<cpu::SampleSearch>> other;
+        // large one's share the worker pool). A future of void: no
+        // std::future instance over an internal type (the shared library
+        // exports no such symbol, tools/package_test.sh).
+        std::future<void> other;
         if (!options.directedOnly)
             other = std::async(std::launch::async, [&] {
-                return std::unique_ptr<cpu::SampleSearch>(
-                    std::make_unique<cpu::BvhSampleSearch>(wa, slack, options.threads, options.cancel));
+                bToA = std::make_unique<cpu::BvhSampleSearch>(wa, slack, options.threads, options.cancel);
             });
         aToB = std::make_unique<cpu::BvhSampleSearch>(wb, slack, options.threads, options.cancel);
-        if (other.valid()) bToA = other.get();
+        if (other.valid()) other.get();
     }
     const double buildMs = core::msSince(buildStart);
     Result<SurfaceBoundsResult> result =
