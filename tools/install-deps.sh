@@ -6,7 +6,8 @@
 # already present are left alone. Needs root or sudo.
 #   RTHDIST_BENCH_DEPS=1  also python3-scipy/numpy for tools/bench
 #   RTHDIST_LINT_DEPS=1   also clang-format for .ci/run
-#   RTHDIST_FUZZ_DEPS=1   also clang-14 and its libFuzzer runtime (tools/fuzz/run.sh)
+#   RTHDIST_FUZZ_DEPS=1   also clang-14 and its libFuzzer and sanitizer runtimes (tools/fuzz/run.sh,
+#                         the asan preset's compiler)
 #   RTHDIST_MASKS_DEPS=0  skip the Python oracle of tests/masks (numpy, scipy, scikit-image,
 #                         nibabel; on by default: ctest runs it)
 #   RTHDIST_PYTHON_DEPS=0 skip the Python package's build and tests (pybind11, pytest, venv,

@@ -28,9 +28,11 @@ TEST(GpuDensity, EveryCaseMatchesItsReference) {
         const DensityReference ref = densityReference(c);
         auto r = engine->compute(c.a, c.b);
         ASSERT_TRUE(r.ok()) << r.error().message;
-        std::printf("  %-28s %7zu x %-7zu H %.9g  %.0f ms, cells %u/%u, iterations %u/%u\n", c.name.c_str(),
-                    c.a.size(), c.b.size(), r->hausdorff, r->timings.total, r->aToB.counters.occupiedCells,
-                    r->bToA.counters.occupiedCells, r->aToB.counters.iterations, r->bToA.counters.iterations);
+        std::printf("  %-28s %7zu x %-7zu H %.9g  %.0f ms, cells %llu/%llu, iterations %u/%u\n",
+                    c.name.c_str(), c.a.size(), c.b.size(), r->hausdorff, r->timings.total,
+                    static_cast<unsigned long long>(r->aToB.counters.occupiedCells),
+                    static_cast<unsigned long long>(r->bToA.counters.occupiedCells),
+                    r->aToB.counters.iterations, r->bToA.counters.iterations);
         expectMatchesDensity(c, ref, *r);
         EXPECT_EQ(r->validationMessages, 0u);
         auto p = perPointEngine->compute(c.a, c.b);
