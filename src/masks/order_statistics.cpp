@@ -62,7 +62,9 @@ std::pair<double, double> bucketSelect(std::span<const double> values, size_t k,
         return nthAndNext(copy, k);
     }
     const double low = lo;  // (a structured binding is not captured by clang 14)
-    const auto bucketOf = [low, scale](double v) { return std::min(kBuckets - 1, size_t((v - low) * scale)); };
+    const auto bucketOf = [low, scale](double v) {
+        return std::min(kBuckets - 1, size_t((v - low) * scale));
+    };
     const int workers = core::resolveThreads(threads, chunks);
     // Each thread zeroes its own histogram at its first chunk (kept blocks:
     // core::UninitVector, no fresh pages per call).
