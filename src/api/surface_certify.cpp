@@ -310,7 +310,7 @@ std::vector<uint64_t> bandBySearched(const PointView& points, const MeshView& su
 Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface, double magnitude,
                                      std::span<const uint32_t> candidate, const SurfaceOptions& options,
                                      std::span<const uint32_t> open, std::span<const float> searched2,
-                                     double searchScale, std::vector<uint32_t>* openNearest) {
+                                     double searchScale, EveryQueryBound* every) {
     if (options.perPointDistances)
         return Error{ErrorCode::kInvalidArgument,
                      "the proof of a surface search gives no per-point distances"};
@@ -324,7 +324,6 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     // bound); each then takes its nearest triangle for its candidate, so its
     // U below is its exact nearest distance.
     const core::Clock::time_point openStart = core::Clock::now();
-    if (openNearest != nullptr) openNearest->clear();
     Known known;
     std::vector<uint32_t> settledCandidate;
     if (!open.empty()) {
@@ -344,7 +343,6 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
         for (size_t i = 0; i < openQueries.size(); ++i) {
             known.emplace_back(openQueries[i], nearest[i]);
             settledCandidate[openQueries[i]] = nearest[i].triangle;
-            if (openNearest != nullptr) openNearest->push_back(nearest[i].triangle);
         }
         candidate = settledCandidate;
     }
@@ -362,7 +360,8 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
         searched2 = openAdjusted;
     }
     const SearchedBound searched{searched2, searchScale, kSearchedReach / searchScale};
-    bool bySearched = searched2.size() == points.count && searchScale > 0.0 && std::isfinite(searched.reach);
+    bool bySearched = every == nullptr && searched2.size() == points.count && searchScale > 0.0 &&
+                      std::isfinite(searched.reach);
     Largest largest;
     core::UninitVector<double> bound;
     if (bySearched) {
@@ -416,6 +415,10 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     d.counters.queries = points.count;
     d.counters.band = bandIndex.size();
     exact->stages.tailHost = openMs;
+    if (every != nullptr) {  // every U(q) measured (not bySearched)
+        every->bound2 = std::move(bound);
+        every->triangle.assign(candidate.begin(), candidate.end());
+    }
     return exact;
 }
 

@@ -26,6 +26,7 @@
 #include <span>
 #include <vector>
 
+#include "core/uninit_vector.hpp"
 #include "rthdist/surface.hpp"
 
 namespace rthdist::api {
@@ -47,11 +48,18 @@ namespace rthdist::api {
 // rounding reach, checked on a sample of the call) does not rule it out
 // (surface_certify.cpp, kSearchedReach; design.md §11). The answer is the
 // same either way.
-// openNearest (may be null): the open queries' exact nearest triangles, in
-// the order of `open` (the brute force's: the smallest index on a tie).
+// every (may be null): also every query's U(q) (squared) and the triangle
+// that gives it, in query order: its candidate, or an open query's exact
+// nearest (the brute force's). The proof then measures every U(q) (as
+// without searched2), whose values it hands back instead of the caller
+// measuring them again (the GPU's surface to surface, api/surface_pair_gpu.hpp).
+struct EveryQueryBound {
+    core::UninitVector<double> bound2;  // +inf: no triangle
+    std::vector<uint32_t> triangle;
+};
 [[nodiscard]] Result<SurfaceResult> certifySurface(
     const PointView& points, const MeshView& surface, double magnitude, std::span<const uint32_t> candidate,
     const SurfaceOptions& options, std::span<const uint32_t> open = {}, std::span<const float> searched2 = {},
-    double searchScale = 0.0, std::vector<uint32_t>* openNearest = nullptr);
+    double searchScale = 0.0, EveryQueryBound* every = nullptr);
 
 }  // namespace rthdist::api

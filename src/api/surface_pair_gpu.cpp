@@ -2,11 +2,8 @@
 
 #include <cmath>
 #include <string>
-#include <vector>
 
 #include "api/surface_certify.hpp"
-#include "core/parallel.hpp"
-#include "core/point_triangle.hpp"
 
 namespace rthdist::api {
 
@@ -32,35 +29,20 @@ Result<size_t> DeviceSampleSearch::search(std::span<const glm::dvec3> points, st
     SurfaceOptions proofOptions;
     proofOptions.threads = m_threads;
     proofOptions.cancel = m_cancel;
-    std::vector<uint32_t> openNearest;
-    Result<SurfaceResult> proof = certifySurface(view, m_to, m_magnitude, found->triangle, proofOptions,
-                                                 found->open, found->distance2, m_frame.scale, &openNearest);
+    EveryQueryBound every;
+    // (No device distances: every U(q) is measured, so none would be skipped.)
+    Result<SurfaceResult> proof =
+        certifySurface(view, m_to, m_magnitude, found->triangle, proofOptions, found->open, {}, 0.0, &every);
     if (!proof) return proof.error();
-
-    // Every sample's candidate (an open one's: its exact nearest) and the
-    // rule's distance to it in double.
-    std::span<uint32_t> candidate(found->triangle.data(), points.size());
-    for (size_t k = 0; k < found->open.size(); ++k) candidate[found->open[k]] = openNearest[k];
-    const size_t triangles = m_to.triangleCount();
-    std::atomic<size_t> missing{points.size()};
-    core::parallelChunks(points.size(), core::balancedChunk(points.size(), m_threads), m_threads,
-                         [&](size_t begin, size_t end, int) {
-                             for (size_t i = begin; i < end; ++i) {
-                                 const uint32_t t = candidate[i];
-                                 if (t >= triangles) {
-                                     missing.store(i, std::memory_order_relaxed);
-                                     continue;
-                                 }
-                                 nearest[i] = t;
-                                 distance[i] =
-                                     std::sqrt(core::closestOnTriangle(points[i], m_to.corner(t, 0),
-                                                                       m_to.corner(t, 1), m_to.corner(t, 2))
-                                                   .distance2);
-                             }
-                         });
-    if (missing.load() != points.size())
-        return Error{ErrorCode::kInternal, "surface to surface: the device search left sample " +
-                                               std::to_string(missing.load()) + " without a triangle"};
+    // Every sample's U (the rule in double to its candidate; an open one's
+    // exact nearest) and that triangle, as the proof measured them.
+    for (size_t i = 0; i < points.size(); ++i) {
+        if (!std::isfinite(every.bound2[i]))
+            return Error{ErrorCode::kInternal, "surface to surface: the device search left sample " +
+                                                   std::to_string(i) + " without a triangle"};
+        distance[i] = std::sqrt(every.bound2[i]);
+        nearest[i] = every.triangle[i];
+    }
     // The proven maximum: the exact distance and nearest triangle.
     const auto k = size_t(proof->directed.queryIndex);
     distance[k] = proof->directed.distance;
