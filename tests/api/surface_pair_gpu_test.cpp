@@ -21,7 +21,6 @@
 namespace rthdist {
 namespace {
 
-using test::checkAgainstSampling;
 using test::expectBrackets;
 using test::PairMesh;
 using test::translated;
@@ -112,16 +111,10 @@ TEST(SurfacePairGpu, SegmentAboveATriangleDirectedAndBoth) {
 
 TEST(SurfacePairGpu, HeightFieldsAgainstDenseSampling) {
     for (uint64_t seed : {3470u, 3471u}) {
-        const PairMesh a = test::fromCase(test::heightField(seed, 7, 5.0));
-        const PairMesh b =
-            translated(test::fromCase(test::heightField(seed + 100, 9, 5.0)), {0.3, -0.2, 0.4});
+        const auto [a, b] = test::heightFieldPair(seed);
         Result<SurfaceBoundsResult> r = onGpu(a, b, 1e-3);
         RTHDIST_REQUIRE_GPU_PAIR(r);
-        EXPECT_LE(r->upper - r->lower, 1e-3);
-        EXPECT_EQ(r->lower, std::max(r->aToB.lower, r->bToA.lower));
-        EXPECT_EQ(r->upper, std::max(r->aToB.upper, r->bToA.upper));
-        checkAgainstSampling(a, b, r->aToB);
-        checkAgainstSampling(b, a, r->bToA);
+        test::expectSampledBothWays(a, b, *r, 1e-3);
     }
 }
 

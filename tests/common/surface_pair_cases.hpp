@@ -129,4 +129,22 @@ inline void checkAgainstSampling(const PairMesh& a, const PairMesh& b, const Sur
     EXPECT_NEAR(glm::distance(d.fromPoint, d.toPoint), d.distance, 1e-12);
 }
 
+// The height-field pair of the dense-sampling tests: seed's 7 x 7 field
+// over [0, 5]^2 and seed + 100's 9 x 9 one moved by (0.3, -0.2, 0.4).
+inline std::pair<PairMesh, PairMesh> heightFieldPair(uint64_t seed) {
+    return {fromCase(heightField(seed, 7, 5.0)),
+            translated(fromCase(heightField(seed + 100, 9, 5.0)), {0.3, -0.2, 0.4})};
+}
+
+// H's bounds within `tolerance` and each the larger of the directions',
+// both directions against dense sampling.
+inline void expectSampledBothWays(const PairMesh& a, const PairMesh& b, const SurfaceBoundsResult& r,
+                                  double tolerance) {
+    EXPECT_LE(r.upper - r.lower, tolerance);
+    EXPECT_EQ(r.lower, std::max(r.aToB.lower, r.bToA.lower));
+    EXPECT_EQ(r.upper, std::max(r.aToB.upper, r.bToA.upper));
+    checkAgainstSampling(a, b, r.aToB);
+    checkAgainstSampling(b, a, r.bToA);
+}
+
 }  // namespace rthdist::test
