@@ -91,18 +91,20 @@ Result<std::unique_ptr<ComputeBackend>> openBackend(const EngineOptions& options
     return makeGpuBackend(options, nullptr);
 }
 
-OneShotBackend openOneShot(Backend backend, int deviceIndex, bool validation, int threads) {
-    const core::Clock::time_point start = core::Clock::now();
-    EngineOptions engine;
-    engine.backend = backend;
-    engine.deviceIndex = deviceIndex;
-    engine.validation = validation;
-    engine.threads = threads;
-    engine.tuning = tuningFromEnvironment();
-    OneShotBackend out;
-    out.backend = openBackend(engine, nullptr);
-    out.ms = core::msSince(start);
-    return out;
+std::future<OneShotBackend> openOneShot(Backend backend, int deviceIndex, bool validation, int threads) {
+    return std::async(std::launch::async, [=] {
+        const core::Clock::time_point start = core::Clock::now();
+        EngineOptions engine;
+        engine.backend = backend;
+        engine.deviceIndex = deviceIndex;
+        engine.validation = validation;
+        engine.threads = threads;
+        engine.tuning = tuningFromEnvironment();
+        OneShotBackend out;
+        out.backend = openBackend(engine, nullptr);
+        out.ms = core::msSince(start);
+        return out;
+    });
 }
 
 }  // namespace rthdist::api

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <memory>
 #include <optional>
 #include <span>
@@ -153,13 +154,14 @@ public:
 
 // The backend of a one-shot surface call (hausdorffToSurface,
 // surfaceHausdorff on a GPU backend): an Engine's options from the call's,
-// the tuning from the environment, opened by openBackend; `ms` the time it
-// took (the result's buildMs). Any thread.
+// the tuning from the environment, opened by openBackend on a thread of its
+// own while the caller checks the inputs; `ms` the time it took.
 struct OneShotBackend {
     Result<std::unique_ptr<ComputeBackend>> backend = Error{ErrorCode::kInternal, "not opened"};
     double ms = 0.0;
 };
-[[nodiscard]] OneShotBackend openOneShot(Backend backend, int deviceIndex, bool validation, int threads);
+[[nodiscard]] std::future<OneShotBackend> openOneShot(Backend backend, int deviceIndex, bool validation,
+                                                      int threads);
 
 [[nodiscard]] std::unique_ptr<ComputeBackend> makeCpuBackend(const EngineOptions& options);
 [[nodiscard]] Result<std::unique_ptr<ComputeBackend>> makeGpuBackend(const EngineOptions& options,

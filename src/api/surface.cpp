@@ -77,10 +77,7 @@ Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, con
     // A GPU call's device opens on another thread while the inputs are checked.
     std::future<api::OneShotBackend> opening;
     if (plan.route == api::Route::kSurfaceGpu)
-        opening = std::async(std::launch::async, [&options] {
-            return api::openOneShot(options.backend, options.deviceIndex, options.validation,
-                                    options.threads);
-        });
+        opening = api::openOneShot(options.backend, options.deviceIndex, options.validation, options.threads);
     Result<api::SurfaceInputs> inputs = checkInputs(points, surface, options.threads);
     if (!inputs) return inputs.error();  // bad input first, even where no device opens
     Result<SurfaceResult> result = Error{ErrorCode::kInternal, "no route"};

@@ -116,10 +116,7 @@ Result<SurfaceBoundsResult> surfaceHausdorff(MeshView a, MeshView b, const Surfa
     // A GPU call's device opens on another thread while the meshes are checked.
     std::future<api::OneShotBackend> opening;
     if (gpu)
-        opening = std::async(std::launch::async, [&options] {
-            return api::openOneShot(options.backend, options.deviceIndex, options.validation,
-                                    options.threads);
-        });
+        opening = api::openOneShot(options.backend, options.deviceIndex, options.validation, options.threads);
     Result<core::SetSummary> sa = checkMesh(a, "A", options.threads);
     if (!sa) return sa.error();
     Result<core::SetSummary> sb = checkMesh(b, "B", options.threads);
@@ -173,12 +170,12 @@ Result<SurfaceBoundsResult> surfaceHausdorff(MeshView a, MeshView b, const Surfa
     result->origin = origin;
     shiftBack(result->aToB, origin);
     if (!options.directedOnly) shiftBack(result->bToA, origin);
+    result->buildMs = buildMs;  // both BVHs, or (GPU) both meshes' corners framed
     if (gpu) {
         api::ComputeBackend& backend = *device.backend.value();
         result->backend = backend.kind();
         result->device = backend.deviceName();
         result->setupMs = device.ms;
-        result->buildMs = buildMs;  // the corners framed
         for (const std::unique_ptr<cpu::SampleSearch>* s : {&aToB, &bToA}) {
             if (*s) result->gpuMs += static_cast<const api::DeviceSampleSearch&>(**s).gpuMs();
         }
@@ -186,7 +183,6 @@ Result<SurfaceBoundsResult> surfaceHausdorff(MeshView a, MeshView b, const Surfa
     } else {
         result->backend = Backend::kCpu;
         result->device = "cpu";
-        result->buildMs = buildMs;  // both BVHs
     }
     result->totalMs = core::msSince(start);
     return result;
