@@ -408,8 +408,9 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
                 const uint64_t p = first + i;
                 const double d = dir.distance[p];
                 const double radius = d * scale * (1.0 + 0x1p-12) + slack;
-                if (!pieces.solidAround(qs.cell[p], radius) &&
-                    !pieces.boxInPiece(core::scaled(qs.points[p], scale), radius, uint32_t(k))) {
+                const glm::vec3 q = core::scaled(qs.points[p], scale);
+                if (!pieces.solidAround(pieces.cellOfScaled(q), radius) &&
+                    !pieces.boxInPiece(q, radius, uint32_t(k))) {
                     open.push_back({uint32_t(p), uint32_t(k), UINT32_MAX});
                     continue;
                 }
@@ -831,15 +832,26 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
             limits.a = std::min(tile, (a.size() + l2 - 1) / l2);
             limits.b = std::min(tile, (b.size() + l2 - 1) / l2);
         }
+        // Pieces (at most the grid's 2^18 cells plus a set's points over its
+        // limit) are numbered below 2^31 in the partition (kSharedBlock).
+        if (a.size() / limits.a + b.size() / limits.b > (uint64_t(1) << 30)) {
+            return Error{ErrorCode::kOutOfMemory,
+                         "out of core: a budget of " + std::to_string(perCall) + " points a call (" +
+                             budget.source + ") cuts " + std::to_string(a.size()) + " + " +
+                             std::to_string(b.size()) + " points into more than 2^30 pieces"};
+        }
         core::Clock::time_point start = core::Clock::now();
         std::optional<SpatialPieces> cut;
         try {
-            cut = SpatialPieces::partition(a, b, scale, limits, threads);
+            // Per-point output names each query's nearest point: pieces in input
+            // order break ties as one call would. Otherwise blocks in space.
+            cut = SpatialPieces::partition(a, b, scale, limits, threads,
+                                           call.perPointDistances ? PieceOrder::kInput : PieceOrder::kBlocks);
         } catch (const std::bad_alloc&) {
             return Error{ErrorCode::kOutOfMemory,
                          "out of host memory cutting " + std::to_string(a.size()) + " + " +
                              std::to_string(b.size()) + " points into pieces in space (about " +
-                             std::to_string((a.size() + b.size()) * 20 / 1000000) + " MB beside the inputs)"};
+                             std::to_string((a.size() + b.size()) * 16 / 1000000) + " MB beside the inputs)"};
         }
         const SpatialPieces& pieces = *cut;
         partitionMs = core::msSince(start);

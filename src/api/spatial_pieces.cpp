@@ -3,6 +3,7 @@
 #include <glm/common.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -43,6 +44,10 @@ void forRanges(const Ranges& r, Fn&& fn) {
     });
 }
 
+// blockOf's mark of a shared cell (its first block's number beside it):
+// blocks are fewer than 2^31 (at most 2^12 groups and a block per piece).
+constexpr uint32_t kSharedBlock = uint32_t(1) << 31;
+
 // A shared cell's points by rank in input order over its `span` pieces:
 // rank r (of `total`) goes to piece floor(r * span / total) of the cell's.
 uint32_t pieceOfRank(uint64_t rank, uint64_t span, uint64_t total) { return uint32_t(rank * span / total); }
@@ -57,22 +62,6 @@ PieceRanks pieceRanks(uint64_t m, uint64_t span, uint64_t total) {
 }
 
 }  // namespace
-
-// (v - lo) * inverse side: a monotone function of v (as is each rounding),
-// the same for points and boxes; clamped to the grid.
-uint32_t SpatialPieces::axisCell(double v, int axis) const {
-    // Clamped without branches (NaN to 0, as `c > 0` is false for it), so
-    // that the keys' pass vectorizes: the same cells as before for every v.
-    double c = (v - m_lo[axis]) * m_inverse[axis];
-    c = c > 0.0 ? c : 0.0;
-    const double top = double(m_cells - 1);
-    c = c < top ? c : top;
-    return uint32_t(c);
-}
-
-uint32_t SpatialPieces::cellOf(const glm::dvec3& p) const {
-    return core::mortonEncode(axisCell(p.x, 0), axisCell(p.y, 1), axisCell(p.z, 2));
-}
 
 bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) const {
     uint32_t lo[3], hi[3];
@@ -92,7 +81,8 @@ bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) co
     return true;
 }
 
-SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits limits, int threads) {
+SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits limits, int threads,
+                                       PieceOrder order) {
     SpatialPieces out;
     const Span sets[2] = {a, b};
     const uint64_t limit[2] = {std::max<uint64_t>(limits.a, 1), std::max<uint64_t>(limits.b, 1)};
@@ -231,7 +221,38 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
 
     lap(out.m_times.plan);
 
-    // Each point's piece, then a stable scatter by piece.
+    // The blocks each set is scattered into, in order: a block is a piece's
+    // points in one group of 2^blockShift cells of consecutive Morton codes
+    // (order kBlocks), or the whole piece (kInput); a shared cell's pieces
+    // are a block each. Pieces are runs of cells in Morton order, so blocks
+    // ordered by (piece, group) follow the cells' order.
+    const uint32_t cellBits = 3 * uint32_t(std::countr_zero(out.m_cells));
+    const uint32_t blockShift =
+        order == PieceOrder::kBlocks ? (cellBits > kBlockGroupBits ? cellBits - kBlockGroupBits : 0u) : 32u;
+    std::vector<uint32_t> blockOf(cellCount, 0);  // a cell's block (a shared cell's first | kSharedBlock)
+    std::vector<uint32_t> blockPiece;             // each block's piece
+    {
+        uint64_t last = UINT64_MAX;  // (piece, group) of the latest block
+        for (uint32_t cell = 0; cell < cellCount; ++cell) {
+            const uint32_t owner = out.m_owner[cell];
+            if (owner == kEmpty) continue;
+            if (owner == kShared) {
+                blockOf[cell] = uint32_t(blockPiece.size()) | kSharedBlock;
+                for (uint32_t m = 0; m < span[cell]; ++m) blockPiece.push_back(firstPiece[cell] + m);
+                last = UINT64_MAX;
+                continue;
+            }
+            const uint64_t key = (uint64_t(owner) << 32) | (blockShift >= 32 ? 0u : cell >> blockShift);
+            if (key != last) {
+                blockPiece.push_back(owner);
+                last = key;
+            }
+            blockOf[cell] = uint32_t(blockPiece.size() - 1);
+        }
+    }
+    const size_t blocks = blockPiece.size();
+
+    // Each point's block, then a stable scatter by block.
     for (int s = 0; s < 2; ++s) {
         const Span points = sets[s];
         const Ranges& r = ranges[s];
@@ -248,27 +269,26 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
                 before += counts[s][size_t(t)][sharedCells[j]];
             }
         }
-        // A point's piece from its cell (and, in a shared cell, its rank
+        // A point's block from its cell (and, in a shared cell, its rank
         // there in input order: the ranges run in order, so the scatter
-        // below finds the same pieces with a fresh copy of the bases).
-        // The owner table answers for every cell but a shared one (one
-        // lookup a point, not two).
-        auto pieceOf = [&](uint32_t cell, std::vector<uint64_t>& rank) {
-            const uint32_t owner = out.m_owner[cell];
-            if (owner != kShared) return owner;
+        // below finds the same blocks with a fresh copy of the bases).
+        // One lookup a point: a shared cell's entry carries kSharedBlock.
+        auto blockOfPoint = [&](uint32_t cell, std::vector<uint64_t>& rank) {
+            const uint32_t block = blockOf[cell];
+            if ((block & kSharedBlock) == 0) return block;
             const auto j =
                 size_t(std::lower_bound(sharedCells.begin(), sharedCells.end(), cell) - sharedCells.begin());
-            return firstPiece[cell] + pieceOfRank(rank[j]++, span[cell], total[s][cell]);
+            return (block & ~kSharedBlock) + pieceOfRank(rank[j]++, span[cell], total[s][cell]);
         };
-        // Each range's count of every piece, from its counts of the cells: a
-        // cell's points go to its piece, a shared cell's ranks [base, base +
-        // count) to the pieces whose rank intervals (pieceRanks) they meet.
-        std::vector<std::vector<uint64_t>> perPiece(size_t(r.count), std::vector<uint64_t>(pieces, 0));
+        // Each range's count of every block, from its counts of the cells: a
+        // cell's points go to its block, a shared cell's ranks [base, base +
+        // count) to the blocks whose rank intervals (pieceRanks) they meet.
+        std::vector<std::vector<uint64_t>> perBlock(size_t(r.count), std::vector<uint64_t>(blocks, 0));
         forRanges(r, [&](int t, size_t, size_t) {
-            std::vector<uint64_t>& mine = perPiece[size_t(t)];
+            std::vector<uint64_t>& mine = perBlock[size_t(t)];
             const std::vector<uint32_t>& cells = counts[s][size_t(t)];
             for (uint32_t cell = 0; cell < cellCount; ++cell)
-                if (span[cell] == 1 && cells[cell] != 0) mine[firstPiece[cell]] += cells[cell];
+                if (span[cell] == 1 && cells[cell] != 0) mine[blockOf[cell]] += cells[cell];
             for (size_t j = 0; j < sharedCells.size(); ++j) {
                 const uint32_t cell = sharedCells[j];
                 const uint64_t lo = rankBase[size_t(t)][j], hi = lo + cells[cell];
@@ -277,38 +297,35 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
                 for (uint32_t m = pieceOfRank(lo, span[cell], total[s][cell]); m <= last; ++m) {
                     const PieceRanks ranks = pieceRanks(m, span[cell], total[s][cell]);
                     const uint64_t from = std::max(lo, ranks.begin), to = std::min(hi, ranks.end);
-                    if (from < to) mine[firstPiece[cell] + m] += to - from;
+                    if (from < to) mine[(blockOf[cell] & ~kSharedBlock) + m] += to - from;
                 }
             }
         });
+        // perBlock becomes each range's next position in each block; blocks
+        // come in piece order, so piece k starts after the pieces before it.
         Set& set = s == 0 ? out.m_a : out.m_b;
-        set.start.assign(pieces + 1, 0);
-        for (uint32_t k = 0; k < pieces; ++k) {
-            uint64_t n = 0;
-            for (int t = 0; t < r.count; ++t) n += perPiece[size_t(t)][k];
-            set.start[k + 1] = set.start[k] + n;
-        }
-        // perPiece becomes each range's next position in each piece.
-        for (uint32_t k = 0; k < pieces; ++k) {
-            uint64_t at = set.start[k];
+        std::vector<uint64_t> inPiece(pieces, 0);
+        uint64_t at = 0;
+        for (size_t blk = 0; blk < blocks; ++blk) {
             for (int t = 0; t < r.count; ++t) {
-                const uint64_t n = perPiece[size_t(t)][k];
-                perPiece[size_t(t)][k] = at;
+                const uint64_t n = perBlock[size_t(t)][blk];
+                perBlock[size_t(t)][blk] = at;
                 at += n;
+                inPiece[blockPiece[blk]] += n;
             }
         }
+        set.start.assign(pieces + 1, 0);
+        for (uint32_t k = 0; k < pieces; ++k) set.start[k + 1] = set.start[k] + inPiece[k];
         set.points.resize(points.size());
         set.input.resize(points.size());
-        set.cell.resize(points.size());
         forRanges(r, [&](int t, size_t begin, size_t end) {
-            std::vector<uint64_t>& next = perPiece[size_t(t)];
+            std::vector<uint64_t>& next = perBlock[size_t(t)];
             std::vector<uint64_t>& rank = rankBase[size_t(t)];
             for (size_t i = begin; i < end; ++i) {
                 const uint32_t cell = key[s][i];
-                const uint64_t at = next[pieceOf(cell, rank)]++;
-                set.points[at] = points[i];
-                set.input[at] = uint32_t(i);
-                set.cell[at] = cell;
+                const uint64_t to = next[blockOfPoint(cell, rank)]++;
+                set.points[to] = points[i];
+                set.input[to] = uint32_t(i);
             }
         });
         key[s] = {};

@@ -7,16 +7,25 @@
 // set than the limit is split over several pieces by input order (a
 // "shared" cell: such pieces overlap in space; correct, only slower).
 //
-// Each set is gathered piece after piece, in input order within a piece, so
-// that a call on a piece breaks ties as a call on the whole set would (the
-// smaller input index first), and `input` maps a gathered point back.
+// Each set is gathered piece after piece, and `input` maps a gathered point
+// back. Within a piece (PieceOrder):
+//   - kInput: input order, so that a call on a piece breaks ties as a call
+//     on the whole set would (the smaller input index first): for callers
+//     whose per-point output names each query's nearest point;
+//   - kBlocks: blocks in space, each the piece's points in one group of
+//     cells (the grid's cells cut into at most 2^kBlockGroupBits groups of
+//     consecutive Morton codes: 4 x 4 x 4 cells at the largest grid), the
+//     groups in Morton order, input order within a group. A query's nearest target then lies near the query
+//     in memory as in space: reading every query's pair after a call (round one of the out-of-core route)
+//     reads a few blocks of targets at a time instead of a random 64-byte line per query (issue 33; the
+//     pieces and their points are the same as with kInput).
 //
 // Threading: partition() runs its passes on `threads` threads (0: all); the
 // object is then read-only and may be read from any thread.
-// Memory: per set 20 bytes per point (the gathered copy, its input indices
-// and cells) plus 4 bytes per point while partitioning; the grid at most
-// 2^18 cells (4 bytes and a bit each) and 4 bytes per cell and host thread
-// while partitioning.
+// Memory: per set 16 bytes per point (the gathered copy and its input
+// indices) plus 4 bytes per point while partitioning; the grid at most
+// 2^18 cells (4 bytes and a bit each) and, while partitioning, 4 bytes per
+// cell and 8 per block for each host thread.
 // Limits: each set below 2^32 points (the input indices are 32-bit).
 #pragma once
 
@@ -26,9 +35,15 @@
 #include <span>
 #include <vector>
 
+#include "core/index_space.hpp"
 #include "core/uninit_vector.hpp"
 
 namespace rthdist::api {
+
+// The order of a piece's points (above).
+enum class PieceOrder { kInput, kBlocks };
+// kBlocks: the grid's cells fall into at most 2^kBlockGroupBits groups.
+inline constexpr uint32_t kBlockGroupBits = 12;
 
 // Points of each set that one piece may hold (>= 1 each).
 struct PieceLimits {
@@ -42,7 +57,6 @@ public:
     struct Set {
         core::UninitVector<glm::vec3> points;  // piece after piece, input order within a piece
         core::UninitVector<uint32_t> input;    // the input index of each gathered point
-        core::UninitVector<uint32_t> cell;     // the grid cell of each (its Morton code)
         std::vector<uint64_t> start;           // piece k holds [start[k], start[k + 1])
         [[nodiscard]] std::span<const glm::vec3> piece(size_t k) const {
             return {points.data() + start[k], size_t(start[k + 1] - start[k])};
@@ -52,9 +66,10 @@ public:
 
     // Cuts sets a and b (scaled by the exact power of two `scale` as searched;
     // each below 2^32 points, at least one point in all) into pieces within
-    // `limits`.
+    // `limits`, each piece's points in `order`.
     [[nodiscard]] static SpatialPieces partition(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                                 double scale, PieceLimits limits, int threads);
+                                                 double scale, PieceLimits limits, int threads,
+                                                 PieceOrder order = PieceOrder::kInput);
 
     // The partition's passes, ms (for RTHDIST_SUBMIT_TRACE's pieces line).
     struct PassTimes {
@@ -76,9 +91,12 @@ public:
     // of it, computed in double for points and box alike. False for a box of
     // more than 64 cells.
     [[nodiscard]] bool boxInPiece(const glm::vec3& q, double radius, uint32_t k) const;
+    // The grid cell (its Morton code) of a point scaled as searched
+    // (core::scaled): the cell the partition put it in.
+    [[nodiscard]] uint32_t cellOfScaled(const glm::vec3& q) const { return cellOf(glm::dvec3(q)); }
     // The same answer, cheaper, for most points of a spread set: true when a
     // box of `radius` (at most half a cell a side) around a point of `cell`
-    // (Set::cell) stays within the cells around it, and those hold the
+    // (cellOfScaled) stays within the cells around it, and those hold the
     // points of that cell's piece only, or none (a "solid" cell; each axis's
     // cell moves by at most one). False says nothing: ask boxInPiece.
     // Inline: asked once for every query after round one.
@@ -91,8 +109,20 @@ private:
     static constexpr uint32_t kEmpty = UINT32_MAX;       // a cell without points
     static constexpr uint32_t kShared = UINT32_MAX - 1;  // a cell split over several pieces
 
-    [[nodiscard]] uint32_t cellOf(const glm::dvec3& p) const;
-    [[nodiscard]] uint32_t axisCell(double v, int axis) const;
+    // (v - lo) * inverse side: a monotone function of v (as is each
+    // rounding), the same for points and boxes; clamped to the grid, without
+    // branches (NaN to 0, as `c > 0` is false for it), so that the keys'
+    // pass vectorizes. Inline: round one asks it of every query.
+    [[nodiscard]] uint32_t axisCell(double v, int axis) const {
+        double c = (v - m_lo[axis]) * m_inverse[axis];
+        c = c > 0.0 ? c : 0.0;
+        const double top = double(m_cells - 1);
+        c = c < top ? c : top;
+        return uint32_t(c);
+    }
+    [[nodiscard]] uint32_t cellOf(const glm::dvec3& p) const {
+        return core::mortonEncode(axisCell(p.x, 0), axisCell(p.y, 1), axisCell(p.z, 2));
+    }
 
     Set m_a, m_b;
     PassTimes m_times;

@@ -1,12 +1,14 @@
 // The pieces in space of the out-of-core route (src/api/spatial_pieces.hpp)
 // on the host: every point in exactly one piece, input order within a
-// piece, the limits kept (crowded cells split by input order), and
-// boxInPiece never true for a box that holds a point of another piece.
+// piece (or blocks in space: PieceOrder::kBlocks), the limits kept (crowded
+// cells split by input order), and boxInPiece never true for a box that
+// holds a point of another piece.
 #include <gtest/gtest.h>
 
 #include <glm/common.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <vector>
 
 #include "api/spatial_pieces.hpp"
@@ -17,6 +19,7 @@ namespace rthdist::test {
 namespace {
 
 using api::PieceLimits;
+using api::PieceOrder;
 using api::SpatialPieces;
 
 std::vector<glm::vec3> cloud(size_t n, uint64_t seed, float spread, glm::vec3 at = glm::vec3(0.0f)) {
@@ -95,12 +98,67 @@ TEST(SpatialPieces, SeveralRangesCutAsOne) {
             EXPECT_TRUE(
                 std::equal(one.set(s).input.begin(), one.set(s).input.end(), four.set(s).input.begin()))
                 << "set " << s;
-            EXPECT_TRUE(std::equal(one.set(s).cell.begin(), one.set(s).cell.end(), four.set(s).cell.begin()))
-                << "set " << s;
         }
         EXPECT_EQ(four.largestMagnitude(),
                   std::max(core::largestMagnitude(a, 1), core::largestMagnitude(b, 1)));
         EXPECT_EQ(four.largestMagnitude(), 40.0);
+    }
+}
+
+// The cells' group of kBlocks: the grid's Morton codes cut into at most
+// 2^kBlockGroupBits groups.
+uint32_t groupOf(const SpatialPieces& pieces, uint32_t cell) {
+    const auto cellBits = uint32_t(3 * std::countr_zero(pieces.cellsPerAxis()));
+    return cellBits > api::kBlockGroupBits ? cell >> (cellBits - api::kBlockGroupBits) : cell;
+}
+
+// kBlocks holds the pieces of kInput, each with the same points, ordered by
+// their cells' groups (input order within a group); one thread cuts as four.
+// Sets of 2^18 cells (the largest grid, 64 cells a group) with crowded cells
+// shared by pieces, and small ones.
+TEST(SpatialPieces, BlocksInSpaceHoldTheSamePieces) {
+    std::vector<glm::vec3> a = cloud(300000, 7, 2.0f, glm::vec3(-1.0f));
+    for (size_t i = 0; i < a.size(); i += 5) a[i] = glm::vec3(0.5f, 0.25f, -0.75f);  // one crowded cell
+    std::vector<glm::vec3> b = cloud(250000, 8, 1.0f);
+    b.push_back(glm::vec3(-40.0f, 3.0f, 9.0f));
+    const std::vector<glm::vec3> small = cloud(3000, 9, 1.0f, glm::vec3(0.3f));
+    struct Case {
+        const std::vector<glm::vec3>* a;
+        const std::vector<glm::vec3>* b;
+        PieceLimits limits;
+    };
+    for (const Case& c :
+         {Case{&a, &b, {30011, 9999}}, Case{&a, &b, {200000, 3}}, Case{&small, &a, {400, 70000}}}) {
+        const SpatialPieces input =
+            SpatialPieces::partition(*c.a, *c.b, 0.5, c.limits, 4, PieceOrder::kInput);
+        const SpatialPieces blocks =
+            SpatialPieces::partition(*c.a, *c.b, 0.5, c.limits, 4, PieceOrder::kBlocks);
+        const SpatialPieces one = SpatialPieces::partition(*c.a, *c.b, 0.5, c.limits, 1, PieceOrder::kBlocks);
+        ASSERT_EQ(input.count(), blocks.count());
+        for (int s = 0; s < 2; ++s) {
+            const SpatialPieces::Set& x = input.set(s);
+            const SpatialPieces::Set& y = blocks.set(s);
+            ASSERT_EQ(x.start, y.start) << "set " << s;
+            EXPECT_TRUE(std::equal(y.input.begin(), y.input.end(), one.set(s).input.begin())) << "set " << s;
+            for (size_t k = 0; k < input.count(); ++k) {
+                std::vector<uint32_t> mine(y.input.begin() + ptrdiff_t(y.start[k]),
+                                           y.input.begin() + ptrdiff_t(y.start[k + 1]));
+                for (uint64_t g = y.start[k]; g < y.start[k + 1]; ++g) {
+                    ASSERT_EQ(y.points[g], (s == 0 ? *c.a : *c.b)[y.input[g]]);
+                    if (g == y.start[k]) continue;
+                    const uint32_t before =
+                        groupOf(blocks, blocks.cellOfScaled(core::scaled(y.points[g - 1], 0.5)));
+                    const uint32_t here =
+                        groupOf(blocks, blocks.cellOfScaled(core::scaled(y.points[g], 0.5)));
+                    ASSERT_LE(before, here) << "set " << s << " piece " << k << " at " << g;
+                    if (before == here) ASSERT_LT(y.input[g - 1], y.input[g]) << "input order within a group";
+                }
+                std::sort(mine.begin(), mine.end());
+                EXPECT_TRUE(std::equal(mine.begin(), mine.end(), x.input.begin() + ptrdiff_t(x.start[k])))
+                    << "set " << s << " piece " << k;
+            }
+        }
+        if (c.a == &a) EXPECT_EQ(blocks.cellsPerAxis(), 64u);
     }
 }
 
@@ -130,7 +188,7 @@ TEST(SpatialPieces, BoxInPieceHoldsOnlyThatPiecesPoints) {
         while (qs.input[g] != i) ++g;
         ++tried;
         const bool inBoxOfK = pieces.boxInPiece(q, radius, k);
-        const bool solidAroundIt = pieces.solidAround(qs.cell[g], radius);
+        const bool solidAroundIt = pieces.solidAround(pieces.cellOfScaled(q), radius);
         if (!inBoxOfK && !solidAroundIt) continue;
         inside += inBoxOfK ? 1 : 0;
         solid += solidAroundIt ? 1 : 0;

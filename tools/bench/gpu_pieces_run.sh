@@ -11,7 +11,9 @@
 # budget case, default 3), BEFORE (processes of the before build, default 1),
 # VERIFY (1: one more after process with --verify, default 1), BIG (1: also
 # the 1B x 1B torus, default 1), BIG_RUNS (default 2), DEVICES (e.g. "0,1":
-# the budget case and the 1B x 1B also on these devices), ALT_ENV (e.g.
+# the budget case and the 1B x 1B also on these devices), BIG_BEFORE (1:
+# each 1B x 1B process of the after build preceded by one of the before
+# build, default 0), ALT_ENV (e.g.
 # "RTHDIST_HOST_IMPORT=1": every process of the after build is followed by
 # one with these variables set, labelled "+ALT_ENV"), TRACE (1: every
 # process with RTHDIST_SUBMIT_TRACE=1, its stderr kept beside its JSON),
@@ -63,6 +65,7 @@ if [ "${BIG:-1}" = 1 ]; then
   scale_files "$B" "$S"
   cat "${files[@]}" > /dev/null
   for r in $(seq 1 "${BIG_RUNS:-2}"); do
+    [ "${BIG_BEFORE:-0}" = 1 ] && run "torus 1B x 1B (before)" rthdist-pieces-before
     run "torus 1B x 1B (after)" rthdist
     [ -n "${DEVICES:-}" ] && run "torus 1B x 1B (after, devices $DEVICES)" rthdist --devices "$DEVICES"
   done
