@@ -280,13 +280,32 @@ Result<DirectionState> runChunks(Span q, Span t, double scale, const CallOptions
 
 // ---- Pieces ordered in space (spatial_pieces.hpp) ----------------------
 
-// A query of round two: its position, its own piece, and the piece it was
-// sent to first when its own held no targets (UINT32_MAX: none).
+// A query of round two: its position, its own piece, the piece it was sent
+// to first when its own held no targets (UINT32_MAX: none), and its best
+// pair so far (+inf: none yet; the target's position in T's gathered order).
 struct OpenQuery {
     uint32_t p = 0;
     uint32_t home = 0;
     uint32_t visited = UINT32_MAX;
+    uint32_t nearest = 0;
+    double distance = std::numeric_limits<double>::infinity();
 };
+
+// A query round one settled whose pair may reach the band (keepFloor).
+struct Candidate {
+    uint32_t p = 0;
+    uint32_t nearest = 0;
+    double distance = 0.0;
+};
+
+// The least search-units distance a settled query needs to be kept as a
+// candidate, given a settled maximum m (input units) of the same direction:
+// below it, a query lies below the band's threshold of any maximum hf >= m
+// (core::bandThreshold2: (hf - 2 slack)^2 (1 - 2^-20), hf in search units),
+// so it can be neither the witness nor a query of the band.
+double keepFloor(double m, double scale, double slack) {
+    return m < 0.0 ? -std::numeric_limits<double>::infinity() : m * scale * (1.0 - 0x1p-18) - 4.0 * slack;
+}
 
 // The running maximum of round one's settled queries (design.md §3's early
 // break): a query whose best pair is nearer cannot be the maximum, one as
@@ -304,23 +323,34 @@ struct SettledMaximum {
     }
 };
 
-// One direction Q -> T of the pieces in space: every query's best pair so
-// far, by its position in Q's gathered order: the distance its call
-// reported (in double from the pair, as every route reports it; +inf: none
-// yet) and the target's position in T's gathered order. Pairs are compared
-// by that distance, then by the target's input index: the certificate
-// settles the witness in double from the band whatever the order of
-// near-ties, so the result is the one call's.
+// One direction Q -> T of the pieces in space. A query's best pair: the
+// distance its call reported (in double from the pair, as every route
+// reports it; +inf: none yet) and the target's position in T's gathered
+// order. Pairs are compared by that distance, then by the target's input
+// index: the certificate settles the witness in double from the band
+// whatever the order of near-ties, so the result is the one call's.
+// Only the queries that may matter keep theirs: those round one left open
+// (round two improves them), and the settled ones that may reach the band
+// (candidates). With per-point output (keepAll) every query's best is kept
+// as well, by its position in Q's gathered order (`distance`, `nearest`):
+// 12 bytes a query of fresh memory written once, which the other route
+// spares (on the H200 machine its first touch alone was 0.3 s of round
+// one's 1.7-1.9 s on 700M queries).
 struct SpaceDirection {
     int q = 0;  // Q's set in the pieces: 0 (A -> B) or 1 (B -> A)
-    core::UninitVector<double> distance;
+    bool keepAll = false;
+    core::UninitVector<double> distance;  // keepAll only
     core::UninitVector<uint32_t> nearest;
     SharedDirection shared;
     uint64_t crossPiece = 0;  // queries sent to another piece's targets
     // Round one's verdicts, per query piece: its queries left open for round
-    // two (in position order) and the maximum over those it settled.
+    // two (in position order), the maximum over those it settled and the
+    // settled ones that may reach the band (not with keepAll: every query's
+    // pair is in the arrays then).
     std::vector<std::vector<OpenQuery>> openOf;
     std::vector<SettledMaximum> settledOf;
+    std::vector<std::vector<Candidate>> candidatesOf;
+    std::vector<OpenQuery> open;  // after round two: every open query with its best pair
 };
 
 // The host's own work between the pieces' calls (Timings::pieces), added
@@ -338,44 +368,40 @@ struct HostClock {
     }
 };
 
-// The queries of one call and where they sit in the gathered order: a
-// piece's range, or a list.
-struct CallQueries {
-    uint64_t first = 0;  // with no list: positions first, first + 1, ...
-    const std::vector<uint32_t>* list = nullptr;
-    [[nodiscard]] uint64_t at(size_t k) const { return list != nullptr ? (*list)[k] : first + k; }
-};
-
-// A call's per-point result merged into the direction's bests: a nearer pair
-// replaces, an equal one only with a smaller target input index. Queries:
-// the call's, `points` (gathered); targets: the gathered target piece
-// starting at `tileStart`. A target's input index is read only on a tie.
-void mergeBests(SpaceDirection& dir, const SpatialPieces& pieces, const CallQueries& queries, Span points,
-                uint64_t tileStart, const PerPoint& pp, int threads) {
-    const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
+// A call's per-point result merged into the open queries' bests: a nearer
+// pair replaces, an equal one only with a smaller target input index.
+// Queries: the call's, `batch` (indices into `open`) at `points`
+// (gathered); targets: the gathered target piece starting at `tileStart`. A
+// target's input index is read only on a tie.
+void mergeBests(std::vector<OpenQuery>& open, const SpatialPieces::Set& ts,
+                const std::vector<uint32_t>& batch, Span points, uint64_t tileStart, const PerPoint& pp,
+                int threads) {
     const size_t n = pp.nearest.size();
     core::parallelChunks(
         n, kHostChunk, core::resolveThreads(threads, n / kHostChunk + 1), [&](size_t begin, size_t end, int) {
             for (size_t k = begin; k < end; ++k) {
-                const uint64_t p = queries.at(k);
+                OpenQuery& o = open[batch[k]];
                 const auto g = uint32_t(tileStart + pp.nearest[k]);
                 const double d = pairDistance(points[k], ts.points[g]);
-                if (d < dir.distance[p] || (d == dir.distance[p] && ts.input[g] < ts.input[dir.nearest[p]])) {
-                    dir.distance[p] = d;
-                    dir.nearest[p] = g;
+                if (d < o.distance || (d == o.distance && ts.input[g] < ts.input[o.nearest])) {
+                    o.distance = d;
+                    o.nearest = g;
                 }
             }
         });
 }
 
 // Round one's results for piece k, in one pass: every query of the piece
-// gets its first pair, its distance computed here (each position is written
-// once in round one, so nothing is compared and the arrays need no pass
-// before it), and is settled or left open for round two. Settled: its best
-// pair lies in its own piece and no other piece's point can be as near (the
-// box of its best distance, widened by a relative margin and the
-// certificate's slack, touches cells of its own piece only); the maximum
-// over those is kept for round two's early break.
+// gets its first pair, its distance computed here, and is settled or left
+// open for round two (with that pair). Settled: its best pair lies in its
+// own piece and no other piece's point can be as near (the box of its best
+// distance, widened by a relative margin and the certificate's slack,
+// touches cells of its own piece only); the maximum over those is kept for
+// round two's early break, and those that may reach the band as
+// candidates (keepFloor of the running maximum, then of the piece's). With
+// keepAll every query's pair is written to the direction's arrays (each
+// position once in round one, so nothing is compared and the arrays need no
+// pass before it).
 void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, const PerPoint& pp, double scale,
                  int threads) {
     const SpatialPieces::Set& qs = pieces.set(dir.q);
@@ -384,38 +410,52 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
     const double slack = dir.shared.slack;
     const size_t n = pp.nearest.size();
     const int workers = core::resolveThreads(threads, n / kHostChunk + 1);
-    std::vector<std::vector<OpenQuery>> parts((n + kHostChunk - 1) / kHostChunk);
+    const size_t chunks = (n + kHostChunk - 1) / kHostChunk;
+    std::vector<std::vector<OpenQuery>> parts(chunks);
+    std::vector<std::vector<Candidate>> kept(chunks);
     std::vector<SettledMaximum> maxima(static_cast<size_t>(workers));
     core::parallelChunks(n, kHostChunk, workers, [&](size_t begin, size_t end, int w) {
         std::vector<OpenQuery>& open = parts[begin / kHostChunk];
+        std::vector<Candidate>& candidates = kept[begin / kHostChunk];
         SettledMaximum best = maxima[size_t(w)];  // a copy: no cache line shared while it runs
-        // In runs: first the pairs' distances, a loop of independent random
-        // reads of the targets (a piece's targets are gigabytes: each read
-        // is asked for kAhead pairs early so that many are in flight); then
-        // the verdicts, on what that loop left in the cache. One loop doing
-        // both was 1.8x slower on the H200 machine than the two passes it
+        double floor = keepFloor(best.distance, scale, slack);
+        // In runs: first the pairs' distances, a loop of independent reads
+        // of the targets (a piece's targets are gigabytes: each read is
+        // asked for kAhead pairs early so that many are in flight); then the
+        // verdicts, on what that loop left in the cache. One loop doing both
+        // was 1.8x slower on the H200 machine than the two passes it
         // replaced (700M queries: 4.1 s against 2.3 + 0.7 s).
         constexpr size_t kRun = 2048, kAhead = 32;
+        double distance[kRun];
         for (size_t r0 = begin; r0 < end; r0 += kRun) {
             const size_t r1 = std::min(end, r0 + kRun);
             for (size_t i = r0; i < r1; ++i) {
                 if (i + kAhead < end) __builtin_prefetch(&ts.points[tileStart + pp.nearest[i + kAhead]]);
-                const auto g = uint32_t(tileStart + pp.nearest[i]);
-                dir.distance[first + i] = pairDistance(qs.points[first + i], ts.points[g]);
-                dir.nearest[first + i] = g;
+                distance[i - r0] = pairDistance(qs.points[first + i], ts.points[tileStart + pp.nearest[i]]);
+            }
+            if (dir.keepAll) {
+                for (size_t i = r0; i < r1; ++i) {
+                    dir.distance[first + i] = distance[i - r0];
+                    dir.nearest[first + i] = uint32_t(tileStart + pp.nearest[i]);
+                }
             }
             for (size_t i = r0; i < r1; ++i) {
                 const uint64_t p = first + i;
-                const double d = dir.distance[p];
+                const double d = distance[i - r0];
+                const auto g = uint32_t(tileStart + pp.nearest[i]);
                 const double radius = d * scale * (1.0 + 0x1p-12) + slack;
                 const glm::vec3 q = core::scaled(qs.points[p], scale);
                 if (!pieces.solidAround(pieces.cellOfScaled(q), radius) &&
                     !pieces.boxInPiece(q, radius, uint32_t(k))) {
-                    open.push_back({uint32_t(p), uint32_t(k), UINT32_MAX});
+                    open.push_back({uint32_t(p), uint32_t(k), UINT32_MAX, g, d});
                     continue;
                 }
                 const SettledMaximum m{d, qs.input[p], p};
-                if (m.beats(best)) best = m;
+                if (m.beats(best)) {
+                    best = m;
+                    floor = keepFloor(best.distance, scale, slack);
+                }
+                if (!dir.keepAll && d * scale >= floor) candidates.push_back({uint32_t(p), g, d});
             }
         }
         maxima[size_t(w)] = best;
@@ -425,20 +465,25 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
         if (m.beats(top)) top = m;
     dir.openOf[k] = core::concatenateParts<std::vector<OpenQuery>>(parts);
     dir.settledOf[k] = top;
+    if (dir.keepAll) return;
+    const double floor = keepFloor(top.distance, scale, slack);
+    std::vector<Candidate>& candidates = dir.candidatesOf[k];
+    candidates.clear();
+    for (const std::vector<Candidate>& part : kept)
+        for (const Candidate& c : part)
+            if (c.distance * scale >= floor) candidates.push_back(c);
 }
 
 // Piece k's queries when the piece holds no targets: no pair yet, all open.
 void openAll(SpaceDirection& dir, const SpatialPieces& pieces, size_t k) {
     const SpatialPieces::Set& qs = pieces.set(dir.q);
     const uint64_t begin = qs.start[k], end = qs.start[k + 1];
-    std::fill(dir.distance.begin() + ptrdiff_t(begin), dir.distance.begin() + ptrdiff_t(end),
-              std::numeric_limits<double>::infinity());
-    std::fill(dir.nearest.begin() + ptrdiff_t(begin), dir.nearest.begin() + ptrdiff_t(end), 0u);
     std::vector<OpenQuery>& open = dir.openOf[k];
     open.clear();
     open.reserve(end - begin);
     for (uint64_t p = begin; p < end; ++p) open.push_back({uint32_t(p), uint32_t(k), UINT32_MAX});
     dir.settledOf[k] = {};
+    dir.candidatesOf[k].clear();
 }
 
 void addCallTo(SharedDirection& shared, const Counters& c, const Timings* t) {
@@ -578,6 +623,7 @@ struct RoundTwo {
 // than their best pair (no point of the tile can be nearer, nor tie with a
 // smaller index: the box gap is a lower bound, widened here by 2^-40).
 // `first`: the queries without a pair yet, each to the tile nearest it only.
+// Indices into round.open.
 std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double scale, int threads) {
     SpaceDirection& dir = *round.dir;
     const SpatialPieces::Set& qs = round.pieces->set(dir.q);
@@ -586,7 +632,7 @@ std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double 
         std::vector<uint32_t>& keep = parts[begin / kHostChunk];
         for (size_t i = begin; i < end; ++i) {
             OpenQuery& o = round.open[i];
-            const double d = dir.distance[o.p];
+            const double d = o.distance;
             if (first) {
                 if (d != std::numeric_limits<double>::infinity()) continue;
                 uint32_t nearest = UINT32_MAX;
@@ -601,14 +647,14 @@ std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double 
                 }
                 if (nearest != j) continue;
                 o.visited = j;
-                keep.push_back(o.p);
+                keep.push_back(uint32_t(i));
                 continue;
             }
             const double reach = d * scale;
             if (o.home == j || o.visited == j || round.maximum.drops(d, qs.input[o.p]) ||
                 boxGap2(qs.points[o.p], round.boxes[j], scale) * (1.0 - 0x1p-40) > reach * reach)
                 continue;
-            keep.push_back(o.p);
+            keep.push_back(uint32_t(i));
         }
     });
     return core::concatenateParts<std::vector<uint32_t>>(parts);
@@ -645,7 +691,7 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
                                                   selected.begin() + ptrdiff_t(b0 + n));
                 gathered.resize(n);
                 core::parallelChunks(n, kHostChunk, lane.threads, [&](size_t begin, size_t end, int) {
-                    for (size_t k = begin; k < end; ++k) gathered[k] = qs.points[batch[k]];
+                    for (size_t k = begin; k < end; ++k) gathered[k] = qs.points[round.open[batch[k]].p];
                 });
                 host.add(start, HostClock::kRoundTwo);
                 Result<HausdorffResult> r = lane.call(gathered, ts.piece(j), piece);
@@ -657,8 +703,7 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
                 {
                     std::lock_guard lock(round.mutex);
                     addCallTo(dir.shared, r->aToB.counters, &r->timings);
-                    mergeBests(dir, *round.pieces, CallQueries{0, &batch}, gathered, ts.start[j], r->aNearest,
-                               lane.threads);
+                    mergeBests(round.open, ts, batch, gathered, ts.start[j], r->aNearest, lane.threads);
                 }
                 lane.giveBack(std::move(r->aNearest), PerPoint{});
                 host.add(start, HostClock::kRoundTwo);
@@ -672,19 +717,38 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
     }
 }
 
-// The direction's result from every query's best pair: the witness (the
-// largest, the smallest input index among ties), the certificate's band,
-// per-point output by input index.
-DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces, Span q, Span t,
-                               bool perPoint, double scale, int threads) {
+// The direction's result from the best pairs that may matter: the witness
+// (the largest, the smallest input index among ties), the certificate's
+// band, per-point output by input index. With keepAll every query's, from
+// the arrays (round two's open queries written back first); otherwise the
+// candidates of round one and the open queries: every other query was
+// settled below keepFloor of a settled maximum, hence below the band's
+// threshold and the witness.
+DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces, Span q, Span t, double scale,
+                               int threads) {
     const SpatialPieces::Set& qs = pieces.set(dir.q);
     const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
-    const size_t n = qs.points.size();
+    std::vector<Candidate> kept;
+    if (dir.keepAll) {
+        for (const OpenQuery& o : dir.open) {
+            dir.distance[o.p] = o.distance;
+            dir.nearest[o.p] = o.nearest;
+        }
+    } else {
+        kept = core::concatenateParts<std::vector<Candidate>>(dir.candidatesOf);
+        for (const OpenQuery& o : dir.open) kept.push_back({o.p, o.nearest, o.distance});
+    }
+    // The i-th best pair: its position, target position and distance.
+    const size_t n = dir.keepAll ? qs.points.size() : kept.size();
+    const auto at = [&](size_t i) {
+        return dir.keepAll ? Candidate{uint32_t(i), dir.nearest[i], dir.distance[i]} : kept[i];
+    };
     std::vector<SettledMaximum> maxima(size_t(core::resolveThreads(threads)));
     core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int w) {
         SettledMaximum m = maxima[size_t(w)];  // a copy: no cache line shared while it runs
-        for (size_t p = begin; p < end; ++p) {
-            const SettledMaximum here{dir.distance[p], qs.input[p], p};
+        for (size_t i = begin; i < end; ++i) {
+            const Candidate c = at(i);
+            const SettledMaximum here{c.distance, qs.input[c.p], i};
             if (here.beats(m)) m = here;
         }
         maxima[size_t(w)] = m;
@@ -692,13 +756,13 @@ DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces,
     SettledMaximum top;
     for (const SettledMaximum& m : maxima)
         if (m.beats(top)) top = m;
-    const uint64_t w = top.at;
-    const uint32_t target = ts.input[dir.nearest[w]];
+    const Candidate w = at(top.at);
+    const uint32_t target = ts.input[w.nearest];
     DirectionState s = std::move(dir.shared.state);
-    s.witness.distance = dir.distance[w];
-    s.witness.queryIndex = qs.input[w];
+    s.witness.distance = w.distance;
+    s.witness.queryIndex = qs.input[w.p];
     s.witness.targetIndex = target;
-    s.witness.queryPoint = glm::dvec3(q[qs.input[w]]);
+    s.witness.queryPoint = glm::dvec3(q[qs.input[w.p]]);
     s.witness.targetPoint = glm::dvec3(t[target]);
 
     // The band: every query whose best pair (a real pair: its distance is an
@@ -706,20 +770,21 @@ DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces,
     core::DirectionBand& band = s.band;
     band.present = true;
     band.slack = dir.shared.slack;
-    band.hf = dir.distance[w] * scale;
+    band.hf = w.distance * scale;
     band.scale = scale;
     s.reach = band.hf - band.slack;
     const double lo2 = core::bandThreshold2(band.hf * band.hf, band.slack);
     std::vector<std::vector<core::BandQuery>> parts((n + kHostChunk - 1) / kHostChunk);
     core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
-        for (size_t p = begin; p < end; ++p) {
-            const double d = dir.distance[p] * scale;
-            if (d * d >= lo2) parts[begin / kHostChunk].push_back({qs.input[p], ts.input[dir.nearest[p]]});
+        for (size_t i = begin; i < end; ++i) {
+            const Candidate c = at(i);
+            const double d = c.distance * scale;
+            if (d * d >= lo2) parts[begin / kHostChunk].push_back({qs.input[c.p], ts.input[c.nearest]});
         }
     });
     band.queries = core::concatenateParts<std::vector<core::BandQuery>>(parts);
 
-    if (perPoint) {
+    if (dir.keepAll) {
         s.perPoint.distance.resize(n);
         s.perPoint.nearest.resize(n);
         core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
@@ -734,7 +799,7 @@ DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces,
         queryPieces += qs.size(k) != 0 ? 1 : 0;
         targetPieces += ts.size(k) != 0 ? 1 : 0;
     }
-    s.counters.queries = n;
+    s.counters.queries = qs.points.size();
     s.counters.queryChunks = queryPieces;
     s.counters.targetTiles = targetPieces;
     s.counters.crossPieceQueries = dir.crossPiece;
@@ -750,14 +815,18 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
                                 const CallOptions& call, uint64_t perCall, uint64_t maxPiece,
                                 const DirectedCall& directed, const RecycleCall& recycle, int lanes,
                                 int threads, HostClock& host) {
-    // Unwritten: round one writes every position once (settlePiece, openAll).
+    // Unwritten: round one writes every position once (settlePiece), or
+    // leaves it open (openAll; round two's result is written back).
     for (int d = 0; d < 2; ++d) {
         if (dirs[d] == nullptr) continue;
         const size_t n = pieces.set(dirs[d]->q).points.size();
-        dirs[d]->distance.resize(n);
-        dirs[d]->nearest.resize(n);
+        if (dirs[d]->keepAll) {
+            dirs[d]->distance.resize(n);
+            dirs[d]->nearest.resize(n);
+        }
         dirs[d]->openOf.assign(pieces.count(), {});
         dirs[d]->settledOf.assign(pieces.count(), {});
+        dirs[d]->candidatesOf.assign(pieces.count(), {});
     }
     core::Clock::time_point start;
     lanes = int(std::min<size_t>(size_t(std::max(lanes, 1)), pieces.count()));
@@ -798,6 +867,7 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
             });
             if (failure.error) return failure.error;
         }
+        dir->open = std::move(round.open);
     }
     return std::nullopt;
 }
@@ -859,13 +929,14 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
         dirAB.q = 0;
         dirBA.q = 1;
         dirAB.shared.slack = dirBA.shared.slack = core::searchSlack(pieces.largestMagnitude() * scale);
+        dirAB.keepAll = dirBA.keepAll = call.perPointDistances;
         SpaceDirection* const dirs[2] = {spaceAB ? &dirAB : nullptr, spaceBA ? &dirBA : nullptr};
         if (auto err = runInSpace(pieces, dirs, scale, call, perCall, maxPiece, directed, recycle, lanes,
                                   threads, host))
             return *err;
         start = core::Clock::now();
-        if (spaceAB) ab = finishDirection(dirAB, pieces, a, b, call.perPointDistances, scale, threads);
-        if (spaceBA) ba = finishDirection(dirBA, pieces, b, a, call.perPointDistances, scale, threads);
+        if (spaceAB) ab = finishDirection(dirAB, pieces, a, b, scale, threads);
+        if (spaceBA) ba = finishDirection(dirBA, pieces, b, a, scale, threads);
         finishMs = core::msSince(start);
         if (trace) {
             const SpatialPieces::PassTimes& p = pieces.passTimes();
