@@ -318,6 +318,7 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         for (uint32_t k = 0; k < pieces; ++k) set.start[k + 1] = set.start[k] + inPiece[k];
         set.points.resize(points.size());
         set.input.resize(points.size());
+        set.cell.resize(points.size());
         forRanges(r, [&](int t, size_t begin, size_t end) {
             std::vector<uint64_t>& next = perBlock[size_t(t)];
             std::vector<uint64_t>& rank = rankBase[size_t(t)];
@@ -326,6 +327,7 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
                 const uint64_t to = next[blockOfPoint(cell, rank)]++;
                 set.points[to] = points[i];
                 set.input[to] = uint32_t(i);
+                set.cell[to] = cell;
             }
         });
         key[s] = {};

@@ -22,8 +22,8 @@
 //
 // Threading: partition() runs its passes on `threads` threads (0: all); the
 // object is then read-only and may be read from any thread.
-// Memory: per set 16 bytes per point (the gathered copy and its input
-// indices) plus 4 bytes per point while partitioning; the grid at most
+// Memory: per set 20 bytes per point (the gathered copy, its input indices
+// and cells) plus 4 bytes per point while partitioning; the grid at most
 // 2^18 cells (4 bytes and a bit each) and, while partitioning, 4 bytes per
 // cell and 8 per block for each host thread.
 // Limits: each set below 2^32 points (the input indices are 32-bit).
@@ -57,6 +57,7 @@ public:
     struct Set {
         core::UninitVector<glm::vec3> points;  // piece after piece, input order within a piece
         core::UninitVector<uint32_t> input;    // the input index of each gathered point
+        core::UninitVector<uint32_t> cell;     // the grid cell of each (its Morton code: cellOfScaled)
         std::vector<uint64_t> start;           // piece k holds [start[k], start[k + 1])
         [[nodiscard]] std::span<const glm::vec3> piece(size_t k) const {
             return {points.data() + start[k], size_t(start[k + 1] - start[k])};
@@ -96,7 +97,7 @@ public:
     [[nodiscard]] uint32_t cellOfScaled(const glm::vec3& q) const { return cellOf(glm::dvec3(q)); }
     // The same answer, cheaper, for most points of a spread set: true when a
     // box of `radius` (at most half a cell a side) around a point of `cell`
-    // (cellOfScaled) stays within the cells around it, and those hold the
+    // (Set::cell) stays within the cells around it, and those hold the
     // points of that cell's piece only, or none (a "solid" cell; each axis's
     // cell moves by at most one). False says nothing: ask boxInPiece.
     // Inline: asked once for every query after round one.

@@ -98,6 +98,8 @@ TEST(SpatialPieces, SeveralRangesCutAsOne) {
             EXPECT_TRUE(
                 std::equal(one.set(s).input.begin(), one.set(s).input.end(), four.set(s).input.begin()))
                 << "set " << s;
+            EXPECT_TRUE(std::equal(one.set(s).cell.begin(), one.set(s).cell.end(), four.set(s).cell.begin()))
+                << "set " << s;
         }
         EXPECT_EQ(four.largestMagnitude(),
                   std::max(core::largestMagnitude(a, 1), core::largestMagnitude(b, 1)));
@@ -145,11 +147,9 @@ TEST(SpatialPieces, BlocksInSpaceHoldTheSamePieces) {
                                            y.input.begin() + ptrdiff_t(y.start[k + 1]));
                 for (uint64_t g = y.start[k]; g < y.start[k + 1]; ++g) {
                     ASSERT_EQ(y.points[g], (s == 0 ? *c.a : *c.b)[y.input[g]]);
+                    ASSERT_EQ(y.cell[g], blocks.cellOfScaled(core::scaled(y.points[g], 0.5)));
                     if (g == y.start[k]) continue;
-                    const uint32_t before =
-                        groupOf(blocks, blocks.cellOfScaled(core::scaled(y.points[g - 1], 0.5)));
-                    const uint32_t here =
-                        groupOf(blocks, blocks.cellOfScaled(core::scaled(y.points[g], 0.5)));
+                    const uint32_t before = groupOf(blocks, y.cell[g - 1]), here = groupOf(blocks, y.cell[g]);
                     ASSERT_LE(before, here) << "set " << s << " piece " << k << " at " << g;
                     if (before == here) ASSERT_LT(y.input[g - 1], y.input[g]) << "input order within a group";
                 }
@@ -188,7 +188,7 @@ TEST(SpatialPieces, BoxInPieceHoldsOnlyThatPiecesPoints) {
         while (qs.input[g] != i) ++g;
         ++tried;
         const bool inBoxOfK = pieces.boxInPiece(q, radius, k);
-        const bool solidAroundIt = pieces.solidAround(pieces.cellOfScaled(q), radius);
+        const bool solidAroundIt = pieces.solidAround(qs.cell[g], radius);
         if (!inBoxOfK && !solidAroundIt) continue;
         inside += inBoxOfK ? 1 : 0;
         solid += solidAroundIt ? 1 : 0;
