@@ -11,11 +11,23 @@
 // every operation as written, and computes the same bits as the baseline
 // (IEEE arithmetic, vector or scalar).
 //
-// Elsewhere (not x86-64, or not an ELF target) the functions are compiled
-// once, as written.
+// Elsewhere (not x86-64, not an ELF target, or under a sanitizer) the
+// functions are compiled once, as written: a clone's resolver runs while
+// the program is relocated, before a sanitizer's runtime is up, and
+// ThreadSanitizer's instrumentation of it crashed the tests at start
+// (rthdist_core_tests, GCC 12).
 #pragma once
 
-#if defined(__x86_64__) && defined(__ELF__)
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define RTHDIST_UNDER_SANITIZER 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define RTHDIST_UNDER_SANITIZER 1
+#endif
+
+#if defined(__x86_64__) && defined(__ELF__) && !defined(RTHDIST_UNDER_SANITIZER)
 #define RTHDIST_VECTOR_CLONES __attribute__((target_clones("default", "avx2", "arch=x86-64-v4")))
 #else
 #define RTHDIST_VECTOR_CLONES
