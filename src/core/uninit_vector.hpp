@@ -36,6 +36,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/sanitizers.hpp"
+
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
@@ -44,14 +46,8 @@ namespace rthdist::core {
 
 namespace detail {
 
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(RTHDIST_ASAN)
 inline constexpr bool kMapLargeBlocks = false;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-inline constexpr bool kMapLargeBlocks = false;
-#else
-inline constexpr bool kMapLargeBlocks = true;
-#endif
 #else
 inline constexpr bool kMapLargeBlocks = true;
 #endif

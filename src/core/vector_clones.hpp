@@ -18,14 +18,7 @@
 // (rthdist_core_tests, GCC 12).
 #pragma once
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-#define RTHDIST_UNDER_SANITIZER 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define RTHDIST_UNDER_SANITIZER 1
-#endif
+#include "core/sanitizers.hpp"
 
 #if defined(__x86_64__) && defined(__ELF__) && !defined(RTHDIST_UNDER_SANITIZER)
 #define RTHDIST_VECTOR_CLONES __attribute__((target_clones("default", "avx2", "arch=x86-64-v4")))

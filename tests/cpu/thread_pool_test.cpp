@@ -23,15 +23,8 @@
 #include <vector>
 
 #include "core/parallel.hpp"
+#include "core/sanitizers.hpp"
 #include "core/thread_pool.hpp"
-
-#if defined(__SANITIZE_THREAD__)
-#define RTHDIST_TEST_TSAN 1
-#elif defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-#define RTHDIST_TEST_TSAN 1
-#endif
-#endif
 
 namespace rthdist::core {
 namespace {
@@ -222,7 +215,7 @@ TEST(ThreadPool, GrowsOnlyToWhatACallAsksFor) {
 // id), and its exit does not wait for the parent's workers (std::exit runs
 // the static destructors that join the pool).
 TEST(ThreadPool, ForkedChildRunsCallsOnItsOwnThread) {
-#ifdef RTHDIST_TEST_TSAN
+#ifdef RTHDIST_TSAN
     GTEST_SKIP() << "ThreadSanitizer does not support fork() of a multithreaded process";
 #else
     ASSERT_TRUE(coversEveryIndexOnce(10000, 16, 4));
