@@ -594,11 +594,11 @@ std::vector<TileBox> tileBoxes(const SpatialPieces::Set& ts, double scale, int t
 }
 
 // After round one: the queries it left open, in position order, and the
-// maximum over those it settled (none with per-point output: nothing is
-// dropped then).
-std::vector<OpenQuery> openQueries(SpaceDirection& dir, bool perPoint, SettledMaximum& maximum) {
+// maximum over those it settled (none with per-point output, keepAll:
+// nothing is dropped then).
+std::vector<OpenQuery> openQueries(SpaceDirection& dir, SettledMaximum& maximum) {
     maximum = {};
-    if (!perPoint)
+    if (!dir.keepAll)
         for (const SettledMaximum& m : dir.settledOf)
             if (m.beats(maximum)) maximum = m;
     std::vector<OpenQuery> open = core::concatenateParts<std::vector<OpenQuery>>(dir.openOf);
@@ -847,7 +847,7 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
         RoundTwo round;
         round.dir = dir;
         round.pieces = &pieces;
-        round.open = openQueries(*dir, call.perPointDistances, round.maximum);
+        round.open = openQueries(*dir, round.maximum);
         if (round.open.empty()) {
             host.add(start, HostClock::kOpen);
             continue;

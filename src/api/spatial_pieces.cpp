@@ -235,8 +235,10 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
     // are a block each. Pieces are runs of cells in Morton order, so blocks
     // ordered by (piece, group) follow the cells' order.
     const uint32_t cellBits = 3 * uint32_t(std::countr_zero(out.m_cells));
-    const uint32_t blockShift =
-        order == PieceOrder::kBlocks ? (cellBits > kBlockGroupBits ? cellBits - kBlockGroupBits : 0u) : 32u;
+    const uint32_t blockShift = cellBits > kBlockGroupBits ? cellBits - kBlockGroupBits : 0u;
+    const auto groupOf = [&](uint32_t cell) {
+        return order == PieceOrder::kBlocks ? cell >> blockShift : 0u;
+    };
     std::vector<uint32_t> blockOf(cellCount, 0);  // a cell's block (a shared cell's first | kSharedBlock)
     std::vector<uint32_t> blockPiece;             // each block's piece
     {
@@ -250,7 +252,7 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
                 last = UINT64_MAX;
                 continue;
             }
-            const uint64_t key = (uint64_t(owner) << 32) | (blockShift >= 32 ? 0u : cell >> blockShift);
+            const uint64_t key = (uint64_t(owner) << 32) | groupOf(cell);
             if (key != last) {
                 blockPiece.push_back(owner);
                 last = key;

@@ -15,10 +15,12 @@
 //   - kBlocks: blocks in space, each the piece's points in one group of
 //     cells (the grid's cells cut into at most 2^kBlockGroupBits groups of
 //     consecutive Morton codes: 4 x 4 x 4 cells at the largest grid), the
-//     groups in Morton order, input order within a group. A query's nearest target then lies near the query
-//     in memory as in space: reading every query's pair after a call (round one of the out-of-core route)
-//     reads a few blocks of targets at a time instead of a random 64-byte line per query (issue 33; the
-//     pieces and their points are the same as with kInput).
+//     groups in Morton order, input order within a group. A query's
+//     nearest target then lies near it in memory as in space, for the read
+//     of every query's pair after a call (round one of the out-of-core
+//     route: 1.9 s against 2.3-2.4 s in input order on the torus quarter,
+//     docs/bench/scale session 13). The pieces and their points are those
+//     of kInput.
 //
 // Threading: partition() runs its passes on `threads` threads (0: all); the
 // object is then read-only and may be read from any thread.
@@ -55,7 +57,7 @@ class SpatialPieces {
 public:
     // One set, gathered piece after piece.
     struct Set {
-        core::UninitVector<glm::vec3> points;  // piece after piece, input order within a piece
+        core::UninitVector<glm::vec3> points;  // piece after piece, in the partition's PieceOrder
         core::UninitVector<uint32_t> input;    // the input index of each gathered point
         core::UninitVector<uint32_t> cell;     // the grid cell of each (its Morton code: cellOfScaled)
         std::vector<uint64_t> start;           // piece k holds [start[k], start[k + 1])
@@ -113,7 +115,8 @@ private:
     // (v - lo) * inverse side: a monotone function of v (as is each
     // rounding), the same for points and boxes; clamped to the grid, without
     // branches (NaN to 0, as `c > 0` is false for it), so that the keys'
-    // pass vectorizes. Inline: round one asks it of every query.
+    // pass vectorizes. Inline, so that each of the keys pass's clones
+    // (spatial_pieces.cpp, cellsOf) compiles it for its own instructions.
     [[nodiscard]] uint32_t axisCell(double v, int axis) const {
         double c = (v - m_lo[axis]) * m_inverse[axis];
         c = c > 0.0 ? c : 0.0;
