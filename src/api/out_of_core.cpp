@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <mutex>
@@ -342,7 +343,8 @@ struct SpaceDirection {
     core::UninitVector<double> distance;  // keepAll only
     core::UninitVector<uint32_t> nearest;
     SharedDirection shared;
-    uint64_t crossPiece = 0;  // queries sent to another piece's targets
+    uint64_t crossPiece = 0;   // queries sent to another piece's targets
+    uint64_t hostScanned = 0;  // of those, answered on the host (scanOnHost)
     // Round one's verdicts, per query piece: its queries left open for round
     // two (in position order), the maximum over those it settled and the
     // settled ones that may reach the band (not with keepAll: every query's
@@ -661,8 +663,92 @@ std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double 
     return core::concatenateParts<std::vector<uint32_t>>(parts);
 }
 
+// Round two's selected queries for tile j that the host answers itself: a
+// query whose reach (its best distance, widened as settlePiece widens it)
+// touches few blocks of the tile (SpatialPieces::blocksNear) is compared in
+// double with every point of those blocks, while the points so compared
+// stay within the tile's size: a call would upload and index every point of
+// the tile (on the torus quarter, round two's calls for 24 queries doubled
+// the calls' upload and index, docs/bench/scale session 14). Every point of
+// the tile within the reach lies in those blocks, so the best pair found is
+// the query's nearest in the tile in double, ties to the smaller input
+// index, merged as a call's (mergeBests). Returns the queries left for calls.
+std::vector<uint32_t> scanOnHost(RoundTwo& round, uint32_t j, const std::vector<uint32_t>& selected,
+                                 double scale, int threads) {
+    SpaceDirection& dir = *round.dir;
+    const SpatialPieces& pieces = *round.pieces;
+    const SpatialPieces::Set& qs = pieces.set(dir.q);
+    const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
+    struct Range {
+        uint32_t scan = 0;  // into `scanned`
+        uint64_t begin = 0, end = 0;
+    };
+    std::vector<uint32_t> scanned, called, blocks;
+    std::vector<glm::vec3> points;  // each scanned query's point
+    std::vector<Range> ranges;
+    uint64_t budget = ts.size(j);
+    {
+        std::lock_guard lock(round.mutex);  // lanes merge into other tiles' queries meanwhile
+        for (const uint32_t i : selected) {
+            const OpenQuery& o = round.open[i];
+            const double radius = o.distance * scale * (1.0 + 0x1p-12) + dir.shared.slack;
+            if (std::isfinite(radius) &&
+                pieces.blocksNear(core::scaled(qs.points[o.p], scale), radius, j, blocks)) {
+                uint64_t count = 0;
+                for (const uint32_t b : blocks) count += ts.blockStart[b + 1] - ts.blockStart[b];
+                if (count <= budget) {
+                    budget -= count;
+                    for (const uint32_t b : blocks)
+                        for (uint64_t at = ts.blockStart[b]; at < ts.blockStart[b + 1]; at += kHostChunk)
+                            ranges.push_back({uint32_t(scanned.size()), at,
+                                              std::min<uint64_t>(ts.blockStart[b + 1], at + kHostChunk)});
+                    scanned.push_back(i);
+                    points.push_back(qs.points[o.p]);
+                    continue;
+                }
+            }
+            called.push_back(i);
+        }
+    }
+    struct Best {
+        double distance = std::numeric_limits<double>::infinity();
+        uint32_t nearest = UINT32_MAX;
+    };
+    std::vector<Best> best(ranges.size());
+    core::parallelChunks(
+        ranges.size(), 1, core::resolveThreads(threads, ranges.size()), [&](size_t r0, size_t r1, int) {
+            for (size_t r = r0; r < r1; ++r) {
+                const glm::vec3 q = points[ranges[r].scan];
+                Best b;
+                for (uint64_t t = ranges[r].begin; t < ranges[r].end; ++t) {
+                    const double d = pairDistance(q, ts.points[t]);
+                    if (d < b.distance || (d == b.distance && ts.input[t] < ts.input[b.nearest])) {
+                        b.distance = d;
+                        b.nearest = uint32_t(t);
+                    }
+                }
+                best[r] = b;
+            }
+        });
+    std::lock_guard lock(round.mutex);
+    for (size_t r = 0; r < ranges.size(); ++r) {
+        const Best& b = best[r];
+        OpenQuery& o = round.open[scanned[ranges[r].scan]];
+        if (b.nearest == UINT32_MAX) continue;
+        if (b.distance < o.distance ||
+            (b.distance == o.distance && ts.input[b.nearest] < ts.input[o.nearest])) {
+            o.distance = b.distance;
+            o.nearest = b.nearest;
+        }
+    }
+    dir.hostScanned += scanned.size();
+    return called;
+}
+
 // A lane's share of round two: the next tile not yet taken, its selected
-// queries in calls within the budget, merged under the round's lock.
+// queries answered on the host where few points are near them
+// (scanOnHost), the rest in calls within the budget, merged under the
+// round's lock.
 void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call, const Lane& lane,
               RoundFailure& failure, HostClock& host, double from, double width) {
     SpaceDirection& dir = *round.dir;
@@ -681,6 +767,7 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
                 selected = selectFor(round, uint32_t(j), first, scale, lane.threads);
                 dir.crossPiece += selected.size();
             }
+            if (!first) selected = scanOnHost(round, uint32_t(j), selected, scale, lane.threads);
             host.add(start, HostClock::kRoundTwo);
             const CallOptions piece =
                 spaceOptions(call, from + width * double(j) / double(round.boxes.size()),
@@ -945,10 +1032,12 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
                 stderr,
                 "rthdist pieces: %zu in space (%u cells an axis), partition %.1f ms (box %.1f, keys "
                 "%.1f, plan %.1f, scatter %.1f), between calls %.1f ms (round one %.1f, open queries "
-                "%.1f, round two %.1f), results %.1f ms, queries past their piece %llu + %llu\n",
+                "%.1f, round two %.1f), results %.1f ms, queries past their piece %llu + %llu (on the host "
+                "%llu + %llu)\n",
                 pieces.count(), pieces.cellsPerAxis(), partitionMs, p.box, p.keys, p.plan, p.scatter, host.ms,
                 host.part[HostClock::kRoundOne], host.part[HostClock::kOpen], host.part[HostClock::kRoundTwo],
-                finishMs, (unsigned long long)dirAB.crossPiece, (unsigned long long)dirBA.crossPiece);
+                finishMs, (unsigned long long)dirAB.crossPiece, (unsigned long long)dirBA.crossPiece,
+                (unsigned long long)dirAB.hostScanned, (unsigned long long)dirBA.hostScanned);
         }
         if (release) release();
     }

@@ -91,6 +91,31 @@ bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) co
     return true;
 }
 
+bool SpatialPieces::blocksNear(const glm::vec3& q, double radius, uint32_t k,
+                               std::vector<uint32_t>& blocks) const {
+    uint32_t lo[3], hi[3];
+    uint64_t cells = 1;
+    for (int axis = 0; axis < 3; ++axis) {
+        lo[axis] = axisCell(double(q[axis]) - radius, axis);
+        hi[axis] = axisCell(double(q[axis]) + radius, axis);
+        cells *= hi[axis] - lo[axis] + 1;
+    }
+    if (cells > kNearCells) return false;
+    blocks.clear();
+    for (uint32_t z = lo[2]; z <= hi[2]; ++z)
+        for (uint32_t y = lo[1]; y <= hi[1]; ++y)
+            for (uint32_t x = lo[0]; x <= hi[0]; ++x) {
+                const uint32_t cell = core::mortonEncode(x, y, z);
+                const uint32_t owner = m_owner[cell];
+                if (owner == kEmpty || (owner != kShared && owner != k)) continue;
+                for (uint32_t b = m_blockFirst[cell]; b < m_blockFirst[cell] + m_blockCount[cell]; ++b)
+                    if (m_blockPiece[b] == k) blocks.push_back(b);
+            }
+    std::sort(blocks.begin(), blocks.end());
+    blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
+    return true;
+}
+
 SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits limits, int threads,
                                        PieceOrder order) {
     SpatialPieces out;
@@ -240,7 +265,9 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         return order == PieceOrder::kBlocks ? cell >> blockShift : 0u;
     };
     std::vector<uint32_t> blockOf(cellCount, 0);  // a cell's block (a shared cell's first | kSharedBlock)
-    std::vector<uint32_t> blockPiece;             // each block's piece
+    std::vector<uint32_t>& blockPiece = out.m_blockPiece;  // each block's piece
+    out.m_blockFirst.assign(cellCount, 0);
+    out.m_blockCount.assign(cellCount, 0);
     {
         uint64_t last = UINT64_MAX;  // (piece, group) of the latest block
         for (uint32_t cell = 0; cell < cellCount; ++cell) {
@@ -248,6 +275,8 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
             if (owner == kEmpty) continue;
             if (owner == kShared) {
                 blockOf[cell] = uint32_t(blockPiece.size()) | kSharedBlock;
+                out.m_blockFirst[cell] = uint32_t(blockPiece.size());
+                out.m_blockCount[cell] = span[cell];
                 for (uint32_t m = 0; m < span[cell]; ++m) blockPiece.push_back(firstPiece[cell] + m);
                 last = UINT64_MAX;
                 continue;
@@ -258,6 +287,8 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
                 last = key;
             }
             blockOf[cell] = uint32_t(blockPiece.size() - 1);
+            out.m_blockFirst[cell] = blockOf[cell];
+            out.m_blockCount[cell] = 1;
         }
     }
     const size_t blocks = blockPiece.size();
@@ -316,7 +347,9 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         Set& set = s == 0 ? out.m_a : out.m_b;
         std::vector<uint64_t> inPiece(pieces, 0);
         uint64_t at = 0;
+        set.blockStart.assign(blocks + 1, 0);
         for (size_t blk = 0; blk < blocks; ++blk) {
+            set.blockStart[blk] = at;
             for (int t = 0; t < r.count; ++t) {
                 const uint64_t n = perBlock[size_t(t)][blk];
                 perBlock[size_t(t)][blk] = at;
@@ -324,6 +357,7 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
                 inPiece[blockPiece[blk]] += n;
             }
         }
+        set.blockStart[blocks] = at;
         set.start.assign(pieces + 1, 0);
         for (uint32_t k = 0; k < pieces; ++k) set.start[k + 1] = set.start[k] + inPiece[k];
         set.points.resize(points.size());

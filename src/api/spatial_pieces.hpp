@@ -26,8 +26,8 @@
 // object is then read-only and may be read from any thread.
 // Memory: per set 20 bytes per point (the gathered copy, its input indices
 // and cells) plus 4 bytes per point while partitioning; the grid at most
-// 2^18 cells (4 bytes and a bit each) and, while partitioning, 4 bytes per
-// cell and 8 per block for each host thread.
+// 2^18 cells (12 bytes and a bit each), 12 bytes per block and, while
+// partitioning, 4 bytes per cell and 8 per block for each host thread.
 // Limits: each set below 2^32 points (the input indices are 32-bit).
 #pragma once
 
@@ -61,6 +61,7 @@ public:
         core::UninitVector<uint32_t> input;    // the input index of each gathered point
         core::UninitVector<uint32_t> cell;     // the grid cell of each (its Morton code: cellOfScaled)
         std::vector<uint64_t> start;           // piece k holds [start[k], start[k + 1])
+        std::vector<uint64_t> blockStart;      // block b holds [blockStart[b], blockStart[b + 1])
         [[nodiscard]] std::span<const glm::vec3> piece(size_t k) const {
             return {points.data() + start[k], size_t(start[k + 1] - start[k])};
         }
@@ -94,6 +95,14 @@ public:
     // of it, computed in double for points and box alike. False for a box of
     // more than 64 cells.
     [[nodiscard]] bool boxInPiece(const glm::vec3& q, double radius, uint32_t k) const;
+    // The blocks of piece k (Set::blockStart: each set's points of block b
+    // lie in one range; both sets share the numbering) that hold every point
+    // of piece k whose scaled coordinates lie within `radius` of q on every
+    // axis (q scaled as searched), each block once, in `blocks` (cleared
+    // first). Exact as boxInPiece. False (and `blocks` undefined) for a box
+    // of more than kNearCells cells.
+    static constexpr uint64_t kNearCells = 64;
+    bool blocksNear(const glm::vec3& q, double radius, uint32_t k, std::vector<uint32_t>& blocks) const;
     // The grid cell (its Morton code) of a point scaled as searched
     // (core::scaled): the cell the partition put it in.
     [[nodiscard]] uint32_t cellOfScaled(const glm::vec3& q) const { return cellOf(glm::dvec3(q)); }
@@ -137,6 +146,8 @@ private:
     double m_inverse[3] = {1.0, 1.0, 1.0};  // cells per unit on each axis
     std::vector<uint64_t> m_solid;  // a bit per cell: it and its neighbours hold one piece's points, or none
     std::vector<uint32_t> m_owner;  // per cell (Morton code): its piece, kEmpty or kShared
+    // Per cell, the blocks holding its points: [first, first + count); per block, its piece.
+    std::vector<uint32_t> m_blockFirst, m_blockCount, m_blockPiece;
 };
 
 }  // namespace rthdist::api

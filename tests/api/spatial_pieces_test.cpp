@@ -1,8 +1,9 @@
 // The pieces in space of the out-of-core route (src/api/spatial_pieces.hpp)
 // on the host: every point in exactly one piece, input order within a
 // piece (or blocks in space: PieceOrder::kBlocks), the limits kept (crowded
-// cells split by input order), and boxInPiece never true for a box that
-// holds a point of another piece.
+// cells split by input order), boxInPiece never true for a box that
+// holds a point of another piece, and blocksNear never missing a point of
+// its piece in its box.
 #include <gtest/gtest.h>
 
 #include <glm/common.hpp>
@@ -202,6 +203,83 @@ TEST(SpatialPieces, BoxInPieceHoldsOnlyThatPiecesPoints) {
     }
     EXPECT_GT(solid, 0u);
     EXPECT_GT(inside, tried / 2);
+}
+
+// blocksNear: each set's blocks cut it into consecutive ranges, each in one
+// piece; the blocks it names for piece k are that piece's, each once, and
+// hold every point of piece k (of either set) within the box; it refuses
+// boxes of more than kNearCells cells. Both orders, with shared cells (a
+// crowded cell over several pieces) and without.
+TEST(SpatialPieces, BlocksNearHoldEveryPointOfThePieceInTheBox) {
+    std::vector<glm::vec3> a = cloud(60000, 10, 2.0f, glm::vec3(-1.0f));
+    for (size_t i = 0; i < a.size(); i += 9) a[i] = glm::vec3(0.5f, 0.25f, -0.75f);  // one crowded cell
+    const std::vector<glm::vec3> b = cloud(50000, 11, 1.5f, glm::vec3(-0.5f));
+    const double scale = 0.5;
+    Rng rng(12);
+    size_t named = 0, refused = 0;
+    for (const PieceOrder order : {PieceOrder::kBlocks, PieceOrder::kInput})
+        for (const PieceLimits limits : {PieceLimits{9000, 7000}, PieceLimits{2000, 60000}}) {
+            const SpatialPieces pieces = SpatialPieces::partition(a, b, scale, limits, 3, order);
+            std::vector<uint32_t> blockPiece;  // each block's piece, from the sets' ranges
+            for (int s = 0; s < 2; ++s) {
+                const SpatialPieces::Set& set = pieces.set(s);
+                ASSERT_GE(set.blockStart.size(), 2u);
+                ASSERT_EQ(set.blockStart.front(), 0u);
+                ASSERT_EQ(set.blockStart.back(), set.points.size());
+                ASSERT_TRUE(std::is_sorted(set.blockStart.begin(), set.blockStart.end()));
+                if (s == 1) ASSERT_EQ(set.blockStart.size(), pieces.set(0).blockStart.size());
+            }
+            // A block's piece: the piece whose range holds its points (blocks of
+            // no points in either set are named by no test below).
+            blockPiece.assign(pieces.set(0).blockStart.size() - 1, UINT32_MAX);
+            for (int s = 0; s < 2; ++s) {
+                const SpatialPieces::Set& set = pieces.set(s);
+                for (size_t blk = 0; blk + 1 < set.blockStart.size(); ++blk) {
+                    if (set.blockStart[blk] == set.blockStart[blk + 1]) continue;
+                    const auto k =
+                        uint32_t(std::upper_bound(set.start.begin(), set.start.end(), set.blockStart[blk]) -
+                                 set.start.begin() - 1);
+                    ASSERT_LE(set.blockStart[blk + 1], set.start[k + 1])
+                        << "block " << blk << " spans pieces";
+                    if (blockPiece[blk] != UINT32_MAX) ASSERT_EQ(blockPiece[blk], k) << "block " << blk;
+                    blockPiece[blk] = k;
+                }
+            }
+            std::vector<uint32_t> blocks;
+            for (int probe = 0; probe < 300; ++probe) {
+                const glm::vec3 q = core::scaled(
+                    probe % 3 == 0
+                        ? a[rng.index(a.size())]
+                        : glm::vec3(float(rng.uniform()), float(rng.uniform()), float(rng.uniform())) * 3.0f -
+                              glm::vec3(1.5f),
+                    scale);
+                const double radius = probe % 10 == 0 ? 0.5 : 0.001 * double(rng.index(40));
+                const auto k = uint32_t(rng.index(pieces.count()));
+                if (!pieces.blocksNear(q, radius, k, blocks)) {
+                    ++refused;
+                    continue;
+                }
+                ++named;
+                ASSERT_TRUE(std::is_sorted(blocks.begin(), blocks.end()));
+                ASSERT_TRUE(std::adjacent_find(blocks.begin(), blocks.end()) == blocks.end());
+                for (const uint32_t blk : blocks)
+                    if (blockPiece[blk] != UINT32_MAX) ASSERT_EQ(blockPiece[blk], k) << "block " << blk;
+                for (int s = 0; s < 2; ++s) {
+                    const SpatialPieces::Set& set = pieces.set(s);
+                    for (uint64_t g = set.start[k]; g < set.start[k + 1]; ++g) {
+                        const glm::dvec3 p(core::scaled(set.points[g], scale));
+                        if (!glm::all(glm::lessThanEqual(glm::abs(p - glm::dvec3(q)), glm::dvec3(radius))))
+                            continue;
+                        const bool held = std::any_of(blocks.begin(), blocks.end(), [&](uint32_t blk) {
+                            return set.blockStart[blk] <= g && g < set.blockStart[blk + 1];
+                        });
+                        ASSERT_TRUE(held) << "set " << s << " point " << set.input[g] << " piece " << k;
+                    }
+                }
+            }
+        }
+    EXPECT_GT(named, 1000u);
+    EXPECT_GT(refused, 0u);
 }
 
 }  // namespace
