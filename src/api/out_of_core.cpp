@@ -509,12 +509,9 @@ struct RoundFailure {
 
 // Round one: every piece's queries against the same piece's targets, both
 // directions in one call where both are in pieces (`dirs` null where not).
-// A piece's results are settled (settlePiece) on a thread of their own while
-// the lane's next call runs: the host's threads are idle while the device
-// indexes and culls. The per-point arrays go back to the lane's backend only
-// between its calls (GpuHausdorff::recyclePerPoint is not called beside a
-// call), so each call after the second takes the arrays of the call two
-// before it.
+// (The verdicts were tried on a thread of their own beside the lane's next
+// call: on the H200 machine the call's upload then took as long as the
+// verdicts saved, both bound by the host's memory.)
 void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double scale,
               const CallOptions& call, const Lane& lane, std::atomic<size_t>& next, RoundFailure& failure,
               HostClock& host, double from, double width) {
@@ -522,39 +519,9 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double
     const int qset = dirs[0] != nullptr ? 0 : 1;
     const SpatialPieces::Set& qs = pieces.set(qset);
     const SpatialPieces::Set& ts = pieces.set(1 - qset);
-    struct Called {
-        size_t k = 0;
-        HausdorffResult r;
-    };
-    const auto outOfMemory = [&lane](size_t k) {
-        return Error{ErrorCode::kOutOfMemory, "out of host memory in piece " + std::to_string(k) +
-                                                  " (device lane " + std::to_string(lane.index) + ")"};
-    };
-    // A piece's verdicts; its arrays stay with it until handed back.
-    const auto settle = [&](Called& c) {
-        try {
-            const core::Clock::time_point start = core::Clock::now();
-            SpaceDirection& first = *dirs[qset];
-            addCallTo(first.shared, c.r.aToB.counters, &c.r.timings);
-            settlePiece(first, pieces, c.k, c.r.aNearest, scale, lane.threads);
-            if (both) {
-                addCallTo(dirs[1]->shared, c.r.bToA.counters, nullptr);
-                settlePiece(*dirs[1], pieces, c.k, c.r.bNearest, scale, lane.threads);
-            }
-            host.add(start, HostClock::kRoundOne);
-        } catch (const std::bad_alloc&) {
-            failure.set(outOfMemory(c.k));
-        }
-    };
-    std::optional<Called> settling;  // the previous call's piece, settled beside the next call
-    const auto handBack = [&] {
-        if (!settling) return;
-        lane.giveBack(std::move(settling->r.aNearest), std::move(settling->r.bNearest));
-        settling.reset();
-    };
     for (;;) {
         const size_t k = next.fetch_add(1);
-        if (k >= pieces.count() || failure.failed.load()) break;
+        if (k >= pieces.count() || failure.failed.load()) return;
         try {
             if (qs.size(k) == 0 || ts.size(k) == 0) {  // its queries go to other pieces in round two
                 openAll(*dirs[qset], pieces, k);
@@ -564,31 +531,27 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double
             CallOptions piece = spaceOptions(call, from + width * double(k) / double(pieces.count()),
                                              width / double(pieces.count()));
             piece.directedOnly = !both;
-            std::thread beside;
-            if (settling) beside = std::thread([&settle, &settling] { settle(*settling); });
-            Result<HausdorffResult> r = [&] {
-                try {
-                    return lane.call(qs.piece(k), ts.piece(k), piece);
-                } catch (...) {
-                    if (beside.joinable()) beside.join();
-                    throw;
-                }
-            }();
-            if (beside.joinable()) beside.join();
-            handBack();
+            Result<HausdorffResult> r = lane.call(qs.piece(k), ts.piece(k), piece);
             if (!r) {
                 failure.set(r.error());
                 return;
             }
-            settling = Called{k, std::move(*r)};
+            const core::Clock::time_point start = core::Clock::now();
+            SpaceDirection& first = *dirs[qset];
+            addCallTo(first.shared, r->aToB.counters, &r->timings);
+            settlePiece(first, pieces, k, r->aNearest, scale, lane.threads);
+            if (both) {
+                addCallTo(dirs[1]->shared, r->bToA.counters, nullptr);
+                settlePiece(*dirs[1], pieces, k, r->bNearest, scale, lane.threads);
+            }
+            lane.giveBack(std::move(r->aNearest), std::move(r->bNearest));
+            host.add(start, HostClock::kRoundOne);
         } catch (const std::bad_alloc&) {
-            failure.set(outOfMemory(k));
+            failure.set(Error{ErrorCode::kOutOfMemory, "out of host memory in piece " + std::to_string(k) +
+                                                           " (device lane " + std::to_string(lane.index) +
+                                                           ")"});
             return;
         }
-    }
-    if (settling) {
-        settle(*settling);
-        handBack();
     }
 }
 
