@@ -9,8 +9,14 @@
 
 #include "core/index_space.hpp"
 #include "core/parallel.hpp"
+#include "core/sanitizers.hpp"
 #include "core/stopwatch.hpp"
 #include "core/vector_clones.hpp"
+
+#if defined(__SSE2__) && !defined(RTHDIST_UNDER_SANITIZER)
+#include <emmintrin.h>
+#define RTHDIST_STREAMING_STORES 1
+#endif
 
 namespace rthdist::api {
 
@@ -70,6 +76,116 @@ struct PieceRanks {
 PieceRanks pieceRanks(uint64_t m, uint64_t span, uint64_t total) {
     return {(m * total + span - 1) / span, ((m + 1) * total + span - 1) / span};
 }
+
+// A host range's scatter into its runs of a set's gathered arrays (points,
+// input indices, cells), one run per block. Each block's next 16 points
+// wait in a buffer placed as their destinations lie in cache lines; a
+// buffer that ends on a line boundary of the destinations goes out at once,
+// a whole group of 16 (three lines of points, one of indices, one of cells)
+// with streaming stores, which write the lines without reading them first
+// (the scatter's writes otherwise read every destination line from memory
+// before writing it: half its memory traffic). A run's first and last
+// partial groups, and every write where the arrays are not 64-byte aligned
+// or under a sanitizer, are ordinary stores. Each range's runs are its own
+// (the lines a streaming store writes lie inside one run), so ranges run
+// at once; finish() makes the streaming stores visible before the range's
+// thread ends.
+class BlockWriter {
+public:
+    static constexpr uint32_t kGroup = 16;  // points: 192 bytes = 3 lines; indices and cells: 1 line
+    // Blocks past this are written directly (the buffers: 320 bytes a block).
+    static constexpr size_t kMaxBlocks = size_t(1) << 14;
+
+    BlockWriter(SpatialPieces::Set& set, std::vector<uint64_t>& next)
+        : m_points(set.points.data()), m_input(set.input.data()), m_cell(set.cell.data()), m_next(next) {
+        const auto aligned = [](const void* p) { return reinterpret_cast<uintptr_t>(p) % 64 == 0; };
+        m_buffered = next.size() <= kMaxBlocks;
+#if defined(RTHDIST_STREAMING_STORES)
+        m_streaming = m_buffered && aligned(m_points) && aligned(m_input) && aligned(m_cell);
+#else
+        (void)aligned;
+#endif
+        if (m_buffered) {
+            m_fill.assign(next.size(), 0);
+            m_bufPoints.resize(next.size() * kGroup);
+            m_bufInput.resize(next.size() * kGroup);
+            m_bufCell.resize(next.size() * kGroup);
+        }
+    }
+
+    void put(uint32_t block, const glm::vec3& p, uint32_t input, uint32_t cell) {
+        if (!m_buffered) {
+            const uint64_t to = m_next[block]++;
+            m_points[to] = p;
+            m_input[to] = input;
+            m_cell[to] = cell;
+            return;
+        }
+        const uint64_t at = m_next[block] + m_fill[block];  // this point's destination
+        const size_t slot = size_t(block) * kGroup + at % kGroup;
+        m_bufPoints[slot] = p;
+        m_bufInput[slot] = input;
+        m_bufCell[slot] = cell;
+        ++m_fill[block];
+        if ((at + 1) % kGroup == 0) flush(block);
+    }
+
+    // The partial groups left, then a fence for the streaming stores.
+    void finish() {
+        if (m_buffered)
+            for (uint32_t b = 0; b < m_fill.size(); ++b)
+                if (m_fill[b] != 0) flush(b);
+#if defined(RTHDIST_STREAMING_STORES)
+        if (m_streaming) _mm_sfence();
+#endif
+    }
+
+private:
+    // The buffered points of `block`: destinations [next, next + fill), in
+    // slots next % kGroup onwards.
+    void flush(uint32_t block) {
+        const uint64_t first = m_next[block];
+        const uint32_t count = m_fill[block];
+        const size_t base = size_t(block) * kGroup;
+        const size_t from = first % kGroup;
+#if defined(RTHDIST_STREAMING_STORES)
+        if (m_streaming && count == kGroup) {  // from == 0: a whole, aligned group
+            stream(m_points + first, &m_bufPoints[base], kGroup * sizeof(glm::vec3));
+            stream(m_input + first, &m_bufInput[base], kGroup * sizeof(uint32_t));
+            stream(m_cell + first, &m_bufCell[base], kGroup * sizeof(uint32_t));
+            m_next[block] = first + count;
+            m_fill[block] = 0;
+            return;
+        }
+#endif
+        for (uint32_t k = 0; k < count; ++k) {
+            m_points[first + k] = m_bufPoints[base + from + k];
+            m_input[first + k] = m_bufInput[base + from + k];
+            m_cell[first + k] = m_bufCell[base + from + k];
+        }
+        m_next[block] = first + count;
+        m_fill[block] = 0;
+    }
+
+#if defined(RTHDIST_STREAMING_STORES)
+    static void stream(void* to, const void* from, size_t bytes) {
+        auto* d = static_cast<__m128i*>(to);
+        const auto* s = static_cast<const char*>(from);
+        for (size_t k = 0; k < bytes / 16; ++k)
+            _mm_stream_si128(d + k, _mm_loadu_si128(reinterpret_cast<const __m128i*>(s + 16 * k)));
+    }
+#endif
+
+    glm::vec3* m_points;
+    uint32_t* m_input;
+    uint32_t* m_cell;
+    std::vector<uint64_t>& m_next;
+    bool m_buffered = false;
+    bool m_streaming = false;
+    std::vector<uint8_t> m_fill;
+    std::vector<glm::vec3> m_bufPoints;
+    std::vector<uint32_t> m_bufInput, m_bufCell;
+};
 
 }  // namespace
 
@@ -264,6 +380,8 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
     const auto groupOf = [&](uint32_t cell) {
         return order == PieceOrder::kBlocks ? cell >> blockShift : 0u;
     };
+    // blockOf: m_blockFirst with a shared cell marked in the same word, so
+    // that the scatter looks up one word a point.
     std::vector<uint32_t> blockOf(cellCount, 0);  // a cell's block (a shared cell's first | kSharedBlock)
     std::vector<uint32_t>& blockPiece = out.m_blockPiece;  // each block's piece
     out.m_blockFirst.assign(cellCount, 0);
@@ -364,15 +482,13 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         set.input.resize(points.size());
         set.cell.resize(points.size());
         forRanges(r, [&](int t, size_t begin, size_t end) {
-            std::vector<uint64_t>& next = perBlock[size_t(t)];
+            BlockWriter writer(set, perBlock[size_t(t)]);
             std::vector<uint64_t>& rank = rankBase[size_t(t)];
             for (size_t i = begin; i < end; ++i) {
                 const uint32_t cell = key[s][i];
-                const uint64_t to = next[blockOfPoint(cell, rank)]++;
-                set.points[to] = points[i];
-                set.input[to] = uint32_t(i);
-                set.cell[to] = cell;
+                writer.put(blockOfPoint(cell, rank), points[i], uint32_t(i), cell);
             }
+            writer.finish();
         });
         key[s] = {};
     }
