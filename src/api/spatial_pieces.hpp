@@ -27,7 +27,10 @@
 // Memory: per set 20 bytes per point (the gathered copy, its input indices
 // and cells) plus 4 bytes per point while partitioning; the grid at most
 // 2^18 cells (12 bytes and a bit each), 12 bytes per block and, while
-// partitioning, 4 bytes per cell and 8 per block for each host thread.
+// partitioning, 4 bytes per cell and 8 per block for each host thread, and
+// while scattering 321 bytes per block for each host thread where blocks
+// are at most 2^14 (each block's next 16 points, written a whole cache line
+// at a time).
 // Limits: each set below 2^32 points (the input indices are 32-bit).
 #pragma once
 
