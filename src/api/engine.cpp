@@ -290,7 +290,7 @@ Result<HausdorffResult> runFramed(Engine::Impl& impl, int lane, std::span<const 
 // Route::kPieces and kSeveralDevices (out_of_core.hpp), over the backend's lanes.
 Result<HausdorffResult> runInPieces(Engine::Impl& impl, std::span<const glm::vec3> a,
                                     std::span<const glm::vec3> b, double scale, const CallOptions& call,
-                                    const api::MemoryBudget& pieces) {
+                                    const api::MemoryBudget& pieces, const std::optional<core::Bounds>& box) {
     api::ComputeBackend& backend = *impl.backend;
     const std::function<void()> release = [&backend] { backend.releaseScratch(); };
     const api::DirectedCall directed = [&](int lane, std::span<const glm::vec3> q,
@@ -303,7 +303,7 @@ Result<HausdorffResult> runInPieces(Engine::Impl& impl, std::span<const glm::vec
     release();
     Result<HausdorffResult> r = api::computeInPieces(
         a, b, scale, call, pieces, directed, release, backend.caps().lanes, impl.options.threads, recycle,
-        impl.options.tuning && impl.options.tuning->traceSubmits);
+        impl.options.tuning && impl.options.tuning->traceSubmits, box);
     release();  // the pieces' scratch is no use to the next call
     if (!r) return r;
     r->backend = backend.kind();
@@ -313,8 +313,10 @@ Result<HausdorffResult> runInPieces(Engine::Impl& impl, std::span<const glm::vec
 
 // A framed pair on the planner's route: one call (scanned whole or indexed;
 // in pieces after a kOutOfMemory under the automatic budget), or pieces.
+// `box`: both sets' box when the spans are the caller's points (for pieces).
 Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm::vec3> a,
-                                        std::span<const glm::vec3> b, double scale, const CallOptions& call) {
+                                        std::span<const glm::vec3> b, double scale, const CallOptions& call,
+                                        const std::optional<core::Bounds>& box) {
     const api::Plan plan =
         api::planFramedCall(a.size(), b.size(), call, impl.backend->memoryBudget(), impl.backend->caps());
     if (plan.route == api::Route::kSmallPairScan || plan.route == api::Route::kOneCall) {
@@ -323,7 +325,7 @@ Result<HausdorffResult> runWithinBudget(Engine::Impl& impl, std::span<const glm:
         // A direction already handed back (perPointReady) is not handed back again from pieces.
         if (impl.backend->handedBack() != 0) return r;
     }
-    return runInPieces(impl, a, b, scale, call, plan.pieces);
+    return runInPieces(impl, a, b, scale, call, plan.pieces, box);
 }
 
 Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, const PointView& b,
@@ -355,7 +357,12 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     const double scale = core::exactScale(
         std::max(core::searchMagnitude(checked.a, origin), core::searchMagnitude(checked.b, origin)));
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
-    Result<HausdorffResult> r = finished(impl, runWithinBudget(impl, fa.span(), fb.span(), scale, call),
+    // The spans are the caller's floats: the checked boxes are theirs.
+    std::optional<core::Bounds> box;
+    if (!copied)
+        box = core::Bounds{glm::min(checked.a.box.lo, checked.b.box.lo),
+                           glm::max(checked.a.box.hi, checked.b.box.hi)};
+    Result<HausdorffResult> r = finished(impl, runWithinBudget(impl, fa.span(), fb.span(), scale, call, box),
                                          Frame{origin, a, b, copied}, call, t0);
     if (r) r->timings.pieces += narrowingMs;
     return r;

@@ -965,7 +965,8 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
 Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOptions& call,
                                       const MemoryBudget& budget, const DirectedCall& directed,
                                       const RecycleCall& recycle, const std::function<void()>& release,
-                                      int lanes, int threads, bool trace) {
+                                      int lanes, int threads, bool trace,
+                                      const std::optional<core::Bounds>& box) {
     const Result<DirectionSplit> splitAB = splitDirection(budget, a.size(), b.size(), lanes);
     if (!splitAB) return splitAB.error();
     const uint64_t perCall = budget.pointsPerCall();
@@ -1004,7 +1005,8 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
             // Per-point output names each query's nearest point: pieces in input
             // order break ties as one call would. Otherwise blocks in space.
             cut = SpatialPieces::partition(a, b, scale, limits, threads,
-                                           call.perPointDistances ? PieceOrder::kInput : PieceOrder::kBlocks);
+                                           call.perPointDistances ? PieceOrder::kInput : PieceOrder::kBlocks,
+                                           box ? &*box : nullptr);
         } catch (const std::bad_alloc&) {
             return Error{ErrorCode::kOutOfMemory,
                          "out of host memory cutting " + std::to_string(a.size()) + " + " +
@@ -1120,13 +1122,14 @@ Result<DirectionSplit> splitDirection(const MemoryBudget& budget, uint64_t nq, u
 Result<HausdorffResult> computeInPieces(Span a, Span b, double scale, const CallOptions& call,
                                         const MemoryBudget& given, const DirectedCall& directed,
                                         const std::function<void()>& release, int lanes, int threads,
-                                        const RecycleCall& recycle, bool trace) {
+                                        const RecycleCall& recycle, bool trace,
+                                        const std::optional<core::Bounds>& box) {
     // The budget halved after each kOutOfMemory (the per-point figure is an
     // estimate; a device may hold less than it reports).
     MemoryBudget budget = given;
     for (;;) {
         Result<HausdorffResult> r =
-            computeWithin(a, b, scale, call, budget, directed, recycle, release, lanes, threads, trace);
+            computeWithin(a, b, scale, call, budget, directed, recycle, release, lanes, threads, trace, box);
         // The host's own memory does not grow with a smaller budget.
         if (r || r.error().code != ErrorCode::kOutOfMemory || budget.pointsPerCall() < 4 ||
             r.error().message.rfind("out of host memory", 0) == 0)

@@ -42,9 +42,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 
+#include "core/index_space.hpp"
 #include "rthdist/rthdist.hpp"
 
 namespace rthdist::api {
@@ -123,9 +125,12 @@ using RecycleCall = std::function<void(int lane, PerPoint&& a, PerPoint&& b)>;
 // `release` is called between directions and after a failure, with no lane
 // running. Timings::pieces: the host's own work of the pieces (partition,
 // merges, selections, the proof); `trace` prints its parts to stderr.
+// `box`: the box of a and b together as given, when the caller has it
+// exactly (SpatialPieces::partition).
 [[nodiscard]] Result<HausdorffResult> computeInPieces(
     std::span<const glm::vec3> a, std::span<const glm::vec3> b, double scale, const CallOptions& call,
     const MemoryBudget& budget, const DirectedCall& directed, const std::function<void()>& release,
-    int lanes = 1, int threads = 0, const RecycleCall& recycle = {}, bool trace = false);
+    int lanes = 1, int threads = 0, const RecycleCall& recycle = {}, bool trace = false,
+    const std::optional<core::Bounds>& box = std::nullopt);
 
 }  // namespace rthdist::api

@@ -233,7 +233,7 @@ bool SpatialPieces::blocksNear(const glm::vec3& q, double radius, uint32_t k,
 }
 
 SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits limits, int threads,
-                                       PieceOrder order) {
+                                       PieceOrder order, const core::Bounds* box) {
     SpatialPieces out;
     const Span sets[2] = {a, b};
     const uint64_t limit[2] = {std::max<uint64_t>(limits.a, 1), std::max<uint64_t>(limits.b, 1)};
@@ -245,10 +245,16 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         pass = core::Clock::now();
     };
 
-    // The pair's box, scaled as searched.
+    // The pair's box, scaled as searched (scaling by a power of two is
+    // monotone, so the scaled box of a given box is that of the points).
     glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    if (box != nullptr) {
+        lo = glm::dvec3(core::scaled(glm::vec3(box->lo), scale));
+        hi = glm::dvec3(core::scaled(glm::vec3(box->hi), scale));
+        out.m_magnitude = core::largestMagnitude(*box);
+    }
     for (const Span s : sets) {
-        if (s.empty()) continue;
+        if (s.empty() || box != nullptr) continue;
         std::vector<glm::dvec3> partLo(size_t(threads), glm::dvec3(core::scaled(s[0], scale)));
         std::vector<glm::dvec3> partHi = partLo;
         std::vector<float> partMagnitude(size_t(threads), 0.0f);

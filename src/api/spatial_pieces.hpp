@@ -73,10 +73,14 @@ public:
 
     // Cuts sets a and b (scaled by the exact power of two `scale` as searched;
     // each below 2^32 points, at least one point in all) into pieces within
-    // `limits`, each piece's points in `order`.
+    // `limits`, each piece's points in `order`. `box`: the box of both sets'
+    // points as given (not scaled), when the caller has it (the Engine's
+    // input check): it spares a pass over the points, and must be exact
+    // (each face attained by a point), as largestMagnitude() comes from it.
     [[nodiscard]] static SpatialPieces partition(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                  double scale, PieceLimits limits, int threads,
-                                                 PieceOrder order = PieceOrder::kInput);
+                                                 PieceOrder order = PieceOrder::kInput,
+                                                 const core::Bounds* box = nullptr);
 
     // The partition's passes, ms (for RTHDIST_SUBMIT_TRACE's pieces line).
     struct PassTimes {

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <limits>
 #include <vector>
 
 #include "api/spatial_pieces.hpp"
@@ -203,6 +204,40 @@ TEST(SpatialPieces, BoxInPieceHoldsOnlyThatPiecesPoints) {
     }
     EXPECT_GT(solid, 0u);
     EXPECT_GT(inside, tried / 2);
+}
+
+// The pair's box given (as the Engine's input check has it) cuts as the
+// box the partition finds itself: the same pieces, points, cells and
+// largest magnitude, both orders.
+TEST(SpatialPieces, AGivenBoxCutsAsTheSetsOwn) {
+    std::vector<glm::vec3> a = cloud(40000, 13, 3.0f, glm::vec3(-2.0f, 0.5f, 7.0f));
+    a.push_back(glm::vec3(-40.0f, 1.0f, 2.0f));
+    const std::vector<glm::vec3> b = cloud(30000, 14, 1.0f, glm::vec3(0.25f));
+    core::Bounds box{glm::dvec3(std::numeric_limits<double>::infinity()),
+                     glm::dvec3(-std::numeric_limits<double>::infinity())};
+    const std::vector<glm::vec3>* sets[2] = {&a, &b};
+    for (const std::vector<glm::vec3>* s : sets)
+        for (const glm::vec3& p : *s) {
+            box.lo = glm::min(box.lo, glm::dvec3(p));
+            box.hi = glm::max(box.hi, glm::dvec3(p));
+        }
+    for (const PieceOrder order : {PieceOrder::kBlocks, PieceOrder::kInput}) {
+        const SpatialPieces own = SpatialPieces::partition(a, b, 0.25, PieceLimits{9000, 8000}, 3, order);
+        const SpatialPieces given =
+            SpatialPieces::partition(a, b, 0.25, PieceLimits{9000, 8000}, 3, order, &box);
+        ASSERT_GT(own.count(), 2u);
+        ASSERT_EQ(own.count(), given.count());
+        EXPECT_EQ(own.largestMagnitude(), given.largestMagnitude());
+        EXPECT_EQ(given.largestMagnitude(), 40.0);
+        for (int s = 0; s < 2; ++s) {
+            EXPECT_EQ(own.set(s).start, given.set(s).start) << "set " << s;
+            EXPECT_EQ(own.set(s).blockStart, given.set(s).blockStart) << "set " << s;
+            EXPECT_TRUE(
+                std::equal(own.set(s).input.begin(), own.set(s).input.end(), given.set(s).input.begin()));
+            EXPECT_TRUE(
+                std::equal(own.set(s).cell.begin(), own.set(s).cell.end(), given.set(s).cell.begin()));
+        }
+    }
 }
 
 // blocksNear: each set's blocks cut it into consecutive ranges, each in one
