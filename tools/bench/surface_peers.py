@@ -57,6 +57,7 @@ import argparse
 import json
 import os
 import platform
+import shutil
 import statistics
 import subprocess
 import sys
@@ -401,6 +402,12 @@ def main():
         elif name == "cgal":
             tools[name] = cgal_tool(args)
         elif name == "meshlab":
+            # Checked before any row runs: each row would otherwise stop the
+            # script at MeshLab's first call.
+            missing = [c for c in ("meshlabserver", "xvfb-run") if shutil.which(c) is None]
+            if missing:
+                sys.exit("meshlab: " + " and ".join(missing) + " not found (bash tools/bench/setup.sh installs "
+                         "them; or leave meshlab out of --tools)")
             tools[name] = meshlab_tool(args)
         elif name:
             sys.exit("unknown tool " + name)
