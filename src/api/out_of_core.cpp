@@ -32,6 +32,10 @@ using Span = std::span<const glm::vec3>;
 
 // Points per task of the host passes over queries and targets.
 constexpr size_t kHostChunk = size_t(1) << 16;
+// Round two compares this many points on the host for a tile whatever its
+// size (scanOnHost): about a millisecond on a few cores, below a call's
+// fixed cost (a submission, the tile's upload and index).
+constexpr uint64_t kHostScanPoints = uint64_t(1) << 20;
 
 // The running state of one direction: its witness so far, every query's best
 // pair (when the caller asked for per-point output), and the counters and
@@ -667,9 +671,10 @@ std::vector<uint32_t> selectFor(RoundTwo& round, uint32_t j, bool first, double 
 // query whose reach (its best distance, widened as settlePiece widens it)
 // touches few blocks of the tile (SpatialPieces::blocksNear) is compared in
 // double with every point of those blocks, while the points so compared
-// stay within the tile's size: a call would upload and index every point of
-// the tile (on the torus quarter, round two's calls for 24 queries doubled
-// the calls' upload and index, docs/bench/scale session 14). Every point of
+// stay within the tile's size (or kHostScanPoints, a call's fixed cost): a
+// call would upload and index every point of the tile (on the torus
+// quarter, round two's calls for 24 queries doubled the calls' upload and
+// index, docs/bench/scale session 14). Every point of
 // the tile within the reach lies in those blocks, so the best pair found is
 // the query's nearest in the tile in double, ties to the smaller input
 // index, merged as a call's (mergeBests). Returns the queries left for calls.
@@ -686,7 +691,7 @@ std::vector<uint32_t> scanOnHost(RoundTwo& round, uint32_t j, const std::vector<
     std::vector<uint32_t> scanned, called, blocks;
     std::vector<glm::vec3> points;  // each scanned query's point
     std::vector<Range> ranges;
-    uint64_t budget = ts.size(j);
+    uint64_t budget = std::max(ts.size(j), kHostScanPoints);
     {
         std::lock_guard lock(round.mutex);  // lanes merge into other tiles' queries meanwhile
         for (const uint32_t i : selected) {

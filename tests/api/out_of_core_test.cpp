@@ -222,6 +222,38 @@ TEST(OutOfCore, PiecesInSpaceSendEachQueryAboutOnce) {
     }
 }
 
+// Round two asks no call for queries that few points of the other pieces
+// can be near (api/out_of_core.cpp scanOnHost): on a spread lattice with
+// per-point output (no query dropped by the early break) every call is a
+// piece's round-one call, and the queries past their piece get the brute
+// force's nearest points all the same, ties to the smaller index.
+TEST(OutOfCore, RoundTwoAnswersQueriesNearTheirPieceOnTheHost) {
+    std::vector<glm::vec3> a = slabLattice(16, 0.0f);
+    std::vector<glm::vec3> b = slabLattice(16, 0.5f);
+    Rng rng(13);
+    for (std::vector<glm::vec3>* s : {&a, &b})
+        for (size_t i = s->size() - 1; i > 0; --i) std::swap((*s)[i], (*s)[rng.index(i + 1)]);
+    api::MemoryBudget budget;
+    budget.bytes = 2 * 512 * api::kBytesPerPoint;
+    CountingBruteForce fake;
+    const api::DirectedCall call = [&fake](int, auto q, auto t, const CallOptions& o) {
+        return fake(q, t, o);
+    };
+    CallOptions options;
+    options.perPointDistances = true;
+    auto r = api::computeInPieces(a, b, 1.0, options, budget, call, {});
+    ASSERT_TRUE(r) << r.error().message;
+    for (auto [got, q, t] : {std::tuple{&r->aNearest, &a, &b}, std::tuple{&r->bNearest, &b, &a}}) {
+        const std::vector<oracle::NearestExact> want = oracle::bruteForceNearestIndexed(*q, *t, 1);
+        ASSERT_EQ(got->nearest.size(), want.size());
+        for (size_t i = 0; i < want.size(); ++i) ASSERT_EQ(got->nearest[i], want[i].targetIndex) << i;
+    }
+    EXPECT_GT(r->aToB.counters.crossPieceQueries, 0u);
+    EXPECT_GT(r->bToA.counters.crossPieceQueries, 0u);
+    EXPECT_EQ(r->aToB.counters.queryChunks, r->bToA.counters.queryChunks);
+    EXPECT_EQ(fake.calls.load(), uint64_t(r->aToB.counters.queryChunks));  // round one's calls only
+}
+
 // Per-point output through pieces in space: every query's nearest distance
 // and index as the brute force's (the smaller index among equal distances),
 // on a lattice whose queries sit at equal distances from several targets.
