@@ -182,7 +182,7 @@ private:
     uint32_t* m_cell;
     std::vector<uint64_t>& m_next;
     bool m_buffered = false;
-    bool m_streaming = false;
+    [[maybe_unused]] bool m_streaming = false;  // read only where streaming stores exist
     std::vector<uint8_t> m_fill;
     std::vector<glm::vec3> m_bufPoints;
     std::vector<uint32_t> m_bufInput, m_bufCell;
