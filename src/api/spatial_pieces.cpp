@@ -190,26 +190,8 @@ private:
 
 }  // namespace
 
-bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) const {
-    uint32_t lo[3], hi[3];
-    uint64_t cells = 1;
-    for (int axis = 0; axis < 3; ++axis) {
-        lo[axis] = axisCell(double(q[axis]) - radius, axis);
-        hi[axis] = axisCell(double(q[axis]) + radius, axis);
-        cells *= hi[axis] - lo[axis] + 1;
-    }
-    if (cells > 64) return false;
-    for (uint32_t z = lo[2]; z <= hi[2]; ++z)
-        for (uint32_t y = lo[1]; y <= hi[1]; ++y)
-            for (uint32_t x = lo[0]; x <= hi[0]; ++x) {
-                const uint32_t owner = m_owner[core::mortonEncode(x, y, z)];
-                if (owner != k && owner != kEmpty) return false;
-            }
-    return true;
-}
-
-bool SpatialPieces::blocksNear(const glm::vec3& q, double radius, uint32_t k,
-                               std::vector<uint32_t>& blocks) const {
+template <class Fn>
+bool SpatialPieces::forCellsInBox(const glm::vec3& q, double radius, Fn&& fn) const {
     uint32_t lo[3], hi[3];
     uint64_t cells = 1;
     for (int axis = 0; axis < 3; ++axis) {
@@ -218,16 +200,31 @@ bool SpatialPieces::blocksNear(const glm::vec3& q, double radius, uint32_t k,
         cells *= hi[axis] - lo[axis] + 1;
     }
     if (cells > kNearCells) return false;
-    blocks.clear();
     for (uint32_t z = lo[2]; z <= hi[2]; ++z)
         for (uint32_t y = lo[1]; y <= hi[1]; ++y)
-            for (uint32_t x = lo[0]; x <= hi[0]; ++x) {
-                const uint32_t cell = core::mortonEncode(x, y, z);
-                const uint32_t owner = m_owner[cell];
-                if (owner == kEmpty || (owner != kShared && owner != k)) continue;
-                for (uint32_t b = m_blockFirst[cell]; b < m_blockFirst[cell] + m_blockCount[cell]; ++b)
-                    if (m_blockPiece[b] == k) blocks.push_back(b);
-            }
+            for (uint32_t x = lo[0]; x <= hi[0]; ++x)
+                if (!fn(core::mortonEncode(x, y, z))) return false;
+    return true;
+}
+
+bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) const {
+    return forCellsInBox(q, radius, [&](uint32_t cell) {
+        const uint32_t owner = m_owner[cell];
+        return owner == k || owner == kEmpty;
+    });
+}
+
+bool SpatialPieces::blocksNear(const glm::vec3& q, double radius, uint32_t k,
+                               std::vector<uint32_t>& blocks) const {
+    blocks.clear();
+    const bool few = forCellsInBox(q, radius, [&](uint32_t cell) {
+        const uint32_t owner = m_owner[cell];
+        if (owner == kEmpty || (owner != kShared && owner != k)) return true;
+        for (uint32_t b = m_blockFirst[cell]; b < m_blockFirst[cell] + m_blockCount[cell]; ++b)
+            if (m_blockPiece[b] == k) blocks.push_back(b);
+        return true;
+    });
+    if (!few) return false;
     std::sort(blocks.begin(), blocks.end());
     blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
     return true;

@@ -58,6 +58,9 @@ struct PieceLimits {
 
 class SpatialPieces {
 public:
+    // The most grid cells a box of boxInPiece or blocksNear may cover.
+    static constexpr uint64_t kNearCells = 64;
+
     // One set, gathered piece after piece.
     struct Set {
         core::UninitVector<glm::vec3> points;  // piece after piece, in the partition's PieceOrder
@@ -100,7 +103,7 @@ public:
     // belongs to piece k: the cells that box touches hold points of piece k
     // only, or none. Exact: the cell of a coordinate is a monotone function
     // of it, computed in double for points and box alike. False for a box of
-    // more than 64 cells.
+    // more than kNearCells cells.
     [[nodiscard]] bool boxInPiece(const glm::vec3& q, double radius, uint32_t k) const;
     // The blocks of piece k (Set::blockStart: each set's points of block b
     // lie in one range; both sets share the numbering) that hold every point
@@ -108,7 +111,6 @@ public:
     // axis (q scaled as searched), each block once, in `blocks` (cleared
     // first). Exact as boxInPiece. False (and `blocks` undefined) for a box
     // of more than kNearCells cells.
-    static constexpr uint64_t kNearCells = 64;
     bool blocksNear(const glm::vec3& q, double radius, uint32_t k, std::vector<uint32_t>& blocks) const;
     // The grid cell (its Morton code) of a point scaled as searched
     // (core::scaled): the cell the partition put it in.
@@ -143,6 +145,11 @@ private:
     [[nodiscard]] uint32_t cellOf(const glm::dvec3& p) const {
         return core::mortonEncode(axisCell(p.x, 0), axisCell(p.y, 1), axisCell(p.z, 2));
     }
+    // fn(cell) for each cell (Morton code) that the box of half-side
+    // `radius` around q (scaled) touches, until fn returns false; false then,
+    // or when the box covers more than kNearCells cells.
+    template <class Fn>
+    bool forCellsInBox(const glm::vec3& q, double radius, Fn&& fn) const;
 
     Set m_a, m_b;
     PassTimes m_times;
