@@ -177,6 +177,11 @@ std::vector<glm::vec3> slabLattice(int n, float shift) {
     return p;
 }
 
+// The points in a random order (Fisher-Yates).
+void shuffle(std::vector<glm::vec3>& p, Rng& rng) {
+    for (size_t i = p.size() - 1; i > 0; --i) std::swap(p[i], p[rng.index(i + 1)]);
+}
+
 // The pieces are cut in space whatever the input order: a lattice given in
 // z-slab order and the same lattice shuffled each meet only the border
 // layers of neighbouring pieces, so the calls send about each query once;
@@ -192,8 +197,8 @@ TEST(OutOfCore, PiecesInSpaceSendEachQueryAboutOnce) {
         b.push_back(glm::vec3(40.25f, -3.5f, 7.125f));  // the outlier: h(B,A) is its
         if (shuffled) {
             Rng rng(7);
-            for (std::vector<glm::vec3>* s : {&a, &b})
-                for (size_t i = s->size() - 1; i > 0; --i) std::swap((*s)[i], (*s)[rng.index(i + 1)]);
+            shuffle(a, rng);
+            shuffle(b, rng);
         }
         using Sets = const std::vector<glm::vec3>*;
         api::MemoryBudget budget;
@@ -222,47 +227,18 @@ TEST(OutOfCore, PiecesInSpaceSendEachQueryAboutOnce) {
     }
 }
 
-// Round two asks no call for queries that few points of the other pieces
-// can be near (api/out_of_core.cpp scanOnHost): on a spread lattice with
-// per-point output (no query dropped by the early break) every call is a
-// piece's round-one call, and the queries past their piece get the brute
-// force's nearest points all the same, ties to the smaller index.
-TEST(OutOfCore, RoundTwoAnswersQueriesNearTheirPieceOnTheHost) {
-    std::vector<glm::vec3> a = slabLattice(16, 0.0f);
-    std::vector<glm::vec3> b = slabLattice(16, 0.5f);
-    Rng rng(13);
-    for (std::vector<glm::vec3>* s : {&a, &b})
-        for (size_t i = s->size() - 1; i > 0; --i) std::swap((*s)[i], (*s)[rng.index(i + 1)]);
-    api::MemoryBudget budget;
-    budget.bytes = 2 * 512 * api::kBytesPerPoint;
-    CountingBruteForce fake;
-    const api::DirectedCall call = [&fake](int, auto q, auto t, const CallOptions& o) {
-        return fake(q, t, o);
-    };
-    CallOptions options;
-    options.perPointDistances = true;
-    auto r = api::computeInPieces(a, b, 1.0, options, budget, call, {});
-    ASSERT_TRUE(r) << r.error().message;
-    for (auto [got, q, t] : {std::tuple{&r->aNearest, &a, &b}, std::tuple{&r->bNearest, &b, &a}}) {
-        const std::vector<oracle::NearestExact> want = oracle::bruteForceNearestIndexed(*q, *t, 1);
-        ASSERT_EQ(got->nearest.size(), want.size());
-        for (size_t i = 0; i < want.size(); ++i) ASSERT_EQ(got->nearest[i], want[i].targetIndex) << i;
-    }
-    EXPECT_GT(r->aToB.counters.crossPieceQueries, 0u);
-    EXPECT_GT(r->bToA.counters.crossPieceQueries, 0u);
-    EXPECT_EQ(r->aToB.counters.queryChunks, r->bToA.counters.queryChunks);
-    EXPECT_EQ(fake.calls.load(), uint64_t(r->aToB.counters.queryChunks));  // round one's calls only
-}
-
 // Per-point output through pieces in space: every query's nearest distance
 // and index as the brute force's (the smaller index among equal distances),
 // on a lattice whose queries sit at equal distances from several targets.
+// Round two asks no call for the queries past their piece (few points of
+// the other pieces can be near them: api/out_of_core.cpp scanOnHost): every
+// call is a piece's round-one call.
 TEST(OutOfCore, PiecesInSpaceBreakTiesByInputIndex) {
     std::vector<glm::vec3> a = slabLattice(10, 0.0f);
     std::vector<glm::vec3> b = slabLattice(10, 0.5f);
     Rng rng(11);
-    for (std::vector<glm::vec3>* s : {&a, &b})
-        for (size_t i = s->size() - 1; i > 0; --i) std::swap((*s)[i], (*s)[rng.index(i + 1)]);
+    shuffle(a, rng);
+    shuffle(b, rng);
     api::MemoryBudget budget;
     budget.bytes = 2 * 128 * api::kBytesPerPoint;
     CountingBruteForce fake;
@@ -282,6 +258,9 @@ TEST(OutOfCore, PiecesInSpaceBreakTiesByInputIndex) {
         }
     }
     EXPECT_GT(r->aToB.counters.crossPieceQueries, 0u);  // border queries did go on
+    EXPECT_GT(r->bToA.counters.crossPieceQueries, 0u);
+    EXPECT_EQ(r->aToB.counters.queryChunks, r->bToA.counters.queryChunks);
+    EXPECT_EQ(fake.calls.load(), uint64_t(r->aToB.counters.queryChunks));  // round one's calls only
 }
 
 // Lanes (several devices) take a direction's chunks in parallel; the early
