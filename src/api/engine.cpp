@@ -359,9 +359,7 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     const bool copied = fa.span().data() != a.data || fb.span().data() != b.data;
     // The spans are the caller's floats: the checked boxes are theirs.
     std::optional<core::Bounds> box;
-    if (!copied)
-        box = core::Bounds{glm::min(checked.a.box.lo, checked.b.box.lo),
-                           glm::max(checked.a.box.hi, checked.b.box.hi)};
+    if (!copied) box = core::unite(checked.a.box, checked.b.box);
     Result<HausdorffResult> r = finished(impl, runWithinBudget(impl, fa.span(), fb.span(), scale, call, box),
                                          Frame{origin, a, b, copied}, call, t0);
     if (r) r->timings.pieces += narrowingMs;

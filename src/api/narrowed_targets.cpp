@@ -48,10 +48,6 @@ bool isFloat(const glm::dvec3& p) { return glm::dvec3(glm::vec3(p)) == p; }
 
 core::Bounds emptyBox() { return core::Bounds{glm::dvec3(kInf), glm::dvec3(-kInf)}; }
 
-core::Bounds unite(const core::Bounds& a, const core::Bounds& b) {
-    return core::Bounds{glm::min(a.lo, b.lo), glm::max(a.hi, b.hi)};
-}
-
 // The points of `v` at `indices` (ascending), packed in v's scalar type.
 PointSubset listedSubset(const PointView& v, std::vector<uint64_t> indices, int workers) {
     PointSubset out;
@@ -259,7 +255,7 @@ std::optional<Kept> keepWithin(const PointView& t, const core::Bounds& box, doub
     for (size_t c = 0; c < chunks; ++c) {
         offset[c] = total;
         total += parts[c].kept.size();
-        out.summary.box = unite(out.summary.box, parts[c].box);
+        out.summary.box = core::unite(out.summary.box, parts[c].box);
         out.summary.floatExact = out.summary.floatExact && parts[c].floatExact;
     }
     if (total == 0 || total == t.count) return std::nullopt;
@@ -323,7 +319,7 @@ std::optional<NarrowedTargets> narrowWith(const PointView& q, const CoreSplit& s
     const double radius = reachRadius(coreBox, q.at(firstCoreIndex(split.strays)), t, threads);
     if (!std::isfinite(radius)) return std::nullopt;
     const core::Bounds reach{glm::max(coreBox.lo - radius, tBox.lo), glm::min(coreBox.hi + radius, tBox.hi)};
-    if (!narrowingPays(whole, frameMagnitude(unite(coreBox, reach), floatExact))) return std::nullopt;
+    if (!narrowingPays(whole, frameMagnitude(core::unite(coreBox, reach), floatExact))) return std::nullopt;
     std::optional<Kept> kept = keepWithin(t, coreBox, radius, workers);
     if (!kept) return std::nullopt;
     NarrowedTargets out;
@@ -504,7 +500,7 @@ std::optional<CoreSplit> splitCore(const PointView& q, const core::SetSummary& s
     out.core.box = emptyBox();
     for (const Part& part : parts) {
         out.strays.insert(out.strays.end(), part.strays.begin(), part.strays.end());
-        out.core.box = unite(out.core.box, part.box);
+        out.core.box = core::unite(out.core.box, part.box);
         out.core.floatExact = out.core.floatExact && part.floatExact;
     }
     if (out.strays.empty() || out.strays.size() == q.count) return std::nullopt;
@@ -516,7 +512,7 @@ std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bou
                                              int threads, const std::optional<CoreSplit>* split) {
     if (q.count == 0 || t.count < 2) return std::nullopt;
     const bool floatExact = qFloatExact && tFloatExact;
-    const double whole = frameMagnitude(unite(qBox, tBox), floatExact);
+    const double whole = frameMagnitude(core::unite(qBox, tBox), floatExact);
     const std::optional<CoreSplit> own =
         split != nullptr ? *split
                          : splitCore(q, core::SetSummary{qBox, qFloatExact}, floatExact, whole, threads);
@@ -528,7 +524,7 @@ std::optional<PairNarrowing> narrowPair(const PointView& a, const core::SetSumma
                                         const core::SetSummary& sb, bool directedOnly, int threads) {
     if (a.count == 0 || b.count == 0) return std::nullopt;
     const bool floatExact = sa.floatExact && sb.floatExact;
-    const double whole = frameMagnitude(unite(sa.box, sb.box), floatExact);
+    const double whole = frameMagnitude(core::unite(sa.box, sb.box), floatExact);
     const std::optional<CoreSplit> splitA = splitCore(a, sa, floatExact, whole, threads);
     if (!splitA && directedOnly) return std::nullopt;
     const std::optional<CoreSplit> splitB = splitCore(b, sb, floatExact, whole, threads);
@@ -547,7 +543,7 @@ std::optional<PairNarrowing> narrowPair(const PointView& a, const core::SetSumma
         (directedOnly || !splitB ? 0.0 : double(splitB->strays.size()) * double(a.count));
     if (splitA && splitB && (!splitA->strays.empty() || !splitB->strays.empty()) &&
         strayWork <= double(kMaxJointStrayWork) &&
-        narrowingPays(whole, frameMagnitude(unite(splitA->core.box, splitB->core.box), floatExact)) &&
+        narrowingPays(whole, frameMagnitude(core::unite(splitA->core.box, splitB->core.box), floatExact)) &&
         straysBeyondReach(a, *splitA, b, *splitB, threads) &&
         (directedOnly || straysBeyondReach(b, *splitB, a, *splitA, threads))) {
         JointCores& j = out.joint.emplace();

@@ -7,6 +7,7 @@
 // the same point (L = 0) s is 1, so nothing divides by zero.
 #pragma once
 
+#include <glm/common.hpp>
 #include <glm/vec3.hpp>
 
 #include <array>
@@ -30,6 +31,11 @@ struct Bounds {
     glm::dvec3 lo{0.0};
     glm::dvec3 hi{0.0};
 };
+
+// The smallest box holding both.
+[[nodiscard]] inline Bounds unite(const Bounds& a, const Bounds& b) {
+    return Bounds{glm::min(a.lo, b.lo), glm::max(a.hi, b.hi)};
+}
 
 struct GridSpec {
     glm::dvec3 origin{0.0};  // min corner of the target bounds
