@@ -374,6 +374,14 @@ struct HostClock {
     }
 };
 
+// Whether the pair of a query with target g (gathered position) at distance
+// d is better than its pair with target `at` at `best`: nearer, or as near
+// with a smaller target input index. (`at` is read only on a tie, so it may
+// be anything while best is +inf.)
+bool betterPair(double d, uint32_t g, double best, uint32_t at, const SpatialPieces::Set& ts) {
+    return d < best || (d == best && ts.input[g] < ts.input[at]);
+}
+
 // A call's per-point result merged into the open queries' bests: a nearer
 // pair replaces, an equal one only with a smaller target input index.
 // Queries: the call's, `batch` (indices into `open`) at `points`
@@ -383,18 +391,18 @@ void mergeBests(std::vector<OpenQuery>& open, const SpatialPieces::Set& ts,
                 const std::vector<uint32_t>& batch, Span points, uint64_t tileStart, const PerPoint& pp,
                 int threads) {
     const size_t n = pp.nearest.size();
-    core::parallelChunks(
-        n, kHostChunk, core::resolveThreads(threads, n / kHostChunk + 1), [&](size_t begin, size_t end, int) {
-            for (size_t k = begin; k < end; ++k) {
-                OpenQuery& o = open[batch[k]];
-                const auto g = uint32_t(tileStart + pp.nearest[k]);
-                const double d = pairDistance(points[k], ts.points[g]);
-                if (d < o.distance || (d == o.distance && ts.input[g] < ts.input[o.nearest])) {
-                    o.distance = d;
-                    o.nearest = g;
-                }
-            }
-        });
+    core::parallelChunks(n, kHostChunk, core::resolveThreads(threads, n / kHostChunk + 1),
+                         [&](size_t begin, size_t end, int) {
+                             for (size_t k = begin; k < end; ++k) {
+                                 OpenQuery& o = open[batch[k]];
+                                 const auto g = uint32_t(tileStart + pp.nearest[k]);
+                                 const double d = pairDistance(points[k], ts.points[g]);
+                                 if (betterPair(d, g, o.distance, o.nearest, ts)) {
+                                     o.distance = d;
+                                     o.nearest = g;
+                                 }
+                             }
+                         });
 }
 
 // Round one's results for piece k, in one pass: every query of the piece
@@ -720,28 +728,27 @@ std::vector<uint32_t> scanOnHost(RoundTwo& round, uint32_t j, const std::vector<
         uint32_t nearest = UINT32_MAX;
     };
     std::vector<Best> best(ranges.size());
-    core::parallelChunks(
-        ranges.size(), 1, core::resolveThreads(threads, ranges.size()), [&](size_t r0, size_t r1, int) {
-            for (size_t r = r0; r < r1; ++r) {
-                const glm::vec3 q = points[ranges[r].scan];
-                Best b;
-                for (uint64_t t = ranges[r].begin; t < ranges[r].end; ++t) {
-                    const double d = pairDistance(q, ts.points[t]);
-                    if (d < b.distance || (d == b.distance && ts.input[t] < ts.input[b.nearest])) {
-                        b.distance = d;
-                        b.nearest = uint32_t(t);
-                    }
-                }
-                best[r] = b;
-            }
-        });
+    core::parallelChunks(ranges.size(), 1, core::resolveThreads(threads, ranges.size()),
+                         [&](size_t r0, size_t r1, int) {
+                             for (size_t r = r0; r < r1; ++r) {
+                                 const glm::vec3 q = points[ranges[r].scan];
+                                 Best b;
+                                 for (uint64_t t = ranges[r].begin; t < ranges[r].end; ++t) {
+                                     const double d = pairDistance(q, ts.points[t]);
+                                     if (betterPair(d, uint32_t(t), b.distance, b.nearest, ts)) {
+                                         b.distance = d;
+                                         b.nearest = uint32_t(t);
+                                     }
+                                 }
+                                 best[r] = b;
+                             }
+                         });
     std::lock_guard lock(round.mutex);
     for (size_t r = 0; r < ranges.size(); ++r) {
         const Best& b = best[r];
         OpenQuery& o = round.open[scanned[ranges[r].scan]];
         if (b.nearest == UINT32_MAX) continue;
-        if (b.distance < o.distance ||
-            (b.distance == o.distance && ts.input[b.nearest] < ts.input[o.nearest])) {
+        if (betterPair(b.distance, b.nearest, o.distance, o.nearest, ts)) {
             o.distance = b.distance;
             o.nearest = b.nearest;
         }
