@@ -34,12 +34,19 @@ void main() {
         vec4At(pc.witnessOut, 0u).v = vec4At(pc.sorted, slot).v;
         StateRef(pc.witnessOut + 16ul).v = stateAt(pc.state, slot).v;
     }
+    // A per-point call with a floor (its kill threshold in the counter
+    // block): a DEAD query holds a target nearer than it, and reads back as
+    // RTHDIST_BELOW_FLOOR.
+    float floor2 = FloatRef(pc.counters + RTHDIST_CTR_KILL_FLOOR).v;
+    bool belowFloor = pc.perPoint != 0u && st.status == RTHDIST_DEAD;
     if (pc.nearestOut != 0ul)
-        uintAt(pc.nearestOut, floatBitsToUint(vec4At(pc.sorted, i).v.w)).v = uint(st.best & 0xffffffffu);
+        uintAt(pc.nearestOut, floatBitsToUint(vec4At(pc.sorted, i).v.w)).v =
+            belowFloor ? RTHDIST_BELOW_FLOOR : uint(st.best & 0xffffffffu);
     float maxD2 = packedDist2(packed);
-    bool settled = st.status == RTHDIST_EXACT || (st.status == RTHDIST_DEAD && pc.perPoint == 0u);
-    if (!settled || !(packedDist2(st.best) <= maxD2))
-        atomicAdd(U64Ref(pc.counters + RTHDIST_CTR_CHECK_BAD).v, 1ul);
+    bool settled = st.status == RTHDIST_EXACT || (st.status == RTHDIST_DEAD && (pc.perPoint == 0u || floor2 > 0.0));
+    bool bounded = belowFloor ? packedDist2(st.best) < floor2 : packedDist2(st.best) <= maxD2;
+    if (!settled || !bounded) atomicAdd(U64Ref(pc.counters + RTHDIST_CTR_CHECK_BAD).v, 1ul);
+    if (belowFloor) return;  // no witness, no band: the call has no result of its own
     // The certificate's band (core/certificate.hpp): every query whose best
     // lies within 2e of the maximum, with its best target. The threshold is
     // rounded down (a relative 2^-20 on the maximum and on the square), so it

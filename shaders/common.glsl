@@ -101,9 +101,11 @@ float shrunkDist2(float d2, float by) {
 // that a query killed below it lies below the band the self-check hands to
 // the certificate (check_queries.comp: 2e under the final maximum, which
 // is at least this one): dead queries need no brute force in double.
-// A negative lowerBound2 turns the early break off (per-point distances).
+// A negative lowerBound2 turns the early break off (per-point distances),
+// but for the call's floor (core/per_point_floor.hpp: 0 where none), a
+// threshold given by the host, not raised by the call's own maximum.
 float deadThreshold(uint64_t maxPacked, float lowerBound2) {
-    if (lowerBound2 < 0.0) return 0.0;
+    if (lowerBound2 < 0.0) return FloatRef(maxPacked + uint64_t(RTHDIST_CTR_KILL_FLOOR - RTHDIST_CTR_MAX_PACKED)).v;
     uint64_t m = U64Ref(maxPacked).v;
     float thr = max(packedDist2(m), lowerBound2);
     float e = FloatRef(maxPacked + uint64_t(RTHDIST_CTR_KILL_SLACK - RTHDIST_CTR_MAX_PACKED)).v;

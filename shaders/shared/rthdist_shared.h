@@ -49,6 +49,8 @@ struct vec3f {
 #define RTHDIST_CTR_INGEST 1152      // IngestSummary: ingest.comp, one set's bounds and first bad point
 #define RTHDIST_CTR_INGEST64 1184    // IngestSummary64: ingest_f64.comp, one device view's box in double
 #define RTHDIST_CTR_KILL_SLACK 1272  // float: the certificate's slack e (deadThreshold kills below its band)
+#define RTHDIST_CTR_KILL_FLOOR \
+    1276  // float: a per-point call's kill threshold (core/per_point_floor.hpp; 0: none)
 #define RTHDIST_CTR_SEARCH_LOG 1280  // SearchLogEntry[RTHDIST_SEARCH_LOG_MAX]: the radii of one submission
 #define RTHDIST_CTR_SEARCH_ARGS \
     1600  // uint[3] groups of the search and resolve, uint[3] rays (search_advance.comp)
@@ -58,6 +60,10 @@ struct vec3f {
 #define RTHDIST_CTR_BYTES 2048
 // Radii of the candidate search recorded in one submission, at most.
 #define RTHDIST_SEARCH_LOG_MAX 16
+
+// PerPoint::nearest of a query a per-point call's floor stopped
+// (core::kBelowFloor; UINT32_MAX is the fill of "never written").
+#define RTHDIST_BELOW_FLOOR 0xfffffffeu
 
 // Query status values.
 #define RTHDIST_OPEN 0u
@@ -591,7 +597,8 @@ static_assert(sizeof(ProbeLevelsPush) == 64 &&
               RTHDIST_CTR_SEARCH_ARGS + 24 <= RTHDIST_CTR_CHECK_ARGS &&
               RTHDIST_CTR_CHECK_ARGS + 12 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDIST_CTR_KILL_SLACK &&
-              RTHDIST_CTR_KILL_SLACK + 4 <= RTHDIST_CTR_SEARCH_LOG &&
+              RTHDIST_CTR_KILL_SLACK + 4 <= RTHDIST_CTR_KILL_FLOOR &&
+              RTHDIST_CTR_KILL_FLOOR + 4 <= RTHDIST_CTR_SEARCH_LOG &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(CounterFields) <= RTHDIST_CTR_READBACK);
 static_assert(sizeof(TailScanPush) == 80);

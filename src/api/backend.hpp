@@ -26,6 +26,7 @@
 #include "api/out_of_core.hpp"
 #include "api/route_planner.hpp"
 #include "core/input_frame.hpp"
+#include "core/per_point_floor.hpp"
 #include "core/uninit_vector.hpp"
 #include "rthdist/rthdist.hpp"
 #include "rthdist/vulkan_interop.hpp"
@@ -90,9 +91,12 @@ public:
     // A framed pair in one call on device `lane` (0 .. caps().lanes - 1):
     // indexed (Route::kOneCall and the pieces), or scanned whole
     // (Route::kSmallPairScan; backends whose caps scan no pair need not).
+    // `floor`: per-point queries that may stop below it
+    // (core/per_point_floor.hpp; the pieces' round one).
     [[nodiscard]] virtual Result<HausdorffResult> computeFramed(int lane, std::span<const glm::vec3> a,
                                                                 std::span<const glm::vec3> b, double scale,
-                                                                const CallOptions& call) = 0;
+                                                                const CallOptions& call,
+                                                                const core::PerPointFloor& floor) = 0;
     [[nodiscard]] virtual Result<HausdorffResult> scanFramed(int lane, std::span<const glm::vec3> a,
                                                              std::span<const glm::vec3> b, double scale,
                                                              const CallOptions& call);

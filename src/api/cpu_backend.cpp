@@ -45,11 +45,12 @@ public:
 
     [[nodiscard]] Result<HausdorffResult> computeFramed(int /*lane*/, std::span<const glm::vec3> a,
                                                         std::span<const glm::vec3> b, double scale,
-                                                        const CallOptions& call) override {
+                                                        const CallOptions& call,
+                                                        const core::PerPointFloor& floor) override {
         Options options;
         static_cast<CallOptions&>(options) = call;
         static_cast<EngineOptions&>(options) = m_options;
-        return cpu::cpuHausdorff(a, b, scale, options);
+        return cpu::cpuHausdorff(a, b, scale, options, floor);
     }
 
     [[nodiscard]] Result<std::shared_ptr<BackendSet>> prepare(std::span<const glm::vec3> floats, double scale,

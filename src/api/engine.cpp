@@ -279,12 +279,16 @@ Error refusal(const api::Plan& plan) { return Error{plan.code, plan.reason}; }
 
 // One backend call of a framed pair, on device `lane`: scanned whole or
 // indexed, as the planner says (every piece of the pieces' routes too).
+// `floor`: the pieces' round one (core/per_point_floor.hpp); a pair scanned
+// whole searches every query to its end.
 Result<HausdorffResult> runFramed(Engine::Impl& impl, int lane, std::span<const glm::vec3> a,
-                                  std::span<const glm::vec3> b, double scale, const CallOptions& call) {
+                                  std::span<const glm::vec3> b, double scale, const CallOptions& call,
+                                  const core::PerPointFloor& floor = {}) {
     const api::Plan plan =
         api::planFramedCall(a.size(), b.size(), call, api::MemoryBudget{}, impl.backend->caps());
-    return plan.route == api::Route::kSmallPairScan ? impl.backend->scanFramed(lane, a, b, scale, call)
-                                                    : impl.backend->computeFramed(lane, a, b, scale, call);
+    return plan.route == api::Route::kSmallPairScan
+               ? impl.backend->scanFramed(lane, a, b, scale, call)
+               : impl.backend->computeFramed(lane, a, b, scale, call, floor);
 }
 
 // Route::kPieces and kSeveralDevices (out_of_core.hpp), over the backend's lanes.
@@ -293,10 +297,9 @@ Result<HausdorffResult> runInPieces(Engine::Impl& impl, std::span<const glm::vec
                                     const api::MemoryBudget& pieces, const std::optional<core::Bounds>& box) {
     api::ComputeBackend& backend = *impl.backend;
     const std::function<void()> release = [&backend] { backend.releaseScratch(); };
-    const api::DirectedCall directed = [&](int lane, std::span<const glm::vec3> q,
-                                           std::span<const glm::vec3> t, const CallOptions& piece) {
-        return runFramed(impl, lane, q, t, scale, piece);
-    };
+    const api::DirectedCall directed =
+        [&](int lane, std::span<const glm::vec3> q, std::span<const glm::vec3> t, const CallOptions& piece,
+            const core::PerPointFloor& floor) { return runFramed(impl, lane, q, t, scale, piece, floor); };
     const api::RecycleCall recycle = [&backend](int lane, PerPoint&& a, PerPoint&& b) {
         backend.recyclePerPoint(lane, std::move(a), std::move(b));
     };

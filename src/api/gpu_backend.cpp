@@ -130,8 +130,9 @@ public:
 
     [[nodiscard]] Result<HausdorffResult> computeFramed(int lane, std::span<const glm::vec3> a,
                                                         std::span<const glm::vec3> b, double scale,
-                                                        const CallOptions& call) override {
-        return gpu(lane).computeIndexed(a, b, scale, call);
+                                                        const CallOptions& call,
+                                                        const core::PerPointFloor& floor) override {
+        return gpu(lane).computeIndexed(a, b, scale, call, floor);
     }
     [[nodiscard]] Result<HausdorffResult> scanFramed(int lane, std::span<const glm::vec3> a,
                                                      std::span<const glm::vec3> b, double scale,

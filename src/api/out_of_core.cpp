@@ -165,11 +165,12 @@ struct Lane {
     void giveBack(PerPoint&& a, PerPoint&& b = PerPoint{}) const {
         if (recycle != nullptr && *recycle) (*recycle)(index, std::move(a), std::move(b));
     }
-    [[nodiscard]] Result<HausdorffResult> call(Span q, Span t, const CallOptions& piece) const {
-        if (index == 0) return (*directed)(index, q, t, piece);
+    [[nodiscard]] Result<HausdorffResult> call(Span q, Span t, const CallOptions& piece,
+                                               const core::PerPointFloor& floor = {}) const {
+        if (index == 0) return (*directed)(index, q, t, piece, floor);
         CallOptions quiet = piece;
         quiet.progress = nullptr;
-        return (*directed)(index, q, t, quiet);
+        return (*directed)(index, q, t, quiet, floor);
     }
 };
 
@@ -357,6 +358,13 @@ struct SpaceDirection {
     std::vector<SettledMaximum> settledOf;
     std::vector<std::vector<Candidate>> candidatesOf;
     std::vector<OpenQuery> open;  // after round two: every open query with its best pair
+    // The largest settled so far over the pieces round one has finished (by
+    // any lane; under shared.mutex): the next calls' floor (callFloor) and
+    // the verdicts' first keep floor.
+    SettledMaximum settledSoFar;
+    // The largest exact nearest distance of a sample of queries (seedFloor;
+    // -1: none): a lower bound of h before round one settles anything.
+    double seed = -1.0;
 };
 
 // The host's own work between the pieces' calls (Timings::pieces), added
@@ -427,7 +435,12 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
     const size_t chunks = (n + kHostChunk - 1) / kHostChunk;
     std::vector<std::vector<OpenQuery>> parts(chunks);
     std::vector<std::vector<Candidate>> kept(chunks);
-    std::vector<SettledMaximum> maxima(static_cast<size_t>(workers));
+    SettledMaximum soFar;
+    {
+        std::lock_guard lock(dir.shared.mutex);
+        soFar = dir.settledSoFar;
+    }
+    std::vector<SettledMaximum> maxima(static_cast<size_t>(workers), soFar);
     core::parallelChunks(n, kHostChunk, workers, [&](size_t begin, size_t end, int w) {
         std::vector<OpenQuery>& open = parts[begin / kHostChunk];
         std::vector<Candidate>& candidates = kept[begin / kHostChunk];
@@ -444,8 +457,12 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
         for (size_t r0 = begin; r0 < end; r0 += kRun) {
             const size_t r1 = std::min(end, r0 + kRun);
             for (size_t i = r0; i < r1; ++i) {
-                if (i + kAhead < end) __builtin_prefetch(&ts.points[tileStart + pp.nearest[i + kAhead]]);
-                distance[i - r0] = pairDistance(qs.points[first + i], ts.points[tileStart + pp.nearest[i]]);
+                if (i + kAhead < end && pp.nearest[i + kAhead] != core::kBelowFloor)
+                    __builtin_prefetch(&ts.points[tileStart + pp.nearest[i + kAhead]]);
+                distance[i - r0] =
+                    pp.nearest[i] == core::kBelowFloor
+                        ? -1.0
+                        : pairDistance(qs.points[first + i], ts.points[tileStart + pp.nearest[i]]);
             }
             if (dir.keepAll) {
                 for (size_t i = r0; i < r1; ++i) {
@@ -456,6 +473,7 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
             for (size_t i = r0; i < r1; ++i) {
                 const uint64_t p = first + i;
                 const double d = distance[i - r0];
+                if (d < 0.0) continue;  // below the call's floor: settled, neither maximum nor candidate
                 const auto g = uint32_t(tileStart + pp.nearest[i]);
                 const double radius = d * scale * (1.0 + 0x1p-12) + slack;
                 // The stored cell: on the H200 machine's host computing a
@@ -478,6 +496,10 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
     SettledMaximum top;
     for (const SettledMaximum& m : maxima)
         if (m.beats(top)) top = m;
+    {
+        std::lock_guard lock(dir.shared.mutex);
+        if (top.beats(dir.settledSoFar)) dir.settledSoFar = top;
+    }
     dir.openOf[k] = core::concatenateParts<std::vector<OpenQuery>>(parts);
     dir.settledOf[k] = top;
     if (dir.keepAll) return;
@@ -487,6 +509,61 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
     for (const std::vector<Candidate>& part : kept)
         for (const Candidate& c : part)
             if (c.distance * scale >= floor) candidates.push_back(c);
+}
+
+// A round-one call's floor for direction `dir` (search units,
+// core/per_point_floor.hpp): the keep floor of the largest settled so far.
+// A query below it has a pair below the band of any maximum the direction
+// can reach, so it is settled without its nearest point (settlePiece). None
+// with per-point output (every query's nearest is the result then).
+double callFloor(SpaceDirection& dir, double scale) {
+    if (dir.keepAll) return 0.0;
+    std::lock_guard lock(dir.shared.mutex);
+    return std::max(0.0, keepFloor(std::max(dir.settledSoFar.distance, dir.seed), scale, dir.shared.slack));
+}
+
+// Queries of a direction sampled for its first floor (seedFloor).
+constexpr size_t kSeedQueries = 1024;
+
+// The first pieces' floor: without it round one's first calls (one a lane)
+// would search every query to its end. A strided sample of the queries,
+// each compared in double with the points of its own piece within a
+// quarter cell of it on every axis (SpatialPieces::blocksNear holds them
+// all): where the nearest of those lies nearer than that quarter cell, it
+// is the query's nearest in its piece, and where it settles as round one
+// settles (its widened ball within its own piece's cells), it is its
+// nearest in the whole set: a lower bound of h. The largest such is the
+// seed; a sample query that does not settle counts for nothing.
+void seedFloor(SpaceDirection& dir, const SpatialPieces& pieces, double scale, int threads) {
+    if (dir.keepAll) return;
+    const SpatialPieces::Set& qs = pieces.set(dir.q);
+    const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
+    const size_t n = qs.points.size(), samples = std::min(n, kSeedQueries);
+    const double reach = 0.25 * pieces.smallestCellEdge();
+    const int workers = core::resolveThreads(threads, samples / 64 + 1);
+    std::vector<double> best(size_t(workers), -1.0);
+    core::parallelChunks(samples, 64, workers, [&](size_t begin, size_t end, int w) {
+        std::vector<uint32_t> blocks;
+        double top = best[size_t(w)];
+        for (size_t s = begin; s < end; ++s) {
+            const uint64_t p = uint64_t(s) * n / samples;
+            const auto k =
+                uint32_t(std::upper_bound(qs.start.begin(), qs.start.end(), p) - qs.start.begin() - 1);
+            if (ts.size(k) == 0) continue;
+            const glm::vec3 q = core::scaled(qs.points[p], scale);
+            if (!pieces.blocksNear(q, reach, k, blocks)) continue;
+            double d = std::numeric_limits<double>::infinity();
+            for (const uint32_t b : blocks)
+                for (uint64_t t = ts.blockStart[b]; t < ts.blockStart[b + 1]; ++t)
+                    d = std::min(d, pairDistance(qs.points[p], ts.points[t]));
+            if (!(d * scale * (1.0 + 0x1p-20) < reach)) continue;  // the nearest may lie past the box
+            const double radius = d * scale * (1.0 + 0x1p-12) + dir.shared.slack;
+            if (pieces.solidAround(qs.cell[p], radius) || pieces.boxInPiece(q, radius, k))
+                top = std::max(top, d);
+        }
+        best[size_t(w)] = top;
+    });
+    for (const double d : best) dir.seed = std::max(dir.seed, d);
 }
 
 // Piece k's queries when the piece holds no targets: no pair yet, all open.
@@ -543,7 +620,10 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double
             CallOptions piece = spaceOptions(call, from + width * double(k) / double(pieces.count()),
                                              width / double(pieces.count()));
             piece.directedOnly = !both;
-            Result<HausdorffResult> r = lane.call(qs.piece(k), ts.piece(k), piece);
+            core::PerPointFloor floor;
+            floor.search[0] = callFloor(*dirs[qset], scale);
+            if (both) floor.search[1] = callFloor(*dirs[1], scale);
+            Result<HausdorffResult> r = lane.call(qs.piece(k), ts.piece(k), piece, floor);
             if (!r) {
                 failure.set(r.error());
                 return;
@@ -928,7 +1008,10 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
         dirs[d]->settledOf.assign(pieces.count(), {});
         dirs[d]->candidatesOf.assign(pieces.count(), {});
     }
-    core::Clock::time_point start;
+    core::Clock::time_point start = core::Clock::now();
+    for (int d = 0; d < 2; ++d)
+        if (dirs[d] != nullptr) seedFloor(*dirs[d], pieces, scale, threads);
+    host.add(start, HostClock::kRoundOne);
     lanes = int(std::min<size_t>(size_t(std::max(lanes, 1)), pieces.count()));
     {
         RoundFailure failure;
@@ -1047,11 +1130,12 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
                 "rthdist pieces: %zu in space (%u cells an axis), partition %.1f ms (box %.1f, keys "
                 "%.1f, plan %.1f, scatter %.1f), between calls %.1f ms (round one %.1f, open queries "
                 "%.1f, round two %.1f), results %.1f ms, queries past their piece %llu + %llu (on the host "
-                "%llu + %llu)\n",
+                "%llu + %llu), first floors %.6g + %.6g\n",
                 pieces.count(), pieces.cellsPerAxis(), partitionMs, p.box, p.keys, p.plan, p.scatter, host.ms,
                 host.part[HostClock::kRoundOne], host.part[HostClock::kOpen], host.part[HostClock::kRoundTwo],
                 finishMs, (unsigned long long)dirAB.crossPiece, (unsigned long long)dirBA.crossPiece,
-                (unsigned long long)dirAB.hostScanned, (unsigned long long)dirBA.hostScanned);
+                (unsigned long long)dirAB.hostScanned, (unsigned long long)dirBA.hostScanned, dirAB.seed,
+                dirBA.seed);
         }
         if (release) release();
     }

@@ -47,6 +47,7 @@
 #include <string>
 
 #include "core/index_space.hpp"
+#include "core/per_point_floor.hpp"
 #include "rthdist/rthdist.hpp"
 
 namespace rthdist::api {
@@ -98,10 +99,11 @@ struct DirectionSplit {
 // set; call.perPointDistances is set when the caller needs every query's
 // nearest point. Lanes are called from their own threads at once; one lane's
 // calls come one at a time. Only lane 0 (the calling thread) gets
-// call.progress.
-using DirectedCall =
-    std::function<Result<HausdorffResult>(int lane, std::span<const glm::vec3> queries,
-                                          std::span<const glm::vec3> targets, const CallOptions& call)>;
+// call.progress. `floor`: round one's per-point calls may leave a query
+// below it unsearched (core/per_point_floor.hpp); none elsewhere.
+using DirectedCall = std::function<Result<HausdorffResult>(
+    int lane, std::span<const glm::vec3> queries, std::span<const glm::vec3> targets, const CallOptions& call,
+    const core::PerPointFloor& floor)>;
 // Hands the per-point arrays of a lane's call, once merged, back to that
 // lane's backend for its next call (GpuHausdorff::recyclePerPoint); may be empty.
 using RecycleCall = std::function<void(int lane, PerPoint&& a, PerPoint&& b)>;

@@ -36,6 +36,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -97,6 +98,10 @@ public:
     // The largest magnitude of a coordinate of either set as given (not
     // scaled): core::largestMagnitude of both, found in the partition's pass.
     [[nodiscard]] double largestMagnitude() const { return m_magnitude; }
+    // The narrowest edge of a grid cell, in search units (scaled).
+    [[nodiscard]] double smallestCellEdge() const {
+        return 1.0 / std::max({m_inverse[0], m_inverse[1], m_inverse[2]});
+    }
 
     // True only when every point of either set whose scaled coordinates lie
     // within `radius` of q on every axis (q scaled as searched: core::scaled)

@@ -512,6 +512,24 @@ inline Best nearestOf(const Direction& d, size_t i, Seeds& seeds, CellCache& cel
     return best;
 }
 
+inline bool killedBySeeds(const Direction& d, size_t i, const Query& q, float k, Seeds& seeds, Best& best,
+                          SearchStats& stat);
+
+// Query i's exact nearest target, or a target nearer than `kill` (> 0)
+// found on the way (the early break of a per-point floor): the seeds of the
+// early-break pass first (the previous query's point, its bucket, the own
+// cell, the subtree around them), then the search with the kill.
+inline Best nearestAbove(const Direction& d, size_t i, float kill, Seeds& seeds, CellCache& cells,
+                         SearchStats& stat) {
+    const TargetIndex& t = d.t;
+    const Query q = d.query(i);
+    Best best;
+    if (killedBySeeds(d, i, q, kill, seeds, best, stat)) return best;
+    if (!nearestInCells(t, q, d.qx[i], d.qy[i], d.qz[i], d.qKey[i], seeds.cursor, cells, best, stat))
+        searchTree(t, q, kill, best, stat);
+    return best;
+}
+
 // The certificate's slack e for a direction (core/certificate.hpp): 2^-20 of
 // the largest |coordinate| of both sets (scaled, as searched).
 double slackOf(const Direction& d) {
@@ -544,8 +562,11 @@ void proveDirection(const Direction& d, DirectedOutput& out, PerPoint* perPoint 
 // Every query's exact float nearest neighbour. A query equal to the previous
 // one takes its nearest target. Fills `nearest` (input order) with the target
 // index and the double distance recomputed from the pair.
+// With a kill threshold (core::PerPointFloor::kill2, > 0) a query with a
+// target nearer than it stops there and comes back as core::kBelowFloor
+// (distance -1).
 void perPointPass(const Direction& d, PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress,
-                  std::atomic<bool>& lost) {
+                  std::atomic<bool>& lost, float kill2) {
     const size_t nq = d.queryCount();
     nearest.distance.assign(nq, 0.0);
     nearest.nearest.assign(nq, 0);
@@ -558,14 +579,20 @@ void perPointPass(const Direction& d, PerPoint& nearest, std::vector<SearchStats
         for (size_t i = begin; i < end; ++i) {
             const uint32_t src = uint32_t(d.qKeyed[i]);  // input index
             if (!(i > begin && seeds.bucket != kNone && d.sameAsPrevious(i))) {
-                const Best best = nearestOf(d, i, seeds, cells, stat);
+                const Best best = kill2 > 0.0f ? nearestAbove(d, i, kill2, seeds, cells, stat)
+                                               : nearestOf(d, i, seeds, cells, stat);
                 if (best.pos == kNone) {
                     lost.store(true, std::memory_order_relaxed);
                     seeds.bucket = kNone;
                     continue;
                 }
-                seeds.bucket = d.t.bucketOf[best.pos];
-                target = best.target;
+                seeds.follow(d.t, best);
+                target = best.d2 < kill2 ? core::kBelowFloor : best.target;
+            }
+            if (target == core::kBelowFloor) {
+                nearest.distance[src] = -1.0;
+                nearest.nearest[src] = target;
+                continue;
             }
             const glm::dvec3 diff = glm::dvec3(d.queries[src]) - glm::dvec3(d.targets[target]);
             nearest.distance[src] = std::sqrt(diff.x * diff.x + diff.y * diff.y + diff.z * diff.z);
@@ -579,16 +606,25 @@ void perPointPass(const Direction& d, PerPoint& nearest, std::vector<SearchStats
 // Every query's NN: no lower bound, no kill. The witness is the largest
 // double distance (smallest query index among ties), so it is consistent
 // with the per-point array by construction.
-void perPointDirection(const Direction& d, PerPoint& perPoint, Progress& progress, DirectedOutput& out) {
+// With a floor (kill2 > 0) only the per-point array and the counters: no
+// witness, band or proof (core/per_point_floor.hpp).
+void perPointDirection(const Direction& d, PerPoint& perPoint, Progress& progress, DirectedOutput& out,
+                       float kill2) {
     auto start = Clock::now();
     std::vector<SearchStats> stats(static_cast<size_t>(d.threads));
     std::atomic<bool> lost{false};
-    perPointPass(d, perPoint, stats, progress, lost);
+    perPointPass(d, perPoint, stats, progress, lost, kill2);
     out.lostQuery = lost.load();
     out.cancelled = progress.cancelled();
     if (out.cancelled) return;
     out.searchMs = msSince(start);
     progress.report("refine", kSearchDone);
+    if (kill2 > 0.0f) {
+        out.directed.counters = passCounters(d, stats);
+        out.directed.counters.survivingQueries = d.queryCount();
+        progress.report("refine", 1.0);
+        return;
+    }
     start = Clock::now();
     size_t win = 0;
     for (size_t i = 1; i < d.queryCount(); ++i) {
@@ -818,7 +854,7 @@ void earlyBreakDirection(const Direction& d, double boxBound2, Progress& progres
 }
 
 DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet, int threads,
-                                 PerPoint* perPoint, Progress& progress) {
+                                 PerPoint* perPoint, Progress& progress, float kill2) {
     DirectedOutput out;
     progress.report("index", 0.0);
     const auto start = Clock::now();
@@ -831,7 +867,7 @@ DirectedOutput directedHausdorff(const CpuSet& querySet, const CpuSet& targetSet
     out.indexMs = msSince(start);
     progress.report("index", kIndexDone);
     if (perPoint != nullptr) {
-        perPointDirection(d, *perPoint, progress, out);
+        perPointDirection(d, *perPoint, progress, out, kill2);
     } else {
         earlyBreakDirection(d, keys.farthest2, progress, out);
     }
@@ -847,8 +883,8 @@ double chooseScale(std::span<const glm::vec3> a, std::span<const glm::vec3> b, i
 // why it has no result.
 std::optional<Error> runDirection(const CpuSet& q, const CpuSet& t, int threads, Progress& progress,
                                   PerPoint* perPoint, Directed& into, core::DirectionBand& band,
-                                  Timings& timings) {
-    const DirectedOutput o = directedHausdorff(q, t, threads, perPoint, progress);
+                                  Timings& timings, float kill2) {
+    const DirectedOutput o = directedHausdorff(q, t, threads, perPoint, progress, kill2);
     timings.index += o.indexMs;
     timings.cull += o.cullMs;
     timings.search += o.searchMs;
@@ -889,7 +925,7 @@ std::shared_ptr<CpuSet> prepareCpuSet(std::span<const glm::vec3> points, double 
 }
 
 Result<HausdorffResult> cpuHausdorff(const CpuSet& a, const CpuSet& b, const CallOptions& options,
-                                     int threadCount) {
+                                     int threadCount, const core::PerPointFloor& floor) {
     const auto start = Clock::now();
     HausdorffResult r;
     r.backend = Backend::kCpu;
@@ -899,24 +935,29 @@ Result<HausdorffResult> cpuHausdorff(const CpuSet& a, const CpuSet& b, const Cal
     const bool perPoint = options.perPointDistances;
     Progress first(options, 0.0, options.directedOnly ? 1.0 : 0.5);
     auto material = std::make_shared<detail::ProofMaterial>();
+    const core::PerPointFloor none;
+    const core::PerPointFloor& floors = perPoint ? floor : none;
     if (auto e = runDirection(a, b, threads, first, perPoint ? &r.aNearest : nullptr, r.aToB, material->aToB,
-                              r.timings))
+                              r.timings, floors.kill2(0)))
         return *e;
     r.hausdorff = r.aToB.distance;
     if (!options.directedOnly) {
         Progress second(options, 0.5, 0.5);
         if (auto e = runDirection(b, a, threads, second, perPoint ? &r.bNearest : nullptr, r.bToA,
-                                  material->bToA, r.timings))
+                                  material->bToA, r.timings, floors.kill2(1)))
             return *e;
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
     }
-    r.proofMaterial = std::move(material);
+    if (floors.any())
+        r.hausdorff = 0.0;  // no witness: only the per-point arrays
+    else
+        r.proofMaterial = std::move(material);
     r.timings.total = msSince(start);
     return r;
 }
 
 Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b, double scale,
-                                     const Options& options) {
+                                     const Options& options, const core::PerPointFloor& floor) {
     if (a.empty() || b.empty()) {
         return Error{ErrorCode::kInvalidArgument, "cpuHausdorff: empty point set (H is undefined)"};
     }
@@ -925,7 +966,7 @@ Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<con
     const std::shared_ptr<CpuSet> setA = prepareCpuSet(a, scale, options.bits, options.threads);
     const std::shared_ptr<CpuSet> setB = prepareCpuSet(b, scale, options.bits, options.threads);
     const double orderMs = msSince(start);
-    Result<HausdorffResult> r = cpuHausdorff(*setA, *setB, options, options.threads);
+    Result<HausdorffResult> r = cpuHausdorff(*setA, *setB, options, options.threads, floor);
     if (!r) return r;
     r->timings.index += orderMs;
     r->timings.total = msSince(start);

@@ -54,6 +54,7 @@
 #include <mutex>
 #include <span>
 
+#include "core/per_point_floor.hpp"
 #include "cpu/adaptive_order.hpp"
 #include "cpu/target_index.hpp"
 #include "rthdist/result.hpp"
@@ -84,15 +85,18 @@ private:
 [[nodiscard]] std::shared_ptr<CpuSet> prepareCpuSet(std::span<const glm::vec3> points, double scale, int bits,
                                                     int threads);
 
-// H (or h) of two prepared sets of one scale.
+// H (or h) of two prepared sets of one scale. `floor` (with per-point
+// output): queries below it may stop there (core/per_point_floor.hpp).
 [[nodiscard]] Result<HausdorffResult> cpuHausdorff(const CpuSet& a, const CpuSet& b,
-                                                   const CallOptions& options, int threads);
+                                                   const CallOptions& options, int threads,
+                                                   const core::PerPointFloor& floor = {});
 
 // One-shot: both sets prepared for this call at `scale`, the exact power of
 // two of the pair's frame (core::exactScale of the largest coordinate
 // magnitude of both; the Engine decides it once per call).
 [[nodiscard]] Result<HausdorffResult> cpuHausdorff(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                                   double scale, const Options& options);
+                                                   double scale, const Options& options,
+                                                   const core::PerPointFloor& floor = {});
 
 // One-shot at the scale of the shared rule over both sets (core::exactScale
 // of their largest magnitude, a pass over the points).

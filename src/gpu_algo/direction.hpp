@@ -31,7 +31,8 @@ struct DirectionRun {
     bool perPointDistances = true;  // false: perPoint's nearest only (CallOptions::perPointNearestOnly)
     Directed out{};
     double lowerBound2Exact = 0.0;  // the boxes' bound (double), for the witness check
-    float lowerBound2 = 0.0f;       // < 0: per-point (no early break)
+    float lowerBound2 = 0.0f;       // < 0: per-point (no early break but killFloor2's)
+    float killFloor2 = 0.0f;        // per-point: DEAD below it (core/per_point_floor.hpp; 0: none)
     float epsilon = 0.0f;
     Buffer* state = nullptr;                   // QueryState per query slot
     Buffer* active[2] = {nullptr, nullptr};    // active slots, ping-pong

@@ -175,7 +175,7 @@ struct GpuHausdorff::State {
     // after the other in the same scratch (a submission is then cheap beside
     // the work, and the device holds one set's scratch, not two).
     void hostPair(std::span<const glm::vec3> a, std::span<const glm::vec3> b, double scale,
-                  const CallOptions& options, HausdorffResult& res) {
+                  const CallOptions& options, HausdorffResult& res, const core::PerPointFloor& floor = {}) {
         DeviceSet da, db;
         const bool together = a.size() + b.size() <= kFusedBuildPoints;
         std::array<BuildScratch, 2>& builds = ws.scratch.builds;
@@ -200,7 +200,7 @@ struct GpuHausdorff::State {
             index.buildIndexes(std::array{&second.ix});
         }
         reportProgress(options, "index", 0.1);
-        runPair(da, db, options, res, 0.1);
+        runPair(da, db, options, res, 0.1, floor);
     }
 
     // Device input: refuses a frame whose searched magnitudes need the exact
@@ -291,8 +291,14 @@ struct GpuHausdorff::State {
 
     // H (or h) of two indexed sets of one scale into `res`; progress covers
     // [from, 1] of the call.
-    void runPair(DeviceSet& a, DeviceSet& b, const CallOptions& options, HausdorffResult& res, double from) {
+    // `floor`: honoured in per-point calls of nearest targets only (the
+    // read-back's distances and restoreOriginal's need every query's); the
+    // result then holds the per-point arrays and counters only.
+    void runPair(DeviceSet& a, DeviceSet& b, const CallOptions& options, HausdorffResult& res, double from,
+                 const core::PerPointFloor& given = {}) {
         const bool pp = options.perPointDistances;
+        const core::PerPointFloor floor =
+            pp && options.perPointNearestOnly && !options.perPointReady ? given : core::PerPointFloor{};
         if (pp) {  // filled whole: the read-back writes every entry
             res.aNearest = std::move(spare);
             if (!options.directedOnly) res.bNearest = std::move(spareB);
@@ -303,6 +309,8 @@ struct GpuHausdorff::State {
         DirectionRun ab{a.ix, b.ix, a.pts, b.pts, ws.blocks[0], pp ? &res.aNearest : nullptr};
         DirectionRun ba{b.ix, a.ix, b.pts, a.pts, ws.blocks[1], pp ? &res.bNearest : nullptr};
         ab.perPointDistances = ba.perPointDistances = !options.perPointNearestOnly;
+        ab.killFloor2 = floor.kill2(0);
+        ba.killFloor2 = floor.kill2(1);
         cull.startDirection(ab, 0);
         certificate.startDirection(ab, 0);
         if (!options.directedOnly) {
@@ -339,12 +347,16 @@ struct GpuHausdorff::State {
                                              ? searchAndCheck(*s.run, s.survivors, options, lo, hi)
                                              : check.finishCheck(*s.run);
             auto t0 = Clock::now();
-            *s.out = check.finishDirection(*s.run, witness);
-            const auto tc = Clock::now();
-            core::DirectionBand& band = s.direction == 0 ? material->aToB : material->bToA;
-            band = certificate.prove(*s.run, *s.out);
-            band.scale = a.scale;  // the caller's units to the search's (both sets share it)
-            ws.timings->certificate += msSince(tc);
+            if (floor.any()) {  // counters only: no witness, no proof
+                *s.out = s.run->out;
+            } else {
+                *s.out = check.finishDirection(*s.run, witness);
+                const auto tc = Clock::now();
+                core::DirectionBand& band = s.direction == 0 ? material->aToB : material->bToA;
+                band = certificate.prove(*s.run, *s.out);
+                band.scale = a.scale;  // the caller's units to the search's (both sets share it)
+                ws.timings->certificate += msSince(tc);
+            }
             ws.timings->check += msSince(t0);
             if (handBack && i + 1 < count) {  // read back beside the next direction's search: not timed
                 handing.handBeside(*s.run, *s.run->perPoint, s.direction);
@@ -356,6 +368,10 @@ struct GpuHausdorff::State {
             if (handBack) handing.handHere(*s.run->perPoint, s.direction);
         }
         handing.join();
+        if (floor.any()) {
+            res.hausdorff = 0.0;
+            return;
+        }
         res.hausdorff =
             options.directedOnly ? res.aToB.distance : std::max(res.aToB.distance, res.bToA.distance);
         res.proofMaterial = std::move(material);
@@ -501,7 +517,8 @@ Result<HausdorffResult> GpuHausdorff::scanWhole(std::span<const glm::vec3> a, st
 
 Result<HausdorffResult> GpuHausdorff::computeIndexed(std::span<const glm::vec3> a,
                                                      std::span<const glm::vec3> b, double scale,
-                                                     const CallOptions& options) {
+                                                     const CallOptions& options,
+                                                     const core::PerPointFloor& floor) {
     State& st = *m_state;
     HausdorffResult res = st.emptyResult(options);
     // Squared distances are float on the device: coordinates so large (or so
@@ -509,7 +526,7 @@ Result<HausdorffResult> GpuHausdorff::computeIndexed(std::span<const glm::vec3> 
     // which is exact; values and witnesses are recomputed from the inputs.
     // Each set is indexed once with its own grid: as targets for the other
     // direction, and as cell-ordered (Morton) queries for its own.
-    auto err = st.guarded(res.timings, [&] { st.hostPair(a, b, scale, options, res); });
+    auto err = st.guarded(res.timings, [&] { st.hostPair(a, b, scale, options, res, floor); });
     if (err) return *err;
     return res;
 }

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "core/input_frame.hpp"
+#include "core/per_point_floor.hpp"
 #include "core/scan_limits.hpp"
 #include "gpu_algo/set_points.hpp"
 #include "gpu_algo/surface_search.hpp"
@@ -57,9 +58,12 @@ public:
     // compute picks by scansWhole.
     [[nodiscard]] Result<HausdorffResult> compute(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                   double scale, const CallOptions& options);
+    // `floor` (per-point calls with perPointNearestOnly; ignored otherwise):
+    // queries below it may stop there (core/per_point_floor.hpp).
     [[nodiscard]] Result<HausdorffResult> computeIndexed(std::span<const glm::vec3> a,
                                                          std::span<const glm::vec3> b, double scale,
-                                                         const CallOptions& options);
+                                                         const CallOptions& options,
+                                                         const core::PerPointFloor& floor = {});
     // A small pair (scanLimits) staged by the host and scanned whole in one
     // submission (small_pairs.hpp).
     [[nodiscard]] Result<HausdorffResult> scanWhole(std::span<const glm::vec3> a,

@@ -34,6 +34,9 @@ void NeighbourhoodPass::startDirection(DirectionRun& d, size_t direction) {
     // Per-point distances need every query's NN: a negative bound turns
     // the early break off in every shader (deadThreshold returns 0).
     d.lowerBound2 = d.perPoint ? -1.0f : float(d.lowerBound2Exact * (1.0 - 1e-5));
+    // Per-point: the host's floor, the one kill threshold (common.glsl deadThreshold).
+    if (d.perPoint == nullptr) d.killFloor2 = 0.0f;
+    std::memcpy(d.blk.host + RTHDIST_CTR_KILL_FLOOR, &d.killFloor2, 4);
     double maxAbs = 0.0;
     for (const core::Bounds* b : {&d.Q.bounds, static_cast<const core::Bounds*>(&d.T.bounds)})
         maxAbs = std::max({maxAbs, std::abs(b->lo.x), std::abs(b->lo.y), std::abs(b->lo.z), std::abs(b->hi.x),

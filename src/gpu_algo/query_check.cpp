@@ -1,6 +1,7 @@
 #include "gpu_algo/query_check.hpp"
 
 #include "core/parallel.hpp"
+#include "core/per_point_floor.hpp"
 #include "gpu_algo/certificate_pass.hpp"
 
 #include <atomic>
@@ -94,9 +95,10 @@ SampledQuery QueryCheck::finishCheck(const DirectionRun& d) {
     }
     const uint64_t bad = d.blk.fields().checkBad;
     if (bad == 0) fetchSampled(d, sampled);
-    std::string why = bad != 0 ? std::to_string(bad) + " of " + std::to_string(d.Q.n) +
-                                     " queries ended unsettled or above the maximum"
-                               : sampledQueryFailure(sampled, d.qPts, d.tPts, packed, d.perPoint != nullptr);
+    std::string why =
+        bad != 0 ? std::to_string(bad) + " of " + std::to_string(d.Q.n) +
+                       " queries ended unsettled or above the maximum"
+                 : sampledQueryFailure(sampled, d.qPts, d.tPts, packed, d.perPoint != nullptr, d.killFloor2);
     if (!why.empty()) throw SelfCheckError(d.name() + ": " + why);
     return sampled.back();
 }
@@ -134,6 +136,11 @@ void QueryCheck::readPerPoint(const DirectionRun& d, PerPoint& out) {
     core::parallelChunks(d.Q.n, kPerPointChunk, m_ws.threads, [&](size_t begin, size_t end, int) {
         for (size_t qi = begin; qi < end; ++qi) {
             const uint32_t ti = nearest[qi];
+            if (ti == RTHDIST_BELOW_FLOOR && d.killFloor2 > 0.0f) {  // core/per_point_floor.hpp
+                out.nearest[qi] = core::kBelowFloor;
+                if (distances) out.distance[qi] = -1.0;
+                continue;
+            }
             if (ti >= tPts.size()) {
                 uint64_t seen = firstBad.load();
                 while (qi < seen && !firstBad.compare_exchange_weak(seen, qi)) {
@@ -147,6 +154,7 @@ void QueryCheck::readPerPoint(const DirectionRun& d, PerPoint& out) {
     if (firstBad.load() != UINT64_MAX)
         throw std::runtime_error("per-point read-back: query " + std::to_string(firstBad.load()) +
                                  " has no nearest point of " + d.T.name);
+    static_assert(RTHDIST_BELOW_FLOOR == core::kBelowFloor);
     // The queries the certificate settled in double take their exact nearest
     // targets, so that the array's maximum is the proven witness.
     for (const core::BandNearest& b : d.settled) {

@@ -23,14 +23,16 @@ bool sameFloat(float a, float b) { return std::bit_cast<uint32_t>(a) == std::bit
 std::string describe(const SampledQuery& s) { return "query slot " + std::to_string(s.slot); }
 
 std::string checkOne(const SampledQuery& s, const SetPoints& qPts, const SetPoints& tPts, float maxD2,
-                     bool perPoint) {
+                     bool perPoint, float killFloor2) {
     const uint32_t qi = std::bit_cast<uint32_t>(s.sorted[3]);
     if (qi >= qPts.size())
         return describe(s) + " names query " + std::to_string(qi) + " of " + std::to_string(qPts.size());
     const glm::vec3 q = qPts.searched(qi);
     if (!sameFloat(q.x, s.sorted[0]) || !sameFloat(q.y, s.sorted[1]) || !sameFloat(q.z, s.sorted[2]))
         return describe(s) + " holds coordinates that are not query " + std::to_string(qi) + "'s";
-    const bool settled = s.state.status == RTHDIST_EXACT || (s.state.status == RTHDIST_DEAD && !perPoint);
+    const bool belowFloor = perPoint && s.state.status == RTHDIST_DEAD;
+    const bool settled = s.state.status == RTHDIST_EXACT ||
+                         (s.state.status == RTHDIST_DEAD && (!perPoint || killFloor2 > 0.0f));
     if (!settled) return describe(s) + " ended with status " + std::to_string(s.state.status);
     const uint32_t ti = uint32_t(s.state.best & 0xffffffffu);
     if (ti >= tPts.size())
@@ -42,7 +44,10 @@ std::string checkOne(const SampledQuery& s, const SetPoints& qPts, const SetPoin
     if (!(std::fabs(stored - recomputed) <= 4e-7f * std::fabs(recomputed) + 1e-37f))
         return describe(s) + ": squared distance " + std::to_string(stored) + " on the device, " +
                std::to_string(recomputed) + " from the points it names";
-    if (!(stored <= maxD2))
+    if (belowFloor && !(stored < killFloor2))
+        return describe(s) + ": stopped at distance^2 " + std::to_string(stored) + ", not below the floor " +
+               std::to_string(killFloor2);
+    if (!belowFloor && !(stored <= maxD2))
         return describe(s) + ": distance^2 " + std::to_string(stored) + " above the maximum " +
                std::to_string(maxD2);
     return "";
@@ -76,13 +81,16 @@ std::string indexCheckFailure(uint64_t n, uint64_t badRecords, uint64_t indexSum
 }
 
 std::string sampledQueryFailure(std::span<const SampledQuery> samples, const SetPoints& qPts,
-                                const SetPoints& tPts, uint64_t maxPacked, bool perPoint) {
+                                const SetPoints& tPts, uint64_t maxPacked, bool perPoint, float killFloor2) {
     const float maxD2 = packedDist2(maxPacked);
-    for (const SampledQuery& s : samples) {
-        std::string why = checkOne(s, qPts, tPts, maxD2, perPoint);
+    const bool floor = perPoint && killFloor2 > 0.0f;
+    // With a floor the last sample (the maximum's slot) may be no query's
+    // maximum at all: every query of the call may lie below the floor.
+    for (size_t k = 0; k + (floor ? 1 : 0) < samples.size(); ++k) {
+        std::string why = checkOne(samples[k], qPts, tPts, maxD2, perPoint, killFloor2);
         if (!why.empty()) return why;
     }
-    if (!samples.empty()) {
+    if (!samples.empty() && !floor) {
         const SampledQuery& witness = samples.back();
         if (witness.slot != uint32_t(maxPacked & 0xffffffffu) ||
             !sameFloat(packedDist2(witness.state.best), maxD2))

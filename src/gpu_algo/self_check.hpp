@@ -51,9 +51,12 @@ struct SampledQuery {
 // its best names a real target whose float squared distance (computed as the
 // shaders do) equals the stored one, and it is not above the final maximum
 // maxPacked. The last sample is the witness: its best is the maximum.
-// "" when every sample holds, else the first failure.
+// A per-point call with a floor (killFloor2 > 0): a DEAD record is settled
+// when its best lies below the floor, and the witness is not checked (the
+// call has none). "" when every sample holds, else the first failure.
 [[nodiscard]] std::string sampledQueryFailure(std::span<const SampledQuery> samples, const SetPoints& qPts,
-                                              const SetPoints& tPts, uint64_t maxPacked, bool perPoint);
+                                              const SetPoints& tPts, uint64_t maxPacked, bool perPoint,
+                                              float killFloor2 = 0.0f);
 // The same over host arrays.
 [[nodiscard]] inline std::string sampledQueryFailure(std::span<const SampledQuery> samples,
                                                      std::span<const glm::vec3> qPts,

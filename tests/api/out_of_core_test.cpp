@@ -204,9 +204,8 @@ TEST(OutOfCore, PiecesInSpaceSendEachQueryAboutOnce) {
         api::MemoryBudget budget;
         budget.bytes = 2 * 512 * api::kBytesPerPoint;  // pieces of at most 512 points of each set
         CountingBruteForce fake;
-        const api::DirectedCall call = [&fake](int, auto q, auto t, const CallOptions& o) {
-            return fake(q, t, o);
-        };
+        const api::DirectedCall call = [&fake](int, auto q, auto t, const CallOptions& o,
+                                               const core::PerPointFloor&) { return fake(q, t, o); };
         auto r = api::computeInPieces(a, b, 1.0, CallOptions{}, budget, call, {});
         ASSERT_TRUE(r) << r.error().message;
         for (auto [got, q, t] : {std::tuple<const Directed*, Sets, Sets>{&r->aToB, &a, &b},
@@ -242,9 +241,8 @@ TEST(OutOfCore, PiecesInSpaceBreakTiesByInputIndex) {
     api::MemoryBudget budget;
     budget.bytes = 2 * 128 * api::kBytesPerPoint;
     CountingBruteForce fake;
-    const api::DirectedCall call = [&fake](int, auto q, auto t, const CallOptions& o) {
-        return fake(q, t, o);
-    };
+    const api::DirectedCall call = [&fake](int, auto q, auto t, const CallOptions& o,
+                                           const core::PerPointFloor&) { return fake(q, t, o); };
     CallOptions options;
     options.perPointDistances = true;
     auto r = api::computeInPieces(a, b, 1.0, options, budget, call, {});
@@ -263,6 +261,31 @@ TEST(OutOfCore, PiecesInSpaceBreakTiesByInputIndex) {
     EXPECT_EQ(fake.calls.load(), uint64_t(r->aToB.counters.queryChunks));  // round one's calls only
 }
 
+// Round one's calls stop a query below a floor (core/per_point_floor.hpp)
+// taken from queries known to be settled: the maximum settled so far and a
+// sample whose nearest in its own piece is proven its nearest in the whole
+// set (api/out_of_core.cpp seedFloor). Here every point of B is a point of
+// A moved by 2-4 thousandths; a query near a piece's border has its partner
+// in the next piece and its nearest in its own piece tens of times farther:
+// a floor from such a query would stop the witness. The result is the brute
+// force's.
+TEST(OutOfCore, FloorsComeFromSettledQueriesOnly) {
+    RTHDIST_REQUIRE_TEST_ENGINE(whole);
+    Engine split = budgetEngine(2400);
+    Rng rng(41);
+    std::vector<glm::vec3> a = randomCloud(12000, 41), b;
+    for (const glm::vec3& p : a) {
+        const glm::dvec3 move = glm::dvec3(rng.gauss(), rng.gauss(), rng.gauss());
+        b.push_back(glm::vec3(glm::dvec3(p) + (0.002 + 0.002 * rng.uniform()) * glm::normalize(move)));
+    }
+    shuffle(b, rng);
+    const OracleCase c{"partners-across-pieces", 41, a, b};
+    auto got = split.compute(c.a, c.b);
+    ASSERT_TRUE(got) << got.error().message;
+    expectMatchesOracle(c, *got);
+    EXPECT_GT(got->aToB.counters.queryChunks, 4u);
+}
+
 // Lanes (several devices) take a direction's chunks in parallel; the early
 // break reads other lanes' witnesses, and ties go to the smallest query
 // index: the result is the one-lane result, witnesses included, with tiles
@@ -273,9 +296,8 @@ TEST(OutOfCore, LanesGiveTheOneLaneResult) {
     b.insert(b.begin() + 700, glm::vec3(-9.5f, 4.25f, 6.0f));  // h(B,A) witnessed inside a middle chunk
     b.push_back(glm::vec3(20.5f, 4.25f, 6.0f));                // and tied by the mirror outlier at the end
     CountingBruteForce fake;
-    const api::DirectedCall call = [&fake](int, auto q, auto t, const CallOptions& o) {
-        return fake(q, t, o);
-    };
+    const api::DirectedCall call = [&fake](int, auto q, auto t, const CallOptions& o,
+                                           const core::PerPointFloor&) { return fake(q, t, o); };
     for (uint64_t budgetPoints : {uint64_t(600), uint64_t(1) << 40}) {
         for (bool perPoint : {false, true}) {
             api::MemoryBudget budget;

@@ -14,6 +14,7 @@
 
 #include "common/brute_force.hpp"
 #include "common/oracle_cases.hpp"
+#include "common/per_point_floor_check.hpp"
 #include "cpu/cpu_hausdorff.hpp"
 
 namespace rthdist::test {
@@ -154,6 +155,37 @@ TEST(CpuPerPointLattice, TiesPickTheSmallestIndex) {
             }
         }
     }
+}
+
+// A per-point call with a floor (core/per_point_floor.hpp: the pieces'
+// round one), both directions at the median nearest distance: a query stops
+// below its floor only where its nearest lies below it (distance -1), and
+// comes back with its exact nearest otherwise; without a floor none stops.
+TEST(CpuPerPointFloor, StopsOnlyQueriesBelowIt) {
+    const std::vector<OracleCase>& all = cases();
+    size_t below = 0, run = 0;
+    for (size_t i = 0; i < all.size(); i += 3) {
+        const OracleCase& c = all[i];
+        if (c.a.size() * c.b.size() > 40000000 || c.a.size() + c.b.size() < 8) continue;
+        SCOPED_TRACE("case " + c.name + " seed " + std::to_string(c.seed));
+        const double scale = searchScale(c.a, c.b);
+        const CaseNearest nearest(c);
+        const core::PerPointFloor floor = medianFloors(nearest, scale);
+        Options options;
+        options.perPointDistances = true;
+        auto r = cpu::cpuHausdorff(c.a, c.b, scale, options, floor);
+        ASSERT_TRUE(r.ok()) << r.error().message;
+        below += expectFloorHolds(c, nearest, *r, floor, scale);
+        for (const PerPoint* pp : {&r->aNearest, &r->bNearest})
+            for (size_t k = 0; k < pp->nearest.size(); ++k)
+                if (pp->nearest[k] == core::kBelowFloor) EXPECT_EQ(pp->distance[k], -1.0);
+        auto whole = cpu::cpuHausdorff(c.a, c.b, scale, options);
+        ASSERT_TRUE(whole.ok()) << whole.error().message;
+        EXPECT_EQ(expectFloorHolds(c, nearest, *whole, floor, scale), 0u);
+        ++run;
+    }
+    EXPECT_GT(run, 50u);
+    EXPECT_GT(below, 1000u);  // the floor stops queries
 }
 
 TEST(CpuPerPointOptions, OffLeavesArraysEmpty) {

@@ -9,6 +9,9 @@
 #include "common/case_sample.hpp"
 #include "common/geo_cases.hpp"
 #include "common/oracle_cases.hpp"
+#include "common/per_point_floor_check.hpp"
+#include "gpu_algo/gpu_context_support.hpp"
+#include "gpu_algo/gpu_hausdorff.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {
@@ -93,6 +96,39 @@ TEST(GpuOracle, PerPointDistancesMatchBruteForce) {
         }
         EXPECT_EQ(r->validationMessages, 0u);
     }
+}
+
+// A per-point call with a floor (core/per_point_floor.hpp: the pieces'
+// round one), both directions at the median nearest distance: every query
+// stops below its floor only where its nearest lies below it, and comes back
+// with its exact nearest otherwise; without a floor none stops.
+TEST(GpuOracle, PerPointFloorStopsOnlyQueriesBelowIt) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
+    ASSERT_TRUE(engine) << engine.error().message;
+    CallOptions options;
+    options.perPointDistances = true;
+    options.perPointNearestOnly = true;
+    const std::vector<OracleCase> cases = makeOracleCases();
+    size_t below = 0, run = 0;
+    for (size_t i = 0; i < cases.size(); i += 5) {
+        const OracleCase& c = cases[i];
+        if (c.a.size() * c.b.size() > 40000000 || c.a.size() + c.b.size() < 8) continue;
+        SCOPED_TRACE("case " + c.name + " seed " + std::to_string(c.seed));
+        const double scale = searchScale(c.a, c.b);
+        const CaseNearest nearest(c);
+        const core::PerPointFloor floor = medianFloors(nearest, scale);
+        auto r = (*engine)->computeIndexed(c.a, c.b, scale, options, floor);
+        ASSERT_TRUE(r) << r.error().message;
+        below += expectFloorHolds(c, nearest, *r, floor, scale);
+        auto whole = (*engine)->computeIndexed(c.a, c.b, scale, options);
+        ASSERT_TRUE(whole) << whole.error().message;
+        EXPECT_EQ(expectFloorHolds(c, nearest, *whole, floor, scale), 0u);
+        ++run;
+    }
+    EXPECT_GT(run, 30u);
+    EXPECT_GT(below, 1000u);  // the floor stops queries
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
 }  // namespace
