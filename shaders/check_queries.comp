@@ -47,6 +47,12 @@ void main() {
     bool bounded = belowFloor ? packedDist2(st.best) < floor2 : packedDist2(st.best) <= maxD2;
     if (!settled || !bounded) atomicAdd(U64Ref(pc.counters + RTHDIST_CTR_CHECK_BAD).v, 1ul);
     if (belowFloor) return;  // no witness, no band: the call has no result of its own
+    uint64_t above = U64Ref(pc.counters + RTHDIST_CTR_ABOVE_OUT).v;
+    if (pc.nearestOut != 0ul && above != 0ul) {  // a floor call handed back sparse
+        uint k = atomicAdd(UintRef(pc.counters + RTHDIST_CTR_ABOVE_COUNT).v, 1u);
+        if (k < UintRef(pc.counters + RTHDIST_CTR_ABOVE_CAPACITY).v)
+            uvec2At(above, k).v = uvec2(floatBitsToUint(vec4At(pc.sorted, i).v.w), uint(st.best & 0xffffffffu));
+    }
     // The certificate's band (core/certificate.hpp): every query whose best
     // lies within 2e of the maximum, with its best target. The threshold is
     // rounded down (a relative 2^-20 on the maximum and on the square), so it

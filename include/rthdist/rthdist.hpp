@@ -83,7 +83,8 @@
 namespace rthdist {
 namespace detail {
 struct ProofMaterial;  // core/certificate.hpp
-}
+struct AboveFloor;     // core/per_point_floor.hpp
+}  // namespace detail
 
 // Every point's nearest neighbour in the other set (perPointDistances).
 struct PerPoint {
@@ -203,6 +204,9 @@ struct HausdorffResult {
     // candidate targets), which the Engine settles in double from the
     // caller's coordinates; opaque, empty in a returned result.
     std::shared_ptr<const detail::ProofMaterial> proofMaterial;
+    // The library's own out-of-core pieces only: a per-point call's queries
+    // above its floor; opaque, empty in a returned result.
+    std::shared_ptr<const detail::AboveFloor> aboveFloor;
 };
 
 // A Vulkan physical device and what rthdist can do with it.

@@ -57,6 +57,13 @@ struct vec3f {
 #define RTHDIST_CTR_CHECK_ARGS \
     1624                        // uint[3] groups of the self-check behind search radii (search_advance.comp)
 #define RTHDIST_CTR_PROBE 1536  // uint[RTHDIST_PROBE_LEVELS + 1]: probe_levels.comp, distinct cells per level
+// A per-point call with a floor, handed back sparse (check_queries.comp): the
+// queries above the floor appended as uvec2 (original index, nearest) to the
+// list at ABOVE_OUT (0: none) while they fit ABOVE_CAPACITY; ABOVE_COUNT
+// goes on past it (overflow: the host reads the dense array instead).
+#define RTHDIST_CTR_ABOVE_COUNT 1640     // uint
+#define RTHDIST_CTR_ABOVE_CAPACITY 1644  // uint
+#define RTHDIST_CTR_ABOVE_OUT 1648       // uint64
 #define RTHDIST_CTR_BYTES 2048
 // Radii of the candidate search recorded in one submission, at most.
 #define RTHDIST_SEARCH_LOG_MAX 16
@@ -595,7 +602,8 @@ static_assert(sizeof(ProbeLevelsPush) == 64 &&
               RTHDIST_CTR_SEARCH_LOG + RTHDIST_SEARCH_LOG_MAX * 16 <= RTHDIST_CTR_PROBE &&
               RTHDIST_CTR_PROBE + (RTHDIST_PROBE_LEVELS + 1) * 4 <= RTHDIST_CTR_SEARCH_ARGS &&
               RTHDIST_CTR_SEARCH_ARGS + 24 <= RTHDIST_CTR_CHECK_ARGS &&
-              RTHDIST_CTR_CHECK_ARGS + 12 <= RTHDIST_CTR_BYTES);
+              RTHDIST_CTR_CHECK_ARGS + 12 <= RTHDIST_CTR_ABOVE_COUNT &&
+              RTHDIST_CTR_ABOVE_OUT + 8 <= RTHDIST_CTR_BYTES);
 static_assert(sizeof(SearchLogEntry) == 16 && RTHDIST_CTR_INGEST64 + 56 <= RTHDIST_CTR_KILL_SLACK &&
               RTHDIST_CTR_KILL_SLACK + 4 <= RTHDIST_CTR_KILL_FLOOR &&
               RTHDIST_CTR_KILL_FLOOR + 4 <= RTHDIST_CTR_SEARCH_LOG &&

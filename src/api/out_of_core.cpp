@@ -424,13 +424,20 @@ void mergeBests(std::vector<OpenQuery>& open, const SpatialPieces::Set& ts,
 // keepAll every query's pair is written to the direction's arrays (each
 // position once in round one, so nothing is compared and the arrays need no
 // pass before it).
-void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, const PerPoint& pp, double scale,
-                 int threads) {
+// A call handed back sparse (`above`, core/per_point_floor.hpp) lists the
+// queries above its floor; every other query of the piece stopped below it.
+void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, const PerPoint& pp,
+                 const std::vector<detail::QueryNearest>* above, double scale, int threads) {
     const SpatialPieces::Set& qs = pieces.set(dir.q);
     const SpatialPieces::Set& ts = pieces.set(1 - dir.q);
     const uint64_t first = qs.start[k], tileStart = ts.start[k];
     const double slack = dir.shared.slack;
-    const size_t n = pp.nearest.size();
+    if (above != nullptr && dir.keepAll)
+        throw std::logic_error("settlePiece: a sparse call where every query's pair is kept");
+    const size_t n = above != nullptr ? above->size() : pp.nearest.size();
+    // The i-th entry's query (its index in the piece) and its nearest target (in the tile).
+    const auto queryOf = [&](size_t i) { return above != nullptr ? (*above)[i].query : uint32_t(i); };
+    const auto nearestOf = [&](size_t i) { return above != nullptr ? (*above)[i].nearest : pp.nearest[i]; };
     const int workers = core::resolveThreads(threads, n / kHostChunk + 1);
     const size_t chunks = (n + kHostChunk - 1) / kHostChunk;
     std::vector<std::vector<OpenQuery>> parts(chunks);
@@ -457,12 +464,12 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
         for (size_t r0 = begin; r0 < end; r0 += kRun) {
             const size_t r1 = std::min(end, r0 + kRun);
             for (size_t i = r0; i < r1; ++i) {
-                if (i + kAhead < end && pp.nearest[i + kAhead] != core::kBelowFloor)
-                    __builtin_prefetch(&ts.points[tileStart + pp.nearest[i + kAhead]]);
+                if (i + kAhead < end && nearestOf(i + kAhead) != core::kBelowFloor)
+                    __builtin_prefetch(&ts.points[tileStart + nearestOf(i + kAhead)]);
                 distance[i - r0] =
-                    pp.nearest[i] == core::kBelowFloor
+                    nearestOf(i) == core::kBelowFloor
                         ? -1.0
-                        : pairDistance(qs.points[first + i], ts.points[tileStart + pp.nearest[i]]);
+                        : pairDistance(qs.points[first + queryOf(i)], ts.points[tileStart + nearestOf(i)]);
             }
             if (dir.keepAll) {
                 for (size_t i = r0; i < r1; ++i) {
@@ -471,10 +478,10 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
                 }
             }
             for (size_t i = r0; i < r1; ++i) {
-                const uint64_t p = first + i;
+                const uint64_t p = first + queryOf(i);
                 const double d = distance[i - r0];
                 if (d < 0.0) continue;  // below the call's floor: settled, neither maximum nor candidate
-                const auto g = uint32_t(tileStart + pp.nearest[i]);
+                const auto g = uint32_t(tileStart + nearestOf(i));
                 const double radius = d * scale * (1.0 + 0x1p-12) + slack;
                 // The stored cell: on the H200 machine's host computing a
                 // cell (~23 ns a point a thread) costs more than reading it.
@@ -631,10 +638,13 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double
             const core::Clock::time_point start = core::Clock::now();
             SpaceDirection& first = *dirs[qset];
             addCallTo(first.shared, r->aToB.counters, &r->timings);
-            settlePiece(first, pieces, k, r->aNearest, scale, lane.threads);
+            const auto sparse = [&r](int d) -> const std::vector<detail::QueryNearest>* {
+                return r->aboveFloor != nullptr && r->aboveFloor->of[d] ? &*r->aboveFloor->of[d] : nullptr;
+            };
+            settlePiece(first, pieces, k, r->aNearest, sparse(0), scale, lane.threads);
             if (both) {
                 addCallTo(dirs[1]->shared, r->bToA.counters, nullptr);
-                settlePiece(*dirs[1], pieces, k, r->bNearest, scale, lane.threads);
+                settlePiece(*dirs[1], pieces, k, r->bNearest, sparse(1), scale, lane.threads);
             }
             lane.giveBack(std::move(r->aNearest), std::move(r->bNearest));
             host.add(start, HostClock::kRoundOne);

@@ -14,12 +14,17 @@
 // -1); every other query's entry is its exact nearest, as without a floor.
 // A call with any floor leaves its result's witnesses, hausdorff and proof
 // empty: only the per-point arrays and the counters mean anything. A
-// floor of 0 (or below) is none.
+// floor of 0 (or below) is none. A backend may hand a direction back
+// sparse instead (HausdorffResult::aboveFloor, detail::AboveFloor below):
+// its PerPoint arrays empty, the queries that did not stop listed with
+// their exact nearest targets, every other query below the floor.
 #pragma once
 
 #include <bit>
 #include <cstdint>
 #include <limits>
+#include <optional>
+#include <vector>
 
 namespace rthdist::core {
 
@@ -52,3 +57,21 @@ struct PerPointFloor {
 };
 
 }  // namespace rthdist::core
+
+namespace rthdist::detail {
+
+// A query of a per-point call with a floor that did not stop below it, and
+// its exact nearest target (indices into the call's sets).
+struct QueryNearest {
+    uint32_t query = 0;
+    uint32_t nearest = 0;
+};
+
+// HausdorffResult::aboveFloor: per direction (0: A -> B), when handed back
+// sparse, its queries above the floor in query order (unset: the
+// direction's PerPoint arrays hold it densely).
+struct AboveFloor {
+    std::optional<std::vector<QueryNearest>> of[2];
+};
+
+}  // namespace rthdist::detail

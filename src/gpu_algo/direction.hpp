@@ -39,6 +39,9 @@ struct DirectionRun {
     int cur = 0;                               // active[cur] holds this iteration's slots
     Buffer* nearest = nullptr;                 // per-point: uint nearest target per query (device)
     Buffer* nearestHost = nullptr;             // per-point: `nearest` copied by each self-check
+    Buffer* above = nullptr;                   // a floor call: its queries above the floor (sparse)
+    Buffer* aboveHost = nullptr;               // `above` copied by each self-check
+    uint32_t aboveCapacity = 0;                // entries `above` holds
     std::vector<uint32_t> checkSlots{};        // the self-check's sampled query slots
     Buffer* band = nullptr;                    // host: the certificate's band (certificate_pass.hpp)
     uint32_t bandCapacity = 0;                 // queries `band` holds

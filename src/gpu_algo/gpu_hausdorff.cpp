@@ -318,6 +318,7 @@ struct GpuHausdorff::State {
             certificate.startDirection(ba, 1);
         }
         auto material = std::make_shared<detail::ProofMaterial>();
+        auto aboveFloor = std::make_shared<detail::AboveFloor>();
         // Both culls (and their checks) in one submission; a direction with
         // survivors searches, then checks again.
         std::array<uint32_t, 2> survivors{};
@@ -363,13 +364,22 @@ struct GpuHausdorff::State {
                 continue;
             }
             t0 = Clock::now();
-            if (pp) check.readPerPoint(*s.run, *s.run->perPoint);
+            std::optional<std::vector<detail::QueryNearest>> above;
+            if (s.run->above != nullptr) above = check.readAboveFloor(*s.run);
+            if (above) {  // sparse: the arrays stay empty
+                s.run->perPoint->distance.clear();
+                s.run->perPoint->nearest.clear();
+                aboveFloor->of[s.direction] = std::move(above);
+            } else if (pp) {
+                check.readPerPoint(*s.run, *s.run->perPoint);
+            }
             ws.timings->check += msSince(t0);
             if (handBack) handing.handHere(*s.run->perPoint, s.direction);
         }
         handing.join();
         if (floor.any()) {
             res.hausdorff = 0.0;
+            res.aboveFloor = std::move(aboveFloor);
             return;
         }
         res.hausdorff =
@@ -469,6 +479,10 @@ uint64_t GpuHausdorff::adoptedBuffers() const { return m_state->ws.adopted; }
 
 void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
     m_state->ws.maxPairCapacity = std::max<uint64_t>(1, pairs);
+}
+
+void GpuHausdorff::setAboveFloorCapacity(uint32_t queries) {
+    m_state->ws.aboveFloorCapacity = std::max<uint32_t>(1, queries);
 }
 
 void GpuHausdorff::recyclePerPoint(PerPoint&& a, PerPoint&& b) {

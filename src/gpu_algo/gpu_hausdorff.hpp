@@ -144,6 +144,10 @@ public:
     // Caps the candidate-pair buffer (default 2^26 pairs); tests shrink it
     // so that queries must retry until their pairs fit.
     void setMaxPairCapacity(uint64_t pairs);
+    // Caps the list of a floor call's queries above its floor (default
+    // kAboveFloorCapacity); tests shrink it so that the dense read-back
+    // takes over.
+    void setAboveFloorCapacity(uint32_t queries);
     // Box tests (leaf groups and leaves) the neighbourhood pass makes in one
     // crowded cell at most (default kCullCellTests); past them the cell is
     // left to the search. Tests set 0 (a crowded cell gives its first point

@@ -52,6 +52,21 @@ void NeighbourhoodPass::startDirection(DirectionRun& d, size_t direction) {
         d.nearestHost =
             &m_ws.grow(memory.nearestHost, bytes, d.name() + ".nearestHost", MemoryKind::kReadback);
     }
+    // A floor call hands back its queries above the floor sparse, while they
+    // fit its capacity (kAboveFloorCapacity; query_check.cpp readAboveFloor).
+    d.above = d.aboveHost = nullptr;
+    d.aboveCapacity = 0;
+    if (d.perPoint && d.killFloor2 > 0.0f) {
+        d.aboveCapacity = std::min(d.Q.n, m_ws.aboveFloorCapacity);
+        const VkDeviceSize bytes = VkDeviceSize(d.aboveCapacity) * 8;
+        d.above = &m_ws.grow(memory.above, bytes, d.name() + ".above");
+        d.aboveHost = &m_ws.grow(memory.aboveHost, bytes, d.name() + ".aboveHost", MemoryKind::kReadback);
+    }
+    const uint64_t aboveAt = d.above != nullptr ? d.above->address() : 0;
+    const uint32_t none = 0;
+    std::memcpy(d.blk.host + RTHDIST_CTR_ABOVE_COUNT, &none, 4);
+    std::memcpy(d.blk.host + RTHDIST_CTR_ABOVE_CAPACITY, &d.aboveCapacity, 4);
+    std::memcpy(d.blk.host + RTHDIST_CTR_ABOVE_OUT, &aboveAt, 8);
     d.checkSlots = sampleSlots(d.Q.n, kCheckSamples);
 }
 

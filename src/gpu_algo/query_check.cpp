@@ -4,6 +4,7 @@
 #include "core/per_point_floor.hpp"
 #include "gpu_algo/certificate_pass.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -23,6 +24,7 @@ bool QueryCheck::foldsIntoSearch(const DirectionRun& d) const {
 void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, CheckAt at) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "query check");
     d.blk.fields().checkBad = 0;
+    if (d.above != nullptr) std::memset(d.blk.host + RTHDIST_CTR_ABOVE_COUNT, 0, 4);
     const VkDeviceSize readback = d.blk.offset + RTHDIST_CTR_READBACK;
     const VkDeviceSize witnessAt = readback + VkDeviceSize(d.checkSlots.size()) * 32;
     sh::CheckPush cp{d.Q.sorted->address(),
@@ -45,7 +47,13 @@ void QueryCheck::cmdCheckQueries(VkCommandBuffer cmd, const DirectionRun& d, Che
     else
         m_ws.dispatch(cmd, Kernel::kCheckQueries, cp, d.Q.n);
     cmdScanWitness(m_ws, cmd, d, at);
-    if (d.nearest != nullptr) {
+    if (d.above != nullptr) {
+        // A floor call: its list of the queries above the floor comes back
+        // (the dense array only when the list overflowed: readAboveFloor).
+        m_ws.barrier(cmd);
+        const VkBufferCopy all{0, 0, VkDeviceSize(d.aboveCapacity) * 8};
+        vkCmdCopyBuffer(cmd, d.above->handle(), d.aboveHost->handle(), 1, &all);
+    } else if (d.nearest != nullptr) {
         // Per-point: the whole direction's nearest targets come back with
         // the check (a check behind the cull that found survivors copies
         // what the check after the search overwrites).
@@ -118,6 +126,34 @@ Directed QueryCheck::finishDirection(DirectionRun& d, const SampledQuery& witnes
     out.targetPoint = d.tPts.original(ti);
     out.distance = glm::length(out.queryPoint - out.targetPoint);
     return out;
+}
+
+std::optional<std::vector<detail::QueryNearest>> QueryCheck::readAboveFloor(const DirectionRun& d) {
+    uint32_t count = 0;
+    std::memcpy(&count, d.blk.host + RTHDIST_CTR_ABOVE_COUNT, 4);
+    if (count > d.aboveCapacity) {  // overflowed: the dense array, as readPerPoint reads it
+        VkCommandBuffer cmd = m_ws.ctx.begin();
+        const VkBufferCopy all{0, 0, VkDeviceSize(d.Q.n) * 4};
+        vkCmdCopyBuffer(cmd, d.nearest->handle(), d.nearestHost->handle(), 1, &all);
+        m_ws.ctx.submitAndWait(cmd);
+        return std::nullopt;
+    }
+    const auto* words = static_cast<const uint32_t*>(d.aboveHost->mapped());
+    std::vector<detail::QueryNearest> above(count);
+    for (uint32_t k = 0; k < count; ++k) {
+        above[k] = {words[2 * size_t(k)], words[2 * size_t(k) + 1]};
+        if (above[k].query >= d.Q.n || above[k].nearest >= d.T.n)
+            throw std::runtime_error("per-point read-back: entry " + std::to_string(k) + " of " + d.name() +
+                                     "'s queries above the floor names query " +
+                                     std::to_string(above[k].query) + " and target " +
+                                     std::to_string(above[k].nearest));
+    }
+    std::sort(above.begin(), above.end(), [](const auto& x, const auto& y) { return x.query < y.query; });
+    for (uint32_t k = 1; k < count; ++k)
+        if (above[k].query == above[k - 1].query)
+            throw std::runtime_error("per-point read-back: " + d.name() + " lists query " +
+                                     std::to_string(above[k].query) + " twice above the floor");
+    return above;
 }
 
 void QueryCheck::readPerPoint(const DirectionRun& d, PerPoint& out) {

@@ -4,8 +4,11 @@
 // witness becomes the direction's result, with its per-point distances.
 #pragma once
 
+#include <optional>
 #include <span>
+#include <vector>
 
+#include "core/per_point_floor.hpp"
 #include "gpu_algo/direction.hpp"
 #include "gpu_algo/self_check.hpp"
 #include "gpu_algo/workspace.hpp"
@@ -54,6 +57,11 @@ public:
     // the host's points: may run on another thread while the other
     // direction is searched.
     void readPerPoint(const DirectionRun& d, PerPoint& out);
+    // A call with a floor (d.above set): its queries above the floor, in
+    // query order, from the list its self-check copied back, when they fit
+    // it; otherwise nothing (the dense array is then copied back for
+    // readPerPoint, in a submission of its own).
+    [[nodiscard]] std::optional<std::vector<detail::QueryNearest>> readAboveFloor(const DirectionRun& d);
 
     // Device input: copies the query points `queries` and target points
     // `targets` (input indices) from the embedder's buffers to the host in

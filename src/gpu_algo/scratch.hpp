@@ -50,7 +50,9 @@ struct DirectionBuffers {
     std::array<Buffer, 2> active;
     Buffer nearest;
     Buffer nearestHost;
-    Buffer band;  // host: the certificate's band (check_queries.comp)
+    Buffer above;      // a floor call's queries above it (check_queries.comp), device
+    Buffer aboveHost;  // and its read-back
+    Buffer band;       // host: the certificate's band (check_queries.comp)
 };
 
 // The certificate's brute force (certificate_pass.hpp): its band queries and

@@ -41,6 +41,10 @@ inline constexpr VkDeviceSize kMaxSlack = VkDeviceSize(64) << 20;
 inline constexpr VkDeviceSize kAdoptMinBytes = VkDeviceSize(16) << 20;
 // Query slots whose device records the self-check compares with the host.
 inline constexpr uint32_t kCheckSamples = RTHDIST_CHECK_SAMPLES;
+// Queries above its floor a per-point call with a floor hands back sparse
+// (core/per_point_floor.hpp; 8 bytes each, on the device and read back); past
+// it the dense array is read back instead.
+inline constexpr uint32_t kAboveFloorCapacity = uint32_t(1) << 22;
 
 // One block of the host-visible counters (offsets RTHDIST_CTR_* of
 // rthdist_shared.h, the read-back area after them). The shaders find a
@@ -94,6 +98,7 @@ struct Workspace {
     Buffer hostSmall;                    // the counter blocks (RTHDIST_CTR_*), read-backs after each
     std::array<CounterBlock, 2> blocks;  // blocks[0]: every stage; [1]: a second index build
     uint64_t maxPairCapacity = kMaxPairCapacity;
+    uint32_t aboveFloorCapacity = kAboveFloorCapacity;  // a floor call's sparse list, at most
     uint32_t cullCellTests = kCullCellTests;            // 0: crowded cells give their first point only
     uint32_t leafGroupLeaves = kLeafGroupLeaves;        // leaves per group of a split index built next
     size_t chunkedUploadPoints = kChunkedUploadPoints;  // a larger host-staged set goes up in chunks

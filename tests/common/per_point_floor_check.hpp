@@ -46,16 +46,31 @@ inline core::PerPointFloor medianFloors(const CaseNearest& nearest, double scale
     return floor;
 }
 
-// Checks both directions of `r`; returns how many queries came back below
-// their floor.
+// Checks both directions of `r` (a direction handed back sparse, as its
+// dense equivalent: `sparse` counts them); returns how many queries came
+// back below their floor.
 inline size_t expectFloorHolds(const OracleCase& c, const CaseNearest& nearest, const HausdorffResult& r,
-                               const core::PerPointFloor& floor, double scale) {
+                               const core::PerPointFloor& floor, double scale, size_t* sparse = nullptr) {
     size_t below = 0;
     for (int d = 0; d < 2; ++d) {
         SCOPED_TRACE("direction " + std::to_string(d));
         const std::vector<glm::vec3>& q = d == 0 ? c.a : c.b;
         const std::vector<glm::vec3>& t = d == 0 ? c.b : c.a;
-        const PerPoint& pp = d == 0 ? r.aNearest : r.bNearest;
+        PerPoint pp = d == 0 ? r.aNearest : r.bNearest;
+        if (r.aboveFloor != nullptr && r.aboveFloor->of[d]) {
+            EXPECT_TRUE(pp.nearest.empty() && pp.distance.empty());
+            pp.nearest.assign(q.size(), core::kBelowFloor);
+            uint32_t last = 0;
+            for (const detail::QueryNearest& e : *r.aboveFloor->of[d]) {
+                EXPECT_LT(e.query, q.size());
+                if (e.query >= q.size()) return below;
+                EXPECT_TRUE(&e == &r.aboveFloor->of[d]->front() || e.query > last)
+                    << "queries in order, once";
+                last = e.query;
+                pp.nearest[e.query] = e.nearest;
+            }
+            if (sparse != nullptr) ++*sparse;
+        }
         const std::vector<double>& want = nearest.distance[d];
         EXPECT_EQ(pp.nearest.size(), q.size());
         if (pp.nearest.size() != q.size()) return below;

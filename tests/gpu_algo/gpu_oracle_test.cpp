@@ -12,6 +12,7 @@
 #include "common/per_point_floor_check.hpp"
 #include "gpu_algo/gpu_context_support.hpp"
 #include "gpu_algo/gpu_hausdorff.hpp"
+#include "gpu_algo/workspace.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {
@@ -101,7 +102,9 @@ TEST(GpuOracle, PerPointDistancesMatchBruteForce) {
 // A per-point call with a floor (core/per_point_floor.hpp: the pieces'
 // round one), both directions at the median nearest distance: every query
 // stops below its floor only where its nearest lies below it, and comes back
-// with its exact nearest otherwise; without a floor none stops.
+// with its exact nearest otherwise, in the sparse list of those above the
+// floor or, past the list's capacity, in the dense array; without a floor
+// none stops.
 TEST(GpuOracle, PerPointFloorStopsOnlyQueriesBelowIt) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
     auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
@@ -110,7 +113,7 @@ TEST(GpuOracle, PerPointFloorStopsOnlyQueriesBelowIt) {
     options.perPointDistances = true;
     options.perPointNearestOnly = true;
     const std::vector<OracleCase> cases = makeOracleCases();
-    size_t below = 0, run = 0;
+    size_t below = 0, run = 0, sparse[2] = {0, 0}, withFloor = 0;
     for (size_t i = 0; i < cases.size(); i += 5) {
         const OracleCase& c = cases[i];
         if (c.a.size() * c.b.size() > 40000000 || c.a.size() + c.b.size() < 8) continue;
@@ -118,15 +121,25 @@ TEST(GpuOracle, PerPointFloorStopsOnlyQueriesBelowIt) {
         const double scale = searchScale(c.a, c.b);
         const CaseNearest nearest(c);
         const core::PerPointFloor floor = medianFloors(nearest, scale);
-        auto r = (*engine)->computeIndexed(c.a, c.b, scale, options, floor);
-        ASSERT_TRUE(r) << r.error().message;
-        below += expectFloorHolds(c, nearest, *r, floor, scale);
+        withFloor += (floor.kill2(0) > 0.0f ? 1 : 0) + (floor.kill2(1) > 0.0f ? 1 : 0);
+        // The queries above the floor handed back sparse, then (a list of
+        // 3 at most) the dense read-back where more are above it.
+        for (const uint32_t capacity : {gpu_algo::kAboveFloorCapacity, 3u}) {
+            (*engine)->setAboveFloorCapacity(capacity);
+            auto r = (*engine)->computeIndexed(c.a, c.b, scale, options, floor);
+            ASSERT_TRUE(r) << r.error().message;
+            below += expectFloorHolds(c, nearest, *r, floor, scale, &sparse[capacity == 3u ? 1 : 0]);
+        }
         auto whole = (*engine)->computeIndexed(c.a, c.b, scale, options);
         ASSERT_TRUE(whole) << whole.error().message;
+        EXPECT_EQ(whole->aboveFloor, nullptr);
         EXPECT_EQ(expectFloorHolds(c, nearest, *whole, floor, scale), 0u);
         ++run;
     }
     EXPECT_GT(run, 30u);
+    EXPECT_EQ(sparse[0], withFloor);      // every direction with a floor handed back sparse
+    EXPECT_LT(sparse[1], withFloor / 2);  // most read back dense past a list of 3
+    EXPECT_GT(sparse[1], 0u);
     EXPECT_GT(below, 1000u);  // the floor stops queries
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
