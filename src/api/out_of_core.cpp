@@ -907,6 +907,42 @@ void roundTwo(RoundTwo& round, bool first, double scale, const CallOptions& call
     }
 }
 
+// Band queries the proof takes its candidates from the pieces for, at most
+// (the farthest first; the others go to its brute force over every target).
+constexpr size_t kBandCandidates = 64;
+
+// The certificate's candidates (core::DirectionBand::candidates) of the
+// band's farthest queries: every target within a query's upper bound U (its
+// best pair's distance) lies in the box of half-side U s (widened as
+// settlePiece widens a reach) around it, and every point of the box in the
+// blocks blocksNear names in each piece. The proof then compares a band
+// query with those targets, not with the whole set (the quarter torus's
+// proof was 0.22 s, 1B x 1B's 0.65 s: a pass over every target per band
+// query). A query whose box covers too many cells gets none.
+void addBandCandidates(core::DirectionBand& band, std::vector<Candidate> inBand, const SpatialPieces& pieces,
+                       int q, double scale) {
+    const SpatialPieces::Set& qs = pieces.set(q);
+    const SpatialPieces::Set& ts = pieces.set(1 - q);
+    std::sort(inBand.begin(), inBand.end(),
+              [](const Candidate& x, const Candidate& y) { return x.distance > y.distance; });
+    if (inBand.size() > kBandCandidates) inBand.resize(kBandCandidates);
+    std::vector<uint32_t> blocks;
+    for (const Candidate& c : inBand) {
+        const double radius = c.distance * scale * (1.0 + 0x1p-12) + band.slack;
+        const glm::vec3 p = core::scaled(qs.points[c.p], scale);
+        std::vector<uint64_t> targets;
+        bool all = std::isfinite(radius);
+        for (uint32_t k = 0; all && k < pieces.count(); ++k) {
+            if (ts.size(k) == 0) continue;
+            all = pieces.blocksNear(p, radius, k, blocks);
+            for (size_t b = 0; all && b < blocks.size(); ++b)
+                for (uint64_t t = ts.blockStart[blocks[b]]; t < ts.blockStart[blocks[b] + 1]; ++t)
+                    targets.push_back(ts.input[t]);
+        }
+        if (all) band.candidates.emplace_back(qs.input[c.p], std::move(targets));
+    }
+}
+
 // The direction's result from the best pairs that may matter: the witness
 // (the largest, the smallest input index among ties), the certificate's
 // band, per-point output by input index. With keepAll every query's, from
@@ -964,15 +1000,17 @@ DirectionState finishDirection(SpaceDirection& dir, const SpatialPieces& pieces,
     band.scale = scale;
     s.reach = band.hf - band.slack;
     const double lo2 = core::bandThreshold2(band.hf * band.hf, band.slack);
-    std::vector<std::vector<core::BandQuery>> parts((n + kHostChunk - 1) / kHostChunk);
+    std::vector<std::vector<Candidate>> parts((n + kHostChunk - 1) / kHostChunk);
     core::parallelChunks(n, kHostChunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
             const Candidate c = at(i);
             const double d = c.distance * scale;
-            if (d * d >= lo2) parts[begin / kHostChunk].push_back({qs.input[c.p], ts.input[c.nearest]});
+            if (d * d >= lo2) parts[begin / kHostChunk].push_back(c);
         }
     });
-    band.queries = core::concatenateParts<std::vector<core::BandQuery>>(parts);
+    std::vector<Candidate> inBand = core::concatenateParts<std::vector<Candidate>>(parts);
+    for (const Candidate& c : inBand) band.queries.push_back({qs.input[c.p], ts.input[c.nearest]});
+    addBandCandidates(band, inBand, pieces, dir.q, scale);
 
     if (dir.keepAll) {
         s.perPoint.distance.resize(n);

@@ -14,6 +14,7 @@
 #include "common/case_sample.hpp"
 #include "common/oracle_cases.hpp"
 #include "common/rng.hpp"
+#include "core/search_mutant.hpp"
 #include "engine_test_support.hpp"
 
 namespace rthdist::test {
@@ -284,6 +285,48 @@ TEST(OutOfCore, FloorsComeFromSettledQueriesOnly) {
     ASSERT_TRUE(got) << got.error().message;
     expectMatchesOracle(c, *got);
     EXPECT_GT(got->aToB.counters.queryChunks, 4u);
+}
+
+// The pieces' proof takes each band query's candidates from the blocks near
+// it (api/out_of_core.cpp addBandCandidates). Under a search that misses
+// targets (core::searchMutant) round one's pairs are not all nearest: a
+// band query's bound is then above its nearest, which must lie among its
+// candidates for the proof to find it. Every value stays exact (a proof
+// that fails is recomputed by the Engine), and some are recomputed. As in
+// Certificate.MutantSearchIsCaughtAndRecomputed, the GPU's open queries go
+// to the rays (whose refinement the mutant cuts short).
+TEST(OutOfCore, MutantSearchIsCaughtByThePiecesProof) {
+    RTHDIST_REQUIRE_TEST_ENGINE(whole);
+    Tuning raysOnly;
+    raysOnly.smallPairWork = 0;
+    raysOnly.sweepWork = 0;
+    raysOnly.tailScanWork = 0;
+    raysOnly.tailScanStartWork = 0;
+    uint64_t recomputed = 0, split = 0;
+    const std::vector<OracleCase> cases = makeOracleCases();
+    struct Mutant {
+        Mutant() { core::searchMutant() = true; }
+        ~Mutant() { core::searchMutant() = false; }
+    } mutant;
+    for (size_t i = 0; i < cases.size(); i += 4) {
+        const OracleCase& c = cases[i];
+        if (c.a.size() + c.b.size() < 400) continue;
+        SCOPED_TRACE(c.name + " seed " + std::to_string(c.seed));
+        EngineOptions o = engineUnderTest();
+        o.memoryBudget = std::max<uint64_t>(2, (c.a.size() + c.b.size()) / 3) * api::kBytesPerPoint;
+        o.tuning = raysOnly;
+        auto pieces = Engine::create(o);
+        ASSERT_TRUE(pieces) << pieces.error().message;
+        auto got = pieces->compute(c.a, c.b);
+        ASSERT_TRUE(got) << got.error().message;
+        expectMatchesOracle(c, *got);
+        for (const Directed* d : {&got->aToB, &got->bToA}) recomputed += d->certificate.recomputed ? 1 : 0;
+        split += got->aToB.counters.targetTiles > 1 ? 1 : 0;
+    }
+    std::printf("  the mutant's answers recomputed: %llu directions (%llu pairs in pieces)\n",
+                static_cast<unsigned long long>(recomputed), static_cast<unsigned long long>(split));
+    EXPECT_GT(split, 20u);
+    EXPECT_GT(recomputed, 0u) << "the mutant never gave a wrong answer: the test tests nothing";
 }
 
 // Lanes (several devices) take a direction's chunks in parallel; the early
