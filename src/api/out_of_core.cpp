@@ -657,7 +657,8 @@ void roundOne(const SpatialPieces& pieces, SpaceDirection* const dirs[2], double
     }
 }
 
-// The target pieces as tiles of round two: each piece's box, scaled as searched.
+// The target pieces as tiles of round two: each piece's box, scaled as
+// searched (SpatialPieces::pieceBoxes: every point of the piece lies in it).
 struct TileBox {
     glm::dvec3 lo{0.0}, hi{0.0};
     bool empty = true;
@@ -670,31 +671,6 @@ double boxGap2(const glm::vec3& q, const TileBox& box, double scale) {
     const glm::dvec3 qs(core::scaled(q, scale));
     const glm::dvec3 d = glm::max(glm::max(box.lo - qs, qs - box.hi), glm::dvec3(0.0));
     return glm::dot(d, d);
-}
-
-std::vector<TileBox> tileBoxes(const SpatialPieces::Set& ts, double scale, int threads) {
-    std::vector<TileBox> boxes(ts.start.size() - 1);
-    for (size_t k = 0; k + 1 < ts.start.size(); ++k) {
-        const Span t = ts.piece(k);
-        if (t.empty()) continue;
-        const int n = core::resolveThreads(threads, t.size() / kHostChunk + 1);
-        std::vector<glm::vec3> lo(size_t(n), t[0]), hi(size_t(n), t[0]);
-        core::parallelChunks(t.size(), kHostChunk, n, [&](size_t begin, size_t end, int w) {
-            glm::vec3 l = t[begin], h = t[begin];  // kept in registers, not in the shared vectors
-            for (size_t i = begin; i < end; ++i) {
-                l = glm::min(l, t[i]);
-                h = glm::max(h, t[i]);
-            }
-            lo[size_t(w)] = glm::min(lo[size_t(w)], l);
-            hi[size_t(w)] = glm::max(hi[size_t(w)], h);
-        });
-        for (int w = 1; w < n; ++w) {
-            lo[0] = glm::min(lo[0], lo[size_t(w)]);
-            hi[0] = glm::max(hi[0], hi[size_t(w)]);
-        }
-        boxes[k] = {glm::dvec3(core::scaled(lo[0], scale)), glm::dvec3(core::scaled(hi[0], scale)), false};
-    }
-    return boxes;
 }
 
 // After round one: the queries it left open, in position order, and the
@@ -1083,7 +1059,11 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
             continue;
         }
         const SpatialPieces::Set& ts = pieces.set(1 - dir->q);
-        round.boxes = tileBoxes(ts, scale, threads);
+        // The target pieces' boxes from the grid's cells (no pass over the points).
+        const std::vector<core::Bounds> boxes = pieces.pieceBoxes();
+        round.boxes.resize(boxes.size());
+        for (size_t k = 0; k < boxes.size(); ++k)
+            round.boxes[k] = {boxes[k].lo, boxes[k].hi, ts.size(k) == 0};
         uint64_t largestTile = 0;
         for (size_t k = 0; k < pieces.count(); ++k) largestTile = std::max(largestTile, ts.size(k));
         round.maxQueries =

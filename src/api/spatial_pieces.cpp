@@ -214,6 +214,41 @@ bool SpatialPieces::boxInPiece(const glm::vec3& q, double radius, uint32_t k) co
     });
 }
 
+std::vector<core::Bounds> SpatialPieces::pieceBoxes() const {
+    const double inf = std::numeric_limits<double>::infinity();
+    std::vector<core::Bounds> boxes(m_pieces, core::Bounds{glm::dvec3(inf), glm::dvec3(-inf)});
+    const auto add = [&boxes](uint32_t k, const glm::dvec3& lo, const glm::dvec3& hi) {
+        boxes[k].lo = glm::min(boxes[k].lo, lo);
+        boxes[k].hi = glm::max(boxes[k].hi, hi);
+    };
+    for (uint32_t z = 0; z < m_cells; ++z)
+        for (uint32_t y = 0; y < m_cells; ++y)
+            for (uint32_t x = 0; x < m_cells; ++x) {
+                const uint32_t cell = core::mortonEncode(x, y, z);
+                const uint32_t owner = m_owner[cell];
+                if (owner == kEmpty) continue;
+                const glm::dvec3 at(x, y, z);
+                const glm::dvec3 side(1.0 / m_inverse[0], 1.0 / m_inverse[1], 1.0 / m_inverse[2]);
+                const glm::dvec3 origin(m_lo[0], m_lo[1], m_lo[2]);
+                const glm::dvec3 lo = origin + at * side, hi = origin + (at + 1.0) * side;
+                if (owner != kShared) {
+                    add(owner, lo, hi);
+                    continue;
+                }
+                for (uint32_t b = m_blockFirst[cell]; b < m_blockFirst[cell] + m_blockCount[cell]; ++b)
+                    add(m_blockPiece[b], lo, hi);
+            }
+    for (int axis = 0; axis < 3; ++axis) {
+        const double top = m_lo[axis] + double(m_cells) / m_inverse[axis];
+        const double widen = 0x1p-36 * (std::abs(m_lo[axis]) + std::abs(top)) + 0x1p-1000;
+        for (core::Bounds& box : boxes) {
+            box.lo[axis] -= widen;
+            box.hi[axis] += widen;
+        }
+    }
+    return boxes;
+}
+
 bool SpatialPieces::blocksNear(const glm::vec3& q, double radius, uint32_t k,
                                std::vector<uint32_t>& blocks) const {
     blocks.clear();

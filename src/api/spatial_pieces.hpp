@@ -117,6 +117,14 @@ public:
     // first). Exact as boxInPiece. False (and `blocks` undefined) for a box
     // of more than kNearCells cells.
     bool blocksNear(const glm::vec3& q, double radius, uint32_t k, std::vector<uint32_t>& blocks) const;
+    // Each piece's box (scaled as searched): the cells that hold its points
+    // (of either set), widened by 2^-36 of the grid's magnitude on each axis,
+    // so that every point of piece k of either set lies in box k whatever
+    // the rounding of its cell. A piece with no points keeps an empty box
+    // (lo = +inf, hi = -inf). Looser than the points' own box, found with no
+    // pass over the points: a lower bound of the distance to a piece's points
+    // for round two, which needs it for a handful of queries.
+    [[nodiscard]] std::vector<core::Bounds> pieceBoxes() const;
     // The grid cell (its Morton code) of a point scaled as searched
     // (core::scaled): the cell the partition put it in.
     [[nodiscard]] uint32_t cellOfScaled(const glm::vec3& q) const { return cellOf(glm::dvec3(q)); }

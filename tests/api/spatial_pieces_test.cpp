@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <glm/common.hpp>
+#include <glm/vector_relational.hpp>
 
 #include <algorithm>
 #include <bit>
@@ -245,6 +246,42 @@ TEST(SpatialPieces, AGivenBoxCutsAsTheSetsOwn) {
 // hold every point of piece k (of either set) within the box; it refuses
 // boxes of more than kNearCells cells. Both orders, with shared cells (a
 // crowded cell over several pieces) and without.
+// Each piece's box from the grid's cells holds every point of the piece, of
+// either set (crowded cells split over pieces included), and is no larger
+// than the cells around them: within a cell's side of the points' own box.
+TEST(SpatialPieces, PieceBoxesHoldTheirPoints) {
+    std::vector<glm::vec3> a = cloud(40000, 20, 2.0f, glm::vec3(-1.0f));
+    for (size_t i = 0; i < a.size(); i += 7) a[i] = glm::vec3(0.5f, 0.25f, -0.75f);  // one crowded cell
+    const std::vector<glm::vec3> b = cloud(30000, 21, 1.5f, glm::vec3(-0.5f, 3.0f, 0.0f));
+    for (const double scale : {0.5, 1024.0})
+        for (const PieceOrder order : {PieceOrder::kBlocks, PieceOrder::kInput}) {
+            const SpatialPieces pieces =
+                SpatialPieces::partition(a, b, scale, PieceLimits{3000, 2500}, 3, order);
+            const std::vector<core::Bounds> boxes = pieces.pieceBoxes();
+            ASSERT_EQ(boxes.size(), pieces.count());
+            ASSERT_GT(pieces.count(), 20u);
+            const double cell =
+                2.0 * 4.5 * scale / double(pieces.cellsPerAxis());  // the grid's widest side, twice
+            for (size_t k = 0; k < pieces.count(); ++k) {
+                core::Bounds own{glm::dvec3(std::numeric_limits<double>::infinity()),
+                                 glm::dvec3(-std::numeric_limits<double>::infinity())};
+                for (int s = 0; s < 2; ++s)
+                    for (const glm::vec3& p : pieces.set(s).piece(k)) {
+                        const glm::dvec3 q(core::scaled(p, scale));
+                        ASSERT_TRUE(glm::all(glm::lessThanEqual(boxes[k].lo, q)) &&
+                                    glm::all(glm::lessThanEqual(q, boxes[k].hi)))
+                            << "piece " << k << " set " << s;
+                        own.lo = glm::min(own.lo, q);
+                        own.hi = glm::max(own.hi, q);
+                    }
+                if (pieces.set(0).size(k) + pieces.set(1).size(k) == 0) continue;
+                const auto widest = [](const glm::dvec3& v) { return std::max({v.x, v.y, v.z}); };
+                EXPECT_LT(widest(own.lo - boxes[k].lo), cell) << "piece " << k;
+                EXPECT_LT(widest(boxes[k].hi - own.hi), cell) << "piece " << k;
+            }
+        }
+}
+
 TEST(SpatialPieces, BlocksNearHoldEveryPointOfThePieceInTheBox) {
     std::vector<glm::vec3> a = cloud(60000, 10, 2.0f, glm::vec3(-1.0f));
     for (size_t i = 0; i < a.size(); i += 9) a[i] = glm::vec3(0.5f, 0.25f, -0.75f);  // one crowded cell
