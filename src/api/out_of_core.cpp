@@ -485,7 +485,7 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
                 const double radius = d * scale * (1.0 + 0x1p-12) + slack;
                 // The stored cell: on the H200 machine's host computing a
                 // cell (~23 ns a point a thread) costs more than reading it.
-                if (!pieces.solidAround(qs.cell[p], radius) &&
+                if (!pieces.solidAround(pieces.cellAt(dir.q, p), radius) &&
                     !pieces.boxInPiece(core::scaled(qs.points[p], scale), radius, uint32_t(k))) {
                     open.push_back({uint32_t(p), uint32_t(k), UINT32_MAX, g, d});
                     continue;
@@ -565,7 +565,7 @@ void seedFloor(SpaceDirection& dir, const SpatialPieces& pieces, double scale, i
                     d = std::min(d, pairDistance(qs.points[p], ts.points[t]));
             if (!(d * scale * (1.0 + 0x1p-20) < reach)) continue;  // the nearest may lie past the box
             const double radius = d * scale * (1.0 + 0x1p-12) + dir.shared.slack;
-            if (pieces.solidAround(qs.cell[p], radius) || pieces.boxInPiece(q, radius, k))
+            if (pieces.solidAround(pieces.cellAt(dir.q, p), radius) || pieces.boxInPiece(q, radius, k))
                 top = std::max(top, d);
         }
         best[size_t(w)] = top;
@@ -1126,15 +1126,19 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
         std::optional<SpatialPieces> cut;
         try {
             // Per-point output names each query's nearest point: pieces in input
-            // order break ties as one call would. Otherwise blocks in space.
+            // order break ties as one call would, and round one judges every
+            // query (its cell kept). Otherwise blocks in space, and the cells
+            // of the few queries above round one's floors computed.
             cut = SpatialPieces::partition(a, b, scale, limits, threads,
                                            call.perPointDistances ? PieceOrder::kInput : PieceOrder::kBlocks,
-                                           box ? &*box : nullptr);
+                                           box ? &*box : nullptr, call.perPointDistances);
         } catch (const std::bad_alloc&) {
-            return Error{ErrorCode::kOutOfMemory,
-                         "out of host memory cutting " + std::to_string(a.size()) + " + " +
-                             std::to_string(b.size()) + " points into pieces in space (about " +
-                             std::to_string((a.size() + b.size()) * 20 / 1000000) + " MB beside the inputs)"};
+            return Error{
+                ErrorCode::kOutOfMemory,
+                "out of host memory cutting " + std::to_string(a.size()) + " + " + std::to_string(b.size()) +
+                    " points into pieces in space (about " +
+                    std::to_string((a.size() + b.size()) * (call.perPointDistances ? 24 : 20) / 1000000) +
+                    " MB beside the inputs)"};
         }
         const SpatialPieces& pieces = *cut;
         partitionMs = core::msSince(start);

@@ -78,7 +78,7 @@ PieceRanks pieceRanks(uint64_t m, uint64_t span, uint64_t total) {
 }
 
 // A host range's scatter into its runs of a set's gathered arrays (points,
-// input indices, cells), one run per block. Each block's next 16 points
+// input indices, cells where kept), one run per block. Each block's next 16 points
 // wait in a buffer placed as their destinations lie in cache lines; a
 // buffer that ends on a line boundary of the destinations goes out at once,
 // a whole group of 16 (three lines of points, one of indices, one of cells)
@@ -98,11 +98,15 @@ public:
     static constexpr size_t kMaxBlocks = size_t(1) << 14;
 
     BlockWriter(SpatialPieces::Set& set, std::vector<uint64_t>& next)
-        : m_points(set.points.data()), m_input(set.input.data()), m_cell(set.cell.data()), m_next(next) {
+        : m_points(set.points.data()),
+          m_input(set.input.data()),
+          m_cell(set.cell.empty() ? nullptr : set.cell.data()),
+          m_next(next) {
         const auto aligned = [](const void* p) { return reinterpret_cast<uintptr_t>(p) % 64 == 0; };
         m_buffered = next.size() <= kMaxBlocks;
 #if defined(RTHDIST_STREAMING_STORES)
-        m_streaming = m_buffered && aligned(m_points) && aligned(m_input) && aligned(m_cell);
+        m_streaming =
+            m_buffered && aligned(m_points) && aligned(m_input) && (m_cell == nullptr || aligned(m_cell));
 #else
         (void)aligned;
 #endif
@@ -110,7 +114,7 @@ public:
             m_fill.assign(next.size(), 0);
             m_bufPoints.resize(next.size() * kGroup);
             m_bufInput.resize(next.size() * kGroup);
-            m_bufCell.resize(next.size() * kGroup);
+            if (m_cell != nullptr) m_bufCell.resize(next.size() * kGroup);
         }
     }
 
@@ -119,14 +123,14 @@ public:
             const uint64_t to = m_next[block]++;
             m_points[to] = p;
             m_input[to] = input;
-            m_cell[to] = cell;
+            if (m_cell != nullptr) m_cell[to] = cell;
             return;
         }
         const uint64_t at = m_next[block] + m_fill[block];  // this point's destination
         const size_t slot = size_t(block) * kGroup + at % kGroup;
         m_bufPoints[slot] = p;
         m_bufInput[slot] = input;
-        m_bufCell[slot] = cell;
+        if (m_cell != nullptr) m_bufCell[slot] = cell;
         ++m_fill[block];
         if ((at + 1) % kGroup == 0) flush(block);
     }
@@ -153,7 +157,7 @@ private:
         if (m_streaming && count == kGroup) {  // from == 0: a whole, aligned group
             stream(m_points + first, &m_bufPoints[base], kGroup * sizeof(glm::vec3));
             stream(m_input + first, &m_bufInput[base], kGroup * sizeof(uint32_t));
-            stream(m_cell + first, &m_bufCell[base], kGroup * sizeof(uint32_t));
+            if (m_cell != nullptr) stream(m_cell + first, &m_bufCell[base], kGroup * sizeof(uint32_t));
             m_next[block] = first + count;
             m_fill[block] = 0;
             return;
@@ -162,7 +166,7 @@ private:
         for (uint32_t k = 0; k < count; ++k) {
             m_points[first + k] = m_bufPoints[base + from + k];
             m_input[first + k] = m_bufInput[base + from + k];
-            m_cell[first + k] = m_bufCell[base + from + k];
+            if (m_cell != nullptr) m_cell[first + k] = m_bufCell[base + from + k];
         }
         m_next[block] = first + count;
         m_fill[block] = 0;
@@ -266,8 +270,9 @@ bool SpatialPieces::blocksNear(const glm::vec3& q, double radius, uint32_t k,
 }
 
 SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits limits, int threads,
-                                       PieceOrder order, const core::Bounds* box) {
+                                       PieceOrder order, const core::Bounds* box, bool keepCells) {
     SpatialPieces out;
+    out.m_scale = scale;
     const Span sets[2] = {a, b};
     const uint64_t limit[2] = {std::max<uint64_t>(limits.a, 1), std::max<uint64_t>(limits.b, 1)};
     threads = core::resolveThreads(threads, (a.size() + b.size()) / 65536 + 1);
@@ -519,7 +524,7 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         for (uint32_t k = 0; k < pieces; ++k) set.start[k + 1] = set.start[k] + inPiece[k];
         set.points.resize(points.size());
         set.input.resize(points.size());
-        set.cell.resize(points.size());
+        if (keepCells) set.cell.resize(points.size());
         forRanges(r, [&](int t, size_t begin, size_t end) {
             BlockWriter writer(set, perBlock[size_t(t)]);
             std::vector<uint64_t>& rank = rankBase[size_t(t)];

@@ -24,8 +24,9 @@
 //
 // Threading: partition() runs its passes on `threads` threads (0: all); the
 // object is then read-only and may be read from any thread.
-// Memory: per set 20 bytes per point (the gathered copy, its input indices
-// and cells) plus 4 bytes per point while partitioning; the grid at most
+// Memory: per set 16 bytes per point (the gathered copy and its input
+// indices; 20 with the cells kept) plus 4 bytes per point while
+// partitioning; the grid at most
 // 2^18 cells (12 bytes and a bit each), 12 bytes per block and, while
 // partitioning, 4 bytes per cell and 8 per block for each host thread, and
 // while scattering 321 bytes per block for each host thread where blocks
@@ -66,7 +67,8 @@ public:
     struct Set {
         core::UninitVector<glm::vec3> points;  // piece after piece, in the partition's PieceOrder
         core::UninitVector<uint32_t> input;    // the input index of each gathered point
-        core::UninitVector<uint32_t> cell;     // the grid cell of each (its Morton code: cellOfScaled)
+        core::UninitVector<uint32_t> cell;     // the grid cell of each (its Morton code: cellOfScaled),
+                                               // when kept (partition's keepCells; else empty: cellAt)
         std::vector<uint64_t> start;           // piece k holds [start[k], start[k + 1])
         std::vector<uint64_t> blockStart;      // block b holds [blockStart[b], blockStart[b + 1])
         [[nodiscard]] std::span<const glm::vec3> piece(size_t k) const {
@@ -81,10 +83,13 @@ public:
     // points as given (not scaled), when the caller has it (the Engine's
     // input check): it spares a pass over the points, and must be exact
     // (each face attained by a point), as largestMagnitude() comes from it.
+    // `keepCells`: each gathered point's cell is kept (Set::cell; 4 bytes a
+    // point the scatter writes), for callers that ask every point's cell;
+    // otherwise cellAt computes the few they ask.
     [[nodiscard]] static SpatialPieces partition(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                                                  double scale, PieceLimits limits, int threads,
                                                  PieceOrder order = PieceOrder::kInput,
-                                                 const core::Bounds* box = nullptr);
+                                                 const core::Bounds* box = nullptr, bool keepCells = true);
 
     // The partition's passes, ms (for RTHDIST_SUBMIT_TRACE's pieces line).
     struct PassTimes {
@@ -128,6 +133,12 @@ public:
     // The grid cell (its Morton code) of a point scaled as searched
     // (core::scaled): the cell the partition put it in.
     [[nodiscard]] uint32_t cellOfScaled(const glm::vec3& q) const { return cellOf(glm::dvec3(q)); }
+    // The cell of set s's gathered point p: Set::cell's where kept, else
+    // computed (~23 ns on the H200 machine's host, where a read costs less).
+    [[nodiscard]] uint32_t cellAt(int s, uint64_t p) const {
+        const Set& set = this->set(s);
+        return set.cell.empty() ? cellOfScaled(core::scaled(set.points[p], m_scale)) : set.cell[p];
+    }
     // The same answer, cheaper, for most points of a spread set: true when a
     // box of `radius` (at most half a cell a side) around a point of `cell`
     // (Set::cell) stays within the cells around it, and those hold the
@@ -169,6 +180,7 @@ private:
     size_t m_pieces = 0;
     uint32_t m_cells = 1;  // per axis (a power of two)
     double m_magnitude = 0.0;
+    double m_scale = 1.0;  // the scale the points are searched at
     double m_lo[3] = {0.0, 0.0, 0.0};
     double m_inverse[3] = {1.0, 1.0, 1.0};  // cells per unit on each axis
     std::vector<uint64_t> m_solid;  // a bit per cell: it and its neighbours hold one piece's points, or none

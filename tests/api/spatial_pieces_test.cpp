@@ -209,7 +209,8 @@ TEST(SpatialPieces, BoxInPieceHoldsOnlyThatPiecesPoints) {
 
 // The pair's box given (as the Engine's input check has it) cuts as the
 // box the partition finds itself: the same pieces, points, cells and
-// largest magnitude, both orders.
+// largest magnitude, both orders. Without the cells kept, the same pieces
+// and points, and cellAt computes each point's kept cell.
 TEST(SpatialPieces, AGivenBoxCutsAsTheSetsOwn) {
     std::vector<glm::vec3> a = cloud(40000, 13, 3.0f, glm::vec3(-2.0f, 0.5f, 7.0f));
     a.push_back(glm::vec3(-40.0f, 1.0f, 2.0f));
@@ -237,6 +238,22 @@ TEST(SpatialPieces, AGivenBoxCutsAsTheSetsOwn) {
                 std::equal(own.set(s).input.begin(), own.set(s).input.end(), given.set(s).input.begin()));
             EXPECT_TRUE(
                 std::equal(own.set(s).cell.begin(), own.set(s).cell.end(), given.set(s).cell.begin()));
+        }
+        const SpatialPieces bare =
+            SpatialPieces::partition(a, b, 0.25, PieceLimits{9000, 8000}, 3, order, &box, false);
+        ASSERT_EQ(bare.count(), own.count());
+        for (int s = 0; s < 2; ++s) {
+            const SpatialPieces::Set& kept = own.set(s);
+            EXPECT_TRUE(bare.set(s).cell.empty());
+            ASSERT_EQ(kept.cell.size(), kept.points.size());
+            EXPECT_EQ(bare.set(s).start, kept.start) << "set " << s;
+            EXPECT_EQ(bare.set(s).blockStart, kept.blockStart) << "set " << s;
+            EXPECT_TRUE(std::equal(kept.points.begin(), kept.points.end(), bare.set(s).points.begin()));
+            EXPECT_TRUE(std::equal(kept.input.begin(), kept.input.end(), bare.set(s).input.begin()));
+            for (uint64_t p = 0; p < kept.points.size(); ++p) {
+                ASSERT_EQ(bare.cellAt(s, p), kept.cell[p]) << "set " << s << " point " << p;
+                ASSERT_EQ(own.cellAt(s, p), kept.cell[p]);
+            }
         }
     }
 }
