@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Session 15: the pieces without every point's cell (b912546 before, ce7e14f after), quarter alternated.
+set -uo pipefail
+B=.devp; S=/tmp/rthdist-scale; mkdir -p $S $OUT /tmp/res; trap "tar czf $OUT/res.tgz -C /tmp res" EXIT
+nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; nproc
+one() {  # label bin args...
+  local label=$1 bin=$2; shift 2
+  env RTHDIST_SUBMIT_TRACE=1 $B/$bin --json --quiet --backend rt-pipeline "$@" $S/a.ply $S/b.ply > /tmp/res/"${label// /_}".json 2> /tmp/res/"${label// /_}".err
+  grep "^rthdist pieces" /tmp/res/"${label// /_}".err > /tmp/res/"${label// /_}".e2; mv /tmp/res/"${label// /_}".e2 /tmp/res/"${label// /_}".err
+  echo "$label rc=$? $(grep -o 'partition [0-9.]* ms ([^)]*)' /tmp/res/"${label// /_}".err | head -1)"
+  python3 -c "
+import json,sys; d=json.load(open(sys.argv[1])); t=d['timings_ms']
+print('   H', d['hausdorff'], 'cert', d['certificate']['a_to_b'].get('confirmed'), d['certificate']['b_to_a'].get('confirmed'), 'total', round(t['total']), 'pieces', round(t.get('pieces',0)))" /tmp/res/"${label// /_}".json
+}
+(./$B/rthdist-scale-gen torus 300000000 11 $S/a.ply & ./$B/rthdist-scale-gen torus 400000000 12 $S/b.ply & wait); cat $S/*.ply > /dev/null
+for r in 1 2 3; do for v in rthdist-before rthdist; do one "quarter $v $r" $v --memory-budget 22400; done; done
