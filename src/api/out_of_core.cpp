@@ -348,8 +348,9 @@ struct SpaceDirection {
     core::UninitVector<double> distance;  // keepAll only
     core::UninitVector<uint32_t> nearest;
     SharedDirection shared;
-    uint64_t crossPiece = 0;   // queries sent to another piece's targets
-    uint64_t hostScanned = 0;  // of those, answered on the host (scanOnHost)
+    uint64_t crossPiece = 0;          // queries sent to another piece's targets
+    uint64_t hostScanned = 0;         // of those, answered on the host (scanOnHost)
+    std::atomic<uint64_t> judged{0};  // round one's queries with a pair (above the calls' floors)
     // Round one's verdicts, per query piece: its queries left open for round
     // two (in position order), the maximum over those it settled and the
     // settled ones that may reach the band (not with keepAll: every query's
@@ -477,14 +478,17 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
                     dir.nearest[first + i] = uint32_t(tileStart + pp.nearest[i]);
                 }
             }
+            uint64_t judged = 0;
             for (size_t i = r0; i < r1; ++i) {
                 const uint64_t p = first + queryOf(i);
                 const double d = distance[i - r0];
                 if (d < 0.0) continue;  // below the call's floor: settled, neither maximum nor candidate
+                ++judged;
                 const auto g = uint32_t(tileStart + nearestOf(i));
                 const double radius = d * scale * (1.0 + 0x1p-12) + slack;
-                // The stored cell: on the H200 machine's host computing a
-                // cell (~23 ns a point a thread) costs more than reading it.
+                // Its cell: kept where every query is judged (per-point
+                // output; computing one costs ~23 ns a point a thread on the
+                // H200 machine's host, more than reading it), else computed.
                 if (!pieces.solidAround(pieces.cellAt(dir.q, p), radius) &&
                     !pieces.boxInPiece(core::scaled(qs.points[p], scale), radius, uint32_t(k))) {
                     open.push_back({uint32_t(p), uint32_t(k), UINT32_MAX, g, d});
@@ -497,6 +501,7 @@ void settlePiece(SpaceDirection& dir, const SpatialPieces& pieces, size_t k, con
                 }
                 if (!dir.keepAll && d * scale >= floor) candidates.push_back({uint32_t(p), g, d});
             }
+            dir.judged.fetch_add(judged, std::memory_order_relaxed);
         }
         maxima[size_t(w)] = best;
     });
@@ -1162,12 +1167,12 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
                 "rthdist pieces: %zu in space (%u cells an axis), partition %.1f ms (box %.1f, keys "
                 "%.1f, plan %.1f, scatter %.1f), between calls %.1f ms (round one %.1f, open queries "
                 "%.1f, round two %.1f), results %.1f ms, queries past their piece %llu + %llu (on the host "
-                "%llu + %llu), first floors %.6g + %.6g\n",
+                "%llu + %llu), first floors %.6g + %.6g, round one judged %llu + %llu\n",
                 pieces.count(), pieces.cellsPerAxis(), partitionMs, p.box, p.keys, p.plan, p.scatter, host.ms,
                 host.part[HostClock::kRoundOne], host.part[HostClock::kOpen], host.part[HostClock::kRoundTwo],
                 finishMs, (unsigned long long)dirAB.crossPiece, (unsigned long long)dirBA.crossPiece,
                 (unsigned long long)dirAB.hostScanned, (unsigned long long)dirBA.hostScanned, dirAB.seed,
-                dirBA.seed);
+                dirBA.seed, (unsigned long long)dirAB.judged.load(), (unsigned long long)dirBA.judged.load());
         }
         if (release) release();
     }
