@@ -288,6 +288,8 @@ struct DirectedOutput {
     bool cancelled = false;  // CallOptions::cancel was set: the output is incomplete
     double indexMs = 0.0, cullMs = 0.0, searchMs = 0.0, refineMs = 0.0;
     double certificateMs = 0.0;  // proveDirection: the band settled in double (after refine)
+    // With a floor: the queries above it, by input index (core/per_point_floor.hpp).
+    std::optional<std::vector<detail::QueryNearest>> above;
 };
 
 // Stage boundaries of one direction as fractions of it (search dominates).
@@ -563,13 +565,20 @@ void proveDirection(const Direction& d, DirectedOutput& out, PerPoint* perPoint 
 // one takes its nearest target. Fills `nearest` (input order) with the target
 // index and the double distance recomputed from the pair.
 // With a kill threshold (core::PerPointFloor::kill2, > 0) a query with a
-// target nearer than it stops there and comes back as core::kBelowFloor
-// (distance -1).
+// target nearer than it stops there, and only the others are listed, in
+// `above` (by input index), the arrays left empty: a piece's call of the
+// out-of-core route needs a handful of its queries, and the arrays' fresh
+// pages cost more than the search (their zeroing 28 % of a torus pair's
+// pieces on this repository's 2-core VM).
 void perPointPass(const Direction& d, PerPoint& nearest, std::vector<SearchStats>& stats, Progress& progress,
-                  std::atomic<bool>& lost, float kill2) {
+                  std::atomic<bool>& lost, float kill2, std::vector<detail::QueryNearest>* above) {
     const size_t nq = d.queryCount();
-    nearest.distance.assign(nq, 0.0);
-    nearest.nearest.assign(nq, 0);
+    if (above == nullptr) {
+        nearest.distance.assign(nq, 0.0);
+        nearest.nearest.assign(nq, 0);
+    }
+    std::vector<std::vector<detail::QueryNearest>> parts(
+        above != nullptr ? (nq + kQueryChunk - 1) / kQueryChunk : 0);
     parallelChunks(nq, kQueryChunk, d.threads, [&](size_t begin, size_t end, int w) {
         if (progress.cancelled()) return;
         SearchStats stat;
@@ -589,9 +598,8 @@ void perPointPass(const Direction& d, PerPoint& nearest, std::vector<SearchStats
                 seeds.follow(d.t, best);
                 target = best.d2 < kill2 ? core::kBelowFloor : best.target;
             }
-            if (target == core::kBelowFloor) {
-                nearest.distance[src] = -1.0;
-                nearest.nearest[src] = target;
+            if (above != nullptr) {
+                if (target != core::kBelowFloor) parts[begin / kQueryChunk].push_back({src, target});
                 continue;
             }
             const glm::dvec3 diff = glm::dvec3(d.queries[src]) - glm::dvec3(d.targets[target]);
@@ -601,19 +609,23 @@ void perPointPass(const Direction& d, PerPoint& nearest, std::vector<SearchStats
         stats[size_t(w)].bucketsScanned += stat.bucketsScanned;
         progress.queriesDone(end - begin, nq, w);
     });
+    if (above == nullptr) return;
+    *above = core::concatenateParts<std::vector<detail::QueryNearest>>(parts);
+    std::sort(above->begin(), above->end(), [](const auto& x, const auto& y) { return x.query < y.query; });
 }
 
 // Every query's NN: no lower bound, no kill. The witness is the largest
 // double distance (smallest query index among ties), so it is consistent
 // with the per-point array by construction.
-// With a floor (kill2 > 0) only the per-point array and the counters: no
-// witness, band or proof (core/per_point_floor.hpp).
+// With a floor (kill2 > 0) only the queries above it (out.above) and the
+// counters: no witness, band or proof (core/per_point_floor.hpp).
 void perPointDirection(const Direction& d, PerPoint& perPoint, Progress& progress, DirectedOutput& out,
                        float kill2) {
     auto start = Clock::now();
     std::vector<SearchStats> stats(static_cast<size_t>(d.threads));
     std::atomic<bool> lost{false};
-    perPointPass(d, perPoint, stats, progress, lost, kill2);
+    if (kill2 > 0.0f) out.above.emplace();
+    perPointPass(d, perPoint, stats, progress, lost, kill2, out.above ? &*out.above : nullptr);
     out.lostQuery = lost.load();
     out.cancelled = progress.cancelled();
     if (out.cancelled) return;
@@ -828,8 +840,14 @@ void earlyBreakDirection(const Direction& d, double boxBound2, Progress& progres
 
     start = Clock::now();
     std::atomic<bool> lost{false};
-    std::vector<float> bestD2(d.queryCount());
-    std::vector<uint32_t> bestTarget(d.queryCount());
+    // Written by the pass for every query (read only when none was lost or
+    // the call cancelled): not zeroed first (core/uninit_vector.hpp; fresh
+    // pages zeroed by one thread were ~0.2 s of a torus 10M x 12M call on
+    // this repository's 2-core VM).
+    UninitVector<float> bestD2;
+    UninitVector<uint32_t> bestTarget;
+    bestD2.resize(d.queryCount());
+    bestTarget.resize(d.queryCount());
     searchPass(d, kill, tally, progress, lost, QueryBests{bestD2.data(), bestTarget.data()});
     out.searchMs = msSince(start);
     out.lostQuery = lost.load();
@@ -880,11 +898,12 @@ double chooseScale(std::span<const glm::vec3> a, std::span<const glm::vec3> b, i
 }
 
 // One direction into `r` (its witness, per-point array and stage times), or
-// why it has no result.
+// why it has no result; with a floor, its queries above it into `above`.
 std::optional<Error> runDirection(const CpuSet& q, const CpuSet& t, int threads, Progress& progress,
                                   PerPoint* perPoint, Directed& into, core::DirectionBand& band,
-                                  Timings& timings, float kill2) {
-    const DirectedOutput o = directedHausdorff(q, t, threads, perPoint, progress, kill2);
+                                  Timings& timings, float kill2,
+                                  std::optional<std::vector<detail::QueryNearest>>& above) {
+    DirectedOutput o = directedHausdorff(q, t, threads, perPoint, progress, kill2);
     timings.index += o.indexMs;
     timings.cull += o.cullMs;
     timings.search += o.searchMs;
@@ -894,6 +913,7 @@ std::optional<Error> runDirection(const CpuSet& q, const CpuSet& t, int threads,
     if (o.lostQuery) return Error{ErrorCode::kInternal, "CPU backend: a query found no target"};
     into = o.directed;
     band = o.band;
+    above = std::move(o.above);
     return std::nullopt;
 }
 
@@ -937,21 +957,24 @@ Result<HausdorffResult> cpuHausdorff(const CpuSet& a, const CpuSet& b, const Cal
     auto material = std::make_shared<detail::ProofMaterial>();
     const core::PerPointFloor none;
     const core::PerPointFloor& floors = perPoint ? floor : none;
+    auto above = std::make_shared<detail::AboveFloor>();
     if (auto e = runDirection(a, b, threads, first, perPoint ? &r.aNearest : nullptr, r.aToB, material->aToB,
-                              r.timings, floors.kill2(0)))
+                              r.timings, floors.kill2(0), above->of[0]))
         return *e;
     r.hausdorff = r.aToB.distance;
     if (!options.directedOnly) {
         Progress second(options, 0.5, 0.5);
         if (auto e = runDirection(b, a, threads, second, perPoint ? &r.bNearest : nullptr, r.bToA,
-                                  material->bToA, r.timings, floors.kill2(1)))
+                                  material->bToA, r.timings, floors.kill2(1), above->of[1]))
             return *e;
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
     }
-    if (floors.any())
-        r.hausdorff = 0.0;  // no witness: only the per-point arrays
-    else
+    if (floors.any()) {  // no witness: the queries above the floors (the arrays of a direction without one)
+        r.hausdorff = 0.0;
+        r.aboveFloor = std::move(above);
+    } else {
         r.proofMaterial = std::move(material);
+    }
     r.timings.total = msSince(start);
     return r;
 }
