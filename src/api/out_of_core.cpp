@@ -1051,6 +1051,9 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
         });
         if (failure.error) return failure.error;
     }
+    // The pieces' boxes from the grid's cells (no pass over the points; the
+    // same for both directions), once the first direction has open queries.
+    std::vector<core::Bounds> boxes;
     for (int d = 0; d < 2; ++d) {
         SpaceDirection* dir = dirs[d];
         if (dir == nullptr) continue;
@@ -1064,8 +1067,7 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
             continue;
         }
         const SpatialPieces::Set& ts = pieces.set(1 - dir->q);
-        // The target pieces' boxes from the grid's cells (no pass over the points).
-        const std::vector<core::Bounds> boxes = pieces.pieceBoxes();
+        if (boxes.empty()) boxes = pieces.pieceBoxes();
         round.boxes.resize(boxes.size());
         for (size_t k = 0; k < boxes.size(); ++k)
             round.boxes[k] = {boxes[k].lo, boxes[k].hi, ts.size(k) == 0};

@@ -225,6 +225,8 @@ std::vector<core::Bounds> SpatialPieces::pieceBoxes() const {
         boxes[k].lo = glm::min(boxes[k].lo, lo);
         boxes[k].hi = glm::max(boxes[k].hi, hi);
     };
+    const glm::dvec3 side(1.0 / m_inverse[0], 1.0 / m_inverse[1], 1.0 / m_inverse[2]);
+    const glm::dvec3 origin(m_lo[0], m_lo[1], m_lo[2]);
     for (uint32_t z = 0; z < m_cells; ++z)
         for (uint32_t y = 0; y < m_cells; ++y)
             for (uint32_t x = 0; x < m_cells; ++x) {
@@ -232,8 +234,6 @@ std::vector<core::Bounds> SpatialPieces::pieceBoxes() const {
                 const uint32_t owner = m_owner[cell];
                 if (owner == kEmpty) continue;
                 const glm::dvec3 at(x, y, z);
-                const glm::dvec3 side(1.0 / m_inverse[0], 1.0 / m_inverse[1], 1.0 / m_inverse[2]);
-                const glm::dvec3 origin(m_lo[0], m_lo[1], m_lo[2]);
                 const glm::dvec3 lo = origin + at * side, hi = origin + (at + 1.0) * side;
                 if (owner != kShared) {
                     add(owner, lo, hi);

@@ -32,9 +32,9 @@ void NeighbourhoodPass::startDirection(DirectionRun& d, size_t direction) {
     // query that realizes h.
     d.lowerBound2Exact = boxLowerBound2(d.Q.bounds, d.T.bounds);
     // Per-point distances need every query's NN: a negative bound turns
-    // the early break off in every shader (deadThreshold returns 0).
+    // the early break off in every shader (deadThreshold returns the
+    // host's floor instead, killFloor2: 0 but in the pieces' round one).
     d.lowerBound2 = d.perPoint ? -1.0f : float(d.lowerBound2Exact * (1.0 - 1e-5));
-    // Per-point: the host's floor, the one kill threshold (common.glsl deadThreshold).
     if (d.perPoint == nullptr) d.killFloor2 = 0.0f;
     std::memcpy(d.blk.host + RTHDIST_CTR_KILL_FLOOR, &d.killFloor2, 4);
     double maxAbs = 0.0;
