@@ -324,24 +324,24 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         out.m_inverse[axis] = side > 0.0 && std::isfinite(1.0 / side) ? 1.0 / side : 1.0;
     }
 
-    // Each point's cell (Morton code), and each range's count of every cell.
-    core::UninitVector<uint32_t> key[2];
+    // Each range's count of every cell. The points' cells (Morton codes)
+    // are computed in runs of kRun (cellsOf) here and again in the scatter,
+    // not stored: an array of them (4 bytes a point, fresh memory) cost more
+    // to write and read back than the second computation.
+    constexpr size_t kRun = 1024;
     Ranges ranges[2];
     std::vector<std::vector<uint32_t>> counts[2];
     for (int s = 0; s < 2; ++s) {
         const Span points = sets[s];
         ranges[s] = Ranges{points.size(), core::resolveThreads(threads, points.size() / 65536 + 1)};
-        key[s].resize(points.size());
         counts[s].assign(size_t(ranges[s].count), std::vector<uint32_t>(cellCount, 0u));
         forRanges(ranges[s], [&](int t, size_t begin, size_t end) {
             std::vector<uint32_t>& mine = counts[s][size_t(t)];
-            uint32_t* keys = key[s].data();
-            // In runs: the keys first (cellsOf), then their counts.
-            constexpr size_t kRun = 1024;
+            uint32_t keys[kRun];
             for (size_t r0 = begin; r0 < end; r0 += kRun) {
-                const size_t r1 = std::min(end, r0 + kRun);
-                cellsOf(out, points.data() + r0, scale, r1 - r0, keys + r0);
-                for (size_t i = r0; i < r1; ++i) ++mine[keys[i]];
+                const size_t n = std::min(end, r0 + kRun) - r0;
+                cellsOf(out, points.data() + r0, scale, n, keys);
+                for (size_t i = 0; i < n; ++i) ++mine[keys[i]];
             }
         });
     }
@@ -528,13 +528,15 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         forRanges(r, [&](int t, size_t begin, size_t end) {
             BlockWriter writer(set, perBlock[size_t(t)]);
             std::vector<uint64_t>& rank = rankBase[size_t(t)];
-            for (size_t i = begin; i < end; ++i) {
-                const uint32_t cell = key[s][i];
-                writer.put(blockOfPoint(cell, rank), points[i], uint32_t(i), cell);
+            uint32_t keys[kRun];
+            for (size_t r0 = begin; r0 < end; r0 += kRun) {
+                const size_t n = std::min(end, r0 + kRun) - r0;
+                cellsOf(out, points.data() + r0, scale, n, keys);
+                for (size_t i = 0; i < n; ++i)
+                    writer.put(blockOfPoint(keys[i], rank), points[r0 + i], uint32_t(r0 + i), keys[i]);
             }
             writer.finish();
         });
-        key[s] = {};
     }
     lap(out.m_times.scatter);
     return out;

@@ -365,7 +365,7 @@ struct GpuHausdorff::State {
             }
             t0 = Clock::now();
             std::optional<std::vector<detail::QueryNearest>> above;
-            if (s.run->above != nullptr) above = check.readAboveFloor(*s.run);
+            if (s.run->above != nullptr) above = check.readAboveFloor(*s.run, size_t(s.direction));
             if (above) {  // sparse: the arrays stay empty
                 s.run->perPoint->distance.clear();
                 s.run->perPoint->nearest.clear();

@@ -23,54 +23,52 @@ int clampedBits(int bits, uint32_t n) {
 
 namespace {
 
-// Points [begin, end) as vec4 records (w = 0) at dst; with kBox also their
-// box into lo, hi (a chunked upload took the box before: stageIndex).
-template <bool kBox>
+// Points [begin, end) as vec4 records (w = 0) at dst, their box into lo, hi
+// (kept in registers: dst may alias them as far as the compiler knows).
 void toRecords(std::span<const glm::vec3> pts, size_t begin, size_t end, float* dst, glm::vec3& lo,
                glm::vec3& hi) {
+    glm::vec3 l = lo, h = hi;
     for (size_t i = begin; i < end; ++i) {
         const glm::vec3 p = pts[i];
         dst[4 * (i - begin) + 0] = p.x;
         dst[4 * (i - begin) + 1] = p.y;
         dst[4 * (i - begin) + 2] = p.z;
         dst[4 * (i - begin) + 3] = 0.0f;
-        if constexpr (kBox) {
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
-        }
+        l = glm::min(l, p);
+        h = glm::max(h, p);
     }
+    lo = l;
+    hi = h;
 }
 
 }  // namespace
 
 void IndexBuild::stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int bits) {
     ix.n = uint32_t(pts.size());
-    const bool chunked = pts.size() > m_ws.chunkedUploadPoints;
-    ix.hostSource = chunked ? pts : std::span<const glm::vec3>();
-    float* dst = nullptr;
-    if (!chunked) {
-        Buffer& staging =
-            m_ws.grow(ix.scratch->staging, VkDeviceSize(ix.n) * 16, ix.name + ".staging", MemoryKind::kHost);
-        dst = static_cast<float*>(staging.mapped());
+    if (pts.size() > m_ws.chunkedUploadPoints) {
+        // The records go up in chunks (uploadChunked), whose pass over the
+        // points takes their box; the grid follows it there.
+        ix.hostSource = pts;
+        ix.hostSourceBits = bits;
+        return;
     }
+    ix.hostSource = {};
+    Buffer& staging =
+        m_ws.grow(ix.scratch->staging, VkDeviceSize(ix.n) * 16, ix.name + ".staging", MemoryKind::kHost);
+    auto* dst = static_cast<float*>(staging.mapped());
     const int threads = core::resolveThreads(m_ws.threads, ix.n / kHostChunk + 1);
     std::vector<glm::vec3> lo(size_t(threads), pts[0]), hi(size_t(threads), pts[0]);
     core::parallelChunks(ix.n, kHostChunk, threads, [&](size_t begin, size_t end, int t) {
-        glm::vec3 l = lo[size_t(t)], h = hi[size_t(t)];
-        if (dst != nullptr) {
-            toRecords<true>(pts, begin, end, dst + 4 * begin, l, h);
-        } else {  // the box only: the records go up in chunks (uploadChunked)
-            for (size_t i = begin; i < end; ++i) {
-                l = glm::min(l, pts[i]);
-                h = glm::max(h, pts[i]);
-            }
-        }
-        lo[size_t(t)] = l;
-        hi[size_t(t)] = h;
+        toRecords(pts, begin, end, dst + 4 * begin, lo[size_t(t)], hi[size_t(t)]);
     });
-    for (int t = 1; t < threads; ++t) {
-        lo[0] = glm::min(lo[0], lo[size_t(t)]);
-        hi[0] = glm::max(hi[0], hi[size_t(t)]);
+    setGrid(ix, pts, lo, hi, bits);
+}
+
+void IndexBuild::setGrid(PointIndex& ix, std::span<const glm::vec3> pts, std::span<glm::vec3> lo,
+                         std::span<glm::vec3> hi, int bits) {
+    for (size_t t = 1; t < lo.size(); ++t) {
+        lo[0] = glm::min(lo[0], lo[t]);
+        hi[0] = glm::max(hi[0], hi[t]);
     }
     ix.bounds.lo = glm::dvec3(lo[0]);
     ix.bounds.hi = glm::dvec3(hi[0]);
@@ -89,12 +87,15 @@ void IndexBuild::uploadChunked(PointIndex& ix) {
         m_ws.grow(m_ws.scratch.uploadChunk, 2 * chunkBytes, "uploadChunk", MemoryKind::kHost, false);
     Buffer& points = m_ws.grow(ix.scratch->points, VkDeviceSize(ix.n) * 16, ix.name + ".points");
     const std::span<const glm::vec3> pts = ix.hostSource;
+    // The box, per host thread (the fills run one at a time: the next starts
+    // after the previous one's get()).
+    const int threads = core::resolveThreads(m_ws.threads, chunkPoints / kHostChunk + 1);
+    std::vector<glm::vec3> lo(size_t(threads), pts[0]), hi(size_t(threads), pts[0]);
     auto fill = [&](size_t first, int half) {
         float* dst = static_cast<float*>(chunks.mapped()) + 4 * chunkPoints * size_t(half);
         const size_t count = std::min(chunkPoints, pts.size() - first);
-        core::parallelChunks(count, kHostChunk, m_ws.threads, [&](size_t begin, size_t end, int) {
-            glm::vec3 unused(0.0f);  // the box was taken by stageIndex
-            toRecords<false>(pts.subspan(first), begin, end, dst + 4 * begin, unused, unused);
+        core::parallelChunks(count, kHostChunk, threads, [&](size_t begin, size_t end, int t) {
+            toRecords(pts.subspan(first), begin, end, dst + 4 * begin, lo[size_t(t)], hi[size_t(t)]);
         });
     };
     const auto t0 = Clock::now();
@@ -118,6 +119,7 @@ void IndexBuild::uploadChunked(PointIndex& ix) {
         m_ws.timings->gpuUpload += m_ws.ctx.lastGpuMs();
         if (filling.valid()) filling.get();
     }
+    setGrid(ix, pts, lo, hi, ix.hostSourceBits);
     m_ws.timings->upload += msSince(t0);
     ix.hostSource = {};
 }

@@ -26,10 +26,16 @@ public:
     explicit IndexBuild(Workspace& workspace) : m_ws(workspace) {}
 
     // Host half of an index build: the points into the set's staging buffer
-    // (vec4) in one parallel pass that also takes their bounds (past
-    // kChunkedUploadPoints: the bounds alone, the points go up in chunks,
-    // uploadChunked), then the bit count and the grid. Nothing is submitted.
+    // (vec4) in one parallel pass that also takes their bounds, then the bit
+    // count and the grid (past kChunkedUploadPoints: nothing yet, the points
+    // go up in chunks whose pass takes the bounds, uploadChunked, and the
+    // grid follows there). Nothing is submitted.
     void stageIndex(PointIndex& ix, std::span<const glm::vec3> pts, int bits);
+
+    // The bounds of per-thread boxes [lo, hi] (reduced into lo[0], hi[0]),
+    // then the bit count (`bits`, or chosen from pts when <= 0) and the grid.
+    void setGrid(PointIndex& ix, std::span<const glm::vec3> pts, std::span<glm::vec3> lo,
+                 std::span<glm::vec3> hi, int bits);
 
     // The staged points' copy to the device (before cmdBuildIndex, with a
     // barrier between: several sets' copies run back to back).
@@ -38,8 +44,9 @@ public:
     // A large set's upload (ix.hostSource, set by stageIndex past
     // kChunkedUploadPoints): chunks of kUploadChunkPoints converted to vec4
     // records by the host's threads into one reused host buffer, each copied
-    // by a submission of its own into the set's points. buildIndexes runs it
-    // before the build's submission.
+    // by a submission of its own into the set's points; the same pass takes
+    // the set's bounds, then its grid follows (setGrid). buildIndexes runs
+    // it before the build's submission.
     void uploadChunked(PointIndex& ix);
 
     // Device half of an index build, recorded into `cmd` after the upload:

@@ -128,10 +128,12 @@ Directed QueryCheck::finishDirection(DirectionRun& d, const SampledQuery& witnes
     return out;
 }
 
-std::optional<std::vector<detail::QueryNearest>> QueryCheck::readAboveFloor(const DirectionRun& d) {
+std::optional<std::vector<detail::QueryNearest>> QueryCheck::readAboveFloor(DirectionRun& d, size_t direction) {
     uint32_t count = 0;
     std::memcpy(&count, d.blk.host + RTHDIST_CTR_ABOVE_COUNT, 4);
     if (count > d.aboveCapacity) {  // overflowed: the dense array, as readPerPoint reads it
+        d.nearestHost = &m_ws.grow(m_ws.scratch.directions[direction].nearestHost, VkDeviceSize(d.Q.n) * 4,
+                                   d.name() + ".nearestHost", MemoryKind::kReadback);
         VkCommandBuffer cmd = m_ws.ctx.begin();
         const VkBufferCopy all{0, 0, VkDeviceSize(d.Q.n) * 4};
         vkCmdCopyBuffer(cmd, d.nearest->handle(), d.nearestHost->handle(), 1, &all);

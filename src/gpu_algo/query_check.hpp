@@ -60,8 +60,9 @@ public:
     // A call with a floor (d.above set): its queries above the floor, in
     // query order, from the list its self-check copied back, when they fit
     // it; otherwise nothing (the dense array is then copied back for
-    // readPerPoint, in a submission of its own).
-    [[nodiscard]] std::optional<std::vector<detail::QueryNearest>> readAboveFloor(const DirectionRun& d);
+    // readPerPoint, into the read-back buffer of `direction`, taken then).
+    [[nodiscard]] std::optional<std::vector<detail::QueryNearest>> readAboveFloor(DirectionRun& d,
+                                                                                  size_t direction);
 
     // Device input: copies the query points `queries` and target points
     // `targets` (input indices) from the embedder's buffers to the host in

@@ -306,6 +306,12 @@ TEST(LargeSizes, ChunkedUploadEqualsWholeStaging) {
             ASSERT_TRUE(r) << r.error().message;
             expectMatchesOracle(c, *r);
             expectSameValueAndWitnesses(*r, *w);
+            // The chunks' pass takes the box the grid is made from: the
+            // same grid as the whole staging's pass gives.
+            for (Directed HausdorffResult::*d : {&HausdorffResult::aToB, &HausdorffResult::bToA}) {
+                EXPECT_EQ(((*r).*d).counters.bits, ((*w).*d).counters.bits);
+                EXPECT_EQ(((*r).*d).counters.occupiedCells, ((*w).*d).counters.occupiedCells);
+            }
         }
     }
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
