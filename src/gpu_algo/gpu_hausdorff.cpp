@@ -476,6 +476,7 @@ void GpuHausdorff::setUploadChunks(size_t past, size_t chunk) {
 
 void GpuHausdorff::setAdoptMinBytes(uint64_t bytes) { m_state->ws.adoptMinBytes = bytes; }
 uint64_t GpuHausdorff::adoptedBuffers() const { return m_state->ws.adopted; }
+size_t GpuHausdorff::spareBuffers() const { return m_state->ws.spare.size(); }
 
 void GpuHausdorff::setMaxPairCapacity(uint64_t pairs) {
     m_state->ws.maxPairCapacity = std::max<uint64_t>(1, pairs);

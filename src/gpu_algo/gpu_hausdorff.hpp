@@ -169,6 +169,8 @@ public:
     void setAdoptMinBytes(uint64_t bytes);
     // How many spent buffers requests have adopted so far (tests).
     [[nodiscard]] uint64_t adoptedBuffers() const;
+    // How many spent buffers wait in the workspace for a request (tests).
+    [[nodiscard]] size_t spareBuffers() const;
     // Frees the scratch buffers and acceleration structures kept between
     // one-shot calls (the next call allocates them again). Out-of-core calls
     // free one direction's before the other's. Prepared sets keep theirs.

@@ -30,7 +30,10 @@ Workspace::Workspace(gpu::Context& c, const std::string& cacheDir, int hostThrea
 }
 
 void Workspace::recycle(Buffer& b) {
-    if (b) spare.push_back(std::move(b));  // the move leaves b empty
+    // A buffer smaller than any request that adopts stays in its slot for
+    // the slot's next use: in `spare` no request could take it, and every
+    // call of a small pair would add its builds' scratch there for good.
+    if (b && b.size() >= adoptMinBytes) spare.push_back(std::move(b));  // the move leaves b empty
 }
 
 void Workspace::recycleBuild(BuildScratch& build) {

@@ -131,8 +131,10 @@ struct Workspace {
     // captures and validation messages.
     Buffer& grow(Buffer& b, VkDeviceSize bytes, const std::string& name,
                  MemoryKind kind = MemoryKind::kDevice, bool slack = true);
-    // Moves `b` (if it holds a buffer) to `spare`: nothing of this call reads
-    // or writes it again through any pointer, and its slot is empty after.
+    // Moves `b` (if it holds a buffer of at least adoptMinBytes) to `spare`:
+    // nothing of this call reads or writes it again through any pointer, and
+    // its slot is empty after. A smaller buffer stays in its slot (the
+    // slot's next grow reuses it).
     void recycle(Buffer& b);
     // A build's scratch (points, keys, flags, boundsU) once its index is
     // built and checked: the leaf split and the next build adopt from it.

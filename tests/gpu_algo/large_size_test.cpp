@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -360,6 +361,33 @@ TEST(LargeSizes, SpentBuffersServeTheRestOfTheCall) {
     }
     EXPECT_GT((*adopting)->adoptedBuffers(), run.size());  // the path under test ran
     EXPECT_EQ((*fresh)->adoptedBuffers(), 0u);
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// Calls of a small pair on one engine (the default adoption threshold, which
+// no small request meets) keep the builds' scratch in its slots: the spare
+// buffers do not grow from call to call (each call added its eight there,
+// never freed, before), and every call gives the same answer.
+TEST(LargeSizes, SmallCallsLeaveNoSpareBuffersBehind) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
+    ASSERT_TRUE(engine);
+    const std::vector<OracleCase> cases = makeOracleCases();
+    const auto it = std::find_if(cases.begin(), cases.end(), [](const OracleCase& c) {
+        return c.a.size() + c.b.size() >= 3000 && c.a.size() + c.b.size() <= 20000;
+    });
+    ASSERT_NE(it, cases.end());
+    const OracleCase& c = *it;
+    auto first = (*engine)->compute(c.a, c.b, Options{});
+    ASSERT_TRUE(first) << first.error().message;
+    expectMatchesOracle(c, *first);
+    const size_t spare = (*engine)->spareBuffers();
+    for (int call = 0; call < 5; ++call) {
+        auto r = (*engine)->compute(c.a, c.b, Options{});
+        ASSERT_TRUE(r) << r.error().message;
+        expectSameValueAndWitnesses(*r, *first);
+        EXPECT_EQ((*engine)->spareBuffers(), spare) << "after call " << call + 2;
+    }
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
