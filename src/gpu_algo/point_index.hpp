@@ -93,7 +93,7 @@ struct PointIndex {
     // A large set staged by the host: its points, still on the host, which
     // buildIndexes uploads in chunks (empty: staged whole, or ingested).
     std::span<const glm::vec3> hostSource;
-    int hostSourceBits = 0;  // its bit count as asked (<= 0: chosen once its bounds are known)
+    int hostSourceBits = 0;   // its bit count as asked (<= 0: chosen once its bounds are known)
     Buffer* cells = nullptr;  // Cell per occupied cell
     uint32_t numCells = 0;
     uint64_t cellCapacity = 0;                // room of `cells` at the build: min(n, keys)

@@ -128,7 +128,8 @@ Directed QueryCheck::finishDirection(DirectionRun& d, const SampledQuery& witnes
     return out;
 }
 
-std::optional<std::vector<detail::QueryNearest>> QueryCheck::readAboveFloor(DirectionRun& d, size_t direction) {
+std::optional<std::vector<detail::QueryNearest>> QueryCheck::readAboveFloor(DirectionRun& d,
+                                                                            size_t direction) {
     uint32_t count = 0;
     std::memcpy(&count, d.blk.host + RTHDIST_CTR_ABOVE_COUNT, 4);
     if (count > d.aboveCapacity) {  // overflowed: the dense array, as readPerPoint reads it
