@@ -534,11 +534,8 @@ double callFloor(SpaceDirection& dir, double scale) {
     return std::max(0.0, keepFloor(std::max(dir.settledSoFar.distance, dir.seed), scale, dir.shared.slack));
 }
 
-// Queries of a direction sampled for its first floor (seedFloor). Each
-// reads every point of the blocks near it (up to 64 cells each): 1024 took
-// ~130 ms of the 10M x 12M torus's round one on 2 cores, 256 ~45 ms, with
-// first floors within 6 % of 1024's.
-constexpr size_t kSeedQueries = 256;
+// Queries of a direction sampled for its first floor (seedFloor).
+constexpr size_t kSeedQueries = 1024;
 
 // The first pieces' floor: without it round one's first calls (one a lane)
 // would search every query to its end. A strided sample of the queries,
