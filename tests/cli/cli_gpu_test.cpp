@@ -167,6 +167,17 @@ TEST_P(CliGpu, DeviceIndexOutOfRangeIsNoDevice) {
     EXPECT_EQ(run.err.rfind("rthdist: ", 0), 0u) << run;
 }
 
+// The engine is created while the files load (cli/main.cpp): a file the
+// loader rejects is still reported as bad input (exit 3, the file named),
+// before a device that does not exist (exit 4).
+TEST_P(CliGpu, BadFileBeforeMissingDevice) {
+    TempDir dir;
+    const std::string bad = dir.write("nan.xyz", "0 0 0\n1 nan 2\n");
+    const CliRun run = runCli({"--backend", GetParam(), "--device", "999", bad, kSampleB});
+    EXPECT_EQ(run.exitCode, 3) << run;
+    EXPECT_NE(run.err.find("nan.xyz"), std::string::npos) << run;
+}
+
 // --devices opens each device once (issue 36: 0,0,0,... opened the device
 // once per entry, unbounded): a repeated index or more than 16 entries is a
 // usage error (exit 2) before any device is opened. Several lanes on one
