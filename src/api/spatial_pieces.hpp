@@ -25,8 +25,8 @@
 // Threading: partition() runs its passes on `threads` threads (0: all); the
 // object is then read-only and may be read from any thread.
 // Memory: per set 16 bytes per point (the gathered copy and its input
-// indices; 20 with the cells kept) plus 4 bytes per point while
-// partitioning; the grid at most
+// indices; 20 with the cells kept; the cells are computed twice while
+// partitioning, not stored); the grid at most
 // 2^18 cells (12 bytes and a bit each), 12 bytes per block and, while
 // partitioning, 4 bytes per cell and 8 per block for each host thread, and
 // while scattering 321 bytes per block for each host thread where blocks
