@@ -13,6 +13,7 @@ void main() {
     uint slot = gl_GlobalInvocationID.x;
     if (slot >= searchedCount(pc.counters, pc.numActive)) return;
     uint qi = uintAt(pc.activeList, slot).v;
+    if (waitsForItsClass(qi)) return;
     vec3 q = vec4At(pc.queries, qi).v.xyz;
     QueryState st = stateAt(pc.state, qi).v;
     float rLo = st.rLo;

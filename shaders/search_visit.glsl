@@ -48,3 +48,14 @@ bool visitCell(uint slot, uint qi, vec3 q, float rLo, float thr, uint cellIndex,
     }
     return false;
 }
+
+// RadiusSchedule's retry classes: while a full pair buffer stalls the search,
+// one class of queries (qi % retryStride == retryPhase) is searched at a time
+// and the others wait, marked RETRY (resolve.comp keeps them open with the
+// rLo they had, or 0 after a level change: nothing is skipped on their word).
+// Returns true when q waits this radius out.
+bool waitsForItsClass(uint qi) {
+    if (pc.retryStride <= 1u || qi % pc.retryStride == pc.retryPhase) return false;
+    stateAt(pc.state, qi).v.status = RTHDIST_RETRY;
+    return true;
+}

@@ -353,6 +353,8 @@ struct SearchPush {
     uint skipScanned;  // 1: cells within rLo were scanned at this same level
     uint slotBase;     // rt-pipeline: first active slot of this trace (traces are split by
                        // maxRayDispatchInvocationCount); 0 for the ray-query dispatch
+    uint retryStride;  // > 1: only queries qi with qi % retryStride == retryPhase are searched,
+    uint retryPhase;   // the others marked RETRY (RadiusSchedule's retry classes)
 };
 
 // Query slots the self-check samples: all of n <= RTHDIST_CHECK_SAMPLES,

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "gpu/barriers.hpp"
@@ -42,6 +43,7 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
         std::min(std::clamp<uint64_t>(pairBase * 4, 1u << 16, 1u << 22), m_ws.maxPairCapacity);
     Buffer* pairs = nullptr;
     int builtLevel = -1;  // level of the BLAS now built (-1: none yet)
+    uint64_t steps = 0;   // radii searched, a retry class's turns at a radius as one (kMaxIterations)
     while (numActive > 0) {
         if (!pairs) {
             pairs = &m_ws.grow(m_ws.scratch.search.pairs, pairCapacity * 8, "pairs");
@@ -67,13 +69,25 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
         }
         const int level = schedule.level();
         const std::vector<double> submitted = schedule.nextRadii();
+        const bool classTurn = schedule.retryStride() > 1;
+        m_retryStride = schedule.retryStride();
+        m_retryPhase = schedule.retryPhase();
         const RadiiOutcome out =
             runRadii(d, level, level == builtLevel, submitted, *pairs, pairCapacity, numActive);
-        schedule.advance(submitted, numActive, out);
+        schedule.advance(submitted, numActive, out, pairCapacity >= m_ws.maxPairCapacity ? pairCapacity : 0);
+        m_retryStride = 1;
+        m_retryPhase = 0;
+        if (schedule.retryExhausted())
+            throw std::runtime_error("candidate search: one query's candidate cells at radius " +
+                                     std::to_string(submitted[out.run - 1]) + " exceed the pair buffer's " +
+                                     std::to_string(pairCapacity) + " pairs, its most");
         builtLevel = level;
         d.out.counters.iterations += out.run;
-        if (d.out.counters.iterations > kMaxIterations)
-            throw std::runtime_error("candidate search did not converge");
+        // A retry class's turns at one radius (bounded by the classes) are one step.
+        steps += classTurn ? 0u : out.run;
+        if (steps > kMaxIterations)
+            throw std::runtime_error("candidate search did not converge within " +
+                                     std::to_string(kMaxIterations) + " radii");
         numActive = out.stillOpen;
         reportProgress(
             options, "search",
@@ -218,6 +232,8 @@ void CandidateSearch::cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const Poin
     sp.rayTMax = rayTMax;
     sp.skipScanned = sameLevel ? 1u : 0u;
     sp.slotBase = 0u;
+    sp.retryStride = m_retryStride;
+    sp.retryPhase = m_retryPhase;
     // Sized by the device (search_advance.comp: the queries still searched)
     // where one dispatch or trace holds them all; else numActive slots, the
     // ones past the device's count returning at once.

@@ -77,6 +77,8 @@ private:
     IndexBuild& m_index;
     Refinement& m_refine;
     QueryCheck& m_check;
+    // The retry class the next cmdSearch searches (RadiusSchedule::retryStride, retryPhase).
+    uint32_t m_retryStride = 1, m_retryPhase = 0;
 };
 
 }  // namespace rthdist::gpu_algo

@@ -59,7 +59,8 @@ int RadiusSchedule::tailLevel(uint32_t open, int builtLevels,
 std::vector<double> RadiusSchedule::nextRadii() const {
     const int first = level();
     std::vector<double> radii{m_radius};
-    while (radii.size() < std::min(m_chunk, m_settings.radiiPerSubmission)) {
+    const uint32_t chunk = m_stride > 1 ? 1u : std::min(m_chunk, m_settings.radiiPerSubmission);
+    while (radii.size() < chunk) {
         const double next = radii.back() * m_step;
         if (levelFor(m_grid, next) != first) break;
         radii.push_back(next);
@@ -67,13 +68,48 @@ std::vector<double> RadiusSchedule::nextRadii() const {
     return radii;
 }
 
-void RadiusSchedule::advance(std::span<const double> radii, uint32_t before, const RadiiOutcome& out) {
+namespace {
+
+// The classes that share a full buffer's pairs: as many as the pairs
+// reported would fill it twice over, at least 2 (classes of queries by
+// index hold about even shares of them).
+uint64_t classesFor(uint64_t pairs, uint64_t capacity) {
+    return std::max<uint64_t>(2, (2 * pairs + capacity - 1) / std::max<uint64_t>(capacity, 1));
+}
+
+}  // namespace
+
+void RadiusSchedule::advance(std::span<const double> radii, uint32_t before, const RadiiOutcome& out,
+                             uint64_t fullCapacity) {
     m_traced = true;
     m_chunk =
         2 * uint64_t(out.stillOpen) > before ? std::min<uint32_t>(2 * m_chunk, RTHDIST_SEARCH_LOG_MAX) : 2;
     m_step = m_settings.squaredTailGrowth ? tailStep(m_growth, m_searched, before, out.stillOpen) : m_growth;
     m_radius = radii[out.run - 1];
-    if (!out.overflowed) m_radius *= m_step;
+    const bool full = out.overflowed && fullCapacity > 0;
+    bool again = out.overflowed;  // the same radius next
+    if (m_stride > 1) {
+        if (full) {
+            // This class overflowed too: split it (its queries fall into
+            // classes m_phase + k * m_stride of the finer split, which the
+            // turns from m_phase on reach; the earlier ones are done).
+            const uint64_t finer =
+                uint64_t(m_stride) *
+                std::min<uint64_t>(classesFor(out.lastPairs, fullCapacity), kMaxRetryClasses);
+            m_exhausted = m_stride >= m_queries || finer > kMaxRetryClasses;
+            if (!m_exhausted) m_stride = uint32_t(finer);
+            again = true;
+        } else if (!out.overflowed && ++m_phase == m_stride) {
+            m_stride = 1;  // every class had its turn: the radius grows
+            m_phase = 0;
+        } else {
+            again = true;  // the next class (or this one again, with a larger buffer)
+        }
+    } else if (full && uint64_t(out.stillOpen) * 8 > uint64_t(before) * 7) {
+        m_stride = uint32_t(std::min<uint64_t>(classesFor(out.lastPairs, fullCapacity), kMaxRetryClasses));
+        m_phase = 0;
+    }
+    if (!again) m_radius *= m_step;
 }
 
 bool RadiusSchedule::sweeps(uint32_t open, uint64_t targets) const {

@@ -47,6 +47,10 @@ inline constexpr uint32_t kTailScanCells = 4096;
 inline constexpr uint64_t kSweepWorkGpu = uint64_t(1) << 31;
 inline constexpr uint64_t kSweepWorkCpuDevice = uint64_t(1) << 24;
 
+// Retry classes (RadiusSchedule::advance) at most: past this a class that
+// still overflows the full buffer is one query's own candidates.
+inline constexpr uint32_t kMaxRetryClasses = uint32_t(1) << 16;
+
 // What the schedule knows of the target index (gpu_algo/point_index.hpp):
 // its grid's cell edge s and bit count, and whether crowded cells were cut
 // into leaves (then minEdge is the narrowest leaf's edge).
@@ -149,10 +153,9 @@ public:
 
     // The radii of the next submission: the current radius and those that
     // follow it (the current step each time) at its search level, at most
-    // the chunk (2, doubled after a submission that left more than half of
-    // its queries going on, up to RTHDIST_SEARCH_LOG_MAX; a radius recorded
-    // after the search ended costs a BLAS refit, ~a submission's overhead on
-    // an H100: docs/bench/prepared) and radiiPerSubmission.
+    // the chunk (one while retry classes take turns; 2, doubled after a submission that left more than half
+    // of its queries going on, up to RTHDIST_SEARCH_LOG_MAX; a radius recorded after the search ended costs a
+    // BLAS refit, ~a submission's overhead on an H100: docs/bench/prepared) and radiiPerSubmission.
     [[nodiscard]] std::vector<double> nextRadii() const;
     // The search level of nextRadii().
     [[nodiscard]] int level() const { return levelFor(m_grid, m_radius); }
@@ -161,8 +164,28 @@ public:
     // entered: the chunk and step for the next, and the radius it starts at,
     // the last radius that searched times the step, or that radius again
     // when its pairs overflowed (its queries that lost pairs retry).
+    // `fullCapacity`: the pair buffer's size when it can grow no more (0:
+    // it still can). A full buffer that overflows and leaves more than 7/8
+    // of the queries going on (few queries' pairs all fitted: on an H200 the retries met the
+    // same candidates in the same traversal order every time, and the search
+    // never ended) splits the queries into retry classes by index,
+    // qi % retryStride(): one class a submission at the same radius, the
+    // others waiting (search_visit.glsl), as many classes as the pairs
+    // reported would fill the buffer twice over, a class that overflows
+    // again split further (its turns then come from its own on), until
+    // every class has had its turn; then the radius grows. Each class's
+    // queries searched alone at most kMaxRetryClasses apart: a class that
+    // still overflows then is retryExhausted().
     // Precondition: out.run is 1 .. radii.size().
-    void advance(std::span<const double> radii, uint32_t before, const RadiiOutcome& out);
+    void advance(std::span<const double> radii, uint32_t before, const RadiiOutcome& out,
+                 uint64_t fullCapacity = 0);
+    // The retry classes (1: every query is searched) and the class whose
+    // turn it is.
+    [[nodiscard]] uint32_t retryStride() const { return m_stride; }
+    [[nodiscard]] uint32_t retryPhase() const { return m_phase; }
+    // Whether a class of at most one query (stride >= `queries`) overflowed
+    // the full buffer: its own candidate cells at this radius exceed it.
+    [[nodiscard]] bool retryExhausted() const { return m_exhausted; }
 
     [[nodiscard]] double radius() const { return m_radius; }
     [[nodiscard]] double step() const { return m_step; }
@@ -180,6 +203,8 @@ private:
     double m_step;
     uint32_t m_chunk = 2;
     bool m_traced = false;
+    uint32_t m_stride = 1, m_phase = 0;
+    bool m_exhausted = false;
 };
 
 }  // namespace rthdist::gpu_algo

@@ -122,6 +122,74 @@ TEST(RadiusSchedule, OverflowRetriesTheLastRadiusThatSearched) {
     EXPECT_EQ(s.chunk(), 4u);
 }
 
+RadiiOutcome overflowedFull(uint32_t stillOpen, uint64_t pairs) {
+    RadiiOutcome out = reported(1, stillOpen, true);
+    out.lastPairs = pairs;
+    return out;
+}
+
+// A buffer that can grow no more and overflows with most queries going on
+// (on an H200 the retries met the same candidates every time): the queries
+// take turns in classes by index at the same radius, one radius a
+// submission, as many classes as the pairs fill the buffer twice over; the
+// radius grows once every class had its turn.
+TEST(RadiusSchedule, StalledFullBufferSearchesRetryClassesInTurn) {
+    RadiusSchedule s(unitGrid(), ScheduleSettings{}, 2.0, 1000, 1000);
+    EXPECT_EQ(s.retryStride(), 1u);
+    s.advance(s.nextRadii(), 1000, overflowedFull(900, 250), 100);
+    EXPECT_EQ(s.retryStride(), 5u);  // 2 x 250 pairs / 100
+    EXPECT_EQ(s.retryPhase(), 0u);
+    EXPECT_EQ(s.radius(), 2.0);
+    EXPECT_EQ(s.nextRadii(), (std::vector<double>{2.0}));
+    for (uint32_t phase = 1; phase < 5; ++phase) {
+        s.advance(s.nextRadii(), 900, reported(1, 850), 100);
+        EXPECT_EQ(s.retryStride(), 5u);
+        EXPECT_EQ(s.retryPhase(), phase);
+        EXPECT_EQ(s.radius(), 2.0);
+    }
+    s.advance(s.nextRadii(), 850, reported(1, 800), 100);  // the last class
+    EXPECT_EQ(s.retryStride(), 1u);
+    EXPECT_EQ(s.retryPhase(), 0u);
+    EXPECT_EQ(s.radius(), 4.0);
+    EXPECT_FALSE(s.retryExhausted());
+}
+
+// A class that overflows the full buffer again is split (the stride a
+// multiple of the old, its turns from the same phase on); an overflow while
+// the buffer can still grow retries the same class; a class of at most one
+// query that overflows is exhausted.
+TEST(RadiusSchedule, RetryClassThatOverflowsIsSplitUntilOneQuery) {
+    RadiusSchedule s(unitGrid(), ScheduleSettings{}, 2.0, 1000, 1000);
+    s.advance(s.nextRadii(), 1000, overflowedFull(1000, 100), 100);
+    EXPECT_EQ(s.retryStride(), 2u);
+    s.advance(s.nextRadii(), 1000, reported(1, 990), 100);
+    EXPECT_EQ(s.retryPhase(), 1u);
+    s.advance(s.nextRadii(), 990, overflowedFull(990, 300), 100);  // class 1 of 2 overflows
+    EXPECT_EQ(s.retryStride(), 12u);                               // 2 x 6
+    EXPECT_EQ(s.retryPhase(), 1u);
+    s.advance(s.nextRadii(), 990, overflowedFull(990, 300), 0);  // a buffer that grows: the same turn
+    EXPECT_EQ(s.retryStride(), 12u);
+    EXPECT_EQ(s.retryPhase(), 1u);
+    EXPECT_EQ(s.radius(), 2.0);
+    while (s.retryStride() < 1000 && !s.retryExhausted())
+        s.advance(s.nextRadii(), 990, overflowedFull(990, 1000), 100);
+    EXPECT_FALSE(s.retryExhausted());
+    s.advance(s.nextRadii(), 990, overflowedFull(990, 1000), 100);
+    EXPECT_TRUE(s.retryExhausted());
+}
+
+// An overflow that still lets most queries finish, or one of a buffer that
+// can grow, keeps every query in the search (no classes).
+TEST(RadiusSchedule, NoRetryClassesWhileTheSearchProgresses) {
+    RadiusSchedule grows(unitGrid(), ScheduleSettings{}, 2.0, 1000, 1000);
+    grows.advance(grows.nextRadii(), 1000, overflowedFull(1000, 500), 0);
+    EXPECT_EQ(grows.retryStride(), 1u);
+    RadiusSchedule progresses(unitGrid(), ScheduleSettings{}, 2.0, 1000, 1000);
+    progresses.advance(progresses.nextRadii(), 1000, overflowedFull(800, 500), 100);
+    EXPECT_EQ(progresses.retryStride(), 1u);
+    EXPECT_EQ(progresses.radius(), 2.0);
+}
+
 TEST(RadiusSchedule, RadiiThatSearchedNoQueryAreSkipped) {
     RadiusSchedule s(unitGrid(), ScheduleSettings{}, 2.0, 1000, 1000);
     // The first radius settled every query but one; the second had none.
