@@ -336,6 +336,22 @@ Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, 
                                         std::chrono::steady_clock::time_point t0,
                                         const api::PairNarrowing& narrowed, double narrowingMs);
 
+Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
+                                        const CallOptions& call, std::chrono::steady_clock::time_point t0,
+                                        bool narrow = true);
+
+// The route of a pair of host views (Engine::compute's and a narrowed
+// pair's calls').
+api::Plan planHostViews(const Engine::Impl& impl, const PointView& a, const PointView& b,
+                        const CallOptions& call) {
+    api::PairShape shape;
+    shape.input = api::PairShape::Input::kHostViews;
+    shape.a = a.count;
+    shape.b = b.count;
+    shape.packedFloat = a.packedFloat() && b.packedFloat();
+    return api::planRoute(shape, call, impl.backend->memoryBudget(), impl.backend->caps());
+}
+
 // Host views checked on the host: the frame entered (origin, float copies
 // where needed, the exact scale), the pair run, the frame left. A pair that
 // narrows (api/narrowed_targets.hpp) runs as computeNarrowed says unless
@@ -367,6 +383,22 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
                                          Frame{origin, a, b, copied}, call, t0);
     if (r) r->timings.pieces += narrowingMs;
     return r;
+}
+
+// One call of a narrowed pair (both cores, or a direction's core and kept
+// targets) on the route Engine::compute takes for its shape, without
+// looking for narrowing again: on a GPU, packed float32 subsets go to the
+// device ingest (the device converts them: the host staging of
+// computeViews took ~2 of the 5 ms of a call of 2 x 200k points on an H200,
+// the ingest ~0.3); on a CPU device (lavapipe) to computeViews, which
+// reuses the boxes the narrowing took (there the ingest's pass is host
+// work too: 63 -> 80 ms on that pair on 2 cores).
+Result<HausdorffResult> computeNarrowedCall(Engine::Impl& impl, const PointView& a, const PointView& b,
+                                            const CheckedInputs& checked, const CallOptions& call,
+                                            std::chrono::steady_clock::time_point t0) {
+    if (!impl.backend->caps().cpuDevice && planHostViews(impl, a, b, call).route == api::Route::kDeviceIngest)
+        return computeIngested(impl, a, b, call, t0, false);
+    return computeViews(impl, a, b, checked, call, t0, false);
 }
 
 // A direction searched over subsets (queries `core` of q, targets `targets`
@@ -438,8 +470,8 @@ Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, 
     Result<HausdorffResult> r = Error{ErrorCode::kInternal, "narrowed pair not run"};
     if (narrowed.joint) {
         const api::JointCores& j = *narrowed.joint;
-        r = computeViews(impl, j.coreA.view, j.coreB.view, CheckedInputs{j.summaryA, j.summaryB}, sub, t0,
-                         false);
+        r = computeNarrowedCall(impl, j.coreA.view, j.coreB.view, CheckedInputs{j.summaryA, j.summaryB}, sub,
+                                t0);
         if (!r) return r;
         const auto mergeStart = core::Clock::now();
         mergeDirection(r->aToB, r->aNearest, j.coreA, j.straysA, j.coreB, a, b, call, threads);
@@ -451,10 +483,10 @@ Result<HausdorffResult> computeNarrowed(Engine::Impl& impl, const PointView& a, 
         auto one = [&](const PointView& q, const core::SetSummary& qSummary, const PointView& t,
                        const core::SetSummary& tSummary,
                        const std::optional<api::NarrowedTargets>& n) -> Result<HausdorffResult> {
-            if (!n) return computeViews(impl, q, t, CheckedInputs{qSummary, tSummary}, sub, t0, false);
+            if (!n) return computeNarrowedCall(impl, q, t, CheckedInputs{qSummary, tSummary}, sub, t0);
             Result<HausdorffResult> d =
-                computeViews(impl, n->core.view, n->targets.view,
-                             CheckedInputs{n->coreSummary, n->targetsSummary}, sub, t0, false);
+                computeNarrowedCall(impl, n->core.view, n->targets.view,
+                                    CheckedInputs{n->coreSummary, n->targetsSummary}, sub, t0);
             if (!d) return d;
             const auto mergeStart = core::Clock::now();
             mergeDirection(d->aToB, d->aNearest, n->core, n->strays, n->targets, q, t, call, threads);
@@ -545,8 +577,10 @@ bool mayNarrow(const core::Bounds& boxA, const core::Bounds& boxB, const PointVi
 // pairs that do not narrow), else from the device's bounds: when the pair
 // narrows, the device stops before its indexes, its upload thrown away
 // (its wall reported as upload). Packed float32 views: float-exact summaries.
+// `narrow` false: no look (the calls of computeNarrowed).
 Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
-                                        const CallOptions& call, std::chrono::steady_clock::time_point t0) {
+                                        const CallOptions& call, std::chrono::steady_clock::time_point t0,
+                                        bool narrow) {
     if (auto err = core::checkShape(a, "A")) return *err;
     if (auto err = core::checkShape(b, "B")) return *err;
     if (auto err = validateCallOptions(call)) return *err;
@@ -554,7 +588,8 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
     std::optional<CheckedInputs> checked;
     double narrowingMs = 0.0;  // looking for it (Timings::pieces), whether it narrows or not
     std::function<bool(const core::Bounds&, const core::Bounds&)> leave;
-    const bool check = a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call);
+    const bool check =
+        narrow && a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call);
     const int threads = impl.options.threads;
     if (check && impl.backend->caps().narrowOnHost) {
         // The boxes on the host first; bad points are left to the ingest to report.
@@ -598,13 +633,7 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
 
 Result<HausdorffResult> Engine::compute(PointView a, PointView b, const CallOptions& call) {
     const auto t0 = std::chrono::steady_clock::now();
-    api::PairShape shape;
-    shape.input = api::PairShape::Input::kHostViews;
-    shape.a = a.count;
-    shape.b = b.count;
-    shape.packedFloat = a.packedFloat() && b.packedFloat();
-    const api::Plan plan =
-        api::planRoute(shape, call, m_impl->backend->memoryBudget(), m_impl->backend->caps());
+    const api::Plan plan = planHostViews(*m_impl, a, b, call);
     if (plan.route == api::Route::kDeviceIngest) return computeIngested(*m_impl, a, b, call, t0);
     if (auto err = validatePerPointSizes(a, b, call)) return *err;
     Result<CheckedInputs> checked = checkInputs(a, b, m_impl->options.threads);

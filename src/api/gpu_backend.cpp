@@ -97,7 +97,8 @@ public:
         caps.ingestPoints = gpu_algo::GpuHausdorff::ingestPoints();
         caps.lanes = int(m_lanes.size());
         caps.piecesOnOutOfMemory = m_options.memoryBudget == 0;
-        caps.narrowOnHost = m_options.tuning->narrowHostBounds.value_or(first().context->cpuDevice());
+        caps.cpuDevice = first().context->cpuDevice();
+        caps.narrowOnHost = m_options.tuning->narrowHostBounds.value_or(caps.cpuDevice);
         if (!first().context->borrowed())
             caps.noDeviceViews =
                 "device views (DevicePointView) need an Engine created on your VkDevice "

@@ -91,6 +91,10 @@ struct BackendCaps {
     // targets from boxes taken on the host before the ingest, not from the
     // ingest's own (Tuning::narrowHostBounds).
     bool narrowOnHost = false;
+    // The device is the host's own CPU (lavapipe): what the device does
+    // costs host time too (a narrowed pair's calls then stay on the host
+    // views whose boxes the narrowing took, engine.cpp computeNarrowedCall).
+    bool cpuDevice = false;
 };
 
 struct Plan {
