@@ -571,12 +571,13 @@ bool mayNarrow(const core::Bounds& boxA, const core::Bounds& boxB, const PointVi
 
 // Route::kDeviceIngest: a one-shot call on packed float arrays: the device
 // checks, bounds and samples the points; the host only copies them.
-// Pairs of at most kNarrowCheckPoints points in all look for narrowed
-// targets (route_planner.hpp): from boxes the host takes first where the
-// backend says so (BackendCaps::narrowOnHost; the device then ingests only
-// pairs that do not narrow), else from the device's bounds: when the pair
-// narrows, the device stops before its indexes, its upload thrown away
-// (its wall reported as upload). Packed float32 views: float-exact summaries.
+// Every pair looks for narrowed targets (route_planner.hpp): pairs of at
+// most kNarrowCheckPoints points in all from boxes the host takes first
+// where the backend says so (BackendCaps::narrowOnHost; the device then
+// ingests only pairs that do not narrow), the others from the device's
+// bounds: when the pair narrows, the device stops before its indexes, its
+// upload thrown away (its wall reported as upload). Packed float32 views:
+// float-exact summaries.
 // `narrow` false: no look (the calls of computeNarrowed).
 Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, const PointView& b,
                                         const CallOptions& call, std::chrono::steady_clock::time_point t0,
@@ -588,10 +589,9 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
     std::optional<CheckedInputs> checked;
     double narrowingMs = 0.0;  // looking for it (Timings::pieces), whether it narrows or not
     std::function<bool(const core::Bounds&, const core::Bounds&)> leave;
-    const bool check =
-        narrow && a.count + b.count <= api::kNarrowCheckPoints && !validatePerPointSizes(a, b, call);
+    const bool check = narrow && !validatePerPointSizes(a, b, call);
     const int threads = impl.options.threads;
-    if (check && impl.backend->caps().narrowOnHost) {
+    if (check && impl.backend->caps().narrowOnHost && a.count + b.count <= api::kNarrowCheckPoints) {
         // The boxes on the host first; bad points are left to the ingest to report.
         const auto start = core::Clock::now();
         Result<CheckedInputs> boxes = checkInputs(a, b, threads);

@@ -294,6 +294,57 @@ TEST(NarrowedTargets, DeviceIngestNarrowsFromEitherBoxes) {
     }
 }
 
+// A device-ingest pair past kNarrowCheckPoints narrows too (from the
+// device's bounds; until session 17 it was ingested as it was and every
+// cluster query went to the rays: 8 s for 5M + 5M on an H200). A 1 mm
+// lattice of 128^3 points at spacing 2^-17 m and one common point 1.7 km
+// away in each set, B the lattice moved by 2^-19 m along x (both in one
+// shuffled order): every cluster query's nearest is its twin at exactly
+// 2^-19 (all coordinates float values), so H = 2^-19 and both witnesses are
+// query 0 and target 0 (the smallest indices of the tie).
+TEST(NarrowedTargets, IngestPairsPastTheHostCheckSizeNarrowToo) {
+    constexpr int kSide = 128;
+    constexpr float kStep = 0x1p-17f, kShift = 0x1p-19f;
+    std::vector<glm::vec3> a, b;
+    a.reserve(size_t(kSide) * kSide * kSide + 1);
+    b.reserve(a.capacity());
+    for (int z = 0; z < kSide; ++z)
+        for (int y = 0; y < kSide; ++y)
+            for (int x = 0; x < kSide; ++x) {
+                const glm::vec3 p(float(x) * kStep, float(y) * kStep, float(z) * kStep);
+                a.push_back(p);
+                b.push_back(p + glm::vec3(kShift, 0.0f, 0.0f));
+            }
+    // One shuffle for both (twins keep one index): in lattice order a
+    // strided sample of the queries would see x = 0 only (its stride is a
+    // multiple of 128) and no core would split off.
+    std::vector<size_t> order(a.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::shuffle(order.begin(), order.end(), std::mt19937_64(17));
+    std::vector<glm::vec3> sa(a.size()), sb(b.size());
+    for (size_t i = 0; i < order.size(); ++i) {
+        sa[i] = a[order[i]];
+        sb[i] = b[order[i]];
+    }
+    a = std::move(sa);
+    b = std::move(sb);
+    const glm::vec3 far(1000.0f, 1000.0f, 1000.0f);
+    a.push_back(far);
+    b.push_back(far);
+    ASSERT_GT(a.size() + b.size(), api::kNarrowCheckPoints);
+    RTHDIST_REQUIRE_ENGINE(engine, test::engineUnderTest());
+    Result<HausdorffResult> r = engine->compute(a, b);
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_EQ(r->hausdorff, double(kShift));
+    for (const Directed* d : {&r->aToB, &r->bToA}) {
+        EXPECT_EQ(d->distance, double(kShift));
+        EXPECT_EQ(d->queryIndex, 0u);
+        EXPECT_EQ(d->targetIndex, 0u);
+        EXPECT_TRUE(d->certificate.confirmed);
+    }
+    EXPECT_GT(r->aToB.counters.narrowedTargets + r->bToA.counters.narrowedTargets, 0u);
+}
+
 // The narrowing alone (host): the kept targets are exactly those within R of
 // Q's box, in input order, R bounds every query's nearest distance, and
 // nothing narrows where no gain is possible.
