@@ -100,8 +100,9 @@ struct Counters {
     uint64_t queries = 0;                // query points
     uint64_t culledByNeighbourhood = 0;  // queries resolved before any ray
     uint64_t survivingQueries = 0;       // queries that entered candidate search
-    uint32_t iterations = 0;             // candidate-search radius iterations
-    uint64_t rays = 0;                   // rays cast over all iterations
+    uint32_t iterations = 0;             // candidate-search radius iterations (each retry class's turn one)
+    uint64_t rays = 0;                   // rays cast over all iterations (a retry class's turn: every
+                                         // open query, its class's cast and the others waiting)
     uint64_t candidatePairs = 0;         // (query, cell) pairs refined
     uint64_t tailScanned = 0;            // GPU backends: queries of the search's far tail that
                                          // scanned whole cells of a coarse level instead of more radii

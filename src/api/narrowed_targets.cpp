@@ -431,7 +431,12 @@ core::Bounds sampledCore(const PointView& q, size_t samples) {
     constexpr size_t kDrop = 8;
     const size_t step = std::max<size_t>(1, q.count / std::max<size_t>(samples, 1));
     std::vector<double> axis[3];
-    for (size_t i = 0; i < q.count; i += step) {
+    for (size_t s = 0, first = 0; first < q.count; ++s, first += step) {
+        // One point of each stride, at a fixed pseudo-random place in it: a
+        // lattice in raster order (a voxel grid's points) sampled at a
+        // stride that is a multiple of its row put every sample on one
+        // plane, a box of no extent on that axis, and no core split off.
+        const size_t i = std::min(q.count - 1, first + size_t((s * 0x9E3779B97F4A7C15ull) >> 40) % step);
         const glm::dvec3 p = q.at(i);
         for (int k = 0; k < 3; ++k) axis[k].push_back(p[k]);
     }

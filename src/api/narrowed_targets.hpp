@@ -117,10 +117,11 @@ struct PairNarrowing {
 // one box), as the search would see it.
 [[nodiscard]] double frameMagnitude(const core::Bounds& box, bool floatExact);
 
-// A box around most of q's points (q not empty): a strided sample's box
-// (about `samples` points) without its 8 most extreme values on each side of
-// each axis, grown by its extent on every side (the sample misses the
-// core's own extremes). Where the strays are few, they lie outside it.
+// A box around most of q's points (q not empty): the box of a sample of
+// about `samples` points (one of each stride of q.count / samples, at a
+// fixed pseudo-random place in it) without its 8 most extreme values on each
+// side of each axis, grown by its extent on every side (the sample misses
+// the core's own extremes). Where the strays are few, they lie outside it.
 [[nodiscard]] core::Bounds sampledCore(const PointView& q, size_t samples = 1024);
 
 // q's core when its frame can gain against the pair's magnitude `whole`

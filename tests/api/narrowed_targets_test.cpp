@@ -438,6 +438,29 @@ TEST(NarrowTargets, NothingNarrowsWithoutGain) {
                                    core::boundsOf(withStrays), false, 2));
 }
 
+// A lattice in raster order (a voxel grid's points): a sample at a stride
+// that is a multiple of its rows saw x = 0 alone, its box had no extent on
+// x and no core split off (every other point lay outside it). The sample's
+// place in each stride varies now: the core is the lattice, the strays the
+// three far points.
+TEST(NarrowTargets, RasterOrderLatticeSplitsOffItsStrays) {
+    constexpr int kSide = 64;
+    std::vector<glm::vec3> q;
+    for (int z = 0; z < kSide; ++z)
+        for (int y = 0; y < kSide; ++y)
+            for (int x = 0; x < kSide; ++x) q.push_back(glm::vec3(float(x), float(y), float(z)) * 0x1p-16f);
+    for (const glm::vec3& far :
+         {glm::vec3(3000.0f, 0.0f, 0.0f), glm::vec3(0.0f, -2000.0f, 10.0f), glm::vec3(1.0f, 1.0f, 9000.0f)})
+        q.push_back(far);
+    const core::Bounds box = core::boundsOf(q);
+    const std::optional<api::CoreSplit> split =
+        api::splitCore(q, core::SetSummary{box, true}, true, core::largestMagnitude(box), 2);
+    ASSERT_TRUE(split);
+    EXPECT_EQ(split->strays, (std::vector<uint64_t>{q.size() - 3, q.size() - 2, q.size() - 1}));
+    EXPECT_EQ(split->core.box.lo, glm::dvec3(0.0));
+    EXPECT_EQ(split->core.box.hi, glm::dvec3(double(kSide - 1) * 0x1p-16));
+}
+
 TEST(NarrowTargets, GainThreshold) {
     EXPECT_TRUE(api::narrowingPays(256.0, 1.0));
     EXPECT_FALSE(api::narrowingPays(255.0, 1.0));
