@@ -503,7 +503,8 @@ std::optional<CoreSplit> splitCore(const PointView& q, const core::SetSummary& s
                 S c[3];
                 std::memcpy(c, base + i * q.strideBytes, sizeof(c));
                 const V p(c[0], c[1], c[2]);
-                outside |= glm::any(glm::lessThan(p, boxLo)) | glm::any(glm::greaterThan(p, boxHi));
+                outside =
+                    outside || glm::any(glm::lessThan(p, boxLo)) || glm::any(glm::greaterThan(p, boxHi));
                 coreLo = glm::min(coreLo, p);
                 coreHi = glm::max(coreHi, p);
                 if constexpr (std::is_same_v<S, double>) floatExact &= isFloat(p);
