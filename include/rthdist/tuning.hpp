@@ -65,8 +65,18 @@ struct Tuning {
     // on a CPU device (lavapipe: the ingest is host work as well, about 55 of
     // cluster-1M's 590-650 ms on 2 cores), off on a GPU (where the ingest is
     // cheap and the pass would cost every pair that does not narrow).
+    // Larger pairs look from the ingest's bounds whatever this says.
     // RTHDIST_NARROW_HOST_BOUNDS (0: off, else on).
     std::optional<bool> narrowHostBounds;
+    // A narrowed pair's calls (its cores, or a direction's core and kept
+    // targets, packed float32) take the device ingest, which converts the
+    // points on the device; else the host views' route, which reuses the
+    // boxes the narrowing took and stages the points from the host. Default:
+    // on a GPU (on an H200 the host staging was ~2 of cluster-200k's 5 ms),
+    // off on a CPU device (lavapipe: the ingest's pass is host work too,
+    // 63 -> 80 ms on that row on 2 cores). RTHDIST_NARROWED_INGEST (0: off,
+    // else on).
+    std::optional<bool> narrowedIngest;
     // Debug names and labels on Vulkan objects and command buffers without
     // validation, for GPU captures (~0.1 ms per prepared set on an H100).
     // RTHDIST_DEBUG_LABELS (set and not 0).

@@ -387,16 +387,18 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
 
 // One call of a narrowed pair (both cores, or a direction's core and kept
 // targets) on the route Engine::compute takes for its shape, without
-// looking for narrowing again: on a GPU, packed float32 subsets go to the
-// device ingest (the device converts them: the host staging of
-// computeViews took ~2 of the 5 ms of a call of 2 x 200k points on an H200,
-// the ingest ~0.3); on a CPU device (lavapipe) to computeViews, which
-// reuses the boxes the narrowing took (there the ingest's pass is host
-// work too: 63 -> 80 ms on that pair on 2 cores).
+// looking for narrowing again: where BackendCaps::narrowedIngest (a GPU by
+// default), packed float32 subsets go to the device ingest (the device
+// converts them: the host staging of computeViews took ~2 of the 5 ms of a
+// call of 2 x 200k points on an H200, the ingest ~0.3); else (a CPU device,
+// lavapipe) to computeViews, which reuses the boxes the narrowing took
+// (there the ingest's pass is host work too: 63 -> 80 ms on that pair on 2
+// cores).
 Result<HausdorffResult> computeNarrowedCall(Engine::Impl& impl, const PointView& a, const PointView& b,
                                             const CheckedInputs& checked, const CallOptions& call,
                                             std::chrono::steady_clock::time_point t0) {
-    if (!impl.backend->caps().cpuDevice && planHostViews(impl, a, b, call).route == api::Route::kDeviceIngest)
+    if (impl.backend->caps().narrowedIngest &&
+        planHostViews(impl, a, b, call).route == api::Route::kDeviceIngest)
         return computeIngested(impl, a, b, call, t0, false);
     return computeViews(impl, a, b, checked, call, t0, false);
 }

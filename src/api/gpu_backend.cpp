@@ -97,8 +97,9 @@ public:
         caps.ingestPoints = gpu_algo::GpuHausdorff::ingestPoints();
         caps.lanes = int(m_lanes.size());
         caps.piecesOnOutOfMemory = m_options.memoryBudget == 0;
-        caps.cpuDevice = first().context->cpuDevice();
-        caps.narrowOnHost = m_options.tuning->narrowHostBounds.value_or(caps.cpuDevice);
+        const bool cpuDevice = first().context->cpuDevice();
+        caps.narrowOnHost = m_options.tuning->narrowHostBounds.value_or(cpuDevice);
+        caps.narrowedIngest = m_options.tuning->narrowedIngest.value_or(!cpuDevice);
         if (!first().context->borrowed())
             caps.noDeviceViews =
                 "device views (DevicePointView) need an Engine created on your VkDevice "

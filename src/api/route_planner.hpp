@@ -92,10 +92,10 @@ struct BackendCaps {
     // ingest's own (Tuning::narrowHostBounds); larger pairs always from the
     // ingest's.
     bool narrowOnHost = false;
-    // The device is the host's own CPU (lavapipe): what the device does
-    // costs host time too (a narrowed pair's calls then stay on the host
-    // views whose boxes the narrowing took, engine.cpp computeNarrowedCall).
-    bool cpuDevice = false;
+    // A narrowed pair's calls take the device ingest (Tuning::narrowedIngest;
+    // engine.cpp computeNarrowedCall), else the host views whose boxes the
+    // narrowing took.
+    bool narrowedIngest = false;
 };
 
 struct Plan {

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "api/narrowed_targets.hpp"
@@ -267,19 +268,24 @@ TEST(NarrowedTargets, TiesBetweenTheCoreAndAStrayTakeTheSmallerQueryIndex) {
 
 // Pairs of the device ingest (packed float32, no small-pair scan) look for
 // narrowing from the host's boxes or from the device's, which it then
-// leaves (Tuning::narrowHostBounds): the same exact answers either way.
+// leaves (Tuning::narrowHostBounds), and the narrowed calls take the device
+// ingest or the host views (Tuning::narrowedIngest; lavapipe's default is
+// the views, a GPU's the ingest): the same exact answers every way.
 TEST(NarrowedTargets, DeviceIngestNarrowsFromEitherBoxes) {
     std::vector<glm::vec3> a = farCluster(3000, 1e-3f, 0, 101), b = farCluster(2800, 1e-3f, 0, 102);
     const glm::vec3 far(0.0f, 1700.0f, 0.0f);
     a.push_back(far);
     b.push_back(far);
     const std::vector<glm::vec3> one = farCluster(2600, 1e-3f, 5, 103), c = farCluster(2700, 1e-3f, 0, 104);
-    for (bool hostBounds : {false, true}) {
-        SCOPED_TRACE(hostBounds ? "host bounds" : "device bounds");
+    for (int way = 0; way < 4; ++way) {
+        const bool hostBounds = way % 2 == 1, narrowedIngest = way / 2 == 1;
+        SCOPED_TRACE(std::string(hostBounds ? "host bounds" : "device bounds") +
+                     (narrowedIngest ? ", narrowed calls ingested" : ", narrowed calls on host views"));
         EngineOptions options = test::engineUnderTest();
         options.tuning = Tuning{};
         options.tuning->smallPairWork = 0;
         options.tuning->narrowHostBounds = hostBounds;
+        options.tuning->narrowedIngest = narrowedIngest;
         RTHDIST_REQUIRE_ENGINE(engine, options);
         for (auto [q, t] : {std::pair{a, b}, std::pair{one, c}, std::pair{c, one}}) {
             for (bool perPoint : {false, true}) {

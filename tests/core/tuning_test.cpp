@@ -15,7 +15,8 @@ TEST(Tuning, EveryVariableLandsInItsField) {
         e("RTHDIST_TAIL_SCAN_START", "4294967296"), f("RTHDIST_HOST_IMPORT", "1"),
         g("RTHDIST_DEBUG_LABELS", "yes"), h("RTHDIST_SUBMIT_TRACE", "1"), i("RTHDIST_FENCE_SPIN_US", "7"),
         j("RTHDIST_POOL_SPIN_US", "0"), k("RTHDIST_CACHE_DIR", "/tmp/rthdist-tuning-test"),
-        l("RTHDIST_SWEEP_WORK", "99"), m("RTHDIST_NARROW_HOST_BOUNDS", "0");
+        l("RTHDIST_SWEEP_WORK", "99"), m("RTHDIST_NARROW_HOST_BOUNDS", "0"),
+        n("RTHDIST_NARROWED_INGEST", "1");
     const Tuning t = tuningFromEnvironment();
     EXPECT_EQ(t.smallPairWork, 0u);
     EXPECT_EQ(t.searchRadiiPerSubmission, 3u);
@@ -25,6 +26,7 @@ TEST(Tuning, EveryVariableLandsInItsField) {
     EXPECT_EQ(t.sweepWork, 99u);
     EXPECT_TRUE(t.hostImport);
     EXPECT_EQ(t.narrowHostBounds, false);
+    EXPECT_EQ(t.narrowedIngest, true);
     EXPECT_TRUE(t.debugLabels);
     EXPECT_TRUE(t.traceSubmits);
     EXPECT_EQ(t.fenceSpinMicros, 7u);
@@ -38,7 +40,8 @@ TEST(Tuning, UnsetOrUnparsableLeavesTheLibrarysChoice) {
         e("RTHDIST_TAIL_SCAN_START", ""), f("RTHDIST_HOST_IMPORT", "yes"), g("RTHDIST_DEBUG_LABELS", "0"),
         h("RTHDIST_SUBMIT_TRACE", nullptr), i("RTHDIST_FENCE_SPIN_US", "12us"),
         j("RTHDIST_POOL_SPIN_US", nullptr), k("RTHDIST_CACHE_DIR", nullptr), l("XDG_CACHE_HOME", "/tmp/xdg"),
-        m("HOME", "/tmp/home"), n("RTHDIST_SWEEP_WORK", "x"), o("RTHDIST_NARROW_HOST_BOUNDS", nullptr);
+        m("HOME", "/tmp/home"), n("RTHDIST_SWEEP_WORK", "x"), o("RTHDIST_NARROW_HOST_BOUNDS", nullptr),
+        q("RTHDIST_NARROWED_INGEST", nullptr);
     const Tuning t = tuningFromEnvironment();
     EXPECT_FALSE(t.smallPairWork);
     EXPECT_FALSE(t.searchRadiiPerSubmission);
@@ -48,6 +51,7 @@ TEST(Tuning, UnsetOrUnparsableLeavesTheLibrarysChoice) {
     EXPECT_FALSE(t.sweepWork);
     EXPECT_FALSE(t.hostImport);
     EXPECT_FALSE(t.narrowHostBounds);
+    EXPECT_FALSE(t.narrowedIngest);
     EXPECT_FALSE(t.debugLabels);
     EXPECT_FALSE(t.traceSubmits);
     EXPECT_FALSE(t.fenceSpinMicros);
