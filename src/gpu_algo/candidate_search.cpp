@@ -78,7 +78,8 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
         m_retryStride = 1;
         m_retryPhase = 0;
         if (schedule.retryExhausted())
-            throw std::runtime_error("candidate search: one query's candidate cells at radius " +
+            throw std::runtime_error("candidate search: the candidate cells of one retry class of " +
+                                     std::to_string(schedule.retryStride()) + " at radius " +
                                      std::to_string(submitted[out.run - 1]) + " exceed the pair buffer's " +
                                      std::to_string(pairCapacity) + " pairs, its most");
         builtLevel = level;

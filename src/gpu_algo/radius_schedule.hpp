@@ -183,8 +183,10 @@ public:
     // turn it is.
     [[nodiscard]] uint32_t retryStride() const { return m_stride; }
     [[nodiscard]] uint32_t retryPhase() const { return m_phase; }
-    // Whether a class of at most one query (stride >= `queries`) overflowed
-    // the full buffer: its own candidate cells at this radius exceed it.
+    // Whether a class that overflowed the full buffer cannot be split
+    // further: it holds at most one query (stride >= `queries`: that
+    // query's own candidate cells at this radius exceed the buffer), or the
+    // split would pass kMaxRetryClasses.
     [[nodiscard]] bool retryExhausted() const { return m_exhausted; }
 
     [[nodiscard]] double radius() const { return m_radius; }
