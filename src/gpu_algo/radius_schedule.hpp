@@ -47,8 +47,9 @@ inline constexpr uint32_t kTailScanCells = 4096;
 inline constexpr uint64_t kSweepWorkGpu = uint64_t(1) << 31;
 inline constexpr uint64_t kSweepWorkCpuDevice = uint64_t(1) << 24;
 
-// Retry classes (RadiusSchedule::advance) at most: past this a class that
-// still overflows the full buffer is one query's own candidates.
+// Retry classes (RadiusSchedule::advance) at most: a class that still
+// overflows the full buffer when a finer split would pass this, or that
+// holds one query, ends the search with an error (retryExhausted).
 inline constexpr uint32_t kMaxRetryClasses = uint32_t(1) << 16;
 
 // What the schedule knows of the target index (gpu_algo/point_index.hpp):
