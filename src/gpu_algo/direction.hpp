@@ -48,6 +48,12 @@ struct DirectionRun {
     double slack = 0.0;                        // the certificate's e, search units
     std::vector<core::BandNearest> settled{};  // band queries the certificate settled in double
     [[nodiscard]] std::string name() const { return Q.name + "->" + T.name; }
+    // Takes nearestHost, `nearest`'s host copy (Q.n words of read-back
+    // memory), from the workspace slot of `direction`.
+    void takeNearestHost(Workspace& ws, size_t direction) {
+        nearestHost = &ws.grow(ws.scratch.directions[direction].nearestHost, VkDeviceSize(Q.n) * 4,
+                               name() + ".nearestHost", MemoryKind::kReadback);
+    }
 };
 
 // The addresses that the candidate search and the refinement of one radius

@@ -56,9 +56,7 @@ void NeighbourhoodPass::startDirection(DirectionRun& d, size_t direction) {
     if (d.perPoint) {
         const VkDeviceSize bytes = VkDeviceSize(d.Q.n) * 4;
         d.nearest = &m_ws.grow(memory.nearest, bytes, d.name() + ".nearest");
-        if (!sparse)
-            d.nearestHost =
-                &m_ws.grow(memory.nearestHost, bytes, d.name() + ".nearestHost", MemoryKind::kReadback);
+        if (!sparse) d.takeNearestHost(m_ws, direction);
     }
     d.above = d.aboveHost = nullptr;
     d.aboveCapacity = 0;

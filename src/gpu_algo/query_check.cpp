@@ -133,8 +133,7 @@ std::optional<std::vector<detail::QueryNearest>> QueryCheck::readAboveFloor(Dire
     uint32_t count = 0;
     std::memcpy(&count, d.blk.host + RTHDIST_CTR_ABOVE_COUNT, 4);
     if (count > d.aboveCapacity) {  // overflowed: the dense array, as readPerPoint reads it
-        d.nearestHost = &m_ws.grow(m_ws.scratch.directions[direction].nearestHost, VkDeviceSize(d.Q.n) * 4,
-                                   d.name() + ".nearestHost", MemoryKind::kReadback);
+        d.takeNearestHost(m_ws, direction);
         VkCommandBuffer cmd = m_ws.ctx.begin();
         const VkBufferCopy all{0, 0, VkDeviceSize(d.Q.n) * 4};
         vkCmdCopyBuffer(cmd, d.nearest->handle(), d.nearestHost->handle(), 1, &all);
