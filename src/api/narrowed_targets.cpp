@@ -485,36 +485,22 @@ std::optional<CoreSplit> splitCore(const PointView& q, const core::SetSummary& s
             Part& part = parts[begin / kChunk];
             V coreLo(std::numeric_limits<S>::infinity()), coreHi(-std::numeric_limits<S>::infinity());
             bool floatExact = true;
-            // Most chunks hold no stray: their box without a branch a point
-            // first (packed floats four at a time), the chunk again point by
-            // point only when one lies outside.
-            bool outside = false, scanned = false;
+            // Packed floats four at a time (most chunks hold no stray: their
+            // box is then the chunk's); other views, and a chunk with a point
+            // outside, point by point.
+            bool scanned = false;
             if constexpr (std::is_same_v<S, float>) {
                 if (q.strideBytes == 3 * sizeof(float)) {
                     const core::PackedScan scan = core::scanPackedFloats(
                         reinterpret_cast<const float*>(base) + 3 * begin, end - begin, lo, hi);
-                    coreLo = scan.box.lo;
-                    coreHi = scan.box.hi;
-                    outside = scan.outside;
-                    scanned = true;
+                    scanned = !scan.outside;
+                    if (scanned) {
+                        coreLo = scan.box.lo;
+                        coreHi = scan.box.hi;
+                    }
                 }
             }
             for (size_t i = scanned ? end : begin; i < end; ++i) {
-                S c[3];
-                std::memcpy(c, base + i * q.strideBytes, sizeof(c));
-                const V p(c[0], c[1], c[2]);
-                outside =
-                    outside || glm::any(glm::lessThan(p, boxLo)) || glm::any(glm::greaterThan(p, boxHi));
-                coreLo = glm::min(coreLo, p);
-                coreHi = glm::max(coreHi, p);
-                if constexpr (std::is_same_v<S, double>) floatExact &= isFloat(p);
-            }
-            if (outside) {
-                coreLo = V(std::numeric_limits<S>::infinity());
-                coreHi = V(-std::numeric_limits<S>::infinity());
-                floatExact = true;
-            }
-            for (size_t i = outside ? begin : end; i < end; ++i) {
                 S c[3];
                 std::memcpy(c, base + i * q.strideBytes, sizeof(c));
                 const V p(c[0], c[1], c[2]);
