@@ -69,23 +69,19 @@ void CandidateSearch::runSearch(DirectionRun& d, uint32_t numActive, const CallO
         }
         const int level = schedule.level();
         const std::vector<double> submitted = schedule.nextRadii();
-        const bool classTurn = schedule.retryStride() > 1;
-        m_retryStride = schedule.retryStride();
-        m_retryPhase = schedule.retryPhase();
-        const RadiiOutcome out =
-            runRadii(d, level, level == builtLevel, submitted, *pairs, pairCapacity, numActive);
+        const RetryClass retry = schedule.retryClass();
+        const RadiiOutcome out = runRadii(d, level, level == builtLevel, submitted, *pairs, pairCapacity,
+                                          numActive, SearchStep::kRadii, retry);
         schedule.advance(submitted, numActive, out, pairCapacity >= m_ws.maxPairCapacity ? pairCapacity : 0);
-        m_retryStride = 1;
-        m_retryPhase = 0;
         if (schedule.retryExhausted())
             throw std::runtime_error("candidate search: the candidate cells of one retry class of " +
-                                     std::to_string(schedule.retryStride()) + " at radius " +
+                                     std::to_string(schedule.retryClass().stride) + " at radius " +
                                      std::to_string(submitted[out.run - 1]) + " exceed the pair buffer's " +
                                      std::to_string(pairCapacity) + " pairs, its most");
         builtLevel = level;
         d.out.counters.iterations += out.run;
         // A retry class's turns at one radius (bounded by the classes) are one step.
-        steps += classTurn ? 0u : out.run;
+        steps += retry.stride > 1 ? 0u : out.run;
         if (steps > kMaxIterations)
             throw std::runtime_error("candidate search did not converge within " +
                                      std::to_string(kMaxIterations) + " radii");
@@ -112,7 +108,7 @@ int CandidateSearch::tailScanLevel(const RadiusSchedule& schedule, PointIndex& T
 
 RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLevel,
                                        std::span<const double> radii, Buffer& pairs, uint64_t pairCapacity,
-                                       uint32_t numActive, SearchStep step) {
+                                       uint32_t numActive, SearchStep step, RetryClass retry) {
     const bool wholeLevel = step != SearchStep::kRadii;
     const PointIndex::Level lv = m_index.levelCells(d.T, level);  // may build the level (a submission)
     const auto t0 = Clock::now();
@@ -139,7 +135,7 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
             m_refine.cmdTailScan(cmd, d, lv, level > 0, numActive);
         } else {
             const uint32_t before = i == 0 ? 0 : marks.back().second + 1;
-            cmdSearch(cmd, d, lv, sameLevel || i > 0, radii[i], pairs, pairCapacity, numActive);
+            cmdSearch(cmd, d, lv, sameLevel || i > 0, radii[i], pairs, pairCapacity, numActive, retry);
             marks.emplace_back(before, m_ws.ctx.cmdMark(cmd));
             m_ws.barrier(cmd);
             m_refine.cmdRefine(cmd, d, lv, level > 0, float(radii[i]), sameLevel || i > 0, pairs,
@@ -202,7 +198,7 @@ RadiiOutcome CandidateSearch::runRadii(DirectionRun& d, int level, bool sameLeve
 
 void CandidateSearch::cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv,
                                 bool sameLevel, double radius, Buffer& pairs, uint64_t pairCapacity,
-                                uint32_t numActive) {
+                                uint32_t numActive, RetryClass retry) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "candidate search");
     PointIndex& T = d.T;
     const float r = float(radius);
@@ -233,8 +229,8 @@ void CandidateSearch::cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const Poin
     sp.rayTMax = rayTMax;
     sp.skipScanned = sameLevel ? 1u : 0u;
     sp.slotBase = 0u;
-    sp.retryStride = m_retryStride;
-    sp.retryPhase = m_retryPhase;
+    sp.retryStride = retry.stride;
+    sp.retryPhase = retry.phase;
     // Sized by the device (search_advance.comp: the queries still searched)
     // where one dispatch or trace holds them all; else numActive slots, the
     // ones past the device's count returning at once.

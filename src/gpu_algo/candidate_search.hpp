@@ -55,15 +55,16 @@ public:
     // only once no query goes on). `step` kTailScan: one step, the far
     // tail's scan of every cell of `level`; kSweep: one step, every target
     // (radii unused); after either no query goes on.
+    // `retry`: the queries the radii search (the others wait).
     RadiiOutcome runRadii(DirectionRun& d, int level, bool sameLevel, std::span<const double> radii,
                           Buffer& pairs, uint64_t pairCapacity, uint32_t numActive,
-                          SearchStep step = SearchStep::kRadii);
+                          SearchStep step = SearchStep::kRadii, RetryClass retry = {});
 
     // Records the search of one radius: the level's boxes grown by the
     // radius, the BLAS refitted (same level) or rebuilt, one ray per active
     // query; the rays append (query, cell) pairs.
     void cmdSearch(VkCommandBuffer cmd, DirectionRun& d, const PointIndex::Level& lv, bool sameLevel,
-                   double radius, Buffer& pairs, uint64_t pairCapacity, uint32_t numActive);
+                   double radius, Buffer& pairs, uint64_t pairCapacity, uint32_t numActive, RetryClass retry);
 
     // One ray per active slot, in traces of at most maxRayDispatch rays
     // (each trace sees its first slot in SearchPush::slotBase).
@@ -77,8 +78,6 @@ private:
     IndexBuild& m_index;
     Refinement& m_refine;
     QueryCheck& m_check;
-    // The retry class the next cmdSearch searches (RadiusSchedule::retryStride, retryPhase).
-    uint32_t m_retryStride = 1, m_retryPhase = 0;
 };
 
 }  // namespace rthdist::gpu_algo

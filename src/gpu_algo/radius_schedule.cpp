@@ -59,7 +59,7 @@ int RadiusSchedule::tailLevel(uint32_t open, int builtLevels,
 std::vector<double> RadiusSchedule::nextRadii() const {
     const int first = level();
     std::vector<double> radii{m_radius};
-    const uint32_t chunk = m_stride > 1 ? 1u : std::min(m_chunk, m_settings.radiiPerSubmission);
+    const uint32_t chunk = m_retry.stride > 1 ? 1u : std::min(m_chunk, m_settings.radiiPerSubmission);
     while (radii.size() < chunk) {
         const double next = radii.back() * m_step;
         if (levelFor(m_grid, next) != first) break;
@@ -88,26 +88,27 @@ void RadiusSchedule::advance(std::span<const double> radii, uint32_t before, con
     m_radius = radii[out.run - 1];
     const bool full = out.overflowed && fullCapacity > 0;
     bool again = out.overflowed;  // the same radius next
-    if (m_stride > 1) {
+    if (m_retry.stride > 1) {
         if (full) {
             // This class overflowed too: split it (its queries fall into
-            // classes m_phase + k * m_stride of the finer split, which the
-            // turns from m_phase on reach; the earlier ones are done).
+            // classes m_retry.phase + k * m_retry.stride of the finer split, which the
+            // turns from m_retry.phase on reach; the earlier ones are done).
             const uint64_t finer =
-                uint64_t(m_stride) *
+                uint64_t(m_retry.stride) *
                 std::min<uint64_t>(classesFor(out.lastPairs, fullCapacity), kMaxRetryClasses);
-            m_exhausted = m_stride >= m_queries || finer > kMaxRetryClasses;
-            if (!m_exhausted) m_stride = uint32_t(finer);
+            m_exhausted = m_retry.stride >= m_queries || finer > kMaxRetryClasses;
+            if (!m_exhausted) m_retry.stride = uint32_t(finer);
             again = true;
-        } else if (!out.overflowed && ++m_phase == m_stride) {
-            m_stride = 1;  // every class had its turn: the radius grows
-            m_phase = 0;
+        } else if (!out.overflowed && ++m_retry.phase == m_retry.stride) {
+            m_retry.stride = 1;  // every class had its turn: the radius grows
+            m_retry.phase = 0;
         } else {
             again = true;  // the next class (or this one again, with a larger buffer)
         }
     } else if (full && uint64_t(out.stillOpen) * 8 > uint64_t(before) * 7) {
-        m_stride = uint32_t(std::min<uint64_t>(classesFor(out.lastPairs, fullCapacity), kMaxRetryClasses));
-        m_phase = 0;
+        m_retry.stride =
+            uint32_t(std::min<uint64_t>(classesFor(out.lastPairs, fullCapacity), kMaxRetryClasses));
+        m_retry.phase = 0;
     }
     if (!again) m_radius *= m_step;
 }

@@ -52,6 +52,13 @@ inline constexpr uint64_t kSweepWorkCpuDevice = uint64_t(1) << 24;
 // holds one query, ends the search with an error (retryExhausted).
 inline constexpr uint32_t kMaxRetryClasses = uint32_t(1) << 16;
 
+// The queries a search submission searches: those with qi % stride ==
+// phase (stride 1: all); the others wait (RadiusSchedule::advance).
+struct RetryClass {
+    uint32_t stride = 1;
+    uint32_t phase = 0;
+};
+
 // What the schedule knows of the target index (gpu_algo/point_index.hpp):
 // its grid's cell edge s and bit count, and whether crowded cells were cut
 // into leaves (then minEdge is the narrowest leaf's edge).
@@ -170,7 +177,7 @@ public:
     // of the queries going on (few queries' pairs all fitted: on an H200 the retries met the
     // same candidates in the same traversal order every time, and the search
     // never ended) splits the queries into retry classes by index,
-    // qi % retryStride(): one class a submission at the same radius, the
+    // qi % retryClass().stride: one class a submission at the same radius, the
     // others waiting (search_visit.glsl), as many classes as the pairs
     // reported would fill the buffer twice over, a class that overflows
     // again split further (its turns then come from its own on), until
@@ -180,10 +187,9 @@ public:
     // Precondition: out.run is 1 .. radii.size().
     void advance(std::span<const double> radii, uint32_t before, const RadiiOutcome& out,
                  uint64_t fullCapacity = 0);
-    // The retry classes (1: every query is searched) and the class whose
-    // turn it is.
-    [[nodiscard]] uint32_t retryStride() const { return m_stride; }
-    [[nodiscard]] uint32_t retryPhase() const { return m_phase; }
+    // The retry classes (stride 1: every query is searched) and the class
+    // whose turn it is.
+    [[nodiscard]] RetryClass retryClass() const { return m_retry; }
     // Whether a class that overflowed the full buffer cannot be split
     // further: it holds at most one query (stride >= `queries`: that
     // query's own candidate cells at this radius exceed the buffer), or the
@@ -206,7 +212,7 @@ private:
     double m_step;
     uint32_t m_chunk = 2;
     bool m_traced = false;
-    uint32_t m_stride = 1, m_phase = 0;
+    RetryClass m_retry;
     bool m_exhausted = false;
 };
 

@@ -135,21 +135,21 @@ RadiiOutcome overflowedFull(uint32_t stillOpen, uint64_t pairs) {
 // radius grows once every class had its turn.
 TEST(RadiusSchedule, StalledFullBufferSearchesRetryClassesInTurn) {
     RadiusSchedule s(unitGrid(), ScheduleSettings{}, 2.0, 1000, 1000);
-    EXPECT_EQ(s.retryStride(), 1u);
+    EXPECT_EQ(s.retryClass().stride, 1u);
     s.advance(s.nextRadii(), 1000, overflowedFull(900, 250), 100);
-    EXPECT_EQ(s.retryStride(), 5u);  // 2 x 250 pairs / 100
-    EXPECT_EQ(s.retryPhase(), 0u);
+    EXPECT_EQ(s.retryClass().stride, 5u);  // 2 x 250 pairs / 100
+    EXPECT_EQ(s.retryClass().phase, 0u);
     EXPECT_EQ(s.radius(), 2.0);
     EXPECT_EQ(s.nextRadii(), (std::vector<double>{2.0}));
     for (uint32_t phase = 1; phase < 5; ++phase) {
         s.advance(s.nextRadii(), 900, reported(1, 850), 100);
-        EXPECT_EQ(s.retryStride(), 5u);
-        EXPECT_EQ(s.retryPhase(), phase);
+        EXPECT_EQ(s.retryClass().stride, 5u);
+        EXPECT_EQ(s.retryClass().phase, phase);
         EXPECT_EQ(s.radius(), 2.0);
     }
     s.advance(s.nextRadii(), 850, reported(1, 800), 100);  // the last class
-    EXPECT_EQ(s.retryStride(), 1u);
-    EXPECT_EQ(s.retryPhase(), 0u);
+    EXPECT_EQ(s.retryClass().stride, 1u);
+    EXPECT_EQ(s.retryClass().phase, 0u);
     EXPECT_EQ(s.radius(), 4.0);
     EXPECT_FALSE(s.retryExhausted());
 }
@@ -161,17 +161,17 @@ TEST(RadiusSchedule, StalledFullBufferSearchesRetryClassesInTurn) {
 TEST(RadiusSchedule, RetryClassThatOverflowsIsSplitUntilOneQuery) {
     RadiusSchedule s(unitGrid(), ScheduleSettings{}, 2.0, 1000, 1000);
     s.advance(s.nextRadii(), 1000, overflowedFull(1000, 100), 100);
-    EXPECT_EQ(s.retryStride(), 2u);
+    EXPECT_EQ(s.retryClass().stride, 2u);
     s.advance(s.nextRadii(), 1000, reported(1, 990), 100);
-    EXPECT_EQ(s.retryPhase(), 1u);
+    EXPECT_EQ(s.retryClass().phase, 1u);
     s.advance(s.nextRadii(), 990, overflowedFull(990, 300), 100);  // class 1 of 2 overflows
-    EXPECT_EQ(s.retryStride(), 12u);                               // 2 x 6
-    EXPECT_EQ(s.retryPhase(), 1u);
+    EXPECT_EQ(s.retryClass().stride, 12u);                         // 2 x 6
+    EXPECT_EQ(s.retryClass().phase, 1u);
     s.advance(s.nextRadii(), 990, overflowedFull(990, 300), 0);  // a buffer that grows: the same turn
-    EXPECT_EQ(s.retryStride(), 12u);
-    EXPECT_EQ(s.retryPhase(), 1u);
+    EXPECT_EQ(s.retryClass().stride, 12u);
+    EXPECT_EQ(s.retryClass().phase, 1u);
     EXPECT_EQ(s.radius(), 2.0);
-    while (s.retryStride() < 1000 && !s.retryExhausted())
+    while (s.retryClass().stride < 1000 && !s.retryExhausted())
         s.advance(s.nextRadii(), 990, overflowedFull(990, 1000), 100);
     EXPECT_FALSE(s.retryExhausted());
     s.advance(s.nextRadii(), 990, overflowedFull(990, 1000), 100);
@@ -183,10 +183,10 @@ TEST(RadiusSchedule, RetryClassThatOverflowsIsSplitUntilOneQuery) {
 TEST(RadiusSchedule, NoRetryClassesWhileTheSearchProgresses) {
     RadiusSchedule grows(unitGrid(), ScheduleSettings{}, 2.0, 1000, 1000);
     grows.advance(grows.nextRadii(), 1000, overflowedFull(1000, 500), 0);
-    EXPECT_EQ(grows.retryStride(), 1u);
+    EXPECT_EQ(grows.retryClass().stride, 1u);
     RadiusSchedule progresses(unitGrid(), ScheduleSettings{}, 2.0, 1000, 1000);
     progresses.advance(progresses.nextRadii(), 1000, overflowedFull(800, 500), 100);
-    EXPECT_EQ(progresses.retryStride(), 1u);
+    EXPECT_EQ(progresses.retryClass().stride, 1u);
     EXPECT_EQ(progresses.radius(), 2.0);
 }
 
