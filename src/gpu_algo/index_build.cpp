@@ -23,6 +23,11 @@ int clampedBits(int bits, uint32_t n) {
 
 namespace {
 
+// Crowded sets of at most this many points together split side by side
+// (IndexBuild::splitLeaves): the second set's leaf scratch and ping-pong
+// buffers (~36 bytes a point) are held beside the first's.
+constexpr uint64_t kSideBySideSplitPoints = uint64_t(1) << 24;
+
 // Points [begin, end) as vec4 records (w = 0) at dst, their box into lo, hi
 // (kept in registers: dst may alias them as far as the compiler knows).
 void toRecords(std::span<const glm::vec3> pts, size_t begin, size_t end, float* dst, glm::vec3& lo,
@@ -179,16 +184,16 @@ void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const Counte
     m_ws.barrier(cmd);
     m_ws.cmdScan(cmd, flags.address(), ix.n, ix.scratch->scanFlags, "scanFlags");
     m_ws.barrier(cmd);
-    cmdCellBuild(cmd, cp);
+    cmdCellBuild(cmd, std::span(&cp, 1));
     m_ws.barrier(cmd);
     cmdCheckIndex(cmd, ix, blk);  // in the same submission: no extra wait
 }
 
-void IndexBuild::finishIndex(PointIndex& ix, const CounterBlock& blk) {
+bool IndexBuild::finishIndex(PointIndex& ix, const CounterBlock& blk) {
     ix.numCells = blk.fields().cells;
     verifyIndex(ix, ix.cellCapacity, blk);
     if (ix.scratch != nullptr) m_ws.recycleBuild(*ix.scratch);  // sorted: the unsorted points, keys spent
-    if (blk.fields().maxCount > kCrowdedCell) splitLeaves(ix);
+    return blk.fields().maxCount > kCrowdedCell;
 }
 
 void IndexBuild::buildIndexes(std::span<PointIndex* const> sets, bool ingested) {
@@ -213,16 +218,29 @@ void IndexBuild::buildIndexes(std::span<PointIndex* const> sets, bool ingested) 
     m_ws.timings->upload += uploadMs;
     m_ws.timings->gpuUpload += uploadMs;
     m_ws.timings->gpuIndex += m_ws.ctx.lastGpuMs() - uploadMs;
-    for (size_t k = 0; k < sets.size(); ++k) finishIndex(*sets[k], m_ws.blocks[k]);
+    std::vector<PointIndex*> crowded;
+    uint64_t crowdedPoints = 0;
+    for (size_t k = 0; k < sets.size(); ++k) {
+        if (!finishIndex(*sets[k], m_ws.blocks[k])) continue;
+        crowded.push_back(sets[k]);
+        crowdedPoints += sets[k]->n;
+    }
+    // Small sets split side by side (their submissions' round trips are a
+    // large share of their split); large ones one after the other, so that
+    // the first's spent buffers serve the second.
+    if (crowdedPoints <= kSideBySideSplitPoints)
+        splitLeaves(crowded);
+    else
+        for (PointIndex* ix : crowded) splitLeaves(std::span(&ix, 1));
     m_ws.timings->index += msSince(t0) - uploadMs;
 }
 
-void IndexBuild::cmdCellBuild(VkCommandBuffer cmd, const sh::CellsPush& cp) {
-    m_ws.dispatch(cmd, Kernel::kCellBuild, cp, cp.n);
+void IndexBuild::cmdCellBuild(VkCommandBuffer cmd, std::span<const sh::CellsPush> cps) {
+    for (const sh::CellsPush& cp : cps) m_ws.dispatch(cmd, Kernel::kCellBuild, cp, cp.n);
     m_ws.barrier(cmd);
-    m_ws.dispatch(cmd, Kernel::kCellBounds, cp, cp.n);
+    for (const sh::CellsPush& cp : cps) m_ws.dispatch(cmd, Kernel::kCellBounds, cp, cp.n);
     m_ws.barrier(cmd);
-    m_ws.dispatch(cmd, Kernel::kCellBoundsFix, cp, cp.cellCapacity);
+    for (const sh::CellsPush& cp : cps) m_ws.dispatch(cmd, Kernel::kCellBoundsFix, cp, cp.cellCapacity);
 }
 
 void IndexBuild::cmdCheckIndex(VkCommandBuffer cmd, const PointIndex& ix, const CounterBlock& blk) {

@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
 
 #include "gpu_algo/point_index.hpp"
 #include "gpu_algo/workspace.hpp"
@@ -57,8 +58,9 @@ public:
     void cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const CounterBlock& blk);
 
     // After the build's submission: the self-check's verdict and the cell
-    // count from `blk`; crowded cells are split into leaves (own submissions).
-    void finishIndex(PointIndex& ix, const CounterBlock& blk);
+    // count from `blk`; true when crowded cells are to be split into leaves
+    // (splitLeaves, own submissions).
+    [[nodiscard]] bool finishIndex(PointIndex& ix, const CounterBlock& blk);
 
     // Indexes the staged sets (one or two) in one submission: both uploads
     // back to back, then each build; then each set's checks and leaves.
@@ -66,8 +68,9 @@ public:
     void buildIndexes(std::span<PointIndex* const> sets, bool ingested = false);
 
     // One Cell per run of equal keys (heads flagged and scanned before):
-    // small cells' boxes by their head thread, large cells' in parallel.
-    void cmdCellBuild(VkCommandBuffer cmd, const sh::CellsPush& cp);
+    // small cells' boxes by their head thread, large cells' in parallel;
+    // each set's (one push each) steps side by side.
+    void cmdCellBuild(VkCommandBuffer cmd, std::span<const sh::CellsPush> cps);
 
     // Self-check of an index, recorded after its build (check_index.comp);
     // verifyIndex reads the verdict once the submission has completed.
@@ -97,29 +100,40 @@ public:
     // words it for host input).
     void finishIngest(PointIndex& ix, const CounterBlock& blk);
 
-    // Cuts the crowded cells of `ix` into leaves (leaf_*.comp), round by
-    // round, then checks the index again. Each round is two submissions: a
-    // counting sort by slot inside every cell that also counts the new
-    // cells, then the cells of the new order in a buffer of that size.
-    void splitLeaves(PointIndex& ix);
+    // Cuts the crowded cells of each set (one or two) into leaves
+    // (leaf_*.comp), round by round, then checks the indexes again. Each
+    // round is two submissions: a counting sort by slot inside every cell
+    // that also counts the new cells, then the cells of the new order in a
+    // buffer of that size. Two sets split side by side (each step's kernels
+    // of both before one barrier, set k on counter block k and leaf scratch
+    // k) until each holds no leaf past kLeafMax: at 200k points a set, the
+    // two sets' steps cost about what one set's did, and half the
+    // submissions.
+    void splitLeaves(std::span<PointIndex* const> sets);
 
-    // The buffers of one leaf-split round: cells, points and keys in and out.
+    // One set's round of a leaf split: its index, the cells, points and keys
+    // in and out, its leaf scratch and counter block.
     struct LeafRound {
-        Buffer* cellsIn;
-        Buffer* sortedIn;
-        Buffer* keysIn;
-        Buffer* sortedOut;
-        Buffer* keysOut;
-        Buffer* cellsOut;
-        uint64_t numSlots;  // one per kept cell, 8^k <= count per split one
+        PointIndex* ix = nullptr;
+        Buffer* cellsIn = nullptr;
+        Buffer* sortedIn = nullptr;
+        Buffer* keysIn = nullptr;
+        Buffer* sortedOut = nullptr;
+        Buffer* keysOut = nullptr;
+        Buffer* cellsOut = nullptr;
+        uint64_t numSlots = 0;  // one per kept cell, 8^k <= count per split one
+        LeafScratch* leaf = nullptr;
+        const CounterBlock* blk = nullptr;
+        std::string leafName;  // labels of its scratch buffers
     };
-    // Records one round's sort: a counting sort by slot inside every cell,
-    // the new order's cell heads scanned and counted (cells_total.comp, into
-    // the cells counter), so that the host sizes the leaves' buffer.
-    void cmdSplitRound(VkCommandBuffer cmd, const PointIndex& ix, const LeafRound& r);
-    // Records the round's `leaves` cells of the new order into r.cellsOut
-    // (sized by the host for them) and their tight boxes.
-    void cmdBuildLeaves(VkCommandBuffer cmd, const PointIndex& ix, const LeafRound& r, uint32_t leaves);
+    // Records each set's round sort: a counting sort by slot inside every
+    // cell, the new order's cell heads scanned and counted (cells_total.comp,
+    // into the set's cells counter), so that the host sizes the leaves' buffer.
+    void cmdSplitRound(VkCommandBuffer cmd, std::span<const LeafRound> rounds);
+    // Records each set's `leaves[k]` cells of the new order into
+    // rounds[k].cellsOut (sized by the host for them) and their tight boxes.
+    void cmdBuildLeaves(VkCommandBuffer cmd, std::span<const LeafRound> rounds,
+                        std::span<const uint32_t> leaves);
 
     // Search cells of level `level` (>= 1) of T, coarsened from the level
     // below on first use (coarsen.comp: head flags, scan, build).

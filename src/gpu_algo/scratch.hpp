@@ -85,7 +85,7 @@ struct BatchScratch {
 struct Scratch {
     std::array<BuildScratch, 2> builds;  // set A (and every single build), set B
     Buffer uploadChunk;  // host: two chunks of a large set's vec4 points (IndexBuild::uploadChunked)
-    LeafScratch leaves;
+    std::array<LeafScratch, 2> leaves;  // set A (and every single split), set B (IndexBuild::splitLeaves)
     LevelScratch levels;
     std::array<DirectionBuffers, 2> directions;  // A->B, B->A
     SearchScratch search;

@@ -42,9 +42,9 @@ void Workspace::recycleBuild(BuildScratch& build) {
 
 void Workspace::recycleBuildScratch() {
     for (BuildScratch& s : scratch.builds) recycleBuild(s);
-    LeafScratch& leaf = scratch.leaves;
-    for (Buffer* b : {&leaf.slotKeys, &leaf.outSlotKeys, &leaf.flags, &leaf.slotDense, &leaf.boundsU})
-        recycle(*b);
+    for (LeafScratch& leaf : scratch.leaves)
+        for (Buffer* b : {&leaf.slotKeys, &leaf.outSlotKeys, &leaf.flags, &leaf.slotDense, &leaf.boundsU})
+            recycle(*b);
 }
 
 Buffer& Workspace::grow(Buffer& b, VkDeviceSize bytes, const std::string& name, MemoryKind kind, bool slack) {

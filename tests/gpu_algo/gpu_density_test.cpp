@@ -69,5 +69,37 @@ TEST(GpuDensity, CrowdedCellIsCutIntoLeaves) {
     EXPECT_EQ(r->validationMessages, 0u);
 }
 
+// Both sets crowded, one needing more split rounds than the other (a
+// cluster inside a cluster 10^4 times smaller), and then one set crowded
+// alone, first as A and then as B: the sets split side by side (each on its
+// own counters and scratch, the one that is done sitting out the other's
+// rounds) or alone. Exact against the brute force.
+TEST(GpuDensity, SetsSplitSideBySideInRoundsOfTheirOwn) {
+    Options options = gpuOptions();
+    RTHDIST_REQUIRE_ENGINE(engine, options);
+    Rng rng(18018);
+    auto cube = [&](std::vector<glm::vec3>& p, int n, glm::dvec3 at, double edge) {
+        for (int i = 0; i < n; ++i)
+            p.emplace_back(at + glm::dvec3(rng.uniform(), rng.uniform(), rng.uniform()) * edge);
+    };
+    std::vector<glm::vec3> nested, plain, sparse;
+    cube(nested, 6000, glm::dvec3(0.0), 1e-3);
+    cube(nested, 4000, glm::dvec3(5e-4), 1e-7);
+    nested.emplace_back(1000.0f, 1000.0f, 1000.0f);
+    cube(plain, 5000, glm::dvec3(0.0), 1e-3);
+    plain.emplace_back(1000.0f, 999.0f, 1000.0f);
+    cube(sparse, 3000, glm::dvec3(0.0), 1000.0);
+    const OracleCase cases[] = {{"nested_and_plain_clusters", 18018, nested, plain},
+                                {"crowded_a_alone", 18018, nested, sparse},
+                                {"crowded_b_alone", 18018, sparse, plain}};
+    for (const OracleCase& c : cases) {
+        SCOPED_TRACE(c.name);
+        auto r = engine->compute(c.a, c.b);
+        ASSERT_TRUE(r.ok()) << r.error().message;
+        expectMatchesOracle(c, *r);
+        EXPECT_EQ(r->validationMessages, 0u);
+    }
+}
+
 }  // namespace
 }  // namespace rthdist::test
