@@ -154,6 +154,9 @@ struct PairNarrowing {
 // gains, at least one set has strays and no stray of either set lies within
 // the other's reach (each direction's kept targets are then the other
 // core); else each direction by narrowTargets. `directedOnly`: a -> b alone.
+// Before any pass over the points: nullopt when a's box reaches 2^(8-20) of
+// the pair's magnitude past b's on some axis and (unless directedOnly) b's
+// past a's (strays of their own both ways, known from the boxes).
 [[nodiscard]] std::optional<PairNarrowing> narrowPair(const PointView& a, const core::SetSummary& sa,
                                                       const PointView& b, const core::SetSummary& sb,
                                                       bool directedOnly, int threads);

@@ -168,6 +168,29 @@ TEST(NarrowedTargets, StraysInBothSetsSearchEveryTarget) {
     EXPECT_EQ(r->bToA.counters.narrowedTargets, 0u);
 }
 
+// Each set's box reaches kilometres past the other's (A's far stray on x,
+// B's on y): both directed values are far above the slack, so the pair is
+// searched whole, decided from the boxes before any pass over the points,
+// although A's first stray lies a few millimetres from B's cluster (whose
+// test alone, the first stray against the other set, narrowed A -> B).
+TEST(NarrowedTargets, BoxesReachingPastEachOtherLeaveThePairWhole) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    std::vector<glm::vec3> a = farCluster(2000, 1e-3f, 0, 91), b = farCluster(2100, 1e-3f, 0, 92);
+    a.push_back(glm::vec3(5e-3f));
+    a.push_back(glm::vec3(5000.0f, 0.0f, 0.0f));
+    b.push_back(glm::vec3(0.0f, -5000.0f, 0.0f));
+    EXPECT_FALSE(narrowing(a, b));
+    EXPECT_FALSE(narrowing(a, b, true));
+    for (bool directed : {false, true}) {
+        CallOptions call;
+        call.directedOnly = directed;
+        Result<HausdorffResult> r = engine->compute(a, b, call);
+        ASSERT_TRUE(r) << r.error().message;
+        expectExact(*r, a, b, false);
+        EXPECT_EQ(r->aToB.counters.narrowedTargets, 0u);
+    }
+}
+
 // The joint call with strays in one set (of their own: B -> A narrows,
 // A's strays go to the brute force) and in both (common ones), and
 // directed (A's strays of their own: nothing narrows): the host's choice,
