@@ -105,7 +105,8 @@ def hausdorff(a, b, *, directed=False, per_point=False, backend="auto", device=N
     device: Vulkan device index (rthdist.list_devices()); None = first usable.
     bits: index-space bit count 0..8 (0 = from the data).
     radius_growth: candidate-search radius factor 1.1..16.
-    threads: CPU backend threads (0 = all).
+    threads: host threads, the CPU backend's and the GPU backends' passes
+        over the points (0 = all).
     progress: callable(stage, fraction) or a tqdm bar, called between stages.
 
     A temporary device is created per call; keep an Engine for repeated calls.

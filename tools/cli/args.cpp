@@ -126,7 +126,8 @@ Options:
                       is one device's); a pair that fits runs on the first
   --bits K            index-space bit count 0..8, 0 = choose from the data (default 0)
   --radius-growth F   candidate-search radius factor per iteration, 1.1..16 (default 2)
-  --threads N         CPU backend threads 0..1024, 0 = all hardware threads (default 0)
+  --threads N         host threads (the cpu backend, and every backend's passes over the
+                      points) 0..1024, 0 = all hardware threads (default 0)
   --memory-budget MIB memory one backend call may hold, in MiB, 0..2^30; larger
                       inputs are computed exactly in query chunks and target
                       tiles (default 0: 3/4 of the device's budget; cpu: none)
