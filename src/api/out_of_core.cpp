@@ -537,7 +537,7 @@ double callFloor(SpaceDirection& dir, double scale) {
 // Queries of a direction that may be sampled for its first floor
 // (seedFloor), and the most pairs its sample measures.
 constexpr size_t kSeedCandidates = 4096;
-constexpr uint64_t kSeedWork = uint64_t(1) << 24;
+constexpr uint64_t kSeedWork = uint64_t(1) << 26;
 
 // The first pieces' floor: without it round one's first calls (one a lane)
 // would search every query to its end. A sample of the queries, each
@@ -555,10 +555,13 @@ constexpr uint64_t kSeedWork = uint64_t(1) << 24;
 // targets costs little and is where nearest distances are large, which is
 // what the floor wants. Until session 18 the sample was every fourth
 // candidate (1024), whose blocks of up to 64 cells each were ~90 % of round
-// one's host time on the torus (session 16); on a 10M x 12M torus in 5
-// pieces the new sample reads a quarter as much (17 against 64 ms on 2
-// cores) and its floors are 1.36e-3 and 1.53e-3 against 1.32e-3 and
-// 1.64e-3 (H 2.48e-3).
+// one's host time on the torus (session 16). Measured (docs/bench/scale,
+// session 18): on the torus quarter in 5 pieces on an H200 host of 32
+// cores, round one 359-440 -> 47-55 ms, floors 3.56e-4 and 3.52e-4 against
+// 3.32e-4 and 3.79e-4 (H 5.90e-4; 2^24 pairs gave 2.88e-4 and 3.26e-4,
+// 6x the queries above them); at 1B x 1B round one 1.21 s -> 49-73 ms,
+// floors 2.32e-4 and 2.46e-4 against 3.11e-4 and 2.78e-4 (the calls'
+// read-back of the queries above them 7 -> 77-95 ms).
 void seedFloor(SpaceDirection& dir, const SpatialPieces& pieces, double scale, int threads) {
     if (dir.keepAll) return;
     const SpatialPieces::Set& qs = pieces.set(dir.q);
