@@ -549,9 +549,13 @@ constexpr uint64_t kSeedWork = uint64_t(1) << 26;
 // whole set: a lower bound of h. The largest such is the seed; a sample
 // query that does not settle counts for nothing, and any sample gives a
 // lower bound.
-// The sample: of kSeedCandidates queries at a stride, those whose blocks
-// hold the fewest targets, until kSeedWork pairs or a quarter of what every
-// fourth candidate would measure, whichever is less. A query among few
+// The sample: of kSeedCandidates queries at a stride, first those whose
+// quarter-cell box lies in their own piece's cells (boxInPiece: any nearest
+// found within it then settles; a box across a piece's border holds fewer
+// targets, so the cheapest were mostly such queries, most of which count
+// for nothing), each group those whose blocks hold the fewest targets
+// first, until kSeedWork pairs or a quarter of what every fourth candidate
+// would measure, whichever is less. A query among few
 // targets costs little and is where nearest distances are large, which is
 // what the floor wants. Until session 18 the sample was every fourth
 // candidate (1024), whose blocks of up to 64 cells each were ~90 % of round
@@ -561,7 +565,11 @@ constexpr uint64_t kSeedWork = uint64_t(1) << 26;
 // 3.32e-4 and 3.79e-4 (H 5.90e-4; 2^24 pairs gave 2.88e-4 and 3.26e-4,
 // 6x the queries above them); at 1B x 1B round one 1.21 s -> 49-73 ms,
 // floors 2.32e-4 and 2.46e-4 against 3.11e-4 and 2.78e-4 (the calls'
-// read-back of the queries above them 7 -> 77-95 ms).
+// read-back of the queries above them 7 -> 77-95 ms). Those figures are
+// without the first group (inside first); with it, on a 10M x 12M torus
+// (2 cores, CPU backend) the floors of B -> A rose from 1.53e-3 to 1.95e-3
+// in 5 and 10 pieces (the queries above them 6486 -> 177 and 2740 -> 86),
+// A -> B's and the seed's cost the same: not measured on a GPU host.
 void seedFloor(SpaceDirection& dir, const SpatialPieces& pieces, double scale, int threads) {
     if (dir.keepAll) return;
     const SpatialPieces::Set& qs = pieces.set(dir.q);
@@ -573,6 +581,7 @@ void seedFloor(SpaceDirection& dir, const SpatialPieces& pieces, double scale, i
         uint64_t p = 0;
         uint32_t k = 0;
         uint64_t work = UINT64_MAX;  // UINT64_MAX: not a candidate (no targets, or too many cells)
+        bool inside = false;         // its reach box holds cells of its own piece only
         std::vector<uint32_t> blocks;
     };
     std::vector<Sample> sample(candidates);
@@ -587,6 +596,7 @@ void seedFloor(SpaceDirection& dir, const SpatialPieces& pieces, double scale, i
                 continue;
             c.work = 0;
             for (const uint32_t b : c.blocks) c.work += ts.blockStart[b + 1] - ts.blockStart[b];
+            c.inside = pieces.boxInPiece(core::scaled(qs.points[c.p], scale), reach, c.k);
         }
     });
     uint64_t strided = 0;  // what every fourth candidate would measure
@@ -596,6 +606,7 @@ void seedFloor(SpaceDirection& dir, const SpatialPieces& pieces, double scale, i
     for (size_t s = 0; s < candidates; ++s)
         if (sample[s].work != UINT64_MAX) order.push_back(uint32_t(s));
     std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
+        if (sample[x].inside != sample[y].inside) return sample[x].inside;
         return sample[x].work != sample[y].work ? sample[x].work < sample[y].work : x < y;
     });
     const uint64_t budget = std::min(kSeedWork, strided / 4);
