@@ -1177,7 +1177,7 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
             limits.a = std::min(tile, (a.size() + l2 - 1) / l2);
             limits.b = std::min(tile, (b.size() + l2 - 1) / l2);
         }
-        // Pieces (at most the grid's 2^18 cells plus a set's points over its
+        // Pieces (at most the grid's 2^15 cells plus a set's points over its
         // limit) are numbered below 2^31 in the partition (kSharedBlock).
         if (a.size() / limits.a + b.size() / limits.b > (uint64_t(1) << 30)) {
             return Error{ErrorCode::kOutOfMemory,

@@ -33,15 +33,20 @@ RTHDIST_VECTOR_CLONES void cellsOf(const SpatialPieces& pieces, const glm::vec3*
     for (size_t i = 0; i < n; ++i) keys[i] = pieces.cellOfScaled(core::scaled(points[i], scale));
 }
 
-// Cells per axis: about 16 points a cell over both sets, 2 to 64 a side
-// (at most 2^18 cells: each host thread's count of every cell, 1 MiB, stays
-// in its cache; 128 a side cost the H200 machine's 32 threads 2.6 s of
-// cache misses on 700M points). Pieces are a handful, so cells of 1/64 of
-// the box cut them finely enough, and a query's best is far below a cell.
+// Cells per axis: about 16 points a cell over both sets, 2 to 32 a side
+// (at most 2^15 cells). Both passes over the points look up a table of
+// every cell at random (each host thread's counts, then each cell's block),
+// so the grid's size is paid per point: 128 a side cost the H200 machine's
+// 32 threads 2.6 s of cache misses on 700M points, and 32 instead of 64 (a
+// 128 KiB table in place of 1 MiB) took the torus quarter's partition on
+// the 32-core x2 host from 947-995 to 791-798 ms, its first floors as
+// good (docs/bench/scale, session 19). 16 a side lowered B's floor on a
+// 30M x 40M torus (2 cores). Pieces are a handful, so cells of 1/32 of the
+// box cut them finely enough, and a query's best is far below a cell.
 uint32_t cellsPerAxisFor(uint64_t points) {
     const double side = std::cbrt(double(points) / 16.0);
     uint32_t cells = 2;
-    while (cells < 64 && double(cells) < side) cells *= 2;
+    while (cells < 32 && double(cells) < side) cells *= 2;
     return cells;
 }
 

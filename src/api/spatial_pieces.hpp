@@ -27,7 +27,7 @@
 // Memory: per set 16 bytes per point (the gathered copy and its input
 // indices; 20 with the cells kept; the cells are computed twice while
 // partitioning, not stored); the grid at most
-// 2^18 cells (12 bytes and a bit each), 12 bytes per block and, while
+// 2^15 cells (12 bytes and a bit each), 12 bytes per block and, while
 // partitioning, 4 bytes per cell and 8 per block for each host thread, and
 // while scattering 321 bytes per block for each host thread where blocks
 // are at most 2^14 (each block's next 16 points, written a whole cache line
