@@ -83,12 +83,12 @@ PieceRanks pieceRanks(uint64_t m, uint64_t span, uint64_t total) {
 }
 
 // A host range's scatter into its runs of a set's gathered arrays (points,
-// input indices, cells where kept), one run per block. Each block's next 16 points
-// wait in a buffer placed as their destinations lie in cache lines; a
-// buffer that ends on a line boundary of the destinations goes out at once,
-// a whole group of 16 (three lines of points, one of indices, one of cells)
-// with streaming stores, which write the lines without reading them first
-// (an ordinary store reads each destination line from memory before
+// input indices, cells where kept), one run per block. Each block's next 16
+// points wait in a buffer placed as their destinations lie in cache lines;
+// a buffer that ends on a line boundary of the destinations goes out at
+// once, a whole group of 16 (three lines of points, one of indices, one of
+// cells) with streaming stores, which write the lines without reading them
+// first (an ordinary store reads each destination line from memory before
 // writing it; on the H200 machine's host the torus quarter's scatter took
 // 1.85-2.25 s with ordinary stores, 1.28-1.49 s so). A run's first and last
 // partial groups, and every write where the arrays are not 64-byte aligned
@@ -96,6 +96,10 @@ PieceRanks pieceRanks(uint64_t m, uint64_t span, uint64_t total) {
 // (the lines a streaming store writes lie inside one run), so ranges run
 // at once; finish() makes the streaming stores visible before the range's
 // thread ends.
+// One counter a block (its next destination; the buffer's slot is its low
+// bits), and the slots of points a few puts ahead prefetched (prefetch()):
+// the torus quarter's scatter 584-647 -> 537-610 ms on the 32-core x2 H200
+// host (a second machine of the kind: level, 658-687 against 694-720).
 class BlockWriter {
 public:
     static constexpr uint32_t kGroup = 16;  // points: 192 bytes = 3 lines; indices and cells: 1 line
@@ -116,65 +120,66 @@ public:
         (void)aligned;
 #endif
         if (m_buffered) {
-            m_fill.assign(next.size(), 0);
+            m_first = next;
             m_bufPoints.resize(next.size() * kGroup);
             m_bufInput.resize(next.size() * kGroup);
             if (m_cell != nullptr) m_bufCell.resize(next.size() * kGroup);
         }
     }
 
+    // Brings the buffer slots the next point of `block` goes to into cache.
+    void prefetch(uint32_t block) const {
+        if (!m_buffered) return;
+        const size_t slot = size_t(block) * kGroup + m_next[block] % kGroup;
+        __builtin_prefetch(&m_bufPoints[slot], 1);
+        __builtin_prefetch(&m_bufInput[slot], 1);
+    }
+
     void put(uint32_t block, const glm::vec3& p, uint32_t input, uint32_t cell) {
+        const uint64_t at = m_next[block]++;  // this point's destination
         if (!m_buffered) {
-            const uint64_t to = m_next[block]++;
-            m_points[to] = p;
-            m_input[to] = input;
-            if (m_cell != nullptr) m_cell[to] = cell;
+            m_points[at] = p;
+            m_input[at] = input;
+            if (m_cell != nullptr) m_cell[at] = cell;
             return;
         }
-        const uint64_t at = m_next[block] + m_fill[block];  // this point's destination
         const size_t slot = size_t(block) * kGroup + at % kGroup;
         m_bufPoints[slot] = p;
         m_bufInput[slot] = input;
         if (m_cell != nullptr) m_bufCell[slot] = cell;
-        ++m_fill[block];
-        if ((at + 1) % kGroup == 0) flush(block);
+        if ((at + 1) % kGroup == 0) flush(block, at + 1);
     }
 
     // The partial groups left, then a fence for the streaming stores.
     void finish() {
         if (m_buffered)
-            for (uint32_t b = 0; b < m_fill.size(); ++b)
-                if (m_fill[b] != 0) flush(b);
+            for (uint32_t b = 0; b < m_next.size(); ++b)
+                if (m_next[b] % kGroup != 0) flush(b, m_next[b]);
 #if defined(RTHDIST_STREAMING_STORES)
         if (m_streaming) _mm_sfence();
 #endif
     }
 
 private:
-    // The buffered points of `block`: destinations [next, next + fill), in
-    // slots next % kGroup onwards.
-    void flush(uint32_t block) {
-        const uint64_t first = m_next[block];
-        const uint32_t count = m_fill[block];
+    // The buffered points of `block` whose destinations lie in [first, end):
+    // the group that `end` closes (or the last, partial one), from the
+    // block's first destination in this range on.
+    void flush(uint32_t block, uint64_t end) {
+        const uint64_t first = std::max((end - 1) / kGroup * kGroup, m_first[block]);
         const size_t base = size_t(block) * kGroup;
-        const size_t from = first % kGroup;
 #if defined(RTHDIST_STREAMING_STORES)
-        if (m_streaming && count == kGroup) {  // from == 0: a whole, aligned group
+        if (m_streaming && end - first == kGroup) {  // a whole, aligned group
             stream(m_points + first, &m_bufPoints[base], kGroup * sizeof(glm::vec3));
             stream(m_input + first, &m_bufInput[base], kGroup * sizeof(uint32_t));
             if (m_cell != nullptr) stream(m_cell + first, &m_bufCell[base], kGroup * sizeof(uint32_t));
-            m_next[block] = first + count;
-            m_fill[block] = 0;
             return;
         }
 #endif
-        for (uint32_t k = 0; k < count; ++k) {
-            m_points[first + k] = m_bufPoints[base + from + k];
-            m_input[first + k] = m_bufInput[base + from + k];
-            if (m_cell != nullptr) m_cell[first + k] = m_bufCell[base + from + k];
+        for (uint64_t at = first; at < end; ++at) {
+            m_points[at] = m_bufPoints[base + at % kGroup];
+            m_input[at] = m_bufInput[base + at % kGroup];
+            if (m_cell != nullptr) m_cell[at] = m_bufCell[base + at % kGroup];
         }
-        m_next[block] = first + count;
-        m_fill[block] = 0;
     }
 
 #if defined(RTHDIST_STREAMING_STORES)
@@ -189,10 +194,10 @@ private:
     glm::vec3* m_points;
     uint32_t* m_input;
     uint32_t* m_cell;
-    std::vector<uint64_t>& m_next;
+    std::vector<uint64_t>& m_next;  // each block's next destination
+    std::vector<uint64_t> m_first;  // each block's first destination in this range
     bool m_buffered = false;
     [[maybe_unused]] bool m_streaming = false;  // read only where streaming stores exist
-    std::vector<uint8_t> m_fill;
     std::vector<glm::vec3> m_bufPoints;
     std::vector<uint32_t> m_bufInput, m_bufCell;
 };
@@ -533,12 +538,17 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         forRanges(r, [&](int t, size_t begin, size_t end) {
             BlockWriter writer(set, perBlock[size_t(t)]);
             std::vector<uint64_t>& rank = rankBase[size_t(t)];
-            uint32_t keys[kRun];
+            uint32_t keys[kRun], blockIds[kRun];
+            constexpr size_t kAhead = 8;  // puts between a slot's prefetch and its write
             for (size_t r0 = begin; r0 < end; r0 += kRun) {
                 const size_t n = std::min(end, r0 + kRun) - r0;
                 cellsOf(out, points.data() + r0, scale, n, keys);
-                for (size_t i = 0; i < n; ++i)
-                    writer.put(blockOfPoint(keys[i], rank), points[r0 + i], uint32_t(r0 + i), keys[i]);
+                for (size_t i = 0; i < n; ++i) blockIds[i] = blockOfPoint(keys[i], rank);
+                for (size_t i = 0; i < std::min(n, kAhead); ++i) writer.prefetch(blockIds[i]);
+                for (size_t i = 0; i < n; ++i) {
+                    if (i + kAhead < n) writer.prefetch(blockIds[i + kAhead]);
+                    writer.put(blockIds[i], points[r0 + i], uint32_t(r0 + i), keys[i]);
+                }
             }
             writer.finish();
         });
