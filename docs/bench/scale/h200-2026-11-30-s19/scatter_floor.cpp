@@ -11,7 +11,9 @@
 //   (argument 3: 0 streaming stores of 16 bytes, 1 of 32, 2 ordinary stores)
 //   scatter-B/G: each point and its index into B buckets (positions from the
 //              counts), each bucket's next G buffered and written as whole
-//              lines with streaming stores (the library's scheme: G = 16)
+//              lines with streaming stores (the library's scheme: G = 16;
+//              larger G: longer runs of lines to each place; B x G at most
+//              2^18, the buffers 4 MiB a thread)
 // Prints ms per pass.
 #include <immintrin.h>
 #include <sys/mman.h>
@@ -46,7 +48,7 @@ double onThreads(int threads, size_t n, Fn&& fn) {
     return msSince(t0);
 }
 
-uint32_t cellOf(const P& p) {
+__attribute__((always_inline)) inline uint32_t cellOf(const P& p) {
     const auto axis = [](float v) {
         float c = (v + 1.0f) * 16.0f;
         c = c > 0.0f ? c : 0.0f;
@@ -100,7 +102,8 @@ int main(int argc, char** argv) {
     std::printf("points %zu threads %d stores %s\n", n, threads, g_store == 3 ? "none" :
                 g_store == 1 ? "streaming 32 B" : g_store == 2 ? "ordinary" : "streaming 16 B");
 
-    for (int round = 0; round < 2; ++round) {
+    const int rounds = argc > 4 ? std::atoi(argv[4]) : 2;
+    for (int round = 0; round < rounds; ++round) {
         std::vector<uint32_t> sums(size_t(threads), 0);
         const auto* words = reinterpret_cast<const uint32_t*>(pts);
         const double read = onThreads(threads, n * 3, [&](int t, size_t b, size_t e) {
@@ -132,9 +135,9 @@ int main(int argc, char** argv) {
             });
         std::printf("round %d: read %.0f ms, cells %.0f ms, copy-nt %.0f ms fresh / %.0f ms again", round, read,
                     cells, copies[0], copies[1]);
-        for (const uint32_t buckets : {64u, 1024u, 4096u})
-            for (const uint64_t group : {uint64_t(16), uint64_t(64)}) {
-                if (buckets == 4096 && group == 64) continue;
+        for (const uint32_t buckets : {64u, 256u, 1024u, 4096u})
+            for (const uint64_t group : {uint64_t(16), uint64_t(32), uint64_t(64), uint64_t(256)}) {
+                if (buckets * group > 262144) continue;  // the buffers past 4 MiB a thread
                 // Each thread's first position in each bucket, from per-thread
                 // counts of the bucket (bucket = cell & (buckets - 1); buckets are powers of two).
                 std::vector<std::vector<uint64_t>> next(size_t(threads), std::vector<uint64_t>(buckets, 0));
