@@ -97,9 +97,12 @@ PieceRanks pieceRanks(uint64_t m, uint64_t span, uint64_t total) {
 // at once; finish() makes the streaming stores visible before the range's
 // thread ends.
 // One counter a block (its next destination; the buffer's slot is its low
-// bits), and the slots of points a few puts ahead prefetched (prefetch()):
-// the torus quarter's scatter 584-647 -> 537-610 ms on the 32-core x2 H200
-// host (a second machine of the kind: level, 658-687 against 694-720).
+// bits); a run of points goes in through putRun, whose loop keeps the
+// arrays' addresses in registers. On one H200's 16-core host the torus
+// quarter's scatter 882-1022 -> 863-912 ms against slots prefetched ahead
+// (the call's total level; on 2 cores 466-511 -> 408-424 ms for 30M points,
+// one thread); the prefetch had measured level against the base + fill
+// pair before it (docs/bench/scale, session 19).
 class BlockWriter {
 public:
     static constexpr uint32_t kGroup = 16;  // points: 192 bytes = 3 lines; indices and cells: 1 line
@@ -127,14 +130,6 @@ public:
         }
     }
 
-    // Brings the buffer slots the next point of `block` goes to into cache.
-    void prefetch(uint32_t block) const {
-        if (!m_buffered) return;
-        const size_t slot = size_t(block) * kGroup + m_next[block] % kGroup;
-        __builtin_prefetch(&m_bufPoints[slot], 1);
-        __builtin_prefetch(&m_bufInput[slot], 1);
-    }
-
     void put(uint32_t block, const glm::vec3& p, uint32_t input, uint32_t cell) {
         const uint64_t at = m_next[block]++;  // this point's destination
         if (!m_buffered) {
@@ -148,6 +143,28 @@ public:
         m_bufInput[slot] = input;
         if (m_cell != nullptr) m_bufCell[slot] = cell;
         if ((at + 1) % kGroup == 0) flush(block, at + 1);
+    }
+
+    // A run of points: points[i] into block blocks[i], input index first +
+    // i, cell cells[i]. Without kept cells (the usual case) a loop of its
+    // own, whose arrays' addresses stay in registers.
+    void putRun(const uint32_t* blocks, const glm::vec3* points, uint32_t first, const uint32_t* cells,
+                size_t n) {
+        if (!m_buffered || m_cell != nullptr) {
+            for (size_t i = 0; i < n; ++i) put(blocks[i], points[i], first + uint32_t(i), cells[i]);
+            return;
+        }
+        uint64_t* const next = m_next.data();
+        glm::vec3* const bufPoints = m_bufPoints.data();
+        uint32_t* const bufInput = m_bufInput.data();
+        for (size_t i = 0; i < n; ++i) {
+            const uint32_t block = blocks[i];
+            const uint64_t at = next[block]++;
+            const size_t slot = size_t(block) * kGroup + at % kGroup;
+            bufPoints[slot] = points[i];
+            bufInput[slot] = first + uint32_t(i);
+            if ((at + 1) % kGroup == 0) flush(block, at + 1);
+        }
     }
 
     // The partial groups left, then a fence for the streaming stores.
@@ -539,16 +556,11 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
             BlockWriter writer(set, perBlock[size_t(t)]);
             std::vector<uint64_t>& rank = rankBase[size_t(t)];
             uint32_t keys[kRun], blockIds[kRun];
-            constexpr size_t kAhead = 8;  // puts between a slot's prefetch and its write
             for (size_t r0 = begin; r0 < end; r0 += kRun) {
                 const size_t n = std::min(end, r0 + kRun) - r0;
                 cellsOf(out, points.data() + r0, scale, n, keys);
                 for (size_t i = 0; i < n; ++i) blockIds[i] = blockOfPoint(keys[i], rank);
-                for (size_t i = 0; i < std::min(n, kAhead); ++i) writer.prefetch(blockIds[i]);
-                for (size_t i = 0; i < n; ++i) {
-                    if (i + kAhead < n) writer.prefetch(blockIds[i + kAhead]);
-                    writer.put(blockIds[i], points[r0 + i], uint32_t(r0 + i), keys[i]);
-                }
+                writer.putRun(blockIds, points.data() + r0, uint32_t(r0), keys, n);
             }
             writer.finish();
         });
