@@ -106,7 +106,8 @@ PieceRanks pieceRanks(uint64_t m, uint64_t span, uint64_t total) {
 class BlockWriter {
 public:
     static constexpr uint32_t kGroup = 16;  // points: 192 bytes = 3 lines; indices and cells: 1 line
-    // Blocks past this are written directly (the buffers: 320 bytes a block).
+    // Blocks past this are written directly (the buffers: 320 bytes a block,
+    // and its first destination).
     static constexpr size_t kMaxBlocks = size_t(1) << 14;
 
     BlockWriter(SpatialPieces::Set& set, std::vector<uint64_t>& next)

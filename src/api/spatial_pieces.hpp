@@ -29,7 +29,7 @@
 // partitioning, not stored); the grid at most
 // 2^15 cells (12 bytes and a bit each), 12 bytes per block and, while
 // partitioning, 4 bytes per cell and 8 per block for each host thread, and
-// while scattering 321 bytes per block for each host thread where blocks
+// while scattering 328 bytes per block for each host thread where blocks
 // are at most 2^14 (each block's next 16 points, written a whole cache line
 // at a time).
 // Limits: each set below 2^32 points (the input indices are 32-bit).
