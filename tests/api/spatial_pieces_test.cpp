@@ -118,7 +118,8 @@ uint32_t groupOf(const SpatialPieces& pieces, uint32_t cell) {
 }
 
 // kBlocks holds the pieces of kInput, each with the same points, ordered by
-// their cells' groups (input order within a group); one thread cuts as four.
+// their cells' groups (input order within a group); one thread cuts as four,
+// and the cells kept or not change nothing else.
 // Sets of 2^15 cells (the largest grid, 8 cells a group) with crowded cells
 // shared by pieces, and small ones.
 TEST(SpatialPieces, BlocksInSpaceHoldTheSamePieces) {
@@ -139,12 +140,20 @@ TEST(SpatialPieces, BlocksInSpaceHoldTheSamePieces) {
         const SpatialPieces blocks =
             SpatialPieces::partition(*c.a, *c.b, 0.5, c.limits, 4, PieceOrder::kBlocks);
         const SpatialPieces one = SpatialPieces::partition(*c.a, *c.b, 0.5, c.limits, 1, PieceOrder::kBlocks);
+        // Without the cells kept (the scatter's own loop for a run of points).
+        const SpatialPieces noCells =
+            SpatialPieces::partition(*c.a, *c.b, 0.5, c.limits, 4, PieceOrder::kBlocks, nullptr, false);
         ASSERT_EQ(input.count(), blocks.count());
         for (int s = 0; s < 2; ++s) {
             const SpatialPieces::Set& x = input.set(s);
             const SpatialPieces::Set& y = blocks.set(s);
             ASSERT_EQ(x.start, y.start) << "set " << s;
             EXPECT_TRUE(std::equal(y.input.begin(), y.input.end(), one.set(s).input.begin())) << "set " << s;
+            EXPECT_TRUE(noCells.set(s).cell.empty());
+            EXPECT_TRUE(std::equal(y.input.begin(), y.input.end(), noCells.set(s).input.begin()))
+                << "set " << s;
+            EXPECT_TRUE(std::equal(y.points.begin(), y.points.end(), noCells.set(s).points.begin()))
+                << "set " << s;
             for (size_t k = 0; k < input.count(); ++k) {
                 std::vector<uint32_t> mine(y.input.begin() + ptrdiff_t(y.start[k]),
                                            y.input.begin() + ptrdiff_t(y.start[k + 1]));
