@@ -591,12 +591,11 @@ void seedFloor(SpaceDirection& dir, const SpatialPieces& pieces, double scale, i
             Sample& c = sample[s];
             c.p = uint64_t(s) * n / candidates;
             c.k = uint32_t(std::upper_bound(qs.start.begin(), qs.start.end(), c.p) - qs.start.begin() - 1);
-            if (ts.size(c.k) == 0 ||
-                !pieces.blocksNear(core::scaled(qs.points[c.p], scale), reach, c.k, c.blocks))
-                continue;
+            const glm::vec3 q = core::scaled(qs.points[c.p], scale);
+            if (ts.size(c.k) == 0 || !pieces.blocksNear(q, reach, c.k, c.blocks)) continue;
             c.work = 0;
             for (const uint32_t b : c.blocks) c.work += ts.blockStart[b + 1] - ts.blockStart[b];
-            c.inside = pieces.boxInPiece(core::scaled(qs.points[c.p], scale), reach, c.k);
+            c.inside = pieces.boxInPiece(q, reach, c.k);
         }
     });
     uint64_t strided = 0;  // what every fourth candidate would measure
