@@ -102,7 +102,10 @@ PieceRanks pieceRanks(uint64_t m, uint64_t span, uint64_t total) {
 // quarter's scatter 882-1022 -> 863-912 ms against slots prefetched ahead
 // (the call's total level; on 2 cores 466-511 -> 408-424 ms for 30M points,
 // one thread); the prefetch had measured level against the base + fill
-// pair before it (docs/bench/scale, session 19).
+// pair before it (docs/bench/scale, session 19). A buffered point and its
+// input index share a 16-byte slot, so that a put touches one line of the
+// buffers, not two (a flush copies the group apart into its two arrays):
+// on 2 cores the scatter 372-378 -> 354-359 ms (70M points, 2 threads).
 class BlockWriter {
 public:
     static constexpr uint32_t kGroup = 16;  // points: 192 bytes = 3 lines; indices and cells: 1 line
@@ -125,8 +128,7 @@ public:
 #endif
         if (m_buffered) {
             m_first = next;
-            m_bufPoints.resize(next.size() * kGroup);
-            m_bufInput.resize(next.size() * kGroup);
+            m_slots.resize(next.size() * kGroup);
             if (m_cell != nullptr) m_bufCell.resize(next.size() * kGroup);
         }
     }
@@ -140,8 +142,7 @@ public:
             return;
         }
         const size_t slot = size_t(block) * kGroup + at % kGroup;
-        m_bufPoints[slot] = p;
-        m_bufInput[slot] = input;
+        m_slots[slot] = Slot{p, input};
         if (m_cell != nullptr) m_bufCell[slot] = cell;
         if ((at + 1) % kGroup == 0) flush(block, at + 1);
     }
@@ -156,14 +157,13 @@ public:
             return;
         }
         uint64_t* const next = m_next.data();
-        glm::vec3* const bufPoints = m_bufPoints.data();
-        uint32_t* const bufInput = m_bufInput.data();
+        Slot* const slots = m_slots.data();
         for (size_t i = 0; i < n; ++i) {
             const uint32_t block = blocks[i];
             const uint64_t at = next[block]++;
-            const size_t slot = size_t(block) * kGroup + at % kGroup;
-            bufPoints[slot] = points[i];
-            bufInput[slot] = first + uint32_t(i);
+            Slot& slot = slots[size_t(block) * kGroup + at % kGroup];
+            slot.p = points[i];
+            slot.input = first + uint32_t(i);
             if ((at + 1) % kGroup == 0) flush(block, at + 1);
         }
     }
@@ -187,15 +187,21 @@ private:
         const size_t base = size_t(block) * kGroup;
 #if defined(RTHDIST_STREAMING_STORES)
         if (m_streaming && end - first == kGroup) {  // a whole, aligned group
-            stream(m_points + first, &m_bufPoints[base], kGroup * sizeof(glm::vec3));
-            stream(m_input + first, &m_bufInput[base], kGroup * sizeof(uint32_t));
+            alignas(64) glm::vec3 points[kGroup];
+            alignas(64) uint32_t input[kGroup];
+            for (uint32_t k = 0; k < kGroup; ++k) {
+                points[k] = m_slots[base + k].p;
+                input[k] = m_slots[base + k].input;
+            }
+            stream(m_points + first, points, kGroup * sizeof(glm::vec3));
+            stream(m_input + first, input, kGroup * sizeof(uint32_t));
             if (m_cell != nullptr) stream(m_cell + first, &m_bufCell[base], kGroup * sizeof(uint32_t));
             return;
         }
 #endif
         for (uint64_t at = first; at < end; ++at) {
-            m_points[at] = m_bufPoints[base + at % kGroup];
-            m_input[at] = m_bufInput[base + at % kGroup];
+            m_points[at] = m_slots[base + at % kGroup].p;
+            m_input[at] = m_slots[base + at % kGroup].input;
             if (m_cell != nullptr) m_cell[at] = m_bufCell[base + at % kGroup];
         }
     }
@@ -216,8 +222,14 @@ private:
     std::vector<uint64_t> m_first;  // each block's first destination in this range
     bool m_buffered = false;
     [[maybe_unused]] bool m_streaming = false;  // read only where streaming stores exist
-    std::vector<glm::vec3> m_bufPoints;
-    std::vector<uint32_t> m_bufInput, m_bufCell;
+    // A buffered point and its input index in one 16-byte slot: a put
+    // touches one line of the buffers, not two.
+    struct alignas(16) Slot {
+        glm::vec3 p;
+        uint32_t input;
+    };
+    std::vector<Slot> m_slots;
+    std::vector<uint32_t> m_bufCell;
 };
 
 }  // namespace
