@@ -1145,6 +1145,25 @@ std::optional<Error> runInSpace(const SpatialPieces& pieces, SpaceDirection* con
     return std::nullopt;
 }
 
+// Each set's most points a piece. One lane: the tile (the fewest pieces).
+// Several: pieces of about equal size whose count is a multiple of the
+// lanes and at least two a lane, so that the lanes' rounds end together
+// (the torus quarter on two H200s came in 5 pieces, 3 on one lane and 2 on
+// the other, docs/bench/scale session 20). A piece is cut at a cell's edge
+// below its limit, so the limits leave 1/32 over the even share: p pieces
+// of that limit hold a set whose cells are each below 1/32 of a share.
+PieceLimits pieceLimits(uint64_t a, uint64_t b, uint64_t tile, int lanes) {
+    if (lanes <= 1) return {tile, tile};
+    const auto l = uint64_t(lanes);
+    const uint64_t needed = std::max((a + tile - 1) / tile, (b + tile - 1) / tile);
+    const uint64_t count = std::max<uint64_t>(2, (needed + l - 1) / l) * l;
+    const auto share = [&](uint64_t n) {
+        const uint64_t even = (n + count - 1) / count;
+        return std::max<uint64_t>(1, std::min(tile, even + even / 32));
+    };
+    return {share(a), share(b)};
+}
+
 // The whole pair within one budget: each direction in chunks (its targets
 // fit one call beside a chunk) or in pieces ordered in space.
 Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOptions& call,
@@ -1169,13 +1188,7 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
                              std::to_string(b.size()) +
                              " points; pieces ordered in space take at most 2^32 - 1 points a set"};
         }
-        // With several lanes, at least two pieces a lane.
-        const uint64_t l2 = 2 * uint64_t(std::max(lanes, 1));
-        PieceLimits limits{tile, tile};
-        if (lanes > 1) {
-            limits.a = std::min(tile, (a.size() + l2 - 1) / l2);
-            limits.b = std::min(tile, (b.size() + l2 - 1) / l2);
-        }
+        const PieceLimits limits = pieceLimits(a.size(), b.size(), tile, lanes);
         // Pieces (at most the grid's 2^15 cells plus a set's points over its
         // limit) are numbered below 2^31 in the partition (kSharedBlock).
         if (a.size() / limits.a + b.size() / limits.b > (uint64_t(1) << 30)) {

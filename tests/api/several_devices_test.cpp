@@ -124,6 +124,24 @@ TEST(SeveralDevices, PerPointDistances) {
         ASSERT_NEAR(got->bNearest.distance[i], want->bNearest.distance[i], tol);
 }
 
+// Pieces in space over two devices come in a multiple of two, so that the
+// lanes' rounds end together: a pair cut by the tile alone into five pieces
+// (the torus quarter on two H200s) kept one lane busy for three while the
+// other ran two.
+TEST(SeveralDevices, PiecesInSpaceComeInAMultipleOfTheLanes) {
+    RTHDIST_REQUIRE_TEST_ENGINE(one);
+    Engine two = severalDevices(*one, 2, 26000);
+    const OracleCase c{"several-devices-balanced", 71, randomCloud(30000, 71),
+                       randomCloud(40000, 72, glm::vec3(0.01f, 0.0f, 0.0f))};
+    auto want = one->compute(c.a, c.b);
+    auto got = two.compute(c.a, c.b);
+    ASSERT_TRUE(want && got);
+    expectOneDeviceResult(c, *got, *want, 2);
+    EXPECT_GE(got->aToB.counters.queryChunks, 4u);
+    EXPECT_EQ(got->aToB.counters.queryChunks % 2, 0u);
+    EXPECT_EQ(got->bToA.counters.queryChunks % 2, 0u);
+}
+
 // Several devices need a GPU backend; a negative index is refused.
 TEST(SeveralDevicesOptions, RefusedWhereTheyCannotRun) {
     EngineOptions o;
