@@ -43,11 +43,13 @@ public:
     void cmdUpload(VkCommandBuffer cmd, PointIndex& ix);
 
     // A large set's upload (ix.hostSource, set by stageIndex past
-    // kChunkedUploadPoints): chunks of kUploadChunkPoints converted to vec4
-    // records by the host's threads into one reused host buffer, each copied
-    // by a submission of its own into the set's points; the same pass takes
-    // the set's bounds, then its grid follows (setGrid). buildIndexes runs
-    // it before the build's submission.
+    // kChunkedUploadPoints): chunks of half of kUploadChunkPoints, packed
+    // floats copied by the host's threads into one reused host buffer, each
+    // copied by a submission of its own into one chunk-sized device buffer
+    // and turned into vec4 records in the set's points there (ingest.comp:
+    // 12 bytes a point cross the bus, not 16); the same pass takes the set's
+    // bounds, then its grid follows (setGrid). buildIndexes runs it before
+    // the build's submission.
     void uploadChunked(PointIndex& ix);
 
     // Device half of an index build, recorded into `cmd` after the upload:

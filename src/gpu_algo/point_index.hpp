@@ -56,8 +56,10 @@ inline constexpr size_t kHostChunk = size_t(1) << 16;
 // A set of more points is not staged whole in host-visible memory (a
 // pinned buffer of 16 bytes a point, allocated per call): its bounds come
 // from one read on the host and its points go up through one reused host
-// buffer of kUploadChunkPoints records, in chunks of half of it: the host
-// writes one half while the device copies the other (IndexBuild::uploadChunked).
+// buffer of kUploadChunkPoints packed points (12 bytes each), in chunks of
+// half of it: the host writes one half while the device copies the other
+// into a chunk-sized device buffer and makes records of it
+// (IndexBuild::uploadChunked).
 inline constexpr size_t kChunkedUploadPoints = size_t(1) << 23;
 inline constexpr size_t kUploadChunkPoints = size_t(1) << 23;
 

@@ -84,7 +84,9 @@ struct BatchScratch {
 
 struct Scratch {
     std::array<BuildScratch, 2> builds;  // set A (and every single build), set B
-    Buffer uploadChunk;  // host: two chunks of a large set's vec4 points (IndexBuild::uploadChunked)
+    Buffer uploadChunk;    // host: two chunks of a large set's packed floats (IndexBuild::uploadChunked)
+    Buffer uploadPacked;   // one chunk of them on the device, which ingest.comp turns into vec4 records
+    Buffer uploadSummary;  // ingest.comp's summary of those chunks (bounds come from the host's pass)
     std::array<LeafScratch, 2> leaves;  // set A (and every single split), set B (IndexBuild::splitLeaves)
     LevelScratch levels;
     std::array<DirectionBuffers, 2> directions;  // A->B, B->A

@@ -290,7 +290,10 @@ TEST(LargeSizes, CrowdedSphereSettlesInThePass) {
 // A large set staged by the host goes up in chunks through one reused host
 // buffer (IndexBuild::uploadChunked, past kChunkedUploadPoints): forced at
 // small sizes, chunks that do not divide the set, the same results as the
-// whole staging and the brute force (one set chunked, the other whole; both).
+// whole staging and the brute force (one set chunked, the other whole;
+// both), and every point's nearest distance the same (a chunk's point left
+// out of the device's records, where the maximum and its witness stayed,
+// changed those).
 TEST(LargeSizes, ChunkedUploadEqualsWholeStaging) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
     auto whole = gpu_algo::GpuHausdorff::create(*ctx, "", 0, *gpuOptions().tuning);
@@ -311,6 +314,13 @@ TEST(LargeSizes, ChunkedUploadEqualsWholeStaging) {
             ASSERT_TRUE(r) << r.error().message;
             expectMatchesOracle(c, *r);
             expectSameValueAndWitnesses(*r, *w);
+            Options perPoint;
+            perPoint.perPointDistances = true;
+            auto wp = (*whole)->compute(c.a, c.b, perPoint);
+            auto rp = (*chunked)->compute(c.a, c.b, perPoint);
+            ASSERT_TRUE(wp && rp);
+            EXPECT_EQ(rp->aNearest.distance, wp->aNearest.distance);
+            EXPECT_EQ(rp->bNearest.distance, wp->bNearest.distance);
             // The chunks' pass takes the box the grid is made from: the
             // same grid as the whole staging's pass gives.
             for (Directed HausdorffResult::*d : {&HausdorffResult::aToB, &HausdorffResult::bToA}) {
