@@ -1212,7 +1212,7 @@ Result<HausdorffResult> computeWithin(Span a, Span b, double scale, const CallOp
                 ErrorCode::kOutOfMemory,
                 "out of host memory cutting " + std::to_string(a.size()) + " + " + std::to_string(b.size()) +
                     " points into pieces in space (about " +
-                    std::to_string((a.size() + b.size()) * (call.perPointDistances ? 20 : 16) / 1000000) +
+                    std::to_string((a.size() + b.size()) * (call.perPointDistances ? 22 : 18) / 1000000) +
                     " MB beside the inputs)"};
         }
         const SpatialPieces& pieces = *cut;

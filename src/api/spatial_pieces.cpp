@@ -34,7 +34,8 @@ RTHDIST_VECTOR_CLONES void cellsOf(const SpatialPieces& pieces, const glm::vec3*
 }
 
 // Cells per axis: about 16 points a cell over both sets, 2 to 32 a side
-// (at most 2^15 cells). Both passes over the points look up a table of
+// (at most 2^15 cells: a cell's Morton code fits the 16 bits the keys pass
+// stores for each point). Both passes over the points look up a table of
 // every cell at random (each host thread's counts, then each cell's block),
 // so the grid's size is paid per point: 128 a side cost the H200 machine's
 // 32 threads 2.6 s of cache misses on 700M points, and 32 instead of 64 (a
@@ -49,6 +50,7 @@ uint32_t cellsPerAxisFor(uint64_t points) {
     while (cells < 32 && double(cells) < side) cells *= 2;
     return cells;
 }
+static_assert(32 * 32 * 32 <= 65536, "a cell's Morton code is stored in 16 bits");
 
 // Host threads and their input ranges: range t is [t * n / T, (t + 1) * n / T),
 // so that ranks and scatter positions follow input order.
@@ -364,24 +366,32 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         out.m_inverse[axis] = side > 0.0 && std::isfinite(1.0 / side) ? 1.0 / side : 1.0;
     }
 
-    // Each range's count of every cell. The points' cells (Morton codes)
-    // are computed in runs of kRun (cellsOf) here and again in the scatter,
-    // not stored: an array of them (4 bytes a point, fresh memory) cost more
-    // to write and read back than the second computation.
+    // Each range's count of every cell, and each point's cell (its Morton
+    // code, below 2^15: 16 bits) for the scatter. Stored, 2 bytes a point,
+    // rather than computed again there: on 2 cores the partition of 70M
+    // points 413-420 -> 335-344 ms (docs/bench/scale, session 20); 4 bytes a
+    // point of fresh memory had cost more than the second computation in
+    // session 16 (a grid of up to 64 a side then).
     constexpr size_t kRun = 1024;
     Ranges ranges[2];
     std::vector<std::vector<uint32_t>> counts[2];
+    core::UninitVector<uint16_t> cellOf16[2];  // each point's cell, in input order
     for (int s = 0; s < 2; ++s) {
         const Span points = sets[s];
         ranges[s] = Ranges{points.size(), core::resolveThreads(threads, points.size() / 65536 + 1)};
         counts[s].assign(size_t(ranges[s].count), std::vector<uint32_t>(cellCount, 0u));
+        cellOf16[s].resize(points.size());
         forRanges(ranges[s], [&](int t, size_t begin, size_t end) {
             std::vector<uint32_t>& mine = counts[s][size_t(t)];
             uint32_t keys[kRun];
+            uint16_t* const cellOf = cellOf16[s].data();
             for (size_t r0 = begin; r0 < end; r0 += kRun) {
                 const size_t n = std::min(end, r0 + kRun) - r0;
                 cellsOf(out, points.data() + r0, scale, n, keys);
-                for (size_t i = 0; i < n; ++i) ++mine[keys[i]];
+                for (size_t i = 0; i < n; ++i) {
+                    ++mine[keys[i]];
+                    cellOf[r0 + i] = uint16_t(keys[i]);
+                }
             }
         });
     }
@@ -571,8 +581,11 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
             uint32_t keys[kRun], blockIds[kRun];
             for (size_t r0 = begin; r0 < end; r0 += kRun) {
                 const size_t n = std::min(end, r0 + kRun) - r0;
-                cellsOf(out, points.data() + r0, scale, n, keys);
-                for (size_t i = 0; i < n; ++i) blockIds[i] = blockOfPoint(keys[i], rank);
+                const uint16_t* const cellOf = cellOf16[s].data() + r0;
+                for (size_t i = 0; i < n; ++i) {
+                    keys[i] = cellOf[i];
+                    blockIds[i] = blockOfPoint(keys[i], rank);
+                }
                 writer.putRun(blockIds, points.data() + r0, uint32_t(r0), keys, n);
             }
             writer.finish();

@@ -25,8 +25,8 @@
 // Threading: partition() runs its passes on `threads` threads (0: all); the
 // object is then read-only and may be read from any thread.
 // Memory: per set 16 bytes per point (the gathered copy and its input
-// indices; 20 with the cells kept; the cells are computed twice while
-// partitioning, not stored); the grid at most
+// indices; 20 with the cells kept) and, while partitioning, 2 more (each
+// point's cell in input order, freed at the end); the grid at most
 // 2^15 cells (12 bytes and a bit each), 12 bytes per block and, while
 // partitioning, 4 bytes per cell and 8 per block for each host thread, and
 // while scattering 328 bytes per block for each host thread where blocks
