@@ -369,7 +369,9 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
     // Each range's count of every cell, and each point's cell (its Morton
     // code, below 2^15: 16 bits) for the scatter. Stored, 2 bytes a point,
     // rather than computed again there: on 2 cores the partition of 70M
-    // points 413-420 -> 335-344 ms (docs/bench/scale, session 20); 4 bytes a
+    // points 413-420 -> 335-344 ms, on one H200's 16-core host the torus
+    // quarter's 1044-1164 -> 965-1010 ms (scatter 832-933 -> 696-734, keys
+    // 210-230 -> 263-272; docs/bench/scale, session 20); 4 bytes a
     // point of fresh memory had cost more than the second computation in
     // session 16 (a grid of up to 64 a side then).
     constexpr size_t kRun = 1024;
