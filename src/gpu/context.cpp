@@ -510,6 +510,7 @@ void Context::submitAndWait(VkCommandBuffer cmd) {
                               VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
     RTHDIST_VK_CHECK(r);
     m_lastGpuMs = gpuMsBetween(0, last);
+    m_lastMarks = last;
     if (m_traceSubmits) traceSubmit();
 }
 
@@ -528,11 +529,14 @@ VkResult Context::waitBriefly(VkFence fence) const {
 void Context::traceSubmit() {
     using Ms = std::chrono::duration<double, std::milli>;
     const auto now = std::chrono::steady_clock::now();
+    std::string between;  // the device time between the submission's marks
+    for (uint32_t m = 1; m_lastMarks > 1 && m <= m_lastMarks; ++m)
+        between += (m == 1 ? ", between marks " : " ") + std::to_string(gpuMsBetween(m - 1, m));
     std::fprintf(
         stderr,
-        "rthdist submit: host before %.3f ms, recording %.3f ms, submit+wait %.3f ms, device %.3f ms\n",
+        "rthdist submit: host before %.3f ms, recording %.3f ms, submit+wait %.3f ms, device %.3f ms%s\n",
         Ms(m_begun - m_lastDone).count(), Ms(m_submitted - m_begun).count(), Ms(now - m_submitted).count(),
-        m_lastGpuMs);
+        m_lastGpuMs, between.c_str());
     m_lastDone = now;
 }
 

@@ -133,6 +133,12 @@ public:
     [[nodiscard]] double gpuMsBetween(uint32_t from, uint32_t to) const;
     // RTHDIST_SUBMIT_TRACE is set: stages may add their own stderr lines.
     [[nodiscard]] bool tracingSubmits() const { return m_traceSubmits; }
+    // With RTHDIST_SUBMIT_TRACE, a mark (cmdMark) where slots remain: the
+    // submission's trace line then lists the device time between its marks
+    // (a stage's phases); nothing otherwise.
+    void cmdTraceMark(VkCommandBuffer cmd) {
+        if (m_traceSubmits && m_marks + 2 < kTimestampSlots) cmdMark(cmd);
+    }
     static constexpr uint32_t kTimestampSlots = 40;
 
     // Debug utilities (VK_EXT_debug_utils, enabled with validation, or with
@@ -198,6 +204,7 @@ private:
     [[nodiscard]] VkResult waitBriefly(VkFence fence) const;
     std::chrono::steady_clock::time_point m_begun, m_submitted, m_lastDone;
     std::array<uint64_t, kTimestampSlots> m_stamps{};  // of the last submission
+    uint32_t m_lastMarks = 0;                          // its last mark (the end)
     uint32_t m_timestampBits = 64;
     Backend m_backend = Backend::kRayQuery;
     std::string m_name;

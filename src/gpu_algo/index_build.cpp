@@ -176,17 +176,22 @@ void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const Counte
 
     blk.fields().maxCount = 0;
     blk.fields().largeCells = 0;
+    m_ws.ctx.cmdTraceMark(cmd);  // the trace's phases: fill, keys, scan, scatter, heads, scan, cells, check
     vkCmdFillBuffer(cmd, ix.dense->handle(), 0, denseBytes, 0);
     m_ws.barrier(cmd);
+    m_ws.ctx.cmdTraceMark(cmd);
     sh::KeysPush kp{points.address(), keys.address(), ix.dense->address(), gridParams(ix.grid), ix.n};
     m_ws.dispatch(cmd, Kernel::kCellKeys, kp, ix.n);
     m_ws.barrier(cmd);
+    m_ws.ctx.cmdTraceMark(cmd);
     m_ws.cmdScan(cmd, ix.dense->address(), numKeys, ix.scratch->scanKeys, "scanKeys");
     m_ws.barrier(cmd);
+    m_ws.ctx.cmdTraceMark(cmd);
     sh::ScatterPush sp{points.address(),     keys.address(),           ix.dense->address(),
                        ix.sorted->address(), ix.sortedKeys->address(), ix.n};
     m_ws.dispatch(cmd, Kernel::kScatter, sp, ix.n);
     m_ws.barrier(cmd);
+    m_ws.ctx.cmdTraceMark(cmd);
     sh::CellsPush cp{
         ix.sorted->address(),
         ix.sortedKeys->address(),
@@ -201,10 +206,13 @@ void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const Counte
         uint32_t(ix.cellCapacity)};
     m_ws.dispatch(cmd, Kernel::kCellHeads, cp, ix.n);
     m_ws.barrier(cmd);
+    m_ws.ctx.cmdTraceMark(cmd);
     m_ws.cmdScan(cmd, flags.address(), ix.n, ix.scratch->scanFlags, "scanFlags");
     m_ws.barrier(cmd);
+    m_ws.ctx.cmdTraceMark(cmd);
     cmdCellBuild(cmd, std::span(&cp, 1));
     m_ws.barrier(cmd);
+    m_ws.ctx.cmdTraceMark(cmd);
     cmdCheckIndex(cmd, ix, blk);  // in the same submission: no extra wait
 }
 
