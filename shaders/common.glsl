@@ -34,6 +34,20 @@ CellRef cellAt(uint64_t base, uint i) { return CellRef(base + uint64_t(i) * 32ul
 StateRef stateAt(uint64_t base, uint i) { return StateRef(base + uint64_t(i) * 16ul); }
 LeafGroupRef groupAt(uint64_t base, uint i) { return LeafGroupRef(base + uint64_t(i) * 32ul); }
 
+// The item of thread t in a pass over n items in space order whose atomics
+// follow the items' cells: the 32 threads of a warp take items ceil(n / 32) apart
+// (lane * rows + t / 32), so that items in space order (the out-of-core
+// pieces' gathered points) do not send a warp's atomics to a few lines of
+// the dense key table. A bijection of [0, 32 rows) onto itself; n (none)
+// for a thread past the items. The host dispatches spreadThreads(n).
+uint spreadItem(uint t, uint n) {
+    uint rows = (n + 31u) / 32u;
+    uint row = t >> 5u;
+    if (row >= rows) return n;
+    uint p = (t & 31u) * rows + row;
+    return p < n ? p : n;
+}
+
 // The queries the radius in flight searches (set by the host, then by
 // search_advance.comp between the radii of one submission), at most the
 // slots dispatched.

@@ -101,10 +101,11 @@ struct GridParams {
 // cell_keys.comp: key per point, histogram into the dense table.
 struct KeysPush {
     uint64_t points;  // vec4[n] input (xyz, w unused)
-    uint64_t keys;    // uint[n] out
+    uint64_t keys;    // uint per thread out (spread: spreadThreads(n) of them, else n)
     uint64_t dense;   // uint[2^(3 bits)] histogram (zeroed)
     GridParams grid;
     uint n;
+    uint spread;  // 1: thread t takes point spreadItem(t, n) (common.glsl), else point t
 };
 
 // ingest.comp: the caller's points (x, y, z floats at source + i * stride, in
@@ -166,11 +167,12 @@ struct ScanPush {
 // scatter.comp: counting-sort scatter; dense[key] ends as the cell's end.
 struct ScatterPush {
     uint64_t points;      // vec4[n] input
-    uint64_t keys;        // uint[n]
+    uint64_t keys;        // uint per thread, as cell_keys.comp wrote them
     uint64_t dense;       // uint[] starts in, ends out
     uint64_t sorted;      // vec4[n] out: xyz, w = original index (float bits)
     uint64_t sortedKeys;  // uint[n] out
     uint n;
+    uint spread;  // as KeysPush::spread (the same order as the keys pass)
 };
 
 // cell_heads.comp writes flags (1 where a cell starts); after a scan

@@ -13,6 +13,7 @@
 #include "core/parallel.hpp"
 #include "gpu/device_limits.hpp"
 #include "gpu_algo/self_check.hpp"
+#include "gpu_algo/space_order.hpp"
 
 namespace rthdist::gpu_algo {
 
@@ -45,6 +46,10 @@ void toRecords(std::span<const glm::vec3> pts, size_t begin, size_t end, float* 
     lo = l;
     hi = h;
 }
+
+// Threads of a pass in spreadItem's order (common.glsl) over n items: n
+// rounded up to whole warps of 32 (n < 2^31: no overflow).
+uint64_t spreadThreads(uint32_t n) { return (uint64_t(n) + 31) / 32 * 32; }
 
 }  // namespace
 
@@ -81,6 +86,7 @@ void IndexBuild::setGrid(PointIndex& ix, std::span<const glm::vec3> pts, std::sp
         bits = clampedBits(core::chooseBits(pts, ix.bounds), ix.n);
     }
     ix.grid = core::makeGrid(ix.bounds, bits);
+    ix.spaceOrder = inSpaceOrder(pts, ix.grid);
 }
 
 void IndexBuild::uploadChunked(PointIndex& ix) {
@@ -163,7 +169,8 @@ void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const Counte
     const VkDeviceSize bytes = VkDeviceSize(ix.n) * 16;
     Buffer& points = m_ws.grow(ix.scratch->points, bytes, ix.name + ".points");
     const uint32_t numKeys = 1u << (3 * ix.grid.bits);
-    Buffer& keys = m_ws.grow(ix.scratch->keys, VkDeviceSize(ix.n) * 4, ix.name + ".keys");
+    const uint64_t threads = ix.spaceOrder ? spreadThreads(ix.n) : ix.n;  // the keys and scatter passes'
+    Buffer& keys = m_ws.grow(ix.scratch->keys, VkDeviceSize(threads) * 4, ix.name + ".keys");
     ix.sortedKeys = &m_ws.setBuffer(ix, ix.store->sortedKeys, ".sortedKeys", VkDeviceSize(ix.n) * 4);
     Buffer& flags = m_ws.grow(ix.scratch->flags, VkDeviceSize(ix.n) * 4, ix.name + ".flags");
     const VkDeviceSize denseBytes = VkDeviceSize(numKeys) * 4;
@@ -180,16 +187,22 @@ void IndexBuild::cmdBuildIndex(VkCommandBuffer cmd, PointIndex& ix, const Counte
     vkCmdFillBuffer(cmd, ix.dense->handle(), 0, denseBytes, 0);
     m_ws.barrier(cmd);
     m_ws.ctx.cmdTraceMark(cmd);
-    sh::KeysPush kp{points.address(), keys.address(), ix.dense->address(), gridParams(ix.grid), ix.n};
-    m_ws.dispatch(cmd, Kernel::kCellKeys, kp, ix.n);
+    const uint32_t spread = ix.spaceOrder ? 1u : 0u;
+    sh::KeysPush kp{points.address(), keys.address(), ix.dense->address(), gridParams(ix.grid), ix.n, spread};
+    m_ws.dispatch(cmd, Kernel::kCellKeys, kp, threads);
     m_ws.barrier(cmd);
     m_ws.ctx.cmdTraceMark(cmd);
     m_ws.cmdScan(cmd, ix.dense->address(), numKeys, ix.scratch->scanKeys, "scanKeys");
     m_ws.barrier(cmd);
     m_ws.ctx.cmdTraceMark(cmd);
-    sh::ScatterPush sp{points.address(),     keys.address(),           ix.dense->address(),
-                       ix.sorted->address(), ix.sortedKeys->address(), ix.n};
-    m_ws.dispatch(cmd, Kernel::kScatter, sp, ix.n);
+    sh::ScatterPush sp{points.address(),
+                       keys.address(),
+                       ix.dense->address(),
+                       ix.sorted->address(),
+                       ix.sortedKeys->address(),
+                       ix.n,
+                       spread};
+    m_ws.dispatch(cmd, Kernel::kScatter, sp, threads);
     m_ws.barrier(cmd);
     m_ws.ctx.cmdTraceMark(cmd);
     sh::CellsPush cp{

@@ -112,6 +112,9 @@ struct PointIndex {
     // small; minEdge is the narrowest split sub-cell's edge (first radius).
     bool split = false;
     double minEdge = 0.0;
+    // Its points lie in space order (the index build's keys and scatter
+    // passes then take them spread; IndexBuild::setGrid decides).
+    bool spaceOrder = false;
     // Search cells by level j >= 1 (edge s * 2^j), built on first use.
     struct Level {
         Buffer* cells = nullptr;

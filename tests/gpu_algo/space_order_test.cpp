@@ -1,0 +1,63 @@
+// Whether a set's points lie in space order (src/gpu_algo/space_order.hpp),
+// on the host: points in no order are not; the same points in Morton order,
+// or gathered by groups of cells as the out-of-core pieces gather them
+// (input order within a group), are; small sets never are.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "gpu_algo/space_order.hpp"
+
+namespace rthdist::gpu_algo {
+namespace {
+
+std::vector<glm::vec3> cloud(size_t n, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::vector<glm::vec3> p(n);
+    for (glm::vec3& v : p) v = glm::vec3(u(rng), u(rng), u(rng));
+    return p;
+}
+
+uint32_t keyOf(const glm::vec3& p, const core::GridSpec& g) {
+    uint32_t c[3];
+    for (int axis = 0; axis < 3; ++axis)
+        c[axis] = core::cellCoord(double(p[axis]), g.origin[axis], g.cellSize, g.cellsPerAxis);
+    return core::mortonEncode(c[0], c[1], c[2]);
+}
+
+// The points ordered by key >> shift, stably (input order within a group).
+std::vector<glm::vec3> byGroups(std::vector<glm::vec3> p, const core::GridSpec& g, uint32_t shift) {
+    std::stable_sort(p.begin(), p.end(), [&](const glm::vec3& a, const glm::vec3& b) {
+        return (keyOf(a, g) >> shift) < (keyOf(b, g) >> shift);
+    });
+    return p;
+}
+
+TEST(SpaceOrder, PointsInNoOrderAreNot) {
+    const std::vector<glm::vec3> p = cloud(200000, 1);
+    const core::GridSpec g = core::makeGrid(core::boundsOf(p), 8);
+    EXPECT_FALSE(inSpaceOrder(p, g));
+}
+
+TEST(SpaceOrder, MortonOrderAndThePiecesGroupsAre) {
+    const std::vector<glm::vec3> p = cloud(200000, 2);
+    const core::GridSpec g = core::makeGrid(core::boundsOf(p), 8);
+    EXPECT_TRUE(inSpaceOrder(byGroups(p, g, 0), g));
+    // 2^12 groups of 2^12 keys each: a piece's blocks (kBlockGroupBits).
+    EXPECT_TRUE(inSpaceOrder(byGroups(p, g, 12), g));
+    // 2^6 groups: too coarse to count.
+    EXPECT_FALSE(inSpaceOrder(byGroups(p, g, 18), g));
+}
+
+TEST(SpaceOrder, SmallSetsAreNot) {
+    std::vector<glm::vec3> p = cloud(2000, 3);
+    const core::GridSpec g = core::makeGrid(core::boundsOf(p), 4);
+    EXPECT_FALSE(inSpaceOrder(byGroups(p, g, 0), g));
+}
+
+}  // namespace
+}  // namespace rthdist::gpu_algo
