@@ -474,6 +474,8 @@ void GpuHausdorff::setUploadChunks(size_t past, size_t chunk) {
     m_state->ws.uploadChunkPoints = std::max<size_t>(1, chunk);
 }
 
+void GpuHausdorff::setSpaceOrderMinPoints(size_t points) { m_state->ws.spaceOrderMinPoints = points; }
+
 void GpuHausdorff::setAdoptMinBytes(uint64_t bytes) { m_state->ws.adoptMinBytes = bytes; }
 uint64_t GpuHausdorff::adoptedBuffers() const { return m_state->ws.adopted; }
 size_t GpuHausdorff::spareBuffers() const { return m_state->ws.spare.size(); }

@@ -163,6 +163,10 @@ public:
     // kUploadChunkPoints);
     // tests shrink both to run the chunked path at small sizes.
     void setUploadChunks(size_t past, size_t chunk);
+    // A set of at least `points` whose points lie in space order has its
+    // index built spread over each warp (space_order.hpp; default
+    // kMinSpaceOrderPoints); tests lower it to run that path at small sizes.
+    void setSpaceOrderMinPoints(size_t points);
     // Requests of at least `bytes` may adopt a spent buffer of the call
     // (Workspace::spare; default kAdoptMinBytes); tests set 0 so that small
     // inputs adopt too.

@@ -86,7 +86,7 @@ void IndexBuild::setGrid(PointIndex& ix, std::span<const glm::vec3> pts, std::sp
         bits = clampedBits(core::chooseBits(pts, ix.bounds), ix.n);
     }
     ix.grid = core::makeGrid(ix.bounds, bits);
-    ix.spaceOrder = inSpaceOrder(pts, ix.grid);
+    ix.spaceOrder = inSpaceOrder(pts, ix.grid, m_ws.spaceOrderMinPoints);
 }
 
 void IndexBuild::uploadChunked(PointIndex& ix) {

@@ -5,9 +5,9 @@
 
 namespace rthdist::gpu_algo {
 
-bool inSpaceOrder(std::span<const glm::vec3> pts, const core::GridSpec& grid) {
+bool inSpaceOrder(std::span<const glm::vec3> pts, const core::GridSpec& grid, size_t minPoints) {
     constexpr size_t kRuns = 64, kRun = 32;
-    if (pts.size() < kRuns * kRun) return false;
+    if (pts.size() < std::max(minPoints, kRuns * kRun)) return false;
     const uint32_t keyBits = 3 * uint32_t(grid.bits);
     const uint64_t narrow = keyBits > 8 ? uint64_t(1) << (keyBits - 8) : 1;
     const auto keyOf = [&](const glm::vec3& p) {

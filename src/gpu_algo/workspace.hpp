@@ -21,6 +21,7 @@
 #include "gpu_algo/pipelines.hpp"
 #include "gpu_algo/point_index.hpp"
 #include "gpu_algo/scratch.hpp"
+#include "gpu_algo/space_order.hpp"
 #include "rthdist/rthdist.hpp"
 #include "rthdist_shared.h"
 
@@ -103,7 +104,9 @@ struct Workspace {
     uint32_t leafGroupLeaves = kLeafGroupLeaves;        // leaves per group of a split index built next
     size_t chunkedUploadPoints = kChunkedUploadPoints;  // a larger host-staged set goes up in chunks
     size_t uploadChunkPoints = kUploadChunkPoints;
-    bool mutant = false;  // tests only: core::searchMutant() when the call started
+    size_t spaceOrderMinPoints =
+        kMinSpaceOrderPoints;  // a smaller set's index build takes its points in order
+    bool mutant = false;       // tests only: core::searchMutant() when the call started
     Timings* timings = nullptr;
     // Buffers live across calls and only grow: allocation is a large share of
     // a call's cost on discrete GPUs. oneShot: the indexes of one-shot sets A, B.

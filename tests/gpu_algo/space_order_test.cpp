@@ -1,7 +1,7 @@
 // Whether a set's points lie in space order (src/gpu_algo/space_order.hpp),
 // on the host: points in no order are not; the same points in Morton order,
 // or gathered by groups of cells as the out-of-core pieces gather them
-// (input order within a group), are; small sets never are.
+// (input order within a group), are; sets below kMinSpaceOrderPoints never are.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -30,21 +30,26 @@ uint32_t keyOf(const glm::vec3& p, const core::GridSpec& g) {
 }
 
 // The points ordered by key >> shift, stably (input order within a group).
-std::vector<glm::vec3> byGroups(std::vector<glm::vec3> p, const core::GridSpec& g, uint32_t shift) {
-    std::stable_sort(p.begin(), p.end(), [&](const glm::vec3& a, const glm::vec3& b) {
-        return (keyOf(a, g) >> shift) < (keyOf(b, g) >> shift);
-    });
-    return p;
+std::vector<glm::vec3> byGroups(const std::vector<glm::vec3>& p, const core::GridSpec& g, uint32_t shift) {
+    std::vector<uint32_t> key(p.size()), order(p.size());
+    for (size_t i = 0; i < p.size(); ++i) {
+        key[i] = keyOf(p[i], g) >> shift;
+        order[i] = uint32_t(i);
+    }
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key[a] < key[b]; });
+    std::vector<glm::vec3> out(p.size());
+    for (size_t i = 0; i < p.size(); ++i) out[i] = p[order[i]];
+    return out;
 }
 
 TEST(SpaceOrder, PointsInNoOrderAreNot) {
-    const std::vector<glm::vec3> p = cloud(200000, 1);
+    const std::vector<glm::vec3> p = cloud(kMinSpaceOrderPoints, 1);
     const core::GridSpec g = core::makeGrid(core::boundsOf(p), 8);
     EXPECT_FALSE(inSpaceOrder(p, g));
 }
 
 TEST(SpaceOrder, MortonOrderAndThePiecesGroupsAre) {
-    const std::vector<glm::vec3> p = cloud(200000, 2);
+    const std::vector<glm::vec3> p = cloud(kMinSpaceOrderPoints, 2);
     const core::GridSpec g = core::makeGrid(core::boundsOf(p), 8);
     EXPECT_TRUE(inSpaceOrder(byGroups(p, g, 0), g));
     // 2^12 groups of 2^12 keys each: a piece's blocks (kBlockGroupBits).
@@ -54,8 +59,8 @@ TEST(SpaceOrder, MortonOrderAndThePiecesGroupsAre) {
 }
 
 TEST(SpaceOrder, SmallSetsAreNot) {
-    std::vector<glm::vec3> p = cloud(2000, 3);
-    const core::GridSpec g = core::makeGrid(core::boundsOf(p), 4);
+    const std::vector<glm::vec3> p = cloud(kMinSpaceOrderPoints - 1, 3);
+    const core::GridSpec g = core::makeGrid(core::boundsOf(p), 8);
     EXPECT_FALSE(inSpaceOrder(byGroups(p, g, 0), g));
 }
 
