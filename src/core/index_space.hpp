@@ -116,4 +116,11 @@ using shared::spreadBits;
     return uint32_t(c);
 }
 
+// The Morton key of p's cell in grid g (cellCoord on each axis).
+[[nodiscard]] inline uint32_t cellKey(const glm::dvec3& p, const GridSpec& g) {
+    return mortonEncode(cellCoord(p.x, g.origin.x, g.cellSize, g.cellsPerAxis),
+                        cellCoord(p.y, g.origin.y, g.cellSize, g.cellsPerAxis),
+                        cellCoord(p.z, g.origin.z, g.cellSize, g.cellsPerAxis));
+}
+
 }  // namespace rthdist::core

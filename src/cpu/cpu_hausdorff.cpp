@@ -351,9 +351,7 @@ QueryKeys keyQueries(const SetOrder& qOrder, const core::GridSpec& g, const core
         double far = 0.0;
         for (size_t i = begin; i < end; ++i) {
             const glm::dvec3 dp(qOrder.x[i], qOrder.y[i], qOrder.z[i]);
-            out.key[i] = core::mortonEncode(core::cellCoord(dp.x, g.origin.x, g.cellSize, g.cellsPerAxis),
-                                            core::cellCoord(dp.y, g.origin.y, g.cellSize, g.cellsPerAxis),
-                                            core::cellCoord(dp.z, g.origin.z, g.cellSize, g.cellsPerAxis));
+            out.key[i] = core::cellKey(dp, g);
             const glm::dvec3 d = glm::max(glm::max(box.lo - dp, dp - box.hi), glm::dvec3(0.0));
             far = std::max(far, d.x * d.x + d.y * d.y + d.z * d.z);
         }

@@ -229,10 +229,7 @@ SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int
     parallelChunks(n, 1 << 16, threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) {
             const glm::vec3 p = scaled(points[i], scale);
-            keys[i] =
-                core::mortonEncode(core::cellCoord(p.x, fine.origin.x, fine.cellSize, fine.cellsPerAxis),
-                                   core::cellCoord(p.y, fine.origin.y, fine.cellSize, fine.cellsPerAxis),
-                                   core::cellCoord(p.z, fine.origin.z, fine.cellSize, fine.cellsPerAxis));
+            keys[i] = core::cellKey(glm::dvec3(p), fine);
         }
     });
     OrderedPoints sorted = sortPointsByKey(keys, 3 * order.fineBits, points, scale, threads, kPad);

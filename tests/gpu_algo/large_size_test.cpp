@@ -338,12 +338,7 @@ TEST(LargeSizes, ChunkedUploadEqualsWholeStaging) {
 // gathered points are.
 std::vector<glm::vec3> inMortonOrder(std::vector<glm::vec3> p) {
     const core::GridSpec g = core::makeGrid(core::boundsOf(p), 10);
-    const auto key = [&](const glm::vec3& v) {
-        uint32_t c[3];
-        for (int axis = 0; axis < 3; ++axis)
-            c[axis] = core::cellCoord(double(v[axis]), g.origin[axis], g.cellSize, g.cellsPerAxis);
-        return core::mortonEncode(c[0], c[1], c[2]);
-    };
+    const auto key = [&](const glm::vec3& v) { return core::cellKey(glm::dvec3(v), g); };
     std::stable_sort(p.begin(), p.end(),
                      [&](const glm::vec3& x, const glm::vec3& y) { return key(x) < key(y); });
     return p;

@@ -22,18 +22,11 @@ std::vector<glm::vec3> cloud(size_t n, uint32_t seed) {
     return p;
 }
 
-uint32_t keyOf(const glm::vec3& p, const core::GridSpec& g) {
-    uint32_t c[3];
-    for (int axis = 0; axis < 3; ++axis)
-        c[axis] = core::cellCoord(double(p[axis]), g.origin[axis], g.cellSize, g.cellsPerAxis);
-    return core::mortonEncode(c[0], c[1], c[2]);
-}
-
 // The points ordered by key >> shift, stably (input order within a group).
 std::vector<glm::vec3> byGroups(const std::vector<glm::vec3>& p, const core::GridSpec& g, uint32_t shift) {
     std::vector<uint32_t> key(p.size()), order(p.size());
     for (size_t i = 0; i < p.size(); ++i) {
-        key[i] = keyOf(p[i], g) >> shift;
+        key[i] = core::cellKey(glm::dvec3(p[i]), g) >> shift;
         order[i] = uint32_t(i);
     }
     std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key[a] < key[b]; });
