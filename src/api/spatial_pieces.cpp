@@ -152,7 +152,7 @@ public:
     // A run of points: points[i] into block blocks[i], input index first +
     // i, cell cells[i]. Without kept cells (the usual case) a loop of its
     // own, whose arrays' addresses stay in registers.
-    void putRun(const uint32_t* blocks, const glm::vec3* points, uint32_t first, const uint32_t* cells,
+    void putRun(const uint32_t* blocks, const glm::vec3* points, uint32_t first, const uint16_t* cells,
                 size_t n) {
         if (!m_buffered || m_cell != nullptr) {
             for (size_t i = 0; i < n; ++i) put(blocks[i], points[i], first + uint32_t(i), cells[i]);
@@ -580,15 +580,12 @@ SpatialPieces SpatialPieces::partition(Span a, Span b, double scale, PieceLimits
         forRanges(r, [&](int t, size_t begin, size_t end) {
             BlockWriter writer(set, perBlock[size_t(t)]);
             std::vector<uint64_t>& rank = rankBase[size_t(t)];
-            uint32_t keys[kRun], blockIds[kRun];
+            uint32_t blockIds[kRun];
             for (size_t r0 = begin; r0 < end; r0 += kRun) {
                 const size_t n = std::min(end, r0 + kRun) - r0;
                 const uint16_t* const cellOf = cellOf16[s].data() + r0;
-                for (size_t i = 0; i < n; ++i) {
-                    keys[i] = cellOf[i];
-                    blockIds[i] = blockOfPoint(keys[i], rank);
-                }
-                writer.putRun(blockIds, points.data() + r0, uint32_t(r0), keys, n);
+                for (size_t i = 0; i < n; ++i) blockIds[i] = blockOfPoint(cellOf[i], rank);
+                writer.putRun(blockIds, points.data() + r0, uint32_t(r0), cellOf, n);
             }
             writer.finish();
         });

@@ -510,8 +510,7 @@ void Context::submitAndWait(VkCommandBuffer cmd) {
                               VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
     RTHDIST_VK_CHECK(r);
     m_lastGpuMs = gpuMsBetween(0, last);
-    m_lastMarks = last;
-    if (m_traceSubmits) traceSubmit();
+    if (m_traceSubmits) traceSubmit(last);
 }
 
 VkResult Context::waitBriefly(VkFence fence) const {
@@ -526,11 +525,11 @@ VkResult Context::waitBriefly(VkFence fence) const {
     return r;
 }
 
-void Context::traceSubmit() {
+void Context::traceSubmit(uint32_t last) {
     using Ms = std::chrono::duration<double, std::milli>;
     const auto now = std::chrono::steady_clock::now();
     std::string between;  // the device time between the submission's marks
-    for (uint32_t m = 1; m_lastMarks > 1 && m <= m_lastMarks; ++m)
+    for (uint32_t m = 1; last > 1 && m <= last; ++m)
         between += (m == 1 ? ", between marks " : " ") + std::to_string(gpuMsBetween(m - 1, m));
     std::fprintf(
         stderr,

@@ -197,14 +197,13 @@ private:
     // recording it, waiting for it, its device time; a benchmark's tool).
     bool m_traceSubmits = false;
     bool m_cpuDevice = false;
-    void traceSubmit();
+    void traceSubmit(uint32_t last);  // last: the submission's end mark
     // How long submitAndWait polls its fence before it sleeps on it
     // (Tuning::fenceSpinMicros; 0: never).
     unsigned long m_spinMicros = 2000;
     [[nodiscard]] VkResult waitBriefly(VkFence fence) const;
     std::chrono::steady_clock::time_point m_begun, m_submitted, m_lastDone;
     std::array<uint64_t, kTimestampSlots> m_stamps{};  // of the last submission
-    uint32_t m_lastMarks = 0;                          // its last mark (the end)
     uint32_t m_timestampBits = 64;
     Backend m_backend = Backend::kRayQuery;
     std::string m_name;
