@@ -29,16 +29,22 @@ struct Device {
 std::optional<Error> openDevice(const EngineOptions& options, Backend backend, int deviceIndex,
                                 Device& device, const VulkanDevice* borrowed) {
     const Tuning& tuning = *options.tuning;
+    const auto t0 = core::Clock::now();
     auto ctx = borrowed ? gpu::Context::borrow(*borrowed, backend, options.validation, tuning)
                         : gpu::Context::create(backend, deviceIndex, options.validation, tuning);
     if (!ctx) return ctx.error();
     device.context = std::move(ctx.value());
+    const double contextMs = core::msSince(t0);
+    const auto t1 = core::Clock::now();
     const std::string cacheDir = options.pipelineCacheDir == "off"  ? std::string()
                                  : options.pipelineCacheDir.empty() ? tuning.pipelineCacheDir
                                                                     : options.pipelineCacheDir;
     auto g = gpu_algo::GpuHausdorff::create(*device.context, cacheDir, options.threads, tuning);
     if (!g) return g.error();
     device.gpu = std::move(g.value());
+    if (device.context->tracingSubmits())
+        std::fprintf(stderr, "rthdist setup: device %d opened in %.1f ms (context %.1f, algorithm %.1f)\n",
+                     deviceIndex, core::msSince(t0), contextMs, core::msSince(t1));
     return std::nullopt;
 }
 
@@ -72,6 +78,11 @@ public:
                          std::chrono::duration<double, std::milli>(t1 - t0).count(), core::msSince(t1));
     }
 
+    // Devices are opened one after the other: opened at once (two H200s,
+    // driver 580), the drivers' device creation waited on each other (the
+    // first device's choice took 418 ms beside the second's VkDevice) and one
+    // process of three never finished opening them (session 21,
+    // docs/bench/scale).
     [[nodiscard]] std::optional<Error> open(const VulkanDevice* borrowed) {
         if (auto err = openDevice(m_options, m_options.backend, m_options.deviceIndex, first(), borrowed))
             return err;

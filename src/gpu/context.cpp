@@ -1,6 +1,7 @@
 #include "gpu/context.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -177,7 +178,9 @@ Result<std::unique_ptr<Context>> Context::create(std::span<const DeviceRequireme
     std::unique_ptr<Context> ctx(new Context());
     ctx->m_tuning = tuning;
     try {
+        const auto t0 = std::chrono::steady_clock::now();
         if (std::optional<Error> err = ctx->createInstance(validation)) return *err;
+        const auto t1 = std::chrono::steady_clock::now();
         const std::vector<VkPhysicalDevice> pds = physicalDevices(ctx->m_instanceHandle);
         if (pds.empty()) return Error{ErrorCode::kNoDevice, "no Vulkan physical device found"};
         std::string reasons;
@@ -192,10 +195,22 @@ Result<std::unique_ptr<Context>> Context::create(std::span<const DeviceRequireme
         const DeviceRequirements& req = alternatives[choice->alternative];
         ctx->m_physical = pds[choice->index];
         ctx->m_backend = req.backend;
+        const auto t2 = std::chrono::steady_clock::now();
         ctx->createDevice(req);
+        const auto t3 = std::chrono::steady_clock::now();
         if (std::optional<Error> err = ctx->loadRtFunctions(req)) return *err;
         ctx->readProperties(req);
         ctx->createCommandObjects();
+        if (ctx->m_traceSubmits) {
+            const auto ms = [](auto from, auto to) {
+                return std::chrono::duration<double, std::milli>(to - from).count();
+            };
+            std::fprintf(stderr,
+                         "rthdist setup: instance %.1f ms, choosing device %d %.1f ms, its VkDevice %.1f ms, "
+                         "properties and command objects %.1f ms\n",
+                         ms(t0, t1), int(choice->index), ms(t1, t2), ms(t2, t3),
+                         ms(t3, std::chrono::steady_clock::now()));
+        }
     } catch (const VulkanError& e) {
         return Error{ErrorCode::kNoDevice, e.what()};
     }

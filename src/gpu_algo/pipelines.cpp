@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cstring>
+#include <exception>
 #include <span>
+#include <thread>
 #include <vector>
 
 #include "gpu/compute_pipeline.hpp"
@@ -114,7 +118,7 @@ const std::array<Spirv, size_t(Kernel::kCount)> kComputeSpirv = {{
 
 uint32_t groupsFor(uint64_t n, uint32_t groupSize) { return uint32_t((n + groupSize - 1) / groupSize); }
 
-Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache)
+Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache, int threads)
     : m_ctx(ctx), m_rayQuery(rayQuery), m_stages(VK_SHADER_STAGE_COMPUTE_BIT) {
     if (!rayQuery) {
         m_stages |= VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_INTERSECTION_BIT_KHR |
@@ -124,10 +128,10 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache)
     // Each step's handles are owned as soon as they exist: a throw in a later
     // step releases them.
     createLayout();
-    createComputePipelines(cache);
-    if (rayQuery) return;
-    createRtPipeline(cache);
-    createShaderBindingTable();
+    const auto t0 = std::chrono::steady_clock::now();
+    createPipelines(cache, threads);
+    m_createMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (!rayQuery) createShaderBindingTable();
 }
 
 void Pipelines::createLayout() {
@@ -159,7 +163,8 @@ void Pipelines::createLayout() {
     RTHDIST_VK_CHECK(vkAllocateDescriptorSets(d, &da, &m_set));
 }
 
-void Pipelines::createComputePipelines(VkPipelineCache cache) {
+std::vector<Kernel> Pipelines::startupKernels() const {
+    std::vector<Kernel> kernels;
     for (size_t k = 0; k < size_t(Kernel::kCount); ++k) {
         if (Kernel(k) == Kernel::kSearchRayQuery && !m_rayQuery) continue;
         if (Kernel(k) == Kernel::kSurfaceSearchRayQuery || Kernel(k) == Kernel::kSurfaceTail)
@@ -167,9 +172,45 @@ void Pipelines::createComputePipelines(VkPipelineCache cache) {
         // Float64 SPIR-V is valid only on a device with shaderFloat64 enabled.
         if ((Kernel(k) == Kernel::kIngestF64 || Kernel(k) == Kernel::kProbeLevels) && !m_ctx.shaderFloat64())
             continue;
-        m_compute[k] = createComputePipeline(m_ctx, kComputeSpirv[k].code, m_layout.get(), cache,
-                                             VK_PIPELINE_CREATE_DISPATCH_BASE_BIT, kComputeSpirv[k].name);
+        kernels.push_back(Kernel(k));
     }
+    return kernels;
+}
+
+// The driver makes each pipeline on its own (compiled, or found in the
+// cache, which Vulkan synchronizes): they are made on up to `threads` host
+// threads at once, the ray-tracing pipeline (the largest) taken first. The
+// first failure is thrown once every thread has stopped.
+void Pipelines::createPipelines(VkPipelineCache cache, int threads) {
+    const std::vector<Kernel> kernels = startupKernels();
+    const size_t items = kernels.size() + (m_rayQuery ? 0 : 1);
+    const size_t hardware = std::max(1u, std::thread::hardware_concurrency());
+    const size_t workers = std::min({items, threads > 0 ? size_t(threads) : hardware, kMaxCreateThreads});
+    std::atomic<size_t> next{0};
+    std::vector<std::exception_ptr> failures(workers);
+    const auto work = [&](size_t worker) {
+        try {
+            for (size_t item = next++; item < items; item = next++) {
+                if (!m_rayQuery && item == 0) {
+                    createRtPipeline(cache);
+                    continue;
+                }
+                const Kernel k = kernels[item - (m_rayQuery ? 0 : 1)];
+                m_compute[size_t(k)] = createComputePipeline(
+                    m_ctx, kComputeSpirv[size_t(k)].code, m_layout.get(), cache,
+                    VK_PIPELINE_CREATE_DISPATCH_BASE_BIT, kComputeSpirv[size_t(k)].name);
+            }
+        } catch (...) {
+            failures[worker] = std::current_exception();
+            next = items;  // the others stop after their current pipeline
+        }
+    };
+    std::vector<std::thread> helpers;
+    for (size_t w = 1; w < workers; ++w) helpers.emplace_back(work, w);
+    work(0);
+    for (std::thread& t : helpers) t.join();
+    for (const std::exception_ptr& f : failures)
+        if (f) std::rethrow_exception(f);
 }
 
 void Pipelines::createRtPipeline(VkPipelineCache cache) {

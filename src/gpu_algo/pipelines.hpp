@@ -6,8 +6,10 @@
 #include <vulkan/vulkan.h>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "gpu/buffer.hpp"
 #include "gpu/unique_handle.hpp"
@@ -64,7 +66,10 @@ enum class Kernel : uint32_t {
 class Pipelines {
 public:
     // cache: a VkPipelineCache (gpu/pipeline_cache.hpp) or VK_NULL_HANDLE.
-    Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache);
+    // threads: host threads that create the pipelines at once (0: one per
+    // hardware thread; at most kMaxCreateThreads).
+    Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache, int threads = 0);
+    static constexpr size_t kMaxCreateThreads = 16;
     ~Pipelines() = default;
     Pipelines(const Pipelines&) = delete;
     Pipelines& operator=(const Pipelines&) = delete;
@@ -85,6 +90,9 @@ public:
     void cmdTraceRaysIndirect(VkCommandBuffer cmd, const void* push, uint32_t pushSize,
                               VkDeviceAddress args) const;
     [[nodiscard]] bool tracesIndirect() const;
+    // How long the constructor took to create the pipelines (with the cache:
+    // found there, else compiled).
+    [[nodiscard]] double createMs() const { return m_createMs; }
 
     // The point-to-surface search's pipelines (design.md §11), created on
     // first use so that point calls never compile them: the ray-query kernel
@@ -102,7 +110,9 @@ private:
     // kernels; the ray-tracing pipeline and its shader binding table.
     void createLayout();
     void cmdBindRt(VkCommandBuffer cmd, const void* push, uint32_t pushSize) const;
-    void createComputePipelines(VkPipelineCache cache);
+    // The compute kernels made at construction (not the surface search's).
+    [[nodiscard]] std::vector<Kernel> startupKernels() const;
+    void createPipelines(VkPipelineCache cache, int threads);
     void createRtPipeline(VkPipelineCache cache);
     void createShaderBindingTable();
     // A ray-tracing pipeline of raygen | miss | procedural hit group, and
@@ -132,6 +142,7 @@ private:
     VkStridedDeviceAddressRegionKHR m_surfaceRaygen{}, m_surfaceMiss{}, m_surfaceHit{};
     VkShaderStageFlags m_stages;  // that see set 0 and the push constants
     VkPipelineStageFlags m_shaderStages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+    double m_createMs = 0.0;
 };
 
 // Groups of 1-D dispatch for n items of RTHDIST_WG threads.

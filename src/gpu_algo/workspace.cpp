@@ -18,11 +18,16 @@ Workspace::Workspace(gpu::Context& c, const std::string& cacheDir, int hostThrea
     : ctx(c),
       tuning(tuned),
       pipelineCache(c.device(), c.physicalDevice(), cacheDir),
-      pipelines(c, c.backend() == Backend::kRayQuery, pipelineCache.handle()),
+      pipelines(c, c.backend() == Backend::kRayQuery, pipelineCache.handle(), hostThreads),
       accel(c),
       rayQuery(c.backend() == Backend::kRayQuery),
       threads(hostThreads) {
+    const auto saveStart = core::Clock::now();
     pipelineCache.save();
+    if (ctx.tracingSubmits())
+        std::fprintf(stderr,
+                     "rthdist setup: pipeline cache %s, pipelines made in %.1f ms, cache saved in %.1f ms\n",
+                     pipelineCache.loadStatus().c_str(), pipelines.createMs(), core::msSince(saveStart));
     hostSmall = Buffer(ctx, kCounterBlockBytes * blocks.size(), gpu::kStorageUsage, MemoryKind::kHost);
     for (size_t k = 0; k < blocks.size(); ++k)
         blocks[k] = CounterBlock{static_cast<char*>(hostSmall.mapped()) + k * kCounterBlockBytes,
