@@ -378,9 +378,22 @@ private:
     std::unique_ptr<Impl> m_impl;
 };
 
-// One-shot convenience: creates an Engine (or runs the CPU backend) and computes.
+// One-shot convenience: creates an Engine (or runs the CPU backend) and
+// computes. The Engine's backend is oneShotBackendFor(a.count + b.count,
+// options): with Backend::kAuto and no device named, a small pair runs on
+// the CPU backend, which answers it before a GPU would be set up.
 [[nodiscard]] RTHDIST_API Result<HausdorffResult> hausdorff(PointView a, PointView b,
                                                             const Options& options = {});
+
+// The backend hausdorff() opens for a pair of `points` in all:
+// options.backend, except Backend::kAuto with no device named (deviceIndex
+// < 0, devices empty) and no validation, which takes the CPU backend for a pair of at most
+// 2^18 points per host thread (options.threads; 0: every hardware thread):
+// about 0.2 s of CPU time at most, where a GPU's device and pipelines take
+// 0.2-0.75 s to set up (README "Backends"). Larger pairs, and every Engine
+// (which keeps its device between calls), take the backend as chosen at
+// creation. Pure: reads no device.
+[[nodiscard]] RTHDIST_API Backend oneShotBackendFor(uint64_t points, const EngineOptions& options);
 
 RTHDIST_API const char* versionString();
 

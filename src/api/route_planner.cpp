@@ -122,6 +122,11 @@ bool narrowingPays(double wholeMagnitude, double narrowedMagnitude) {
     return std::ldexp(narrowedMagnitude, kNarrowGainLog2) <= wholeMagnitude;
 }
 
+Backend oneShotBackend(Backend requested, bool vulkanAsked, uint64_t points, int threads) {
+    if (requested != Backend::kAuto || vulkanAsked || threads < 1) return requested;
+    return points <= kOneShotCpuPointsPerThread * uint64_t(threads) ? Backend::kCpu : requested;
+}
+
 Plan planFramedCall(uint64_t a, uint64_t b, const CallOptions& call, const MemoryBudget& budget,
                     const BackendCaps& caps) {
     if (!fitsOneCall(budget, a, b)) return inPieces(a, b, budget, caps);

@@ -150,6 +150,24 @@ inline constexpr int kNarrowGainLog2 = 8;
 // (every query to the rays) against CuPy's KDTree's 0.33 s.
 inline constexpr uint64_t kNarrowCheckPoints = uint64_t(1) << 22;
 
+// The backend of a one-shot call (hausdorff(), the CLI) of `points` in
+// all: Backend::kAuto with no device named (EngineOptions::deviceIndex < 0,
+// no EngineOptions::devices) and no validation layer asked for
+// (`vulkanAsked` false) takes the CPU backend for a pair of at most
+// kOneShotCpuPointsPerThread points per host thread (`threads`: the
+// resolved count), whose exact answer it has in about 0.2 s of CPU time at
+// most (the crowded sphere, the densest of the scale suite: ~1.4M points a
+// thread-second on a 16-core H200 host; the Dragon rows and surface
+// samplings 3-7M), where a GPU's one-shot call first opens a device and
+// makes its pipelines: 0.36-0.45 s on a 16-core H200 host, 0.63-0.74 s on
+// a 32-core one (the driver's VkDevice alone 0.4-0.55 s; session 21). There
+// the CLI's wall on surface-1M (2M points) went 445-510 -> 45-53 ms and on
+// the Dragon pairs 442-527 -> 203-301 ms (their gzip'd load now most of
+// it). Every other request, and larger pairs, as asked: an Engine keeps its
+// device between calls, and its backend is never chosen by size.
+inline constexpr uint64_t kOneShotCpuPointsPerThread = uint64_t(1) << 18;
+[[nodiscard]] Backend oneShotBackend(Backend requested, bool vulkanAsked, uint64_t points, int threads);
+
 // The route of a pair already checked and framed on the host (float sets of
 // one frame and scale): kSmallPairScan, kOneCall, kSeveralDevices or kPieces.
 // kReframe's pair and every piece of kPieces take it.

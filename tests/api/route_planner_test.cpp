@@ -264,6 +264,40 @@ TEST(RoutePlanner, SurfacePairsRunOnTheBackendNamed) {
         EXPECT_EQ(planSurfacePairRoute(gpu).route, Route::kSurfaceGpu);
 }
 
+TEST(RoutePlanner, SmallOneShotPairsUnderAutoRunOnTheCpu) {
+    const uint64_t perThread = kOneShotCpuPointsPerThread;
+    // At most kOneShotCpuPointsPerThread (2^18) points a host thread: the CPU backend.
+    EXPECT_EQ(oneShotBackend(Backend::kAuto, false, 1, 1), Backend::kCpu);
+    EXPECT_EQ(oneShotBackend(Backend::kAuto, false, perThread, 1), Backend::kCpu);
+    EXPECT_EQ(oneShotBackend(Backend::kAuto, false, 16 * perThread, 16), Backend::kCpu);
+    // One point more, or fewer threads: as asked.
+    EXPECT_EQ(oneShotBackend(Backend::kAuto, false, perThread + 1, 1), Backend::kAuto);
+    EXPECT_EQ(oneShotBackend(Backend::kAuto, false, 16 * perThread, 15), Backend::kAuto);
+    // A device named, or a backend named: never chosen by size.
+    EXPECT_EQ(oneShotBackend(Backend::kAuto, true, 1, 16), Backend::kAuto);
+    for (Backend named : {Backend::kRayQuery, Backend::kRtPipeline, Backend::kCpu})
+        EXPECT_EQ(oneShotBackend(named, false, 1, 16), named);
+}
+
+TEST(RoutePlanner, OneShotBackendForReadsTheOptions) {
+    EngineOptions o;
+    o.threads = 2;
+    EXPECT_EQ(oneShotBackendFor(2 * kOneShotCpuPointsPerThread, o), Backend::kCpu);
+    EXPECT_EQ(oneShotBackendFor(2 * kOneShotCpuPointsPerThread + 1, o), Backend::kAuto);
+    o.deviceIndex = 0;  // a device named keeps the Vulkan path
+    EXPECT_EQ(oneShotBackendFor(1, o), Backend::kAuto);
+    o.deviceIndex = -1;
+    o.devices = {0};
+    EXPECT_EQ(oneShotBackendFor(1, o), Backend::kAuto);
+    o.devices.clear();
+    o.validation = true;  // the Vulkan validation layer asked for: the Vulkan path
+    EXPECT_EQ(oneShotBackendFor(1, o), Backend::kAuto);
+    o.validation = false;
+    EXPECT_EQ(oneShotBackendFor(1, o), Backend::kCpu);
+    o.backend = Backend::kRtPipeline;
+    EXPECT_EQ(oneShotBackendFor(1, o), Backend::kRtPipeline);
+}
+
 TEST(RoutePlanner, EveryRouteHasAName) {
     for (Route r : {Route::kRefused, Route::kSmallPairScan, Route::kDeviceIngest, Route::kOneCall,
                     Route::kSeveralDevices, Route::kPieces, Route::kReframe, Route::kPrepared,

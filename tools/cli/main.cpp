@@ -4,13 +4,16 @@
 // (cli/exit_codes.hpp); nothing escapes main().
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <future>
 #include <limits>
 #include <new>
 #include <optional>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "cli/args.hpp"
@@ -44,6 +47,16 @@ int failWith(const Error& error) { return fail(exitCodeFor(error.code), error.me
 // Writes all of `text` to stdout; false when stdout is gone (closed pipe, full disk).
 bool writeStdout(const std::string& text) {
     return std::fwrite(text.data(), 1, text.size(), stdout) == text.size() && std::fflush(stdout) == 0;
+}
+
+// At least as many points as two files can hold uncompressed (12 bytes a
+// point, the least any format takes); the largest count when a size is
+// unknown (a missing file: its load reports it).
+uint64_t filePointsBound(const std::string& pathA, const std::string& pathB) {
+    std::error_code ea, eb;
+    const uintmax_t a = std::filesystem::file_size(pathA, ea), b = std::filesystem::file_size(pathB, eb);
+    if (ea || eb) return UINT64_MAX;
+    return uint64_t(a) / 12 + uint64_t(b) / 12;
 }
 
 // Loads one input in its file's precision; the message always names the file.
@@ -87,12 +100,17 @@ int run(const std::vector<std::string>& argv) {
                                            std::string(backendName(options.backend)) + " backend");
     }
 
-    // The engine (a device and its pipelines: ~0.4 s on a discrete GPU) is
-    // created while the files load.
-    std::future<Result<Engine>> engine =
-        std::async(std::launch::async, [engineOptions = static_cast<const EngineOptions&>(options)] {
-            return Engine::create(engineOptions);
-        });
+    // The engine (a device and its pipelines: 0.2-0.75 s on a GPU) is
+    // created while the files load, unless they are small enough for a
+    // one-shot call to take the CPU backend (oneShotBackendFor; a file holds
+    // at least 12 bytes a point unless compressed): those load first, and
+    // the engine takes the backend for the points they hold.
+    const auto createEngine = [](const EngineOptions& o) { return Engine::create(o); };
+    const bool loadFirst =
+        oneShotBackendFor(filePointsBound(args.pathA, args.pathB), options) != options.backend;
+    std::future<Result<Engine>> engine;
+    if (!loadFirst)
+        engine = std::async(std::launch::async, createEngine, static_cast<const EngineOptions&>(options));
     const Clock::time_point loadStart = Clock::now();
     io::LoadOptions loadOptions;
     loadOptions.lasClasses = args.lasClasses;
@@ -101,6 +119,11 @@ int run(const std::vector<std::string>& argv) {
     Result<io::PointCloud> b = load(args.pathB, loadOptions);
     if (!b) return failWith(b.error());
     const double loadMs = msSince(loadStart);
+    if (loadFirst) {
+        EngineOptions chosen = options;
+        chosen.backend = oneShotBackendFor(a->size() + b->size(), options);
+        engine = std::async(std::launch::deferred, createEngine, chosen);
+    }
 
     // Progress only on a terminal, for runs longer than a second, and never with --quiet.
     ProgressMeter meter(!args.quiet && ProgressMeter::stderrIsTerminal());
