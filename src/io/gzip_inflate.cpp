@@ -1,10 +1,12 @@
 #include "io/gzip_inflate.hpp"
 
+#include <libdeflate.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <memory>
 
 #include "io/io_error.hpp"
 
@@ -65,6 +67,66 @@ Error tooLarge(const std::string& path, const OutputLimit& cap) {
 // to notice a stream that exceeds it.
 uint64_t pastCap(uint64_t limit) { return limit == kNoInflatedBound ? limit : limit + 1; }
 
+struct FreeDecompressor {
+    void operator()(libdeflate_decompressor* d) const { libdeflate_free_decompressor(d); }
+};
+
+// The whole stream in one call of libdeflate (2.6x zlib's speed on the
+// Dragon's 34 MB of ASCII PLY, 40 against 104 ms), where it applies: one
+// member whose trailer's size hint (ISIZE, mod 2^32) is its whole output,
+// within `cap`, with nothing but zero padding after it; libdeflate checks
+// the CRC and the size. Anything else (several members, an output past 4
+// GiB, corrupt or truncated data, a hint past the cap) is left to zlib's
+// loop (nullopt), whose errors name the offset; the output is then
+// inflated again, only on those inputs.
+std::optional<std::string> inflateWhole(std::string_view compressed, uint64_t cap) {
+    if (compressed.size() < 18) return std::nullopt;
+    const auto* tail = reinterpret_cast<const unsigned char*>(compressed.data() + compressed.size() - 4);
+    const uint64_t hint =
+        uint64_t{tail[0]} | uint64_t{tail[1]} << 8 | uint64_t{tail[2]} << 16 | uint64_t{tail[3]} << 24;
+    if (hint == 0 || hint > cap || hint > uint64_t{compressed.size()} * 1032) return std::nullopt;
+    const std::unique_ptr<libdeflate_decompressor, FreeDecompressor> d(libdeflate_alloc_decompressor());
+    if (!d) return std::nullopt;
+    std::string out(static_cast<size_t>(hint), '\0');
+    size_t consumed = 0, produced = 0;
+    const libdeflate_result r = libdeflate_gzip_decompress_ex(d.get(), compressed.data(), compressed.size(),
+                                                              out.data(), out.size(), &consumed, &produced);
+    if (r != LIBDEFLATE_SUCCESS || produced != out.size()) return std::nullopt;
+    if (compressed.substr(consumed).find_first_not_of('\0') != std::string_view::npos) return std::nullopt;
+    return out;
+}
+
+// The first kInflateHeadBytes of a one-member stream (or all of a shorter
+// one: `whole`), for a format's header check before the whole is inflated;
+// nullopt where zlib's loop should take the stream (an error, a second
+// member).
+struct Head {
+    std::string bytes;
+    bool whole = false;
+};
+std::optional<Head> inflateHead(std::string_view compressed) {
+    Inflater inflater;
+    if (!inflater.init()) return std::nullopt;
+    z_stream& zs = inflater.stream();
+    Head head;
+    head.bytes.resize(kInflateHeadBytes);
+    zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data()));
+    zs.avail_in =
+        static_cast<uInt>(std::min<size_t>(compressed.size(), std::numeric_limits<uInt>::max() / 2));
+    zs.next_out = reinterpret_cast<Bytef*>(head.bytes.data());
+    zs.avail_out = static_cast<uInt>(head.bytes.size());
+    int rc = Z_OK;
+    while (rc == Z_OK && zs.avail_out != 0) rc = inflate(&zs, Z_NO_FLUSH);
+    if (rc != Z_OK && rc != Z_STREAM_END && !(rc == Z_BUF_ERROR && zs.avail_out == 0)) return std::nullopt;
+    head.bytes.resize(head.bytes.size() - zs.avail_out);
+    if (rc == Z_STREAM_END) {
+        const std::string_view rest = compressed.substr(zs.total_in);
+        if (rest.find_first_not_of('\0') != std::string_view::npos) return std::nullopt;
+        head.whole = true;
+    }
+    return head;
+}
+
 }  // namespace
 
 uint64_t inflateCap(uint64_t compressedSize) {
@@ -85,6 +147,27 @@ Result<std::string> gunzip(std::string_view compressed, const std::string& path,
     z_stream& zs = inflater.stream();
 
     OutputLimit cap{maxBytes.value_or(inflateCap(compressed.size()))};
+    // The fast path: the header checked on the head zlib's loop would hand
+    // it (before the rest is inflated; its bound becomes the cap), then the
+    // whole stream at once where inflateWhole applies. A stream it leaves,
+    // or whose head zlib could not give, runs through the loop below from
+    // the start (a bomb past the header's cap among them: refused there).
+    bool fast = true;
+    OutputLimit fastCap = cap;
+    if (bound != nullptr) {
+        const std::optional<Head> head = inflateHead(compressed);
+        fast = head.has_value();
+        if (head) {
+            auto b = bound(head->bytes, head->whole, path);
+            if (!b) return b.error();
+            if (*b != kNoInflatedBound && *b <= cap.limit - std::min(cap.limit, kInflatedSlack))
+                fastCap = OutputLimit{*b + kInflatedSlack, true};
+        }
+    }
+    if (fast) {
+        if (std::optional<std::string> whole = inflateWhole(compressed, fastCap.limit))
+            return std::move(*whole);
+    }
     bool headChecked = bound == nullptr;
     // Inflate only the head until the header has been checked; never
     // allocate past the cap, whatever the trailer's size hint says.

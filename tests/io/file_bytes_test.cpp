@@ -79,6 +79,31 @@ TEST_F(FileBytes, GzipWithoutTrailerIsBadInput) {
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "truncated gzip"));
 }
 
+TEST_F(FileBytes, GzipWithAWrongSizeInItsTrailerIsBadInput) {
+    // The trailer's size (ISIZE) sizes the one-call inflate; one that lies
+    // is refused by the size check, whichever path reads the stream.
+    std::string raw;
+    for (int i = 0; i < 5000; ++i) raw += "1 2 3\n";
+    for (const int delta : {-1, 1}) {
+        std::string gz = gzip(raw);
+        gz[gz.size() - 4] = static_cast<char>(gz[gz.size() - 4] + delta);
+        const std::string path = write("size.xyz.gz", gz);
+        EXPECT_TRUE(isBadInput(loadPoints(path), path, "corrupt gzip stream")) << delta;
+    }
+}
+
+TEST_F(FileBytes, GzipWithZeroPaddingAfterItsMemberLoads) {
+    std::string raw;
+    for (int i = 0; i < 5000; ++i) raw += "1 2 3\n";
+    const std::string path = write("pad.xyz.gz", gzip(raw) + std::string(100, '\0'));
+    auto r = loadPoints(path);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->size(), 5000u);
+    // Anything else after it is a second member, or corrupt.
+    const std::string junk = write("junk.xyz.gz", gzip(raw) + "xyz");
+    EXPECT_FALSE(loadPoints(junk).ok());
+}
+
 TEST_F(FileBytes, NotGzipIsBadInput) {
     const std::string path = write("plain.xyz.gz", "1 2 3\n");
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "byte offset 0"));

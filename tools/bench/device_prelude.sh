@@ -1,7 +1,8 @@
 # Sourced at the top of a one-call script for the device tool (docs/gpu.md),
 # in the repository root, where the tool has set OUT:
 #   source tools/bench/device_prelude.sh
-# It unpacks the carried Vulkan loader (.gl/*.deb), points the loader at the
+# It unpacks the carried Vulkan loader and libdeflate (.gl/*.deb; libdeflate
+# only where the machine has none), points the loader at the
 # NVIDIA driver, unpacks a carried validation layer ($BUNDLE/layers/*.xz,
 # BUNDLE defaulting to .devs), makes RES (default /tmp/res) for the call's
 # files and packs it into $OUT/res.tgz when the script exits (whatever its
@@ -13,7 +14,11 @@ set -uo pipefail
 RES=${RES:-/tmp/res}
 mkdir -p "$OUT" "$RES"
 trap 'tar czf "$OUT/res.tgz" -C "$(dirname "$RES")" "$(basename "$RES")"' EXIT
-for deb in .gl/*.deb; do dpkg -x "$deb" "${GL_ROOT:-/}" > /dev/null; done
+for deb in .gl/*.deb; do
+  # libdeflate (rthdist's gzip reads): the machine's own where it has one.
+  case $deb in */libdeflate0_*) if ldconfig -p 2> /dev/null | grep -q 'libdeflate\.so\.0 '; then continue; fi ;; esac
+  dpkg -x "$deb" "${GL_ROOT:-/}" > /dev/null
+done
 if [ "${GL_ROOT:-/}" = / ]; then ldconfig; fi
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 for layer in "${BUNDLE:-.devs}"/layers/*.xz; do
