@@ -7,6 +7,7 @@
 #include <cstring>
 #include <exception>
 #include <span>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -206,7 +207,10 @@ void Pipelines::createPipelines(VkPipelineCache cache, int threads) {
         }
     };
     std::vector<std::thread> helpers;
-    for (size_t w = 1; w < workers; ++w) helpers.emplace_back(work, w);
+    try {
+        for (size_t w = 1; w < workers; ++w) helpers.emplace_back(work, w);
+    } catch (const std::system_error&) {  // no thread to be had: fewer helpers
+    }
     work(0);
     for (std::thread& t : helpers) t.join();
     for (const std::exception_ptr& f : failures)
