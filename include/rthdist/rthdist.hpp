@@ -388,7 +388,8 @@ private:
 // The backend hausdorff() opens for a pair of `points` in all:
 // options.backend, except Backend::kAuto with no device named (deviceIndex
 // < 0, devices empty) and no validation, which takes the CPU backend for a pair of at most
-// 2^18 points per host thread (options.threads; 0: every hardware thread):
+// 2^18 points per host thread (options.threads; 0: every hardware thread;
+// at most 32 counted):
 // about 0.2 s of CPU time at most, where a GPU's device and pipelines take
 // 0.2-0.75 s to set up (README "Backends"). Larger pairs, and every Engine
 // (which keeps its device between calls), take the backend as chosen at

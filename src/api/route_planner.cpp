@@ -1,5 +1,6 @@
 #include "api/route_planner.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -124,7 +125,8 @@ bool narrowingPays(double wholeMagnitude, double narrowedMagnitude) {
 
 Backend oneShotBackend(Backend requested, bool vulkanAsked, uint64_t points, int threads) {
     if (requested != Backend::kAuto || vulkanAsked || threads < 1) return requested;
-    return points <= kOneShotCpuPointsPerThread * uint64_t(threads) ? Backend::kCpu : requested;
+    const auto counted = uint64_t(std::min(threads, kOneShotCpuThreads));
+    return points <= kOneShotCpuPointsPerThread * counted ? Backend::kCpu : requested;
 }
 
 Plan planFramedCall(uint64_t a, uint64_t b, const CallOptions& call, const MemoryBudget& budget,

@@ -166,6 +166,10 @@ inline constexpr uint64_t kNarrowCheckPoints = uint64_t(1) << 22;
 // it). Every other request, and larger pairs, as asked: an Engine keeps its
 // device between calls, and its backend is never chosen by size.
 inline constexpr uint64_t kOneShotCpuPointsPerThread = uint64_t(1) << 18;
+// Threads counted at most (the CPU backend's rate was measured up to 32: the
+// crowded sphere's 40M points in 0.8 s on a 32-core host; past that its
+// scaling is not known): at most 8.4M points go to the CPU this way.
+inline constexpr int kOneShotCpuThreads = 32;
 [[nodiscard]] Backend oneShotBackend(Backend requested, bool vulkanAsked, uint64_t points, int threads);
 
 // The route of a pair already checked and framed on the host (float sets of

@@ -273,6 +273,9 @@ TEST(RoutePlanner, SmallOneShotPairsUnderAutoRunOnTheCpu) {
     // One point more, or fewer threads: as asked.
     EXPECT_EQ(oneShotBackend(Backend::kAuto, false, perThread + 1, 1), Backend::kAuto);
     EXPECT_EQ(oneShotBackend(Backend::kAuto, false, 16 * perThread, 15), Backend::kAuto);
+    // Threads past kOneShotCpuThreads (32) do not raise the bound.
+    EXPECT_EQ(oneShotBackend(Backend::kAuto, false, 32 * perThread, 128), Backend::kCpu);
+    EXPECT_EQ(oneShotBackend(Backend::kAuto, false, 32 * perThread + 1, 128), Backend::kAuto);
     // A device named, or a backend named: never chosen by size.
     EXPECT_EQ(oneShotBackend(Backend::kAuto, true, 1, 16), Backend::kAuto);
     for (Backend named : {Backend::kRayQuery, Backend::kRtPipeline, Backend::kCpu})
