@@ -19,6 +19,8 @@
 #include "common/oracle_cases.hpp"
 #include "common/oracle_memo.hpp"
 #include "common/scoped_env.hpp"
+#include "gpu_algo/gpu_context_support.hpp"
+#include "gpu_algo/gpu_hausdorff.hpp"
 #include "gpu_test_support.hpp"
 
 namespace rthdist::test {
@@ -62,6 +64,36 @@ void expectExact(Engine& engine, const std::string& name, uint64_t seed, std::ve
     ASSERT_TRUE(r.ok()) << r.error().message;
     expectMatchesOracle(c, *r);
     EXPECT_EQ(r->validationMessages, 0u);
+}
+
+// The pipelines are made on up to 16 host threads at once (pipelines.cpp):
+// engines whose pipelines came from one thread, two, or every hardware
+// thread give one result on a pair whose queries go to the rays (the
+// search's pipeline and every kernel of the cull, the search and the
+// refinement in use), witnesses included (the ray counts vary with the
+// early break's timing, as between two calls of one engine).
+TEST(GpuEngine, PipelinesMadeOnOneThreadOrSeveralGiveOneResult) {
+    RTHDIST_REQUIRE_CONTEXT(ctx);
+    const std::vector<glm::vec3> a = uniformCloud(3000, 11, glm::vec3(0.0f));
+    const std::vector<glm::vec3> b = uniformCloud(2000, 12, glm::vec3(0.6f, 0.0f, 0.0f));
+    std::optional<HausdorffResult> first;
+    for (const int threads : {1, 2, 0}) {
+        SCOPED_TRACE("threads " + std::to_string(threads));
+        auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", threads, *gpuOptions().tuning);
+        ASSERT_TRUE(engine) << engine.error().message;
+        auto r = (*engine)->computeIndexed(a, b, 1.0, CallOptions{});
+        ASSERT_TRUE(r) << r.error().message;
+        EXPECT_GT(r->aToB.counters.rays + r->bToA.counters.rays, 0u);
+        if (!first) {
+            first = *r;
+            continue;
+        }
+        EXPECT_EQ(r->hausdorff, first->hausdorff);
+        EXPECT_EQ(r->aToB.queryIndex, first->aToB.queryIndex);
+        EXPECT_EQ(r->aToB.targetIndex, first->aToB.targetIndex);
+        EXPECT_EQ(r->bToA.queryIndex, first->bToA.queryIndex);
+        EXPECT_EQ(r->bToA.targetIndex, first->bToA.targetIndex);
+    }
 }
 
 TEST(GpuEngine, EmptySetIsAnErrorValue) {
