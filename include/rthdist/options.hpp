@@ -23,7 +23,9 @@ namespace rthdist {
 enum class Backend {
     kAuto,        // a hardware RT device: ray-query if it has it, else rt-pipeline;
                   // no such device (none, or only a software one such as
-                  // lavapipe): the CPU backend, which is faster there
+                  // lavapipe): the CPU backend, which is faster there; a
+                  // one-shot call of a small pair: the CPU backend too
+                  // (oneShotBackendFor, rthdist.hpp)
     kRayQuery,    // VK_KHR_ray_query in compute shaders
     kRtPipeline,  // VK_KHR_ray_tracing_pipeline (raygen + intersection)
     kCpu,         // exact multithreaded CPU implementation (no Vulkan)
