@@ -11,7 +11,9 @@ brute force in double within 1e-6 of the bounding-box diagonal, and the
 reported index pairs realize it (README, Precision). Backends: "cpu" (exact,
 multithreaded), "ray-query" and "rt-pipeline" (Vulkan ray tracing; Mesa's
 lavapipe runs them on the CPU), "auto" (a hardware ray-tracing GPU when
-there is one, else the CPU).
+there is one, else the CPU; rthdist.hausdorff of a pair of at most 2^18
+points per host thread runs on the CPU, which answers it before a GPU has
+opened its device: README, Usage).
 
 Inputs (rthdist._points): (N, 3) array-likes of float32/float64 (C order
 and row slices read in place; Fortran order copied), objects with .points
@@ -101,7 +103,8 @@ def hausdorff(a, b, *, directed=False, per_point=False, backend="auto", device=N
     per_point: also every point's exact nearest distance and index
         (result.a_distances, a_nearest, b_distances, b_nearest) and the
         statistics (percentile, hd95, mean, rms, stats, histogram); slower.
-    backend: "auto", "cpu", "ray-query" or "rt-pipeline".
+    backend: "auto", "cpu", "ray-query" or "rt-pipeline" ("auto": a small
+        pair, at most 2^18 points per host thread, on the CPU backend).
     device: Vulkan device index (rthdist.list_devices()); None = first usable.
     bits: index-space bit count 0..8 (0 = from the data).
     radius_growth: candidate-search radius factor 1.1..16.
