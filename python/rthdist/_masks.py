@@ -377,7 +377,10 @@ def compare_masks(a, b, *, spacing=None, affine=None, convention="rthdist", perc
 
     Returns a MaskResult, or a list of them (label-major, as the CLI's rows)
     when several conventions or labels="all"/a list are asked. A temporary
-    device is created per call; keep a MaskEngine for repeated calls.
+    device is created per call (under "auto", small masks, at most 2^18
+    nonzero voxels a host thread, run on the CPU backend instead, which
+    answers before a GPU has opened its device); keep a MaskEngine for
+    repeated calls.
     Raises ValueError (shapes or affines that differ, not 3-D, non-integral
     or non-int32 labels, bad convention or options), DeviceError,
     OutOfMemoryError, InternalError.
@@ -391,6 +394,16 @@ def compare_masks(a, b, *, spacing=None, affine=None, convention="rthdist", perc
             return x.engine.compare(a, b, spacing=spacing, affine=affine, convention=convention,
                                     percentiles=percentiles, connectivity=connectivity, tolerance=tolerance,
                                     label=label, labels=labels, host_extraction=host_extraction)
+    if backend == "auto" and not device_extraction:
+        # A one-shot call: the backend a call of the run's points would take
+        # (at most the masks' nonzero voxels, eight a voxel for surfels, over
+        # the conventions): the CPU for small masks, which it answers before a
+        # GPU has opened its device (README, rthdist-masks).
+        a, b = _volumes(a, b, spacing, affine)
+        spacing = affine = None
+        voxels = a._v.nonzero_voxels() + b._v.nonzero_voxels()
+        points = sum(voxels * (8 if name == "deepmind" else 1) for name in _conventions(convention))
+        backend = _rthdist._one_shot_backend(points, backend, device, threads, validation)
     with MaskEngine(backend, device=device, threads=threads, validation=validation,
                     device_extraction=device_extraction) as engine:
         return engine.compare(a, b, spacing=spacing, affine=affine, convention=convention,

@@ -3,7 +3,9 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -493,6 +495,16 @@ void bindMasks(py::module_& m) {
                                    return py::make_tuple(s.x, s.y, s.z);
                                })
         .def_property_readonly("transform", [](const PyVolume& v) { return v.volume->transform; })
+        .def("nonzero_voxels",
+             [](const PyVolume& v) {
+                 const masks::Volume& vol = *v.volume;
+                 py::gil_scoped_release release;
+                 if (!vol.labels8.empty())
+                     return uint64_t(vol.labels8.size()) -
+                            uint64_t(std::count(vol.labels8.begin(), vol.labels8.end(), uint8_t(0)));
+                 return uint64_t(vol.labels.size()) -
+                        uint64_t(std::count(vol.labels.begin(), vol.labels.end(), 0));
+             })
         .def("labels_present", [](const PyVolume& v) {
             std::vector<int32_t> out;
             {
@@ -505,6 +517,16 @@ void bindMasks(py::module_& m) {
           py::arg("transform"),
           "A _MaskVolume of a 3-D label array (C or Fortran contiguous, native byte order) and its 4x4 "
           "voxel-to-world affine (rthdist.MaskVolume converts its inputs first).");
+    m.def(
+        "_one_shot_backend",
+        [](uint64_t points, const std::string& backend, std::optional<int> device, int threads,
+           bool validation) {
+            return std::string(
+                backendName(oneShotBackendFor(points, engineOptions(backend, device, threads, validation))));
+        },
+        py::arg("points"), py::arg("backend"), py::arg("device"), py::arg("threads"), py::arg("validation"),
+        "The backend a one-shot call of `points` in all opens (rthdist::oneShotBackendFor): 'cpu' for a "
+        "small pair under 'auto' with no device named and no validation, else the backend asked for.");
     m.def("_conventions", [] {
         std::vector<std::string> out;
         for (Convention c : masks::kAllConventions) out.push_back(masks::conventionName(c));

@@ -538,3 +538,34 @@ def test_prepared_reference_refusals(rng):
             engine.compare(ref, prepared, percentiles=(101,))
     with pytest.raises(ValueError, match="closed"):
         engine.compare(ref, prepared)
+
+
+def test_a_volumes_nonzero_voxels_are_numpys_count():
+    rng = np.random.default_rng(SEED)
+    for dtype in (np.uint8, np.int32, np.float64):
+        labels = (rng.integers(0, 4, size=(7, 5, 3)) * (rng.random((7, 5, 3)) < 0.4)).astype(dtype)
+        v = rthdist.MaskVolume(labels)
+        assert v._v.nonzero_voxels() == np.count_nonzero(labels)
+
+
+def test_one_shot_backend_takes_the_cpu_only_for_a_small_auto_call():
+    # compare_masks is one-shot: under "auto" a run of few points goes to the
+    # CPU backend (rthdist::oneShotBackendFor); a device, validation or a
+    # named backend keep the Vulkan path; past 2^18 points a thread, as asked.
+    one = rthdist._rthdist._one_shot_backend
+    per_thread = 1 << 18
+    assert one(per_thread, "auto", None, 1, False) == "cpu"
+    assert one(per_thread + 1, "auto", None, 1, False) == "auto"
+    assert one(2 * per_thread, "auto", None, 2, False) == "cpu"
+    assert one(10, "auto", 0, 2, False) == "auto"
+    assert one(10, "auto", None, 2, True) == "auto"
+    for named in ("ray-query", "rt-pipeline", "cpu"):
+        assert one(10, named, None, 2, False) == named
+
+
+def test_compare_masks_under_auto_gives_the_cpus_row(pair):
+    a, b = pair
+    auto = rthdist.compare_masks(a, b, convention="all")
+    cpu = rthdist.compare_masks(a, b, convention="all", backend="cpu")
+    assert [r.to_dict()["hd"] for r in auto] == [r.to_dict()["hd"] for r in cpu]
+    assert all(r.backend == "cpu" for r in auto)
