@@ -34,15 +34,23 @@ private:
     bool m_ready = false;
 };
 
-// Deflate cannot expand more than ~1032:1; the gzip trailer's size field is
-// only a hint (mod 2^32, attacker-controlled), so it is clamped by that bound.
+// Deflate cannot expand more than ~1032:1.
+constexpr uint64_t kMaxDeflateRatio = 1032;
+
+// The last member's trailer size field (ISIZE: its inflated size mod 2^32),
+// 0 for a stream too short to hold a member. Only a hint: attacker-controlled.
+uint64_t trailerSize(std::string_view compressed) {
+    if (compressed.size() < 18) return 0;
+    const auto* tail = reinterpret_cast<const unsigned char*>(compressed.data() + compressed.size() - 4);
+    return uint64_t{tail[0]} | uint64_t{tail[1]} << 8 | uint64_t{tail[2]} << 16 | uint64_t{tail[3]} << 24;
+}
+
+// The trailer's hint clamped by deflate's ratio.
 size_t initialCapacity(std::string_view compressed) {
     if (compressed.size() < 18) return 4096;
-    const auto* tail = reinterpret_cast<const unsigned char*>(compressed.data() + compressed.size() - 4);
-    const uint64_t hinted =
-        uint64_t{tail[0]} | uint64_t{tail[1]} << 8 | uint64_t{tail[2]} << 16 | uint64_t{tail[3]} << 24;
-    const uint64_t bound = uint64_t{compressed.size()} * 1032;
-    return static_cast<size_t>(std::clamp<uint64_t>(hinted, 4096, std::max<uint64_t>(bound, 4096)));
+    const uint64_t bound = uint64_t{compressed.size()} * kMaxDeflateRatio;
+    return static_cast<size_t>(
+        std::clamp<uint64_t>(trailerSize(compressed), 4096, std::max<uint64_t>(bound, 4096)));
 }
 
 // The most bytes the output may hold, and whether a format's header set it.
@@ -80,11 +88,8 @@ struct FreeDecompressor {
 // loop (nullopt), whose errors name the offset; the output is then
 // inflated again, only on those inputs.
 std::optional<std::string> inflateWhole(std::string_view compressed, uint64_t cap) {
-    if (compressed.size() < 18) return std::nullopt;
-    const auto* tail = reinterpret_cast<const unsigned char*>(compressed.data() + compressed.size() - 4);
-    const uint64_t hint =
-        uint64_t{tail[0]} | uint64_t{tail[1]} << 8 | uint64_t{tail[2]} << 16 | uint64_t{tail[3]} << 24;
-    if (hint == 0 || hint > cap || hint > uint64_t{compressed.size()} * 1032) return std::nullopt;
+    const uint64_t hint = trailerSize(compressed);
+    if (hint == 0 || hint > cap || hint > uint64_t{compressed.size()} * kMaxDeflateRatio) return std::nullopt;
     const std::unique_ptr<libdeflate_decompressor, FreeDecompressor> d(libdeflate_alloc_decompressor());
     if (!d) return std::nullopt;
     std::string out(static_cast<size_t>(hint), '\0');
