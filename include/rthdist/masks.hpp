@@ -185,6 +185,8 @@ struct LabelArray {
 
 // Sorted distinct non-zero labels present in the volume.
 [[nodiscard]] std::vector<int32_t> labelsPresent(const Volume& v);
+// Voxels whose label is not 0: every label's points lie among them.
+[[nodiscard]] uint64_t nonzeroVoxels(const Volume& v);
 
 // Convention (the enum, kAllConventions and each one's rules): rthdist/mask_conventions.hpp.
 // Its row's name and one-line rule ("?" for a value outside the table).
@@ -321,6 +323,16 @@ struct MaskEngine {
 // devicePass on a GPU backend, the boundary pass on options.deviceIndex
 // (a second Vulkan device of its own).
 [[nodiscard]] Result<MaskEngine> makeMaskEngine(Options options, bool devicePass = false);
+
+// The backend of a one-shot comparison of a and b (one MaskEngine for this
+// pair only: the CLI with one prediction, Python's compare_masks) under
+// `conventions`: oneShotBackendFor (rthdist.hpp) of the run's points, which
+// are at most the volumes' nonzero voxels (boundary or foreground; DeepMind's
+// surfels, corners of them, eight a voxel) summed over the conventions, the
+// labels splitting those voxels. Under auto the CPU backend for small masks,
+// which answers before a GPU has opened its device; options.backend otherwise.
+[[nodiscard]] Backend oneShotMaskBackend(const Options& options, const Volume& a, const Volume& b,
+                                         const std::vector<Convention>& conventions);
 
 // PreparedReference: a reference (ground-truth) mask prepared once and compared with many
 // predictions (models, epochs, raters): its point set is extracted and

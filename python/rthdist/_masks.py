@@ -401,9 +401,8 @@ def compare_masks(a, b, *, spacing=None, affine=None, convention="rthdist", perc
         # GPU has opened its device (README, rthdist-masks).
         a, b = _volumes(a, b, spacing, affine)
         spacing = affine = None
-        voxels = a._v.nonzero_voxels() + b._v.nonzero_voxels()
-        points = sum(voxels * (8 if name == "deepmind" else 1) for name in _conventions(convention))
-        backend = _rthdist._one_shot_backend(points, backend, device, threads, validation)
+        backend = _rthdist._one_shot_mask_backend(a._v, b._v, _conventions(convention), backend, device,
+                                                  threads, validation)
     with MaskEngine(backend, device=device, threads=threads, validation=validation,
                     device_extraction=device_extraction) as engine:
         return engine.compare(a, b, spacing=spacing, affine=affine, convention=convention,

@@ -3,7 +3,6 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -497,13 +496,8 @@ void bindMasks(py::module_& m) {
         .def_property_readonly("transform", [](const PyVolume& v) { return v.volume->transform; })
         .def("nonzero_voxels",
              [](const PyVolume& v) {
-                 const masks::Volume& vol = *v.volume;
                  py::gil_scoped_release release;
-                 if (!vol.labels8.empty())
-                     return uint64_t(vol.labels8.size()) -
-                            uint64_t(std::count(vol.labels8.begin(), vol.labels8.end(), uint8_t(0)));
-                 return uint64_t(vol.labels.size()) -
-                        uint64_t(std::count(vol.labels.begin(), vol.labels.end(), 0));
+                 return masks::nonzeroVoxels(*v.volume);
              })
         .def("labels_present", [](const PyVolume& v) {
             std::vector<int32_t> out;
@@ -527,6 +521,29 @@ void bindMasks(py::module_& m) {
         py::arg("points"), py::arg("backend"), py::arg("device"), py::arg("threads"), py::arg("validation"),
         "The backend a one-shot call of `points` in all opens (rthdist::oneShotBackendFor): 'cpu' for a "
         "small pair under 'auto' with no device named and no validation, else the backend asked for.");
+    m.def(
+        "_one_shot_mask_backend",
+        [](const PyVolume& a, const PyVolume& b, const std::vector<std::string>& names,
+           const std::string& backend, std::optional<int> device, int threads, bool validation) {
+            std::vector<Convention> conventions;
+            for (const std::string& name : names) {
+                Convention c;
+                if (!masks::parseConvention(name, c))
+                    throw py::value_error("unknown convention '" + name + "' (" + masks::conventionNames() +
+                                          ")");
+                conventions.push_back(c);
+            }
+            const Options options = engineOptions(backend, device, threads, validation);
+            Backend chosen;
+            {
+                py::gil_scoped_release release;
+                chosen = masks::oneShotMaskBackend(options, *a.volume, *b.volume, conventions);
+            }
+            return std::string(backendName(chosen));
+        },
+        py::arg("a"), py::arg("b"), py::arg("conventions"), py::arg("backend"), py::arg("device"),
+        py::arg("threads"), py::arg("validation"),
+        "The backend a one-shot comparison of two _MaskVolumes opens (masks::oneShotMaskBackend).");
     m.def("_conventions", [] {
         std::vector<std::string> out;
         for (Convention c : masks::kAllConventions) out.push_back(masks::conventionName(c));

@@ -171,6 +171,15 @@ Result<MaskEngine> makeMaskEngine(Options options, bool devicePass) {
     return m;
 }
 
+Backend oneShotMaskBackend(const Options& options, const Volume& a, const Volume& b,
+                           const std::vector<Convention>& conventions) {
+    const uint64_t voxels = nonzeroVoxels(a) + nonzeroVoxels(b);
+    uint64_t points = 0;
+    for (Convention c : conventions)
+        points += voxels * (conventionRules(c).points == PointSet::kSurfels ? 8 : 1);
+    return oneShotBackendFor(points, options);
+}
+
 Result<MaskResult> compareMasks(MaskEngine& maskEngine, const Volume& a, LabelSelect selectA, const Volume& b,
                                 LabelSelect selectB, const MaskOptions& options) {
     const auto start = Clock::now();

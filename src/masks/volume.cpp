@@ -312,4 +312,11 @@ std::vector<int32_t> labelsPresent(const Volume& v) {
     return out;
 }
 
+uint64_t nonzeroVoxels(const Volume& v) {
+    if (!v.labels8.empty())
+        return uint64_t(v.labels8.size()) -
+               uint64_t(std::count(v.labels8.begin(), v.labels8.end(), uint8_t(0)));
+    return uint64_t(v.labels.size()) - uint64_t(std::count(v.labels.begin(), v.labels.end(), 0));
+}
+
 }  // namespace rthdist::masks

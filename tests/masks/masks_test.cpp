@@ -102,6 +102,36 @@ TEST(MasksLoad, AtlasSformAndLabels) {
     EXPECT_EQ(labelsPresent(*v).size(), 116u);
 }
 
+// A one-shot comparison's backend (oneShotMaskBackend): the run's points
+// are bounded by the nonzero voxels, eight a voxel for DeepMind's surfels,
+// summed over the conventions; under auto a bound within 2^18 points a
+// thread takes the CPU backend.
+TEST(MasksOneShot, TheBoundCountsNonzeroVoxelsAndSurfelCorners) {
+    Volume a, b;
+    a.dims = b.dims = {64, 64, 64};
+    a.labels8.assign(size_t(64 * 64 * 64), 0);
+    b.labels8.assign(size_t(64 * 64 * 64), 0);
+    std::fill(a.labels8.begin(), a.labels8.begin() + 20000, uint8_t(1));
+    std::fill(b.labels8.begin(), b.labels8.begin() + 20000, uint8_t(3));
+    EXPECT_EQ(nonzeroVoxels(a), 20000u);
+    Volume wide = a;
+    wide.labels8.clear();
+    wide.labels.assign(size_t(64 * 64 * 64), 0);
+    std::fill(wide.labels.begin(), wide.labels.begin() + 7, -2);
+    EXPECT_EQ(nonzeroVoxels(wide), 7u);
+    Options o;
+    o.threads = 1;  // 2^18 = 262144 points
+    // 40000 voxels: 40000 points a boundary or foreground convention.
+    EXPECT_EQ(oneShotMaskBackend(o, a, b, {Convention::kRthdist}), Backend::kCpu);
+    EXPECT_EQ(oneShotMaskBackend(o, a, b, {Convention::kMonai, Convention::kItk}), Backend::kCpu);
+    // Surfels: 320000 > 2^18.
+    EXPECT_EQ(oneShotMaskBackend(o, a, b, {Convention::kDeepmind}), Backend::kAuto);
+    o.threads = 2;
+    EXPECT_EQ(oneShotMaskBackend(o, a, b, {Convention::kDeepmind}), Backend::kCpu);
+    o.deviceIndex = 0;  // a device named: as asked
+    EXPECT_EQ(oneShotMaskBackend(o, a, b, {Convention::kRthdist}), Backend::kAuto);
+}
+
 TEST(MasksLoad, GridMismatchNamesBothFiles) {
     Result<Volume> a = loadNifti(kNifti + "/HarvardOxford-cort-maxprob-thr0-1mm.nii.gz");
     Result<Volume> b = loadNifti(kNifti + "/JHU-WhiteMatter-labels-1mm.nii.gz");

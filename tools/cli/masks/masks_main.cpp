@@ -19,10 +19,8 @@
 // the point CLI's (cli/exit_codes.hpp): 0 ok, 1 internal, 2 usage, 3 bad
 // input (unreadable file, grids that differ), 4 no device. Every error names
 // the file it concerns.
-#include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <functional>
@@ -607,29 +605,13 @@ int compareAll(const MasksArgs& args, masks::MaskEngine& engine, const masks::Vo
     return kExitOk;
 }
 
-// The nonzero voxels of a volume: every label's points lie among them.
-uint64_t nonzeroVoxels(const masks::Volume& v) {
-    if (!v.labels8.empty())
-        return uint64_t(v.labels8.size() -
-                        size_t(std::count(v.labels8.begin(), v.labels8.end(), uint8_t(0))));
-    return uint64_t(v.labels.size() - size_t(std::count(v.labels.begin(), v.labels.end(), 0)));
-}
-
-// One pair (one B) under auto, no device named and no device extraction:
-// the engine takes the backend a one-shot call of the run's points would
-// (oneShotBackendFor: the CPU for small masks, which it answers before a
-// GPU has opened its device). Each convention's points lie within the
-// nonzero voxels (boundary or foreground; DeepMind's surfels, corners of
-// them, within 8 a voxel) and the labels split those voxels, so the run's
-// points are at most that sum. Several predictions share one engine as asked.
+// One pair (one B) without device extraction: the backend of a one-shot
+// comparison (masks::oneShotMaskBackend: the CPU for small masks under
+// auto). Several predictions share one engine as asked.
 Options engineOptions(const MasksArgs& args, const masks::Volume& a, const std::optional<masks::Volume>& b) {
     Options options = args.options;
-    if (!b || args.deviceExtraction) return options;
-    const uint64_t voxels = nonzeroVoxels(a) + nonzeroVoxels(*b);
-    uint64_t points = 0;
-    for (Convention c : args.conventions)
-        points += voxels * (masks::conventionRules(c).points == masks::PointSet::kSurfels ? 8 : 1);
-    options.backend = oneShotBackendFor(points, options);
+    if (b && !args.deviceExtraction)
+        options.backend = masks::oneShotMaskBackend(options, a, *b, args.conventions);
     return options;
 }
 
