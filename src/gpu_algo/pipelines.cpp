@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <chrono>
 #include <cstring>
 #include <exception>
 #include <span>
@@ -11,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/stopwatch.hpp"
 #include "gpu/compute_pipeline.hpp"
 #include "gpu/context.hpp"
 #include "gpu/vk_struct.hpp"
@@ -129,9 +129,9 @@ Pipelines::Pipelines(Context& ctx, bool rayQuery, VkPipelineCache cache, int thr
     // Each step's handles are owned as soon as they exist: a throw in a later
     // step releases them.
     createLayout();
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = core::Clock::now();
     createPipelines(cache, threads);
-    m_createMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    m_createMs = core::msSince(t0);
     if (!rayQuery) createShaderBindingTable();
 }
 
