@@ -10,9 +10,13 @@
 //   Point targets (evaluatePoints): both are point sets; the distances are
 //   the exact nearest-neighbour distances of hausdorff() with
 //   Options::perPointDistances. Surface target (evaluateToSurface): G is a
-//   mesh; accuracy is every point of R to G's triangles (hausdorffToSurface,
-//   exact); completeness is every vertex a triangle of G uses (each once)
-//   to R's points (a point set has no surface to measure to).
+//   mesh; accuracy is every point of R to G's triangles (hausdorffToSurface:
+//   exact on the CPU backend, within SurfacePerPoint::tolerance on a GPU
+//   backend); completeness is every vertex a triangle of G uses (each
+//   once) to R's points (a point set has no surface to measure to).
+//   Per-point distances of a GPU backend are within its rounding of the
+//   exact ones (README "Precision"; rthdist/surface.hpp), so a distance
+//   that close to a threshold or the cap may fall on either side of it.
 //
 // Definitions (evaluationSummary; the README repeats them):
 //   cap: with cap > 0, distances d >= cap are dropped from the means,
@@ -95,7 +99,8 @@ struct EvalSummary {
 // Surface target: accuracy to groundTruth's triangles, completeness from
 // its (used) vertices to the reconstruction's points (roles above).
 // options.perPointDistances is set by the call; options.backend and threads
-// apply to both searches.
+// apply to both searches (a GPU backend: one Engine on options.deviceIndex
+// runs both, so the device opens once).
 [[nodiscard]] RTHDIST_API Result<EvalSummary> evaluateToSurface(PointView reconstruction,
                                                                 MeshView groundTruth, const EvalOptions& eval,
                                                                 const SurfaceOptions& options = {});

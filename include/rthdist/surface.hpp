@@ -46,19 +46,21 @@
 //   triangle measures in double at or above the largest query's exact
 //   value are searched again exactly by the CPU backend's BVH), so the
 //   value and witness are the same as on the CPU backend (==), whatever
-//   the float search found. perPointDistances on a GPU backend is
-//   kInvalidArgument: the device's float search gives each query a
-//   candidate triangle, not its exact nearest one, and the host proves only
-//   the maximum (the queries below it are never measured exactly); per-point
-//   values come from the CPU backend (kAuto or kCpu), never a GPU backend's
-//   candidates in their place.
+//   the float search found. perPointDistances on a GPU backend: every
+//   point's entry is the rule in double to the triangle the float search
+//   found for it, within SurfacePerPoint::tolerance of its exact nearest
+//   distance (never below it), the witness's entry the proven one; a
+//   sample of 16 points is measured exactly by the brute force on every
+//   such call as the device's check, and where one falls outside the
+//   tolerance every point is measured by the CPU backend instead
+//   (SurfaceCounters::cpuRecomputed, tolerance 0).
 //
 // On a kept device: Engine::hausdorffToSurface (rthdist.hpp) runs the same
 //   call on an Engine's backend, which keeps its device, pipelines, upload
 //   and search buffers and BLAS storage between calls (a one-shot GPU call
 //   creates them all: ~0.35 s on an H200). The route is the Engine's
 //   EngineOptions::backend's as above: kRayQuery and kRtPipeline search on
-//   its device (per-point distances refused, kInvalidArgument), kCpu and
+//   its device (per-point distances within the tolerance, as above), kCpu and
 //   kAuto run the CPU backend (an auto Engine that chose a GPU too, until
 //   the kept route is measured faster than the CPU backend). The results
 //   are those of hausdorffToSurface with the same backend (==); threads are
@@ -103,9 +105,10 @@ namespace rthdist {
 // What may change from call to call (Engine::hausdorffToSurface).
 struct SurfaceCallOptions {
     // Also return every point's distance, triangle, closest point and
-    // barycentric coordinates (SurfaceResult::perPoint; kAuto and kCpu
-    // only). Every query then needs its own nearest triangle: the early
-    // break against the running maximum is off.
+    // barycentric coordinates (SurfaceResult::perPoint: exact on the CPU
+    // backend, within its tolerance on a GPU backend). Every query then
+    // needs its own nearest triangle: the early break against the running
+    // maximum is off.
     bool perPointDistances = false;
     // Read at every chunk of 256 queries (GPU backends: also before and
     // between the device's submissions): true -> kCancelled. An Engine
@@ -149,6 +152,14 @@ struct SurfaceCounters {
     uint32_t tailTreeReused = 0;
     // Queries searched again exactly on the host (the others are proven below h).
     uint64_t band = 0;
+    // Per-point distances on a GPU backend: 1 where a sample of the device's
+    // entries failed its check (SurfacePerPoint), and every point was then
+    // measured by the CPU backend instead (exact, tolerance 0).
+    uint32_t cpuRecomputed = 0;
+    // Per-point distances on a GPU backend: the triangles the float rule may
+    // measure too far off (slivers, design.md §11 "Per-point distances"),
+    // measured for every point in double on the host instead.
+    uint64_t hostTriangles = 0;
 };
 
 // Where a GPU backend's call went, in milliseconds of host wall clock
@@ -188,11 +199,23 @@ struct SurfaceDirected {
 // the triangle's vertices in index order (non-negative, summing to 1 up to
 // rounding; closest = the vertices weighted by them, up to rounding).
 // SurfaceDirected's entry is the same as the arrays' at its queryIndex.
+// On a GPU backend (tolerance > 0) each entry is the rule in double to the
+// triangle the device's float search found for the point (design.md §11,
+// "Per-point distances"): triangle[i], closest[i] and barycentric[i] are
+// that triangle's, distance[i] = |point i - closest[i]| in double, and
+// d(i) <= distance[i] <= d(i) + tolerance, d(i) the brute force's nearest
+// distance (equal to it, with the brute force's triangle, wherever no
+// other triangle lies within the tolerance of the nearest; the witness's
+// entry always). The tolerance is 2^-15 of the search frame's unit, the
+// power of two just above the half-extent of both inputs' box: at most
+// 2^-14 (6.1e-5) of that half-extent (3.8e-6 m for the Stanford bunny,
+// 0.16 m across).
 struct SurfacePerPoint {
     std::vector<double> distance;
     std::vector<uint32_t> triangle;
     std::vector<glm::dvec3> closest;
     std::vector<glm::dvec3> barycentric;
+    double tolerance = 0.0;  // 0: every entry exact (the CPU backend)
 };
 
 struct SurfaceResult {

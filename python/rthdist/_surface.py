@@ -42,12 +42,14 @@ def hausdorff_to_surface(points, vertices, faces=None, *, per_point=False, backe
     distances (N,) float64, triangles (N,) uint32 (the nearest triangle, the
     smallest index on a tie), surface_points (N, 3) float64 (its closest
     point) and barycentrics (N, 3) float64 (of that point w.r.t. the
-    triangle's vertices in face order). Exact as rthdist.hausdorff is: equal
-    to a brute force in double over every triangle (README "Point to
-    surface"). backend: "auto" or "cpu"; "ray-query" and "rt-pipeline"
-    search on a Vulkan device and give the directed value alone (per_point
-    with them is a ValueError: the device's float search proves only the
-    maximum).
+    triangle's vertices in face order), and tolerance. Exact as
+    rthdist.hausdorff is: equal to a brute force in double over every
+    triangle (README "Point to surface"). backend: "auto" or "cpu" (tolerance
+    0: every per-point value exact), or "ray-query" / "rt-pipeline" (a
+    Vulkan device's float search; hausdorff and its witness still exact,
+    each per-point distance the exact distance to the triangle the device
+    found, at most `tolerance` above the nearest: 2^-15 of the inputs' frame,
+    e.g. 3.8e-6 m for the Stanford bunny).
     """
     v, f = _mesh(vertices, faces, "surface")
     return _rthdist._hausdorff_to_surface(as_points(points, "points"), v, f, per_point=bool(per_point),

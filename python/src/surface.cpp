@@ -88,6 +88,7 @@ py::dict surfaceResultDict(SurfaceResult&& r, bool perPoint) {
         out["triangles"] = ownedArray<uint32_t, uint32_t>(std::move(p.triangle));
         out["surface_points"] = ownedArray<glm::dvec3, double>(std::move(p.closest));
         out["barycentrics"] = ownedArray<glm::dvec3, double>(std::move(p.barycentric));
+        out["tolerance"] = p.tolerance;
     }
     return out;
 }

@@ -36,17 +36,37 @@ Result<EvalSummary> evaluatePoints(PointView reconstruction, PointView groundTru
 
 Result<EvalSummary> evaluateToSurface(PointView reconstruction, MeshView groundTruth, const EvalOptions& eval,
                                       const SurfaceOptions& options) {
+    const std::vector<glm::dvec3> samples = usedVertices(groundTruth);
+    CallOptions call;
+    call.cancel = options.cancel;
+    call.perPointDistances = true;
+    call.directedOnly = true;
+    SurfaceCallOptions surfaceCall;
+    surfaceCall.cancel = options.cancel;
+    surfaceCall.perPointDistances = true;
+    if (options.backend == Backend::kRayQuery || options.backend == Backend::kRtPipeline) {
+        // Both directions on one device: an Engine opens it once.
+        EngineOptions engineOptions;
+        engineOptions.backend = options.backend;
+        engineOptions.threads = options.threads;
+        engineOptions.deviceIndex = options.deviceIndex;
+        engineOptions.validation = options.validation;
+        Result<Engine> engine = Engine::create(engineOptions);
+        if (!engine) return engine.error();
+        Result<SurfaceResult> accuracy = engine->hausdorffToSurface(reconstruction, groundTruth, surfaceCall);
+        if (!accuracy) return accuracy.error();
+        Result<HausdorffResult> completeness = engine->compute(PointView(samples), reconstruction, call);
+        if (!completeness) return completeness.error();
+        return evaluationSummary(accuracy->perPoint.distance, completeness->aNearest.distance, eval);
+    }
     SurfaceOptions so = options;
-    so.perPointDistances = true;
+    static_cast<SurfaceCallOptions&>(so) = surfaceCall;
     Result<SurfaceResult> accuracy = hausdorffToSurface(reconstruction, groundTruth, so);
     if (!accuracy) return accuracy.error();
-    const std::vector<glm::dvec3> samples = usedVertices(groundTruth);
     Options o;
+    static_cast<CallOptions&>(o) = call;
     o.backend = options.backend;
     o.threads = options.threads;
-    o.cancel = options.cancel;
-    o.perPointDistances = true;
-    o.directedOnly = true;
     Result<HausdorffResult> completeness = hausdorff(PointView(samples), reconstruction, o);
     if (!completeness) return completeness.error();
     return evaluationSummary(accuracy->perPoint.distance, completeness->aNearest.distance, eval);

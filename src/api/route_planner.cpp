@@ -103,14 +103,8 @@ const char* routeName(Route route) {
     return "?";
 }
 
-Plan planSurfaceRoute(Backend requested, bool perPoint) {
+Plan planSurfaceRoute(Backend requested) {
     if (requested == Backend::kCpu || requested == Backend::kAuto) return routed(Route::kSurfaceCpu);
-    if (perPoint)
-        return refused(
-            ErrorCode::kInvalidArgument,
-            std::string("per-point distances to a surface come from the CPU backend for now: the ") +
-                backendName(requested) +
-                " backend proves the directed maximum only (use backend cpu or auto)");
     return routed(Route::kSurfaceGpu);
 }
 

@@ -121,10 +121,9 @@ struct Plan {
 // call, whose setup outweighs the CPU search at the sizes one call takes;
 // an auto Engine that chose a GPU stays on the CPU backend too until the
 // kept route is measured faster than it); a GPU backend the caller named
-// takes kSurfaceGpu, or kRefused (kInvalidArgument) with per-point
-// distances, which only the CPU backend gives: never computed on the CPU in
-// its place.
-[[nodiscard]] Plan planSurfaceRoute(Backend requested, bool perPoint = false);
+// takes kSurfaceGpu, per-point distances too (within the float search's
+// tolerance, rthdist/surface.hpp).
+[[nodiscard]] Plan planSurfaceRoute(Backend requested);
 
 // The route of two triangle surfaces (surfaceHausdorff, certified bounds):
 // kSurfaceCpu for kCpu and kAuto (the refinement's batches run on the CPU

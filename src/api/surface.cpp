@@ -1,11 +1,9 @@
 // Public entry of the point-to-surface distance (rthdist/surface.hpp), one-
 // shot and on an Engine (api/surface_engine.hpp): the route chosen
-// (api::planSurfaceRoute: the CPU backend, the device, or a refusal naming
-// the backend), the inputs checked (shape, finite coordinates, triangle
-// indices, the rule's magnitude limit), then the CPU backend's search
-// (cpu/surface_search.hpp), or on a GPU backend the device's search proven
-// on the host (api/surface_gpu.hpp) on the Engine's device or, one-shot, on
-// a device opened while the inputs are checked.
+// (api::planSurfaceRoute: the CPU backend or the device), the inputs checked (shape, finite coordinates,
+// triangle indices, the rule's magnitude limit), then the CPU backend's search (cpu/surface_search.hpp), or
+// on a GPU backend the device's search proven on the host (api/surface_gpu.hpp) on the Engine's device or,
+// one-shot, on a device opened while the inputs are checked.
 #include "rthdist/surface.hpp"
 
 #include <glm/common.hpp>
@@ -72,7 +70,7 @@ Result<api::SurfaceInputs> checkInputs(const PointView& points, const MeshView& 
 Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, const SurfaceOptions& options) {
     const core::Clock::time_point start = core::Clock::now();
     if (options.threads < 0) return Error{ErrorCode::kInvalidArgument, "threads must be >= 0"};
-    const api::Plan plan = api::planSurfaceRoute(options.backend, options.perPointDistances);
+    const api::Plan plan = api::planSurfaceRoute(options.backend);
     if (plan.route == api::Route::kRefused) return Error{plan.code, plan.reason};
     // A GPU call's device opens on another thread while the inputs are checked.
     std::future<api::OneShotBackend> opening;
@@ -104,7 +102,7 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
     options.backend = engine.backend;
     options.threads = engine.threads;
     // The Engine's requested backend picks the route (kAuto: the CPU backend).
-    const Plan plan = planSurfaceRoute(engine.backend, call.perPointDistances);
+    const Plan plan = planSurfaceRoute(engine.backend);
     if (plan.route == Route::kRefused) return Error{plan.code, plan.reason};
     if (plan.route == Route::kSurfaceGpu) {
         Result<SurfaceInputs> inputs = checkInputs(points, surface, options.threads);

@@ -37,9 +37,12 @@ double measure2(const PointView& points, const MeshView& surface, uint64_t q, ui
 }
 
 // U(q) of every query: the rule in double against its candidate (an upper
-// bound of its nearest distance), infinite without one.
+// bound of its nearest distance), infinite without one. `perPoint` (sized
+// by the caller, may be null): also each query's entry from that measure
+// (no triangle: an infinite distance and UINT32_MAX).
 core::UninitVector<double> upperBounds(const PointView& points, const MeshView& surface,
-                                       std::span<const uint32_t> candidate, int threads, Largest& largest) {
+                                       std::span<const uint32_t> candidate, int threads, Largest& largest,
+                                       SurfacePerPoint* perPoint = nullptr) {
     core::UninitVector<double> bound(points.count);  // every element written below
     const size_t chunk = core::balancedChunk(points.count, threads, kMinChunk, 4096);
     const int workers = core::resolveThreads(threads, (points.count + chunk - 1) / chunk);
@@ -47,7 +50,23 @@ core::UninitVector<double> upperBounds(const PointView& points, const MeshView& 
     core::parallelChunks(points.count, chunk, workers, [&](size_t begin, size_t end, int thread) {
         Largest& mine = each[size_t(thread)];
         for (size_t q = begin; q < end; ++q) {
-            bound[q] = measure2(points, surface, q, candidate[q]);
+            const uint32_t t = candidate[q];
+            if (perPoint != nullptr && t < surface.triangleCount()) {
+                const core::TriangleClosest c = core::closestOnTriangle(
+                    points.at(q), surface.corner(t, 0), surface.corner(t, 1), surface.corner(t, 2));
+                bound[q] = c.distance2;
+                perPoint->distance[q] = std::sqrt(c.distance2);
+                perPoint->triangle[q] = t;
+                perPoint->closest[q] = c.point;
+                perPoint->barycentric[q] = c.barycentric;
+            } else {
+                bound[q] = measure2(points, surface, q, t);
+                if (perPoint != nullptr) {
+                    perPoint->distance[q] = std::numeric_limits<double>::infinity();
+                    perPoint->triangle[q] = UINT32_MAX;
+                    perPoint->closest[q] = perPoint->barycentric[q] = glm::dvec3(0.0);
+                }
+            }
             if (bound[q] > mine.bound) mine = Largest{bound[q], q};
         }
     });
@@ -240,7 +259,6 @@ std::vector<uint64_t> bandOf(std::span<const double> bound, double lower2, int t
 // kSearchedSamples queries spread over the indices): any sampled query
 // outside it, or a distance that is not a number, and the proof measures
 // every U(q) instead (upperBounds), trusting nothing of the device's.
-constexpr double kSearchedReach = 0x1p-16;
 constexpr size_t kSearchedSamples = 64;
 
 // Where a query's U(q) may reach L (sqrt(lower2)): a query the device left
@@ -303,6 +321,32 @@ std::vector<uint64_t> bandBySearched(const PointView& points, const MeshView& su
         }
     });
     return core::concatenateParts<std::vector<uint64_t>>(parts);
+}
+
+// The device's check of a per-point call (EveryQueryBound::perPoint):
+// kPerPointSamples queries spread over the indices (not measured exactly
+// already) by the brute force in one pass. Each sample's U(q) must lie
+// within `tolerance` of its exact nearest distance (the float search's
+// bound, design.md §11 "Per-point distances") and agree with the device's
+// distance within the reach; a sample without a candidate fails.
+bool perPointSamplesAgree(const PointView& points, const MeshView& surface, std::span<const double> bound,
+                          const SearchedBound& searched, const Known& known, double tolerance, double slack,
+                          int threads) {
+    std::vector<uint64_t> samples;
+    std::vector<double> within2;
+    const uint64_t step = std::max<uint64_t>(1, points.count / kPerPointSamples);
+    for (uint64_t q = 0; q < points.count && samples.size() < kPerPointSamples; q += step) {
+        if (knownOf(known, q) != nullptr) continue;  // measured exactly already
+        samples.push_back(q);
+        within2.push_back(bound[q]);
+    }
+    const std::vector<Nearest> exact = bruteNearest(points, samples, surface, threads, within2, slack);
+    for (size_t i = 0; i < samples.size(); ++i) {
+        const double u = std::sqrt(within2[i]);
+        if (!(u - std::sqrt(exact[i].distance2) <= tolerance) || !searched.agrees(samples[i], within2[i]))
+            return false;
+    }
+    return true;
 }
 
 }  // namespace
@@ -376,9 +420,20 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
         }
         if (knownOf(known, top) == nullptr) bySearched = bySearched && searched.agrees(top, largest.bound);
     }
+    SurfacePerPoint* perPoint = every != nullptr ? every->perPoint : nullptr;
+    if (perPoint != nullptr) {
+        if (searched2.size() != points.count || !(searchScale > 0.0))
+            return Error{ErrorCode::kInternal,
+                         "surface proof: per-point entries need the device's distances"};
+        perPoint->distance.resize(points.count);
+        perPoint->triangle.resize(points.count);
+        perPoint->closest.resize(points.count);
+        perPoint->barycentric.resize(points.count);
+        perPoint->tolerance = 2.0 * searched.reach;
+    }
     if (!bySearched) {
         largest = Largest{};
-        bound = upperBounds(points, surface, candidate, options.threads, largest);
+        bound = upperBounds(points, surface, candidate, options.threads, largest, perPoint);
     }
     Nearest measured;  // q*'s nearest, exactly
     if (const Nearest* k = knownOf(known, largest.query)) {
@@ -415,6 +470,15 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     d.counters.queries = points.count;
     d.counters.band = bandIndex.size();
     exact->stages.tailHost = openMs;
+    if (perPoint != nullptr) {
+        // The witness's entry is the proven one; then the device's check.
+        perPoint->distance[d.queryIndex] = d.distance;
+        perPoint->triangle[d.queryIndex] = d.triangle;
+        perPoint->closest[d.queryIndex] = d.surfacePoint;
+        perPoint->barycentric[d.queryIndex] = d.barycentric;
+        every->samplesAgree = perPointSamplesAgree(points, surface, bound, searched, known,
+                                                   perPoint->tolerance, slack, options.threads);
+    }
     if (every != nullptr) {  // every U(q) measured (not bySearched)
         every->bound2 = std::move(bound);
         every->triangle.assign(candidate.begin(), candidate.end());

@@ -56,7 +56,28 @@ namespace rthdist::api {
 struct EveryQueryBound {
     core::UninitVector<double> bound2;  // +inf: no triangle
     std::vector<uint32_t> triangle;
+    // Where set (per-point distances on a GPU backend, api/surface_gpu.hpp):
+    // also every query's entry as SurfacePerPoint holds it, from the same
+    // measure (distance = sqrt(U(q)), its triangle, closest point and
+    // barycentric coordinates), the witness's entry the proven one; then
+    // the device is checked on a sample (kPerPointSamples queries spread
+    // over the indices, measured exactly by the brute force): each sample's
+    // U(q) must lie within `perPoint->tolerance` of its exact nearest
+    // distance and agree with its device distance within the reach.
+    // `samplesAgree` false: a sample did not, and the caller must not use
+    // the entries (it recomputes them on the CPU backend).
+    SurfacePerPoint* perPoint = nullptr;
+    bool samplesAgree = true;
 };
+// Queries measured exactly on every per-point call as the device's check.
+inline constexpr size_t kPerPointSamples = 16;
+
+// How far the device's distance to a query's candidate, over the frame's
+// scale, may lie from U(q) (surface_certify.cpp: the frame's and the float
+// rule's rounding, below 2^-18, with a factor 4; checked on a sample of
+// every call). Per-point entries (EveryQueryBound::perPoint) are within
+// twice it of the exact distance, in the frame's units (design.md §11).
+inline constexpr double kSearchedReach = 0x1p-16;
 [[nodiscard]] Result<SurfaceResult> certifySurface(
     const PointView& points, const MeshView& surface, double magnitude, std::span<const uint32_t> candidate,
     const SurfaceOptions& options, std::span<const uint32_t> open = {}, std::span<const float> searched2 = {},

@@ -130,22 +130,6 @@ TEST(SurfaceApi, AnEngineOfTheCpuBackendKeepsItsTreeForTheSameMeshOnly) {
     call(MeshView{PointView(floats), copyIndices}, 1, "the same values in float");
 }
 
-// Per-point distances come from the CPU backend only: a GPU backend the
-// caller named is refused before any device is opened, never replaced.
-TEST(SurfaceApi, PerPointOnAGpuBackendIsRefusedNotReplaced) {
-    const Small s;
-    for (Backend backend : {Backend::kRayQuery, Backend::kRtPipeline}) {
-        SurfaceOptions options;
-        options.backend = backend;
-        options.perPointDistances = true;
-        Result<SurfaceResult> r = hausdorffToSurface(PointView(s.points), s.mesh(), options);
-        ASSERT_FALSE(r);
-        EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
-        EXPECT_NE(r.error().message.find("per-point distances to a surface"), std::string::npos)
-            << r.error().message;
-    }
-}
-
 TEST(SurfaceApi, FloatStridedInputsMatchTheBruteForce) {
     const test::SurfaceCase c = test::heightField(3415, 12, 6.0);
     // Interleaved float vertices (position + a colour) and float queries.

@@ -2,7 +2,8 @@
 // lavapipe (design.md §11, "The GPU backends"): a georeferenced OBJ height
 // field and points around it, the JSON's directed value and witness against
 // the brute force over every triangle (tests/common) with ==, the
-// validation layer silent; per-point outputs refused (exit 2). `--surface
+// validation layer silent; per-point rows within the JSON's tolerance of
+// the brute force. `--surface
 // both` on each GPU backend: the bounds bracket a closed form (a triangle
 // and its parallel offset copy) within --tolerance and meet the cpu
 // backend's; a tolerance below the GPU floor is a usage error naming it.
@@ -10,7 +11,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -18,6 +22,7 @@
 #include "common/rng.hpp"
 #include "common/surface_brute_force.hpp"
 #include "common/surface_cases.hpp"
+#include "core/point_triangle.hpp"
 #include "surface_files.hpp"
 
 namespace rthdist::cli_test {
@@ -109,10 +114,44 @@ TEST_F(CliSurfaceGpu, SurfaceToSurfaceOnEveryGpuBackend) {
     }
 }
 
-TEST_F(CliSurfaceGpu, PerPointOutputsAreUsageErrors) {
-    const CliRun run = runCli({m_xyz, m_mesh, "--surface", "b", "--backend", "ray-query", "--per-point"});
-    EXPECT_EQ(run.exitCode, 2) << run;
-    EXPECT_TRUE(run.out.empty()) << run;
+// Per-point distances of the georeferenced field on each GPU backend: every
+// CSV row's distance within the JSON's tolerance above the brute force's,
+// and the rule in double to the row's own triangle (its closest point).
+TEST_F(CliSurfaceGpu, PerPointRowsLieWithinTheTolerance) {
+    for (const char* backend : {"ray-query", "rt-pipeline"}) {
+        const std::string prefix = (m_dir.path() / (std::string("pp-") + backend)).string();
+        const CliRun run =
+            runCli({m_xyz, m_mesh, "--surface", "b", "--backend", backend, "--json", "--out-csv", prefix});
+        ASSERT_EQ(run.exitCode, 0) << run;
+        const Json j = Json::parse(run.out);
+        EXPECT_EQ(j["hausdorff"].get<double>(), m_want.distance) << backend;
+        const double tolerance = j["per_point"]["tolerance"].get<double>();
+        // The frame is the field's own box (~24 m), not the UTM magnitude.
+        EXPECT_GT(tolerance, 0.0) << backend;
+        EXPECT_LE(tolerance, std::ldexp(24.0, -13)) << backend;
+        std::stringstream in(readFile(prefix + "_a.csv"));
+        std::string line;
+        std::getline(in, line);
+        size_t rows = 0, wrong = 0;
+        for (; std::getline(in, line); ++rows) {
+            std::vector<double> cell;
+            std::stringstream row(line);
+            for (std::string c; std::getline(row, c, ',');) cell.push_back(std::strtod(c.c_str(), nullptr));
+            ASSERT_EQ(cell.size(), 12u) << line;
+            const double exact = std::sqrt(m_want.perQuery.at(rows).distance2);
+            const auto t = size_t(cell[5]);
+            ASSERT_LT(t, m_case.indices.size() / 3) << line;
+            const core::TriangleClosest rule = core::closestOnTriangle(
+                m_points[rows], m_case.vertices[m_case.indices[3 * t]],
+                m_case.vertices[m_case.indices[3 * t + 1]], m_case.vertices[m_case.indices[3 * t + 2]]);
+            const bool ok = cell[4] >= exact && cell[4] <= exact + tolerance &&
+                            cell[4] == std::sqrt(rule.distance2) &&
+                            glm::dvec3(cell[6], cell[7], cell[8]) == rule.point;
+            if (!ok && ++wrong <= 3) ADD_FAILURE() << backend << " row " << rows << ": " << line;
+        }
+        EXPECT_EQ(rows, m_points.size()) << backend;
+        EXPECT_EQ(wrong, 0u) << backend;
+    }
 }
 
 }  // namespace

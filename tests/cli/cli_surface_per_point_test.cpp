@@ -6,8 +6,8 @@
 // ==; the JSON statistics (count, min, max, mean, nearest-rank percentiles,
 // HD95, histogram) against the same distances; the PLY's quality; the
 // points' side alone (--surface a mirrors --surface b); the pictures; the
-// refusals (--surface both, --eval, a GPU backend: exit 2) and an
-// unwritable file (exit 5).
+// refusals (--surface both, --eval: exit 2) and an unwritable file (exit
+// 5); a GPU backend's statistics within its tolerance.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -234,11 +234,33 @@ TEST_F(CliSurfacePerPoint, RefusalsNameTheReason) {
     run = runCli({m_xyz, m_mesh, "--surface", "b", "--eval", "0.1", "--per-point"});
     EXPECT_EQ(run.exitCode, 2) << run;
     EXPECT_NE(run.err.find("--eval"), std::string::npos) << run;
+}
+
+// A GPU backend's per-point statistics: h exact, every statistic within
+// the JSON's tolerance above the brute force's (the device's float search
+// per point), the summary saying so; the cpu backend's tolerance is 0.
+TEST_F(CliSurfacePerPoint, GpuBackendsGiveStatisticsWithinTheirTolerance) {
+    CliRun run = runCli({m_xyz, m_mesh, "--surface", "b", "--json", "--percentile", "90"});
+    ASSERT_EQ(run.exitCode, 0) << run;
+    EXPECT_EQ(Json::parse(run.out)["per_point"]["tolerance"].get<double>(), 0.0);
     for (const char* backend : {"ray-query", "rt-pipeline"}) {
-        run = runCli({m_xyz, m_mesh, "--surface", "b", "--backend", backend, "--percentile", "90"});
-        EXPECT_EQ(run.exitCode, 2) << run;
-        EXPECT_NE(run.err.find("come from the cpu backend"), std::string::npos) << run;
-        EXPECT_TRUE(run.out.empty()) << run;
+        run = runCli({m_xyz, m_mesh, "--surface", "b", "--backend", backend, "--json", "--percentile", "90"});
+        ASSERT_EQ(run.exitCode, 0) << run;
+        const Json j = Json::parse(run.out);
+        EXPECT_EQ(j["hausdorff"].get<double>(), m_want.distance) << backend;
+        const double tolerance = j["per_point"]["tolerance"].get<double>();
+        EXPECT_GT(tolerance, 0.0) << backend;
+        EXPECT_LT(tolerance, 1e-3) << backend;
+        const Json& s = j["per_point"]["a_to_b"];
+        EXPECT_EQ(s["count"].get<size_t>(), m_points.size()) << backend;
+        EXPECT_EQ(s["max"].get<double>(), m_want.distance) << backend;
+        const double p90 = percentileOf(s["percentiles"], 90.0);
+        EXPECT_GE(p90, percentile(90.0)) << backend;
+        EXPECT_LE(p90, percentile(90.0) + tolerance) << backend;
+        EXPECT_EQ(j["counters"]["a_to_b"]["cpu_recomputed"].get<int>(), 0) << backend;
+        run = runCli({m_xyz, m_mesh, "--surface", "b", "--backend", backend, "--per-point"});
+        ASSERT_EQ(run.exitCode, 0) << run;
+        EXPECT_NE(run.out.find("per-point distances within"), std::string::npos) << run;
     }
 }
 

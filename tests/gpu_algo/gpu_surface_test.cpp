@@ -7,7 +7,9 @@
 // inputs; the validation layer on and silent. The kept-device route
 // (Engine::hausdorffToSurface): one Engine serving calls of growing and
 // shrinking sizes equals the brute force and a one-shot call, a cancelled
-// call leaves it usable, per-point distances stay refused. The tail (the
+// call leaves it usable. Per-point distances: within the call's tolerance
+// of the brute force, recomputed by the CPU backend where the mutant makes
+// the device's sample check fail. The tail (the
 // tree descent of the queries the radii leave open, surface_tail.comp,
 // forced by Tuning::surfaceHostWork = 0): every query's candidate against
 // the brute force's nearest triangle, directly on the device search
@@ -23,6 +25,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
@@ -41,6 +44,7 @@
 #include "gpu_algo/gpu_hausdorff.hpp"
 #include "gpu_algo/gpu_test_support.hpp"
 #include "gpu_algo/surface_search.hpp"
+#include "rthdist/eval.hpp"
 #include "rthdist/surface.hpp"
 
 namespace rthdist {
@@ -222,18 +226,168 @@ TEST(GpuSurface, AMissingSearchIsCaughtByTheProof) {
     EXPECT_GT(missing, clean);
 }
 
-TEST(GpuSurface, PerPointDistancesAreRefusedNotReplaced) {
-    const test::SurfaceCase c = test::heightField(3435, 4, 1.0);
-    const std::vector<glm::dvec3> points{{0.5, 0.5, 1.0}};
+Result<SurfaceResult> perPointOnDevice(const test::SurfaceCase& c, Backend backend) {
     SurfaceOptions options;
-    options.backend = test::backendUnderTest();
+    options.backend = backend;
+    options.validation = true;
     options.perPointDistances = true;
-    Result<SurfaceResult> r =
-        hausdorffToSurface(PointView(points), MeshView{PointView(c.vertices), c.indices}, options);
-    ASSERT_FALSE(r);
-    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
-    EXPECT_NE(r.error().message.find("per-point distances to a surface"), std::string::npos)
-        << r.error().message;
+    return hausdorffToSurface(PointView(c.queries), meshOf(c), options);
+}
+
+// Per-point entries of a GPU call against the brute force: each entry is
+// the rule in double to its own triangle, never below the nearest
+// distance and within the call's tolerance above it (0 where the CPU
+// backend recomputed them: equal); the witness's entry is the proven one.
+// Returns how many entries are not the brute force's own (distance and
+// triangle).
+size_t expectPerPointWithinTolerance(const test::SurfaceCase& c, const Result<SurfaceResult>& r) {
+    const oracle::SurfaceDirectedExact want = oracle::bruteForceSurface(c.queries, c.vertices, c.indices);
+    EXPECT_TRUE(r) << c.name << ": " << r.error().message;
+    if (!r) return 0;
+    const SurfacePerPoint& p = r->perPoint;
+    EXPECT_EQ(r->hausdorff, want.distance) << c.name;
+    EXPECT_EQ(r->directed.queryIndex, want.queryIndex) << c.name;
+    EXPECT_EQ(p.distance.size(), c.queries.size()) << c.name;
+    EXPECT_EQ(p.triangle.size(), c.queries.size()) << c.name;
+    EXPECT_EQ(p.closest.size(), c.queries.size()) << c.name;
+    EXPECT_EQ(p.barycentric.size(), c.queries.size()) << c.name;
+    if (p.distance.size() != c.queries.size() || p.closest.size() != c.queries.size()) return 0;
+    if (r->directed.counters.cpuRecomputed != 0)
+        EXPECT_EQ(p.tolerance, 0.0) << c.name;
+    else
+        EXPECT_GT(p.tolerance, 0.0) << c.name;
+    size_t other = 0;
+    for (size_t q = 0; q < c.queries.size(); ++q) {
+        const double exact = std::sqrt(want.perQuery[q].distance2);
+        const uint32_t t = p.triangle[q];
+        EXPECT_LT(size_t(t), c.indices.size() / 3) << c.name << " query " << q;
+        if (size_t(t) >= c.indices.size() / 3) continue;
+        const core::TriangleClosest rule =
+            core::closestOnTriangle(c.queries[q], c.vertices[c.indices[3 * t]],
+                                    c.vertices[c.indices[3 * t + 1]], c.vertices[c.indices[3 * t + 2]]);
+        EXPECT_EQ(p.distance[q], std::sqrt(rule.distance2)) << c.name << " query " << q;
+        EXPECT_EQ(p.closest[q], rule.point) << c.name << " query " << q;
+        EXPECT_EQ(p.barycentric[q], rule.barycentric) << c.name << " query " << q;
+        EXPECT_GE(p.distance[q], exact) << c.name << " query " << q;
+        EXPECT_LE(p.distance[q], exact + p.tolerance)
+            << c.name << " query " << q << ", tolerance " << p.tolerance;
+        if (p.distance[q] != exact || t != want.perQuery[q].triangle) ++other;
+    }
+    const uint64_t w = r->directed.queryIndex;
+    if (w < c.queries.size()) {
+        EXPECT_EQ(p.distance[w], want.distance) << c.name;
+        EXPECT_EQ(p.triangle[w], want.nearest.triangle) << c.name;
+        EXPECT_EQ(p.closest[w], r->directed.surfacePoint) << c.name;
+    }
+    return other;
+}
+
+// Per-point distances on the device: every oracle case's entries within
+// the call's tolerance of the brute force, the device's sample check
+// passing (no recomputation), most entries the brute force's own.
+TEST(GpuSurface, PerPointDistancesLieWithinTheTolerance) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    size_t entries = 0, other = 0;
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        const Result<SurfaceResult> r = perPointOnDevice(c, backend);
+        other += expectPerPointWithinTolerance(c, r);
+        entries += c.queries.size();
+        if (!r) continue;
+        EXPECT_EQ(r->backend, backend) << c.name;
+        EXPECT_EQ(r->directed.counters.cpuRecomputed, 0u) << c.name;
+        EXPECT_EQ(r->validationMessages, 0u) << c.name;
+        // The value and witness are those of the call without per-point output.
+        const Result<SurfaceResult> plain = onDevice(c, backend);
+        ASSERT_TRUE(plain) << c.name << ": " << plain.error().message;
+        EXPECT_EQ(r->directed.distance, plain->directed.distance) << c.name;
+        EXPECT_EQ(r->directed.triangle, plain->directed.triangle) << c.name;
+    }
+    std::printf("%zu of %zu entries not the brute force's own (within the tolerance)\n", other, entries);
+    EXPECT_LT(other, entries / 20 + 1);
+}
+
+// The reconstruction-evaluation summary against a surface on the device
+// (one Engine for both directions): the CPU backend's summary within the
+// per-point tolerances (accuracy: the surface call's; completeness: the
+// point search's 2e, far below it), the same precision and recall at
+// thresholds that no exact distance lies near.
+TEST(GpuSurface, EvaluationToASurfaceIsTheCpuBackendsWithinTheTolerance) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    const test::SurfaceCase c = test::heightField(3482, 10, 5.0);
+    std::vector<glm::dvec3> recon;
+    for (int i = 0; i < 1500; ++i)
+        recon.emplace_back(0.1 + 0.0032 * i, 4.9 - 0.0031 * i, (i % 13) * 0.15 - 0.9);
+    // Each threshold in the middle of the widest gap between exact distances near 0.1 and 0.5.
+    const oracle::SurfaceDirectedExact exact = oracle::bruteForceSurface(recon, c.vertices, c.indices);
+    std::vector<double> sorted;
+    for (const oracle::SurfaceNearest& n : exact.perQuery) sorted.push_back(std::sqrt(n.distance2));
+    std::sort(sorted.begin(), sorted.end());
+    EvalOptions eval;
+    for (double target : {0.1, 0.5}) {
+        double gap = 0.0, tau = target;
+        for (size_t i = 1; i < sorted.size(); ++i) {
+            if (std::abs(sorted[i] - target) < 0.02 && sorted[i] - sorted[i - 1] > gap) {
+                gap = sorted[i] - sorted[i - 1];
+                tau = (sorted[i] + sorted[i - 1]) / 2;
+            }
+        }
+        eval.thresholds.push_back(tau);
+    }
+    SurfaceOptions cpu;
+    cpu.backend = Backend::kCpu;
+    const Result<EvalSummary> want = evaluateToSurface(PointView(recon), meshOf(c), eval, cpu);
+    SurfaceOptions gpu;
+    gpu.backend = backend;
+    gpu.validation = true;
+    const Result<EvalSummary> got = evaluateToSurface(PointView(recon), meshOf(c), eval, gpu);
+    ASSERT_TRUE(want) << want.error().message;
+    ASSERT_TRUE(got) << got.error().message;
+    const Result<SurfaceResult> perPoint =
+        perPointOnDevice(test::SurfaceCase{"eval", 3482, c.vertices, c.indices, recon}, backend);
+    ASSERT_TRUE(perPoint) << perPoint.error().message;
+    const double tolerance = perPoint->perPoint.tolerance;
+    for (const double d : sorted) {
+        for (double tau : eval.thresholds) ASSERT_GT(std::abs(d - tau), tolerance) << tau;
+    }
+    EXPECT_EQ(got->accuracy.count, want->accuracy.count);
+    EXPECT_GE(got->accuracy.mean, want->accuracy.mean);
+    EXPECT_LE(got->accuracy.mean, want->accuracy.mean + tolerance);
+    EXPECT_GE(got->accuracy.median, want->accuracy.median);
+    EXPECT_LE(got->accuracy.median, want->accuracy.median + tolerance);
+    EXPECT_EQ(got->accuracy.max, want->accuracy.max);
+    EXPECT_NEAR(got->completeness.mean, want->completeness.mean, 1e-6 * want->completeness.mean);
+    ASSERT_EQ(got->thresholds.size(), want->thresholds.size());
+    for (size_t i = 0; i < got->thresholds.size(); ++i) {
+        EXPECT_EQ(got->thresholds[i].precision, want->thresholds[i].precision) << i;
+        EXPECT_EQ(got->thresholds[i].recall, want->thresholds[i].recall) << i;
+    }
+}
+
+// A device search that misses every third triangle (core::searchMutant):
+// its candidates lie far outside the tolerance, the sample check finds it
+// on several cases, and those cases' entries are recomputed by the CPU
+// backend, exactly. (A sample of 16 checks the device, it proves no entry:
+// a case whose samples miss the mutant's misses keeps them, as the float
+// search's bound is a property of a working device.)
+TEST(GpuSurface, PerPointDistancesOfAMissingSearchAreRecomputed) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    struct Mutant {
+        Mutant() { core::searchMutant() = true; }
+        ~Mutant() { core::searchMutant() = false; }
+    } mutant;
+    size_t recomputed = 0;
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        const Result<SurfaceResult> r = perPointOnDevice(c, backend);
+        ASSERT_TRUE(r) << c.name << ": " << r.error().message;
+        if (r->directed.counters.cpuRecomputed == 0) continue;
+        ++recomputed;
+        EXPECT_EQ(expectPerPointWithinTolerance(c, r), 0u)
+            << c.name << ": the CPU backend's entries are the brute force's";
+    }
+    std::printf("%zu cases recomputed on the CPU backend\n", recomputed);
+    EXPECT_GT(recomputed, 0u);
 }
 
 }  // namespace
@@ -336,21 +490,23 @@ TEST(GpuSurfaceEngine, ACancelledCallLeavesTheEngineUsable) {
     expectBruteForce(c, backend, engine->hausdorffToSurface(PointView(c.queries), meshOf(c)));
 }
 
-// Per-point distances on the Engine's GPU backend: refused with the
-// reason, as one-shot, never computed on the CPU in its place; the Engine
-// serves the next call.
-TEST(GpuSurfaceEngine, PerPointDistancesAreRefusedNotReplaced) {
+// Per-point distances on the Engine's GPU backend: the one-shot call's
+// entries (the same device search), within the tolerance of the brute
+// force; the Engine's next call without them is exact as before.
+TEST(GpuSurfaceEngine, PerPointDistancesOnAKeptDevice) {
     RTHDIST_REQUIRE_SURFACE_DEVICE();
     Result<Engine> engine = surfaceEngine(backend);
     ASSERT_TRUE(engine) << engine.error().message;
     const test::SurfaceCase c = firstCase();
     SurfaceCallOptions call;
     call.perPointDistances = true;
-    Result<SurfaceResult> r = engine->hausdorffToSurface(PointView(c.queries), meshOf(c), call);
-    ASSERT_FALSE(r);
-    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
-    EXPECT_NE(r.error().message.find("per-point distances to a surface"), std::string::npos)
-        << r.error().message;
+    const Result<SurfaceResult> kept = engine->hausdorffToSurface(PointView(c.queries), meshOf(c), call);
+    expectPerPointWithinTolerance(c, kept);
+    const Result<SurfaceResult> fresh = perPointOnDevice(c, backend);
+    ASSERT_TRUE(kept && fresh);
+    EXPECT_EQ(kept->perPoint.distance, fresh->perPoint.distance);
+    EXPECT_EQ(kept->perPoint.triangle, fresh->perPoint.triangle);
+    EXPECT_EQ(kept->perPoint.tolerance, fresh->perPoint.tolerance);
     expectBruteForce(c, backend, engine->hausdorffToSurface(PointView(c.queries), meshOf(c)));
 }
 

@@ -112,10 +112,17 @@ def test_per_point_arrays_match_a_numpy_brute_force(rng):
 
 
 @pytest.mark.parametrize("gpu", ["ray-query", "rt-pipeline"])
-def test_per_point_on_a_gpu_backend_is_refused(gpu):
-    pts = np.array([[0.5, 0.5, 1.0]])
-    with pytest.raises(ValueError, match="per-point distances to a surface"):
-        rthdist.hausdorff_to_surface(pts, SQUARE_V, SQUARE_F, per_point=True, backend=gpu)
+def test_per_point_on_a_gpu_backend_is_within_its_tolerance(gpu):
+    rng = np.random.default_rng(3483)
+    pts = rng.uniform([-0.5, -0.5, -1.0], [1.5, 1.5, 1.0], size=(400, 3))
+    cpu = rthdist.hausdorff_to_surface(pts, SQUARE_V, SQUARE_F, per_point=True, backend="cpu")
+    r = rthdist.hausdorff_to_surface(pts, SQUARE_V, SQUARE_F, per_point=True, backend=gpu)
+    assert r["backend"] == gpu and cpu["tolerance"] == 0.0
+    assert 0.0 < r["tolerance"] < 1e-3
+    assert r["hausdorff"] == cpu["hausdorff"] and r["query_index"] == cpu["query_index"]
+    assert (r["distances"] >= cpu["distances"]).all()
+    assert (r["distances"] <= cpu["distances"] + r["tolerance"]).all()
+    np.testing.assert_allclose(np.linalg.norm(pts - r["surface_points"], axis=1), r["distances"], rtol=1e-12)
 
 
 def test_triangle_and_its_offset_copy():

@@ -139,8 +139,10 @@ Options:
                       the triangles of SIDE's mesh (obj, ply, off, stl, gltf,
                       glb), directed only: --surface b is h(A, surface of B);
                       the per-point options below give the points' side's
-                      distances (cpu backend: auto picks it), their files
-                      named for that side alone (--surface b: PREFIX_a.*);
+                      distances (exact on the cpu backend, which auto picks;
+                      within the JSON's per_point.tolerance on a GPU one),
+                      their files named for that side alone (--surface b:
+                      PREFIX_a.*);
                       both: certified bounds [lower, upper] on H between the
                       surfaces of both meshes (--directed: h(A, B)), on the
                       cpu backend (auto picks it) or a GPU backend
@@ -359,8 +361,8 @@ void addPerPointOptions(CommandLine& line, CliArgs& out) {
 
 // --surface reports the directed value alone (a|b) or certified bounds
 // (both), on the cpu backend or on one device of a GPU backend, with
-// per-point outputs on the cpu backend for a|b: the options it cannot
-// honour are refused, never ignored.
+// per-point outputs for a|b: the options it cannot honour are refused,
+// never ignored.
 std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
     if (out.tolerance > 0.0 && out.surface != "both")
         return usageError(
@@ -370,14 +372,6 @@ std::optional<Error> checkSurfaceOptions(const CliArgs& out) {
         return usageError(
             "option '--surface both' gives certified bounds between two surfaces, not per-point distances: "
             "--per-point and its options need --surface a or b");
-    if (out.perPoint &&
-        (out.options.backend == Backend::kRayQuery || out.options.backend == Backend::kRtPipeline))
-        return usageError(
-            std::string("option '--surface ") + out.surface +
-            "': per-point outputs (--per-point and its options) come from the cpu backend: the " +
-            backendName(out.options.backend) +
-            " backend's float search gives each point a candidate triangle and proves only the "
-            "directed maximum (use --backend cpu or auto)");
     if (out.verify)
         return usageError("option '--surface' proves its value itself: --verify has nothing to compare");
     if (!out.options.devices.empty() || out.allDevices)

@@ -57,7 +57,9 @@ Json countersJson(const SurfaceCounters& c) {
             {"tail_queries", c.tailQueries},
             {"tail_host_queries", c.tailHostQueries},
             {"tail_tree_reused", c.tailTreeReused},
-            {"band", c.band}};
+            {"band", c.band},
+            {"host_triangles", c.hostTriangles},
+            {"cpu_recomputed", c.cpuRecomputed}};
 }
 
 const char* precisionName(Scalar s) { return s == Scalar::kFloat64 ? "float64" : "float32"; }
@@ -93,7 +95,11 @@ std::string jsonReport(const Run& run) {
         {"validation_messages", r.validationMessages}};
     j["a_to_b"] = b ? directedJson(r.directed, run.sides) : Json();
     j["b_to_a"] = b ? Json() : directedJson(r.directed, run.sides);
-    if (run.stats != nullptr) j["per_point"] = surfaceStatsJson(*run.stats, !b);
+    if (run.stats != nullptr) {
+        j["per_point"] = surfaceStatsJson(*run.stats, !b);
+        // 0: every distance exact (cpu); a GPU backend's bound (rthdist/surface.hpp).
+        j["per_point"]["tolerance"] = r.perPoint.tolerance;
+    }
     const SurfaceStages& st = r.stages;
     j["timings_ms"] = {{"load", run.loadMs},
                        {"build", r.buildMs},
@@ -140,7 +146,14 @@ std::string summaryText(const Run& run) {
     add(std::snprintf(line, sizeof line, "  %s[%" PRIu64 "] %s -> %s triangle %u at %s\n", Q.c_str(),
                       d.queryIndex, text(d.queryPoint).c_str(), S.c_str(), d.triangle,
                       text(d.surfacePoint).c_str()));
-    if (run.stats != nullptr) s += surfaceStatsText(*run.stats, run.sides.q == "b");
+    if (run.stats != nullptr) {
+        s += surfaceStatsText(*run.stats, run.sides.q == "b");
+        if (r.perPoint.tolerance > 0.0)
+            add(std::snprintf(line, sizeof line,
+                              "  per-point distances within %.3g above the exact ones (the device's float "
+                              "search; h and its witness exact)\n",
+                              r.perPoint.tolerance));
+    }
     add(std::snprintf(line, sizeof line,
                       "time (ms)  load %.2f | build %.2f | search %.2f | total %.2f | wall %.2f\n",
                       run.loadMs, r.buildMs, r.searchMs, r.totalMs, run.wallMs));
