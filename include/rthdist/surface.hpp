@@ -177,6 +177,8 @@ struct SurfaceStages {
     double tailBuild = 0.0;  // the tail's tree of the triangles built on the host (part of search)
     double gpuTail = 0.0;    // device time of the tail's tree descent and its copies (part of gpuMs)
     double tailHost = 0.0;   // the open queries measured exactly on the host instead (part of certify)
+    double perPoint =
+        0.0;  // per-point entries: slivers measured on the host, the sample check (part of certify)
 };
 
 // h(points, surface) with its witness.

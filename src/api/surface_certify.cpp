@@ -323,32 +323,6 @@ std::vector<uint64_t> bandBySearched(const PointView& points, const MeshView& su
     return core::concatenateParts<std::vector<uint64_t>>(parts);
 }
 
-// The device's check of a per-point call (EveryQueryBound::perPoint):
-// kPerPointSamples queries spread over the indices (not measured exactly
-// already) by the brute force in one pass. Each sample's U(q) must lie
-// within `tolerance` of its exact nearest distance (the float search's
-// bound, design.md §11 "Per-point distances") and agree with the device's
-// distance within the reach; a sample without a candidate fails.
-bool perPointSamplesAgree(const PointView& points, const MeshView& surface, std::span<const double> bound,
-                          const SearchedBound& searched, const Known& known, double tolerance, double slack,
-                          int threads) {
-    std::vector<uint64_t> samples;
-    std::vector<double> within2;
-    const uint64_t step = std::max<uint64_t>(1, points.count / kPerPointSamples);
-    for (uint64_t q = 0; q < points.count && samples.size() < kPerPointSamples; q += step) {
-        if (knownOf(known, q) != nullptr) continue;  // measured exactly already
-        samples.push_back(q);
-        within2.push_back(bound[q]);
-    }
-    const std::vector<Nearest> exact = bruteNearest(points, samples, surface, threads, within2, slack);
-    for (size_t i = 0; i < samples.size(); ++i) {
-        const double u = std::sqrt(within2[i]);
-        if (!(u - std::sqrt(exact[i].distance2) <= tolerance) || !searched.agrees(samples[i], within2[i]))
-            return false;
-    }
-    return true;
-}
-
 }  // namespace
 
 Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface, double magnitude,
@@ -471,19 +445,35 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     d.counters.band = bandIndex.size();
     exact->stages.tailHost = openMs;
     if (perPoint != nullptr) {
-        // The witness's entry is the proven one; then the device's check.
+        // The witness's entry is the proven one.
         perPoint->distance[d.queryIndex] = d.distance;
         perPoint->triangle[d.queryIndex] = d.triangle;
         perPoint->closest[d.queryIndex] = d.surfacePoint;
         perPoint->barycentric[d.queryIndex] = d.barycentric;
-        every->samplesAgree = perPointSamplesAgree(points, surface, bound, searched, known,
-                                                   perPoint->tolerance, slack, options.threads);
     }
     if (every != nullptr) {  // every U(q) measured (not bySearched)
         every->bound2 = std::move(bound);
         every->triangle.assign(candidate.begin(), candidate.end());
     }
     return exact;
+}
+
+bool perPointSamplesAgree(const PointView& points, const MeshView& surface, const SurfacePerPoint& entries,
+                          double magnitude, int threads) {
+    std::vector<uint64_t> samples;
+    std::vector<double> within2;
+    const uint64_t step = std::max<uint64_t>(1, points.count / kPerPointSamples);
+    for (uint64_t q = 0; q < points.count && samples.size() < kPerPointSamples; q += step) {
+        samples.push_back(q);
+        within2.push_back(measure2(points, surface, q, entries.triangle[q]));
+    }
+    const std::vector<Nearest> exact =
+        bruteNearest(points, samples, surface, threads, within2, core::closestSlack(magnitude));
+    for (size_t i = 0; i < samples.size(); ++i) {
+        const double d = entries.distance[samples[i]], nearest = std::sqrt(exact[i].distance2);
+        if (!(d >= nearest && d - nearest <= entries.tolerance)) return false;
+    }
+    return true;
 }
 
 }  // namespace rthdist::api

@@ -59,18 +59,19 @@ struct EveryQueryBound {
     // Where set (per-point distances on a GPU backend, api/surface_gpu.hpp):
     // also every query's entry as SurfacePerPoint holds it, from the same
     // measure (distance = sqrt(U(q)), its triangle, closest point and
-    // barycentric coordinates), the witness's entry the proven one; then
-    // the device is checked on a sample (kPerPointSamples queries spread
-    // over the indices, measured exactly by the brute force): each sample's
-    // U(q) must lie within `perPoint->tolerance` of its exact nearest
-    // distance and agree with its device distance within the reach.
-    // `samplesAgree` false: a sample did not, and the caller must not use
-    // the entries (it recomputes them on the CPU backend).
+    // barycentric coordinates; tolerance 2 kSearchedReach / searchScale), the
+    // witness's entry the proven one. Needs the device's distances.
     SurfacePerPoint* perPoint = nullptr;
-    bool samplesAgree = true;
 };
-// Queries measured exactly on every per-point call as the device's check.
+
+// The device's check of a per-point call (design.md §11, "Per-point
+// distances"): kPerPointSamples queries spread over the indices measured
+// exactly by the brute force in one pass over the triangles. True when
+// each sample's entry lies within entries.tolerance of its exact nearest
+// distance (and is not below it); a sample without a triangle fails.
 inline constexpr size_t kPerPointSamples = 16;
+[[nodiscard]] bool perPointSamplesAgree(const PointView& points, const MeshView& surface,
+                                        const SurfacePerPoint& entries, double magnitude, int threads);
 
 // How far the device's distance to a query's candidate, over the frame's
 // scale, may lie from U(q) (surface_certify.cpp: the frame's and the float

@@ -15,6 +15,7 @@
 #include "core/stopwatch.hpp"
 #include "core/uninit_vector.hpp"
 #include "cpu/surface_search.hpp"
+#include "cpu/triangle_bvh.hpp"
 
 namespace rthdist::api {
 
@@ -59,87 +60,98 @@ namespace {
 constexpr double kRuleErrorBound = 0x1p-17;
 
 // Whether the float rule may measure triangle (a, b, c) (the device's float
-// corners, in the frame) farther than kRuleErrorBound from the double rule.
-// Its signed areas, of degree 4, carry absolute errors ~u_f L^3 D (L its
-// longest edge, D the query's distance, at most the frame's diameter 2
-// sqrt(3)); divided by their sum |n|^2 they move the closest point by up to
-// u_f L^4 D / |n|^2 along the triangle (never past it: a convex
-// combination). Well-shaped triangles (|n| ~ L^2) stay near u_f D; a
-// sliver (|n| = L w, w its width) reaches its own length once w^2 ~ u_f L D.
-// Flagged (with a factor 4): those past the bound, and zero area (n = 0 in
-// float) unless the three corners are one point.
-bool illConditioned(const glm::vec3& fa, const glm::vec3& fb, const glm::vec3& fc) {
+// corners, in the frame) farther than kRuleErrorBound from the double rule
+// for a query within `reach` of it (frame units). Its signed areas, of
+// degree 4, carry absolute errors ~u_f L^3 D (L its longest edge, D the
+// query's distance to a corner: at most reach + L); divided by their sum
+// |n|^2 they move the closest point by up to u_f L^4 D / |n|^2 along the
+// triangle (never past it: a convex combination). Well-shaped triangles
+// (|n| ~ L^2) stay near u_f D; a sliver (|n| = L w, w its width) reaches
+// its own length once w^2 ~ u_f L D. Flagged (with a factor 4): those past
+// the bound, and zero area (n = 0 in float) unless the corners are one
+// point. Only triangles nearer than a query's entry can change it, so
+// `reach` is the largest entry (in frame units).
+bool illConditioned(const glm::vec3& fa, const glm::vec3& fb, const glm::vec3& fc, double reach) {
     const glm::dvec3 a(fa), b(fb), c(fc);
     const double l2 = std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
     if (l2 == 0.0) return false;  // one point: its distance is a vertex's
     const glm::dvec3 n = glm::cross(b - a, c - a);
-    const double n2 = glm::dot(n, n);
-    constexpr double kFrameDiameter = 3.4641016151377546;  // 2 sqrt(3)
-    return !(4.0 * 0x1p-24 * kFrameDiameter * l2 * l2 * std::sqrt(l2) <= kRuleErrorBound * n2);
+    const double n2 = glm::dot(n, n), l = std::sqrt(l2);
+    return !(4.0 * 0x1p-24 * l2 * l2 * (reach + l) <= kRuleErrorBound * n2);
 }
 
-// Per-point entries: the triangles the float rule may mismeasure are
-// measured for every query in double by the CPU backend's search over them
-// alone, and a query whose candidate they beat (or tie with a smaller
-// index) takes theirs, its device distance set from the exact one. The
-// others' candidates keep what the float search found (within its bound).
-// Returns how many triangles were measured so.
-Result<uint64_t> measureIllConditioned(const PointView& points, const MeshView& surface,
-                                       std::span<const glm::vec3> corners, const SearchFrame& frame,
-                                       double magnitude, const SurfaceOptions& options,
-                                       TriangleCandidates& found) {
-    const size_t triangles = surface.triangleCount();
-    const size_t chunk = core::balancedChunk(triangles, options.threads, 1 << 10);
+// The triangles of `surface` whose float corners (in the frame) the float
+// rule may mismeasure for queries within `reach` (frame units), in index
+// order (the worker pool in chunks).
+std::vector<uint32_t> illConditionedTriangles(std::span<const glm::vec3> corners, double reach, int threads) {
+    const size_t triangles = corners.size() / 3;
+    const size_t chunk = core::balancedChunk(triangles, threads, 1 << 10);
     std::vector<std::vector<uint32_t>> parts((triangles + chunk - 1) / chunk);
-    core::parallelChunks(triangles, chunk, options.threads, [&](size_t begin, size_t end, int) {
+    core::parallelChunks(triangles, chunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t t = begin; t < end; ++t) {
-            if (illConditioned(corners[3 * t], corners[3 * t + 1], corners[3 * t + 2]))
+            if (illConditioned(corners[3 * t], corners[3 * t + 1], corners[3 * t + 2], reach))
                 parts[begin / chunk].push_back(uint32_t(t));
         }
     });
-    const std::vector<uint32_t> flagged = core::concatenateParts<std::vector<uint32_t>>(parts);
-    if (flagged.empty()) return uint64_t(0);
+    return core::concatenateParts<std::vector<uint32_t>>(parts);
+}
+
+// Per-point entries after the proof: every query measures in double the
+// `flagged` triangles (those the float rule may mismeasure) that can come
+// nearer than its entry, found in a BVH of those triangles alone descended
+// within the entry's distance plus the BVH's rounding slack (a query near
+// the surface, whose entry is small, leaves at the root's first levels),
+// and takes one that is nearer (or as near with a smaller index). The
+// others' entries keep the float search's triangle, within its bound.
+void measureIllConditioned(const PointView& points, const MeshView& surface,
+                           std::span<const uint32_t> flagged, double magnitude, int threads,
+                           SurfacePerPoint& entries) {
     std::vector<uint32_t> indices;
     indices.reserve(3 * flagged.size());
     for (const uint32_t t : flagged) {
         for (size_t k = 0; k < 3; ++k) indices.push_back(surface.indices[3 * size_t(t) + k]);
     }
-    SurfaceOptions exact;
-    exact.backend = Backend::kCpu;
-    exact.threads = options.threads;
-    exact.cancel = options.cancel;
-    exact.perPointDistances = true;
-    Result<SurfaceResult> near =
-        cpu::surfaceSearch(points, MeshView{surface.vertices, indices}, magnitude, exact);
-    if (!near) return near.error();
-    const SurfacePerPoint& p = near->perPoint;
-    const double reach = kSearchedReach / frame.scale;
-    const double scale2 = frame.scale * frame.scale;
+    const cpu::TriangleBvh tree(MeshView{surface.vertices, indices}, threads);
+    const auto& nodes = tree.nodes();
+    const auto& order = tree.triangleOrder();
+    const double slack = core::closestSlack(magnitude);
     core::parallelChunks(
-        points.count, core::balancedChunk(points.count, options.threads), options.threads,
+        points.count, core::balancedChunk(points.count, threads), threads,
         [&](size_t begin, size_t end, int) {
+            uint32_t stack[64];
             for (size_t q = begin; q < end; ++q) {
-                const uint32_t mine = flagged[p.triangle[q]];
-                const uint32_t t = found.triangle[q];
-                const float f2 = found.distance2[q];
-                double u2 = std::numeric_limits<double>::infinity();
-                if (t < triangles) {
-                    // Past the candidate's U for sure: nothing to compare.
-                    if (f2 >= 0.0f && std::sqrt(double(f2)) / frame.scale + reach < p.distance[q]) continue;
-                    u2 = core::closestOnTriangle(points.at(q), surface.corner(t, 0), surface.corner(t, 1),
-                                                 surface.corner(t, 2))
-                             .distance2;
-                }
-                const double d2 = core::closestOnTriangle(points.at(q), surface.corner(mine, 0),
-                                                          surface.corner(mine, 1), surface.corner(mine, 2))
-                                      .distance2;
-                if (d2 < u2 || (d2 == u2 && mine < t)) {
-                    found.triangle[q] = mine;
-                    found.distance2[q] = float(d2 * scale2);
+                const double entry = entries.distance[q];
+                if (!(entry > 0.0)) continue;  // on the surface: nothing is nearer
+                const glm::dvec3 p = points.at(q);
+                double reach = entry + slack, best2 = entry * entry;
+                uint32_t bestTriangle = entries.triangle[q];
+                size_t top = 0;
+                stack[top++] = 0;
+                while (top > 0) {
+                    const cpu::TriangleBvh::Node& node = nodes[stack[--top]];
+                    if (core::boxDistance2(p, glm::dvec3(node.lo), glm::dvec3(node.hi)) > reach * reach)
+                        continue;
+                    if (node.count == 0) {
+                        stack[top++] = node.first;
+                        stack[top++] = node.first + 1;
+                        continue;
+                    }
+                    for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+                        const uint32_t t = flagged[order[i]];
+                        const core::TriangleClosest c = core::closestOnTriangle(
+                            p, surface.corner(t, 0), surface.corner(t, 1), surface.corner(t, 2));
+                        if (c.distance2 > best2 || (c.distance2 == best2 && t >= bestTriangle)) continue;
+                        best2 = c.distance2;
+                        bestTriangle = t;
+                        entries.distance[q] = std::sqrt(c.distance2);
+                        entries.triangle[q] = t;
+                        entries.closest[q] = c.point;
+                        entries.barycentric[q] = c.barycentric;
+                        reach = entries.distance[q] + slack;
+                    }
                 }
             }
         });
-    return uint64_t(flagged.size());
 }
 
 }  // namespace
@@ -157,15 +169,9 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
         return Error{ErrorCode::kCancelled, "the call was cancelled (SurfaceOptions::cancel)"};
 
     const core::Clock::time_point certifyStart = core::Clock::now();
-    uint64_t hostTriangles = 0;
-    if (options.perPointDistances) {
-        Result<uint64_t> measured =
-            measureIllConditioned(points, surface, corners, frame, inputs.magnitude, options, found.value());
-        if (!measured) return measured.error();
-        hostTriangles = *measured;
-    }
-    // Per-point entries: every U(q) with its triangle's closest point, then
-    // the device's check on a sample (EveryQueryBound::perPoint).
+    // Per-point entries: every U(q) with its triangle's closest point
+    // (EveryQueryBound::perPoint), the flagged triangles measured on the
+    // host, then the device's check on a sample.
     SurfacePerPoint perPoint;
     EveryQueryBound every;
     every.perPoint = &perPoint;
@@ -175,17 +181,29 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
         certifySurface(points, surface, inputs.magnitude, found->triangle, proofOptions, found->open,
                        found->distance2, frame.scale, options.perPointDistances ? &every : nullptr);
     if (!result) return result.error();
+    uint64_t hostTriangles = 0;
     bool recomputed = false;
-    if (options.perPointDistances && every.samplesAgree) {
-        result->perPoint = std::move(perPoint);
-    } else if (options.perPointDistances) {
-        // A sample outside the float search's bound: the device is not what
-        // the bound assumes, so none of its entries is used.
-        result = cpu::surfaceSearch(points, surface, inputs.magnitude, options);
-        if (!result) return result.error();
-        recomputed = true;
+    const core::Clock::time_point perPointStart = core::Clock::now();
+    if (options.perPointDistances) {
+        // Every entry lies within the tolerance above h.
+        const double reach = (result->hausdorff + perPoint.tolerance) * frame.scale;
+        const std::vector<uint32_t> flagged = illConditionedTriangles(corners, reach, options.threads);
+        hostTriangles = flagged.size();
+        if (!flagged.empty())
+            measureIllConditioned(points, surface, flagged, inputs.magnitude, options.threads, perPoint);
+        if (perPointSamplesAgree(points, surface, perPoint, inputs.magnitude, options.threads)) {
+            result->perPoint = std::move(perPoint);
+        } else {
+            // A sample outside the float search's bound: the device is not
+            // what the bound assumes, so none of its entries is used.
+            result = cpu::surfaceSearch(points, surface, inputs.magnitude, options);
+            if (!result) return result.error();
+            recomputed = true;
+        }
     }
+    const double perPointMs = options.perPointDistances ? core::msSince(perPointStart) : 0.0;
     SurfaceResult& r = result.value();
+    r.stages.perPoint = perPointMs;
     r.directed.counters.cpuRecomputed = recomputed ? 1u : 0u;
     r.directed.counters.hostTriangles = hostTriangles;
     r.backend = device.kind();

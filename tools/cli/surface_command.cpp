@@ -116,7 +116,8 @@ std::string jsonReport(const Run& run) {
                          {"gpu_build", st.gpuBuild},
                          {"tail_build", st.tailBuild},
                          {"gpu_tail", st.gpuTail},
-                         {"tail_host", st.tailHost}}}};
+                         {"tail_host", st.tailHost},
+                         {"per_point", st.perPoint}}}};
     j["counters"] = {{"a_to_b", b ? countersJson(r.directed.counters) : Json()},
                      {"b_to_a", b ? Json() : countersJson(r.directed.counters)}};
     return jsonText(j) + "\n";
