@@ -110,6 +110,11 @@ struct SurfaceCallOptions {
     // needs its own nearest triangle: the early break against the running
     // maximum is off.
     bool perPointDistances = false;
+    // With perPointDistances: fill only SurfacePerPoint::distance and
+    // ::triangle, leaving closest and barycentric empty (the evaluation's
+    // use, rthdist/eval.hpp: 12 bytes a point instead of 60). Ignored
+    // without perPointDistances.
+    bool perPointDistancesOnly = false;
     // Read at every chunk of 256 queries (GPU backends: also before and
     // between the device's submissions): true -> kCancelled. An Engine
     // stays usable after a cancelled call.

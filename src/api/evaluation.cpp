@@ -44,6 +44,7 @@ Result<EvalSummary> evaluateToSurface(PointView reconstruction, MeshView groundT
     SurfaceCallOptions surfaceCall;
     surfaceCall.cancel = options.cancel;
     surfaceCall.perPointDistances = true;
+    surfaceCall.perPointDistancesOnly = true;  // the summary reads the distances alone
     if (options.backend == Backend::kRayQuery || options.backend == Backend::kRtPipeline) {
         // Both directions on one device: an Engine opens it once.
         EngineOptions engineOptions;

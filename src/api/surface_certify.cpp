@@ -47,25 +47,24 @@ core::UninitVector<double> upperBounds(const PointView& points, const MeshView& 
     const size_t chunk = core::balancedChunk(points.count, threads, kMinChunk, 4096);
     const int workers = core::resolveThreads(threads, (points.count + chunk - 1) / chunk);
     std::vector<Largest> each(static_cast<size_t>(workers));
+    const bool withPoints = perPoint != nullptr && !perPoint->closest.empty();
     core::parallelChunks(points.count, chunk, workers, [&](size_t begin, size_t end, int thread) {
         Largest& mine = each[size_t(thread)];
         for (size_t q = begin; q < end; ++q) {
             const uint32_t t = candidate[q];
-            if (perPoint != nullptr && t < surface.triangleCount()) {
+            if (withPoints && t < surface.triangleCount()) {
                 const core::TriangleClosest c = core::closestOnTriangle(
                     points.at(q), surface.corner(t, 0), surface.corner(t, 1), surface.corner(t, 2));
                 bound[q] = c.distance2;
-                perPoint->distance[q] = std::sqrt(c.distance2);
-                perPoint->triangle[q] = t;
                 perPoint->closest[q] = c.point;
                 perPoint->barycentric[q] = c.barycentric;
             } else {
                 bound[q] = measure2(points, surface, q, t);
-                if (perPoint != nullptr) {
-                    perPoint->distance[q] = std::numeric_limits<double>::infinity();
-                    perPoint->triangle[q] = UINT32_MAX;
-                    perPoint->closest[q] = perPoint->barycentric[q] = glm::dvec3(0.0);
-                }
+                if (withPoints) perPoint->closest[q] = perPoint->barycentric[q] = glm::dvec3(0.0);
+            }
+            if (perPoint != nullptr) {
+                perPoint->distance[q] = std::sqrt(bound[q]);
+                perPoint->triangle[q] = t < surface.triangleCount() ? t : UINT32_MAX;
             }
             if (bound[q] > mine.bound) mine = Largest{bound[q], q};
         }
@@ -399,10 +398,7 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
         if (searched2.size() != points.count || !(searchScale > 0.0))
             return Error{ErrorCode::kInternal,
                          "surface proof: per-point entries need the device's distances"};
-        perPoint->distance.resize(points.count);
-        perPoint->triangle.resize(points.count);
-        perPoint->closest.resize(points.count);
-        perPoint->barycentric.resize(points.count);
+        cpu::sizePerPoint(*perPoint, points.count, !options.perPointDistancesOnly, options.threads);
         perPoint->tolerance = 2.0 * searched.reach;
     }
     if (!bySearched) {
@@ -448,8 +444,10 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
         // The witness's entry is the proven one.
         perPoint->distance[d.queryIndex] = d.distance;
         perPoint->triangle[d.queryIndex] = d.triangle;
-        perPoint->closest[d.queryIndex] = d.surfacePoint;
-        perPoint->barycentric[d.queryIndex] = d.barycentric;
+        if (!perPoint->closest.empty()) {
+            perPoint->closest[d.queryIndex] = d.surfacePoint;
+            perPoint->barycentric[d.queryIndex] = d.barycentric;
+        }
     }
     if (every != nullptr) {  // every U(q) measured (not bySearched)
         every->bound2 = std::move(bound);

@@ -3,6 +3,7 @@
 #include <glm/common.hpp>
 
 #include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -103,9 +104,80 @@ std::vector<uint32_t> illConditionedTriangles(std::span<const glm::vec3> corners
 // the surface, whose entry is small, leaves at the root's first levels),
 // and takes one that is nearer (or as near with a smaller index). The
 // others' entries keep the float search's triangle, within its bound.
+// Cells of a 128^3 grid over the flagged triangles' boxes, marked where a
+// box meets them (with a margin for rounding): a query whose
+// cube of half-side r meets no marked cell lies farther than r from every
+// flagged triangle, and skips the BVH (most queries of a scan near the
+// surface: their entries are small and slivers rare).
+class FlaggedCells {
+public:
+    FlaggedCells(const MeshView& surface, std::span<const uint32_t> flagged)
+        : m_bits(kCells * kCells * kCells / 64) {
+        for (const uint32_t t : flagged) {
+            for (int k = 0; k < 3; ++k) {
+                m_lo = glm::min(m_lo, surface.corner(t, k));
+                m_hi = glm::max(m_hi, surface.corner(t, k));
+            }
+        }
+        const glm::dvec3 extent = m_hi - m_lo;
+        for (int a = 0; a < 3; ++a) m_inverse[a] = extent[a] > 0.0 ? double(kCells) / extent[a] : 0.0;
+        for (const uint32_t t : flagged) {
+            const glm::dvec3 a = surface.corner(t, 0), b = surface.corner(t, 1), c = surface.corner(t, 2);
+            const Range r = rangeOf(glm::min(glm::min(a, b), c), glm::max(glm::max(a, b), c));
+            for (int x = r.lo.x; x <= r.hi.x; ++x)
+                for (int y = r.lo.y; y <= r.hi.y; ++y)
+                    for (int z = r.lo.z; z <= r.hi.z; ++z) {
+                        const size_t i = (size_t(x) * kCells + size_t(y)) * kCells + size_t(z);
+                        m_bits[i / 64] |= uint64_t(1) << (i % 64);
+                    }
+        }
+    }
+    // Whether the cube of half-side `r` around p meets a marked cell (true
+    // where it spans more than kMostCells cells: the BVH decides).
+    [[nodiscard]] bool near(const glm::dvec3& p, double r) const {
+        const glm::dvec3 lo = p - r, hi = p + r;
+        if (lo.x > m_hi.x || lo.y > m_hi.y || lo.z > m_hi.z || hi.x < m_lo.x || hi.y < m_lo.y ||
+            hi.z < m_lo.z)
+            return false;
+        const Range c = rangeOf(lo, hi);
+        if (uint64_t(c.hi.x - c.lo.x + 1) * uint64_t(c.hi.y - c.lo.y + 1) * uint64_t(c.hi.z - c.lo.z + 1) >
+            kMostCells)
+            return true;
+        for (int x = c.lo.x; x <= c.hi.x; ++x)
+            for (int y = c.lo.y; y <= c.hi.y; ++y)
+                for (int z = c.lo.z; z <= c.hi.z; ++z) {
+                    const size_t i = (size_t(x) * kCells + size_t(y)) * kCells + size_t(z);
+                    if ((m_bits[i / 64] >> (i % 64)) & 1u) return true;
+                }
+        return false;
+    }
+
+private:
+    static constexpr int kCells = 128;
+    static constexpr uint64_t kMostCells = 64;
+    struct Range {
+        glm::ivec3 lo, hi;
+    };
+    [[nodiscard]] Range rangeOf(const glm::dvec3& lo, const glm::dvec3& hi) const {
+        Range r;
+        for (int a = 0; a < 3; ++a) {
+            // (A margin of 2^-20 of a cell either way for the rounding of the products.)
+            const double from = std::floor((lo[a] - m_lo[a]) * m_inverse[a] - 0x1p-20);
+            const double to = std::floor((hi[a] - m_lo[a]) * m_inverse[a] + 0x1p-20);
+            r.lo[a] = int(std::clamp(from, 0.0, double(kCells - 1)));
+            r.hi[a] = int(std::clamp(to, 0.0, double(kCells - 1)));
+        }
+        return r;
+    }
+    glm::dvec3 m_lo{std::numeric_limits<double>::infinity()}, m_hi{-std::numeric_limits<double>::infinity()};
+    glm::dvec3 m_inverse{0.0};
+    std::vector<uint64_t> m_bits;
+};
+
 void measureIllConditioned(const PointView& points, const MeshView& surface,
                            std::span<const uint32_t> flagged, double magnitude, int threads,
                            SurfacePerPoint& entries) {
+    const FlaggedCells cells(surface, flagged);
     std::vector<uint32_t> indices;
     indices.reserve(3 * flagged.size());
     for (const uint32_t t : flagged) {
@@ -124,6 +196,7 @@ void measureIllConditioned(const PointView& points, const MeshView& surface,
                 if (!(entry > 0.0)) continue;  // on the surface: nothing is nearer
                 const glm::dvec3 p = points.at(q);
                 double reach = entry + slack, best2 = entry * entry;
+                if (!cells.near(p, reach)) continue;
                 uint32_t bestTriangle = entries.triangle[q];
                 size_t top = 0;
                 stack[top++] = 0;
@@ -145,8 +218,10 @@ void measureIllConditioned(const PointView& points, const MeshView& surface,
                         bestTriangle = t;
                         entries.distance[q] = std::sqrt(c.distance2);
                         entries.triangle[q] = t;
-                        entries.closest[q] = c.point;
-                        entries.barycentric[q] = c.barycentric;
+                        if (!entries.closest.empty()) {
+                            entries.closest[q] = c.point;
+                            entries.barycentric[q] = c.barycentric;
+                        }
                         reach = entries.distance[q] + slack;
                     }
                 }

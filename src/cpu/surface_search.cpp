@@ -118,6 +118,17 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
     return result;
 }
 
+void sizePerPoint(SurfacePerPoint& perPoint, size_t count, bool points, int threads) {
+    core::parallelChunks(points ? 4 : 2, 1, threads, [&](size_t begin, size_t, int) {
+        switch (begin) {
+            case 0: perPoint.distance.resize(count); break;
+            case 1: perPoint.triangle.resize(count); break;
+            case 2: perPoint.closest.resize(count); break;
+            default: perPoint.barycentric.resize(count); break;
+        }
+    });
+}
+
 Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& surface, double magnitude,
                                     const SurfaceOptions& options, const TriangleBvh& bvh,
                                     const TriangleBlocks* blocks) {
@@ -129,12 +140,8 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
     const core::Clock::time_point searchStart = core::Clock::now();
     const double slack = core::closestSlack(magnitude);
     const bool perPoint = options.perPointDistances;
-    if (perPoint) {
-        result.perPoint.distance.resize(points.count);
-        result.perPoint.triangle.resize(points.count);
-        result.perPoint.closest.resize(points.count);
-        result.perPoint.barycentric.resize(points.count);
-    }
+    const bool perPointClosest = perPoint && !options.perPointDistancesOnly;
+    if (perPoint) sizePerPoint(result.perPoint, points.count, perPointClosest, options.threads);
     const int threads = core::resolveThreads(options.threads, (points.count + kChunk - 1) / kChunk);
     std::vector<ThreadBest> best(static_cast<size_t>(threads));
     std::atomic<uint64_t> runningMax{0};
@@ -157,8 +164,10 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
             if (perPoint) {
                 result.perPoint.distance[q] = std::sqrt(hit.distance2);
                 result.perPoint.triangle[q] = hit.triangle;
-                result.perPoint.closest[q] = hit.point;
-                result.perPoint.barycentric[q] = hit.barycentric;
+                if (perPointClosest) {
+                    result.perPoint.closest[q] = hit.point;
+                    result.perPoint.barycentric[q] = hit.barycentric;
+                }
             }
             if (beats(hit, q, mine)) {
                 mine.hit = hit;

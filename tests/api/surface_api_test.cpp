@@ -222,6 +222,27 @@ TEST(SurfaceApi, PerPointArraysMatchTheBruteForceOnEveryCase) {
     }
 }
 
+// perPointDistancesOnly: the same distances and triangles, no closest
+// points or barycentric coordinates.
+TEST(SurfaceApi, PerPointDistancesOnlyKeepTheDistancesAndTriangles) {
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        SCOPED_TRACE(c.name);
+        SurfaceOptions options;
+        options.perPointDistances = true;
+        const MeshView mesh{PointView(c.vertices), c.indices};
+        const Result<SurfaceResult> all = hausdorffToSurface(PointView(c.queries), mesh, options);
+        options.perPointDistancesOnly = true;
+        const Result<SurfaceResult> some = hausdorffToSurface(PointView(c.queries), mesh, options);
+        ASSERT_TRUE(all && some);
+        EXPECT_EQ(some->perPoint.distance, all->perPoint.distance);
+        EXPECT_EQ(some->perPoint.triangle, all->perPoint.triangle);
+        EXPECT_TRUE(some->perPoint.closest.empty());
+        EXPECT_TRUE(some->perPoint.barycentric.empty());
+        EXPECT_EQ(some->directed.surfacePoint, all->directed.surfacePoint);
+    }
+}
+
 TEST(SurfaceApi, IndexOutOfRangeNamesTheTriangle) {
     Small s;
     s.indices[4] = 9;

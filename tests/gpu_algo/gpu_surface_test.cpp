@@ -364,6 +364,27 @@ TEST(GpuSurface, EvaluationToASurfaceIsTheCpuBackendsWithinTheTolerance) {
     }
 }
 
+// perPointDistancesOnly on the device: the full call's distances and
+// triangles, no closest points or barycentric coordinates.
+TEST(GpuSurface, PerPointDistancesOnlyKeepTheDistancesAndTriangles) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+        if (c.queries.empty()) continue;
+        SurfaceOptions options;
+        options.backend = backend;
+        options.perPointDistances = true;
+        const Result<SurfaceResult> all = hausdorffToSurface(PointView(c.queries), meshOf(c), options);
+        options.perPointDistancesOnly = true;
+        const Result<SurfaceResult> some = hausdorffToSurface(PointView(c.queries), meshOf(c), options);
+        ASSERT_TRUE(all && some) << c.name;
+        EXPECT_EQ(some->perPoint.distance, all->perPoint.distance) << c.name;
+        EXPECT_EQ(some->perPoint.triangle, all->perPoint.triangle) << c.name;
+        EXPECT_EQ(some->perPoint.tolerance, all->perPoint.tolerance) << c.name;
+        EXPECT_TRUE(some->perPoint.closest.empty()) << c.name;
+        EXPECT_TRUE(some->perPoint.barycentric.empty()) << c.name;
+    }
+}
+
 // A device search that misses every third triangle (core::searchMutant):
 // its candidates lie far outside the tolerance, the sample check finds it
 // on several cases, and those cases' entries are recomputed by the CPU
