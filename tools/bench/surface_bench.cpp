@@ -4,6 +4,7 @@
 //
 //   rthdist-surface-bench POINTS MESH [--backend B] [--runs N] [--warmup W]
 //                         [--one-shot N] [--threads T] [--name NAME] [--no-verify]
+//                         [--per-point [--distances-only]]
 // POINTS: any point input (a mesh's vertices); MESH: a file with faces.
 // One Engine is created (setup_ms); its first --warmup calls are timed apart
 // (warmup_ms: the first call also compiles what the driver compiles on first
@@ -13,7 +14,12 @@
 // and the wall clock of the call. --one-shot N more calls of the free
 // function (a device per call) give one_shot medians (total, build = the
 // device and its pipelines). --no-verify skips the CPU backend's call that
-// checks value and witness (==: both are exact). Prints one JSON object.
+// checks value and witness (==: both are exact). --per-point: every call
+// asks per-point distances (SurfaceCallOptions::perPointDistances; with
+// --distances-only, perPointDistancesOnly), the stage per_point is timed
+// too, and the check also compares every point's distance with the CPU
+// backend's per-point call: equal, or within the call's tolerance above it
+// (per_point_within). Prints one JSON object.
 // Not a test: no thresholds.
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -45,13 +51,13 @@ double median(std::vector<double> v) {
 struct Settings {
     std::string points, mesh, name, backend = "rt-pipeline";
     int runs = 7, warmup = 2, oneShot = 0, threads = 0;
-    bool verify = true;
+    bool verify = true, perPoint = false, distancesOnly = false;
 };
 
 // The series of one kind of call: every stage's milliseconds per call.
 struct Series {
     std::vector<double> wall, total, build, search, frame, upload, device, readback, certify, gpu, gpuBuild,
-        tailBuild, gpuTail, tailHost;
+        tailBuild, gpuTail, tailHost, perPoint;
 
     void add(const SurfaceResult& r, double wallMs) {
         wall.push_back(wallMs);
@@ -68,6 +74,7 @@ struct Series {
         tailBuild.push_back(r.stages.tailBuild);
         gpuTail.push_back(r.stages.gpuTail);
         tailHost.push_back(r.stages.tailHost);
+        perPoint.push_back(r.stages.perPoint);
     }
     [[nodiscard]] nlohmann::json medians() const {
         return {
@@ -75,7 +82,7 @@ struct Series {
             {"search", median(search)},    {"frame", median(frame)},        {"upload", median(upload)},
             {"device", median(device)},    {"readback", median(readback)},  {"certify", median(certify)},
             {"gpu", median(gpu)},          {"gpu_build", median(gpuBuild)}, {"tail_build", median(tailBuild)},
-            {"gpu_tail", median(gpuTail)}, {"tail_host", median(tailHost)}};
+            {"gpu_tail", median(gpuTail)}, {"tail_host", median(tailHost)}, {"per_point", median(perPoint)}};
     }
 };
 
@@ -88,7 +95,9 @@ nlohmann::json countersJson(const rthdist::SurfaceCounters& c) {
             {"tail_queries", c.tailQueries},
             {"tail_host_queries", c.tailHostQueries},
             {"tail_tree_reused", c.tailTreeReused},
-            {"band", c.band}};
+            {"band", c.band},
+            {"host_triangles", c.hostTriangles},
+            {"cpu_recomputed", c.cpuRecomputed}};
 }
 
 int fail(const std::string& what, const rthdist::Error& e) {
@@ -111,6 +120,8 @@ int main(int argc, char** argv) {
     app.add_option("--threads", s.threads, "host threads (0: all)")->check(CLI::NonNegativeNumber);
     app.add_option("--name", s.name, "the case's name in the output");
     app.add_flag("!--no-verify", s.verify, "skip the CPU backend's reference call");
+    app.add_flag("--per-point", s.perPoint, "every call asks per-point distances");
+    app.add_flag("--distances-only", s.distancesOnly, "with --per-point: distances and triangles only");
     CLI11_PARSE(app, argc, argv);
 
     rthdist::EngineOptions engineOptions;
@@ -136,9 +147,12 @@ int main(int argc, char** argv) {
     std::vector<double> warmup;
     Series kept, once;
     SurfaceResult last;
+    rthdist::SurfaceCallOptions call;
+    call.perPointDistances = s.perPoint;
+    call.perPointDistancesOnly = s.distancesOnly;
     for (int r = 0; r < s.warmup + s.runs; ++r) {
         t0 = Clock::now();
-        auto res = engine->hausdorffToSurface(query, surface);
+        auto res = engine->hausdorffToSurface(query, surface, call);
         const double wall = msSince(t0);
         if (!res) return fail("engine call", res.error());
         if (r < s.warmup) {
@@ -149,6 +163,7 @@ int main(int argc, char** argv) {
         last = std::move(res.value());
     }
     rthdist::SurfaceOptions oneShot;
+    static_cast<rthdist::SurfaceCallOptions&>(oneShot) = call;
     oneShot.backend = engineOptions.backend;
     oneShot.threads = s.threads;
     for (int r = 0; r < s.oneShot; ++r) {
@@ -163,6 +178,7 @@ int main(int argc, char** argv) {
     nlohmann::json reference;
     if (s.verify) {
         rthdist::SurfaceOptions cpu;
+        static_cast<rthdist::SurfaceCallOptions&>(cpu) = call;
         cpu.backend = rthdist::Backend::kCpu;
         cpu.threads = s.threads;
         t0 = Clock::now();
@@ -172,6 +188,18 @@ int main(int argc, char** argv) {
         agree = ref->hausdorff == last.hausdorff && ref->directed.queryIndex == last.directed.queryIndex &&
                 ref->directed.triangle == last.directed.triangle;
         reference = {{"hausdorff", ref->hausdorff}, {"wall_ms", cpuMs}, {"total_ms", ref->totalMs}};
+        if (s.perPoint) {
+            const std::vector<double>&want = ref->perPoint.distance, &got = last.perPoint.distance;
+            uint64_t exact = 0, within = want.size() == got.size() ? 0 : UINT64_MAX;
+            for (size_t i = 0; i < want.size() && within != UINT64_MAX; ++i) {
+                exact += got[i] == want[i] ? 1 : 0;
+                within += got[i] >= want[i] && got[i] <= want[i] + last.perPoint.tolerance ? 1 : 0;
+            }
+            reference["per_point_equal"] = exact;
+            reference["per_point_within"] = within;
+            reference["tolerance"] = last.perPoint.tolerance;
+            agree = agree && within == want.size();
+        }
     }
 
     nlohmann::json j = {{"case", s.name.empty() ? s.points + " > " + s.mesh : s.name},
