@@ -425,8 +425,13 @@ NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& 
         if (node.count > 0) {
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
                 const Corner* c = &corners[3 * size_t(i)];
-                const core::TriangleClosest r =
-                    core::closestOnTriangle(p, glm::dvec3(c[0]), glm::dvec3(c[1]), glm::dvec3(c[2]));
+                const glm::dvec3 a(c[0]), b(c[1]), cc(c[2]);
+                // The triangle's own box, as its node's (which holds it) is
+                // pruned: past the bound it holds neither the nearest nor a tie.
+                if (core::boxDistance2(p, glm::min(glm::min(a, b), cc), glm::max(glm::max(a, b), cc)) >
+                    bound2)
+                    continue;
+                const core::TriangleClosest r = core::closestOnTriangle(p, a, b, cc);
                 ++best.trianglesTested;
                 const uint32_t t = m_original[i];
                 if (r.distance2 < best.distance2 || (r.distance2 == best.distance2 && t < best.triangle)) {
