@@ -104,6 +104,7 @@ struct Engine::Impl {
     double setupMs = 0.0;
     uint64_t preparedCount = 0;
     cpu::KeptSurfaceTree surfaceTree;  // the CPU route's last mesh and its BVH
+    SurfacePerPoint spareSurface;      // a recycled surface result's arrays (Engine::recycle)
 };
 
 struct PreparedSet::Impl {
@@ -650,13 +651,15 @@ Result<SurfaceResult> Engine::hausdorffToSurface(PointView points, MeshView surf
 // Point to surface on the kept backend (api/surface_engine.hpp routes it).
 Result<SurfaceResult> Engine::hausdorffToSurface(PointView points, MeshView surface,
                                                  const SurfaceCallOptions& call) {
-    return api::surfaceOnEngine(*m_impl->backend, m_impl->options, m_impl->surfaceTree, points, surface,
-                                call);
+    return api::surfaceOnEngine(*m_impl->backend, m_impl->options, m_impl->surfaceTree, points, surface, call,
+                                m_impl->spareSurface);
 }
 
 void Engine::recycle(HausdorffResult&& spent) {
     m_impl->backend->recyclePerPoint(0, std::move(spent.aNearest), std::move(spent.bNearest));
 }
+
+void Engine::recycle(SurfaceResult&& spent) { m_impl->spareSurface = std::move(spent.perPoint); }
 
 Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& options) {
     if (auto err = validateBits(options.bits)) return *err;

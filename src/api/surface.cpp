@@ -95,7 +95,8 @@ namespace api {
 
 Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptions& engine,
                                       cpu::KeptSurfaceTree& kept, const PointView& points,
-                                      const MeshView& surface, const SurfaceCallOptions& call) {
+                                      const MeshView& surface, const SurfaceCallOptions& call,
+                                      SurfacePerPoint& spare) {
     const core::Clock::time_point start = core::Clock::now();
     SurfaceOptions options;
     static_cast<SurfaceCallOptions&>(options) = call;
@@ -107,7 +108,8 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
     if (plan.route == Route::kSurfaceGpu) {
         Result<SurfaceInputs> inputs = checkInputs(points, surface, options.threads);
         if (!inputs) return inputs.error();
-        Result<SurfaceResult> result = surfaceOnGpu(backend, points, surface, *inputs, options);
+        Result<SurfaceResult> result = surfaceOnGpu(backend, points, surface, *inputs, options,
+                                                    call.perPointDistances ? &spare : nullptr);
         if (result) result->totalMs = core::msSince(start);
         return result;
     }
@@ -124,7 +126,8 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
     const cpu::TriangleBvh& tree = reused ? kept.tree() : kept.keep(surface, inputs->b, options.threads);
     treeMs += core::msSince(buildStart);
     Result<SurfaceResult> result =
-        cpu::surfaceSearch(points, surface, inputs->magnitude, options, tree, &kept.blocks());
+        cpu::surfaceSearch(points, surface, inputs->magnitude, options, tree, &kept.blocks(),
+                           call.perPointDistances ? &spare : nullptr);
     if (!result) return result;
     result->buildMs = treeMs;  // the tree's build, or the comparison that kept it
     result->directed.counters.tailTreeReused = reused ? 1 : 0;

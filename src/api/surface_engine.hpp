@@ -13,8 +13,11 @@ namespace rthdist::api {
 
 // engine: the Engine's options (its requested backend and threads). kept:
 // the Engine's CPU-backend tree, reused by the CPU route for the same mesh.
+// spare: a recycled result's per-point arrays (Engine::recycle), taken by a
+// per-point call on either route (left as they are by the others).
 [[nodiscard]] Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptions& engine,
                                                     cpu::KeptSurfaceTree& kept, const PointView& points,
-                                                    const MeshView& surface, const SurfaceCallOptions& call);
+                                                    const MeshView& surface, const SurfaceCallOptions& call,
+                                                    SurfacePerPoint& spare);
 
 }  // namespace rthdist::api

@@ -49,7 +49,8 @@ core::UninitVector<glm::vec3> framedCorners(const MeshView& surface, const Searc
 }
 
 Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& points, const MeshView& surface,
-                                   const SurfaceInputs& inputs, const SurfaceOptions& options) {
+                                   const SurfaceInputs& inputs, const SurfaceOptions& options,
+                                   SurfacePerPoint* spare) {
     const core::Clock::time_point start = core::Clock::now();
     const SearchFrame frame(inputs.a.box, inputs.b.box);
     const core::UninitVector<glm::vec3> queries = framedPoints(points, frame, options.threads);
@@ -65,6 +66,7 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
     // (EveryQueryBound::perPoint), the flagged triangles measured on the
     // host, then the device's check on a sample.
     SurfacePerPoint perPoint;
+    if (spare != nullptr) perPoint = std::move(*spare);
     EveryQueryBound every;
     every.perPoint = &perPoint;
     SurfaceOptions proofOptions = options;

@@ -45,9 +45,12 @@ struct SurfaceInputs {
 
 // Inputs checked by the caller; `device`: a GPU backend, opened for this
 // call or kept by an Engine (its buffers stay for the next call). Fills
-// every stage of SurfaceResult::stages but setup (the caller's).
+// every stage of SurfaceResult::stages but setup (the caller's). spare
+// (may be null): arrays the per-point entries are written into (moved out
+// of it; Engine::recycle).
 [[nodiscard]] Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& points,
                                                  const MeshView& surface, const SurfaceInputs& inputs,
-                                                 const SurfaceOptions& options);
+                                                 const SurfaceOptions& options,
+                                                 SurfacePerPoint* spare = nullptr);
 
 }  // namespace rthdist::api

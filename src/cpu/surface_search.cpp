@@ -119,6 +119,10 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
 }
 
 void sizePerPoint(SurfacePerPoint& perPoint, size_t count, bool points, int threads) {
+    if (!points) {  // (recycled arrays may hold a full call's)
+        perPoint.closest.clear();
+        perPoint.barycentric.clear();
+    }
     core::parallelChunks(points ? 4 : 2, 1, threads, [&](size_t begin, size_t, int) {
         switch (begin) {
             case 0: perPoint.distance.resize(count); break;
@@ -131,7 +135,7 @@ void sizePerPoint(SurfacePerPoint& perPoint, size_t count, bool points, int thre
 
 Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& surface, double magnitude,
                                     const SurfaceOptions& options, const TriangleBvh& bvh,
-                                    const TriangleBlocks* blocks) {
+                                    const TriangleBlocks* blocks, SurfacePerPoint* spare) {
     const core::Clock::time_point start = core::Clock::now();
     SurfaceResult result;
     result.backend = Backend::kCpu;
@@ -141,6 +145,7 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
     const double slack = core::closestSlack(magnitude);
     const bool perPoint = options.perPointDistances;
     const bool perPointClosest = perPoint && !options.perPointDistancesOnly;
+    if (perPoint && spare != nullptr) result.perPoint = std::move(*spare);  // every element is written below
     if (perPoint) sizePerPoint(result.perPoint, points.count, perPointClosest, options.threads);
     const int threads = core::resolveThreads(options.threads, (points.count + kChunk - 1) / kChunk);
     std::vector<ThreadBest> best(static_cast<size_t>(threads));

@@ -243,6 +243,52 @@ TEST(SurfaceApi, PerPointDistancesOnlyKeepTheDistancesAndTriangles) {
     }
 }
 
+// Engine::recycle(SurfaceResult&&): the next per-point call writes into the
+// recycled arrays (the same blocks where they are large enough), with the
+// one-shot call's entries; a distances-only call after a full one leaves no
+// stale closest points.
+TEST(SurfaceApi, ARecycledResultsArraysServeTheNextPerPointCall) {
+    EngineOptions o;
+    o.backend = Backend::kCpu;
+    Result<Engine> engine = Engine::create(o);
+    ASSERT_TRUE(engine) << engine.error().message;
+    std::vector<test::SurfaceCase> cases;
+    for (const test::SurfaceCase& c : test::makeSurfaceCases())
+        if (c.queries.size() > 8) cases.push_back(c);
+    ASSERT_GE(cases.size(), 2u);
+    SurfaceCallOptions call;
+    call.perPointDistances = true;
+    const test::SurfaceCase& big = cases[0].queries.size() >= cases[1].queries.size() ? cases[0] : cases[1];
+    const test::SurfaceCase& small = &big == &cases[0] ? cases[1] : cases[0];
+    const MeshView bigMesh{PointView(big.vertices), big.indices},
+        smallMesh{PointView(small.vertices), small.indices};
+    Result<SurfaceResult> first = engine->hausdorffToSurface(PointView(big.queries), bigMesh, call);
+    ASSERT_TRUE(first) << first.error().message;
+    const double* distances = first->perPoint.distance.data();
+    const glm::dvec3* closest = first->perPoint.closest.data();
+    engine->recycle(std::move(*first));
+    Result<SurfaceResult> second = engine->hausdorffToSurface(PointView(small.queries), smallMesh, call);
+    ASSERT_TRUE(second) << second.error().message;
+    EXPECT_EQ(second->perPoint.distance.data(), distances);
+    EXPECT_EQ(second->perPoint.closest.data(), closest);
+    SurfaceOptions oneShot;
+    oneShot.backend = Backend::kCpu;
+    oneShot.perPointDistances = true;
+    const Result<SurfaceResult> want = hausdorffToSurface(PointView(small.queries), smallMesh, oneShot);
+    ASSERT_TRUE(want) << want.error().message;
+    EXPECT_EQ(second->perPoint.distance, want->perPoint.distance);
+    EXPECT_EQ(second->perPoint.triangle, want->perPoint.triangle);
+    EXPECT_EQ(second->perPoint.closest, want->perPoint.closest);
+    EXPECT_EQ(second->perPoint.barycentric, want->perPoint.barycentric);
+    engine->recycle(std::move(*second));
+    call.perPointDistancesOnly = true;
+    const Result<SurfaceResult> third = engine->hausdorffToSurface(PointView(big.queries), bigMesh, call);
+    ASSERT_TRUE(third) << third.error().message;
+    EXPECT_EQ(third->perPoint.distance.size(), big.queries.size());
+    EXPECT_TRUE(third->perPoint.closest.empty());
+    EXPECT_TRUE(third->perPoint.barycentric.empty());
+}
+
 TEST(SurfaceApi, IndexOutOfRangeNamesTheTriangle) {
     Small s;
     s.indices[4] = 9;

@@ -531,6 +531,35 @@ TEST(GpuSurfaceEngine, PerPointDistancesOnAKeptDevice) {
     expectBruteForce(c, backend, engine->hausdorffToSurface(PointView(c.queries), meshOf(c)));
 }
 
+// Engine::recycle(SurfaceResult&&) on the device: the next per-point call
+// writes into the recycled arrays and gives the one-shot call's entries.
+TEST(GpuSurfaceEngine, ARecycledResultsArraysServeTheNextPerPointCall) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    Result<Engine> engine = surfaceEngine(backend);
+    ASSERT_TRUE(engine) << engine.error().message;
+    test::SurfaceCase big = test::heightField(3443, 20, 10.0);
+    for (int i = 0; i < 600; ++i)
+        big.queries.emplace_back(0.2 + 0.015 * i, 9.6 - 0.014 * i, (i % 9) * 0.2 - 0.8);
+    const test::SurfaceCase small = firstCase();
+    SurfaceCallOptions call;
+    call.perPointDistances = true;
+    Result<SurfaceResult> first = engine->hausdorffToSurface(PointView(big.queries), meshOf(big), call);
+    ASSERT_TRUE(first) << first.error().message;
+    ASSERT_GE(big.queries.size(), small.queries.size());
+    const double* distances = first->perPoint.distance.data();
+    engine->recycle(std::move(*first));
+    const Result<SurfaceResult> second =
+        engine->hausdorffToSurface(PointView(small.queries), meshOf(small), call);
+    expectPerPointWithinTolerance(small, second);
+    ASSERT_TRUE(second);
+    EXPECT_EQ(second->perPoint.distance.data(), distances);
+    const Result<SurfaceResult> fresh = perPointOnDevice(small, backend);
+    ASSERT_TRUE(fresh) << fresh.error().message;
+    EXPECT_EQ(second->perPoint.distance, fresh->perPoint.distance);
+    EXPECT_EQ(second->perPoint.triangle, fresh->perPoint.triangle);
+    EXPECT_EQ(second->perPoint.closest, fresh->perPoint.closest);
+}
+
 // Bad input on the kept device: the same errors as one-shot, the Engine usable after.
 TEST(GpuSurfaceEngine, BadInputIsReportedAndTheEngineServesOn) {
     RTHDIST_REQUIRE_SURFACE_DEVICE();

@@ -4,7 +4,7 @@
 //
 //   rthdist-surface-bench POINTS MESH [--backend B] [--runs N] [--warmup W]
 //                         [--one-shot N] [--threads T] [--name NAME] [--no-verify]
-//                         [--per-point [--distances-only]]
+//                         [--per-point [--distances-only] [--recycle]]
 // POINTS: any point input (a mesh's vertices); MESH: a file with faces.
 // One Engine is created (setup_ms); its first --warmup calls are timed apart
 // (warmup_ms: the first call also compiles what the driver compiles on first
@@ -19,7 +19,8 @@
 // --distances-only, perPointDistancesOnly), the stage per_point is timed
 // too, and the check also compares every point's distance with the CPU
 // backend's per-point call: equal, or within the call's tolerance above it
-// (per_point_within). Prints one JSON object.
+// (per_point_within); --recycle hands each call's result back to the
+// Engine (Engine::recycle) but the last's. Prints one JSON object.
 // Not a test: no thresholds.
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -51,7 +52,7 @@ double median(std::vector<double> v) {
 struct Settings {
     std::string points, mesh, name, backend = "rt-pipeline";
     int runs = 7, warmup = 2, oneShot = 0, threads = 0;
-    bool verify = true, perPoint = false, distancesOnly = false;
+    bool verify = true, perPoint = false, distancesOnly = false, recycle = false;
 };
 
 // The series of one kind of call: every stage's milliseconds per call.
@@ -122,6 +123,7 @@ int main(int argc, char** argv) {
     app.add_flag("!--no-verify", s.verify, "skip the CPU backend's reference call");
     app.add_flag("--per-point", s.perPoint, "every call asks per-point distances");
     app.add_flag("--distances-only", s.distancesOnly, "with --per-point: distances and triangles only");
+    app.add_flag("--recycle", s.recycle, "hand each call's result back to the Engine");
     CLI11_PARSE(app, argc, argv);
 
     rthdist::EngineOptions engineOptions;
@@ -157,9 +159,14 @@ int main(int argc, char** argv) {
         if (!res) return fail("engine call", res.error());
         if (r < s.warmup) {
             warmup.push_back(wall);
+            if (s.recycle) engine->recycle(std::move(res.value()));
             continue;
         }
         kept.add(*res, wall);
+        if (s.recycle && r + 1 < s.warmup + s.runs) {
+            engine->recycle(std::move(res.value()));
+            continue;
+        }
         last = std::move(res.value());
     }
     rthdist::SurfaceOptions oneShot;
