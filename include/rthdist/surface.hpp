@@ -72,7 +72,8 @@
 //   comparison's), any other builds and keeps a new one. A GPU backend
 //   uploads its inputs afresh and keeps its tail's tree for the same
 //   corners; its buffers only grow, to the largest call's, until the
-//   Engine is destroyed.
+//   Engine is destroyed. Engine::recycle(SurfaceResult&&) hands a spent
+//   result's per-point arrays to the Engine's next per-point call.
 //
 // Threading: reentrant; the BVH build and the search (on a GPU backend: the
 //   framing and the proof) run on SurfaceOptions::threads threads of the
