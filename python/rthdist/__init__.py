@@ -31,7 +31,7 @@ from . import _rthdist
 from ._device_owner import DeviceOwner as _DeviceOwner
 from ._masks import CONVENTIONS, DirectedMask, MaskEngine, MaskResult, MaskVolume, PreparedReference, compare_masks
 from ._points import as_points
-from ._surface import evaluate, hausdorff_to_surface, surface_hausdorff
+from ._surface import _mesh, evaluate, hausdorff_to_surface, surface_hausdorff
 from ._rthdist import (  # noqa: F401 - re-exported
     CancelledError,
     DeviceError,
@@ -186,6 +186,16 @@ class Engine(_DeviceOwner):
         pb = _points_or_prepared(b, "b")
         return self._engine.hausdorff(pa, pb, directed=bool(directed), per_point=bool(per_point), bits=int(bits),
                                       radius_growth=float(radius_growth), progress=_progress_callable(progress))
+
+    def hausdorff_to_surface(self, points, vertices, faces=None, *, per_point=False):
+        """h(points, surface) on this Engine: as rthdist.hausdorff_to_surface, without the device setup.
+
+        The Engine keeps its device (a GPU backend) or its last mesh's tree
+        (the CPU backend: a call with the same mesh, compared exactly, skips
+        its build), so repeated calls against one mesh pay the search alone.
+        """
+        v, f = _mesh(vertices, faces, "surface")
+        return self._engine.hausdorff_to_surface(as_points(points, "points"), v, f, per_point=bool(per_point))
 
     def hausdorff_many(self, sets, pairs, *, directed=False, per_point=False, bits=0, radius_growth=2.0,
                        progress=None):

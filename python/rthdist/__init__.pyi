@@ -140,6 +140,9 @@ class Engine:
         radius_growth: float = 2.0,
         progress: Optional[Progress] = None,
     ) -> HausdorffResult: ...
+    def hausdorff_to_surface(
+        self, points: PointsLike, vertices: Any, faces: Any = ..., *, per_point: bool = ...
+    ) -> dict[str, Any]: ...
     def hausdorff_many(
         self,
         sets: Sequence[PreparedSet],

@@ -14,6 +14,7 @@
 #include "points.hpp"
 #include "result.hpp"
 #include "rthdist/rthdist.hpp"
+#include "surface.hpp"
 
 namespace py = pybind11;
 
@@ -204,6 +205,28 @@ public:
         return wrap(valueOrRaise(std::move(*r)), arrayA, arrayB, perPoint);
     }
 
+    // h(points, surface) on this Engine (Engine::hausdorffToSurface): its
+    // device, and on the CPU backend its last mesh's tree, kept.
+    py::dict hausdorffToSurface(const py::array& points, const py::array& vertices, const py::array& faces,
+                                bool perPoint) {
+        const PointView vp = viewOf(points, "points"), vv = viewOf(vertices, "vertices");
+        const std::vector<uint32_t> f = facesOf(faces, vv.count, "faces");
+        SurfaceCallOptions call;
+        call.perPointDistances = perPoint;
+        std::optional<Result<SurfaceResult>> r;
+        {
+            py::gil_scoped_release release;
+            std::lock_guard<std::mutex> lock(m_mutex);
+            const PointCopy cp(vp), cv(vv);
+            if (!m_engine) {
+                r.emplace(Error{ErrorCode::kInvalidArgument, "this Engine is closed"});
+            } else {
+                r.emplace(m_engine->hausdorffToSurface(cp.view(), MeshView{cv.view(), f}, call));
+            }
+        }
+        return surfaceResultDict(valueOrRaise(std::move(*r)), perPoint);
+    }
+
     std::unique_ptr<PyPrepared> prepare(const py::array& points, int bits,
                                         std::optional<std::array<double, 3>> origin) {
         if (bits < 0 || bits > 8) throw py::value_error("bits must be in 0..8 (0 = from the data)");
@@ -367,6 +390,8 @@ void bindEngine(py::module_& m) {
         .def("hausdorff", &PyEngine::hausdorff, py::arg("a"), py::arg("b"), py::arg("directed"),
              py::arg("per_point"), py::arg("bits"), py::arg("radius_growth"), py::arg("progress"))
         .def("prepare", &PyEngine::prepare, py::arg("points"), py::arg("bits"), py::arg("origin"))
+        .def("hausdorff_to_surface", &PyEngine::hausdorffToSurface, py::arg("points"), py::arg("vertices"),
+             py::arg("faces"), py::arg("per_point"))
         .def("hausdorff_many", &PyEngine::hausdorffMany, py::arg("sets"), py::arg("pairs"),
              py::arg("directed"), py::arg("per_point"), py::arg("bits"), py::arg("radius_growth"),
              py::arg("progress"))

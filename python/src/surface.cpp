@@ -39,17 +39,6 @@ std::vector<uint32_t> facesAs(const py::array& faces, size_t vertices, const cha
     return out;
 }
 
-std::vector<uint32_t> facesOf(const py::array& faces, size_t vertices, const char* name) {
-    if (faces.ndim() != 2 || faces.shape(1) != 3)
-        throw py::value_error(std::string(name) + ": expected an (F, 3) array of faces, got shape " +
-                              std::string(py::str(faces.attr("shape"))));
-    if (faces.dtype().is(py::dtype::of<int32_t>())) return facesAs<int32_t>(faces, vertices, name);
-    if (faces.dtype().is(py::dtype::of<int64_t>())) return facesAs<int64_t>(faces, vertices, name);
-    if (faces.dtype().is(py::dtype::of<uint32_t>())) return facesAs<uint32_t>(faces, vertices, name);
-    throw py::value_error(std::string(name) + ": expected int32, int64 or uint32 faces, got dtype " +
-                          std::string(py::str(faces.dtype())));
-}
-
 py::tuple vec(const glm::dvec3& v) { return py::make_tuple(v.x, v.y, v.z); }
 
 Backend surfaceBackend(const std::string& backend, int threads) {
@@ -69,27 +58,6 @@ py::array ownedArray(std::vector<T>&& values) {
     py::array_t<Scalar> out =
         columns > 1 ? py::array_t<Scalar>({n, columns}, data, owner) : py::array_t<Scalar>({n}, data, owner);
     py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-    return out;
-}
-
-py::dict surfaceResultDict(SurfaceResult&& r, bool perPoint) {
-    const SurfaceDirected& d = r.directed;
-    py::dict out;
-    out["hausdorff"] = r.hausdorff;
-    out["query_index"] = d.queryIndex;
-    out["triangle"] = d.triangle;
-    out["query_point"] = vec(d.queryPoint);
-    out["surface_point"] = vec(d.surfacePoint);
-    out["barycentric"] = vec(d.barycentric);
-    out["backend"] = backendName(r.backend);
-    if (perPoint) {  // moved into the arrays, in point order
-        SurfacePerPoint& p = r.perPoint;
-        out["distances"] = ownedArray<double, double>(std::move(p.distance));
-        out["triangles"] = ownedArray<uint32_t, uint32_t>(std::move(p.triangle));
-        out["surface_points"] = ownedArray<glm::dvec3, double>(std::move(p.closest));
-        out["barycentrics"] = ownedArray<glm::dvec3, double>(std::move(p.barycentric));
-        out["tolerance"] = p.tolerance;
-    }
     return out;
 }
 
@@ -214,6 +182,38 @@ py::dict evaluate(const py::array& reconstruction, const py::array& truth, std::
 }
 
 }  // namespace
+
+std::vector<uint32_t> facesOf(const py::array& faces, size_t vertices, const char* name) {
+    if (faces.ndim() != 2 || faces.shape(1) != 3)
+        throw py::value_error(std::string(name) + ": expected an (F, 3) array of faces, got shape " +
+                              std::string(py::str(faces.attr("shape"))));
+    if (faces.dtype().is(py::dtype::of<int32_t>())) return facesAs<int32_t>(faces, vertices, name);
+    if (faces.dtype().is(py::dtype::of<int64_t>())) return facesAs<int64_t>(faces, vertices, name);
+    if (faces.dtype().is(py::dtype::of<uint32_t>())) return facesAs<uint32_t>(faces, vertices, name);
+    throw py::value_error(std::string(name) + ": expected int32, int64 or uint32 faces, got dtype " +
+                          std::string(py::str(faces.dtype())));
+}
+
+py::dict surfaceResultDict(SurfaceResult&& r, bool perPoint) {
+    const SurfaceDirected& d = r.directed;
+    py::dict out;
+    out["hausdorff"] = r.hausdorff;
+    out["query_index"] = d.queryIndex;
+    out["triangle"] = d.triangle;
+    out["query_point"] = vec(d.queryPoint);
+    out["surface_point"] = vec(d.surfacePoint);
+    out["barycentric"] = vec(d.barycentric);
+    out["backend"] = backendName(r.backend);
+    if (perPoint) {  // moved into the arrays, in point order
+        SurfacePerPoint& p = r.perPoint;
+        out["distances"] = ownedArray<double, double>(std::move(p.distance));
+        out["triangles"] = ownedArray<uint32_t, uint32_t>(std::move(p.triangle));
+        out["surface_points"] = ownedArray<glm::dvec3, double>(std::move(p.closest));
+        out["barycentrics"] = ownedArray<glm::dvec3, double>(std::move(p.barycentric));
+        out["tolerance"] = p.tolerance;
+    }
+    return out;
+}
 
 void bindSurface(py::module_& m) {
     m.def("_hausdorff_to_surface", &toSurface, py::arg("points"), py::arg("vertices"), py::arg("faces"),

@@ -125,6 +125,24 @@ def test_per_point_on_a_gpu_backend_is_within_its_tolerance(gpu):
     np.testing.assert_allclose(np.linalg.norm(pts - r["surface_points"], axis=1), r["distances"], rtol=1e-12)
 
 
+@pytest.mark.parametrize("backend", ["cpu", "ray-query", "rt-pipeline"])
+def test_an_engine_keeps_its_device_or_tree_for_surface_calls(backend):
+    rng = np.random.default_rng(3485)
+    pts = rng.uniform([-0.5, -0.5, -1.0], [1.5, 1.5, 1.0], size=(300, 3))
+    with rthdist.Engine(backend=backend) as engine:
+        for per_point in (False, True, True):
+            r = engine.hausdorff_to_surface(pts, SQUARE_V, SQUARE_F, per_point=per_point)
+            want = rthdist.hausdorff_to_surface(pts, SQUARE_V, SQUARE_F, per_point=per_point, backend=backend)
+            assert r["backend"] == backend
+            assert r["hausdorff"] == want["hausdorff"] and r["query_index"] == want["query_index"]
+            assert r["surface_point"] == want["surface_point"]
+            if per_point:
+                np.testing.assert_array_equal(r["distances"], want["distances"])
+                assert r["tolerance"] == want["tolerance"]
+    with pytest.raises(ValueError, match="closed"):
+        engine.hausdorff_to_surface(pts, SQUARE_V, SQUARE_F)
+
+
 def test_triangle_and_its_offset_copy():
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float64)
     f = np.array([[0, 1, 2]], dtype=np.int32)
