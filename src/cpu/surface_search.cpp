@@ -13,6 +13,7 @@
 #include "core/parallel.hpp"
 #include "core/point_triangle.hpp"
 #include "core/stopwatch.hpp"
+#include "cpu/query_order.hpp"
 #include "cpu/triangle_blocks.hpp"
 #include "cpu/triangle_bvh.hpp"
 
@@ -148,6 +149,9 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
     if (perPoint && spare != nullptr) result.perPoint = std::move(*spare);  // every element is written below
     if (perPoint) sizePerPoint(result.perPoint, points.count, perPointClosest, options.threads);
     const int threads = core::resolveThreads(options.threads, (points.count + kChunk - 1) / kChunk);
+    // Queries near each other one after another (cpu/query_order.hpp): the
+    // tree's nodes stay in cache; no answer depends on the order.
+    const std::vector<uint32_t> order = spatialOrder(points, options.threads);
     std::vector<ThreadBest> best(static_cast<size_t>(threads));
     std::atomic<uint64_t> runningMax{0};
     core::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int thread) {
@@ -156,7 +160,8 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
             mine.cancelled = true;
             return;
         }
-        for (size_t q = begin; q < end; ++q) {
+        for (size_t k = begin; k < end; ++k) {
+            const size_t q = order.empty() ? k : order[k];
             const double stop =
                 perPoint ? 0.0 : std::bit_cast<double>(runningMax.load(std::memory_order_relaxed));
             const NearestTriangle hit = bvh.nearest(points.at(q), slack, stop);
