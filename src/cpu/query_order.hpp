@@ -18,6 +18,14 @@ namespace rthdist::cpu {
 
 // From this many queries the order is worth its sort (~10-20 ns a query).
 inline constexpr uint64_t kSpatialOrderFrom = uint64_t(1) << 12;
+// Past this many queries a search that stops early (the directed maximum:
+// a query stops at the first triangle below the running maximum) keeps
+// input order: reading the points out of order then costs what the tree's
+// locality saves (an H200's 16 cores, the scale row of docs/bench/surfaces
+// session 22: 1M samples 43 -> 30 ms in Morton order, 10M 371-392 ->
+// 390-419 ms), while a per-point search (every query to its nearest) gains
+// at both sizes (108 -> 76 ms, 1081-1138 -> 774-790 ms).
+inline constexpr uint64_t kSpatialOrderEarlyBreakUpTo = uint64_t(1) << 22;
 
 // The queries' indices in Morton order of their cells (10 bits an axis over
 // their box), ties by index; empty (input order) below kSpatialOrderFrom

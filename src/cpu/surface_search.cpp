@@ -151,7 +151,9 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
     const int threads = core::resolveThreads(options.threads, (points.count + kChunk - 1) / kChunk);
     // Queries near each other one after another (cpu/query_order.hpp): the
     // tree's nodes stay in cache; no answer depends on the order.
-    const std::vector<uint32_t> order = spatialOrder(points, options.threads);
+    const std::vector<uint32_t> order = perPoint || points.count <= kSpatialOrderEarlyBreakUpTo
+                                            ? spatialOrder(points, options.threads)
+                                            : std::vector<uint32_t>{};
     std::vector<ThreadBest> best(static_cast<size_t>(threads));
     std::atomic<uint64_t> runningMax{0};
     core::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int thread) {
