@@ -5,7 +5,11 @@
 // device search (gpu_algo/surface_search.hpp) gives each query a nearest
 // triangle (a few far queries it hands back open); api/surface_certify.hpp
 // measures those exactly and proves the directed maximum from the caller's
-// coordinates in double.
+// coordinates in double; with per-point distances it also hands back every
+// query's entry (the rule in double to its triangle, within the tolerance
+// of design.md §11 "Per-point distances"), the slivers measured on the host
+// (api/surface_slivers.hpp) and 16 queries checked exactly (a failure:
+// every query recomputed by the CPU backend).
 #pragma once
 
 #include <glm/vec3.hpp>
