@@ -40,12 +40,12 @@
 # About 3-6 minutes of device time (the CGAL surfaces rows dominate).
 # TOOLS overrides the peers and CPU columns (default rthdist-cpu,rthdist-cpu-1t,cgal);
 # ONESHOT=rt-pipeline adds one-shot calls in one process (rthdist-rt-pipeline-oneshot).
-# Open3D there: Debian 12's python3.11, numpy and python3-open3d with the
-# libraries they load (not libc or libstdc++: the machine's newer ones serve),
-# unpacked into a folder with a run.sh that sets LD_LIBRARY_PATH, PYTHONHOME
-# and PYTHONPATH (~44 MB as tar.xz, carried in two parts beside the bundle:
-# docs/bench/surfaces, session 10); then OPEN3D_PYTHON=that/run.sh (Open3D's
-# worker only) and TOOLS=...,open3d.
+# Open3D there: tools/bench/open3d_bundle.sh packs Debian 12's python3.11,
+# numpy and python3-open3d with the libraries they load (not libc or
+# libstdc++: the machine's newer ones serve) with a run.sh that sets
+# LD_LIBRARY_PATH, PYTHONHOME and PYTHONPATH (~41 MB as tar.xz, carried in
+# two calls: docs/bench/surfaces, sessions 10 and 22); then
+# OPEN3D_PYTHON=that/run.sh (Open3D's worker only) and TOOLS=...,open3d.
 set -uo pipefail
 B=$(cd "${1:?bundle dir}" && pwd); OUT=${2:?out dir}; ROWS=${3:-}
 here=$(cd "$(dirname "$0")" && pwd)
