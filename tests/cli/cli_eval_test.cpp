@@ -90,6 +90,29 @@ TEST_F(CliEval, SurfaceTargetMeasuresToTheTriangles) {
     EXPECT_TRUE(e["cap"].is_null());
 }
 
+// The same on each GPU backend (lavapipe here), the validation layer on:
+// the surface's per-point distances within their tolerance (these are
+// exact: a vertex and a point above a face's centre), both directions on
+// one device.
+TEST_F(CliEval, SurfaceTargetOnEveryGpuBackend) {
+    for (const char* backend : {"ray-query", "rt-pipeline"}) {
+        const CliRun run = runCli({m_above, m_square, "--surface", "b", "--eval", "0.5", "--json",
+                                   "--backend", backend, "--validation"});
+        ASSERT_EQ(run.exitCode, 0) << run;
+        const Json e = Json::parse(run.out)["eval"];
+        EXPECT_NEAR(e["accuracy"]["mean"].get<double>(), 0.5, 1e-6) << backend;
+        EXPECT_EQ(e["accuracy"]["max"].get<double>(), 1.0) << backend;
+        EXPECT_EQ(e["completeness"]["count"].get<int>(), 4) << backend;
+        EXPECT_NEAR(e["completeness"]["median"].get<double>(), 1.0, 1e-6) << backend;
+        EXPECT_EQ(e["thresholds"][0]["recall"].get<double>(), 0.25) << backend;
+        // The device named is the one opened (none: exit 4 naming it).
+        const CliRun none = runCli(
+            {m_above, m_square, "--surface", "b", "--eval", "0.5", "--backend", backend, "--device", "99"});
+        EXPECT_EQ(none.exitCode, 4) << none;
+        EXPECT_NE(none.err.find("device 99"), std::string::npos) << none;
+    }
+}
+
 TEST_F(CliEval, SummaryText) {
     const CliRun run = runCli({m_a, m_b, "--eval", "0.6"});
     ASSERT_EQ(run.exitCode, 0) << run;

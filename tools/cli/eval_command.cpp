@@ -134,6 +134,8 @@ Result<EvalSummary> evaluate(const CliArgs& args, const Loaded& in) {
         SurfaceOptions options;
         options.backend = args.options.backend;
         options.threads = args.options.threads;
+        options.deviceIndex = args.options.deviceIndex;
+        options.validation = args.options.validation;
         return evaluateToSurface(in.reconstruction.view(), in.truthMesh->view(), eval, options);
     }
     return evaluatePoints(in.reconstruction.view(), in.truthPoints->view(), eval, args.options);
