@@ -131,12 +131,12 @@ private:
     std::vector<uint64_t> m_bits;
 };
 
-// Per-point entries after the proof: every query measures in double the
-// `flagged` triangles (those the float rule may mismeasure) that can come
-// nearer than its entry, found in a BVH of those triangles alone descended
-// within the entry's distance plus the BVH's rounding slack (a query near
-// the surface, whose entry is small, leaves at the root's first levels),
-// and takes one that is nearer (or as near with a smaller index). The
+// Per-point entries after the proof: a query whose cube of half-side its
+// entry (plus the BVH's rounding slack) meets a flagged triangle's cell
+// finds its nearest `flagged` triangle (those the float rule may
+// mismeasure) in double by the CPU backend's BVH search over them alone,
+// and takes it where it is nearer than its entry (or as near with a
+// smaller index). The
 // others' entries keep the float search's triangle, within its bound.
 void measureIllConditioned(const PointView& points, const MeshView& surface,
                            std::span<const uint32_t> flagged, double magnitude, int threads,
@@ -148,49 +148,29 @@ void measureIllConditioned(const PointView& points, const MeshView& surface,
         for (size_t k = 0; k < 3; ++k) indices.push_back(surface.indices[3 * size_t(t) + k]);
     }
     const cpu::TriangleBvh tree(MeshView{surface.vertices, indices}, threads);
-    const auto& nodes = tree.nodes();
-    const auto& order = tree.triangleOrder();
     const double slack = core::closestSlack(magnitude);
-    core::parallelChunks(
-        points.count, core::balancedChunk(points.count, threads), threads,
-        [&](size_t begin, size_t end, int) {
-            uint32_t stack[64];
-            for (size_t q = begin; q < end; ++q) {
-                const double entry = entries.distance[q];
-                if (!(entry > 0.0)) continue;  // on the surface: nothing is nearer
-                const glm::dvec3 p = points.at(q);
-                double reach = entry + slack, best2 = entry * entry;
-                if (!cells.near(p, reach)) continue;
-                uint32_t bestTriangle = entries.triangle[q];
-                size_t top = 0;
-                stack[top++] = 0;
-                while (top > 0) {
-                    const cpu::TriangleBvh::Node& node = nodes[stack[--top]];
-                    if (core::boxDistance2(p, glm::dvec3(node.lo), glm::dvec3(node.hi)) > reach * reach)
-                        continue;
-                    if (node.count == 0) {
-                        stack[top++] = node.first;
-                        stack[top++] = node.first + 1;
-                        continue;
-                    }
-                    for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-                        const uint32_t t = flagged[order[i]];
-                        const core::TriangleClosest c = core::closestOnTriangle(
-                            p, surface.corner(t, 0), surface.corner(t, 1), surface.corner(t, 2));
-                        if (c.distance2 > best2 || (c.distance2 == best2 && t >= bestTriangle)) continue;
-                        best2 = c.distance2;
-                        bestTriangle = t;
-                        entries.distance[q] = std::sqrt(c.distance2);
-                        entries.triangle[q] = t;
-                        if (!entries.closest.empty()) {
-                            entries.closest[q] = c.point;
-                            entries.barycentric[q] = c.barycentric;
-                        }
-                        reach = entries.distance[q] + slack;
-                    }
-                }
-            }
-        });
+    core::parallelChunks(points.count, core::balancedChunk(points.count, threads), threads,
+                         [&](size_t begin, size_t end, int) {
+                             for (size_t q = begin; q < end; ++q) {
+                                 const double entry = entries.distance[q];
+                                 if (!(entry > 0.0)) continue;  // on the surface: nothing is nearer
+                                 const glm::dvec3 p = points.at(q);
+                                 if (!cells.near(p, entry + slack)) continue;
+                                 // The nearest flagged triangle (the smallest index on a tie:
+                                 // the sub-mesh keeps `flagged`'s ascending order).
+                                 const cpu::NearestTriangle hit = tree.nearest(p, slack);
+                                 const uint32_t t = flagged[hit.triangle];
+                                 if (hit.distance2 > entry * entry ||
+                                     (hit.distance2 == entry * entry && t >= entries.triangle[q]))
+                                     continue;
+                                 entries.distance[q] = std::sqrt(hit.distance2);
+                                 entries.triangle[q] = t;
+                                 if (!entries.closest.empty()) {
+                                     entries.closest[q] = hit.point;
+                                     entries.barycentric[q] = hit.barycentric;
+                                 }
+                             }
+                         });
 }
 
 }  // namespace

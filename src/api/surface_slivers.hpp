@@ -24,8 +24,8 @@ namespace rthdist::api {
 // 2^-17 of the frame off for a query within h + tolerance of it, and gives
 // each query whose entry a flagged triangle can beat (nearer in double, or
 // as near with a smaller index) that triangle's entry: found through a
-// 128^3 grid of the flagged triangles' cells, then a BVH of them alone
-// descended within the entry plus the BVH's rounding slack. The worker
+// 128^3 grid of the flagged triangles' cells (the queries whose entry
+// reaches one), then the CPU backend's BVH search over them alone. The worker
 // pool on `threads`. Returns how many triangles were flagged.
 [[nodiscard]] uint64_t measureSlivers(const PointView& points, const MeshView& surface,
                                       std::span<const glm::vec3> corners, double scale, double hausdorff,
