@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/input_frame.hpp"
 #include "core/parallel.hpp"
 #include "cpu/key_sort.hpp"
 #include "rthdist_morton.h"
@@ -40,27 +41,14 @@ bool inSpaceOrder(const PointView& points, double extent) {
 std::vector<uint32_t> spatialOrder(const PointView& points, int threads) {
     const uint64_t n = points.count;
     if (n < kSpatialOrderFrom || n >= (uint64_t(1) << 32)) return {};
-    const size_t chunk = core::balancedChunk(n, threads);
-    std::vector<glm::dvec3> los((n + chunk - 1) / chunk, glm::dvec3(std::numeric_limits<double>::infinity())),
-        his(los.size(), glm::dvec3(-std::numeric_limits<double>::infinity()));
-    core::parallelChunks(n, chunk, threads, [&](size_t begin, size_t end, int) {
-        glm::dvec3 lo = los[begin / chunk], hi = his[begin / chunk];
-        for (size_t q = begin; q < end; ++q) {
-            const glm::dvec3 p = points.at(q);
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
-        }
-        los[begin / chunk] = lo;
-        his[begin / chunk] = hi;
-    });
-    glm::dvec3 lo = los.front(), hi = his.front();
-    for (size_t i = 1; i < los.size(); ++i) {
-        lo = glm::min(lo, los[i]);
-        hi = glm::max(hi, his[i]);
-    }
+    // The queries' box by the input checks' own pass (they are checked: finite).
+    const Result<core::SetSummary> summary = core::summarizeSet(points, "queries", threads);
+    if (!summary) return {};
+    const glm::dvec3 lo = summary->box.lo, hi = summary->box.hi;
     const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
     if (inSpaceOrder(points, extent)) return {};
     const double toCell = extent > 0.0 ? 1023.0 / extent : 0.0;
+    const size_t chunk = core::balancedChunk(n, threads);
     std::vector<uint64_t> keyed(n);
     core::parallelChunks(n, chunk, threads, [&](size_t begin, size_t end, int) {
         for (size_t q = begin; q < end; ++q) {
