@@ -1,9 +1,11 @@
 // Public entry of the point-to-surface distance (rthdist/surface.hpp), one-
 // shot and on an Engine (api/surface_engine.hpp): the route chosen
-// (api::planSurfaceRoute: the CPU backend or the device), the inputs checked (shape, finite coordinates,
-// triangle indices, the rule's magnitude limit), then the CPU backend's search (cpu/surface_search.hpp), or
-// on a GPU backend the device's search proven on the host (api/surface_gpu.hpp) on the Engine's device or,
-// one-shot, on a device opened while the inputs are checked.
+// (api::planSurfaceRoute: the CPU backend or the device), the inputs
+// checked (shape, finite coordinates, triangle indices, the rule's
+// magnitude limit), then the CPU backend's search (cpu/surface_search.hpp),
+// or on a GPU backend the device's search proven on the host
+// (api/surface_gpu.hpp) on the Engine's device or, one-shot, on a device
+// opened while the inputs are checked.
 #include "rthdist/surface.hpp"
 
 #include <glm/common.hpp>

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "common/oracle_cases.hpp"
-#include "core/search_mutant.hpp"
+#include "common/scoped_mutant.hpp"
 #include "engine_test_support.hpp"
 
 namespace rthdist::test {
@@ -80,10 +80,7 @@ TEST(Certificate, MutantSearchIsCaughtAndRecomputed) {
     ASSERT_TRUE(engine) << engine.error().message;
     uint64_t recomputed = 0, directions = 0;
     {
-        struct Mutant {
-            Mutant() { core::searchMutant() = true; }
-            ~Mutant() { core::searchMutant() = false; }
-        } mutant;
+        const test::ScopedSearchMutant mutant;
         checkSampledCases(*engine, [&](const Directed& d) {
             recomputed += d.certificate.recomputed ? 1 : 0;
             ++directions;

@@ -14,7 +14,7 @@
 #include "common/case_sample.hpp"
 #include "common/oracle_cases.hpp"
 #include "common/rng.hpp"
-#include "core/search_mutant.hpp"
+#include "common/scoped_mutant.hpp"
 #include "engine_test_support.hpp"
 
 namespace rthdist::test {
@@ -304,10 +304,7 @@ TEST(OutOfCore, MutantSearchIsCaughtByThePiecesProof) {
     raysOnly.tailScanStartWork = 0;
     uint64_t recomputed = 0, split = 0;
     const std::vector<OracleCase> cases = makeOracleCases();
-    struct Mutant {
-        Mutant() { core::searchMutant() = true; }
-        ~Mutant() { core::searchMutant() = false; }
-    } mutant;
+    const test::ScopedSearchMutant mutant;
     for (size_t i = 0; i < cases.size(); i += 4) {
         const OracleCase& c = cases[i];
         if (c.a.size() + c.b.size() < 400) continue;

@@ -35,10 +35,10 @@
 #include <string>
 #include <vector>
 
+#include "common/scoped_mutant.hpp"
 #include "common/surface_brute_force.hpp"
 #include "common/surface_cases.hpp"
 #include "core/point_triangle.hpp"
-#include "core/search_mutant.hpp"
 #include "gpu/context.hpp"
 #include "gpu_algo/gpu_context_support.hpp"
 #include "gpu_algo/gpu_hausdorff.hpp"
@@ -204,17 +204,13 @@ TEST(GpuSurface, TiesGoToTheSmallestTriangleAndQuery) {
 // force's.
 TEST(GpuSurface, AMissingSearchIsCaughtByTheProof) {
     RTHDIST_REQUIRE_SURFACE_DEVICE();
-    struct Mutant {
-        Mutant() { core::searchMutant() = true; }
-        ~Mutant() { core::searchMutant() = false; }
-    };
     uint64_t clean = 0, missing = 0;
     for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
         if (c.queries.empty()) continue;
         Result<SurfaceResult> r = onDevice(c, backend);
         ASSERT_TRUE(r) << c.name << ": " << r.error().message;
         clean += r->directed.counters.band;
-        const Mutant mutant;
+        const test::ScopedSearchMutant mutant;
         expectBruteForce(c, backend);
         r = onDevice(c, backend);
         ASSERT_TRUE(r) << c.name << ": " << r.error().message;
@@ -393,10 +389,7 @@ TEST(GpuSurface, PerPointDistancesOnlyKeepTheDistancesAndTriangles) {
 // search's bound is a property of a working device.)
 TEST(GpuSurface, PerPointDistancesOfAMissingSearchAreRecomputed) {
     RTHDIST_REQUIRE_SURFACE_DEVICE();
-    struct Mutant {
-        Mutant() { core::searchMutant() = true; }
-        ~Mutant() { core::searchMutant() = false; }
-    } mutant;
+    const test::ScopedSearchMutant mutant;
     size_t recomputed = 0;
     for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
         if (c.queries.empty()) continue;
@@ -886,10 +879,6 @@ TEST(GpuSurfaceTail, AMissingTailIsCaughtByTheProof) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
     auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, tailTuning(kAlwaysTree));
     ASSERT_TRUE(engine) << engine.error().message;
-    struct Mutant {
-        Mutant() { core::searchMutant() = true; }
-        ~Mutant() { core::searchMutant() = false; }
-    };
     const Backend backend = test::backendUnderTest();
     Result<Engine> tree = tunedSurfaceEngine(backend, kAlwaysTree);
     ASSERT_TRUE(tree) << tree.error().message;
@@ -902,7 +891,7 @@ TEST(GpuSurfaceTail, AMissingTailIsCaughtByTheProof) {
         EXPECT_GT(right->directed.counters.tailQueries, 0u) << c.name;
         clean += right->directed.counters.band;
 
-        const Mutant mutant;
+        const test::ScopedSearchMutant mutant;
         Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
         ASSERT_TRUE(found) << c.name << ": " << found.error().message;
         EXPECT_GT(found->tailQueries, 0u) << c.name;
@@ -1034,11 +1023,7 @@ TEST(GpuSurfaceHost, OpenQueriesAreMeasuredExactlyOnTheHost) {
         EXPECT_GE(n.trianglesTested, n.tailHostQueries) << c.name;
         EXPECT_LE(n.band, descended->directed.counters.band) << c.name;
 
-        struct Mutant {
-            Mutant() { core::searchMutant() = true; }
-            ~Mutant() { core::searchMutant() = false; }
-        };
-        const Mutant mutant;
+        const test::ScopedSearchMutant mutant;
         const Result<SurfaceResult> missing = host->hausdorffToSurface(PointView(c.queries), meshOf(c));
         expectBruteForce(c, backend, missing);
         ASSERT_TRUE(missing);
