@@ -22,10 +22,13 @@
 //   returned (a mismatch is kInternal, never a value).
 //
 // Precision: the rule runs in double on the coordinates as given (float
-//   inputs are exact in double). A closest point is a point of the triangle
-//   up to rounding (~1e-16 of the coordinates' magnitude: 1e-10 m at UTM
-//   magnitudes of 1e6 m); a point exactly at a vertex measures exactly 0, as
-//   does one on an edge or face at dyadic barycentric coordinates.
+//   inputs are exact in double), and in 113-bit arithmetic for a thin
+//   triangle whose normal double would lose (design.md §11 "Thin
+//   triangles"). A closest point is a point of the triangle up to rounding
+//   and its distance within a few u of the coordinates' magnitude m of the
+//   exact one (~1e-16 m: 1e-10 m at UTM magnitudes of 1e6 m), slivers
+//   included; a point exactly at a vertex measures exactly 0, as does one
+//   on an edge or face at dyadic barycentric coordinates.
 //   Degenerate triangles (zero area: repeated or collinear vertices) are
 //   measured by their edges, and a sliver's closest point is a convex
 //   combination of its vertices (never outside it).

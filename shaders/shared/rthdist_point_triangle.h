@@ -1,9 +1,11 @@
 // The closest point of a triangle to a point: one definition for C++
 // (core/point_triangle.hpp: the CPU backend's search and the tests' brute
-// force, in double) and GLSL (a later GPU surface search, in the precision
-// the includer chooses), so that every backend measures a triangle alike
-// (design.md §11). The subset both languages share: vector arithmetic, dot,
-// cross, `out` parameters spelled RTHDIST_PT_OUT.
+// force, in double, and in 113-bit arithmetic for a thin triangle, whose
+// normal double would lose: a template over the vector type there) and GLSL
+// (the GPU surface search, in the precision the includer chooses), so that
+// every backend measures a triangle alike (design.md §11). The subset both
+// languages share: vector arithmetic, dot, cross, `out` parameters spelled
+// RTHDIST_PT_OUT.
 //
 // The rule (no tolerance anywhere, so that two evaluations of the same
 // inputs agree to the bit):
@@ -33,14 +35,15 @@
 #define RTHDIST_POINT_TRIANGLE_H
 
 #ifdef __cplusplus
+// C++: templates over the vector type (glm::dvec3, or core/point_triangle.cpp's
+// wider type for thin triangles); pt_real is its value_type.
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 namespace rthdist::shared {
-using pt_real = double;
-using pt_vec3 = glm::dvec3;
 using glm::cross;
 using glm::dot;
-#define RTHDIST_PT_FN [[nodiscard]] inline
+#define pt_real typename pt_vec3::value_type
+#define RTHDIST_PT_FN template <class pt_vec3> [[nodiscard]] inline
 #define RTHDIST_PT_OUT(T) T&
 #else
 // GLSL: the includer may #define pt_real and pt_vec3 (double, dvec3) first.
@@ -137,6 +140,7 @@ RTHDIST_PT_FN pt_real pointTriangleClosest(pt_vec3 p, pt_vec3 a, pt_vec3 b, pt_v
 #undef RTHDIST_PT_FN
 #undef RTHDIST_PT_OUT
 #ifdef __cplusplus
+#undef pt_real
 }  // namespace rthdist::shared
 #endif
 #endif

@@ -20,8 +20,21 @@ struct TriangleClosest {
     glm::dvec3 barycentric{0.0};
 };
 
+// Precision: within ~16 u m of the exact closest point and distance (u =
+// 2^-53, m the largest |coordinate|) for every triangle: a thin one
+// (thinTriangle) is measured by the same rule in 113-bit arithmetic (about
+// 100x the time of the double rule), its point rounded to double once.
 [[nodiscard]] TriangleClosest closestOnTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b,
                                                 const glm::dvec3& c);
+// The same, with thin = thinTriangle(a, b, c) computed by the caller once
+// per triangle (the CPU BVH keeps it); the same bits as the overload above.
+[[nodiscard]] TriangleClosest closestOnTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b,
+                                                const glm::dvec3& c, bool thin);
+// Whether the rule in double may be off by more than ~16 u m on triangle
+// (a, b, c): its longest edge L over its width above ~16 m / L, m its
+// corners' largest |coordinate| (point_triangle.cpp). A property of the
+// triangle alone.
+[[nodiscard]] bool thinTriangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
 
 // The slack of a pruning test against this measure (a box lower bound set
 // against the best distance so far): its rounding error and that of a

@@ -264,6 +264,7 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     else
         m_corners.resize(3 * size_t(n));
     m_original.resize(n);
+    m_thin.resize(n);
     if (n == 0) {
         m_nodes[0] = Node{glm::vec3(std::numeric_limits<float>::infinity()),
                           glm::vec3(-std::numeric_limits<float>::infinity()), 0, 0};
@@ -355,7 +356,8 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
         for (size_t i = begin; i < end; ++i) splitSubtree(level[i]);
     });
 
-    // The corners, each triangle's in input order to its BVH place.
+    // The corners, each triangle's in input order to its BVH place, and
+    // whether it is thin (core::thinTriangle).
     core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
         for (size_t t = begin; t < end; ++t) {
             const size_t at = 3 * size_t(placeOf[t]);
@@ -365,6 +367,8 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
                 else
                     m_corners[at + size_t(k)] = mesh.corner(t, k);
             }
+            m_thin[placeOf[t]] =
+                core::thinTriangle(mesh.corner(t, 0), mesh.corner(t, 1), mesh.corner(t, 2)) ? 1 : 0;
         }
     });
 
@@ -431,7 +435,7 @@ NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& 
                 if (core::boxDistance2(p, glm::min(glm::min(a, b), cc), glm::max(glm::max(a, b), cc)) >
                     bound2)
                     continue;
-                const core::TriangleClosest r = core::closestOnTriangle(p, a, b, cc);
+                const core::TriangleClosest r = core::closestOnTriangle(p, a, b, cc, m_thin[i] != 0);
                 ++best.trianglesTested;
                 const uint32_t t = m_original[i];
                 if (r.distance2 < best.distance2 || (r.distance2 == best.distance2 && t < best.triangle)) {
@@ -465,7 +469,8 @@ NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& 
 
 size_t TriangleBvh::hostBytes() const {
     return m_nodes.capacity() * sizeof(Node) + m_corners.capacity() * sizeof(glm::dvec3) +
-           m_cornersF.capacity() * sizeof(glm::vec3) + m_original.capacity() * sizeof(uint32_t);
+           m_cornersF.capacity() * sizeof(glm::vec3) + m_original.capacity() * sizeof(uint32_t) +
+           m_thin.capacity();
 }
 
 }  // namespace rthdist::cpu

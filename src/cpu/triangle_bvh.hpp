@@ -111,6 +111,7 @@ private:
     [[nodiscard]] NearestTriangle nearestIn(const Corner* corners, const glm::dvec3& p, double slack,
                                             double stopBelow2) const;
     core::UninitVector<uint32_t> m_original;  // BVH order -> triangle index
+    core::UninitVector<uint8_t> m_thin;       // BVH order -> core::thinTriangle of its corners
 };
 
 }  // namespace rthdist::cpu

@@ -169,6 +169,36 @@ TEST(PointTriangle, SliverClosestPointStaysOnTheSliver) {
     }
 }
 
+// Points on a thin triangle (its face and its edges, each rounded once to
+// double) measure within rounding of 0 whatever its aspect: its width down
+// to 1e-15 of its length, where the rule in double alone measured up to
+// ~0.1 for unit sizes (the normal's direction lost), and the closest point
+// stays within that of the point.
+TEST(PointTriangle, PointsOnAThinTriangleMeasureWithinRoundingOfZero) {
+    test::Rng rng(3414);
+    for (const double width : {1e-3, 1e-6, 1e-9, 1e-12, 1e-15}) {
+        double worst = 0.0;
+        for (int i = 0; i < 400; ++i) {
+            const dvec3 a(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+            const dvec3 b = a + rng.direction() * rng.uniform(0.1, 1.0);
+            const dvec3 c = a + (b - a) * rng.uniform() + rng.direction() * width;
+            const double s = rng.uniform(), t = rng.uniform() * (1.0 - s);
+            const double e = rng.uniform();
+            for (const dvec3& p :
+                 {a + (b - a) * s + (c - a) * t, a + (b - a) * e, b + (c - b) * e, c + (a - c) * e}) {
+                const double m =
+                    std::max({glm::length(p), glm::length(a), glm::length(b), glm::length(c), 1e-300});
+                const core::TriangleClosest r = core::closestOnTriangle(p, a, b, c);
+                worst = std::max(worst, std::sqrt(r.distance2) / m);
+                ASSERT_LE(std::sqrt(r.distance2), 32 * 0x1p-53 * m)
+                    << "width " << width << ", triangle " << i << ": a point on it measures away from it";
+            }
+        }
+        std::printf("width %g: the largest distance of a point on the triangle %.3g of the magnitude\n",
+                    width, worst);
+    }
+}
+
 TEST(PointTriangle, SlackGrowsWithTheMagnitude) {
     EXPECT_EQ(core::closestSlack(0.0), 0.0);
     EXPECT_GT(core::closestSlack(1e6), core::closestSlack(1.0));
