@@ -106,8 +106,12 @@ struct CallOptions {
     // Radius growth factor between candidate-search iterations (> 1).
     float radiusGrowth = 2.0f;
     // Also return every point's exact nearest-neighbour distance and index
-    // (HausdorffResult::aNearest / bNearest). Every query then needs its own
-    // NN, so the early break against the running maximum is off: slower.
+    // (HausdorffResult::aNearest / bNearest): core::exactDistance in double,
+    // minimal over every point of the other set, the smallest index on a
+    // tie (the float search's pairs made exact on the host; device views
+    // keep the float pairs, within 2e: README "Per-point distances"). Every
+    // query then needs its own NN, so the early break against the running
+    // maximum is off: slower.
     bool perPointDistances = false;
     // With perPointDistances: fill only PerPoint::nearest, leaving
     // PerPoint::distance empty, for callers that recompute each distance in

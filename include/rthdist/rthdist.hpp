@@ -119,6 +119,12 @@ struct Counters {
     // narrowed to those within reach of its queries (a cluster beside far
     // strays in the other set: README "Far strays"); 0 when it searched all.
     uint64_t narrowedTargets = 0;
+    // Per-point calls: the entries whose nearest target the exact pass
+    // changed (the float search's pair was not the nearest in double, or
+    // not the smallest index among equally near ones: README "Per-point
+    // distances"); 0 without per-point output, and where the caller's
+    // coordinates are on a device (no pass).
+    uint64_t perPointMended = 0;
 };
 
 // The proof of one directed value (README "Exactness"; docs/design.md, "The

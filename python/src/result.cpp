@@ -37,6 +37,7 @@ py::dict counters(const Counters& c) {
     d["target_tiles"] = c.targetTiles;
     d["cross_piece_queries"] = c.crossPieceQueries;
     d["narrowed_targets"] = c.narrowedTargets;
+    d["per_point_mended"] = c.perPointMended;
     return d;
 }
 

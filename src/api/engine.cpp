@@ -34,6 +34,7 @@
 #include "core/stopwatch.hpp"
 #include "core/thread_pool.hpp"
 #include "core/timings.hpp"
+#include "cpu/exact_nearest.hpp"
 
 namespace rthdist {
 
@@ -246,6 +247,30 @@ void finishResult(Engine::Impl& impl, HausdorffResult& r, const CallOptions& cal
     r.validationMessages = impl.backend->validationMessages();
 }
 
+// Every per-point entry made the exact one in the caller's coordinates
+// (cpu/exact_nearest.hpp: the backends' entries are their float pairs,
+// within 2e of it), its time counted as refinement; the witness's entry,
+// proven by the certificate, must come out as it is (else kInternal).
+std::optional<Error> makePerPointExact(HausdorffResult& r, const PointView& a, const PointView& b,
+                                       int threads) {
+    const auto start = core::Clock::now();
+    const auto direction = [threads](Directed& d, PerPoint& pp, const PointView& q, const PointView& t,
+                                     const char* name) -> std::optional<Error> {
+        d.counters.perPointMended = cpu::makePerPointExact(pp, q, t, threads);
+        if (pp.nearest.empty() || d.queryIndex >= pp.nearest.size()) return std::nullopt;
+        const bool distanceAgrees = pp.distance.empty() || pp.distance[d.queryIndex] == d.distance;
+        if (pp.nearest[d.queryIndex] == d.targetIndex && distanceAgrees) return std::nullopt;
+        return Error{ErrorCode::kInternal,
+                     std::string("per-point distances: the exact pass and the proof of ") + name +
+                         " disagree on its witness's nearest point"};
+    };
+    if (auto err = direction(r.aToB, r.aNearest, a, b, "h(A,B)")) return err;
+    if (!r.directedOnly)
+        if (auto err = direction(r.bToA, r.bNearest, b, a, "h(B,A)")) return err;
+    r.timings.refine += core::msSince(start);
+    return std::nullopt;
+}
+
 // The pair's frame: where the backend searched it and how its result comes
 // back to the caller's coordinates.
 struct Frame {
@@ -265,6 +290,8 @@ std::optional<Error> leaveFrame(Engine::Impl& impl, HausdorffResult& r, const Fr
     r.origin = frame.origin;
     if (auto err = api::settleCertificates(r, frame.a, frame.b, impl.options.threads, frame.onHost))
         return err;
+    if (call.perPointDistances && frame.onHost)
+        if (auto err = makePerPointExact(r, frame.a, frame.b, impl.options.threads)) return err;
     finishResult(impl, r, call, t0);
     return std::nullopt;
 }

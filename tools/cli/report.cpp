@@ -68,7 +68,8 @@ Json countersJson(const Counters& c) {
             {"query_chunks", c.queryChunks},
             {"target_tiles", c.targetTiles},
             {"cross_piece_queries", c.crossPieceQueries},
-            {"narrowed_targets", c.narrowedTargets}};
+            {"narrowed_targets", c.narrowedTargets},
+            {"per_point_mended", c.perPointMended}};
 }
 
 // One direction; `q`/`t` name the query and target sets ("a"/"b").

@@ -1,0 +1,89 @@
+// Per-point entries are exact on every backend and route (README "Per-point
+// distances"; cpu/exact_nearest.hpp): double inputs whose frame a stray
+// point kilometres away stretches over a millimetre cluster, where the float
+// search's nearest pairs lie up to 2e (~4 mm here) from the nearest; each
+// entry must equal a brute force in double (the smallest index on a tie),
+// the pass must have mended some (Counters::perPointMended), and the
+// witness's entry is the proven one. One call, pieces under a forced
+// budget, and nearest-only calls.
+#include <gtest/gtest.h>
+
+#include <glm/vec3.hpp>
+
+#include <cmath>
+#include <vector>
+
+#include "api/engine_test_support.hpp"
+#include "common/rng.hpp"
+#include "core/certificate.hpp"
+
+namespace rthdist {
+namespace {
+
+struct Exact {
+    double distance;
+    uint32_t index;
+};
+
+std::vector<Exact> bruteNearest(const std::vector<glm::dvec3>& q, const std::vector<glm::dvec3>& t) {
+    std::vector<Exact> out;
+    for (const glm::dvec3& p : q) {
+        Exact best{core::exactDistance(p, t[0]), 0};
+        for (size_t i = 1; i < t.size(); ++i) {
+            const double d = core::exactDistance(p, t[i]);
+            if (d < best.distance) best = {d, uint32_t(i)};
+        }
+        out.push_back(best);
+    }
+    return out;
+}
+
+// A cluster of `n` points in a 1 mm cube at a georeferenced place, and one
+// stray `far` metres away.
+std::vector<glm::dvec3> strayedCluster(size_t n, double far, uint64_t seed) {
+    test::Rng rng(seed);
+    const glm::dvec3 at(512345.125, 5412345.5, 100.0);
+    std::vector<glm::dvec3> p;
+    for (size_t i = 0; i < n; ++i)
+        p.push_back(at + glm::dvec3(rng.uniform(0, 1e-3), rng.uniform(0, 1e-3), rng.uniform(0, 1e-3)));
+    p.push_back(at + glm::dvec3(far, -far, 0.5 * far));
+    return p;
+}
+
+void expectExactEntries(const HausdorffResult& r, const std::vector<glm::dvec3>& a,
+                        const std::vector<glm::dvec3>& b, bool nearestOnly) {
+    for (auto [got, d, q, t] :
+         {std::tuple{&r.aNearest, &r.aToB, &a, &b}, std::tuple{&r.bNearest, &r.bToA, &b, &a}}) {
+        const std::vector<Exact> want = bruteNearest(*q, *t);
+        ASSERT_EQ(got->nearest.size(), want.size());
+        ASSERT_EQ(got->distance.size(), nearestOnly ? 0 : want.size());
+        for (size_t i = 0; i < want.size(); ++i) {
+            ASSERT_EQ(got->nearest[i], want[i].index) << "point " << i;
+            if (!nearestOnly) ASSERT_EQ(got->distance[i], want[i].distance) << "point " << i;
+        }
+        EXPECT_GT(d->counters.perPointMended, 0u) << "no float pair was off: the case tests nothing";
+        EXPECT_EQ(got->nearest[d->queryIndex], d->targetIndex);
+    }
+}
+
+TEST(ExactPerPoint, EntriesAreTheBruteForcesInAFrameStretchedByStrays) {
+    const std::vector<glm::dvec3> a = strayedCluster(3000, 2500.0, 81), b = strayedCluster(2000, 3100.0, 82);
+    for (const uint64_t budget : {uint64_t(0), uint64_t(1) << 20}) {  // one call; pieces
+        EngineOptions o = test::engineUnderTest();
+        o.memoryBudget = budget;
+        RTHDIST_REQUIRE_ENGINE(engine, o);
+        for (const bool nearestOnly : {false, true}) {
+            SCOPED_TRACE(testing::Message() << "budget " << budget << (nearestOnly ? ", nearest only" : ""));
+            CallOptions call;
+            call.perPointDistances = true;
+            call.perPointNearestOnly = nearestOnly;
+            Result<HausdorffResult> r = engine->compute(PointView(a), PointView(b), call);
+            ASSERT_TRUE(r) << r.error().message;
+            expectExactEntries(*r, a, b, nearestOnly);
+            EXPECT_EQ(r->validationMessages, 0u);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace rthdist

@@ -1,0 +1,163 @@
+// Exact nearest neighbours in double (cpu/exact_nearest.hpp): the tree's
+// answer equals a brute force over every target (core::exactDistance, the
+// smallest index on a tie) from any start, on sets built to break float
+// searches: a millimetre cluster beside strays kilometres away, lattices
+// (ties everywhere), copies, points one double apart, float and double
+// views; makePerPointExact mends wrong entries and keeps right ones.
+#include <gtest/gtest.h>
+
+#include <glm/vec3.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "common/rng.hpp"
+#include "core/certificate.hpp"
+#include "cpu/exact_nearest.hpp"
+
+namespace rthdist::cpu {
+namespace {
+
+struct Brute {
+    uint32_t index = 0;
+    double distance = 0.0;
+};
+
+Brute bruteNearest(const glm::dvec3& p, const std::vector<glm::dvec3>& t) {
+    Brute best{0, core::exactDistance(p, t[0])};
+    for (size_t i = 1; i < t.size(); ++i) {
+        const double d = core::exactDistance(p, t[i]);
+        if (d < best.distance) best = {uint32_t(i), d};
+    }
+    return best;
+}
+
+struct Case {
+    std::string name;
+    std::vector<glm::dvec3> targets, queries;
+};
+
+std::vector<Case> cases() {
+    std::vector<Case> out;
+    test::Rng rng(7001);
+    {
+        Case c{"a 1 mm cluster beside strays 1-3 km away", {}, {}};
+        for (int i = 0; i < 3000; ++i)
+            c.targets.emplace_back(rng.uniform(0, 1e-3), rng.uniform(0, 1e-3), rng.uniform(0, 1e-3));
+        for (int i = 0; i < 4; ++i)
+            c.targets.emplace_back(rng.uniform(1e3, 3e3), rng.uniform(1e3, 3e3), rng.uniform(-3e3, 3e3));
+        for (int i = 0; i < 500; ++i)
+            c.queries.emplace_back(rng.uniform(0, 1e-3), rng.uniform(0, 1e-3), rng.uniform(0, 1e-3));
+        c.queries.emplace_back(2e3, 2e3, 0.0);
+        out.push_back(c);
+    }
+    {
+        Case c{"a lattice: every query ties", {}, {}};
+        for (int x = 0; x < 12; ++x)
+            for (int y = 0; y < 12; ++y)
+                for (int z = 0; z < 12; ++z) c.targets.emplace_back(x * 0.25, y * 0.25, z * 0.25);
+        for (int i = 0; i < 500; ++i)  // midpoints and cell centres: 2 to 8 equal targets
+            c.queries.emplace_back(double(rng.index(23)) * 0.125, double(rng.index(23)) * 0.125,
+                                   double(rng.index(23)) * 0.125);
+        out.push_back(c);
+    }
+    {
+        Case c{"copies: 40 points each repeated 50 times", {}, {}};
+        std::vector<glm::dvec3> base;
+        for (int i = 0; i < 40; ++i)
+            base.emplace_back(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+        for (int k = 0; k < 50; ++k)
+            for (const glm::dvec3& b : base) c.targets.push_back(b);
+        for (int i = 0; i < 300; ++i)
+            c.queries.emplace_back(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+        for (const glm::dvec3& b : base) c.queries.push_back(b);
+        out.push_back(c);
+    }
+    {
+        Case c{"points one double apart at UTM magnitudes", {}, {}};
+        const glm::dvec3 o(512345.25, 5412345.5, 100.0);
+        for (int i = 0; i < 2000; ++i) {
+            const double ulp = std::nextafter(o.y, 1e300) - o.y;
+            c.targets.push_back(o +
+                                glm::dvec3(double(rng.index(64)) * ulp, double(rng.index(64)) * ulp, 0.0));
+        }
+        for (int i = 0; i < 300; ++i)
+            c.queries.push_back(c.targets[rng.index(c.targets.size())] + glm::dvec3(1e-10, 0, 0));
+        out.push_back(c);
+    }
+    {
+        Case c{"one target", {{1, 2, 3}}, {{0, 0, 0}, {1, 2, 3}}};
+        out.push_back(c);
+    }
+    return out;
+}
+
+TEST(ExactPointTree, NearestIsTheBruteForcesFromAnyStart) {
+    for (const Case& c : cases()) {
+        for (int threads : {1, 3}) {
+            const ExactPointTree tree(PointView(c.targets), threads);
+            test::Rng rng(7002);
+            for (size_t i = 0; i < c.queries.size(); ++i) {
+                const glm::dvec3& p = c.queries[i];
+                const Brute want = bruteNearest(p, c.targets);
+                const auto start = uint32_t(rng.index(c.targets.size()));
+                const ExactPointTree::Nearest got =
+                    tree.nearest(p, start, core::exactDistance(p, c.targets[start]));
+                ASSERT_EQ(got.distance, want.distance) << c.name << ", query " << i;
+                ASSERT_EQ(got.index, want.index)
+                    << c.name << ", query " << i << ": the smallest index on a tie";
+            }
+        }
+    }
+}
+
+TEST(ExactPointTree, FloatViewsAreTheirValuesInDouble) {
+    test::Rng rng(7003);
+    std::vector<glm::vec3> f;
+    for (int i = 0; i < 5000; ++i)
+        f.emplace_back(rng.uniform(-10, 10), rng.uniform(-10, 10), rng.uniform(-1, 1));
+    const std::vector<glm::dvec3> d(f.begin(), f.end());
+    const ExactPointTree tree(PointView(f), 2);
+    for (int i = 0; i < 300; ++i) {
+        const glm::dvec3 p(rng.uniform(-11, 11), rng.uniform(-11, 11), rng.uniform(-2, 2));
+        const Brute want = bruteNearest(p, d);
+        const ExactPointTree::Nearest got = tree.nearest(p, 0, core::exactDistance(p, d[0]));
+        ASSERT_EQ(got.distance, want.distance);
+        ASSERT_EQ(got.index, want.index);
+    }
+}
+
+// Entries from a search that picked a near but wrong target (here: every
+// query's start is a random target, or its true nearest) become the brute
+// force's; right ones stay; nearest-only arrays get the indices alone.
+TEST(MakePerPointExact, MendsWrongEntriesAndKeepsRightOnes) {
+    for (const Case& c : cases()) {
+        test::Rng rng(7004);
+        PerPoint pp;
+        std::vector<Brute> want;
+        uint64_t wrong = 0;
+        for (const glm::dvec3& p : c.queries) {
+            want.push_back(bruteNearest(p, c.targets));
+            const bool keep = rng.index(2) == 0;
+            const uint32_t start = keep ? want.back().index : uint32_t(rng.index(c.targets.size()));
+            if (start != want.back().index) ++wrong;
+            pp.nearest.push_back(start);
+            pp.distance.push_back(core::exactDistance(p, c.targets[start]));
+        }
+        PerPoint nearestOnly;
+        nearestOnly.nearest = pp.nearest;
+        EXPECT_EQ(makePerPointExact(pp, PointView(c.queries), PointView(c.targets), 2), wrong) << c.name;
+        EXPECT_EQ(makePerPointExact(nearestOnly, PointView(c.queries), PointView(c.targets), 2), wrong)
+            << c.name;
+        EXPECT_TRUE(nearestOnly.distance.empty());
+        for (size_t i = 0; i < c.queries.size(); ++i) {
+            ASSERT_EQ(pp.nearest[i], want[i].index) << c.name << ", query " << i;
+            ASSERT_EQ(pp.distance[i], want[i].distance) << c.name << ", query " << i;
+            ASSERT_EQ(nearestOnly.nearest[i], want[i].index) << c.name << ", query " << i;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace rthdist::cpu
