@@ -105,13 +105,15 @@ struct CallOptions {
     bool directedOnly = false;
     // Radius growth factor between candidate-search iterations (> 1).
     float radiusGrowth = 2.0f;
-    // Also return every point's exact nearest-neighbour distance and index
-    // (HausdorffResult::aNearest / bNearest): core::exactDistance in double,
-    // minimal over every point of the other set, the smallest index on a
-    // tie (the float search's pairs made exact on the host; device views
-    // keep the float pairs, within 2e: README "Per-point distances"). Every
-    // query then needs its own NN, so the early break against the running
-    // maximum is off: slower.
+    // Also return every point's nearest-neighbour distance and index
+    // (HausdorffResult::aNearest / bNearest), core::exactDistance in double
+    // of the pair: for double inputs the exact nearest (minimal over every
+    // point of the other set, the smallest index on a tie: the float
+    // search's pairs made exact on the host); for float32 inputs the float
+    // search's pair, at most a relative 2^-21 above the exact nearest
+    // distance; device views keep the float pairs, within 2e (README
+    // "Per-point distances"). Every query then needs its own NN, so the
+    // early break against the running maximum is off: slower.
     bool perPointDistances = false;
     // With perPointDistances: fill only PerPoint::nearest, leaving
     // PerPoint::distance empty, for callers that recompute each distance in

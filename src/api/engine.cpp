@@ -249,8 +249,9 @@ void finishResult(Engine::Impl& impl, HausdorffResult& r, const CallOptions& cal
 
 // Every per-point entry made the exact one in the caller's coordinates
 // (cpu/exact_nearest.hpp: the backends' entries are their float pairs,
-// within 2e of it), its time counted as refinement; the witness's entry,
-// proven by the certificate, must come out as it is (else kInternal).
+// within 2e of it; README "Per-point distances"), its time counted as
+// refinement; the witness's entry, proven by the certificate, must come out
+// as it is (else kInternal).
 std::optional<Error> makePerPointExact(HausdorffResult& r, const PointView& a, const PointView& b,
                                        int threads) {
     const auto start = core::Clock::now();
@@ -290,7 +291,10 @@ std::optional<Error> leaveFrame(Engine::Impl& impl, HausdorffResult& r, const Fr
     r.origin = frame.origin;
     if (auto err = api::settleCertificates(r, frame.a, frame.b, impl.options.threads, frame.onHost))
         return err;
-    if (call.perPointDistances && frame.onHost)
+    // Only where the backend searched rounded copies (double inputs): their
+    // float pairs' distances may be e, an absolute 2^-20 of the frame, off;
+    // float inputs searched as they are only by a relative ~2^-21.
+    if (call.perPointDistances && frame.onHost && frame.restore)
         if (auto err = makePerPointExact(r, frame.a, frame.b, impl.options.threads)) return err;
     finishResult(impl, r, call, t0);
     return std::nullopt;

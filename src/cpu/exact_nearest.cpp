@@ -84,12 +84,27 @@ ExactPointTree::ExactPointTree(const PointView& points, int threads) {
         node.first = first;
         node.count = count;
         node.right = 0;
+        node.split = 0.0;
+        node.axis = 0;
+        if (lo == hi) {
+            // Copies of one point: every query meets them at one distance, so
+            // only the smallest index can answer; the leaf keeps it alone (the
+            // subtree's other node slots stay unused). Without this a query
+            // beside a million copies would visit each one.
+            Item* smallest = std::min_element(items, items + count,
+                                              [](const Item& x, const Item& y) { return x.index < y.index; });
+            std::swap(*smallest, items[0]);
+            node.count = 1;
+            return;
+        }
         if (count <= kLeafPoints) return;
         const glm::dvec3 e = hi - lo;
         const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
         const uint32_t half = count / 2;
         std::nth_element(items, items + half, items + count,
                          [axis](const Item& x, const Item& y) { return x.p[axis] < y.p[axis]; });
+        node.split = items[half].p[axis];
+        node.axis = uint32_t(axis);
         const uint32_t left = at + 1;
         const auto right = uint32_t(at + 1 + counts.of(half));
         node.right = right;
@@ -165,19 +180,43 @@ ExactPointTree::Nearest ExactPointTree::nearest(const glm::dvec3& p, uint32_t st
                                                 double startDistance) const {
     Nearest best{start, startDistance};
     double bound2 = boundOf(best.distance);
-    // The path to the start's leaf, each step's other child kept.
+    // The path to the start's leaf: each step's other child, and the cell
+    // (the split planes so far) of the child taken.
     const uint32_t at = m_position[start];
-    std::array<uint32_t, 40> others;  // depth <= 33
+    struct Step {
+        uint32_t other;
+        glm::dvec3 lo, hi;  // the cell of the child on the path
+    };
+    std::array<Step, 40> path;  // depth <= 33
     size_t depth = 0;
     uint32_t node = 0;
+    glm::dvec3 lo(-std::numeric_limits<double>::infinity()), hi(std::numeric_limits<double>::infinity());
     while (m_nodes[node].right != 0) {
-        const uint32_t right = m_nodes[node].right;
-        const bool goRight = at >= m_nodes[right].first;
-        others[depth++] = goRight ? node + 1 : right;
-        node = goRight ? right : node + 1;
+        const Node& n = m_nodes[node];
+        const bool goRight = at >= m_nodes[n.right].first;
+        if (goRight)
+            lo[int(n.axis)] = std::max(lo[int(n.axis)], n.split);
+        else
+            hi[int(n.axis)] = std::min(hi[int(n.axis)], n.split);
+        path[depth++] = {goRight ? node + 1 : n.right, lo, hi};
+        node = goRight ? n.right : node + 1;
     }
     descend(p, node, best, bound2);
-    while (depth > 0) descend(p, others[--depth], best, bound2);
+    // Climbing: a point outside the path's subtree at this depth lies on or
+    // past a face of its cell; a face whose rounded gap from p squares above
+    // the bound puts every such point's rounded distance above it too (the
+    // gap, its square and the sum round monotonically), so once every face
+    // does, nothing above can answer.
+    while (depth > 0) {
+        const Step& s = path[--depth];
+        bool inside = true;
+        for (int a = 0; a < 3 && inside; ++a) {
+            const double below = p[a] - s.lo[a], above = s.hi[a] - p[a];
+            inside = below > 0.0 && above > 0.0 && below * below > bound2 && above * above > bound2;
+        }
+        if (inside) break;
+        descend(p, s.other, best, bound2);
+    }
     return best;
 }
 
@@ -192,13 +231,21 @@ uint64_t makePerPointExact(PerPoint& perPoint, const PointView& q, const PointVi
         throw std::logic_error("makePerPointExact: one nearest index per query");
     const ExactPointTree tree(t, threads);
     const bool distances = !perPoint.distance.empty();
+    // The queries by their starts' tree positions, 8 to a key (a counting sort).
+    const size_t nq = q.count, keys = t.count / 8 + 1;
+    std::vector<uint32_t> order(nq), first(keys + 1, 0);
+    for (size_t i = 0; i < nq; ++i) ++first[tree.positionOf(perPoint.nearest[i]) / 8 + 1];
+    for (size_t k = 1; k <= keys; ++k) first[k] += first[k - 1];
+    for (size_t i = 0; i < nq; ++i) order[first[tree.positionOf(perPoint.nearest[i]) / 8]++] = uint32_t(i);
     std::atomic<uint64_t> changed{0};
-    core::parallelChunks(q.count, kQueryChunk, threads, [&](size_t begin, size_t end, int) {
+    core::parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int) {
         uint64_t mine = 0;
-        for (size_t i = begin; i < end; ++i) {
+        for (size_t k = begin; k < end; ++k) {
+            const uint32_t i = order[k];
             const glm::dvec3 p = q.at(i);
             const uint32_t start = perPoint.nearest[i];
-            const ExactPointTree::Nearest n = tree.nearest(p, start, core::exactDistance(p, t.at(start)));
+            const ExactPointTree::Nearest n =
+                tree.nearest(p, start, core::exactDistance(p, tree.pointAt(start)));
             if (n.index != start) {
                 perPoint.nearest[i] = n.index;
                 ++mine;

@@ -41,7 +41,10 @@ public:
     // its leaf is scanned first, then the other subtrees along the path
     // from the root to it, deepest first, each only where its box lies
     // within the best distance (the float search's pair usually is the
-    // nearest, and its leaf's neighbours are the only boxes that close).
+    // nearest, and its leaf's neighbours are the only boxes that close),
+    // until the ball of the best distance lies inside the cell of the
+    // path's subtree (the split planes above it): no point outside it can
+    // be nearer.
     struct Nearest {
         uint32_t index = 0;
         double distance = 0.0;
@@ -49,6 +52,13 @@ public:
     [[nodiscard]] Nearest nearest(const glm::dvec3& p, uint32_t start, double startDistance) const;
 
     [[nodiscard]] size_t hostBytes() const;
+    // Where point `index` sits in the tree order: queries taken in the order
+    // of their starts' positions read the same leaves and boxes one after
+    // another (inputs in no spatial order otherwise miss the cache on every
+    // node: 10M random-order queries took ~2 s on 16 cores).
+    [[nodiscard]] uint32_t positionOf(uint32_t index) const { return m_position[index]; }
+    // Point `index` as the tree holds it (PointView::at's value), read in tree order.
+    [[nodiscard]] const glm::dvec3& pointAt(uint32_t index) const { return m_items[m_position[index]].p; }
 
 private:
     // Node n covers the points [first, first + count) of the tree order; an
@@ -56,8 +66,10 @@ private:
     // subtree), the left holding the first count / 2 points.
     struct Node {
         glm::dvec3 lo, hi;  // the exact box of its points
+        double split;       // inner: the left's points have p[axis] <= split, the right's >= split
         uint32_t first, count;
         uint32_t right;  // inner: the right child's node; leaf: 0
+        uint32_t axis;   // inner: 0, 1 or 2
     };
     struct Item {
         glm::dvec3 p;    // the point, as PointView::at gives it
