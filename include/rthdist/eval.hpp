@@ -1,15 +1,16 @@
 // rthdist — reconstruction evaluation (issue 34): accuracy, completeness,
 // Chamfer distances, precision, recall and F-score at thresholds, in one
-// call, from the exact nearest distances of the engine (point targets) or
-// of the point-to-surface search (surface targets).
+// call, from the per-point nearest distances of the engine (point targets)
+// or of the point-to-surface search (surface targets).
 //
 // Roles: the FIRST input is the reconstruction R, the SECOND the ground
 //   truth G (the CLI's A and B).
 //   accuracy distances:     every point of R to G (R -> G)
 //   completeness distances: every point of G to R (G -> R)
 //   Point targets (evaluatePoints): both are point sets; the distances are
-//   the exact nearest-neighbour distances of hausdorff() with
-//   Options::perPointDistances. Surface target (evaluateToSurface): G is a
+//   the nearest-neighbour distances of hausdorff() with
+//   Options::perPointDistances (exact for double inputs; for float32
+//   inputs at most a relative 2^-21 above the exact ones). Surface target (evaluateToSurface): G is a
 //   mesh; accuracy is every point of R to G's triangles (hausdorffToSurface:
 //   exact on the CPU backend, within SurfacePerPoint::tolerance on a GPU
 //   backend); completeness is every vertex a triangle of G uses (each

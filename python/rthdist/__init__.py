@@ -100,7 +100,9 @@ def hausdorff(a, b, *, directed=False, per_point=False, backend="auto", device=N
 
     a, b: (N, 3) point sets (see rthdist.as_points for what is accepted).
     directed: compute only h(A, B) (result.b_to_a is None).
-    per_point: also every point's exact nearest distance and index
+    per_point: also every point's nearest distance and index (exact for
+        float64 input; for float32, the float search's pair, at most a
+        relative 2^-21 above the exact nearest: README "Per-point distances")
         (result.a_distances, a_nearest, b_distances, b_nearest) and the
         statistics (percentile, hd95, mean, rms, stats, histogram); slower.
     backend: "auto", "cpu", "ray-query" or "rt-pipeline" ("auto": a small

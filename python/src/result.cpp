@@ -329,14 +329,15 @@ void bindResult(py::module_& m) {
         .def_property_readonly(
             "validation_messages", [](const PyResult& r) { return r.result.validationMessages; },
             "validation-layer messages (validation=True only)")
-        .def_property_readonly(
-            "a_distances", perPointArray(&HausdorffResult::aNearest, &PerPoint::distance),
-            "every a's exact nearest distance to B (float64, read-only); None without per_point")
+        .def_property_readonly("a_distances", perPointArray(&HausdorffResult::aNearest, &PerPoint::distance),
+                               "every a's nearest distance to B (float64, read-only; exact for float64 "
+                               "input, at most a relative "
+                               "2^-21 above it for float32); None without per_point")
         .def_property_readonly("a_nearest", perPointArray(&HausdorffResult::aNearest, &PerPoint::nearest),
                                "index in B of every a's nearest point (uint32); None without per_point")
         .def_property_readonly(
             "b_distances", perPointArray(&HausdorffResult::bNearest, &PerPoint::distance),
-            "every b's exact nearest distance to A; None without per_point or when directed")
+            "every b's nearest distance to A (as a_distances); None without per_point or when directed")
         .def_property_readonly(
             "b_nearest", perPointArray(&HausdorffResult::bNearest, &PerPoint::nearest),
             "index in A of every b's nearest point; None without per_point or when directed")

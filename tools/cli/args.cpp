@@ -163,7 +163,7 @@ Options:
                       buildings); needs a .las input, other formats are read whole
 
 Per-point distances (each of these implies --per-point):
-  --per-point         every point's exact nearest distance; statistics in the output
+  --per-point         every point's nearest distance (exact for double input); statistics in the output
   --percentile P      also report the P-th percentile, 0..100, repeatable
                       (default 50 90 95 99; 95 is always reported: HD95)
   --histogram-bins N  histogram bins, 1..10000 (default 20)
