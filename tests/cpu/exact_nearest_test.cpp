@@ -112,6 +112,28 @@ TEST(ExactPointTree, NearestIsTheBruteForcesFromAnyStart) {
     }
 }
 
+// Past 2^16 points a node's halves are built on two threads: the same
+// answers as the brute force on any thread count.
+TEST(ExactPointTree, AParallelBuildAnswersAsTheBruteForce) {
+    test::Rng rng(7005);
+    std::vector<glm::dvec3> t;
+    for (int i = 0; i < 150000; ++i)
+        t.emplace_back(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-0.1, 0.1));
+    for (int i = 0; i < 20000; ++i) t.push_back(t[rng.index(t.size())]);  // copies
+    for (int threads : {1, 4}) {
+        const ExactPointTree tree(PointView(t), threads);
+        test::Rng queries(7006);
+        for (int i = 0; i < 60; ++i) {
+            const glm::dvec3 p(queries.uniform(-1.2, 1.2), queries.uniform(-1.2, 1.2),
+                               queries.uniform(-0.2, 0.2));
+            const Brute want = bruteNearest(p, t);
+            const ExactPointTree::Nearest got = tree.nearest(p, 17, core::exactDistance(p, t[17]));
+            ASSERT_EQ(got.distance, want.distance) << threads << " threads, query " << i;
+            ASSERT_EQ(got.index, want.index) << threads << " threads, query " << i;
+        }
+    }
+}
+
 TEST(ExactPointTree, FloatViewsAreTheirValuesInDouble) {
     test::Rng rng(7003);
     std::vector<glm::vec3> f;
