@@ -18,7 +18,8 @@ namespace rthdist::cpu {
 namespace {
 
 constexpr uint32_t kLeafPoints = 8;
-// Ranges at least this large split their children on two threads.
+// Ranges at least this large are split one level at a time, a level's
+// nodes on the worker pool; smaller ones are whole subtrees of one thread.
 constexpr uint32_t kParallelPoints = uint32_t(1) << 16;
 constexpr size_t kQueryChunk = 1024;
 
@@ -70,19 +71,23 @@ ExactPointTree::ExactPointTree(const PointView& points, int threads) {
     const NodeCounts counts{uint32_t(n)};
     m_nodes.resize(counts.of(uint32_t(n)));
     // Node `at` over [first, first + count): its exact box, then (inner) the
-    // median of its longest axis between its halves, then the halves.
-    const auto build = [&](const auto& self, uint32_t at, uint32_t first, uint32_t count) -> void {
-        Item* const items = m_items.data() + first;
+    // median of its longest axis between its halves; returns the halves
+    // (count 0: a leaf).
+    struct Range {
+        uint32_t at, first, count;
+    };
+    const auto split = [&](const Range& r) -> std::array<Range, 2> {
+        Item* const items = m_items.data() + r.first;
         glm::dvec3 lo = items[0].p, hi = lo;
-        for (uint32_t i = 1; i < count; ++i) {
+        for (uint32_t i = 1; i < r.count; ++i) {
             lo = glm::min(lo, items[i].p);
             hi = glm::max(hi, items[i].p);
         }
-        Node& node = m_nodes[at];
+        Node& node = m_nodes[r.at];
         node.lo = lo;
         node.hi = hi;
-        node.first = first;
-        node.count = count;
+        node.first = r.first;
+        node.count = r.count;
         node.right = 0;
         node.split = 0.0;
         node.axis = 0;
@@ -91,38 +96,46 @@ ExactPointTree::ExactPointTree(const PointView& points, int threads) {
             // only the smallest index can answer; the leaf keeps it alone (the
             // subtree's other node slots stay unused). Without this a query
             // beside a million copies would visit each one.
-            Item* smallest = std::min_element(items, items + count,
+            Item* smallest = std::min_element(items, items + r.count,
                                               [](const Item& x, const Item& y) { return x.index < y.index; });
             std::swap(*smallest, items[0]);
             node.count = 1;
-            return;
+            return {};
         }
-        if (count <= kLeafPoints) return;
+        if (r.count <= kLeafPoints) return {};
         const glm::dvec3 e = hi - lo;
         const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
-        const uint32_t half = count / 2;
-        std::nth_element(items, items + half, items + count,
+        const uint32_t half = r.count / 2;
+        std::nth_element(items, items + half, items + r.count,
                          [axis](const Item& x, const Item& y) { return x.p[axis] < y.p[axis]; });
         node.split = items[half].p[axis];
         node.axis = uint32_t(axis);
-        const uint32_t left = at + 1;
-        const auto right = uint32_t(at + 1 + counts.of(half));
-        node.right = right;
-        if (count >= kParallelPoints && threads != 1) {
-            core::parallelChunks(2, 1, 2, [&](size_t begin, size_t end, int) {
-                for (size_t c = begin; c < end; ++c) {
-                    if (c == 0)
-                        self(self, left, first, half);
-                    else
-                        self(self, right, first + half, count - half);
-                }
-            });
-        } else {
-            self(self, left, first, half);
-            self(self, right, first + half, count - half);
-        }
+        node.right = uint32_t(r.at + 1 + counts.of(half));
+        return {Range{r.at + 1, r.first, half}, Range{node.right, r.first + half, r.count - half}};
     };
-    build(build, 0, 0, uint32_t(n));
+    const auto subtree = [&](const auto& self, const Range& r) -> void {
+        for (const Range& c : split(r))
+            if (c.count > 0) self(self, c);
+    };
+    // The top levels one level at a time, a level's nodes in parallel (the
+    // root's selection alone on one thread); then the subtrees below as
+    // parallel tasks, each depth first on one thread.
+    const int workers = core::resolveThreads(threads, n / kParallelPoints + 1);
+    std::vector<Range> level{Range{0, 0, uint32_t(n)}};
+    while (!level.empty() && level.size() < 4 * size_t(workers) && level.front().count >= kParallelPoints) {
+        std::vector<std::array<Range, 2>> halves(level.size());
+        core::parallelChunks(level.size(), 1, workers, [&](size_t begin, size_t end, int) {
+            for (size_t i = begin; i < end; ++i) halves[i] = split(level[i]);
+        });
+        std::vector<Range> next;
+        for (const auto& h : halves)
+            for (const Range& c : h)
+                if (c.count > 0) next.push_back(c);
+        level = std::move(next);
+    }
+    core::parallelChunks(level.size(), 1, workers, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) subtree(subtree, level[i]);
+    });
     m_position.resize(n);
     core::parallelChunks(n, core::balancedChunk(n, threads), threads, [&](size_t begin, size_t end, int) {
         for (size_t i = begin; i < end; ++i) m_position[m_items[i].index] = uint32_t(i);
