@@ -238,18 +238,49 @@ size_t ExactPointTree::hostBytes() const {
            m_position.capacity() * sizeof(uint32_t);
 }
 
+namespace {
+
+// Whether most consecutive queries start within 64 tree positions of each
+// other (4,096 evenly spaced pairs looked at).
+bool inSpaceOrder(const std::vector<uint32_t>& starts, const ExactPointTree& tree) {
+    const size_t n = starts.size();
+    if (n < 2) return true;
+    const size_t samples = std::min<size_t>(4096, n - 1), step = (n - 1) / samples;
+    size_t near = 0;
+    for (size_t s = 0; s < samples; ++s) {
+        const size_t i = 1 + s * step;
+        const int64_t d = int64_t(tree.positionOf(starts[i])) - int64_t(tree.positionOf(starts[i - 1]));
+        if (d > -64 && d < 64) ++near;
+    }
+    return 2 * near >= samples;
+}
+
+}  // namespace
+
 uint64_t makePerPointExact(PerPoint& perPoint, const PointView& q, const PointView& t, int threads) {
     if (perPoint.nearest.empty() || t.count == 0) return 0;
     if (perPoint.nearest.size() != q.count)
         throw std::logic_error("makePerPointExact: one nearest index per query");
     const ExactPointTree tree(t, threads);
     const bool distances = !perPoint.distance.empty();
-    // The queries by their starts' tree positions, 8 to a key (a counting sort).
-    const size_t nq = q.count, keys = t.count / 8 + 1;
-    std::vector<uint32_t> order(nq), first(keys + 1, 0);
-    for (size_t i = 0; i < nq; ++i) ++first[tree.positionOf(perPoint.nearest[i]) / 8 + 1];
-    for (size_t k = 1; k <= keys; ++k) first[k] += first[k - 1];
-    for (size_t i = 0; i < nq; ++i) order[first[tree.positionOf(perPoint.nearest[i]) / 8]++] = uint32_t(i);
+    // Queries whose starts follow each other in the tree (inputs in space
+    // order: scans) go in input order, which reads the queries and writes
+    // their entries in sequence; others by their starts' tree positions, 8
+    // to a key (a counting sort), which reads the tree in sequence instead
+    // (2 cores: the Dragon's scan-ordered queries 47 -> 40 ms in input
+    // order, 1M shuffled shell points 226 -> 462 ms in it).
+    const size_t nq = q.count;
+    std::vector<uint32_t> order(nq);
+    if (inSpaceOrder(perPoint.nearest, tree)) {
+        for (size_t i = 0; i < nq; ++i) order[i] = uint32_t(i);
+    } else {
+        const size_t keys = t.count / 8 + 1;
+        std::vector<uint32_t> first(keys + 1, 0);
+        for (size_t i = 0; i < nq; ++i) ++first[tree.positionOf(perPoint.nearest[i]) / 8 + 1];
+        for (size_t k = 1; k <= keys; ++k) first[k] += first[k - 1];
+        for (size_t i = 0; i < nq; ++i)
+            order[first[tree.positionOf(perPoint.nearest[i]) / 8]++] = uint32_t(i);
+    }
     std::atomic<uint64_t> changed{0};
     core::parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int) {
         uint64_t mine = 0;
