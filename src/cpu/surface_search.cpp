@@ -20,7 +20,11 @@
 namespace rthdist::cpu {
 namespace {
 
-constexpr size_t kChunk = 256;
+// Chunks of 16 to 256 queries, about four a thread: a query against a fine
+// mesh costs microseconds, so a few hundred (a coarse mesh's vertices
+// against a fine one) still spread over the threads (a fixed 256 left 453
+// queries on two).
+constexpr size_t kMinChunk = 16, kMaxChunk = 256;
 
 // The maximum so far of one thread: the query with the largest distance,
 // the smallest index on a tie.
@@ -148,7 +152,8 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
     const bool perPointClosest = perPoint && !options.perPointDistancesOnly;
     if (perPoint && spare != nullptr) result.perPoint = std::move(*spare);  // every element is written below
     if (perPoint) sizePerPoint(result.perPoint, points.count, perPointClosest, options.threads);
-    const int threads = core::resolveThreads(options.threads, (points.count + kChunk - 1) / kChunk);
+    const size_t chunk = core::balancedChunk(points.count, options.threads, kMinChunk, kMaxChunk);
+    const int threads = core::resolveThreads(options.threads, (points.count + chunk - 1) / chunk);
     // Queries near each other one after another (cpu/query_order.hpp): the
     // tree's nodes stay in cache; no answer depends on the order.
     const std::vector<uint32_t> order = perPoint || points.count <= kSpatialOrderEarlyBreakUpTo
@@ -156,7 +161,7 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
                                             : std::vector<uint32_t>{};
     std::vector<ThreadBest> best(static_cast<size_t>(threads));
     std::atomic<uint64_t> runningMax{0};
-    core::parallelChunks(points.count, kChunk, threads, [&](size_t begin, size_t end, int thread) {
+    core::parallelChunks(points.count, chunk, threads, [&](size_t begin, size_t end, int thread) {
         ThreadBest& mine = best[size_t(thread)];
         if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) {
             mine.cancelled = true;
