@@ -32,6 +32,14 @@ namespace rthdist::core {
     return std::clamp(wanted, minimum, std::max(minimum, maximum));
 }
 
+// The same for elements of a microsecond or more each (a BVH descent, a
+// patch's bounds): 16 to 256 a chunk, so that a few hundred still spread
+// over the threads (a fixed 256 left the surface-to-surface rounds and 453
+// queries of a coarse mesh on one or two threads of sixteen).
+[[nodiscard]] inline size_t heavyItemChunk(size_t count, int threads) {
+    return balancedChunk(count, threads, 16, 256);
+}
+
 // Calls fn(chunkBegin, chunkEnd, threadIndex) once for each chunk of [0, count)
 // of `chunk` elements (the last one shorter), pulled dynamically by up to
 // resolveThreads(threads, chunks) workers: the caller is worker 0, the others

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -13,6 +14,7 @@
 
 #include "core/certificate.hpp"
 #include "core/parallel.hpp"
+#include "cpu/key_sort.hpp"
 
 namespace rthdist::cpu {
 namespace {
@@ -266,26 +268,26 @@ uint64_t makePerPointExact(PerPoint& perPoint, const PointView& q, const PointVi
     // Queries whose starts follow each other in the tree (inputs in space
     // order: scans) go in input order, which reads the queries and writes
     // their entries in sequence; others by their starts' tree positions, 8
-    // to a key (a counting sort), which reads the tree in sequence instead
-    // (2 cores: the Dragon's scan-ordered queries 47 -> 40 ms in input
-    // order, 1M shuffled shell points 226 -> 462 ms in it).
+    // to a key (cpu/key_sort.hpp's radix sort of (key << 32 | query)),
+    // which reads the tree in sequence instead (2 cores: the Dragon's
+    // scan-ordered queries 47 -> 40 ms in input order, 1M shuffled shell
+    // points 226 -> 462 ms in it).
     const size_t nq = q.count;
-    std::vector<uint32_t> order(nq);
-    if (inSpaceOrder(perPoint.nearest, tree)) {
-        for (size_t i = 0; i < nq; ++i) order[i] = uint32_t(i);
-    } else {
-        const size_t keys = t.count / 8 + 1;
-        std::vector<uint32_t> first(keys + 1, 0);
-        for (size_t i = 0; i < nq; ++i) ++first[tree.positionOf(perPoint.nearest[i]) / 8 + 1];
-        for (size_t k = 1; k <= keys; ++k) first[k] += first[k - 1];
-        for (size_t i = 0; i < nq; ++i)
-            order[first[tree.positionOf(perPoint.nearest[i]) / 8]++] = uint32_t(i);
+    std::vector<uint64_t> order;  // empty: input order
+    if (!inSpaceOrder(perPoint.nearest, tree)) {
+        order.resize(nq);
+        core::parallelChunks(nq, core::balancedChunk(nq, threads), threads,
+                             [&](size_t begin, size_t end, int) {
+                                 for (size_t i = begin; i < end; ++i)
+                                     order[i] = uint64_t(tree.positionOf(perPoint.nearest[i]) / 8) << 32 | i;
+                             });
+        radixSortKeys(order, std::bit_width(t.count / 8), threads);
     }
     std::atomic<uint64_t> changed{0};
     core::parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int) {
         uint64_t mine = 0;
         for (size_t k = begin; k < end; ++k) {
-            const uint32_t i = order[k];
+            const auto i = uint32_t(order.empty() ? k : order[k] & 0xffffffffu);
             const glm::dvec3 p = q.at(i);
             const uint32_t start = perPoint.nearest[i];
             const ExactPointTree::Nearest n =

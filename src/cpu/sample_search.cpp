@@ -6,14 +6,6 @@
 #include "core/parallel.hpp"
 
 namespace rthdist::cpu {
-namespace {
-
-// Chunks of 16 to 256 items, about four a thread: an item costs ~1 us (a
-// BVH descent, a patch's bounds), so a round of a few hundred samples
-// still spreads over the threads (a fixed 256 left most rounds on one).
-constexpr size_t kMinChunk = 16, kMaxChunk = 256;
-
-}  // namespace
 
 BvhSampleSearch::BvhSampleSearch(const MeshView& to, double slack, int threads,
                                  const std::atomic<bool>* cancel)
@@ -22,8 +14,8 @@ BvhSampleSearch::BvhSampleSearch(const MeshView& to, double slack, int threads,
 Result<size_t> BvhSampleSearch::search(std::span<const glm::dvec3> points, std::span<double> distance,
                                        std::span<uint32_t> nearest) {
     std::atomic<bool> cancelled{false};
-    core::parallelChunks(points.size(), core::balancedChunk(points.size(), m_threads, kMinChunk, kMaxChunk),
-                         m_threads, [&](size_t lo, size_t hi, int) {
+    core::parallelChunks(points.size(), core::heavyItemChunk(points.size(), m_threads), m_threads,
+                         [&](size_t lo, size_t hi, int) {
                              if (m_cancel != nullptr && m_cancel->load(std::memory_order_relaxed)) {
                                  cancelled.store(true, std::memory_order_relaxed);
                                  return;

@@ -19,10 +19,6 @@
 namespace rthdist::cpu {
 namespace {
 
-// Chunks of 16 to 256 items, about four a thread: an item costs ~1 us (a
-// BVH descent, a patch's bounds), so a round of a few hundred samples
-// still spreads over the threads (a fixed 256 left most rounds on one).
-constexpr size_t kMinChunk = 16, kMaxChunk = 256;
 constexpr uint32_t kNone = UINT32_MAX;
 // A patch at depth k has edges of at most 2^-k of its triangle's (plus
 // rounding), and tolerance >= 4 slack settles it by the Lipschitz bound
@@ -151,8 +147,8 @@ double patchBound(const Direction& dir, const Patch& patch) {
 
 std::vector<double> patchBounds(const Direction& dir, int threads) {
     std::vector<double> bounds(dir.work.size());
-    core::parallelChunks(dir.work.size(), core::balancedChunk(dir.work.size(), threads, kMinChunk, kMaxChunk),
-                         threads, [&](size_t lo, size_t hi, int) {
+    core::parallelChunks(dir.work.size(), core::heavyItemChunk(dir.work.size(), threads), threads,
+                         [&](size_t lo, size_t hi, int) {
                              for (size_t i = lo; i < hi; ++i) bounds[i] = patchBound(dir, dir.work[i]);
                          });
     return bounds;

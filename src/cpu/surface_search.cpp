@@ -20,12 +20,6 @@
 namespace rthdist::cpu {
 namespace {
 
-// Chunks of 16 to 256 queries, about four a thread: a query against a fine
-// mesh costs microseconds, so a few hundred (a coarse mesh's vertices
-// against a fine one) still spread over the threads (a fixed 256 left 453
-// queries on two).
-constexpr size_t kMinChunk = 16, kMaxChunk = 256;
-
 // The maximum so far of one thread: the query with the largest distance,
 // the smallest index on a tie.
 struct ThreadBest {
@@ -152,7 +146,7 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
     const bool perPointClosest = perPoint && !options.perPointDistancesOnly;
     if (perPoint && spare != nullptr) result.perPoint = std::move(*spare);  // every element is written below
     if (perPoint) sizePerPoint(result.perPoint, points.count, perPointClosest, options.threads);
-    const size_t chunk = core::balancedChunk(points.count, options.threads, kMinChunk, kMaxChunk);
+    const size_t chunk = core::heavyItemChunk(points.count, options.threads);
     const int threads = core::resolveThreads(options.threads, (points.count + chunk - 1) / chunk);
     // Queries near each other one after another (cpu/query_order.hpp): the
     // tree's nodes stay in cache; no answer depends on the order.

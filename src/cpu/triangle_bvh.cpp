@@ -361,14 +361,14 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
         for (size_t t = begin; t < end; ++t) {
             const size_t at = 3 * size_t(placeOf[t]);
+            const glm::dvec3 c[3] = {mesh.corner(t, 0), mesh.corner(t, 1), mesh.corner(t, 2)};
             for (int k = 0; k < 3; ++k) {
                 if (m_floatCorners)
-                    m_cornersF[at + size_t(k)] = glm::vec3(mesh.corner(t, k));  // exact: a float's value
+                    m_cornersF[at + size_t(k)] = glm::vec3(c[k]);  // exact: a float's value
                 else
-                    m_corners[at + size_t(k)] = mesh.corner(t, k);
+                    m_corners[at + size_t(k)] = c[k];
             }
-            m_thin[placeOf[t]] =
-                core::thinTriangle(mesh.corner(t, 0), mesh.corner(t, 1), mesh.corner(t, 2)) ? 1 : 0;
+            m_thin[placeOf[t]] = core::thinTriangle(c[0], c[1], c[2]) ? 1 : 0;
         }
     });
 

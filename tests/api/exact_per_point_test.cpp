@@ -14,27 +14,17 @@
 #include <vector>
 
 #include "api/engine_test_support.hpp"
+#include "common/brute_force.hpp"
 #include "common/rng.hpp"
 #include "core/certificate.hpp"
 
 namespace rthdist {
 namespace {
 
-struct Exact {
-    double distance;
-    uint32_t index;
-};
-
-std::vector<Exact> bruteNearest(const std::vector<glm::dvec3>& q, const std::vector<glm::dvec3>& t) {
-    std::vector<Exact> out;
-    for (const glm::dvec3& p : q) {
-        Exact best{core::exactDistance(p, t[0]), 0};
-        for (size_t i = 1; i < t.size(); ++i) {
-            const double d = core::exactDistance(p, t[i]);
-            if (d < best.distance) best = {d, uint32_t(i)};
-        }
-        out.push_back(best);
-    }
+std::vector<oracle::NearestExact> bruteNearest(const std::vector<glm::dvec3>& q,
+                                               const std::vector<glm::dvec3>& t) {
+    std::vector<oracle::NearestExact> out;
+    for (const glm::dvec3& p : q) out.push_back(oracle::bruteForceNearestInDouble(p, t));
     return out;
 }
 
@@ -54,11 +44,11 @@ void expectExactEntries(const HausdorffResult& r, const std::vector<glm::dvec3>&
                         const std::vector<glm::dvec3>& b, bool nearestOnly) {
     for (auto [got, d, q, t] :
          {std::tuple{&r.aNearest, &r.aToB, &a, &b}, std::tuple{&r.bNearest, &r.bToA, &b, &a}}) {
-        const std::vector<Exact> want = bruteNearest(*q, *t);
+        const std::vector<oracle::NearestExact> want = bruteNearest(*q, *t);
         ASSERT_EQ(got->nearest.size(), want.size());
         ASSERT_EQ(got->distance.size(), nearestOnly ? 0 : want.size());
         for (size_t i = 0; i < want.size(); ++i) {
-            ASSERT_EQ(got->nearest[i], want[i].index) << "point " << i;
+            ASSERT_EQ(got->nearest[i], want[i].targetIndex) << "point " << i;
             if (!nearestOnly) ASSERT_EQ(got->distance[i], want[i].distance) << "point " << i;
         }
         EXPECT_GT(d->counters.perPointMended, 0u) << "no float pair was off: the case tests nothing";

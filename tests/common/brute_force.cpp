@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/certificate.hpp"
 #include "core/parallel.hpp"
 
 namespace rthdist::oracle {
@@ -102,6 +103,15 @@ std::vector<NearestExact> bruteForceNearestIndexed(std::span<const glm::vec3> qu
         }
     });
     return out;
+}
+
+NearestExact bruteForceNearestInDouble(const glm::dvec3& p, std::span<const glm::dvec3> targets) {
+    NearestExact best{core::exactDistance(p, targets[0]), 0};
+    for (size_t i = 1; i < targets.size(); ++i) {
+        const double d = core::exactDistance(p, targets[i]);
+        if (d < best.distance) best = {d, uint32_t(i)};
+    }
+    return best;
 }
 
 }  // namespace rthdist::oracle

@@ -39,4 +39,10 @@ struct NearestExact {
                                                                  std::span<const glm::vec3> targets,
                                                                  int threads = 0);
 
+// The nearest of double `targets` (non-empty) to p as the exact per-point
+// entries order them (cpu/exact_nearest.hpp): core::exactDistance, the
+// smallest index among equal distances. One thread.
+[[nodiscard]] NearestExact bruteForceNearestInDouble(const glm::dvec3& p,
+                                                     std::span<const glm::dvec3> targets);
+
 }  // namespace rthdist::oracle

@@ -12,26 +12,13 @@
 #include <string>
 #include <vector>
 
+#include "common/brute_force.hpp"
 #include "common/rng.hpp"
 #include "core/certificate.hpp"
 #include "cpu/exact_nearest.hpp"
 
 namespace rthdist::cpu {
 namespace {
-
-struct Brute {
-    uint32_t index = 0;
-    double distance = 0.0;
-};
-
-Brute bruteNearest(const glm::dvec3& p, const std::vector<glm::dvec3>& t) {
-    Brute best{0, core::exactDistance(p, t[0])};
-    for (size_t i = 1; i < t.size(); ++i) {
-        const double d = core::exactDistance(p, t[i]);
-        if (d < best.distance) best = {uint32_t(i), d};
-    }
-    return best;
-}
 
 struct Case {
     std::string name;
@@ -100,12 +87,12 @@ TEST(ExactPointTree, NearestIsTheBruteForcesFromAnyStart) {
             test::Rng rng(7002);
             for (size_t i = 0; i < c.queries.size(); ++i) {
                 const glm::dvec3& p = c.queries[i];
-                const Brute want = bruteNearest(p, c.targets);
+                const oracle::NearestExact want = oracle::bruteForceNearestInDouble(p, c.targets);
                 const auto start = uint32_t(rng.index(c.targets.size()));
                 const ExactPointTree::Nearest got =
                     tree.nearest(p, start, core::exactDistance(p, c.targets[start]));
                 ASSERT_EQ(got.distance, want.distance) << c.name << ", query " << i;
-                ASSERT_EQ(got.index, want.index)
+                ASSERT_EQ(got.index, want.targetIndex)
                     << c.name << ", query " << i << ": the smallest index on a tie";
             }
         }
@@ -126,10 +113,10 @@ TEST(ExactPointTree, AParallelBuildAnswersAsTheBruteForce) {
         for (int i = 0; i < 60; ++i) {
             const glm::dvec3 p(queries.uniform(-1.2, 1.2), queries.uniform(-1.2, 1.2),
                                queries.uniform(-0.2, 0.2));
-            const Brute want = bruteNearest(p, t);
+            const oracle::NearestExact want = oracle::bruteForceNearestInDouble(p, t);
             const ExactPointTree::Nearest got = tree.nearest(p, 17, core::exactDistance(p, t[17]));
             ASSERT_EQ(got.distance, want.distance) << threads << " threads, query " << i;
-            ASSERT_EQ(got.index, want.index) << threads << " threads, query " << i;
+            ASSERT_EQ(got.index, want.targetIndex) << threads << " threads, query " << i;
         }
     }
 }
@@ -143,10 +130,10 @@ TEST(ExactPointTree, FloatViewsAreTheirValuesInDouble) {
     const ExactPointTree tree(PointView(f), 2);
     for (int i = 0; i < 300; ++i) {
         const glm::dvec3 p(rng.uniform(-11, 11), rng.uniform(-11, 11), rng.uniform(-2, 2));
-        const Brute want = bruteNearest(p, d);
+        const oracle::NearestExact want = oracle::bruteForceNearestInDouble(p, d);
         const ExactPointTree::Nearest got = tree.nearest(p, 0, core::exactDistance(p, d[0]));
         ASSERT_EQ(got.distance, want.distance);
-        ASSERT_EQ(got.index, want.index);
+        ASSERT_EQ(got.index, want.targetIndex);
     }
 }
 
@@ -157,13 +144,13 @@ TEST(MakePerPointExact, MendsWrongEntriesAndKeepsRightOnes) {
     for (const Case& c : cases()) {
         test::Rng rng(7004);
         PerPoint pp;
-        std::vector<Brute> want;
+        std::vector<oracle::NearestExact> want;
         uint64_t wrong = 0;
         for (const glm::dvec3& p : c.queries) {
-            want.push_back(bruteNearest(p, c.targets));
+            want.push_back(oracle::bruteForceNearestInDouble(p, c.targets));
             const bool keep = rng.index(2) == 0;
-            const uint32_t start = keep ? want.back().index : uint32_t(rng.index(c.targets.size()));
-            if (start != want.back().index) ++wrong;
+            const uint32_t start = keep ? want.back().targetIndex : uint32_t(rng.index(c.targets.size()));
+            if (start != want.back().targetIndex) ++wrong;
             pp.nearest.push_back(start);
             pp.distance.push_back(core::exactDistance(p, c.targets[start]));
         }
@@ -174,9 +161,9 @@ TEST(MakePerPointExact, MendsWrongEntriesAndKeepsRightOnes) {
             << c.name;
         EXPECT_TRUE(nearestOnly.distance.empty());
         for (size_t i = 0; i < c.queries.size(); ++i) {
-            ASSERT_EQ(pp.nearest[i], want[i].index) << c.name << ", query " << i;
+            ASSERT_EQ(pp.nearest[i], want[i].targetIndex) << c.name << ", query " << i;
             ASSERT_EQ(pp.distance[i], want[i].distance) << c.name << ", query " << i;
-            ASSERT_EQ(nearestOnly.nearest[i], want[i].index) << c.name << ", query " << i;
+            ASSERT_EQ(nearestOnly.nearest[i], want[i].targetIndex) << c.name << ", query " << i;
         }
     }
 }
