@@ -63,9 +63,14 @@
 //   and search buffers and BLAS storage between calls (a one-shot GPU call
 //   creates them all: ~0.35 s on an H200). The route is the Engine's
 //   EngineOptions::backend's as above: kRayQuery and kRtPipeline search on
-//   its device (per-point distances within the tolerance, as above), kCpu and
-//   kAuto run the CPU backend (an auto Engine that chose a GPU too, until
-//   the kept route is measured faster than the CPU backend). The results
+//   its device (per-point distances within the tolerance, as above), kCpu
+//   runs the CPU backend. kAuto runs the CPU backend too, except on an
+//   Engine that chose a GPU device, where a call without per-point
+//   distances that has at least 2^14 points and at least as many points as
+//   the mesh has triangles searches on the device (the sizes where the kept
+//   GPU route was measured faster on an H200 with 16 host threads; its
+//   value and witness are the CPU backend's, ==; SurfaceResult::backend
+//   names the one that ran). The results
 //   are those of hausdorffToSurface with the same backend (==); threads are
 //   EngineOptions::threads. On the CPU backend an Engine keeps its last
 //   mesh's BVH with a copy of that mesh (24 bytes a vertex, 12 a

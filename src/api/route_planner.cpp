@@ -103,8 +103,15 @@ const char* routeName(Route route) {
     return "?";
 }
 
-Plan planSurfaceRoute(Backend requested) {
-    if (requested == Backend::kCpu || requested == Backend::kAuto) return routed(Route::kSurfaceCpu);
+bool autoSurfaceOnGpu(const SurfaceShape& shape) {
+    return shape.keptDevice && !shape.perPoint && shape.queries >= kAutoSurfaceGpuQueries &&
+           shape.queries >= shape.triangles;
+}
+
+Plan planSurfaceRoute(Backend requested, const SurfaceShape& shape) {
+    if (requested == Backend::kCpu) return routed(Route::kSurfaceCpu);
+    if (requested == Backend::kAuto)
+        return routed(autoSurfaceOnGpu(shape) ? Route::kSurfaceGpu : Route::kSurfaceCpu);
     return routed(Route::kSurfaceGpu);
 }
 

@@ -27,9 +27,10 @@
 //   a point set against a triangle surface (hausdorffToSurface, planSurfaceRoute),
 //   and two surfaces (surfaceHausdorff, planSurfacePairRoute: the same routes, no refusal):
 //       kRefused        per-point distances on a GPU backend (the CPU backend gives them)
-//       kSurfaceCpu     the CPU backend's triangle BVH (api/surface.cpp); also kAuto
-//       kSurfaceGpu     a GPU backend named by the caller: the device's float search
-//                       over triangle boxes, proven in double on the host (api/surface_gpu.cpp)
+//       kSurfaceCpu     the CPU backend's triangle BVH (api/surface.cpp); also kAuto,
+//                       but for the calls autoSurfaceOnGpu sends to an Engine's kept device
+//       kSurfaceGpu     a GPU backend named by the caller (or those calls): the device's float
+//                       search over triangle boxes, proven in double on the host (api/surface_gpu.cpp)
 // Host views that narrow (narrowingPays below, api/narrowed_targets.hpp) run
 // as one call on both sets' cores or as two directed calls, each on the
 // routes above.
@@ -117,13 +118,38 @@ struct Plan {
 // The route of a point set against a triangle surface, chosen before any
 // backend is opened (one-shot: `requested` is SurfaceOptions::backend; on an
 // Engine: its EngineOptions::backend, whose device is kept): Backend::kCpu
-// and kAuto take kSurfaceCpu (one-shot, a GPU call opens a device per
-// call, whose setup outweighs the CPU search at the sizes one call takes;
-// an auto Engine that chose a GPU stays on the CPU backend too until the
-// kept route is measured faster than it); a GPU backend the caller named
-// takes kSurfaceGpu, per-point distances too (within the float search's
-// tolerance, rthdist/surface.hpp).
-[[nodiscard]] Plan planSurfaceRoute(Backend requested);
+// takes kSurfaceCpu; a GPU backend the caller named takes kSurfaceGpu,
+// per-point distances too (within the float search's tolerance,
+// rthdist/surface.hpp). Backend::kAuto takes kSurfaceCpu one-shot (a GPU
+// call opens a device per call, whose setup, 0.36-0.74 s on the H200
+// hosts, outweighs the CPU search at the sizes one call takes) and, on an
+// Engine that keeps a GPU device, kSurfaceGpu where autoSurfaceOnGpu says
+// so (below).
+struct SurfaceShape {
+    uint64_t queries = 0;     // points of the call
+    uint64_t triangles = 0;   // of the surface
+    bool perPoint = false;    // SurfaceCallOptions::perPointDistances (also the evaluation's)
+    bool keptDevice = false;  // an Engine whose backend is a GPU's (not one-shot, not the CPU backend)
+};
+[[nodiscard]] Plan planSurfaceRoute(Backend requested, const SurfaceShape& shape = {});
+
+// An auto Engine with a kept GPU device sends a point-to-surface call to it
+// when the call asks the directed value only (the device's per-point
+// entries are within a tolerance, the CPU backend's exact: auto keeps one
+// contract) and has at least kAutoSurfaceGpuQueries queries and at least as
+// many queries as triangles. The GPU route builds a BLAS of every triangle
+// each call and pays ~0.5 ms of fixed cost; the CPU backend's kept tree is
+// searched in O(log F) a query. Measured on one H200 with 16 host threads,
+// kept Engines (docs/bench/surfaces, sessions 11, 22, 23), every row where
+// queries >= triangles was faster on the GPU (bunny>res2-res4 1.3-1.8x,
+// armadillo>dec 1.4x, scans>bunny 3.2x, dragon>res2 3.3x, 1M-10M samples
+// to dragon res3 9-11x) and every row with fewer was not (bunny-res4>bunny
+// 453 queries to 69k triangles 0.8 vs 1.7 ms, dragon-res4>dragon 1.2 vs 17,
+// armadillo-dec>armadillo 1.1 vs 1.8, bunny>t0.1 3.1 vs 7.7; bunny>t0.001,
+// 36k to 69k, the one near miss: 2.7 vs 2.3). With fewer host threads the
+// CPU side is slower, so the rule errs toward the CPU there.
+inline constexpr uint64_t kAutoSurfaceGpuQueries = uint64_t(1) << 14;
+[[nodiscard]] bool autoSurfaceOnGpu(const SurfaceShape& shape);
 
 // The route of two triangle surfaces (surfaceHausdorff, certified bounds):
 // kSurfaceCpu for kCpu and kAuto (the refinement's batches run on the CPU

@@ -104,8 +104,14 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
     static_cast<SurfaceCallOptions&>(options) = call;
     options.backend = engine.backend;
     options.threads = engine.threads;
-    // The Engine's requested backend picks the route (kAuto: the CPU backend).
-    const Plan plan = planSurfaceRoute(engine.backend);
+    // The Engine's requested backend picks the route; under kAuto the call's
+    // shape, where the Engine keeps a GPU device (autoSurfaceOnGpu).
+    SurfaceShape shape;
+    shape.queries = points.count;
+    shape.triangles = surface.triangleCount();
+    shape.perPoint = call.perPointDistances;
+    shape.keptDevice = backend.kind() != Backend::kCpu;
+    const Plan plan = planSurfaceRoute(engine.backend, shape);
     if (plan.route == Route::kRefused) return Error{plan.code, plan.reason};
     if (plan.route == Route::kSurfaceGpu) {
         Result<SurfaceInputs> inputs = checkInputs(points, surface, options.threads);

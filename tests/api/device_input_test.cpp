@@ -19,6 +19,7 @@
 #include "common/geo_cases.hpp"
 #include "engine_test_support.hpp"
 #include "gpu/vk_struct.hpp"
+#include "rthdist/surface.hpp"
 #include "rthdist/vulkan_interop.hpp"
 
 namespace rthdist::test {
@@ -533,6 +534,69 @@ TEST(DeviceInput, OracleOnRandomSets) {
                                 DevicePointView::doubles(emb.upload(c.b), c.b.size() * 24, c.b.size()));
             ASSERT_TRUE(r) << c.name << ": " << r.error().message;
             expectMatchesGeoOracle(c, *r);
+        }
+    }
+    EXPECT_EQ(emb.messages(), 0);
+}
+
+// An auto Engine on a lent device keeps a GPU backend (an owned auto Engine
+// on lavapipe takes the CPU backend), so here the surface route's auto rule
+// (api::autoSurfaceOnGpu) runs end to end: a call of many queries against
+// few triangles searches on the device, per-point distances and few queries
+// stay on the CPU backend, and every value and witness is the CPU's (==).
+TEST(DeviceInput, AnAutoEngineOnALentDeviceRoutesSurfaceCallsByShape) {
+    if (backendUnderTest() == Backend::kCpu) GTEST_SKIP() << "a lent device needs a GPU backend";
+    Embedder emb(
+        Backend::kAuto);  // the device set up for kAuto, as the Engine's backend (vulkan_interop.hpp)
+    if (!emb.ok()) GTEST_SKIP() << "no device for the auto backend: " << emb.why();
+    EngineOptions autoOptions = engineUnderTest();
+    autoOptions.backend = Backend::kAuto;
+    Result<Engine> engine = Engine::create(emb.handles(), autoOptions);
+    ASSERT_TRUE(engine) << engine.error().message;
+    // A wavy 8 x 8 grid of quads (128 triangles) and points above and below it.
+    std::vector<double> vertices;
+    for (int j = 0; j <= 8; ++j)
+        for (int i = 0; i <= 8; ++i) {
+            const double x = i / 8.0, y = j / 8.0;
+            vertices.insert(vertices.end(), {x, y, 0.1 * std::sin(7.0 * x + 3.0 * y)});
+        }
+    std::vector<uint32_t> indices;
+    for (uint32_t j = 0; j < 8; ++j)
+        for (uint32_t i = 0; i < 8; ++i) {
+            const uint32_t v = j * 9 + i;
+            indices.insert(indices.end(), {v, v + 1, v + 10, v, v + 10, v + 9});
+        }
+    const MeshView mesh{PointView::doubles(vertices.data(), vertices.size() / 3), indices};
+    const std::vector<glm::dvec3> many =
+        randomDoubles(size_t(1) << 14, 71, glm::dvec3(-0.2, -0.2, -0.5), 1.4);
+    std::vector<double> flat;
+    for (const glm::dvec3& p : many) flat.insert(flat.end(), {p.x, p.y, p.z});
+    const PointView manyView = PointView::doubles(flat.data(), many.size());
+    const PointView fewView = PointView::doubles(flat.data(), 1000);
+
+    SurfaceOptions cpu;
+    cpu.backend = Backend::kCpu;
+    for (const PointView& points : {manyView, fewView}) {
+        for (const bool perPoint : {false, true}) {
+            SCOPED_TRACE(std::to_string(points.count) + " points, per point " + std::to_string(perPoint));
+            SurfaceCallOptions call;
+            call.perPointDistances = perPoint;
+            const Result<SurfaceResult> r = engine->hausdorffToSurface(points, mesh, call);
+            ASSERT_TRUE(r) << r.error().message;
+            const bool onDevice = points.count == manyView.count && !perPoint;
+            if (onDevice)
+                EXPECT_NE(r->backend, Backend::kCpu);
+            else
+                EXPECT_EQ(r->backend, Backend::kCpu);
+            SurfaceOptions want = cpu;
+            want.perPointDistances = perPoint;
+            const Result<SurfaceResult> w = hausdorffToSurface(points, mesh, want);
+            ASSERT_TRUE(w) << w.error().message;
+            EXPECT_EQ(r->hausdorff, w->hausdorff);
+            EXPECT_EQ(r->directed.queryIndex, w->directed.queryIndex);
+            EXPECT_EQ(r->directed.triangle, w->directed.triangle);
+            EXPECT_EQ(r->directed.surfacePoint, w->directed.surfacePoint);
+            if (perPoint) EXPECT_EQ(r->perPoint.distance, w->perPoint.distance);
         }
     }
     EXPECT_EQ(emb.messages(), 0);

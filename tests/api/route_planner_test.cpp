@@ -246,6 +246,41 @@ TEST(RoutePlanner, SurfacesRunOnTheBackendNamed) {
     // (Per-point distances too: the GPU route gives them within its tolerance.)
     for (Backend gpu : {Backend::kRayQuery, Backend::kRtPipeline})
         EXPECT_EQ(planSurfaceRoute(gpu).route, Route::kSurfaceGpu);
+    // A named backend is never exchanged, whatever the call's shape.
+    SurfaceShape few;
+    few.queries = 10;
+    few.triangles = 1000000;
+    few.keptDevice = true;
+    few.perPoint = true;
+    EXPECT_EQ(planSurfaceRoute(Backend::kRtPipeline, few).route, Route::kSurfaceGpu);
+    SurfaceShape many;
+    many.queries = 10000000;
+    many.triangles = 10;
+    EXPECT_EQ(planSurfaceRoute(Backend::kCpu, many).route, Route::kSurfaceCpu);
+}
+
+TEST(RoutePlanner, AnAutoEngineWithADeviceSearchesManyQueriesOnIt) {
+    SurfaceShape shape;
+    shape.keptDevice = true;
+    shape.queries = kAutoSurfaceGpuQueries;
+    shape.triangles = kAutoSurfaceGpuQueries;
+    EXPECT_EQ(planSurfaceRoute(Backend::kAuto, shape).route, Route::kSurfaceGpu);
+    // Fewer queries than triangles: the CPU backend's kept tree.
+    shape.triangles = kAutoSurfaceGpuQueries + 1;
+    EXPECT_EQ(planSurfaceRoute(Backend::kAuto, shape).route, Route::kSurfaceCpu);
+    // Fewer than kAutoSurfaceGpuQueries queries, however few the triangles.
+    shape.queries = kAutoSurfaceGpuQueries - 1;
+    shape.triangles = 1;
+    EXPECT_EQ(planSurfaceRoute(Backend::kAuto, shape).route, Route::kSurfaceCpu);
+    // Per-point distances stay on the CPU backend (exact entries, one contract for auto).
+    shape.queries = 1000000;
+    shape.perPoint = true;
+    EXPECT_EQ(planSurfaceRoute(Backend::kAuto, shape).route, Route::kSurfaceCpu);
+    // No kept device (one-shot, or an Engine on the CPU backend): the CPU backend.
+    shape.perPoint = false;
+    EXPECT_EQ(planSurfaceRoute(Backend::kAuto, shape).route, Route::kSurfaceGpu);
+    shape.keptDevice = false;
+    EXPECT_EQ(planSurfaceRoute(Backend::kAuto, shape).route, Route::kSurfaceCpu);
 }
 
 TEST(RoutePlanner, SurfacePairsRunOnTheBackendNamed) {
