@@ -19,7 +19,7 @@ SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 
 BASE_PKGS=(cmake g++ make pkg-config libvulkan-dev glslang-tools libglm-dev
-  libtinygltf-dev libgtest-dev libnanoflann-dev zlib1g-dev libdeflate-dev vulkan-validationlayers
+  libtinygltf-dev libgtest-dev libnanoflann-dev zlib1g-dev libdeflate-dev liblzf-dev vulkan-validationlayers
   vulkan-tools nlohmann-json3-dev libcli11-dev libstb-dev strace
   openmpi-bin libopenmpi-dev)
 EXTRA_PKGS=()

@@ -19,7 +19,10 @@
 //         the size is 84 + 50 * facets or the file holds a NUL byte, whatever
 //         the header's first word.
 //   .off  OFF / COFF / NOFF headers, vertices only
-//   .pcd  ascii and binary (x y z fields, any size/type), not binary_compressed
+//   .pcd  ascii, binary and binary_compressed (x y z fields, any size/type;
+//         binary_compressed is PCL's: the fields' columns LZF-compressed,
+//         inflated by liblzf into a buffer of their declared size, at most
+//         4 GiB - 1 and 88 times the compressed bytes, then converted)
 //   .las  LAS 1.0-1.4, point data formats 0-10 (src/io/las_reader.hpp): X/Y/Z
 //         int32 times scale plus offset, in double; variable-length records
 //         are skipped (the points start at the header's offset to point

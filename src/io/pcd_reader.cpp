@@ -1,10 +1,17 @@
 // PCD v0.7 as documented by the Point Cloud Library ("The PCD (Point Cloud
-// Data) file format"): a text header, then ascii rows or packed binary rows.
+// Data) file format"): a text header, then ascii rows, packed binary rows,
+// or (binary_compressed, PCL's pcl::io::savePCDFileBinaryCompressed) two
+// little-endian uint32 sizes, compressed and uncompressed, and the LZF
+// stream of every field's values one field after another (all points' x,
+// then all points' y, ...), inflated by Debian's liblzf.
 #include "io/pcd_reader.hpp"
+
+#include <lzf.h>
 
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <optional>
 
 #include "io/io_error.hpp"
@@ -39,10 +46,12 @@ std::optional<ScalarType> pcdScalarType(char type, size_t size) {
     return std::nullopt;
 }
 
+enum class PcdData { kAscii, kBinary, kBinaryCompressed };
+
 struct PcdHeader {
     std::vector<PcdField> fields;
     uint64_t points = 0;
-    bool binary = false;
+    PcdData data = PcdData::kAscii;
     size_t dataLine = 0;
     size_t bodyOffset = 0;  // first byte after the DATA line
 };
@@ -129,16 +138,19 @@ Result<PcdHeader> parseHeader(std::string_view bytes, const std::string& path) {
         if (n > tok.size()) return badInput(path, lineWhere(cursor.line()), "too many header values");
         if (auto err = applyHeaderLine(h, tok.data(), n, cursor.line(), path)) return *err;
     }
-    if (h.data != "ascii" && h.data != "binary") {
+    if (h.data != "ascii" && h.data != "binary" && h.data != "binary_compressed") {
         return badInput(path, lineWhere(h.dataLine),
-                        "unsupported DATA '" + h.data + "' (ascii or binary only)");
+                        "unsupported DATA '" + h.data + "' (ascii, binary or binary_compressed only)");
     }
     if (!h.points) {
         if (h.height != 0 && h.width > UINT64_MAX / h.height)
             return badInput(path, "header", "WIDTH * HEIGHT overflows");
         h.points = h.width * h.height;
     }
-    return PcdHeader{std::move(h.fields), *h.points, h.data == "binary", h.dataLine, cursor.offset()};
+    const PcdData data = h.data == "ascii"    ? PcdData::kAscii
+                         : h.data == "binary" ? PcdData::kBinary
+                                              : PcdData::kBinaryCompressed;
+    return PcdHeader{std::move(h.fields), *h.points, data, h.dataLine, cursor.offset()};
 }
 
 // Where x, y, z are in a row (the first element of each), and its size.
@@ -146,6 +158,7 @@ struct PcdLayout {
     std::array<uint64_t, 3> column{};      // ascii value index
     std::array<uint64_t, 3> byteOffset{};  // binary byte offset
     std::array<ScalarType, 3> scalar{};
+    std::array<uint64_t, 3> fieldBytes{};  // of the axis's field in a row (COUNT x SIZE)
     uint64_t valuesPerRow = 0;
     uint64_t bytesPerRow = 0;
 };
@@ -167,6 +180,7 @@ Result<PcdLayout> layoutOf(const std::vector<PcdField>& fields, const std::strin
                 l.column[axis] = l.valuesPerRow;
                 l.byteOffset[axis] = l.bytesPerRow;
                 l.scalar[axis] = *type;
+                l.fieldBytes[axis] = f.count * f.size;
             }
         }
         l.valuesPerRow += f.count;
@@ -195,6 +209,92 @@ Result<PointCloud> readBinaryRows(std::string_view bytes, const PcdHeader& h, co
     std::optional<Error> bad;
     if (out.scalar == Scalar::kFloat64) {
         out.doubles.resize(static_cast<size_t>(h.points));  // unwritten: convertRecords writes each point
+        bad = convertRecords(rows, out.doubles.data(), plan, path);
+    } else {
+        out.floats.resize(static_cast<size_t>(h.points));
+        bad = convertRecords(rows, out.floats.data(), plan, path);
+    }
+    if (bad) return *bad;
+    return out;
+}
+
+// binary_compressed: an LZF stream inflates at most 88 times (a 3-byte
+// back reference copies up to 264 bytes); a declared size past that is
+// refused before anything is allocated.
+constexpr uint64_t kMaxLzfRatio = 88;
+
+uint32_t readLe32(const char* p) {
+    uint32_t v = 0;
+    for (int k = 3; k >= 0; --k) v = v << 8 | static_cast<unsigned char>(p[k]);
+    return v;
+}
+
+// The inflated fields hold each axis's values as a column (stride: its
+// field's bytes); columns of one stride convert in place, others are
+// gathered into xyz records first.
+Result<PointCloud> readCompressedColumns(std::string_view bytes, const PcdHeader& h, const PcdLayout& l,
+                                         const std::string& path, const ChunkPlan& plan) {
+    const size_t at = h.bodyOffset;
+    if (bytes.size() - at < 8)
+        return badInput(path, offsetWhere(at),
+                        "binary_compressed: the two 4-byte sizes are missing (truncated)");
+    const uint32_t compressed = readLe32(bytes.data() + at), inflated = readLe32(bytes.data() + at + 4);
+    if (compressed > bytes.size() - at - 8) {
+        return badInput(path, offsetWhere(at),
+                        "binary_compressed: declares " + std::to_string(compressed) +
+                            " compressed bytes, but only " + std::to_string(bytes.size() - at - 8) +
+                            " follow (truncated)");
+    }
+    if (h.points > UINT32_MAX / l.bytesPerRow || uint64_t(inflated) != h.points * l.bytesPerRow) {
+        return badInput(path, offsetWhere(at + 4),
+                        "binary_compressed: " + std::to_string(h.points) + " points of " +
+                            std::to_string(l.bytesPerRow) + " bytes need " +
+                            std::to_string(h.points * l.bytesPerRow) + " bytes, the stream declares " +
+                            std::to_string(inflated) + " (at most 4 GiB - 1)");
+    }
+    if (uint64_t(inflated) > kMaxLzfRatio * compressed) {
+        return badInput(path, offsetWhere(at),
+                        "binary_compressed: " + std::to_string(compressed) + " LZF bytes cannot inflate to " +
+                            std::to_string(inflated) + " (at most " + std::to_string(kMaxLzfRatio) +
+                            " times)");
+    }
+    std::vector<char> columns(inflated);
+    const unsigned got = lzf_decompress(bytes.data() + at + 8, compressed, columns.data(), inflated);
+    if (got != inflated) {
+        return badInput(path, offsetWhere(at + 8),
+                        "binary_compressed: the LZF stream is corrupt (" +
+                            (got == 0 ? std::string("it does not inflate to the declared ") +
+                                            std::to_string(inflated) + " bytes"
+                                      : "it inflates to " + std::to_string(got) + " of " +
+                                            std::to_string(inflated) + " bytes") +
+                            ")");
+    }
+    // Column of each axis: the bytes of the fields before it, for every point.
+    std::array<size_t, 3> column{};
+    for (size_t axis = 0; axis < 3; ++axis) column[axis] = size_t(l.byteOffset[axis] * h.points);
+    RecordLayout rows{columns.data(), size_t(l.fieldBytes[0]), h.points, column, l.scalar, false};
+    std::vector<char> gathered;
+    if (l.fieldBytes[1] != l.fieldBytes[0] || l.fieldBytes[2] != l.fieldBytes[0]) {
+        std::array<size_t, 3> size{}, offset{};
+        size_t record = 0;
+        for (size_t axis = 0; axis < 3; ++axis) {
+            size[axis] = scalarSize(l.scalar[axis]);
+            offset[axis] = record;
+            record += size[axis];
+        }
+        gathered.resize(size_t(h.points) * record);
+        for (uint64_t i = 0; i < h.points; ++i)
+            for (size_t axis = 0; axis < 3; ++axis)
+                std::memcpy(&gathered[size_t(i) * record + offset[axis]],
+                            &columns[column[axis] + size_t(i * l.fieldBytes[axis])], size[axis]);
+        rows = RecordLayout{gathered.data(), record, h.points, offset, l.scalar, false};
+    }
+    PointCloud out;
+    out.scalar =
+        std::any_of(l.scalar.begin(), l.scalar.end(), needsDouble) ? Scalar::kFloat64 : Scalar::kFloat32;
+    std::optional<Error> bad;
+    if (out.scalar == Scalar::kFloat64) {
+        out.doubles.resize(static_cast<size_t>(h.points));
         bad = convertRecords(rows, out.doubles.data(), plan, path);
     } else {
         out.floats.resize(static_cast<size_t>(h.points));
@@ -273,7 +373,9 @@ Result<PointCloud> readPcd(std::string_view bytes, const std::string& path, cons
     auto layout = layoutOf(header->fields, path);
     if (!layout) return layout.error();
     if (header->points == 0) return PointCloud{};
-    if (header->binary) return readBinaryRows(bytes, *header, *layout, path, plan);
+    if (header->data == PcdData::kBinary) return readBinaryRows(bytes, *header, *layout, path, plan);
+    if (header->data == PcdData::kBinaryCompressed)
+        return readCompressedColumns(bytes, *header, *layout, path, plan);
     return readAsciiRows(bytes, *header, *layout, path, plan);
 }
 
