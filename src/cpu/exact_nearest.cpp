@@ -21,9 +21,22 @@ namespace {
 
 constexpr uint32_t kLeafPoints = 8;
 // Ranges at least this large are split one level at a time, a level's
-// nodes on the worker pool; smaller ones are whole subtrees of one thread.
-constexpr uint32_t kParallelPoints = uint32_t(1) << 16;
+// nodes on the worker pool, until there are four a worker; smaller ones
+// are whole subtrees of one thread (~0.5 ms of work each at 2^12).
+constexpr uint32_t kParallelPoints = uint32_t(1) << 12;
+// A level of fewer ranges than workers splits each range of at least this
+// many points on every worker (parallelSelect): the box, then the median
+// by a sample's two brackets, a parallel three-way scatter and the
+// selection inside the middle bucket only; smaller ones by std::nth_element.
+constexpr uint32_t kParallelSelectPoints = uint32_t(1) << 16;
+// The sample of parallelSelect (evenly spaced items) and its brackets'
+// distance from the median in sample ranks: the middle bucket holds about
+// 2 x 48 / 4096 of the range (~2.3 %); a median outside it (a sample far
+// from the range's distribution) falls back to std::nth_element.
+constexpr size_t kSelectSample = 4096;
+constexpr size_t kSelectBracket = 48;
 constexpr size_t kQueryChunk = 1024;
+constexpr size_t kPrefetch = 16;
 
 // Nodes of a subtree over n points (a leaf up to kLeafPoints, else the
 // node and its halves' subtrees, the left holding n / 2): at each depth the
@@ -72,19 +85,93 @@ ExactPointTree::ExactPointTree(const PointView& points, int threads) {
     });
     const NodeCounts counts{uint32_t(n)};
     m_nodes.resize(counts.of(uint32_t(n)));
+    const int workers = core::resolveThreads(threads, n / kParallelPoints + 1);
     // Node `at` over [first, first + count): its exact box, then (inner) the
     // median of its longest axis between its halves; returns the halves
-    // (count 0: a leaf).
+    // (count 0: a leaf). `wide`: the box and the median on every worker
+    // (parallelSelect), for the few large ranges of the top levels.
     struct Range {
         uint32_t at, first, count;
     };
-    const auto split = [&](const Range& r) -> std::array<Range, 2> {
-        Item* const items = m_items.data() + r.first;
-        glm::dvec3 lo = items[0].p, hi = lo;
-        for (uint32_t i = 1; i < r.count; ++i) {
-            lo = glm::min(lo, items[i].p);
-            hi = glm::max(hi, items[i].p);
+    core::UninitVector<Item> scratch;  // parallelSelect's buckets, allocated at its first use
+    const auto boxOf = [&](const Item* items, uint32_t count, bool wide, glm::dvec3& lo, glm::dvec3& hi) {
+        lo = hi = items[0].p;
+        if (!wide) {
+            for (uint32_t i = 1; i < count; ++i) {
+                lo = glm::min(lo, items[i].p);
+                hi = glm::max(hi, items[i].p);
+            }
+            return;
         }
+        const size_t chunk = (count + 63) / 64;
+        std::array<glm::dvec3, 64> los, his;
+        los.fill(lo);
+        his.fill(hi);
+        core::parallelChunks(count, chunk, workers, [&](size_t begin, size_t end, int) {
+            glm::dvec3 l = items[begin].p, h = l;
+            for (size_t i = begin + 1; i < end; ++i) {
+                l = glm::min(l, items[i].p);
+                h = glm::max(h, items[i].p);
+            }
+            los[begin / chunk] = l;
+            his[begin / chunk] = h;
+        });
+        for (size_t c = 0; c < 64; ++c) {
+            lo = glm::min(lo, los[c]);
+            hi = glm::max(hi, his[c]);
+        }
+    };
+    // items[half] becomes the item of rank `half` by p[axis], none before it
+    // larger and none after it smaller (std::nth_element's contract), on
+    // every worker: the items below a sample's lower bracket, between the
+    // brackets and above the upper one scattered apart in parallel (each
+    // chunk's items in order), then nth_element within the middle only.
+    const auto parallelSelect = [&](Item* items, uint32_t count, uint32_t half, int axis) {
+        const auto less = [axis](const Item& x, const Item& y) { return x.p[axis] < y.p[axis]; };
+        std::vector<double> sample(kSelectSample);
+        for (size_t k = 0; k < kSelectSample; ++k)
+            sample[k] = items[size_t(count) * k / kSelectSample].p[axis];
+        std::sort(sample.begin(), sample.end());
+        const size_t mid = size_t(uint64_t(kSelectSample) * half / count);
+        const double low = sample[mid > kSelectBracket ? mid - kSelectBracket : 0];
+        const double high = sample[std::min(kSelectSample - 1, mid + kSelectBracket)];
+        constexpr size_t kChunks = 256;
+        const size_t chunk = (count + kChunks - 1) / kChunks;
+        std::vector<std::array<uint32_t, 3>> bucket(kChunks, {0u, 0u, 0u});  // below, between, above
+        const auto which = [&](const Item& it) { return it.p[axis] < low ? 0 : (it.p[axis] > high ? 2 : 1); };
+        core::parallelChunks(count, chunk, workers, [&](size_t begin, size_t end, int) {
+            std::array<uint32_t, 3>& c = bucket[begin / chunk];
+            for (size_t i = begin; i < end; ++i) ++c[size_t(which(items[i]))];
+        });
+        uint64_t total[3] = {0, 0, 0};
+        for (const auto& c : bucket)
+            for (int b = 0; b < 3; ++b) total[b] += c[size_t(b)];
+        if (!(total[0] <= half && half < total[0] + total[1])) {
+            std::nth_element(items, items + half, items + count, less);
+            return;
+        }
+        if (scratch.empty()) scratch.resize(n);
+        Item* const to = scratch.data() + (items - m_items.data());
+        std::vector<std::array<uint64_t, 3>> at(kChunks);
+        uint64_t next[3] = {0, total[0], total[0] + total[1]};
+        for (size_t c = 0; c < kChunks; ++c)
+            for (int b = 0; b < 3; ++b) {
+                at[c][size_t(b)] = next[b];
+                next[b] += bucket[c][size_t(b)];
+            }
+        core::parallelChunks(count, chunk, workers, [&](size_t begin, size_t end, int) {
+            std::array<uint64_t, 3> put = at[begin / chunk];
+            for (size_t i = begin; i < end; ++i) to[put[size_t(which(items[i]))]++] = items[i];
+        });
+        std::nth_element(to + total[0], to + half, to + total[0] + total[1], less);
+        core::parallelChunks(count, chunk, workers, [&](size_t begin, size_t end, int) {
+            std::copy(to + begin, to + end, items + begin);
+        });
+    };
+    const auto split = [&](const Range& r, bool wide) -> std::array<Range, 2> {
+        Item* const items = m_items.data() + r.first;
+        glm::dvec3 lo, hi;
+        boxOf(items, r.count, wide, lo, hi);
         Node& node = m_nodes[r.at];
         node.lo = lo;
         node.hi = hi;
@@ -108,27 +195,34 @@ ExactPointTree::ExactPointTree(const PointView& points, int threads) {
         const glm::dvec3 e = hi - lo;
         const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
         const uint32_t half = r.count / 2;
-        std::nth_element(items, items + half, items + r.count,
-                         [axis](const Item& x, const Item& y) { return x.p[axis] < y.p[axis]; });
+        if (wide)
+            parallelSelect(items, r.count, half, axis);
+        else
+            std::nth_element(items, items + half, items + r.count,
+                             [axis](const Item& x, const Item& y) { return x.p[axis] < y.p[axis]; });
         node.split = items[half].p[axis];
         node.axis = uint32_t(axis);
         node.right = uint32_t(r.at + 1 + counts.of(half));
         return {Range{r.at + 1, r.first, half}, Range{node.right, r.first + half, r.count - half}};
     };
     const auto subtree = [&](const auto& self, const Range& r) -> void {
-        for (const Range& c : split(r))
+        for (const Range& c : split(r, false))
             if (c.count > 0) self(self, c);
     };
-    // The top levels one level at a time, a level's nodes in parallel (the
-    // root's selection alone on one thread); then the subtrees below as
+    // The top levels one level at a time: while a level has fewer ranges
+    // than workers, each large range on every worker in turn; then a
+    // level's ranges in parallel, one a task; then the subtrees below as
     // parallel tasks, each depth first on one thread.
-    const int workers = core::resolveThreads(threads, n / kParallelPoints + 1);
     std::vector<Range> level{Range{0, 0, uint32_t(n)}};
     while (!level.empty() && level.size() < 4 * size_t(workers) && level.front().count >= kParallelPoints) {
         std::vector<std::array<Range, 2>> halves(level.size());
-        core::parallelChunks(level.size(), 1, workers, [&](size_t begin, size_t end, int) {
-            for (size_t i = begin; i < end; ++i) halves[i] = split(level[i]);
-        });
+        if (workers > 1 && level.size() < size_t(workers) && level.front().count >= kParallelSelectPoints) {
+            for (size_t i = 0; i < level.size(); ++i) halves[i] = split(level[i], true);
+        } else {
+            core::parallelChunks(level.size(), 1, workers, [&](size_t begin, size_t end, int) {
+                for (size_t i = begin; i < end; ++i) halves[i] = split(level[i], false);
+            });
+        }
         std::vector<Range> next;
         for (const auto& h : halves)
             for (const Range& c : h)
@@ -284,9 +378,18 @@ uint64_t makePerPointExact(PerPoint& perPoint, const PointView& q, const PointVi
         radixSortKeys(order, std::bit_width(t.count / 8), threads);
     }
     std::atomic<uint64_t> changed{0};
+    const auto* queryBytes = static_cast<const char*>(q.data);
     core::parallelChunks(nq, kQueryChunk, threads, [&](size_t begin, size_t end, int) {
         uint64_t mine = 0;
         for (size_t k = begin; k < end; ++k) {
+            // In the starts' order the queries' coordinates and entries are
+            // read at random: each asked for kPrefetch queries ahead.
+            if (!order.empty() && k + kPrefetch < end) {
+                const size_t j = order[k + kPrefetch] & 0xffffffffu;
+                __builtin_prefetch(queryBytes + j * q.strideBytes);
+                __builtin_prefetch(&perPoint.nearest[j], 1);
+                if (distances) __builtin_prefetch(&perPoint.distance[j], 1);
+            }
             const auto i = uint32_t(order.empty() ? k : order[k] & 0xffffffffu);
             const glm::dvec3 p = q.at(i);
             const uint32_t start = perPoint.nearest[i];

@@ -99,24 +99,41 @@ TEST(ExactPointTree, NearestIsTheBruteForcesFromAnyStart) {
     }
 }
 
-// Past 2^16 points a node's halves are built on two threads: the same
-// answers as the brute force on any thread count.
+// Past 2^12 points a level's ranges are built on several threads, and a
+// level of fewer ranges than threads selects each range's median of 2^16 or
+// more points on every thread (a sample's brackets, a three-way scatter):
+// the same answers as the brute force on any thread count, for spread
+// coordinates with copies, a lattice whose split axis holds four values
+// only, points sorted along that axis, and a set whose evenly spaced sample
+// lies far from its median (the selection's fallback).
 TEST(ExactPointTree, AParallelBuildAnswersAsTheBruteForce) {
     test::Rng rng(7005);
-    std::vector<glm::dvec3> t;
+    std::vector<std::vector<glm::dvec3>> sets(4);
     for (int i = 0; i < 150000; ++i)
-        t.emplace_back(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-0.1, 0.1));
-    for (int i = 0; i < 20000; ++i) t.push_back(t[rng.index(t.size())]);  // copies
-    for (int threads : {1, 4}) {
-        const ExactPointTree tree(PointView(t), threads);
-        test::Rng queries(7006);
-        for (int i = 0; i < 60; ++i) {
-            const glm::dvec3 p(queries.uniform(-1.2, 1.2), queries.uniform(-1.2, 1.2),
-                               queries.uniform(-0.2, 0.2));
-            const oracle::NearestExact want = oracle::bruteForceNearestInDouble(p, t);
-            const ExactPointTree::Nearest got = tree.nearest(p, 17, core::exactDistance(p, t[17]));
-            ASSERT_EQ(got.distance, want.distance) << threads << " threads, query " << i;
-            ASSERT_EQ(got.index, want.targetIndex) << threads << " threads, query " << i;
+        sets[0].emplace_back(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-0.1, 0.1));
+    for (int i = 0; i < 20000; ++i) sets[0].push_back(sets[0][rng.index(sets[0].size())]);  // copies
+    for (int i = 0; i < 140000; ++i)
+        sets[1].emplace_back(double(i % 4) * 0.6 - 0.9, rng.uniform(-0.3, 0.3), rng.uniform(-0.1, 0.1));
+    for (int i = 0; i < 140000; ++i)
+        sets[2].emplace_back(-1.0 + 2.0 * i / 140000.0, rng.uniform(-0.2, 0.2), rng.uniform(-0.05, 0.05));
+    for (int i = 0; i < 4096 * 40; ++i)  // the sample reads every 40th item: all at one end
+        sets[3].emplace_back(i % 40 == 0 ? -1.0 : rng.uniform(-1, 1), rng.uniform(-1, 1),
+                             rng.uniform(-0.1, 0.1));
+    for (size_t s = 0; s < sets.size(); ++s) {
+        const std::vector<glm::dvec3>& t = sets[s];
+        for (int threads : {1, 4}) {
+            const ExactPointTree tree(PointView(t), threads);
+            test::Rng queries(7006);
+            for (int i = 0; i < 60; ++i) {
+                const glm::dvec3 p(queries.uniform(-1.2, 1.2), queries.uniform(-1.2, 1.2),
+                                   queries.uniform(-0.2, 0.2));
+                const oracle::NearestExact want = oracle::bruteForceNearestInDouble(p, t);
+                const ExactPointTree::Nearest got = tree.nearest(p, 17, core::exactDistance(p, t[17]));
+                ASSERT_EQ(got.distance, want.distance)
+                    << "set " << s << ", " << threads << " threads, query " << i;
+                ASSERT_EQ(got.index, want.targetIndex)
+                    << "set " << s << ", " << threads << " threads, query " << i;
+            }
         }
     }
 }
