@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "rthdist/export.hpp"
+#include "rthdist/point_view.hpp"
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
 
@@ -85,9 +86,11 @@ struct HausdorffStats {
                                                       const StatsOptions& options, double histogramLo,
                                                       double histogramHi);
 
+// a, b: the sets the result was computed on, as given (float or double
+// views; their diagonals are taken in double from these values, so a double
+// input's diagonal is its own, not its float copy's).
 [[nodiscard]] RTHDIST_API Result<HausdorffStats> hausdorffStats(const HausdorffResult& result,
-                                                                std::span<const glm::vec3> a,
-                                                                std::span<const glm::vec3> b,
+                                                                const PointView& a, const PointView& b,
                                                                 const StatsOptions& options = {});
 
 // Symmetric ("max") or pooled ("pooled") percentile p by variant name; false

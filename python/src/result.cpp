@@ -153,18 +153,16 @@ const std::vector<double>& meanSet(PyResult& r) {
     return r.result.directedOnly ? r.sortedA : r.sortedPooled;
 }
 
-std::vector<glm::vec3> floatPoints(const py::object& array) {
-    const py::array_t<double, py::array::forcecast> d(array);
+// A kept input as C-ordered doubles (N, >= 3): the statistics' diagonals are
+// taken from the values as given (a float32 array's are exact in double).
+py::array_t<double, py::array::c_style | py::array::forcecast> keptDoubles(const py::object& array) {
+    py::array_t<double, py::array::c_style | py::array::forcecast> d(array);
     if (d.ndim() != 2 || d.shape(1) < 3) throw py::value_error("stats: the kept input is not (N, 3)");
-    auto v = d.unchecked<2>();
-    std::vector<glm::vec3> out(size_t(d.shape(0)));
-    constexpr double kMax = std::numeric_limits<float>::max();
-    auto narrow = [](double x) {
-        return x > kMax ? INFINITY : x < -kMax ? -INFINITY : static_cast<float>(x);
-    };
-    for (py::ssize_t i = 0; i < d.shape(0); ++i)
-        out[size_t(i)] = {narrow(v(i, 0)), narrow(v(i, 1)), narrow(v(i, 2))};
-    return out;
+    return d;
+}
+
+PointView viewOf(const py::array_t<double, py::array::c_style | py::array::forcecast>& d) {
+    return PointView::doubles(d.data(), size_t(d.shape(0)), size_t(d.shape(1)) * sizeof(double));
 }
 
 py::list percentileList(const std::vector<Percentile>& list) {
@@ -202,9 +200,9 @@ py::dict stats(PyResult& r, const std::vector<double>& percentiles, int bins, py
     }
     if (bins < 1) throw py::value_error("bins must be >= 1");
     for (double p : percentiles) checkPercentile(p);
-    const std::vector<glm::vec3> a = floatPoints(r.a);
-    const std::vector<glm::vec3> b = floatPoints(r.b);
-    const HausdorffStats s = valueOrRaise(hausdorffStats(r.result, a, b, options));
+    const auto a = keptDoubles(r.a);
+    const auto b = keptDoubles(r.b);
+    const HausdorffStats s = valueOrRaise(hausdorffStats(r.result, viewOf(a), viewOf(b), options));
     const bool directed = r.result.directedOnly;
     py::dict d;
     d["diagonal"] = s.diagonal;
@@ -370,7 +368,10 @@ void bindResult(py::module_& m) {
         .def(
             "histogram",
             [](PyResult& r, int bins, py::object range) {
-                return stats(r, {}, bins, std::move(range))["histogram"];
+                // A dict of its own (an item accessor of the temporary stats
+                // dict would outlive it).
+                const py::dict all = stats(r, {}, bins, std::move(range));
+                return py::dict(all["histogram"]);
             },
             py::arg("bins") = 20, py::arg("range") = py::none(),
             "stats(bins=bins, range=range)['histogram']: counts per direction and pooled, edges, "

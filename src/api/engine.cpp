@@ -114,6 +114,7 @@ struct PreparedSet::Impl {
     glm::dvec3 origin{0.0};
     std::vector<glm::vec3> floats;      // p - origin rounded: what the backend searches
     std::vector<glm::dvec3> originals;  // the input when it is not float-exact
+    bool doubleInput = false;           // given as doubles (per-point entries exact: makePerPointExact)
     double ownScale = 1.0;              // core::exactScale of `floats` alone
     std::shared_ptr<api::BackendSet> set;
     size_t count = 0;
@@ -212,6 +213,10 @@ namespace {
 // is double); witnesses and distances come back in the original coordinates.
 struct CheckedInputs {
     core::SetSummary a, b;
+    // Either set was given as doubles though its view here is float (a
+    // float-exact prepared set indexed again: kReframe): per-point entries
+    // are made exact as for double views.
+    bool givenAsDoubles = false;
 };
 
 Result<CheckedInputs> checkInputs(const PointView& a, const PointView& b, int threads) {
@@ -281,6 +286,10 @@ struct Frame {
     PointView a, b;
     bool restore = false;  // the backend searched copies: distances recomputed from a and b
     bool onHost = true;    // the host can read a and b (else the device's own proof stands)
+    // Either set was given as doubles: per-point entries are made exact
+    // (float-exact doubles too: their float search is a float32 input's,
+    // whose pairs are only within a relative 2^-21).
+    bool doubleInput = false;
 };
 
 // Leaves the frame: the one place a result returns to the caller's
@@ -291,10 +300,11 @@ std::optional<Error> leaveFrame(Engine::Impl& impl, HausdorffResult& r, const Fr
     r.origin = frame.origin;
     if (auto err = api::settleCertificates(r, frame.a, frame.b, impl.options.threads, frame.onHost))
         return err;
-    // Only where the backend searched rounded copies (double inputs): their
-    // float pairs' distances may be e, an absolute 2^-20 of the frame, off;
-    // float inputs searched as they are only by a relative ~2^-21.
-    if (call.perPointDistances && frame.onHost && frame.restore)
+    // Double inputs (README "Per-point distances"): their float pairs'
+    // distances may be e, an absolute 2^-20 of the frame, off (a relative
+    // ~2^-21 where they are float values searched as they are); float
+    // inputs keep their pairs (within that relative bound, documented).
+    if (call.perPointDistances && frame.onHost && frame.doubleInput)
         if (auto err = makePerPointExact(r, frame.a, frame.b, impl.options.threads)) return err;
     finishResult(impl, r, call, t0);
     return std::nullopt;
@@ -411,8 +421,11 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     // The spans are the caller's floats: the checked boxes are theirs.
     std::optional<core::Bounds> box;
     if (!copied) box = core::unite(checked.a.box, checked.b.box);
-    Result<HausdorffResult> r = finished(impl, runWithinBudget(impl, fa.span(), fb.span(), scale, call, box),
-                                         Frame{origin, a, b, copied}, call, t0);
+    Result<HausdorffResult> r = finished(
+        impl, runWithinBudget(impl, fa.span(), fb.span(), scale, call, box),
+        Frame{origin, a, b, copied, true,
+              checked.givenAsDoubles || a.scalar == Scalar::kFloat64 || b.scalar == Scalar::kFloat64},
+        call, t0);
     if (r) r->timings.pieces += narrowingMs;
     return r;
 }
@@ -571,8 +584,12 @@ api::PairShape preparedShape(const Engine::Impl& impl, const PreparedSet::Impl& 
 Frame preparedFrame(const PreparedSet::Impl& a, const PreparedSet::Impl& b) {
     // Sets prepared from device views keep no host copy: their proof is the device's own.
     const bool onHost = !a.onDevice && !b.onDevice;
-    return Frame{a.origin, onHost ? a.input() : PointView{}, onHost ? b.input() : PointView{},
-                 !a.originals.empty() || !b.originals.empty(), onHost};
+    return Frame{a.origin,
+                 onHost ? a.input() : PointView{},
+                 onHost ? b.input() : PointView{},
+                 !a.originals.empty() || !b.originals.empty(),
+                 onHost,
+                 a.doubleInput || b.doubleInput};
 }
 
 }  // namespace
@@ -709,6 +726,7 @@ Result<PreparedSet> Engine::prepare(PointView points, const PrepareOptions& opti
         if (auto err = core::checkShiftedExtent(summary->box, set->origin, "to prepare")) return *err;
     }
     set->floats = core::roundedCopy(points, set->origin, m_impl->options.threads);
+    set->doubleInput = points.scalar == Scalar::kFloat64;
     if (!summary->floatExact) {
         set->originals.resize(points.count);
         for (size_t i = 0; i < points.count; ++i) set->originals[i] = points.at(i);
@@ -763,7 +781,8 @@ Result<HausdorffResult> Engine::compute(const PreparedSet& a, const PreparedSet&
         }
         case api::Route::kReframe:
             // Different frames or scales: both indexed afresh in the union's frame.
-            return computeViews(*m_impl, ia.input(), ib.input(), CheckedInputs{ia.summary, ib.summary}, call,
+            return computeViews(*m_impl, ia.input(), ib.input(),
+                                CheckedInputs{ia.summary, ib.summary, ia.doubleInput || ib.doubleInput}, call,
                                 t0);
         case api::Route::kPrepared:
             return finished(*m_impl, m_impl->backend->computePrepared(*ia.set, *ib.set, call),

@@ -12,17 +12,18 @@
 namespace rthdist {
 namespace {
 
-double diagonalOf(std::span<const glm::vec3> points, glm::dvec3& lo, glm::dvec3& hi) {
-    for (const glm::vec3& p : points) {
-        lo = glm::min(lo, glm::dvec3(p));
-        hi = glm::max(hi, glm::dvec3(p));
+double diagonalOf(const PointView& points, glm::dvec3& lo, glm::dvec3& hi) {
+    for (size_t i = 0; i < points.count; ++i) {
+        const glm::dvec3 p = points.at(i);
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
     }
     if (points.empty()) return 0.0;
     const glm::dvec3 d = hi - lo;
     return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
 }
 
-double diagonalOf(std::span<const glm::vec3> points) {
+double diagonalOf(const PointView& points) {
     glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
     return diagonalOf(points, lo, hi);
 }
@@ -100,8 +101,8 @@ DistanceStats distanceStats(std::span<const double> distances, const StatsOption
     return s;
 }
 
-Result<HausdorffStats> hausdorffStats(const HausdorffResult& result, std::span<const glm::vec3> a,
-                                      std::span<const glm::vec3> b, const StatsOptions& options) {
+Result<HausdorffStats> hausdorffStats(const HausdorffResult& result, const PointView& a, const PointView& b,
+                                      const StatsOptions& options) {
     if (result.aNearest.distance.size() != a.size() ||
         (!result.directedOnly && result.bNearest.distance.size() != b.size())) {
         return Error{ErrorCode::kInvalidArgument,

@@ -11,6 +11,7 @@
 #include <glm/vec3.hpp>
 
 #include <cmath>
+#include <tuple>
 #include <vector>
 
 #include "api/engine_test_support.hpp"
@@ -73,6 +74,59 @@ TEST(ExactPerPoint, EntriesAreTheBruteForcesInAFrameStretchedByStrays) {
             EXPECT_EQ(r->validationMessages, 0u);
         }
     }
+}
+
+// Doubles that are float32 values are searched as they are (origin 0), so
+// their float pairs are only within a relative ~2^-21 of the nearest: far
+// from each other, near ties among the targets are mis-ordered. Their
+// per-point entries are exact too (float64 input), on prepared sets of one
+// frame (Route::kPrepared), of two frames indexed again (kReframe: a set
+// near the origin), against a host array and in computeBatch.
+std::vector<glm::dvec3> floatValued(size_t n, glm::dvec3 at, double side, uint64_t seed) {
+    test::Rng rng(seed);
+    std::vector<glm::dvec3> p;
+    for (size_t i = 0; i < n; ++i)
+        p.push_back(glm::dvec3(
+            glm::vec3(at + glm::dvec3(rng.uniform(0, side), rng.uniform(0, side), rng.uniform(0, side)))));
+    return p;
+}
+
+TEST(ExactPerPoint, FloatValuedDoublesArePreparedAndMadeExact) {
+    const std::vector<glm::dvec3> a = floatValued(400, glm::dvec3(524300.0, 5412345.0, 100.0), 20.0, 91);
+    const std::vector<glm::dvec3> b = floatValued(400, glm::dvec3(530300.0, 5417345.0, 140.0), 20.0, 92);
+    const std::vector<glm::dvec3> nearOrigin = floatValued(300, glm::dvec3(0.25, 0.5, 0.125), 1.0, 93);
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    CallOptions call;
+    call.perPointDistances = true;
+    uint64_t mended = 0;
+    const auto check = [&](const Result<HausdorffResult>& r, const std::vector<glm::dvec3>& q,
+                           const std::vector<glm::dvec3>& t, const char* what) {
+        SCOPED_TRACE(what);
+        ASSERT_TRUE(r) << r.error().message;
+        for (auto [got, d, qq, tt] :
+             {std::tuple{&r->aNearest, &r->aToB, &q, &t}, std::tuple{&r->bNearest, &r->bToA, &t, &q}}) {
+            const std::vector<oracle::NearestExact> want = bruteNearest(*qq, *tt);
+            ASSERT_EQ(got->nearest.size(), want.size());
+            for (size_t i = 0; i < want.size(); ++i) {
+                ASSERT_EQ(got->nearest[i], want[i].targetIndex) << "point " << i;
+                ASSERT_EQ(got->distance[i], want[i].distance) << "point " << i;
+            }
+            mended += d->counters.perPointMended;
+        }
+    };
+    Result<PreparedSet> pa = engine->prepare(PointView(a)), pb = engine->prepare(PointView(b)),
+                        po = engine->prepare(PointView(nearOrigin));
+    ASSERT_TRUE(pa && pb && po);
+    check(engine->compute(*pa, *pb, call), a, b, "prepared, one frame");
+    check(engine->compute(*pa, *po, call), a, nearOrigin, "prepared, two frames");
+    check(engine->compute(PointView(a), PointView(b), call), a, b, "host arrays");
+    const PreparedSet sets[] = {*pa, *pb, *po};
+    const PairRef pairs[] = {{0, 1}, {0, 2}};
+    std::vector<Result<HausdorffResult>> batch = engine->computeBatch(sets, pairs, call);
+    ASSERT_EQ(batch.size(), 2u);
+    check(batch[0], a, b, "batch, one frame");
+    check(batch[1], a, nearOrigin, "batch, two frames");
+    EXPECT_GT(mended, 0u) << "no float pair was off: the case tests nothing";
 }
 
 }  // namespace

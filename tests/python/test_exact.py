@@ -125,3 +125,40 @@ def test_per_point_exact_for_doubles_beside_far_strays(backend):
         np.testing.assert_array_equal(got_d, want_d)
         np.testing.assert_array_equal(got_i, want_i)
         assert r.counters[key]["per_point_mended"] > 0
+
+
+def test_statistics_of_doubles_keep_their_diagonals(backend):
+    """stats()'s diagonals are those of the float64 inputs as given (they were taken from float32
+    copies: two points 1 cm apart at UTM coordinates measured a diagonal of 0), and histogram() is the
+    stats' histogram, a dict of its own (it was an accessor into a freed dict: reading it crashed)."""
+    a = np.array([[500000.0, 5400000.0, 100.0], [500000.01, 5400000.01, 100.0]])
+    b = a + [0.0, 0.0, 0.003]
+    r = rthdist.hausdorff(a, b, per_point=True, backend=backend)
+    s = r.stats(bins=5)
+
+    def diagonal(p):
+        d = p.max(axis=0) - p.min(axis=0)
+        return float(np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))
+
+    assert s["diagonal_a"] == diagonal(a) > 0.0
+    assert s["diagonal_b"] == diagonal(b) > 0.0
+    assert s["diagonal"] == diagonal(np.vstack([a, b]))
+    h = r.histogram(bins=5)
+    del s
+    np.testing.assert_array_equal(h["edges"], r.stats(bins=5)["histogram"]["edges"])
+    assert h["a_to_b"].sum() == len(a) and h["b_to_a"].sum() == len(b)
+
+
+def test_prepared_float_valued_doubles_are_exact(backend):
+    """float64 arrays whose values are float32 values are searched as they are; on prepared sets too
+    their per-point entries are the brute force's in double (they were the float pairs: 13 entries of
+    a differential campaign off, e.g. 5422039.905629439 for 5422039.870868671)."""
+    a = np.array([[502598.625, 5398696.0, 1155.53076171875], [500000.125, 5400000.5, 100.78900146484375]])
+    b = np.array([[0.375, 0.75, 0.125], [0.75, 0.75, 0.125]])
+    want_d, want_i = _nearest_double(a, b)
+    with rthdist.Engine(backend) as engine:
+        pa, pb = engine.prepare(a), engine.prepare(b)
+        for r in (engine.hausdorff(pa, pb, per_point=True), engine.hausdorff(pa, b, per_point=True),
+                  engine.hausdorff_many([pa, pb], [(0, 1)], per_point=True)[0]):
+            np.testing.assert_array_equal(r.a_distances, want_d)
+            np.testing.assert_array_equal(r.a_nearest, want_i)

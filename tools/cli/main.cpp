@@ -141,7 +141,7 @@ int run(const std::vector<std::string>& argv) {
     if (args.perPoint) {
         const std::vector<glm::vec3> floatsA = floatPoints(*a);
         const std::vector<glm::vec3> floatsB = floatPoints(*b);
-        Result<HausdorffStats> s = hausdorffStats(*result, floatsA, floatsB, statsOptionsFrom(args));
+        Result<HausdorffStats> s = hausdorffStats(*result, a->view(), b->view(), statsOptionsFrom(args));
         if (!s) {
             return fail(kExitInternal, std::string("the ") + backendName(result->backend) +
                                            " backend returned no per-point distances: " + s.error().message);

@@ -194,8 +194,15 @@ int surfaceCommand(const CliArgs& args) {
     if (args.perPoint) {
         const std::vector<glm::vec3> floats = floatPoints(*points);
         const std::vector<glm::vec3> vertices = floatPoints(mesh->vertices);
-        const SurfacePerPointRun perPoint{&args,    sides.q == "b",   floats,           vertices,
-                                          &*result, sides.pointsPath, sides.surfacePath};
+        const SurfacePerPointRun perPoint{&args,
+                                          sides.q == "b",
+                                          floats,
+                                          vertices,
+                                          &*result,
+                                          sides.pointsPath,
+                                          sides.surfacePath,
+                                          points->view(),
+                                          mesh->vertices.view()};
         Result<HausdorffStats> s = surfaceStats(perPoint);
         if (!s) return fail(Error{ErrorCode::kInternal, s.error().message});
         stats = std::move(s).value();

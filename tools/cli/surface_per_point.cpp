@@ -59,7 +59,8 @@ Json mirror(const Json& j) {
 Result<HausdorffStats> surfaceStats(const SurfacePerPointRun& run) {
     if (run.result->perPoint.distance.size() != run.points.size())
         return Error{ErrorCode::kInvalidArgument, "the surface search returned no per-point distances"};
-    return hausdorffStats(directedView(*run.result), run.points, run.vertices, statsOptionsFrom(*run.args));
+    return hausdorffStats(directedView(*run.result), run.pointsAsGiven, run.verticesAsGiven,
+                          statsOptionsFrom(*run.args));
 }
 
 Json surfaceStatsJson(const HausdorffStats& stats, bool fromB) {

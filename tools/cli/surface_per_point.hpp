@@ -38,6 +38,9 @@ struct SurfacePerPointRun {
     std::span<const glm::vec3> vertices;  // the surface's vertices, rounded to float
     const SurfaceResult* result = nullptr;
     std::string pointsPath, surfacePath;
+    // Both sides as loaded (double where the files are): the statistics'
+    // diagonals are theirs.
+    PointView pointsAsGiven, verticesAsGiven;
 };
 
 // The statistics of run.result->perPoint.distance (statsOptionsFrom(args));
