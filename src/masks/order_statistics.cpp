@@ -150,8 +150,13 @@ double percentileTorchFloat32(std::span<double> values, double p, int threads, V
 double percentilePlastimatch(std::span<double> values, double p, int threads, ValueRange range) {
     const size_t n = values.size();
     if (n == 0) return 0.0;
-    double k = std::floor((p / 100.0) * double(n) - 1.0);
-    k = std::clamp(k, 0.0, double(n - 1));
+    // As plastimatch's Hausdorff_distance computes it: a float fraction
+    // times the count, minus 1, floored, all in float32. In double the rank
+    // of p = 57 of n = 100 came out 55 (0.57 * 100 = 56.99999999999999),
+    // float32's and the exact floor(pn/100 - 1) are 56.
+    const float fraction = float(p / 100.0);
+    const float rank = std::floor(fraction * float(n) - 1.0f);
+    const double k = std::clamp(double(rank), 0.0, double(n - 1));
     return kthSmallest(values, size_t(k), threads, range);
 }
 

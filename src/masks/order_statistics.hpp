@@ -41,7 +41,8 @@ using ValueRange = std::optional<std::pair<double, double>>;  // least, greatest
 [[nodiscard]] double percentileTorchFloat32(std::span<double> values, double p, int threads,
                                             ValueRange range = {});
 
-// plastimatch: the k-th smallest (0-based), k = floor(f n - 1) clamped to [0, n-1]; 0 when empty.
+// plastimatch: the k-th smallest (0-based), k = floor(f n - 1) clamped to [0, n-1], f = p / 100,
+// evaluated in float32 as plastimatch does; 0 when empty.
 [[nodiscard]] double percentilePlastimatch(std::span<double> values, double p, int threads,
                                            ValueRange range = {});
 

@@ -21,9 +21,24 @@ double sortedLinear(const std::vector<double>& s, double p) {
     return t >= 0.5 ? s[j] - diff * (1.0 - t) : s[i] + diff * t;
 }
 
+// plastimatch's rank: its float fraction times the count, minus 1, floored, in float32.
 double sortedPlastimatch(const std::vector<double>& s, double p) {
-    const double k = std::clamp(std::floor((p / 100.0) * double(s.size()) - 1.0), 0.0, double(s.size() - 1));
+    const float rank = std::floor(float(p / 100.0) * float(s.size()) - 1.0f);
+    const double k = std::clamp(double(rank), 0.0, double(s.size() - 1));
     return s[size_t(k)];
+}
+
+TEST(OrderStatistics, PlastimatchsRankIsItsFloat32One) {
+    // 0.57 * 100 - 1 is 55.99999999999999 in double: floor 55; in float32
+    // (and exactly) 56. The same for p = 29 of 100 and p = 70 of 90.
+    std::vector<double> values(100);
+    for (size_t i = 0; i < values.size(); ++i) values[i] = double(99 - i);  // value = rank
+    std::vector<double> work = values;
+    EXPECT_EQ(percentilePlastimatch(work, 57.0, 2), 56.0);
+    work = values;
+    EXPECT_EQ(percentilePlastimatch(work, 29.0, 2), 28.0);
+    std::vector<double> ninety(values.end() - 90, values.end());
+    EXPECT_EQ(percentilePlastimatch(ninety, 70.0, 2), 62.0);
 }
 
 double sortedNearestRank(const std::vector<double>& s, double p) {
