@@ -409,8 +409,8 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     double narrowingMs = 0.0;  // looking for it (Timings::pieces), whether it narrows or not
     if (narrow) {
         const auto narrowStart = core::Clock::now();
-        std::optional<api::PairNarrowing> narrowed =
-            api::narrowPair(a, checked.a, b, checked.b, call.directedOnly, impl.options.threads);
+        std::optional<api::PairNarrowing> narrowed = api::narrowPair(
+            a, checked.a, b, checked.b, call.directedOnly, impl.options.threads, call.perPointDistances);
         narrowingMs = core::msSince(narrowStart);
         if (narrowed) return computeNarrowed(impl, a, b, checked, call, t0, *narrowed, narrowingMs);
     }
@@ -647,7 +647,8 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
         const auto start = core::Clock::now();
         Result<CheckedInputs> boxes = checkInputs(a, b, threads);
         if (boxes && mayNarrow(boxes->a.box, boxes->b.box, a, b, call))
-            narrowed = api::narrowPair(a, boxes->a, b, boxes->b, call.directedOnly, threads);
+            narrowed =
+                api::narrowPair(a, boxes->a, b, boxes->b, call.directedOnly, threads, call.perPointDistances);
         narrowingMs = core::msSince(start);
         if (narrowed) return computeNarrowed(impl, a, b, *boxes, call, t0, *narrowed, narrowingMs);
     } else if (check) {
@@ -655,7 +656,8 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
             if (!mayNarrow(boxA, boxB, a, b, call)) return false;
             const auto start = core::Clock::now();
             const CheckedInputs boxes{core::SetSummary{boxA, true}, core::SetSummary{boxB, true}};
-            narrowed = api::narrowPair(a, boxes.a, b, boxes.b, call.directedOnly, threads);
+            narrowed =
+                api::narrowPair(a, boxes.a, b, boxes.b, call.directedOnly, threads, call.perPointDistances);
             narrowingMs = core::msSince(start);
             if (!narrowed) return false;
             checked = boxes;

@@ -149,9 +149,9 @@ TEST(NarrowedTargets, CommonStraysAreSetApartAndTheRestNarrowed) {
 // How the pair narrows on the host (api::narrowPair over the sets' own
 // boxes): nullopt, one call on both cores (joint) or directions apart.
 std::optional<api::PairNarrowing> narrowing(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                                            bool directedOnly = false) {
+                                            bool directedOnly = false, bool perPoint = false) {
     return api::narrowPair(a, core::SetSummary{core::boundsOf(a), true}, b,
-                           core::SetSummary{core::boundsOf(b), true}, directedOnly, 2);
+                           core::SetSummary{core::boundsOf(b), true}, directedOnly, 2, perPoint);
 }
 
 // Strays of their own in both sets: h is kilometres, far above the slack,
@@ -166,6 +166,26 @@ TEST(NarrowedTargets, StraysInBothSetsSearchEveryTarget) {
     expectExact(*r, a, b, false);
     EXPECT_EQ(r->aToB.counters.narrowedTargets, 0u);
     EXPECT_EQ(r->bToA.counters.narrowedTargets, 0u);
+}
+
+// The same pair with per-point output: every query's nearest is wanted,
+// not h alone, so the cores are searched jointly in their own frame (the
+// strays' stretched it ~10^6-fold) and the strays against every target.
+TEST(NarrowedTargets, PerPointCallsSearchTheCoresOfStraysOfTheirOwn) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    const std::vector<glm::vec3> a = farCluster(2000, 1e-3f, 3, 31), b = farCluster(2000, 1e-3f, 3, 32);
+    const std::optional<api::PairNarrowing> n = narrowing(a, b, false, true);
+    ASSERT_TRUE(n && n->joint);
+    for (const bool directed : {false, true}) {
+        CallOptions call;
+        call.perPointDistances = true;
+        call.directedOnly = directed;
+        Result<HausdorffResult> r = engine->compute(a, b, call);
+        ASSERT_TRUE(r) << r.error().message;
+        expectExact(*r, a, b, true);
+        EXPECT_EQ(r->aToB.counters.narrowedTargets, 2000u + 4u);  // B's cluster and its duplicates
+        if (!directed) EXPECT_EQ(r->bToA.counters.narrowedTargets, 2000u + 4u);
+    }
 }
 
 // Each set's box reaches kilometres past the other's (A's far stray on x,

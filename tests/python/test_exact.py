@@ -110,13 +110,14 @@ def _nearest_double(q, t):
 
 
 def test_per_point_exact_for_doubles_beside_far_strays(backend):
-    """Double points in a 1 mm cube at UTM coordinates, each set with a stray kilometres away: the float
-    search's pairs are often not the nearest (e ~ 2^-20 of the frame), so the exact pass mends them;
-    every entry equals the brute force in double (README "Per-point distances")."""
+    """Double points in two 1 mm cubes kilometres apart at UTM coordinates (no core of all but a few
+    points to narrow the search to): the float search's pairs are often not the nearest (e ~ 2^-20 of
+    the frame), so the exact pass mends them; every entry equals the brute force in double (README
+    "Per-point distances")."""
     at = np.array([512345.125, 5412345.5, 100.0])
     r1, r2 = np.random.default_rng(81), np.random.default_rng(82)
-    a = np.vstack([at + r1.random((1500, 3)) * 1e-3, at + [2500.0, -2500.0, 1250.0]])
-    b = np.vstack([at + r2.random((1000, 3)) * 1e-3, at + [3100.0, -3100.0, 1550.0]])
+    a = np.vstack([at + r1.random((750, 3)) * 1e-3, at + [2500.0, -2500.0, 1250.0] + r1.random((750, 3)) * 1e-3])
+    b = np.vstack([at + r2.random((500, 3)) * 1e-3, at + [3100.0, -3100.0, 1550.0] + r2.random((500, 3)) * 1e-3])
     r = rthdist.hausdorff(a, b, per_point=True, backend=backend)
     for got_d, got_i, (want_d, want_i), key in (
         (r.a_distances, r.a_nearest, _nearest_double(a, b), "a_to_b"),
@@ -125,6 +126,23 @@ def test_per_point_exact_for_doubles_beside_far_strays(backend):
         np.testing.assert_array_equal(got_d, want_d)
         np.testing.assert_array_equal(got_i, want_i)
         assert r.counters[key]["per_point_mended"] > 0
+
+
+def test_per_point_searches_the_clusters_of_strays_of_their_own(backend):
+    """A double cluster beside a km stray in each set: per point, the clusters are searched together in
+    their own frame (narrowed targets), the strays against every target; every entry is exact."""
+    at = np.array([512345.125, 5412345.5, 100.0])
+    r1, r2 = np.random.default_rng(83), np.random.default_rng(84)
+    a = np.vstack([at + r1.random((1500, 3)) * 1e-3, at + [2500.0, -2500.0, 1250.0]])
+    b = np.vstack([at + r2.random((1000, 3)) * 1e-3, at + [3100.0, -3100.0, 1550.0]])
+    r = rthdist.hausdorff(a, b, per_point=True, backend=backend)
+    for got_d, got_i, (want_d, want_i), key, kept in (
+        (r.a_distances, r.a_nearest, _nearest_double(a, b), "a_to_b", 1000),
+        (r.b_distances, r.b_nearest, _nearest_double(b, a), "b_to_a", 1500),
+    ):
+        np.testing.assert_array_equal(got_d, want_d)
+        np.testing.assert_array_equal(got_i, want_i)
+        assert r.counters[key]["narrowed_targets"] == kept
 
 
 def test_statistics_of_doubles_keep_their_diagonals(backend):
