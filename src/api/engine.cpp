@@ -394,6 +394,12 @@ api::Plan planHostViews(const Engine::Impl& impl, const PointView& a, const Poin
     return api::planRoute(shape, call, impl.backend->memoryBudget(), impl.backend->caps());
 }
 
+// Whether strays of their own leave a pair whole (api::narrowPair's
+// `ownStrays`): not for per-point output, nor on the GPU backends.
+bool coresForOwnStrays(const Engine::Impl& impl, const CallOptions& call) {
+    return call.perPointDistances || impl.backend->caps().coresForOwnStrays;
+}
+
 // Host views checked on the host: the frame entered (origin, float copies
 // where needed, the exact scale), the pair run, the frame left. A pair that
 // narrows (api/narrowed_targets.hpp) runs as computeNarrowed says unless
@@ -409,8 +415,9 @@ Result<HausdorffResult> computeViews(Engine::Impl& impl, const PointView& a, con
     double narrowingMs = 0.0;  // looking for it (Timings::pieces), whether it narrows or not
     if (narrow) {
         const auto narrowStart = core::Clock::now();
-        std::optional<api::PairNarrowing> narrowed = api::narrowPair(
-            a, checked.a, b, checked.b, call.directedOnly, impl.options.threads, call.perPointDistances);
+        std::optional<api::PairNarrowing> narrowed =
+            api::narrowPair(a, checked.a, b, checked.b, call.directedOnly, impl.options.threads,
+                            coresForOwnStrays(impl, call));
         narrowingMs = core::msSince(narrowStart);
         if (narrowed) return computeNarrowed(impl, a, b, checked, call, t0, *narrowed, narrowingMs);
     }
@@ -647,8 +654,8 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
         const auto start = core::Clock::now();
         Result<CheckedInputs> boxes = checkInputs(a, b, threads);
         if (boxes && mayNarrow(boxes->a.box, boxes->b.box, a, b, call))
-            narrowed =
-                api::narrowPair(a, boxes->a, b, boxes->b, call.directedOnly, threads, call.perPointDistances);
+            narrowed = api::narrowPair(a, boxes->a, b, boxes->b, call.directedOnly, threads,
+                                       coresForOwnStrays(impl, call));
         narrowingMs = core::msSince(start);
         if (narrowed) return computeNarrowed(impl, a, b, *boxes, call, t0, *narrowed, narrowingMs);
     } else if (check) {
@@ -656,8 +663,8 @@ Result<HausdorffResult> computeIngested(Engine::Impl& impl, const PointView& a, 
             if (!mayNarrow(boxA, boxB, a, b, call)) return false;
             const auto start = core::Clock::now();
             const CheckedInputs boxes{core::SetSummary{boxA, true}, core::SetSummary{boxB, true}};
-            narrowed =
-                api::narrowPair(a, boxes.a, b, boxes.b, call.directedOnly, threads, call.perPointDistances);
+            narrowed = api::narrowPair(a, boxes.a, b, boxes.b, call.directedOnly, threads,
+                                       coresForOwnStrays(impl, call));
             narrowingMs = core::msSince(start);
             if (!narrowed) return false;
             checked = boxes;

@@ -554,7 +554,7 @@ std::optional<NarrowedTargets> narrowTargets(const PointView& q, const core::Bou
 
 std::optional<PairNarrowing> narrowPair(const PointView& a, const core::SetSummary& sa, const PointView& b,
                                         const core::SetSummary& sb, bool directedOnly, int threads,
-                                        bool perPoint) {
+                                        bool ownStrays) {
     if (a.count == 0 || b.count == 0) return std::nullopt;
     const bool floatExact = sa.floatExact && sb.floatExact;
     const double whole = frameMagnitude(core::unite(sa.box, sb.box), floatExact);
@@ -564,10 +564,8 @@ std::optional<PairNarrowing> narrowPair(const PointView& a, const core::SetSumma
     // other's needs no pass to know it (the look cost 0.1-0.2 s of two
     // passes over 2 x 100M points whose strays lie kilometres apart).
     const double far = std::ldexp(whole, kNarrowGainLog2 - 20);
-    // (Per-point output needs every query's nearest: there strays of their
-    // own leave the cores to a search in the stretched frame, so the cores
-    // are looked for whatever the strays.)
-    if (!perPoint && reachesPast(sa.box, sb.box, far) && (directedOnly || reachesPast(sb.box, sa.box, far)))
+    // (`ownStrays`: the cores are looked for whatever the strays.)
+    if (!ownStrays && reachesPast(sa.box, sb.box, far) && (directedOnly || reachesPast(sb.box, sa.box, far)))
         return std::nullopt;
     const std::optional<CoreSplit> splitA = splitCore(a, sa, floatExact, whole, threads);
     if (!splitA && directedOnly) return std::nullopt;
@@ -577,7 +575,7 @@ std::optional<PairNarrowing> narrowPair(const PointView& a, const core::SetSumma
     const bool ownA = !splitA || straysOfTheirOwn(a, *splitA, b, sb.box, splitB, far, false, threads);
     const bool ownB = !splitB || straysOfTheirOwn(b, *splitB, a, sa.box, splitA, far, false, threads);
     const bool own = ownA && (directedOnly || ownB);
-    if (own && !perPoint) return std::nullopt;
+    if (own && !ownStrays) return std::nullopt;
     PairNarrowing out;
     const int workers = core::resolveThreads(threads, std::max(a.count, b.count) / kChunk + 1);
     const double strayWork =

@@ -157,13 +157,14 @@ struct PairNarrowing {
 // Before any pass over the points: nullopt when a's box reaches 2^(8-20) of
 // the pair's magnitude past b's on some axis and (unless directedOnly) b's
 // past a's (strays of their own both ways, known from the boxes).
-// `perPoint` (per-point output: every query's nearest, not h alone): strays
-// of their own do not leave the pair whole, the cores are looked for and
-// searched jointly where they gain (a 2M double cluster beside a km stray
-// in each set: the cores' frame is the clusters', not the strays').
+// `ownStrays` (per-point output, which needs every query's nearest, and
+// the GPU backends: BackendCaps::coresForOwnStrays): strays of their own do
+// not leave the pair whole, the cores are looked for and searched jointly
+// where they gain (a 2M double cluster beside a km stray in each set: the
+// cores' frame is the clusters', not the strays').
 [[nodiscard]] std::optional<PairNarrowing> narrowPair(const PointView& a, const core::SetSummary& sa,
                                                       const PointView& b, const core::SetSummary& sb,
-                                                      bool directedOnly, int threads, bool perPoint = false);
+                                                      bool directedOnly, int threads, bool ownStrays = false);
 
 template <class Fn>
 void PointSubset::forIndices(uint64_t begin, uint64_t end, Fn&& fn) const {

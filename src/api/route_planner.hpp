@@ -97,6 +97,16 @@ struct BackendCaps {
     // engine.cpp computeNarrowedCall), else the host views whose boxes the
     // narrowing took.
     bool narrowedIngest = false;
+    // A pair whose strays are their own (kilometres from the other set both
+    // ways) runs on the two cores for h alone too (api::narrowPair's
+    // `ownStrays`), not whole: the GPU backends' search of such a pair left
+    // nearly every cluster query uncut in the stretched frame (2M double
+    // points in a 5 cm cube beside one km stray per set: 2.8 s of refinement
+    // on an H200; 100k on lavapipe 1.58 s, 99,967 of 100,001 queries
+    // surviving the cull), where the CPU backend's whole search settles them
+    // at once (0.13 s, 391 surviving). Per-point calls take the cores on
+    // every backend.
+    bool coresForOwnStrays = false;
 };
 
 struct Plan {

@@ -157,15 +157,21 @@ std::optional<api::PairNarrowing> narrowing(std::span<const glm::vec3> a, std::s
 // Strays of their own in both sets: h is kilometres, far above the slack,
 // so the whole search settles the clusters at once; nothing narrows (found
 // from both sets' splits, without a pass over the other set).
+// On the GPU backends (BackendCaps::coresForOwnStrays) the cores run
+// jointly instead: their whole search of such a pair left the clusters'
+// queries uncut.
 TEST(NarrowedTargets, StraysInBothSetsSearchEveryTarget) {
     RTHDIST_REQUIRE_TEST_ENGINE(engine);
     const std::vector<glm::vec3> a = farCluster(2000, 1e-3f, 3, 31), b = farCluster(2000, 1e-3f, 3, 32);
     EXPECT_FALSE(narrowing(a, b));
+    const std::optional<api::PairNarrowing> cores = narrowing(a, b, false, true);
+    ASSERT_TRUE(cores && cores->joint);
     Result<HausdorffResult> r = engine->compute(a, b);
     ASSERT_TRUE(r) << r.error().message;
     expectExact(*r, a, b, false);
-    EXPECT_EQ(r->aToB.counters.narrowedTargets, 0u);
-    EXPECT_EQ(r->bToA.counters.narrowedTargets, 0u);
+    const uint64_t kept = test::backendUnderTest() == Backend::kCpu ? 0u : 2000u + 4u;
+    EXPECT_EQ(r->aToB.counters.narrowedTargets, kept);
+    EXPECT_EQ(r->bToA.counters.narrowedTargets, kept);
 }
 
 // The same pair with per-point output: every query's nearest is wanted,
@@ -201,12 +207,18 @@ TEST(NarrowedTargets, BoxesReachingPastEachOtherLeaveThePairWhole) {
     b.push_back(glm::vec3(0.0f, -5000.0f, 0.0f));
     EXPECT_FALSE(narrowing(a, b));
     EXPECT_FALSE(narrowing(a, b, true));
+    const bool gpu = test::backendUnderTest() != Backend::kCpu;  // BackendCaps::coresForOwnStrays
     for (bool directed : {false, true}) {
         CallOptions call;
         call.directedOnly = directed;
         Result<HausdorffResult> r = engine->compute(a, b, call);
         ASSERT_TRUE(r) << r.error().message;
         expectExact(*r, a, b, false);
+        if (gpu) {
+            const std::optional<api::PairNarrowing> cores = narrowing(a, b, directed, true);
+            EXPECT_EQ(r->aToB.counters.narrowedTargets > 0u, cores.has_value());
+            continue;
+        }
         EXPECT_EQ(r->aToB.counters.narrowedTargets, 0u);
     }
 }
