@@ -8,18 +8,29 @@
 //         item per line with exactly its properties' values; binary bodies
 //         are walked item by item to the end of the file (only blank or NUL
 //         padding may follow). A property name may appear once per element.
-//   .xyz / .txt  one "x y z" per line (extra columns ignored, '#' comments).
+//   .xyz / .txt  one "x y z" per line (extra columns ignored, '#' comments);
+//         values separated by blanks, ',' or ';'; a line that separates them
+//         both by blanks alone and by commas ("1,5 2,5 3,5": decimal commas)
+//         is refused, not read as 1, 5, 2.
 //   .obj  "v x y z" lines only.
 //   .gltf / .glb  POSITION of every primitive of every mesh instanced by the
-//         scene's nodes, with node transforms applied (tinygltf). External
+//         scene's nodes, with node transforms applied (tinygltf); a sparse
+//         POSITION accessor is refused (kBadInput naming it). External
 //         buffers are read only from regular files inside the glTF file's own
 //         directory (no absolute path, no "..", no current-directory lookup);
 //         data: URIs are decoded; images are never read.
 //   .stl  ascii and binary (every facet vertex, duplicates kept); binary when
 //         the size is 84 + 50 * facets or the file holds a NUL byte, whatever
-//         the header's first word.
+//         the header's first word. Ascii: every facet holds exactly three
+//         vertex lines of x y z before its endfacet (a vertex outside a
+//         facet, a facet of two or four, a file ending inside a facet are
+//         refused, naming the facet and line). Binary: at most 49 bytes
+//         may follow the declared facets (50 or more could be facets the
+//         count leaves out: refused).
 //   .off  OFF / COFF / NOFF headers, vertices only
 //   .pcd  ascii, binary and binary_compressed (x y z fields, any size/type;
+//         POINTS rows exactly: an ascii row past them, or a nonzero byte
+//         after the binary rows (PCL pads with zeros), is refused;
 //         binary_compressed is PCL's: the fields' columns LZF-compressed,
 //         inflated by liblzf into a buffer of their declared size, at most
 //         4 GiB - 1 and 88 times the compressed bytes, then converted)

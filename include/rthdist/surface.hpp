@@ -28,7 +28,8 @@
 //   and its distance within a few u of the coordinates' magnitude m of the
 //   exact one (~1e-16 m: 1e-10 m at UTM magnitudes of 1e6 m), slivers
 //   included; a point exactly at a vertex measures exactly 0, as does one
-//   on an edge or face at dyadic barycentric coordinates.
+//   on an edge or face at dyadic barycentric coordinates where the corners'
+//   differences are exact in double (else within the rounding above).
 //   Degenerate triangles (zero area: repeated or collinear vertices) are
 //   measured by their edges, and a sliver's closest point is a convex
 //   combination of its vertices (never outside it).

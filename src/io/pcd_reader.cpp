@@ -197,6 +197,16 @@ Result<PointCloud> readBinaryRows(std::string_view bytes, const PcdHeader& h, co
     if (auto e = checkRecordsFit(path, h.bodyOffset, "", h.points, l.bytesPerRow, bytes.size() - h.bodyOffset,
                                  "remain (truncated body or wrong count)"))
         return *e;
+    // After the rows only zeros may follow (PCL pads its files to a page): a
+    // nonzero byte could be a row the header leaves out.
+    const size_t end = h.bodyOffset + size_t(h.points * l.bytesPerRow);
+    const size_t stray = bytes.find_first_not_of('\0', end);
+    if (stray != std::string_view::npos) {
+        return badInput(path, offsetWhere(end),
+                        "the header declares " + std::to_string(h.points) + " points of " +
+                            std::to_string(l.bytesPerRow) + " bytes, but data follows them (" +
+                            std::to_string(bytes.size() - end) + " bytes past the last row)");
+    }
     const RecordLayout rows{bytes.data() + h.bodyOffset,
                             static_cast<size_t>(l.bytesPerRow),
                             h.points,
@@ -329,6 +339,12 @@ Result<PointCloud> readAsciiRows(std::string_view bytes, const PcdHeader& h, con
                             std::to_string(text.size()) + " bytes follow (truncated body or wrong count)");
     }
     TextChunks chunks = splitLines(text, h.dataLine + 1, &isRowLine, plan);
+    if (chunks.items > h.points) {
+        // Rows the header leaves out would be points silently dropped.
+        return badInput(path, lineWhere(h.dataLine),
+                        "the header declares " + std::to_string(h.points) + " points but " +
+                            std::to_string(chunks.items) + " rows follow");
+    }
     keepItems(chunks, text, &isRowLine, h.points);
     PointArray<glm::dvec3> out(static_cast<size_t>(h.points), glm::dvec3(0.0));
     auto err = parseChunks(

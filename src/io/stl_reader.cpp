@@ -1,6 +1,8 @@
 #include "io/stl_reader.hpp"
 
+#include <array>
 #include <cstdint>
+#include <string>
 
 #include "io/gzip_inflate.hpp"
 #include "io/io_error.hpp"
@@ -28,21 +30,67 @@ PointCloud readBinary(std::string_view bytes, uint64_t facets) {
     return PointCloud{Scalar::kFloat32, std::move(points), {}};
 }
 
+// Line by line: "facet" opens a facet, "vertex x y z" adds its next
+// corner, "endfacet" closes it with exactly three (a mesh's triangle t is
+// facet t's corners: one of two or four would shift every triangle after
+// it); a vertex outside a facet, a fourth vertex and a file that ends
+// inside a facet (truncated) are refused, naming the facet and the line.
+// The solid's name (the rest of a "solid" or "endsolid" line) and other
+// lines ("outer loop", "endloop", an exporter's own keywords) are not read.
 Result<PointCloud> readAscii(std::string_view bytes, const std::string& path) {
     PointArray<glm::dvec3> points;
     TextCursor cursor(bytes);
-    for (std::string_view tok = cursor.nextToken(); !tok.empty(); tok = cursor.nextToken()) {
-        if (tok != "vertex") continue;
-        double v[3];
-        for (size_t axis = 0; axis < 3; ++axis) {
-            const std::string_view num = cursor.nextToken();
-            if (!parseDouble(num, v[axis])) {
+    std::string_view line;
+    std::array<std::string_view, 5> tok{};
+    uint64_t facet = 0;   // facets opened so far
+    int corners = -1;     // of the open facet; -1: none open
+    size_t openedAt = 0;  // its "facet" line
+    auto facetName = [&facet] { return "facet " + std::to_string(facet - 1); };
+    while (cursor.nextLine(line)) {
+        const size_t n = splitTokens(trimBlank(line), tok.data(), tok.size());
+        if (n == 0) continue;
+        const std::string_view key = tok[0];
+        if (key == "facet") {
+            if (corners >= 0)
                 return badInput(path, lineWhere(cursor.line()),
-                                num.empty() ? std::string("file ends inside a vertex") : notANumber(num));
-            }
+                                facetName() + " (line " + std::to_string(openedAt) + ") has no endfacet");
+            ++facet;
+            corners = 0;
+            openedAt = cursor.line();
+        } else if (key == "vertex") {
+            if (corners < 0) return badInput(path, lineWhere(cursor.line()), "a vertex outside any facet");
+            if (corners == 3)
+                return badInput(path, lineWhere(cursor.line()),
+                                facetName() + " has more than 3 vertices (an STL facet is a triangle)");
+            if (n < 4)
+                return badInput(path, lineWhere(cursor.line()),
+                                "a vertex line with " + std::to_string(n - 1) + " values (x y z)");
+            double v[3];
+            for (size_t axis = 0; axis < 3; ++axis)
+                if (!parseDouble(tok[axis + 1], v[axis]))
+                    return badInput(path, lineWhere(cursor.line()), notANumber(tok[axis + 1]));
+            if (n > 4)
+                return badInput(path, lineWhere(cursor.line()),
+                                "a vertex line with " + std::to_string(n - 1) + " values (x y z)");
+            points.emplace_back(v[0], v[1], v[2]);
+            ++corners;
+        } else if (key == "endfacet") {
+            if (corners < 0) return badInput(path, lineWhere(cursor.line()), "endfacet outside any facet");
+            if (corners != 3)
+                return badInput(path, lineWhere(cursor.line()),
+                                facetName() + " has " + std::to_string(corners) +
+                                    " vertices (an STL facet is a triangle)");
+            corners = -1;
+        } else if (key == "endsolid" || key == "solid") {
+            if (corners >= 0)
+                return badInput(path, lineWhere(cursor.line()),
+                                facetName() + " (line " + std::to_string(openedAt) + ") has no endfacet");
         }
-        points.emplace_back(v[0], v[1], v[2]);
     }
+    if (corners >= 0)
+        return badInput(
+            path, lineWhere(cursor.line()),
+            "file ends inside " + facetName() + " (line " + std::to_string(openedAt) + "): truncated");
     return PointCloud{Scalar::kFloat64, {}, std::move(points)};
 }
 
@@ -77,7 +125,16 @@ Result<PointCloud> readStl(std::string_view bytes, const std::string& path) {
                         " bytes) but the file has " + std::to_string(bytes.size()) + " bytes" +
                         (solid ? " (its header starts with 'solid', but the file is not text)" : ""));
             }
-            return readBinary(bytes, facets);  // trailing bytes after the facets are ignored
+            // Trailing bytes after the facets: fewer than a facet's 50 are
+            // padding; more could be facets the count leaves out.
+            if (bytes.size() - need >= kFacetSize)
+                return badInput(path, offsetWhere(kHeaderSize),
+                                "binary STL declares " + std::to_string(facets) + " facets (" +
+                                    std::to_string(need) + " bytes) but the file has " +
+                                    std::to_string(bytes.size()) +
+                                    " bytes: " + std::to_string((bytes.size() - need) / kFacetSize) +
+                                    " more facets' worth follow the declared ones");
+            return readBinary(bytes, facets);
         }
     } else if (!solid) {
         return badInput(path, offsetWhere(0), "neither ascii STL ('solid') nor a complete binary STL header");

@@ -184,7 +184,11 @@ TEST_F(ChunkedLoad, AsciiPcdRowsAndTheirErrors) {
                              std::to_string(kPoints) + "\nDATA ascii\n";
     std::string rows;
     for (int i = 0; i < kPoints; ++i) rows += std::to_string(i) + " " + numbers(i) + (i % 9 ? "\n" : "\n\n");
-    const std::string path = write("p.pcd", head + rows + "trailing text is not read\n");
+    // A row past POINTS (trailing text counts) would be a point dropped unseen: refused.
+    const std::string extra = write("x.pcd", head + rows + "trailing text\n");
+    EXPECT_TRUE(
+        isBadInput(serialLoad(extra), extra, "line 6: the header declares 60 points but 61 rows follow"));
+    const std::string path = write("p.pcd", head + rows + "\n\n");
     auto r = serialLoad(path);
     ASSERT_TRUE(r.ok()) << r.error().message;
     ASSERT_EQ(r->doubles.size(), size_t(kPoints));

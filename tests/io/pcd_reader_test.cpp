@@ -33,6 +33,24 @@ TEST_F(PcdReader, BinaryMixedTypesAndCounts) {
     EXPECT_EQ(*r, (std::vector<glm::vec3>{{1.5f, -2, 3}, {0.25f, 9, -7.5f}}));
 }
 
+// Rows past POINTS would be points dropped unseen: nonzero bytes after the
+// declared rows are refused, zeros (PCL pads its files to a page) are not.
+TEST_F(PcdReader, BinaryDataPastTheDeclaredPoints) {
+    ByteBuilder b;
+    b.text("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA binary\n");
+    const size_t body = b.str().size();
+    b.put(1.f).put(2.f).put(3.f);
+    const std::string padded = write("pad.pcd", b.str() + std::string(4000, '\0'));
+    auto r = loadPoints(padded);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, (std::vector<glm::vec3>{{1, 2, 3}}));
+    b.put(4.f).put(5.f).put(6.f);
+    const std::string more = write("more.pcd", b.str());
+    EXPECT_TRUE(isBadInput(loadPoints(more), more,
+                           "byte offset " + std::to_string(body + 12) +
+                               ": the header declares 1 points of 12 bytes, but data follows them"));
+}
+
 TEST_F(PcdReader, BinaryTruncated) {
     ByteBuilder b;
     b.text("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 100\nDATA binary\n");

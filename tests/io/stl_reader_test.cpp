@@ -78,8 +78,50 @@ TEST_F(StlReader, BinaryWithSolidHeaderAndWrongSizeSaysBinary) {
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "byte offset 80: binary STL declares 2 facets"));
 }
 
+// A facet of two or four vertices would shift every triangle after it
+// (triangle t is facet t's corners): refused, as is a vertex outside a
+// facet and a file that ends inside one (truncated, possibly mid-number).
+TEST_F(StlReader, AsciiFacetsHoldExactlyThreeVertices) {
+    const std::string facet3 =
+        "facet normal 0 0 1\nouter loop\nvertex 1 2 3\nvertex 4 5 6\nvertex 7 8 9\nendloop\nendfacet\n";
+    const std::string two =
+        write("two.stl",
+              "solid t\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3\nvertex 4 5 6\nendloop\nendfacet\n" +
+                  facet3 + "endsolid t\n");
+    EXPECT_TRUE(
+        isBadInput(loadPoints(two), two, "line 7: facet 0 has 2 vertices (an STL facet is a triangle)"));
+    const std::string four = write("four.stl", "solid t\n" + facet3.substr(0, facet3.find("endloop")) +
+                                                   "vertex 0 0 0\nendloop\nendfacet\n");
+    EXPECT_TRUE(isBadInput(loadPoints(four), four, "line 7: facet 0 has more than 3 vertices"));
+    const std::string cut =
+        write("cut.stl", "solid t\n" + facet3 + "facet normal 0 0 1\nouter loop\nvertex 10 11 1");
+    EXPECT_TRUE(isBadInput(loadPoints(cut), cut, "line 11: file ends inside facet 1 (line 9): truncated"));
+    const std::string loose = write("loose.stl", "solid t\nvertex 1 2 3\n" + facet3);
+    EXPECT_TRUE(isBadInput(loadPoints(loose), loose, "line 2: a vertex outside any facet"));
+    const std::string open = write("open.stl", "solid t\nfacet normal 0 0 1\n" + facet3);
+    EXPECT_TRUE(isBadInput(loadPoints(open), open, "line 3: facet 0 (line 2) has no endfacet"));
+    const std::string values = write("values.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 1 2\n");
+    EXPECT_TRUE(isBadInput(loadPoints(values), values, "line 4: a vertex line with 2 values (x y z)"));
+    // Two solids, and no endsolid at the end: read.
+    auto r = loadPoints(write("two_solids.stl", "solid a\n" + facet3 + "endsolid a\nsolid b\n" + facet3));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->size(), 6u);
+}
+
+// Facets past the declared count are refused (points the header leaves
+// out); fewer than a facet's 50 bytes of trailing padding are not.
+TEST_F(StlReader, BinaryFacetsPastTheDeclaredCount) {
+    std::vector<glm::vec3> corners = threePoints();
+    corners.insert(corners.end(), {{0, 0, 0}, {1, 0, 0}, {1.5f, -2.25f, 3.0f}});
+    const std::string more = write("more.stl", binaryStl("binary", corners, 1));
+    EXPECT_TRUE(
+        isBadInput(loadPoints(more), more,
+                   "byte offset 80: binary STL declares 1 facets (134 bytes) but the file has 184 bytes: 1 "
+                   "more facets' worth follow the declared ones"));
+}
+
 TEST_F(StlReader, BinaryWithSolidHeaderAndTrailingBytes) {
-    // Trailing bytes are ignored for binary STL, whatever the header says.
+    // Trailing bytes shorter than a facet are ignored for binary STL, whatever the header says.
     const std::string path =
         write("solid_tail.stl", binaryStl("solid exported", threePoints(), 1) + std::string(7, '\0'));
     auto r = loadPoints(path);

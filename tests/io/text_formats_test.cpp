@@ -14,6 +14,17 @@ TEST_F(TextFormats, XyzColumnsCommentsSeparators) {
     EXPECT_EQ(*r, threePoints());
 }
 
+// Decimal commas ("1,5 2,5 3,5") would read as 1, 5, 2: a line whose
+// values are separated both by blanks alone and by commas is refused.
+TEST_F(TextFormats, XyzDecimalCommasAreRefused) {
+    const std::string path = write("comma.xyz", "1.5 2.5 3.5\n1,5 2,5 3,5\n");
+    EXPECT_TRUE(
+        isBadInput(loadPoints(path), path, "line 2: values separated both by blanks alone and by commas"));
+    auto r = loadPoints(write("csv.xyz", "1, 2, 3\n4 ,5 ,6\n7,8,9,255\n"));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->size(), 3u);
+}
+
 TEST_F(TextFormats, TxtIsXyz) {
     auto r = loadPoints(write("a.txt", "1 2 3"));  // no final newline
     ASSERT_TRUE(r.ok()) << r.error().message;
