@@ -14,7 +14,9 @@
 //         is refused, not read as 1, 5, 2.
 //   .obj  "v x y z" lines only.
 //   .gltf / .glb  POSITION of every primitive of every mesh instanced by the
-//         scene's nodes, with node transforms applied (tinygltf); a sparse
+//         scene's nodes (the file's default `scene`; without one, every
+//         scene's: a node two scenes list counts twice), with node
+//         transforms applied (tinygltf); a sparse
 //         POSITION accessor is refused (kBadInput naming it). External
 //         buffers are read only from regular files inside the glTF file's own
 //         directory (no absolute path, no "..", no current-directory lookup);
@@ -27,7 +29,10 @@
 //         refused, naming the facet and line). Binary: at most 49 bytes
 //         may follow the declared facets (50 or more could be facets the
 //         count leaves out: refused).
-//   .off  OFF / COFF / NOFF headers, vertices only
+//   .off  OFF / COFF / NOFF headers, vertices only; the body must hold
+//         exactly the header's vertices and faces (the faces are parsed and
+//         their indices checked, then dropped), so a vertex line past the
+//         count, a missing face or a line after the last face is refused
 //   .pcd  ascii, binary and binary_compressed (x y z fields, any size/type;
 //         POINTS rows exactly: an ascii row past them, or a nonzero byte
 //         after the binary rows (PCL pads with zeros), is refused;

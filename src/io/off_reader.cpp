@@ -163,10 +163,49 @@ std::optional<Error> parseFaceLine(std::string_view line, size_t lineNo, uint64_
 
 }  // namespace
 
+namespace {
+
+// The body after the vertex block: exactly the header's faces (each parsed
+// into `faces`, its indices below the vertex count), then
+// nothing but blank lines and comments: a vertex line past the declared
+// count, a missing face or a line after the last face is refused (points
+// the header leaves out, or a count that does not match the body).
+std::optional<Error> walkFaces(std::string_view bytes, const OffHeader& header, const std::string& path,
+                               FaceList& faces) {
+    TextCursor cursor(bytes.substr(header.bodyOffset), header.countLine + 1);
+    std::string_view line;
+    for (uint64_t k = 0; k < header.vertexCount; ++k) {
+        if (!nextContentLine(cursor, line)) return std::nullopt;  // readVertices refuses a short block
+    }
+    const uint64_t faceCount = header.hasFaceCount ? header.faceCount : 0;
+    std::vector<int64_t> polygon;
+    for (uint64_t f = 0; f < faceCount; ++f) {
+        if (!nextContentLine(cursor, line)) {
+            return badInput(path, lineWhere(cursor.line()),
+                            "file ends at face " + std::to_string(f) + " of " + std::to_string(faceCount));
+        }
+        if (auto err = parseFaceLine(line, cursor.line(), f, path, polygon)) return *err;
+        if (auto err = faces.addPolygon(path, lineWhere(cursor.line()), f, polygon)) return *err;
+    }
+    if (nextContentLine(cursor, line)) {
+        return badInput(path, lineWhere(cursor.line()),
+                        "a line after the header's " + std::to_string(header.vertexCount) + " vertices and " +
+                            std::to_string(faceCount) + " faces (wrong counts?)");
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
 Result<PointCloud> readOff(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
     Result<OffHeader> header = parseOffHeader(bytes, path);
     if (!header) return header.error();
-    return readVertices(bytes.substr(header->bodyOffset), header->countLine, header->vertexCount, path, plan);
+    Result<PointCloud> cloud =
+        readVertices(bytes.substr(header->bodyOffset), header->countLine, header->vertexCount, path, plan);
+    if (!cloud) return cloud;
+    FaceList faces(header->vertexCount);  // checked, then dropped
+    if (auto err = walkFaces(bytes, *header, path, faces)) return *err;
+    return cloud;
 }
 
 Result<std::vector<uint32_t>> readOffFaces(std::string_view bytes, const std::string& path,
@@ -176,22 +215,8 @@ Result<std::vector<uint32_t>> readOffFaces(std::string_view bytes, const std::st
     if (!header->hasFaceCount) {
         return badInput(path, lineWhere(header->countLine), "no face count (want 'nv nf ne')");
     }
-    TextCursor cursor(bytes.substr(header->bodyOffset), header->countLine + 1);
-    std::string_view line;
-    for (uint64_t k = 0; k < header->vertexCount; ++k) {
-        if (!nextContentLine(cursor, line)) break;  // readOff has refused a short vertex block
-    }
     FaceList faces(vertexCount);
-    std::vector<int64_t> polygon;
-    for (uint64_t f = 0; f < header->faceCount; ++f) {
-        if (!nextContentLine(cursor, line)) {
-            return badInput(
-                path, lineWhere(cursor.line()),
-                "file ends at face " + std::to_string(f) + " of " + std::to_string(header->faceCount));
-        }
-        if (auto err = parseFaceLine(line, cursor.line(), f, path, polygon)) return *err;
-        if (auto err = faces.addPolygon(path, lineWhere(cursor.line()), f, polygon)) return *err;
-    }
+    if (auto err = walkFaces(bytes, *header, path, faces)) return *err;
     return faces.take();
 }
 

@@ -142,10 +142,15 @@ Result<PcdHeader> parseHeader(std::string_view bytes, const std::string& path) {
         return badInput(path, lineWhere(h.dataLine),
                         "unsupported DATA '" + h.data + "' (ascii, binary or binary_compressed only)");
     }
+    if (h.height != 0 && h.width > UINT64_MAX / h.height)
+        return badInput(path, "header", "WIDTH * HEIGHT overflows");
     if (!h.points) {
-        if (h.height != 0 && h.width > UINT64_MAX / h.height)
-            return badInput(path, "header", "WIDTH * HEIGHT overflows");
         h.points = h.width * h.height;
+    } else if (h.width != 0 && h.width * h.height != *h.points) {
+        // PCL refuses such a header too: which count holds is not known.
+        return badInput(path, "header",
+                        "WIDTH * HEIGHT is " + std::to_string(h.width * h.height) + " but POINTS is " +
+                            std::to_string(*h.points));
     }
     const PcdData data = h.data == "ascii"    ? PcdData::kAscii
                          : h.data == "binary" ? PcdData::kBinary

@@ -129,10 +129,17 @@ TEST_F(ChunkedLoad, ObjVerticesAmongOtherLines) {
     EXPECT_TRUE(loadsAlike(bad));
 }
 
-TEST_F(ChunkedLoad, OffVerticesStopAtTheCountAndFacesAreNotRead) {
+TEST_F(ChunkedLoad, OffVerticesStopAtTheCountAndFacesAreChecked) {
     std::string text = "OFF\n# c\n" + std::to_string(kPoints) + " 2 0\n";
     for (int i = 0; i < kPoints; ++i) text += numbers(i) + (i % 4 == 0 ? " # comment\n\n" : "\n");
-    text += "3 0 1 2\n3 a b c\n";  // faces: a vertex parse of them would fail
+    // The faces are checked (a vertex line past the count would read as one)
+    // but not kept: a bad one is refused, loading points or not.
+    const std::string badFaces = write("badf.off", text + "3 0 1 2\n3 a b c\n");
+    EXPECT_TRUE(isBadInput(serialLoad(badFaces), badFaces, "line 80: face 1: 'a' is not a vertex index"));
+    const std::string extra = write("extra.off", text + "3 0 1 2\n3 1 2 3\n4 5 6\n");
+    EXPECT_TRUE(
+        isBadInput(serialLoad(extra), extra, "line 81: a line after the header's 60 vertices and 2 faces"));
+    text += "3 0 1 2\n3 1 2 3\n";
     const std::string path = write("p.off", text);
     auto r = serialLoad(path);
     ASSERT_TRUE(r.ok()) << r.error().message;

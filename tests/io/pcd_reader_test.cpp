@@ -180,6 +180,13 @@ TEST_F(PcdReader, HeaderErrors) {
     EXPECT_TRUE(isBadInput(loadPoints(noData), noData, "header: no DATA line"));
 }
 
+TEST_F(PcdReader, WidthTimesHeightMustBePoints) {
+    const std::string path = write(
+        "wh.pcd",
+        "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 3\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3\n4 5 6\n");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "header: WIDTH * HEIGHT is 3 but POINTS is 2"));
+}
+
 TEST_F(PcdReader, AsciiErrorsNameLineOrVertex) {
     const std::string head = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nHEIGHT 1\nDATA ascii\n";
     const std::string word = write("w.pcd", head + "1 2 3\n1 2 zz\n");
