@@ -6,8 +6,8 @@
     >>> r.distance, r.a_to_b.indices, r.timings["total"]
 
 H(A, B) = max(h(A, B), h(B, A)), h(A, B) = max over a of min over b of |a - b|,
-exact for the coordinates as given (float32 or float64): the value equals a
-brute force in double within 1e-6 of the bounding-box diagonal, and the
+exact for the coordinates as given (float32 or float64): the value equals
+(==) a brute force in double, proven by each answer's certificate, and the
 reported index pairs realize it (README, Precision). Backends: "cpu" (exact,
 multithreaded), "ray-query" and "rt-pipeline" (Vulkan ray tracing; Mesa's
 lavapipe runs them on the CPU), "auto" (a hardware ray-tracing GPU when
