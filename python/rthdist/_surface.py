@@ -89,7 +89,10 @@ def evaluate(reconstruction, ground_truth, thresholds, *, faces=None, cap=0.0, b
     Returns the dict of the CLI's JSON "eval": accuracy and completeness
     {count, kept, mean, median, mean_squared, max}, chamfer {mean_of_means,
     sum_of_means, sum_of_mean_squares}, thresholds [{threshold, precision,
-    recall, fscore}] (precision = share of accuracy distances < tau).
+    recall, fscore}] (precision = share of accuracy distances < tau). Where
+    the JSON has null (nothing kept under the cap), the dict holds NaN
+    (rthdist/eval.hpp); an empty thresholds sequence gives no rows (the CLI
+    refuses an empty --eval).
     """
     if np.isscalar(thresholds):
         thresholds = [thresholds]
