@@ -1,7 +1,8 @@
 """python3 -m rthdist A B: the CLI (tools/cli) through the Python package.
 
-Same inputs, options, summary, --json keys and exit codes as `rthdist` for
-what the package binds: --json, --directed, --backend, --device, --bits,
+Same inputs, options and exit codes as `rthdist`, and a subset of its
+summary and --json keys (docs/python.md "Command line": no certificate
+block, hd95 block or normalized values), for what the package binds: --json, --directed, --backend, --device, --bits,
 --radius-growth, --threads, --per-point (--percentile, --histogram-bins,
 --range), --las-classes, --validation, --list-devices, --version. The
 picture and per-point file outputs (--out-ply, --png, ...) and --verify are

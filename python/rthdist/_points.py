@@ -65,6 +65,10 @@ def as_points(obj, name="points"):
         arr = _host_array(obj)
     except (TypeError, ValueError) as e:
         raise ValueError(f"{name}: not an (N, 3) array of points: {e}") from e
+    if arr.dtype.kind == "f" and (not arr.dtype.isnative or arr.dtype.metadata) and arr.dtype.itemsize in (2, 4, 8):
+        # Another byte order (">f8": FITS data, np.fromfile) or a dtype with
+        # metadata: the same values in a native float copy.
+        arr = arr.astype(np.float64 if arr.dtype.itemsize == 8 else np.float32)
     if arr.dtype not in _KEEP:
         if arr.dtype.kind in "iu":
             arr = arr.astype(np.float64)

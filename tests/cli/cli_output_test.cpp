@@ -139,6 +139,33 @@ TEST_F(CliOutput, SymlinkIsKeptAndItsTargetReplaced) {
               "index,x,y,z,distance,nearest\n0,0,0,0,0,0\n1,1,0,0,1,0\n2,3,0,0,3,0\n");
 }
 
+// The CSV's coordinates are the input's: a double file's as doubles (two
+// points 2 cm apart at UTM coordinates were one float value apart).
+TEST_F(CliOutput, CsvCoordinatesKeepTheInputsPrecision) {
+    const std::string a =
+        m_dir.write("utm_a.xyz", "512345.12 5412345.51 100.25\n512345.14 5412345.53 100.25\n");
+    const std::string b = m_dir.write("utm_b.xyz", "512345.12 5412345.51 100.25\n");
+    const CliRun run = runCli({"--backend", "cpu", "--out-csv", path("u"), a, b});
+    ASSERT_EQ(run.exitCode, 0) << run;
+    const std::string csv = readFile(path("u_a.csv"));
+    EXPECT_NE(csv.find("\n0,512345.12,5412345.51,100.25,0,0\n"), std::string::npos) << csv;
+    EXPECT_NE(csv.find("\n1,512345.14,5412345.53,100.25,"), std::string::npos) << csv;
+}
+
+// A link whose target does not exist yet (in an existing directory, through
+// a second link): the target is created and the links kept, not replaced.
+TEST_F(CliOutput, DanglingSymlinkCreatesItsTarget) {
+    fs::create_directory(path("t"));
+    fs::create_symlink("t/hop.csv", path("d_a.csv"));
+    fs::create_symlink("new.csv", path("t/hop.csv"));
+    const CliRun run = runCli({"--backend", "cpu", "--out-csv", path("d"), m_a, m_b});
+    ASSERT_EQ(run.exitCode, 0) << run;
+    EXPECT_TRUE(fs::is_symlink(path("d_a.csv")));
+    EXPECT_TRUE(fs::is_symlink(path("t/hop.csv")));
+    EXPECT_EQ(readFile(path("t/new.csv")),
+              "index,x,y,z,distance,nearest\n0,0,0,0,0,0\n1,1,0,0,1,0\n2,3,0,0,3,0\n");
+}
+
 // The temporary name must still fit NAME_MAX (255) when the final one does.
 TEST_F(CliOutput, LongestFileNameWorks) {
     const std::string name = std::string(251, 'p') + ".png";

@@ -53,6 +53,11 @@ def test_other_dtypes_and_containers(rng):
     check_result(r, ints.astype(np.float64), b * 1000)
     r16 = rthdist.hausdorff(a.astype(np.float16), b.astype(np.float16), backend="cpu")
     check_result(r16, a.astype(np.float16), b.astype(np.float16))
+    # Big-endian floats (FITS data, np.fromfile(">f8")) and dtypes with metadata: the same values.
+    assert rthdist.hausdorff(a.astype(">f8"), b, backend="cpu").distance == ref
+    f32 = rthdist.hausdorff(a.astype(np.float32), b, backend="cpu").distance
+    assert rthdist.hausdorff(a.astype(">f4"), b, backend="cpu").distance == f32
+    assert rthdist.hausdorff(a.astype(np.dtype(np.float64, metadata={"unit": "m"})), b, backend="cpu").distance == ref
 
 
 class WithPoints:  # Open3D's PointCloud shape: .points is a buffer of (N, 3) doubles

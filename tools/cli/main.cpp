@@ -148,7 +148,8 @@ int run(const std::vector<std::string>& argv) {
         }
         stats = std::move(s).value();
         meter.update("output", 0.0);
-        Result<bool> written = writePerPointOutputs(args, floatsA, floatsB, *result, *stats);
+        Result<bool> written =
+            writePerPointOutputs(args, floatsA, floatsB, a->view(), b->view(), *result, *stats);
         meter.finish();
         if (!written) return fail(kExitOutput, written.error().message);
     }

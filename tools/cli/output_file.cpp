@@ -141,7 +141,21 @@ Result<bool> writeOutputFile(const std::string& path, std::string_view bytes) {
     struct stat st {};
     if (::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode)) {
         std::unique_ptr<char, decltype(&std::free)> resolved(::realpath(path.c_str(), nullptr), &std::free);
-        if (resolved) target = resolved.get();
+        if (resolved) {
+            target = resolved.get();
+        } else {
+            // A dangling link: the file it names is created (not the link
+            // replaced), following a chain of links as the kernel would.
+            for (int hop = 0; hop < 40 && ::lstat(target.c_str(), &st) == 0 && S_ISLNK(st.st_mode); ++hop) {
+                std::string to(size_t(PATH_MAX), '\0');
+                const ssize_t n = ::readlink(target.c_str(), to.data(), to.size() - 1);
+                if (n <= 0) break;
+                to.resize(size_t(n));
+                const size_t slash = target.find_last_of('/');
+                target =
+                    to.front() == '/' || slash == std::string::npos ? to : target.substr(0, slash + 1) + to;
+            }
+        }
     }
     const bool exists = ::stat(target.c_str(), &st) == 0;
     if (exists && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) return writeInPlace(path, target, bytes);

@@ -24,12 +24,18 @@ void appendLe(std::string& out, T v) {
     out.append(b, sizeof(T));
 }
 
-// A CSV row's first columns: index,x,y,z,distance (no line end).
-void appendRowStart(std::string& out, size_t index, const glm::vec3& p, double distance) {
+// A CSV row's first columns: index,x,y,z,distance (no line end); x, y, z
+// in the input's precision (a float view's values are floats: the shortest
+// float decimal; a double view's the shortest double decimal).
+void appendRowStart(std::string& out, size_t index, const PointView& points, double distance) {
     appendNumber(out, uint64_t(index));
-    for (float c : {p.x, p.y, p.z}) {
+    const glm::dvec3 p = points.at(index);
+    for (int k = 0; k < 3; ++k) {
         out.push_back(',');
-        appendNumber(out, c);
+        if (points.scalar == Scalar::kFloat32)
+            appendNumber(out, float(p[k]));
+        else
+            appendNumber(out, p[k]);
     }
     out.push_back(',');
     appendNumber(out, distance);
@@ -64,15 +70,14 @@ Result<bool> writeDistancePly(const std::string& path, std::span<const glm::vec3
     return writeOutputFile(path, out);
 }
 
-Result<bool> writeDistanceCsv(const std::string& path, std::span<const glm::vec3> points,
-                              const PerPoint& nearest) {
+Result<bool> writeDistanceCsv(const std::string& path, const PointView& points, const PerPoint& nearest) {
     if (nearest.distance.size() != points.size() || nearest.nearest.size() != points.size()) {
         return Error{ErrorCode::kInvalidArgument, path + ": per-point distances missing"};
     }
     std::string out = "index,x,y,z,distance,nearest\n";
     out.reserve(points.size() * 64);
     for (size_t i = 0; i < points.size(); ++i) {
-        appendRowStart(out, i, points[i], nearest.distance[i]);
+        appendRowStart(out, i, points, nearest.distance[i]);
         out.push_back(',');
         appendNumber(out, uint64_t(nearest.nearest[i]));
         out.push_back('\n');
@@ -80,7 +85,7 @@ Result<bool> writeDistanceCsv(const std::string& path, std::span<const glm::vec3
     return writeOutputFile(path, out);
 }
 
-Result<bool> writeSurfaceCsv(const std::string& path, std::span<const glm::vec3> points,
+Result<bool> writeSurfaceCsv(const std::string& path, const PointView& points,
                              const SurfacePerPoint& nearest) {
     const size_t n = points.size();
     if (nearest.distance.size() != n || nearest.triangle.size() != n || nearest.closest.size() != n ||
@@ -92,7 +97,7 @@ Result<bool> writeSurfaceCsv(const std::string& path, std::span<const glm::vec3>
         "barycentric_2\n";
     out.reserve(n * 160);
     for (size_t i = 0; i < n; ++i) {
-        appendRowStart(out, i, points[i], nearest.distance[i]);
+        appendRowStart(out, i, points, nearest.distance[i]);
         out.push_back(',');
         appendNumber(out, uint64_t(nearest.triangle[i]));
         for (const glm::dvec3* v : {&nearest.closest[i], &nearest.barycentric[i]}) {

@@ -10,9 +10,10 @@
 //   Point to surface (`--surface a|b`): the same layout, quality the exact
 //   distance to the nearest point of the other file's triangles.
 // CSV: header "index,x,y,z,distance,nearest"; one row per point in input
-//   order; coordinates as the shortest decimal that reads back to the same
-//   float, distance as the shortest decimal of the double, nearest = index of
-//   the nearest point in the other set.
+//   order; coordinates as the input holds them (the shortest decimal that
+//   reads back to the same float for float inputs, to the same double for
+//   double ones), distance as the shortest decimal of the double, nearest =
+//   index of the nearest point in the other set.
 // Surface CSV (writeSurfaceCsv, `--surface a|b`): header "index,x,y,z,
 //   distance,triangle,closest_x,closest_y,closest_z,barycentric_0,
 //   barycentric_1,barycentric_2": x, y, z and distance as above, triangle =
@@ -41,10 +42,11 @@ namespace rthdist::cli {
     const ColourRange& range,
     const std::string& quality = "exact distance to the nearest point of the other set");
 
-[[nodiscard]] Result<bool> writeDistanceCsv(const std::string& path, std::span<const glm::vec3> points,
+// points: the input as loaded (its precision is the coordinates' columns').
+[[nodiscard]] Result<bool> writeDistanceCsv(const std::string& path, const PointView& points,
                                             const PerPoint& nearest);
 
-[[nodiscard]] Result<bool> writeSurfaceCsv(const std::string& path, std::span<const glm::vec3> points,
+[[nodiscard]] Result<bool> writeSurfaceCsv(const std::string& path, const PointView& points,
                                            const SurfacePerPoint& nearest);
 
 }  // namespace rthdist::cli

@@ -70,7 +70,8 @@ Result<bool> writeScenePng(const CliArgs& args, const RenderScene& scene) {
 }
 
 Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3> a,
-                                  std::span<const glm::vec3> b, const HausdorffResult& r,
+                                  std::span<const glm::vec3> b, const PointView& givenA,
+                                  const PointView& givenB, const HausdorffResult& r,
                                   const HausdorffStats& stats) {
     ColourRange range{stats.aToB.histogram.lo, stats.aToB.histogram.hi};
     const bool withB = !r.directedOnly;
@@ -83,10 +84,10 @@ Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3
         }
     }
     if (!args.outCsv.empty()) {
-        Result<bool> ok = writeDistanceCsv(args.outCsv + "_a.csv", a, r.aNearest);
+        Result<bool> ok = writeDistanceCsv(args.outCsv + "_a.csv", givenA, r.aNearest);
         if (!ok) return ok;
         if (withB) {
-            ok = writeDistanceCsv(args.outCsv + "_b.csv", b, r.bNearest);
+            ok = writeDistanceCsv(args.outCsv + "_b.csv", givenB, r.bNearest);
             if (!ok) return ok;
         }
     }

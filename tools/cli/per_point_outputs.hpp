@@ -34,8 +34,11 @@ struct RenderScene;
 // is an output that could not be written, its message naming the file and the
 // reason, and the CLI exits kExitOutput with it. Files written before the
 // failing one stay written.
+// a, b: the float copies (the PLY's float x y z, the picture); givenA,
+// givenB: the inputs as loaded (the CSV's coordinates).
 [[nodiscard]] Result<bool> writePerPointOutputs(const CliArgs& args, std::span<const glm::vec3> a,
-                                                std::span<const glm::vec3> b, const HausdorffResult& result,
+                                                std::span<const glm::vec3> b, const PointView& givenA,
+                                                const PointView& givenB, const HausdorffResult& result,
                                                 const HausdorffStats& stats);
 
 }  // namespace rthdist::cli

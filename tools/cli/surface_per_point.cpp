@@ -84,7 +84,7 @@ Result<bool> writeSurfacePerPointOutputs(const SurfacePerPointRun& run, const Ha
         if (!ok) return ok;
     }
     if (!args.outCsv.empty()) {
-        Result<bool> ok = writeSurfaceCsv(args.outCsv + side + ".csv", run.points, r.perPoint);
+        Result<bool> ok = writeSurfaceCsv(args.outCsv + side + ".csv", run.pointsAsGiven, r.perPoint);
         if (!ok) return ok;
     }
     const std::string Q = run.fromB ? "B" : "A", S = run.fromB ? "A" : "B";
