@@ -77,6 +77,14 @@ struct Tuning {
     // 63 -> 80 ms on that row on 2 cores). RTHDIST_NARROWED_INGEST (0: off,
     // else on).
     std::optional<bool> narrowedIngest;
+    // A pair whose strays are their own (kilometres from the other set both
+    // ways) runs on its two cores for h alone too, not whole (per-point
+    // calls always do). Default: on a GPU backend, whose whole search left
+    // such a pair's cluster queries uncut (2M double points beside one km
+    // stray a set: 3.0 s -> 66-83 ms on an H200, docs/bench/per_point). Off
+    // keeps the whole search (the tail sweep's tests). RTHDIST_CORES_FOR_OWN_STRAYS
+    // (0: off, else on).
+    std::optional<bool> coresForOwnStrays;
     // Debug names and labels on Vulkan objects and command buffers without
     // validation, for GPU captures (~0.1 ms per prepared set on an H100).
     // RTHDIST_DEBUG_LABELS (set and not 0).

@@ -111,7 +111,7 @@ public:
         const bool cpuDevice = first().context->cpuDevice();
         caps.narrowOnHost = m_options.tuning->narrowHostBounds.value_or(cpuDevice);
         caps.narrowedIngest = m_options.tuning->narrowedIngest.value_or(!cpuDevice);
-        caps.coresForOwnStrays = true;
+        caps.coresForOwnStrays = m_options.tuning->coresForOwnStrays.value_or(true);
         if (!first().context->borrowed())
             caps.noDeviceViews =
                 "device views (DevicePointView) need an Engine created on your VkDevice "

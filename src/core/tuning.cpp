@@ -46,6 +46,8 @@ Tuning tuningFromEnvironment() {
     if (const char* v = std::getenv("RTHDIST_NARROW_HOST_BOUNDS"))
         t.narrowHostBounds = std::string_view(v) != "0";
     if (const char* v = std::getenv("RTHDIST_NARROWED_INGEST")) t.narrowedIngest = std::string_view(v) != "0";
+    if (const char* v = std::getenv("RTHDIST_CORES_FOR_OWN_STRAYS"))
+        t.coresForOwnStrays = std::string_view(v) != "0";
     const std::string labels = text("RTHDIST_DEBUG_LABELS");
     t.debugLabels = !labels.empty() && labels != "0";
     t.traceSubmits = std::getenv("RTHDIST_SUBMIT_TRACE") != nullptr;
