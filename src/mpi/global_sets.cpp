@@ -124,6 +124,7 @@ Result<GlobalSets> makeGlobalSets(MPI_Comm comm, PointView localA, PointView loc
     const glm::dvec3 boxLo(lo[0], lo[1], lo[2]), boxHi(hi[0], hi[1], hi[2]);
     const core::SetSummary unionBox{core::Bounds{boxLo, boxHi}, floatExact != 0};
     sets.origin = core::searchOrigin(unionBox, unionBox);  // 0 for float data, else the centre
+    sets.floatExact = floatExact != 0;
 
     // The float search's limits (core/input_limits.hpp), as one process checks
     // them: the sets in checkBFirst's order of their global boxes; within a

@@ -37,6 +37,11 @@ struct GlobalSets {
     // that every rank's engine compares the squared floats one engine would.
     double scale = 1.0;
     double diagonal = 0.0;  // of the union's box, in double, times scale
+    // Every coordinate of both sets is a float32 value: the floats searched
+    // are the inputs themselves (origin 0), so a result proven on them is
+    // proven in double. Else the ranks' proofs hold on the shifted frame's
+    // float32 points only (rthdist/mpi.hpp, Exactness).
+    bool floatExact = true;
 };
 
 // Collective. Checks both slices (stride, NaN/Inf, naming the global index),

@@ -92,6 +92,8 @@ Json certificateJson(const Certificate& c) {
     if (c.recomputed) {
         j["recomputed"] = true;
         j["failure"] = c.failure;
+    } else if (!c.confirmed && !c.failure.empty()) {
+        j["failure"] = c.failure;  // why the value is not proven in double (rthdist-mpi's double inputs)
     }
     return j;
 }
@@ -159,6 +161,7 @@ std::string summaryText(const RunReport& report) {
         std::string text = c.confirmed ? "confirmed" : "not confirmed";
         appendf(text, " (band %llu)", (unsigned long long)c.band);
         if (c.recomputed) text += ", recomputed on the CPU backend: " + c.failure;
+        if (!c.recomputed && !c.confirmed && !c.failure.empty()) text += ": " + c.failure;
         return text;
     };
     appendf(s, "certificate h(A,B) %s", proof(r.aToB.certificate).c_str());
