@@ -14,14 +14,20 @@
 //   global set, no device, out of memory) is agreed on by all ranks before
 //   any collective that could block, so no rank hangs.
 //
-// Exactness: for float32 inputs (every coordinate a float32 value) the
-//   result is the one of rthdist::hausdorff over the concatenated sets, the
-//   double brute force (==) realized by the reported pair. For other double
-//   inputs the ranks search and prove the shifted frame's float32 points
-//   (below): the value is exact on those, within 2e of the double answer,
+// Exactness: the result is the one of rthdist::hausdorff over the
+//   concatenated sets, the double brute force (==) realized by the reported
+//   pair. The ranks search the float32 points below; for float32 inputs
+//   those are the inputs. For other double inputs each rank also keeps every
+//   query's float pair distance (per point), and the queries whose distance
+//   lies within 2^-16 of the scaled frame's magnitude of the largest (the
+//   band: the float rounding of the points and the pairs' relative 2^-21
+//   stay within half of it) are settled in double: each one's exact nearest
+//   distance over every rank's slice of the targets as given (a brute force,
+//   the smallest global index on a tie), the largest winning, the smallest
+//   query on a tie. A band past 2^32 query x target pairs is not settled:
+//   the value is then the shifted frame's (within 2e of the double answer)
 //   and each Directed::certificate is unconfirmed with the reason in
-//   `failure` (one process settles its band in double; this does not yet).
-//   Why it holds on the searched points:
+//   `failure`. Why the searched points' answer holds:
 //   - Frame: the ranks agree on the union's box and on whether every
 //     coordinate is a float32 value, and round p - o to float32 with the very
 //     origin o a one-process call uses (0 for float data, else the box's
@@ -72,10 +78,9 @@
 //   device and backend: rank 0's engine.
 // Identical to one process: on the CPU backend, H, both directed distances
 //   (bit for bit), witness indices and points equal those of
-//   rthdist::hausdorff over the concatenated sets for float32 inputs, and
-//   for double inputs wherever no two candidates lie within the frame's
-//   rounding (tests/mpi, np 1..3, every oracle and georeferenced case; not
-//   a near tie at UTM magnitude: above). On the GPU backends the values keep the
+//   rthdist::hausdorff over the concatenated sets (tests/mpi, np 1..3, every
+//   oracle and georeferenced case, and a near tie at UTM magnitude that the
+//   floats order the other way). On the GPU backends the values keep the
 //   contract above, but among queries whose squared float distances tie the
 //   GPU keeps the one of the largest slot of its own query order, which
 //   depends on the slice a rank holds: the witness (and, for double input,

@@ -13,13 +13,15 @@
 namespace rthdist::mpi {
 
 // Every rank holds all of T (float32) and answers its own slice of Q.
+// perPoint: the outcome keeps every query's float pair distance (PassOutcome).
 [[nodiscard]] Result<PassOutcome> replicatedPass(MPI_Comm comm, Engine& engine, const GlobalSet& q,
-                                                 const GlobalSet& t, const CallOptions& call);
+                                                 const GlobalSet& t, const CallOptions& call, bool perPoint);
 
 // Rank r owns a slab of T along its longest axis and the queries in that
 // slab, and receives the halo of targets that can hold their nearest
 // neighbours. `diagonal`: of the union's box (widens the halo against rounding).
 [[nodiscard]] Result<PassOutcome> spatialPass(MPI_Comm comm, Engine& engine, const GlobalSet& q,
-                                              const GlobalSet& t, double diagonal, const CallOptions& call);
+                                              const GlobalSet& t, double diagonal, const CallOptions& call,
+                                              bool perPoint);
 
 }  // namespace rthdist::mpi

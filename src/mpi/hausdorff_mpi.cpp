@@ -5,9 +5,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
+#include <limits>
+#include <optional>
 #include <vector>
 
+#include "core/certificate.hpp"
+#include "core/parallel.hpp"
 #include "mpi/collectives.hpp"
 #include "mpi/directed_pass.hpp"
 #include "mpi/global_sets.hpp"
@@ -74,31 +79,142 @@ Timings reduceTimings(MPI_Comm comm, const Timings& t) {
     return out;
 }
 
+// The settle in double of a direction whose inputs are not float32 values
+// (one process settles its band the same way, core/certificate.hpp): the
+// ranks searched the shifted frame's floats, whose every query's pair
+// distance (the engine's per-point entry, scaled) lies within
+// kSettleSlackLog2 of the scaled frame's magnitude m of the query's exact
+// nearest distance (float rounding of the points: < 2^-21.8 m; the entry's
+// own relative 2^-21 of a distance <= 2 sqrt(3) m: < 2^-19 m). So only a
+// query whose entry is within twice that of the largest entry can realize
+// (or tie) the exact maximum: those (the band) are measured exactly, by a
+// brute force in double over every rank's slice of the targets as given,
+// the smallest index on a tie, and the largest wins (the smallest query on
+// a tie). A band past kSettleMaxWork query x target pairs is not settled.
+constexpr int kSettleSlackLog2 = -17;
+constexpr double kSettleMaxWork = 0x1p32;
+
+struct BandQuery {
+    glm::dvec3 p;
+    uint32_t id = 0;
+    uint32_t padding = 0;
+};
+struct BandNearest {
+    double distance = 0.0;
+    uint32_t target = 0;
+    uint32_t padding = 0;
+};
+
+// The exact h over the band, or nullopt when the band is too large.
+std::optional<Directed> settleInDouble(MPI_Comm comm, const mpi::GlobalSet& q, const mpi::GlobalSet& t,
+                                       const mpi::PassOutcome& pass, int threads) {
+    double m = 0.0, largest = -1.0;
+    for (const std::vector<glm::vec3>* floats : {&q.floats, &t.floats})
+        for (const glm::vec3& p : *floats)
+            m = std::max({m, double(std::abs(p.x)), double(std::abs(p.y)), double(std::abs(p.z))});
+    for (double d : pass.queryDistances) largest = std::max(largest, d);
+    double reduced[2] = {m, largest};
+    MPI_Allreduce(MPI_IN_PLACE, reduced, 2, MPI_DOUBLE, MPI_MAX, comm);
+    const double floor = reduced[1] - 2.0 * std::ldexp(reduced[0], kSettleSlackLog2);
+    std::vector<uint32_t> mine;
+    for (size_t i = 0; i < pass.queryDistances.size(); ++i)
+        if (pass.queryDistances[i] >= floor) mine.push_back(pass.queryIds[i]);
+    uint64_t count = mine.size();
+    MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_UINT64_T, MPI_SUM, comm);
+    if (double(count) * double(t.total()) > kSettleMaxWork) return std::nullopt;
+    Result<std::vector<uint32_t>> ids = mpi::allgatherRecords(comm, mine);
+    if (!ids || ids->empty()) return std::nullopt;
+    std::sort(ids->begin(), ids->end());
+    // Each band query's coordinates as given, from the rank whose slice holds it.
+    std::vector<BandQuery> owned;
+    for (const uint32_t id : *ids)
+        if (id >= q.offset() && id < q.offset() + q.local.count)
+            owned.push_back(BandQuery{q.local.at(size_t(id - q.offset())), id, 0});
+    Result<std::vector<BandQuery>> band = mpi::allgatherRecords(comm, owned);
+    if (!band || band->size() != ids->size()) return std::nullopt;
+    std::sort(band->begin(), band->end(), [](const BandQuery& x, const BandQuery& y) { return x.id < y.id; });
+    // This rank's nearest of each over its own slice of the targets.
+    std::vector<BandNearest> nearest(band->size(),
+                                     BandNearest{std::numeric_limits<double>::infinity(), UINT32_MAX, 0});
+    core::parallelChunks(band->size(), 1, threads, [&](size_t begin, size_t end, int) {
+        for (size_t k = begin; k < end; ++k) {
+            BandNearest& best = nearest[k];
+            for (size_t j = 0; j < t.local.count; ++j) {
+                const double d = core::exactDistance((*band)[k].p, t.local.at(j));
+                if (d < best.distance) best = BandNearest{d, uint32_t(t.offset() + j), 0};
+            }
+        }
+    });
+    Result<std::vector<BandNearest>> all = mpi::allgatherRecords(comm, nearest);
+    if (!all) return std::nullopt;
+    // Ranks in order: slices in global order, so the first of equal
+    // distances is the smallest index.
+    Directed d;
+    bool any = false;
+    for (size_t k = 0; k < band->size(); ++k) {
+        BandNearest best{std::numeric_limits<double>::infinity(), UINT32_MAX, 0};
+        for (size_t r = 0; r * band->size() + k < all->size(); ++r) {
+            const BandNearest& c = (*all)[r * band->size() + k];
+            if (c.distance < best.distance) best = c;
+        }
+        if (!any || best.distance > d.distance) {
+            any = true;
+            d.distance = best.distance;
+            d.queryIndex = (*band)[k].id;
+            d.targetIndex = best.target;
+            d.queryPoint = (*band)[k].p;
+        }
+    }
+    d.targetPoint = mpi::broadcastPoint(comm, t, d.targetIndex);
+    d.certificate.confirmed = core::exactDistance(d.queryPoint, d.targetPoint) == d.distance;
+    d.certificate.query = d.queryIndex;
+    d.certificate.nearest = d.targetIndex;
+    d.certificate.distance = d.distance;
+    d.certificate.band = band->size();
+    return d;
+}
+
 // One direction: the pass, then the winner with its points in the caller's coordinates.
 Result<Directed> direction(MPI_Comm comm, Engine& engine, const mpi::GlobalSets& sets, bool aToB,
-                           bool spatial, const CallOptions& call, Timings& timings, uint64_t& validation) {
+                           bool spatial, const CallOptions& call, Timings& timings, uint64_t& validation,
+                           int threads) {
     const mpi::GlobalSet& q = aToB ? sets.a : sets.b;
     const mpi::GlobalSet& t = aToB ? sets.b : sets.a;
-    Result<mpi::PassOutcome> pass = spatial ? mpi::spatialPass(comm, engine, q, t, sets.diagonal, call)
-                                            : mpi::replicatedPass(comm, engine, q, t, call);
+    // Inputs that are not float32 values: every query's float pair kept for the settle in double.
+    const bool settle = !sets.floatExact;
+    Result<mpi::PassOutcome> pass = spatial
+                                        ? mpi::spatialPass(comm, engine, q, t, sets.diagonal, call, settle)
+                                        : mpi::replicatedPass(comm, engine, q, t, call, settle);
     if (!pass) return pass.error();
     const mpi::Candidate best = winnerOf(comm, pass->best);
     if (!best.any) return Error{ErrorCode::kInternal, "no rank reported a witness"};
+    if (settle) {
+        const auto settleStart = Clock::now();
+        std::optional<Directed> exact = settleInDouble(comm, q, t, *pass, threads);
+        if (exact) {
+            exact->counters = reduceCounters(comm, pass->counters);
+            pass->timings.refine +=
+                std::chrono::duration<double, std::milli>(Clock::now() - settleStart).count();
+            mpi::addTimings(timings, pass->timings);
+            validation += pass->validationMessages;
+            return *exact;
+        }
+    }
     Directed d;
     d.queryIndex = best.query;
     d.targetIndex = best.target;
     d.queryPoint = mpi::broadcastPoint(comm, q, best.query);
     d.targetPoint = mpi::broadcastPoint(comm, t, best.target);
     d.distance = glm::length(d.queryPoint - d.targetPoint);
-    // Double inputs that are not float32 values: the ranks proved the value
-    // on the shifted frame's float32 points, within 2e of the double answer,
-    // not in double (one process settles its band in double; this path does
-    // not yet): reported unconfirmed, with the reason.
+    // Double inputs that are not float32 values whose band was too large to
+    // settle in double: the ranks proved the value on the shifted frame's
+    // float32 points only, within 2e of the double answer: reported
+    // unconfirmed, with the reason.
     d.certificate.confirmed = best.confirmed != 0 && sets.floatExact;
     if (best.confirmed != 0 && !sets.floatExact)
         d.certificate.failure =
-            "double inputs over MPI: proven on the shifted frame's float32 points (within 2e of the "
-            "double answer), not in double";
+            "double inputs over MPI: too many queries near the maximum to settle in double; proven on the "
+            "shifted frame's float32 points (within 2e of the double answer), not in double";
     d.certificate.query = d.queryIndex;
     d.certificate.nearest = d.targetIndex;
     d.certificate.distance = d.distance;
@@ -183,13 +299,15 @@ Result<HausdorffResult> hausdorffMpi(MPI_Comm comm, Engine& engine, PointView lo
     HausdorffResult r;
     Timings timings;
     uint64_t validation = 0;
-    Result<Directed> ab = direction(comm, engine, *sets, true, spatial, call, timings, validation);
+    const int threads = 0;  // the settle's brute force: every hardware thread of the rank
+    Result<Directed> ab = direction(comm, engine, *sets, true, spatial, call, timings, validation, threads);
     if (!ab) return ab.error();
     r.aToB = *ab;
     r.hausdorff = r.aToB.distance;
     r.directedOnly = call.directedOnly;
     if (!call.directedOnly) {
-        Result<Directed> ba = direction(comm, engine, *sets, false, spatial, call, timings, validation);
+        Result<Directed> ba =
+            direction(comm, engine, *sets, false, spatial, call, timings, validation, threads);
         if (!ba) return ba.error();
         r.bToA = *ba;
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);

@@ -27,10 +27,11 @@ void addTimings(Timings& into, const Timings& t) {
 
 namespace {
 
-CallOptions directedCall(const CallOptions& call) {
+CallOptions directedCall(const CallOptions& call, bool perPoint) {
     CallOptions directed = call;
     directed.directedOnly = true;
-    directed.perPointDistances = false;
+    directed.perPointDistances = perPoint;
+    directed.perPointNearestOnly = false;
     directed.perPointReady = nullptr;
     directed.progress = nullptr;
     return directed;
@@ -53,6 +54,10 @@ PassOutcome outcomeOf(const HausdorffResult& r, std::span<const glm::vec3> queri
     out.counters = r.aToB.counters;
     out.timings = r.timings;
     out.validationMessages = r.validationMessages;
+    if (!r.aNearest.distance.empty()) {
+        out.queryIds.assign(queryIds.begin(), queryIds.end());
+        out.queryDistances = r.aNearest.distance;
+    }
     return out;
 }
 
@@ -60,10 +65,10 @@ PassOutcome outcomeOf(const HausdorffResult& r, std::span<const glm::vec3> queri
 
 Result<PassOutcome> searchLocal(Engine& engine, std::span<const glm::vec3> queries,
                                 std::span<const uint32_t> queryIds, std::span<const glm::vec3> targets,
-                                std::span<const uint32_t> targetIds, const CallOptions& call) {
+                                std::span<const uint32_t> targetIds, const CallOptions& call, bool perPoint) {
     if (queries.empty()) return PassOutcome{};
     if (targets.empty()) return Error{ErrorCode::kInternal, "a rank's target set is empty"};
-    Result<HausdorffResult> r = engine.compute(queries, targets, directedCall(call));
+    Result<HausdorffResult> r = engine.compute(queries, targets, directedCall(call, perPoint));
     if (!r) return r.error();
     return outcomeOf(*r, queries, queryIds, targets, targetIds);
 }
@@ -71,7 +76,7 @@ Result<PassOutcome> searchLocal(Engine& engine, std::span<const glm::vec3> queri
 Result<PassOutcome> searchPrepared(Engine& engine, const PreparedSet* prepared,
                                    std::span<const glm::vec3> queries, std::span<const uint32_t> queryIds,
                                    std::span<const glm::vec3> targets, std::span<const uint32_t> targetIds,
-                                   const CallOptions& call) {
+                                   const CallOptions& call, bool perPoint) {
     if (queries.empty()) return PassOutcome{};
     if (targets.empty()) return Error{ErrorCode::kInternal, "a rank's target set is empty"};
     const auto start = std::chrono::steady_clock::now();
@@ -80,7 +85,7 @@ Result<PassOutcome> searchPrepared(Engine& engine, const PreparedSet* prepared,
     Result<PreparedSet> t = engine.prepare(targets, options);
     if (!t) return t.error();
     const double prepareMs = msSince(start);
-    Result<HausdorffResult> r = engine.compute(*prepared, *t, directedCall(call));
+    Result<HausdorffResult> r = engine.compute(*prepared, *t, directedCall(call, perPoint));
     if (!r) return r.error();
     PassOutcome out = outcomeOf(*r, queries, queryIds, targets, targetIds);
     out.timings.index += prepareMs;  // the target's index is built by prepare()

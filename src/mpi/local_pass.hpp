@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "rthdist/result.hpp"
 #include "rthdist/rthdist.hpp"
@@ -29,6 +30,11 @@ struct Candidate {
 
 struct PassOutcome {
     Candidate best;
+    // With `perPoint` (double inputs that are not float32 values, for the
+    // settle in double): every query's float pair distance in the search
+    // frame (the engine's per-point entry), and its global index.
+    std::vector<uint32_t> queryIds;
+    std::vector<double> queryDistances;
     Counters counters;
     Timings timings;
     uint64_t validationMessages = 0;
@@ -44,7 +50,8 @@ void addTimings(Timings& into, const Timings& t);
 [[nodiscard]] Result<PassOutcome> searchLocal(Engine& engine, std::span<const glm::vec3> queries,
                                               std::span<const uint32_t> queryIds,
                                               std::span<const glm::vec3> targets,
-                                              std::span<const uint32_t> targetIds, const CallOptions& call);
+                                              std::span<const uint32_t> targetIds, const CallOptions& call,
+                                              bool perPoint = false);
 
 // As searchLocal, with the queries prepared once by the caller
 // (Engine::prepare of `queries`, kept for several passes: the spatial mode's
@@ -55,7 +62,7 @@ void addTimings(Timings& into, const Timings& t);
                                                  std::span<const glm::vec3> queries,
                                                  std::span<const uint32_t> queryIds,
                                                  std::span<const glm::vec3> targets,
-                                                 std::span<const uint32_t> targetIds,
-                                                 const CallOptions& call);
+                                                 std::span<const uint32_t> targetIds, const CallOptions& call,
+                                                 bool perPoint = false);
 
 }  // namespace rthdist::mpi

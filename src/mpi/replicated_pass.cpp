@@ -10,7 +10,7 @@
 namespace rthdist::mpi {
 
 Result<PassOutcome> replicatedPass(MPI_Comm comm, Engine& engine, const GlobalSet& q, const GlobalSet& t,
-                                   const CallOptions& call) {
+                                   const CallOptions& call, bool perPoint) {
     std::vector<uint32_t> targetIds, queryIds;
     std::optional<Error> local = guarded([&]() -> std::optional<Error> {
         targetIds.resize(t.total());
@@ -25,7 +25,7 @@ Result<PassOutcome> replicatedPass(MPI_Comm comm, Engine& engine, const GlobalSe
 
     Result<PassOutcome> out = Error{};
     local = guarded([&]() -> std::optional<Error> {
-        out = searchLocal(engine, q.floats, queryIds, *targets, targetIds, call);
+        out = searchLocal(engine, q.floats, queryIds, *targets, targetIds, call, perPoint);
         return out ? std::nullopt : std::optional<Error>(out.error());
     });
     if (auto error = agreeOnError(comm, local)) return *error;

@@ -131,14 +131,15 @@ Result<Queries> prepareQueries(MPI_Comm comm, Engine& engine, const std::vector<
 }
 
 Result<PassOutcome> search(MPI_Comm comm, Engine& engine, const Queries& queries,
-                           const std::vector<Record>& targets, const CallOptions& call) {
+                           const std::vector<Record>& targets, const CallOptions& call,
+                           bool perPoint = false) {
     Result<PassOutcome> out = Error{};
     std::optional<Error> local = guarded([&]() -> std::optional<Error> {
         std::vector<glm::vec3> tp(targets.size());
         std::vector<uint32_t> ti(targets.size());
         for (size_t i = 0; i < targets.size(); ++i) tp[i] = targets[i].p, ti[i] = targets[i].id;
         const PreparedSet* prepared = queries.prepared ? &*queries.prepared : nullptr;
-        out = searchPrepared(engine, prepared, queries.points, queries.ids, tp, ti, call);
+        out = searchPrepared(engine, prepared, queries.points, queries.ids, tp, ti, call, perPoint);
         return out ? std::nullopt : std::optional<Error>(out.error());
     });
     if (auto error = agreeOnError(comm, local)) return *error;
@@ -198,7 +199,7 @@ Result<std::vector<Record>> withHalo(MPI_Comm comm, const std::vector<Record>& o
 }  // namespace
 
 Result<PassOutcome> spatialPass(MPI_Comm comm, Engine& engine, const GlobalSet& q, const GlobalSet& t,
-                                double diagonal, const CallOptions& call) {
+                                double diagonal, const CallOptions& call, bool perPoint) {
     const Slabs slabs = makeSlabs(comm, t);
     Result<std::vector<Record>> owned = distribute(comm, t, slabs);
     if (!owned) return owned.error();
@@ -228,7 +229,7 @@ Result<PassOutcome> spatialPass(MPI_Comm comm, Engine& engine, const GlobalSet& 
     if (!intervals) return intervals.error();
     Result<std::vector<Record>> targets = withHalo(comm, *owned, *intervals, slabs.axis);
     if (!targets) return targets.error();
-    Result<PassOutcome> out = search(comm, engine, *prepared, *targets, call);
+    Result<PassOutcome> out = search(comm, engine, *prepared, *targets, call, perPoint);
     if (!out) return out;
     addTimings(out->timings, bound->timings);
     out->timings.index += prepared->prepareMs;

@@ -54,11 +54,9 @@ std::string mpiUsageText() {
     return R"(Usage: mpirun -np N rthdist-mpi [options] A B
        rthdist-mpi --list-devices [--json]
 
-rthdist over MPI ranks: the same summary, --json object and exit codes as
-rthdist, and its exact H(A,B) for float32 inputs; double inputs that are not
-float32 values are proven on the shifted frame's float32 points only (within
-2e of the double answer; the certificate says "not confirmed" and why).
-Every rank reads its slice of A and B; rank 0 prints.
+rthdist over MPI ranks: the same exact H(A,B), summary, --json object and exit
+codes as rthdist (double inputs: the queries near the maximum settled in
+double across the ranks). Every rank reads its slice of A and B; rank 0 prints.
 
   --mpi-mode NAME     auto | replicated | spatial (default auto: every rank
                       holds the whole target set as float32 when both sets
