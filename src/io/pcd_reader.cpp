@@ -197,6 +197,24 @@ Result<PcdLayout> layoutOf(const std::vector<PcdField>& fields, const std::strin
     return l;
 }
 
+// The cloud of binary records (rows, or the compressed columns): double
+// where an axis's type needs it, else float32; each point converted once.
+Result<PointCloud> cloudOf(const RecordLayout& rows, const std::string& path, const ChunkPlan& plan) {
+    PointCloud out;
+    out.scalar =
+        std::any_of(rows.type.begin(), rows.type.end(), needsDouble) ? Scalar::kFloat64 : Scalar::kFloat32;
+    std::optional<Error> bad;
+    if (out.scalar == Scalar::kFloat64) {
+        out.doubles.resize(static_cast<size_t>(rows.count));  // unwritten: convertRecords writes each point
+        bad = convertRecords(rows, out.doubles.data(), plan, path);
+    } else {
+        out.floats.resize(static_cast<size_t>(rows.count));
+        bad = convertRecords(rows, out.floats.data(), plan, path);
+    }
+    if (bad) return *bad;
+    return out;
+}
+
 Result<PointCloud> readBinaryRows(std::string_view bytes, const PcdHeader& h, const PcdLayout& l,
                                   const std::string& path, const ChunkPlan& plan) {
     if (auto e = checkRecordsFit(path, h.bodyOffset, "", h.points, l.bytesPerRow, bytes.size() - h.bodyOffset,
@@ -218,19 +236,7 @@ Result<PointCloud> readBinaryRows(std::string_view bytes, const PcdHeader& h, co
                             {l.byteOffset[0], l.byteOffset[1], l.byteOffset[2]},
                             l.scalar,
                             false};
-    PointCloud out;
-    out.scalar =
-        std::any_of(l.scalar.begin(), l.scalar.end(), needsDouble) ? Scalar::kFloat64 : Scalar::kFloat32;
-    std::optional<Error> bad;
-    if (out.scalar == Scalar::kFloat64) {
-        out.doubles.resize(static_cast<size_t>(h.points));  // unwritten: convertRecords writes each point
-        bad = convertRecords(rows, out.doubles.data(), plan, path);
-    } else {
-        out.floats.resize(static_cast<size_t>(h.points));
-        bad = convertRecords(rows, out.floats.data(), plan, path);
-    }
-    if (bad) return *bad;
-    return out;
+    return cloudOf(rows, path, plan);
 }
 
 // binary_compressed: an LZF stream inflates at most 88 times (a 3-byte
@@ -304,19 +310,7 @@ Result<PointCloud> readCompressedColumns(std::string_view bytes, const PcdHeader
                             &columns[column[axis] + size_t(i * l.fieldBytes[axis])], size[axis]);
         rows = RecordLayout{gathered.data(), record, h.points, offset, l.scalar, false};
     }
-    PointCloud out;
-    out.scalar =
-        std::any_of(l.scalar.begin(), l.scalar.end(), needsDouble) ? Scalar::kFloat64 : Scalar::kFloat32;
-    std::optional<Error> bad;
-    if (out.scalar == Scalar::kFloat64) {
-        out.doubles.resize(static_cast<size_t>(h.points));
-        bad = convertRecords(rows, out.doubles.data(), plan, path);
-    } else {
-        out.floats.resize(static_cast<size_t>(h.points));
-        bad = convertRecords(rows, out.floats.data(), plan, path);
-    }
-    if (bad) return *bad;
-    return out;
+    return cloudOf(rows, path, plan);
 }
 
 bool isRowLine(std::string_view line) { return !trimBlank(line).empty(); }

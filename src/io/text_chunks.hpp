@@ -90,30 +90,28 @@ struct PointLineFormat {
     std::array<std::string_view, 2> tooFew;
 };
 
+// Whether a line separates its values both by blanks alone and by runs
+// holding a comma ("1,5 2,5 3,5" has decimal commas, which would read as
+// the values 1, 5, 2): such a line is refused rather than guessed. Other
+// separators (';') mix with blanks freely.
+inline bool mixesBlanksAndCommas(std::string_view s) {
+    bool blankRun = false, commaRun = false;
+    for (size_t i = 0; i < s.size();) {
+        if (!isBlank(s[i]) && s[i] != ',') {
+            ++i;
+            continue;
+        }
+        bool comma = false;
+        for (; i < s.size() && (isBlank(s[i]) || s[i] == ','); ++i) comma = comma || s[i] == ',';
+        (comma ? commaRun : blankRun) = true;
+    }
+    return blankRun && commaRun;
+}
+
 // The points of such a format (a leading UTF-8 byte order mark skipped), in
 // parallel chunks; an error names the file line of the first bad item line.
 // The format is a template argument so that its separators and its item
 // test are constants in the per-line loop.
-// Whether a line separates its values both by blanks alone and by runs
-// holding one of `extras` (","; "1,5 2,5 3,5" has decimal commas, which
-// would read as the values 1, 5, 2): such a line is refused rather than
-// guessed. Other separators (';') mix with blanks freely.
-inline bool mixedSeparators(std::string_view s, std::string_view extras) {
-    bool blankRun = false, extraRun = false;
-    size_t i = 0;
-    while (i < s.size()) {
-        const auto isExtra = [&](char c) { return extras.find(c) != std::string_view::npos; };
-        if (!isBlank(s[i]) && !isExtra(s[i])) {
-            ++i;
-            continue;
-        }
-        bool extra = false;
-        for (; i < s.size() && (isBlank(s[i]) || isExtra(s[i])); ++i) extra = extra || isExtra(s[i]);
-        (extra ? extraRun : blankRun) = true;
-    }
-    return blankRun && extraRun;
-}
-
 template <const PointLineFormat& format>
 Result<PointCloud> readPointLines(std::string_view bytes, const std::string& path, const ChunkPlan& plan) {
     const std::string_view text = bytes.substr(bomLength(bytes));
@@ -126,7 +124,7 @@ Result<PointCloud> readPointLines(std::string_view bytes, const std::string& pat
             if (!format.isItem(line)) continue;
             std::array<std::string_view, 3> tok{};
             const std::string_view body = trimBlank(line).substr(format.skip);
-            if (format.separators.find(',') != std::string_view::npos && mixedSeparators(body, ","))
+            if (format.separators.find(',') != std::string_view::npos && mixesBlanksAndCommas(body))
                 return badInput(path, lineWhere(cursor.line()),
                                 "values separated both by blanks alone and by commas (decimal commas?): "
                                 "use one separator");
