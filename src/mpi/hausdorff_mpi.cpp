@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "core/certificate.hpp"
-#include "core/parallel.hpp"
 #include "mpi/collectives.hpp"
 #include "mpi/directed_pass.hpp"
 #include "mpi/global_sets.hpp"
@@ -99,15 +98,10 @@ struct BandQuery {
     uint32_t id = 0;
     uint32_t padding = 0;
 };
-struct BandNearest {
-    double distance = 0.0;
-    uint32_t target = 0;
-    uint32_t padding = 0;
-};
 
 // The exact h over the band, or nullopt when the band is too large.
 std::optional<Directed> settleInDouble(MPI_Comm comm, const mpi::GlobalSet& q, const mpi::GlobalSet& t,
-                                       const mpi::PassOutcome& pass, int threads) {
+                                       const mpi::PassOutcome& pass) {
     double m = 0.0, largest = -1.0;
     for (const std::vector<glm::vec3>* floats : {&q.floats, &t.floats})
         for (const glm::vec3& p : *floats)
@@ -133,29 +127,27 @@ std::optional<Directed> settleInDouble(MPI_Comm comm, const mpi::GlobalSet& q, c
     Result<std::vector<BandQuery>> band = mpi::allgatherRecords(comm, owned);
     if (!band || band->size() != ids->size()) return std::nullopt;
     std::sort(band->begin(), band->end(), [](const BandQuery& x, const BandQuery& y) { return x.id < y.id; });
-    // This rank's nearest of each over its own slice of the targets.
-    std::vector<BandNearest> nearest(band->size(),
-                                     BandNearest{std::numeric_limits<double>::infinity(), UINT32_MAX, 0});
-    core::parallelChunks(band->size(), 1, threads, [&](size_t begin, size_t end, int) {
-        for (size_t k = begin; k < end; ++k) {
-            BandNearest& best = nearest[k];
-            for (size_t j = 0; j < t.local.count; ++j) {
-                const double d = core::exactDistance((*band)[k].p, t.local.at(j));
-                if (d < best.distance) best = BandNearest{d, uint32_t(t.offset() + j), 0};
-            }
-        }
-    });
-    Result<std::vector<BandNearest>> all = mpi::allgatherRecords(comm, nearest);
+    // This rank's nearest of each over its own slice of the targets (the
+    // host brute force of every proof, core/certificate.hpp; every
+    // hardware thread of the rank), in global indices.
+    std::vector<core::BandNearest> nearest(band->size());
+    for (size_t k = 0; k < band->size(); ++k) nearest[k].query = k;
+    const core::BruteForce bruteForce =
+        core::hostBruteForce([&band](uint64_t k) { return (*band)[size_t(k)].p; }, t.local, 0);
+    if (!bruteForce(nearest)) return std::nullopt;
+    for (core::BandNearest& n : nearest)
+        if (n.target != std::numeric_limits<uint64_t>::max()) n.target += t.offset();
+    Result<std::vector<core::BandNearest>> all = mpi::allgatherRecords(comm, nearest);
     if (!all) return std::nullopt;
-    // Ranks in order: slices in global order, so the first of equal
-    // distances is the smallest index.
+    // Each query's nearest over every rank's (BandNearest::offer: the
+    // smaller index on a tie), the largest winning, the smaller query on a tie.
     Directed d;
     bool any = false;
     for (size_t k = 0; k < band->size(); ++k) {
-        BandNearest best{std::numeric_limits<double>::infinity(), UINT32_MAX, 0};
+        core::BandNearest best;
         for (size_t r = 0; r * band->size() + k < all->size(); ++r) {
-            const BandNearest& c = (*all)[r * band->size() + k];
-            if (c.distance < best.distance) best = c;
+            const core::BandNearest& c = (*all)[r * band->size() + k];
+            best.offer(c.target, c.distance);
         }
         if (!any || best.distance > d.distance) {
             any = true;
@@ -176,8 +168,7 @@ std::optional<Directed> settleInDouble(MPI_Comm comm, const mpi::GlobalSet& q, c
 
 // One direction: the pass, then the winner with its points in the caller's coordinates.
 Result<Directed> direction(MPI_Comm comm, Engine& engine, const mpi::GlobalSets& sets, bool aToB,
-                           bool spatial, const CallOptions& call, Timings& timings, uint64_t& validation,
-                           int threads) {
+                           bool spatial, const CallOptions& call, Timings& timings, uint64_t& validation) {
     const mpi::GlobalSet& q = aToB ? sets.a : sets.b;
     const mpi::GlobalSet& t = aToB ? sets.b : sets.a;
     // Inputs that are not float32 values: every query's float pair kept for the settle in double.
@@ -190,7 +181,7 @@ Result<Directed> direction(MPI_Comm comm, Engine& engine, const mpi::GlobalSets&
     if (!best.any) return Error{ErrorCode::kInternal, "no rank reported a witness"};
     if (settle) {
         const auto settleStart = Clock::now();
-        std::optional<Directed> exact = settleInDouble(comm, q, t, *pass, threads);
+        std::optional<Directed> exact = settleInDouble(comm, q, t, *pass);
         if (exact) {
             exact->counters = reduceCounters(comm, pass->counters);
             pass->timings.refine +=
@@ -299,15 +290,13 @@ Result<HausdorffResult> hausdorffMpi(MPI_Comm comm, Engine& engine, PointView lo
     HausdorffResult r;
     Timings timings;
     uint64_t validation = 0;
-    const int threads = 0;  // the settle's brute force: every hardware thread of the rank
-    Result<Directed> ab = direction(comm, engine, *sets, true, spatial, call, timings, validation, threads);
+    Result<Directed> ab = direction(comm, engine, *sets, true, spatial, call, timings, validation);
     if (!ab) return ab.error();
     r.aToB = *ab;
     r.hausdorff = r.aToB.distance;
     r.directedOnly = call.directedOnly;
     if (!call.directedOnly) {
-        Result<Directed> ba =
-            direction(comm, engine, *sets, false, spatial, call, timings, validation, threads);
+        Result<Directed> ba = direction(comm, engine, *sets, false, spatial, call, timings, validation);
         if (!ba) return ba.error();
         r.bToA = *ba;
         r.hausdorff = std::max(r.hausdorff, r.bToA.distance);
