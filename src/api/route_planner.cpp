@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "core/input_limits.hpp"
+
 namespace rthdist::api {
 
 namespace {
@@ -121,6 +123,9 @@ Plan planSurfacePairRoute(Backend requested) {
 }
 
 bool narrowingPays(double wholeMagnitude, double narrowedMagnitude) {
+    // A narrowed frame below float32's normals cannot be searched
+    // (core::checkShiftedExtent refuses it): the pair stays whole.
+    if (narrowedMagnitude > 0.0 && narrowedMagnitude < core::kMinShifted) return false;
     return std::ldexp(narrowedMagnitude, kNarrowGainLog2) <= wholeMagnitude;
 }
 

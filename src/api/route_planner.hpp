@@ -173,6 +173,10 @@ inline constexpr uint64_t kAutoSurfaceGpuQueries = uint64_t(1) << 14;
 // is searched alone, its targets narrowed, in its own frame, when that
 // frame's magnitude (and with it the float search's rounding slack) is at
 // most 2^-kNarrowGainLog2 of the whole pair's; the other direction as it is.
+// Never where the narrowed frame's magnitude is nonzero and below 2^-126
+// (core::kMinShifted: float32's normals; a frame that small cannot be
+// searched, while the whole pair's can: a double point 1e-40 from its
+// nearest beside a stray 1 km away stays one pair).
 inline constexpr int kNarrowGainLog2 = 8;
 [[nodiscard]] bool narrowingPays(double wholeMagnitude, double narrowedMagnitude);
 // A kDeviceIngest pair of at most this many points in all may look for

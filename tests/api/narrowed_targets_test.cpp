@@ -525,6 +525,31 @@ TEST(NarrowTargets, RasterOrderLatticeSplitsOffItsStrays) {
 TEST(NarrowTargets, GainThreshold) {
     EXPECT_TRUE(api::narrowingPays(256.0, 1.0));
     EXPECT_FALSE(api::narrowingPays(255.0, 1.0));
+    EXPECT_TRUE(api::narrowingPays(1000.0, 0.0));
+    EXPECT_TRUE(api::narrowingPays(1000.0, 0x1p-126));
+    EXPECT_FALSE(api::narrowingPays(1000.0, 1e-40));  // below float32's normals: not searchable
+}
+
+// A double cluster whose own frame would lie below 2^-126 (a point 1e-40
+// from its twin) beside a stray 1000 away: the pair stays whole, and the
+// values are the brute force's (it was refused: "every coordinate lies
+// within 5e-41 of the search origin", the cores' frame checked alone).
+TEST(NarrowedTargets, ACoreBelowFloatNormalsLeavesThePairWhole) {
+    RTHDIST_REQUIRE_TEST_ENGINE(engine);
+    const std::vector<glm::dvec3> a{{1e-40, 0.0, 0.0}, {1000.0, 0.0, 0.0}}, b{{0.0, 0.0, 0.0}};
+    for (bool perPoint : {false, true}) {
+        CallOptions call;
+        call.perPointDistances = perPoint;
+        Result<HausdorffResult> r = engine->compute(PointView(a), PointView(b), call);
+        ASSERT_TRUE(r) << r.error().message;
+        EXPECT_EQ(r->hausdorff, 1000.0);
+        EXPECT_EQ(r->aToB.distance, 1000.0);
+        EXPECT_EQ(r->aToB.queryIndex, 1u);
+        EXPECT_EQ(r->bToA.distance, 1e-40);
+        EXPECT_EQ(r->bToA.targetIndex, 0u);
+        EXPECT_TRUE(r->aToB.certificate.confirmed);
+        EXPECT_TRUE(r->bToA.certificate.confirmed);
+    }
 }
 
 }  // namespace
