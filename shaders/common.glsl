@@ -17,6 +17,7 @@
 // bits: with 16-byte records that wraps at 2^28 records (4 GiB), silently
 // reading and writing other records (issue: wrong H at 300M points on NVIDIA).
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Vec4Ref { vec4 v; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Uvec4Ref { uvec4 v; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer UintRef { uint v; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer FloatRef { float v; };
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer Uvec2Ref { uvec2 v; };
@@ -26,6 +27,7 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer StateRef { 
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer LeafGroupRef { LeafGroup v; };
 
 Vec4Ref vec4At(uint64_t base, uint i) { return Vec4Ref(base + uint64_t(i) * 16ul); }
+Uvec4Ref uvec4At(uint64_t base, uint i) { return Uvec4Ref(base + uint64_t(i) * 16ul); }
 UintRef uintAt(uint64_t base, uint i) { return UintRef(base + uint64_t(i) * 4ul); }
 FloatRef floatAt(uint64_t base, uint64_t i) { return FloatRef(base + i * 4ul); }
 Uvec2Ref uvec2At(uint64_t base, uint i) { return Uvec2Ref(base + uint64_t(i) * 8ul); }

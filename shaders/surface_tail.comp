@@ -7,7 +7,8 @@
 // a node whose box lies farther than the best is skipped (a NaN best, none
 // yet, compares false: visited), an inner node's nearer child is taken
 // first and the other kept on the stack, and each triangle of a leaf
-// reached is measured by the rays' own test (surface_visit.glsl). A node's
+// reached is measured by the rays' own test (surface_visit.glsl) on the
+// tree's copy of its corners, a leaf's in consecutive records. A node's
 // box holds its triangles' float boxes, so the skip is surface_visit's box
 // test of each of its triangles lifted: the descent keeps what a visit of
 // every triangle would. Counts the queries it searched.
@@ -15,6 +16,7 @@
 #include "rthdist_surface_search.h"
 layout(local_size_x = RTHDIST_WG) in;
 layout(push_constant) uniform Push { SurfaceTailPush pc; };
+#define RTHDIST_SURFACE_VISIT_CORNERS_ONLY
 #include "surface_visit.glsl"
 
 void main() {
@@ -33,7 +35,14 @@ void main() {
     while (true) {
         if (!(d2 > packedDist2(best))) {
             if (node.count != 0u) {
-                for (uint i = 0u; i < node.count; ++i) visitTriangle(q, uintAt(pc.order, node.first + i).v, best);
+                for (uint i = 0u; i < node.count; ++i) {
+                    uint p = 3u * (node.first + i);
+                    uvec4 a = uvec4At(pc.leafCorners, p).v;
+                    uvec4 b = uvec4At(pc.leafCorners, p + 1u).v;
+                    uvec4 c = uvec4At(pc.leafCorners, p + 2u).v;
+                    visitCorners(q, a.w, uintBitsToFloat(a.xyz), uintBitsToFloat(b.xyz), uintBitsToFloat(c.xyz),
+                                 best);
+                }
             } else {
                 Cell left = cellAt(pc.nodes, node.first).v;
                 Cell right = cellAt(pc.nodes, node.first + 1u).v;

@@ -45,15 +45,18 @@ struct SurfaceSearchPush {
 // The tail (surface_tail.comp): every query the radii left open descends
 // the float BVH of the triangles (gpu_algo/surface_tree.hpp) nearest-first,
 // measuring each triangle of a leaf it reaches by the rays' own test
-// (surface_visit.glsl, which reads `corners` and `mutant` of this block).
+// (surface_visit.glsl's visitCorners) on the corners the tree holds in its
+// own order (`leafCorners`: a leaf's triangles read from consecutive
+// records, no index to follow first).
 #define RTHDIST_SURFACE_TAIL_STACK 32  // at least the tree's levels less one (kSurfaceTreeMaxLevels)
 
 struct SurfaceTailPush {
     uint64_t queries;  // vec4[numQueries]: the points in the search frame
-    uint64_t corners;  // vec4[3 * triangles]: a, b, c of each triangle in the search frame
     uint64_t best;     // uint64[numQueries]: the packed nearest triangle so far, lowered in place
     uint64_t nodes;    // Cell[]: the tree, root first (surface_tree.hpp)
-    uint64_t order;    // uint[triangles]: sorted position -> triangle
+    // uvec4[3 * triangles]: the corners a, b, c (float bits in xyz) of the
+    // triangle at each sorted position of the tree; a's w holds its index.
+    uint64_t leafCorners;
     uint64_t counts;   // uint: the queries the tail searched (atomicAdd)
     uint numQueries;
     float settled2;  // a query whose best is at most this was settled by the radii
@@ -62,10 +65,10 @@ struct SurfaceTailPush {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(SurfaceTailPush) == 64);
-static_assert(offsetof(SurfaceTailPush, counts) == 40);
-static_assert(offsetof(SurfaceTailPush, numQueries) == 48);
-static_assert(offsetof(SurfaceTailPush, mutant) == 56);
+static_assert(sizeof(SurfaceTailPush) == 56);
+static_assert(offsetof(SurfaceTailPush, counts) == 32);
+static_assert(offsetof(SurfaceTailPush, numQueries) == 40);
+static_assert(offsetof(SurfaceTailPush, mutant) == 48);
 static_assert(sizeof(SurfaceRadiusCount) == 8);
 static_assert(sizeof(SurfaceSearchPush) == 64);
 static_assert(offsetof(SurfaceSearchPush, numQueries) == 32);

@@ -25,37 +25,21 @@ constexpr size_t kStageChunk = size_t(1) << 14;
 
 using Box = core::FloatBox;
 
-// One triangle's share of the corners' fingerprint: its nine float
-// corners' bits and its index, mixed.
-uint64_t fingerprintOf(const glm::vec3* corners, uint32_t triangle) {
-    uint32_t w[10];
-    std::memcpy(w, corners, 9 * sizeof(float));
-    w[9] = triangle;
-    uint64_t h = 0x9e3779b97f4a7c15ULL;
-    for (int i = 0; i < 10; i += 2) {
-        h = (h ^ (uint64_t(w[i]) | uint64_t(w[i + 1]) << 32)) * 0xff51afd7ed558ccdULL;
-        h ^= h >> 32;
-    }
-    return h;
-}
-
-// The fingerprint of the corners (SurfaceSearch keeps the tail's tree while
-// it is the same): the sum of the triangles' shares, so the same whatever
-// the threads. ~3 ns per triangle on one thread (0.21 ms for 69,451 on one
-// core of the 2 here): taken where the tree is wanted only, not in the
-// staging pass every call makes.
-uint64_t fingerprintOf(std::span<const glm::vec3> corners, int threads) {
-    const size_t triangles = corners.size() / 3;
+// Whether two sets of corners are the same, every float bit for bit (a kept
+// tree's and a call's): chunks compared on the worker pool, ~36 bytes a
+// triangle read twice (for the bunny's 69,451 triangles ~0.1 ms on one
+// thread), taken where the tree is wanted only.
+bool sameCorners(std::span<const glm::vec3> kept, std::span<const glm::vec3> now, int threads) {
+    if (kept.size() != now.size()) return false;
+    const size_t triangles = now.size() / 3;
     const int workers = core::resolveThreads(threads, triangles / kStageChunk + 1);
-    std::vector<uint64_t> each(static_cast<size_t>(workers), 0);
-    core::parallelChunks(triangles, kStageChunk, workers, [&](size_t begin, size_t end, int thread) {
-        uint64_t sum = 0;
-        for (size_t t = begin; t < end; ++t) sum += fingerprintOf(&corners[3 * t], uint32_t(t));
-        each[size_t(thread)] += sum;
+    std::atomic<bool> same{true};
+    core::parallelChunks(triangles, kStageChunk, workers, [&](size_t begin, size_t end, int) {
+        if (!same.load(std::memory_order_relaxed)) return;
+        if (std::memcmp(&kept[3 * begin], &now[3 * begin], (end - begin) * 3 * sizeof(glm::vec3)) != 0)
+            same.store(false, std::memory_order_relaxed);
     });
-    uint64_t all = 0;
-    for (const uint64_t e : each) all += e;
-    return all;
+    return same.load();
 }
 
 }  // namespace
@@ -100,10 +84,9 @@ struct SurfaceSearch::Stats {
 // The tail's tree of one call (tailTree): kept from the call before, or built.
 struct SurfaceSearch::TailTree {
     bool kept = false;
-    uint64_t fingerprint = 0;
     SurfaceTree tree;  // empty where kept (or where no tail is wanted: nothing to stage)
-    VkDeviceSize nodeBytes = 0, orderBytes = 0;
-    [[nodiscard]] VkDeviceSize bytes() const { return nodeBytes + orderBytes; }
+    VkDeviceSize nodeBytes = 0, cornerBytes = 0;
+    [[nodiscard]] VkDeviceSize bytes() const { return nodeBytes + cornerBytes; }
 };
 
 SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners,
@@ -125,12 +108,17 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     const bool descend = descendOnly(m_ws.tuning, m_queries, m_triangles);
     auto t0 = Clock::now();
     const TailTree tree = descend ? tailTree(corners, out) : TailTree{};
-    const Stats stats = stage(queries, corners, tree.bytes());
-    if (descend) stageTail(tree, inputBytes());
-    const SurfaceRadii radii(stats.sides / double(m_triangles), stats.area, m_queries,
-                             glm::length(glm::dvec3(stats.box.hi) - glm::dvec3(stats.box.lo)));
-    out.firstRadius = radii.first();
-    m_rayTMax = radii.first() * 1e-3;
+    const Stats stats = stage(queries, corners, !descend, tree.bytes());
+    std::vector<double> start;  // the radii of the first submission (none where descending only)
+    if (descend) {
+        stageTail(tree, corners, inputBytes(false));
+    } else {
+        const SurfaceRadii radii(stats.sides / double(m_triangles), stats.area, m_queries,
+                                 glm::length(glm::dvec3(stats.box.hi) - glm::dvec3(stats.box.lo)));
+        out.firstRadius = radii.first();
+        m_rayTMax = radii.first() * 1e-3;
+        start = radii.start();
+    }
     out.stageMs = msSince(t0) - out.tailBuildMs;  // the tree's build is part of submitMs, as after the radii
 
     // The first submission: the upload, then the radii (the first settles
@@ -139,14 +127,13 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     t0 = Clock::now();
     std::fill_n(static_cast<uint32_t*>(m_counts.mapped()), 2 * SurfaceRadii::kStartRadii + 1, 0u);
     VkCommandBuffer cmd = m_ws.ctx.begin();
-    cmdUpload(cmd);
-    const std::vector<double> start = radii.start();
+    cmdUpload(cmd, !descend);
     bool toHost = false;
     if (descend) {
-        cmdTail(cmd, tree, inputBytes(), 0.0);
+        cmdTail(cmd, tree, inputBytes(false), 0.0);
         cmdReadBack(cmd);
         m_ws.ctx.submitAndWait(cmd);
-        finishTail(tree, out);
+        finishTail(tree, corners, out);
         if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
     } else {
         uint64_t open = 0;  // after the last radius that searched a query
@@ -172,7 +159,7 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     // rays' shader tells (its best not within the last radius, or none).
     t0 = Clock::now();
     const auto* packed = static_cast<const uint64_t*>(m_readback.mapped());
-    const float settled2 = std::nextafter(float(start.back() * start.back()), 0.0f);
+    const float settled2 = toHost ? std::nextafter(float(start.back() * start.back()), 0.0f) : 0.0f;
     const size_t chunk = core::balancedChunk(m_queries, m_ws.threads);
     std::vector<std::vector<uint32_t>> openParts(toHost ? (m_queries + chunk - 1) / chunk : 0);
     out.triangle.resize(m_queries);
@@ -197,27 +184,30 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
 
 void SurfaceSearch::release() {
     for (gpu::Buffer* b : {&m_points, &m_corners, &m_boxes, &m_best, &m_aabbs, &m_staging, &m_readback,
-                           &m_counts, &m_nodes, &m_order})
+                           &m_counts, &m_nodes, &m_leafCorners})
         b->reset();
     m_treeTriangles = 0;
+    m_treeCorners = {};
 }
 
-VkDeviceSize SurfaceSearch::inputBytes() const {
-    return VkDeviceSize(m_queries) * 16 + VkDeviceSize(m_triangles) * (48 + sizeof(sh::Cell));
+VkDeviceSize SurfaceSearch::inputBytes(bool rays) const {
+    return VkDeviceSize(m_queries) * 16 + (rays ? VkDeviceSize(m_triangles) * (48 + sizeof(sh::Cell)) : 0);
 }
 
 SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
-                                          std::span<const glm::vec3> corners, VkDeviceSize extra) {
+                                          std::span<const glm::vec3> corners, bool rays, VkDeviceSize extra) {
     const VkDeviceSize pointBytes = VkDeviceSize(m_queries) * 16;
     const VkDeviceSize cornerBytes = VkDeviceSize(m_triangles) * 48;
     const VkDeviceSize boxBytes = VkDeviceSize(m_triangles) * sizeof(sh::Cell);
     gpu::Buffer& staging =
-        m_ws.grow(m_staging, inputBytes() + extra, "surface.staging", gpu::MemoryKind::kHost);
+        m_ws.grow(m_staging, inputBytes(rays) + extra, "surface.staging", gpu::MemoryKind::kHost);
     m_ws.grow(m_points, pointBytes, "surface.queries");
-    m_ws.grow(m_corners, cornerBytes, "surface.corners");
-    m_ws.grow(m_boxes, boxBytes, "surface.boxes");
+    if (rays) {
+        m_ws.grow(m_corners, cornerBytes, "surface.corners");
+        m_ws.grow(m_boxes, boxBytes, "surface.boxes");
+        m_ws.grow(m_aabbs, VkDeviceSize(m_triangles) * 24, "surface.aabbs");
+    }
     m_ws.grow(m_best, VkDeviceSize(m_queries) * 8, "surface.best");
-    m_ws.grow(m_aabbs, VkDeviceSize(m_triangles) * 24, "surface.aabbs");
     m_ws.grow(m_readback, VkDeviceSize(m_queries) * 8, "surface.readback", gpu::MemoryKind::kReadback);
     // Each radius's counts, then the tail's (one uint).
     m_ws.grow(m_counts, SurfaceRadii::kStartRadii * sizeof(sh::SurfaceRadiusCount) + 4, "surface.counts",
@@ -229,8 +219,8 @@ SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
     char* boxOut = bytes + pointBytes + cornerBytes;
     const size_t queryChunk = core::balancedChunk(m_queries, m_ws.threads);
     const size_t triangleChunk = core::balancedChunk(m_triangles, m_ws.threads, size_t(1) << 10);
-    const int workers =
-        core::resolveThreads(m_ws.threads, m_queries / queryChunk + m_triangles / triangleChunk + 1);
+    const int workers = core::resolveThreads(
+        m_ws.threads, m_queries / queryChunk + (rays ? m_triangles / triangleChunk : 0) + 1);
     std::vector<Stats> each(static_cast<size_t>(workers));
     core::parallelChunks(m_queries, queryChunk, workers, [&](size_t begin, size_t end, int thread) {
         Box box;
@@ -241,6 +231,11 @@ SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
         }
         each[size_t(thread)].box.add(box);
     });
+    if (!rays) {
+        Stats all;
+        for (const Stats& e : each) all.add(e);
+        return all;
+    }
     core::parallelChunks(m_triangles, triangleChunk, workers, [&](size_t begin, size_t end, int thread) {
         Stats mine;
         for (size_t t = begin; t < end; ++t) {
@@ -267,16 +262,18 @@ SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
     return all;
 }
 
-void SurfaceSearch::cmdUpload(VkCommandBuffer cmd) {
+void SurfaceSearch::cmdUpload(VkCommandBuffer cmd, bool rays) {
     const VkDeviceSize pointBytes = VkDeviceSize(m_queries) * 16;
     const VkDeviceSize cornerBytes = VkDeviceSize(m_triangles) * 48;
     const VkDeviceSize boxBytes = VkDeviceSize(m_triangles) * sizeof(sh::Cell);
     const VkBufferCopy toPoints{0, 0, pointBytes};
-    const VkBufferCopy toCorners{pointBytes, 0, cornerBytes};
-    const VkBufferCopy toBoxes{pointBytes + cornerBytes, 0, boxBytes};
     vkCmdCopyBuffer(cmd, m_staging.handle(), m_points.handle(), 1, &toPoints);
-    vkCmdCopyBuffer(cmd, m_staging.handle(), m_corners.handle(), 1, &toCorners);
-    vkCmdCopyBuffer(cmd, m_staging.handle(), m_boxes.handle(), 1, &toBoxes);
+    if (rays) {
+        const VkBufferCopy toCorners{pointBytes, 0, cornerBytes};
+        const VkBufferCopy toBoxes{pointBytes + cornerBytes, 0, boxBytes};
+        vkCmdCopyBuffer(cmd, m_staging.handle(), m_corners.handle(), 1, &toCorners);
+        vkCmdCopyBuffer(cmd, m_staging.handle(), m_boxes.handle(), 1, &toBoxes);
+    }
     vkCmdFillBuffer(cmd, m_best.handle(), 0, VkDeviceSize(m_queries) * 8, 0xffffffffu);  // none
     gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
@@ -324,22 +321,22 @@ void SurfaceSearch::cmdReadBack(VkCommandBuffer cmd) {
 
 SurfaceSearch::TailTree SurfaceSearch::tailTree(std::span<const glm::vec3> corners, SurfaceCandidates& out) {
     TailTree t;
-    t.fingerprint = fingerprintOf(corners, m_ws.threads);
-    t.kept = m_treeTriangles == m_triangles && m_treeFingerprint == t.fingerprint;
+    t.kept = m_treeTriangles == m_triangles && sameCorners(m_treeCorners, corners, m_ws.threads);
     out.tailTreeReused = t.kept;
     if (t.kept) return t;
     const auto t0 = Clock::now();
-    m_treeTriangles = 0;  // m_nodes and m_order hold no tree until the tail's submission is done
+    m_treeTriangles = 0;  // m_nodes and m_leafCorners hold no tree until the tail's submission is done
+    m_treeCorners.clear();
     t.tree = buildSurfaceTree(corners, m_ws.threads);
     t.nodeBytes = VkDeviceSize(t.tree.nodes.size()) * sizeof(sh::Cell);
-    t.orderBytes = VkDeviceSize(t.tree.order.size()) * sizeof(uint32_t);
+    t.cornerBytes = VkDeviceSize(t.tree.order.size()) * 48;
     m_ws.grow(m_nodes, t.nodeBytes, "surface.nodes");
-    m_ws.grow(m_order, t.orderBytes, "surface.order");
+    m_ws.grow(m_leafCorners, t.cornerBytes, "surface.leafCorners");
     out.tailBuildMs = msSince(t0);
     return t;
 }
 
-void SurfaceSearch::stageTail(const TailTree& tree, VkDeviceSize at) {
+void SurfaceSearch::stageTail(const TailTree& tree, std::span<const glm::vec3> corners, VkDeviceSize at) {
     if (tree.kept) return;
     gpu::Buffer& staging =
         at == 0 ? m_ws.grow(m_staging, tree.bytes(), "surface.staging", gpu::MemoryKind::kHost) : m_staging;
@@ -347,16 +344,30 @@ void SurfaceSearch::stageTail(const TailTree& tree, VkDeviceSize at) {
         throw std::logic_error("the upload buffer holds no room for the tree");
     auto* bytes = static_cast<char*>(staging.mapped()) + at;
     std::memcpy(bytes, tree.tree.nodes.data(), tree.nodeBytes);
-    std::memcpy(bytes + tree.nodeBytes, tree.tree.order.data(), tree.orderBytes);
+    // Each sorted position's corners, a's fourth word its triangle's index.
+    auto* leafCorners = reinterpret_cast<uint32_t*>(bytes + tree.nodeBytes);
+    const std::vector<uint32_t>& order = tree.tree.order;
+    core::parallelChunks(order.size(), kStageChunk, m_ws.threads, [&](size_t begin, size_t end, int) {
+        for (size_t p = begin; p < end; ++p) {
+            const uint32_t t = order[p];
+            uint32_t record[12];
+            for (size_t k = 0; k < 3; ++k) {
+                std::memcpy(&record[4 * k], &corners[3 * size_t(t) + k], sizeof(glm::vec3));
+                record[4 * k + 3] = 0u;
+            }
+            record[3] = t;
+            std::memcpy(leafCorners + 12 * p, record, sizeof(record));
+        }
+    });
 }
 
 void SurfaceSearch::cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceSize at, double settled) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "surface tail");
     if (!tree.kept) {
         const VkBufferCopy toNodes{at, 0, tree.nodeBytes};
-        const VkBufferCopy toOrder{at + tree.nodeBytes, 0, tree.orderBytes};
+        const VkBufferCopy toCorners{at + tree.nodeBytes, 0, tree.cornerBytes};
         vkCmdCopyBuffer(cmd, m_staging.handle(), m_nodes.handle(), 1, &toNodes);
-        vkCmdCopyBuffer(cmd, m_staging.handle(), m_order.handle(), 1, &toOrder);
+        vkCmdCopyBuffer(cmd, m_staging.handle(), m_leafCorners.handle(), 1, &toCorners);
         // (A kept tree's copies were made visible to compute reads by
         // this barrier in the submission that made them.)
         gpu::cmdBarrier2(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
@@ -365,10 +376,9 @@ void SurfaceSearch::cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceS
     }
     sh::SurfaceTailPush tp{};
     tp.queries = m_points.address();
-    tp.corners = m_corners.address();
     tp.best = m_best.address();
     tp.nodes = m_nodes.address();
-    tp.order = m_order.address();
+    tp.leafCorners = m_leafCorners.address();
     tp.counts = m_counts.address() + SurfaceRadii::kStartRadii * sizeof(sh::SurfaceRadiusCount);
     tp.numQueries = m_queries;
     // The radii's settle2 of the last radius: the queries open after it
@@ -378,10 +388,11 @@ void SurfaceSearch::cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceS
     m_ws.dispatch(cmd, Kernel::kSurfaceTail, tp, m_queries);
 }
 
-void SurfaceSearch::finishTail(const TailTree& tree, SurfaceCandidates& out) {
+void SurfaceSearch::finishTail(const TailTree& tree, std::span<const glm::vec3> corners,
+                               SurfaceCandidates& out) {
     if (!tree.kept) {
         m_treeTriangles = m_triangles;
-        m_treeFingerprint = tree.fingerprint;
+        m_treeCorners.assign(corners.begin(), corners.end());
     }
     ++out.submissions;
     out.tailGpuMs = m_ws.ctx.lastGpuMs();
@@ -393,12 +404,12 @@ void SurfaceSearch::finishTail(const TailTree& tree, SurfaceCandidates& out) {
 void SurfaceSearch::submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out) {
     // (The radii's submission has finished with what the upload buffer held.)
     const TailTree tree = tailTree(corners, out);
-    stageTail(tree, 0);
+    stageTail(tree, corners, 0);
     VkCommandBuffer cmd = m_ws.ctx.begin();
     cmdTail(cmd, tree, 0, settled);
     cmdReadBack(cmd);
     m_ws.ctx.submitAndWait(cmd);
-    finishTail(tree, out);
+    finishTail(tree, corners, out);
 }
 
 uint32_t SurfaceSearch::cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update,

@@ -18,9 +18,10 @@
 // submission runs surface_tail.comp: every open query descends it
 // nearest-first from the best the rays found, by the same per-triangle
 // test, so it ends with what a visit of every triangle would give. The
-// tree stays on the device for the next call, which descends it without a
-// build while the triangles' float corners are the same (their count and a
-// fingerprint, taken only where the tree is wanted). A few open queries
+// tree (with its own copy of the corners, in its order) stays on the
+// device for the next call, which descends it without a build while the
+// triangles' float corners are the same (bit for bit against a host copy,
+// compared only where the tree is wanted). A few open queries
 // (open x triangles at most the host work, surfaceHostWork) are handed
 // back instead (SurfaceCandidates::open): the caller's proof measures them
 // exactly on the host, which costs less than the tree's build and a second
@@ -165,16 +166,19 @@ public:
 
 private:
     struct Stats;
-    // The queries, corners and the triangles' tight boxes (search cells of
-    // one triangle each) written to the upload buffer on the worker pool,
-    // with the statistics of the radii; the device buffers grown.
-    // `extra`: bytes of the upload buffer kept after the inputs (the tail's
-    // tree, where descendOnly); the inputs' bytes are inputBytes().
-    Stats stage(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners,
+    // The queries, and for the radii (`rays`) the corners and the
+    // triangles' tight boxes (search cells of one triangle each), written
+    // to the upload buffer on the worker pool, with the statistics of the
+    // radii; the device buffers grown. `extra`: bytes of the upload buffer
+    // kept after the inputs (the tail's tree, where descendOnly: the
+    // descent reads the tree's own copy of the corners, so no corners or
+    // boxes go up); the inputs' bytes are inputBytes(rays).
+    Stats stage(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners, bool rays,
                 VkDeviceSize extra = 0);
-    [[nodiscard]] VkDeviceSize inputBytes() const;
-    // The upload buffer's copies and every query's best set to none.
-    void cmdUpload(VkCommandBuffer cmd);
+    [[nodiscard]] VkDeviceSize inputBytes(bool rays) const;
+    // The upload buffer's copies (the corners and boxes for the radii) and
+    // every query's best set to none.
+    void cmdUpload(VkCommandBuffer cmd, bool rays);
     // One submission: its radii (each: grown boxes, BLAS build or refit,
     // rays), then every query's best copied for the host. Returns what each
     // radius did.
@@ -185,18 +189,21 @@ private:
     uint32_t cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update,
                        VkDeviceAddress counts);
     // The tail's tree for this call's corners: the one kept from the call
-    // before where the corners are the same (their count and fingerprint),
-    // else built on the host (its device buffers grown).
+    // before where the corners are the same (every float bit for bit, the
+    // kept copy m_treeCorners), else built on the host (its device buffers
+    // grown).
     struct TailTree;
     TailTree tailTree(std::span<const glm::vec3> corners, SurfaceCandidates& out);
-    // A built tree written to the upload buffer at byte `at` (grown when
-    // `at` is 0; else stage() kept the room).
-    void stageTail(const TailTree& tree, VkDeviceSize at);
+    // A built tree, its nodes and its copy of the corners in its order,
+    // written to the upload buffer at byte `at` (grown when `at` is 0; else
+    // stage() kept the room).
+    void stageTail(const TailTree& tree, std::span<const glm::vec3> corners, VkDeviceSize at);
     // The tree's copies from the upload buffer (a built one) and the
     // descent of every query whose best is farther than `settled`.
     void cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceSize at, double settled);
-    // After the tail's submission: the tree kept, the tail's counts.
-    void finishTail(const TailTree& tree, SurfaceCandidates& out);
+    // After the tail's submission: the tree kept (with a copy of the
+    // corners it holds), the tail's counts.
+    void finishTail(const TailTree& tree, std::span<const glm::vec3> corners, SurfaceCandidates& out);
     // The tail's submission for the queries the radii left open (their best
     // farther than `settled`): tailTree, the descent, every query's best
     // copied for the host.
@@ -209,13 +216,15 @@ private:
     double m_rayTMax = 0.0;
     bool m_built = false;  // the BLAS of this call is built (the next radius refits it)
     gpu::Buffer m_points, m_corners, m_boxes, m_best, m_aabbs, m_staging, m_readback, m_counts;
-    gpu::Buffer m_nodes, m_order;  // the tail's tree (surface_tree.hpp)
-    // Of which corners m_nodes and m_order hold the tree (0 triangles: none).
-    // Equal counts keep every index of a kept tree in range; a fingerprint
-    // that matches other corners (a 64-bit collision) would only give worse
-    // candidates, which the host's proof measures like any.
+    // The tail's tree (surface_tree.hpp): its nodes, and the corners of the
+    // triangle at each of its sorted positions (SurfaceTailPush::leafCorners).
+    gpu::Buffer m_nodes, m_leafCorners;
+    // Of which corners m_nodes and m_leafCorners hold the tree (0 triangles:
+    // none): a kept tree is used only for these very corners, so the
+    // device's distances are those of the call's own triangles, which the
+    // host's proof relies on (api/surface_certify.hpp, searched2).
     uint32_t m_treeTriangles = 0;
-    uint64_t m_treeFingerprint = 0;
+    std::vector<glm::vec3> m_treeCorners;
 };
 
 }  // namespace rthdist::gpu_algo

@@ -913,7 +913,7 @@ TEST(GpuSurfaceTail, AMissingTailIsCaughtByTheProof) {
 }
 
 // A kept Engine keeps the tail's tree while the triangles' float corners
-// are the same (their count and fingerprint): the same inputs again
+// are the same (bit for bit): the same inputs again
 // descend it without building it; other corners (one vertex moved, one
 // triangle fewer) build their own, after which the first inputs build
 // theirs again; a point call between (its own BLAS in the shared storage)
