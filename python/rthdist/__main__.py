@@ -3,10 +3,11 @@
 Same inputs, options and exit codes as `rthdist`, and a subset of its
 summary and --json keys (docs/python.md "Command line": no certificate
 block, hd95 block or normalized values), for what the package binds: --json, --directed, --backend, --device, --bits,
---radius-growth, --threads, --per-point (--percentile, --histogram-bins,
---range), --las-classes, --validation, --list-devices, --version. The
-picture and per-point file outputs (--out-ply, --png, ...) and --verify are
-the CLI's only.
+--radius-growth, --threads, --per-point (--percentile, --histogram-bins and
+--range each imply it, as in the CLI), --las-classes, --validation,
+--list-devices, --version. The picture and per-point file outputs (--out-ply,
+--png, ...) and --verify are the CLI's only. The JSON is strict: a
+non-finite number is written as null, as the CLI writes it.
 
 Exit codes: 0 ok; 1 internal error; 2 usage; 3 bad input (file, empty set,
 NaN); 4 no usable Vulkan device; 130 interrupted.
@@ -14,6 +15,7 @@ NaN); 4 no usable Vulkan device; 130 interrupted.
 
 import argparse
 import json
+import math
 import sys
 import time
 
@@ -68,13 +70,46 @@ def _parser():
     p.add_argument("--per-point", action="store_true", help="per-point distances and their statistics")
     p.add_argument("--percentile", type=_ranged(float, 0.0, 100.0, "--percentile"), action="append",
                    help="also report this percentile (repeatable)")
-    p.add_argument("--histogram-bins", type=_ranged(int, 1, 10000, "--histogram-bins"), default=20)
-    p.add_argument("--range", type=float, nargs=2, metavar=("MIN", "MAX"), help="fixed histogram range")
+    p.add_argument("--histogram-bins", type=_ranged(int, 1, 10000, "--histogram-bins"), default=None,
+                   help="histogram bins, 1..10000 (default 20)")
+    p.add_argument("--range", nargs=2, metavar=("MIN", "MAX"),
+                   help="fixed histogram range, finite, 0 <= MIN < MAX (default 0 .. the largest distance)")
     p.add_argument("--las-classes", type=_classes, default=None, help="LAS classes to read, e.g. 2,6")
     p.add_argument("--validation", action="store_true", help="enable the Vulkan validation layer")
     p.add_argument("--list-devices", action="store_true", help="list every Vulkan device")
     p.add_argument("--version", action="store_true")
     return p
+
+
+def _range(parser, texts):
+    """--range MIN MAX as the CLI checks it (tools/cli/args.cpp): finite, 0 <= MIN < MAX, else exit 2."""
+    try:
+        lo, hi = (float(t) for t in texts)
+    except ValueError:
+        lo = hi = math.nan
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo < hi):
+        parser.error(f"option '--range' expects finite numbers 0 <= MIN < MAX, got '{texts[0]}' '{texts[1]}'")
+    return lo, hi
+
+
+def _strict(value):
+    """value with every non-finite float as None: the CLI's JSON writes NaN and infinities as null."""
+    if isinstance(value, dict):
+        return {k: _strict(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_strict(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _strict(value.tolist())
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
+def _json_text(value):
+    """Standard JSON (RFC 8259: no NaN or Infinity tokens), indented as the CLI's."""
+    return json.dumps(_strict(value), indent=2, allow_nan=False) + "\n"
 
 
 def _fail(code, message):
@@ -153,7 +188,13 @@ def _summary(args, a, b, r, out):
 
 def main(argv=None):
     start = time.perf_counter()
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.range is not None:
+        args.range = _range(parser, args.range)
+    # As in the CLI, each per-point option turns --per-point on.
+    per_point = (args.per_point or bool(args.percentile) or args.histogram_bins is not None
+                 or args.range is not None)
     if args.version:
         print(f"rthdist {rthdist.__version__}")
         return EXIT_OK
@@ -161,7 +202,7 @@ def main(argv=None):
         if args.list_devices:
             devices = rthdist.list_devices()
             if args.json:
-                print(json.dumps(devices, indent=2))
+                sys.stdout.write(_json_text(devices))
             else:
                 for d in devices:
                     paths = [p for p, ok in (("ray-query", d["ray_query"]), ("rt-pipeline", d["rt_pipeline"])) if ok]
@@ -176,16 +217,15 @@ def main(argv=None):
         a = rthdist.load(args.a, las_classes=args.las_classes)
         b = rthdist.load(args.b, las_classes=args.las_classes)
         load_ms = (time.perf_counter() - t0) * 1e3
-        r = rthdist.hausdorff(a, b, directed=args.directed, per_point=args.per_point, backend=args.backend,
+        r = rthdist.hausdorff(a, b, directed=args.directed, per_point=per_point, backend=args.backend,
                               device=args.device, bits=args.bits, radius_growth=args.radius_growth,
                               threads=args.threads, validation=args.validation)
         stats = None
-        if args.per_point:
+        if per_point:
             percentiles = [50.0, 90.0, 95.0, 99.0] if not args.percentile else list(args.percentile)
             if 95.0 not in percentiles:
                 percentiles.append(95.0)
-            stats = r.stats(percentiles=percentiles, bins=args.histogram_bins,
-                            range=tuple(args.range) if args.range else None)
+            stats = r.stats(percentiles=percentiles, bins=args.histogram_bins or 20, range=args.range)
     except (FileNotFoundError, IsADirectoryError, PermissionError) as e:
         return _fail(EXIT_INPUT, f"cannot read '{e.filename}': {e.strerror}")
     except ValueError as e:
@@ -197,7 +237,7 @@ def main(argv=None):
     except rthdist.Error as e:
         return _fail(EXIT_INTERNAL, str(e))
     out = _report(args, a, b, r, load_ms, stats, (time.perf_counter() - start) * 1e3)
-    sys.stdout.write(json.dumps(out, indent=2) + "\n" if args.json else _summary(args, a, b, r, out))
+    sys.stdout.write(_json_text(out) if args.json else _summary(args, a, b, r, out))
     return EXIT_OK
 
 

@@ -81,3 +81,90 @@ def test_module_matches_the_cli_binary():
     assert r.hd95 == ws["hd95"]["max"]
     assert r.percentile(95, "pooled") == ws["hd95"]["pooled"]
     assert r.mean == ws["pooled"]["mean"] and r.rms == ws["pooled"]["rms"]
+
+
+def _small_pair(tmp_path):
+    """Two seeded float64 sets as .xyz files (decimal text loads as float64)."""
+    rng = np.random.default_rng(20250612)
+    paths = []
+    for name, n in (("a", 300), ("b", 200)):
+        path = tmp_path / f"{name}.xyz"
+        np.savetxt(path, rng.random((n, 3)), fmt="%.17g")
+        paths.append(str(path))
+    return paths
+
+
+def _cli_binary():
+    cli = os.environ.get("RTHDIST_CLI", os.path.join(REPO, "build", "rthdist"))
+    return cli if os.path.exists(cli) else None
+
+
+def _no_constants(name):
+    raise AssertionError(f"non-standard JSON token {name}")
+
+
+@pytest.mark.parametrize(
+    "option, percentiles, bins, hist_range",
+    [
+        (["--percentile", "12.5"], [12.5, 95.0], 20, None),
+        (["--histogram-bins", "7"], [50.0, 90.0, 95.0, 99.0], 7, None),
+        (["--range", "0", "0.25"], [50.0, 90.0, 95.0, 99.0], 20, (0.0, 0.25)),
+    ],
+)
+def test_module_per_point_options_imply_per_point(tmp_path, option, percentiles, bins, hist_range):
+    """--percentile, --histogram-bins and --range turn --per-point on, as in the CLI (README "Per-point
+    distances"); python -m rthdist printed no per_point block and dropped the option."""
+    a, b = _small_pair(tmp_path)
+    p = run_module("--json", "--backend", "cpu", *option, a, b)
+    assert p.returncode == 0, p.stderr
+    got = json.loads(p.stdout)["per_point"]
+    r = rthdist.hausdorff(rthdist.load(a), rthdist.load(b), backend="cpu", per_point=True)
+    want = r.stats(percentiles=percentiles, bins=bins, range=hist_range)
+    assert got["percentiles"] == want["percentiles"]
+    assert got["histogram"]["lo"] == want["histogram"]["lo"] and got["histogram"]["hi"] == want["histogram"]["hi"]
+    assert got["histogram"]["a_to_b"] == want["histogram"]["a_to_b"].tolist()
+    text = run_module("--backend", "cpu", *option, a, b)
+    assert text.returncode == 0 and "HD95" in text.stdout
+    cli = _cli_binary()
+    if cli is not None:
+        ref = json.loads(subprocess.run([cli, "--json", "--quiet", "--backend", "cpu", *option, a, b],
+                                        capture_output=True, text=True, check=True).stdout)["per_point"]
+        for block in ("a_to_b", "b_to_a", "pooled"):
+            assert got[block]["percentiles"] == ref[block]["percentiles"], block
+        assert got["histogram"]["a_to_b"] == ref["histogram"]["a_to_b"]
+        assert got["histogram"]["pooled"] == ref["histogram"]["pooled"]
+
+
+@pytest.mark.parametrize(
+    "lo, hi", [("0", "inf"), ("-1", "1"), ("0.5", "0.5"), ("0.5", "0.1"), ("nan", "1"), ("0", "1e400")]
+)
+def test_module_range_is_checked_as_the_cli_does(tmp_path, lo, hi):
+    """--range MIN MAX: finite, 0 <= MIN < MAX, else exit 2 (usage) before any file is read, as the CLI;
+    python -m rthdist ran MIN < 0 or MAX = inf (exit 0, its JSON holding Infinity and NaN) and gave an
+    empty or NaN range exit 3."""
+    a, b = _small_pair(tmp_path)
+    for extra in (["--per-point"], []):
+        p = run_module("--json", "--backend", "cpu", *extra, "--range", lo, hi, a, b)
+        assert p.returncode == 2, (p.returncode, p.stdout[:200], p.stderr)
+        assert "option '--range' expects finite numbers 0 <= MIN < MAX" in p.stderr and p.stdout == ""
+    assert run_module("--range", lo, hi, a, "/nonexistent.ply").returncode == 2
+    cli = _cli_binary()
+    if cli is not None:
+        ref = subprocess.run([cli, "--json", "--quiet", "--per-point", "--range", lo, hi, a, b],
+                             capture_output=True, text=True)
+        assert ref.returncode == 2, ref.stderr
+
+
+def test_module_json_is_strict(tmp_path):
+    """python -m rthdist writes standard JSON: a non-finite number is null, as in the CLI's JSON
+    (json.dumps wrote the tokens NaN and Infinity, which strict parsers refuse)."""
+    from rthdist.__main__ import _json_text
+
+    value = {"nan": float("nan"), "list": [np.float64("inf"), 1.5, np.float32(0.5)],
+             "array": np.array([-np.inf, 2.0]), "count": np.uint64(3), "name": "x", "none": None}
+    assert json.loads(_json_text(value), parse_constant=_no_constants) == {
+        "nan": None, "list": [None, 1.5, 0.5], "array": [None, 2.0], "count": 3, "name": "x", "none": None}
+    a, b = _small_pair(tmp_path)
+    p = run_module("--json", "--backend", "cpu", "--per-point", a, b)
+    assert p.returncode == 0, p.stderr
+    json.loads(p.stdout, parse_constant=_no_constants)
