@@ -25,8 +25,10 @@
 //   is reported so that figure can be formed too.
 //
 // Contract: result.aNearest must hold |a| distances (and bNearest |b| unless
-// result.directedOnly); otherwise kInvalidArgument. With directedOnly the
-// B->A and pooled blocks are empty (count 0) and symmetric values equal A->B.
+// result.directedOnly), histogramBins >= 1, every percentile in [0, 100] and
+// a fixed range finite with rangeLo < rangeHi; otherwise kInvalidArgument.
+// With directedOnly the B->A and pooled blocks are empty (count 0) and
+// symmetric values equal A->B.
 // Threading: pure function of its inputs; reentrant.
 #pragma once
 
@@ -48,7 +50,10 @@ namespace rthdist {
 struct StatsOptions {
     std::vector<double> percentiles{50.0, 90.0, 95.0, 99.0};  // each in [0, 100]
     int histogramBins = 20;                                   // >= 1
-    // Fixed histogram range [rangeLo, rangeHi] when rangeHi > rangeLo; else auto.
+    // Histogram range: both 0 (the default) = auto; anything else is a fixed
+    // range [rangeLo, rangeHi], both finite with rangeLo < rangeHi, else
+    // hausdorffStats returns kInvalidArgument naming the range (an infinite
+    // bound would give infinite bins, NaN edges).
     double rangeLo = 0.0;
     double rangeHi = 0.0;
 };
@@ -81,7 +86,9 @@ struct HausdorffStats {
 // Nearest-rank percentile of ascending `sorted` (non-empty), p in [0, 100].
 [[nodiscard]] RTHDIST_API double percentileNearestRank(std::span<const double> sorted, double p);
 
-// Statistics of one set of distances (any order); empty -> count 0.
+// Statistics of one set of distances (any order); empty -> count 0. The
+// histogram's range: finite, histogramLo < histogramHi (not checked here;
+// hausdorffStats checks StatsOptions' range before it calls this).
 [[nodiscard]] RTHDIST_API DistanceStats distanceStats(std::span<const double> distances,
                                                       const StatsOptions& options, double histogramLo,
                                                       double histogramHi);

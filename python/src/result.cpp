@@ -194,7 +194,12 @@ py::dict stats(PyResult& r, const std::vector<double>& percentiles, int bins, py
     options.histogramBins = bins;
     if (!range.is_none()) {
         const auto lohi = range.cast<std::pair<double, double>>();
-        if (!(lohi.second > lohi.first)) throw py::value_error("range: expected (lo, hi) with hi > lo");
+        // As StatsOptions' fixed range (stats.hpp): finite, lo < hi; (0, 0) is
+        // refused here too (the C++ API reads it as "auto", range=None here).
+        if (!(std::isfinite(lohi.first) && std::isfinite(lohi.second) && lohi.second > lohi.first))
+            throw py::value_error("range: expected finite (lo, hi) with lo < hi, got (" +
+                                  std::string(py::str(py::float_(lohi.first))) + ", " +
+                                  std::string(py::str(py::float_(lohi.second))) + ")");
         options.rangeLo = lohi.first;
         options.rangeHi = lohi.second;
     }
@@ -364,7 +369,8 @@ void bindResult(py::module_& m) {
              py::arg("bins") = 20, py::arg("range") = py::none(),
              "The CLI's --per-point statistics (stats.hpp) as a dict: a_to_b / b_to_a / pooled blocks "
              "(count, min, max, mean, rms, percentiles), symmetric percentiles, diagonals and the "
-             "histogram over [0, max] (or range=(lo, hi)). Needs per_point=True.")
+             "histogram over [0, max] (or range=(lo, hi), finite, lo < hi: else ValueError). Needs "
+             "per_point=True.")
         .def(
             "histogram",
             [](PyResult& r, int bins, py::object range) {

@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <string>
 
 namespace rthdist {
 namespace {
@@ -116,6 +118,17 @@ Result<HausdorffStats> hausdorffStats(const HausdorffResult& result, const Point
             return Error{ErrorCode::kInvalidArgument, "hausdorffStats: percentile outside [0, 100]"};
         }
     }
+    // A fixed range is finite and non-empty: an infinite one put every value
+    // in bin 0 under NaN edges, and a NaN or empty one fell back to auto.
+    const bool autoRange = options.rangeLo == 0.0 && options.rangeHi == 0.0;
+    if (!autoRange && !(std::isfinite(options.rangeLo) && std::isfinite(options.rangeHi) &&
+                        options.rangeLo < options.rangeHi)) {
+        char text[128];
+        std::snprintf(text, sizeof text, "[%g, %g]", options.rangeLo, options.rangeHi);
+        return Error{ErrorCode::kInvalidArgument,
+                     std::string("hausdorffStats: histogram range [rangeLo, rangeHi] = ") + text +
+                         " is not finite with rangeLo < rangeHi (both 0: the automatic range)"};
+    }
     const std::vector<double>& da = result.aNearest.distance;
     const std::vector<double> empty;
     const std::vector<double>& db = result.directedOnly ? empty : result.bNearest.distance;
@@ -127,7 +140,7 @@ Result<HausdorffStats> hausdorffStats(const HausdorffResult& result, const Point
     }
 
     double lo = options.rangeLo, hi = options.rangeHi;
-    if (!(hi > lo)) {
+    if (autoRange) {
         lo = 0.0;
         hi = 0.0;
         for (double d : da) hi = std::max(hi, d);

@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "common/oracle_cases.hpp"
@@ -144,6 +147,40 @@ TEST(Stats, FixedRangeCountsOutside) {
     EXPECT_EQ(s->aToB.histogram.above, 1u);
     EXPECT_EQ(s->aToB.histogram.counts, (std::vector<uint64_t>{1, 1, 0, 1}));
     EXPECT_EQ(s->pooled.histogram.below, 2u);
+}
+
+// A fixed range is finite and non-empty: (0, inf) gave infinite bins (NaN
+// edges, every count in bin 0); NaN or an empty range fell back to auto.
+// Both 0, the default, is the automatic range.
+TEST(Stats, FixedRangeMustBeFiniteAndNonEmpty) {
+    HausdorffResult r;
+    r.aNearest.distance = {0.0, 0.5, 2.0};
+    r.bNearest.distance = {1.0};
+    const std::vector<glm::vec3> a(3), b(1);
+    const double inf = std::numeric_limits<double>::infinity();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const std::pair<double, double> bad[] = {{0.0, inf}, {-inf, 1.0}, {nan, 1.0}, {0.0, nan},
+                                             {0.5, 0.5}, {0.5, 0.1},  {-inf, inf}};
+    for (const auto& [lo, hi] : bad) {
+        StatsOptions o;
+        o.rangeLo = lo;
+        o.rangeHi = hi;
+        Result<HausdorffStats> s = hausdorffStats(r, a, b, o);
+        ASSERT_FALSE(s.ok()) << lo << " " << hi;
+        EXPECT_EQ(s.error().code, ErrorCode::kInvalidArgument);
+        EXPECT_NE(s.error().message.find("histogram range [rangeLo, rangeHi]"), std::string::npos)
+            << s.error().message;
+    }
+    Result<HausdorffStats> automatic = hausdorffStats(r, a, b, StatsOptions{});
+    ASSERT_TRUE(automatic.ok());
+    EXPECT_EQ(automatic->aToB.histogram.lo, 0.0);
+    EXPECT_EQ(automatic->aToB.histogram.hi, 2.0);
+    StatsOptions below;  // a fixed range below 0 is a range: every distance above it
+    below.rangeLo = -2.0;
+    below.rangeHi = -1.0;
+    Result<HausdorffStats> s = hausdorffStats(r, a, b, below);
+    ASSERT_TRUE(s.ok());
+    EXPECT_EQ(s->pooled.histogram.above, 4u);
 }
 
 TEST(Stats, MissingPerPointIsAnError) {

@@ -1,5 +1,7 @@
 """Exactness against cKDTree on random and degenerate sets, float32 and float64, every backend."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -180,3 +182,21 @@ def test_prepared_float_valued_doubles_are_exact(backend):
                   engine.hausdorff_many([pa, pb], [(0, 1)], per_point=True)[0]):
             np.testing.assert_array_equal(r.a_distances, want_d)
             np.testing.assert_array_equal(r.a_nearest, want_i)
+
+
+@pytest.mark.parametrize(
+    "bad", [(0.0, math.inf), (-math.inf, 1.0), (math.nan, 1.0), (0.0, math.nan), (0.5, 0.5), (0.5, 0.1),
+            (0.0, 0.0)]
+)
+def test_histogram_range_must_be_finite_and_non_empty(bad):
+    """stats() and histogram() refuse a non-finite or empty range with a ValueError naming it, as every
+    other option (range=(0, inf) gave edges [nan, inf, ...] and every count in bin 0)."""
+    rng = np.random.default_rng(7)
+    r = rthdist.hausdorff(rng.random((50, 3)), rng.random((40, 3)), per_point=True, backend="cpu")
+    with pytest.raises(ValueError, match=r"^range: expected finite \(lo, hi\) with lo < hi"):
+        r.histogram(bins=4, range=bad)
+    with pytest.raises(ValueError, match=r"^range: "):
+        r.stats(bins=4, range=bad)
+    h = r.histogram(bins=4, range=(0.0, 0.5))
+    np.testing.assert_array_equal(h["edges"], [0.0, 0.125, 0.25, 0.375, 0.5])
+    assert h["a_to_b"].sum() + h["below"]["a_to_b"] + h["above"]["a_to_b"] == 50
