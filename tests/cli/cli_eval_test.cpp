@@ -128,6 +128,10 @@ TEST_F(CliEval, BadValuesAreUsageErrorsNamingTheOption) {
         {{"--eval", "inf"}, "'--eval'"},
         {{"--eval", "0.1", "--eval-cap", "-1"}, "'--eval-cap'"},
         {{"--eval", "0.1", "--eval-cap", "nan"}, "'--eval-cap'"},
+        // 0 is not "no cap" here (that is no --eval-cap): "drop d >= 0" would drop every distance.
+        {{"--eval", "0.1", "--eval-cap", "0"}, "leave --eval-cap out"},
+        // A second list replaced the first silently.
+        {{"--eval", "0.1", "--eval", "0.2"}, "'--eval' is given twice"},
         {{"--eval-cap", "1"}, "'--eval-cap'"},
         {{"--eval-csv", "x.csv"}, "'--eval-csv'"},
         {{"--eval", "0.1", "--surface", "a"}, "'--eval'"},

@@ -153,10 +153,11 @@ Options:
   --eval LIST         reconstruction evaluation, A the reconstruction and B the
                       ground truth: accuracy (A -> B) and completeness (B -> A)
                       mean and median, Chamfer, precision, recall and F-score
-                      at each threshold of LIST (comma-separated, > 0);
-                      with --surface b, accuracy to B's triangles
+                      at each threshold of LIST (comma-separated, > 0; given
+                      once); with --surface b, accuracy to B's triangles
   --eval-cap D        drop distances >= D from the means, medians and Chamfer
-                      (DTU: 20 mm); precision and recall keep them
+                      (DTU: 20 mm), D > 0 (default: no cap); precision and
+                      recall keep them
   --eval-csv FILE     also write the summary as CSV, one row per threshold
   --las-classes LIST  read only the LAS points of these classification values,
                       comma-separated integers 0..255 (e.g. 2,6: ground and
@@ -294,13 +295,19 @@ void addComputeOptions(CommandLine& line, CliArgs& out) {
         out.tolerance = *t;
     });
     addValue(line, "--eval", [&out](const std::string& v) {
+        // A second --eval replaced the first's thresholds silently: one list.
+        if (!out.evalThresholds.empty())
+            reject("option '--eval' is given twice; list every threshold in one (e.g. --eval 0.01,0.02)");
         const auto list = parsePositiveList(v);
         if (!list) outOfRange("--eval", v, "comma-separated finite thresholds > 0 (e.g. 0.01,0.02)");
         out.evalThresholds = *list;
     });
     addValue(line, "--eval-cap", [&out](const std::string& v) {
         const auto d = parseNumber(v);
-        if (!d || !(*d > 0.0)) outOfRange("--eval-cap", v, "a finite distance > 0");
+        // 0 is refused, not read as the library's "no cap" (EvalOptions::cap):
+        // "drop distances >= 0" would drop them all; no --eval-cap is no cap.
+        if (!d || !(*d > 0.0))
+            outOfRange("--eval-cap", v, "a finite distance > 0 (no cap: leave --eval-cap out)");
         out.evalCap = *d;
     });
     addValue(line, "--eval-csv", [&out](const std::string& v) {
