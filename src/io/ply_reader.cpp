@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <unordered_set>
 
 #include "io/face_list.hpp"
 #include "io/gzip_inflate.hpp"
@@ -134,17 +135,24 @@ Result<PlyProperty> parseProperty(const HeaderLine& l, const std::string& path) 
     return PlyProperty{std::string(l.tok[2]), *type, false, ScalarType::kUInt8};
 }
 
-// A property line into the last element declared.
-std::optional<Error> addProperty(const HeaderLine& l, const std::string& path, PlyHeader& header) {
+// A property line into the last element declared; names: the property
+// names of that element so far (views into the header's bytes), so that a
+// header of n properties takes O(n), not O(n^2) (100,000 took 21 s).
+std::optional<Error> addProperty(const HeaderLine& l, const std::string& path, PlyHeader& header,
+                                 std::unordered_set<std::string_view>& names) {
     if (header.elements.empty()) return badInput(path, lineWhere(l.lineNo), "property before any element");
     Result<PlyProperty> prop = parseProperty(l, path);
     if (!prop) return prop.error();
     PlyElement& element = header.elements.back();
-    for (const PlyProperty& seen : element.properties) {
-        if (seen.name == prop->name) {
-            return badInput(path, lineWhere(l.lineNo),
-                            "property '" + prop->name + "' declared twice in element " + element.name);
-        }
+    if (element.properties.size() == kMaxPlyPropertiesPerElement) {
+        return badInput(path, lineWhere(l.lineNo),
+                        "element " + element.name + " has more than " +
+                            std::to_string(kMaxPlyPropertiesPerElement) +
+                            " properties (limit of this loader)");
+    }
+    if (!names.insert(l.tok[l.n - 1]).second) {  // the name ends the line (parseProperty)
+        return badInput(path, lineWhere(l.lineNo),
+                        "property '" + prop->name + "' declared twice in element " + element.name);
     }
     element.properties.push_back(std::move(*prop));
     return std::nullopt;
@@ -158,6 +166,7 @@ Result<PlyHeader> parseHeader(std::string_view bytes, const std::string& path) {
         return badInput(path, lineWhere(1), "not a PLY file (first line is not 'ply')");
     }
     bool haveFormat = false;
+    std::unordered_set<std::string_view> propertyNames;  // of the last element declared
     for (;;) {
         if (!cursor.nextLine(line)) return badInput(path, "header", "no 'end_header' line");
         HeaderLine l;
@@ -179,8 +188,9 @@ Result<PlyHeader> parseHeader(std::string_view bytes, const std::string& path) {
             Result<PlyElement> element = parseElement(l, path);
             if (!element) return element.error();
             header.elements.push_back(std::move(*element));
+            std::unordered_set<std::string_view>().swap(propertyNames);  // clear() is O(buckets)
         } else if (key == "property") {
-            error = addProperty(l, path, header);
+            error = addProperty(l, path, header, propertyNames);
         } else {
             return badInput(path, lineWhere(l.lineNo), "unknown header keyword '" + std::string(key) + "'");
         }

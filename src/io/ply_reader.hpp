@@ -17,6 +17,10 @@
 
 namespace rthdist::io {
 
+// Most properties one element may declare (the 3D Gaussian splats' 62, a
+// point's feature vector, ...): a header past it is refused, not parsed.
+inline constexpr size_t kMaxPlyPropertiesPerElement = 65536;
+
 // bytes: the whole (already gunzipped) file; path names it in error messages.
 // plan: threads and chunk size of the parallel parts (the result does not
 // depend on it).
