@@ -7,8 +7,10 @@
 //         skipped, but must be in the file as declared: ascii bodies hold one
 //         item per line with exactly its properties' values; binary bodies
 //         are walked item by item to the end of the file (only blank or NUL
-//         padding may follow). A property name may appear once per element,
-//         and an element may declare at most 65,536 properties.
+//         padding may follow). An element name may appear once per file
+//         (a second "vertex" element is refused, not skipped), a property
+//         name once per element, and an element may declare at most 65,536
+//         properties.
 //   .xyz / .txt  one "x y z" per line (extra columns ignored, '#' comments);
 //         values separated by blanks, ',' or ';'; a line that separates them
 //         both by blanks alone and by commas ("1,5 2,5 3,5": decimal commas)

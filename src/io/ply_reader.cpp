@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "io/face_list.hpp"
@@ -166,7 +167,8 @@ Result<PlyHeader> parseHeader(std::string_view bytes, const std::string& path) {
         return badInput(path, lineWhere(1), "not a PLY file (first line is not 'ply')");
     }
     bool haveFormat = false;
-    std::unordered_set<std::string_view> propertyNames;  // of the last element declared
+    std::unordered_map<std::string_view, size_t> elementLines;  // each element's name and line
+    std::unordered_set<std::string_view> propertyNames;         // of the last element declared
     for (;;) {
         if (!cursor.nextLine(line)) return badInput(path, "header", "no 'end_header' line");
         HeaderLine l;
@@ -187,6 +189,12 @@ Result<PlyHeader> parseHeader(std::string_view bytes, const std::string& path) {
         } else if (key == "element") {
             Result<PlyElement> element = parseElement(l, path);
             if (!element) return element.error();
+            // A second "vertex" was skipped, its points never read: every name once.
+            if (const auto [at, added] = elementLines.emplace(l.tok[1], l.lineNo); !added) {
+                return badInput(path, lineWhere(l.lineNo),
+                                "element '" + element->name + "' declared twice (first on line " +
+                                    std::to_string(at->second) + ")");
+            }
             header.elements.push_back(std::move(*element));
             std::unordered_set<std::string_view>().swap(propertyNames);  // clear() is O(buckets)
         } else if (key == "property") {

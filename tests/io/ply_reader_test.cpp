@@ -369,6 +369,24 @@ TEST_F(PlyReader, PropertyDeclaredTwiceIsAnError) {
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "line 7: property 'x' declared twice in element vertex"));
 }
 
+TEST_F(PlyReader, ElementDeclaredTwiceIsAnError) {
+    // The second vertex element was skipped: its points were never read.
+    const std::string twoVertex =
+        write("twovertex.ply",
+              header("ascii", "element vertex 1\n" + kXyzFloat + "element vertex 1\n" + kXyzFloat) +
+                  "0 0 0\n1 1 1\n");
+    EXPECT_TRUE(isBadInput(loadPoints(twoVertex), twoVertex,
+                           "line 7: element 'vertex' declared twice (first on line 3)"));
+    const std::string twoFaces =
+        write("twofaces.ply", header("ascii",
+                                     "element face 0\nproperty list uchar int vertex_indices\n"
+                                     "element vertex 1\n" +
+                                         kXyzFloat + "element face 0\nproperty uchar flags\n") +
+                                  "0 0 0\n");
+    EXPECT_TRUE(isBadInput(loadPoints(twoFaces), twoFaces,
+                           "line 9: element 'face' declared twice (first on line 3)"));
+}
+
 // A binary PLY of one vertex (1, 2, 3) whose element has `extra` uchar
 // properties (p0, p1, ...) before x, y, z.
 std::string manyProperties(size_t extra, const std::string& more = "") {
