@@ -20,7 +20,11 @@
 //         scene's nodes (the file's default `scene`; without one, every
 //         scene's: a node two scenes list counts twice), with node
 //         transforms applied (tinygltf); a sparse
-//         POSITION accessor is refused (kBadInput naming it). External
+//         POSITION accessor is refused (kBadInput naming it), and so is one
+//         of a componentType glTF 2.0 does not allow for POSITION (it allows
+//         FLOAT, and BYTE, UNSIGNED_BYTE, SHORT, UNSIGNED_SHORT, normalized
+//         or not, with KHR_mesh_quantization): UNSIGNED_INT, INT and DOUBLE
+//         are refused, not rounded to float. External
 //         buffers are read only from regular files inside the glTF file's own
 //         directory (no absolute path, no "..", no current-directory lookup);
 //         data: URIs are decoded; images are never read.

@@ -86,6 +86,32 @@ std::optional<ScalarType> componentScalar(int componentType) {
     }
 }
 
+// The name glTF gives a componentType (tinygltf's DOUBLE and INT included).
+const char* componentName(int componentType) {
+    switch (componentType) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: return "BYTE";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "UNSIGNED_BYTE";
+        case TINYGLTF_COMPONENT_TYPE_SHORT: return "SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "UNSIGNED_SHORT";
+        case TINYGLTF_COMPONENT_TYPE_INT: return "INT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "UNSIGNED_INT";
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
+        case TINYGLTF_COMPONENT_TYPE_DOUBLE: return "DOUBLE";
+        default: return "unknown";
+    }
+}
+
+// The component types glTF 2.0 allows for POSITION (its table of mesh
+// attributes: FLOAT; with KHR_mesh_quantization also bytes and shorts,
+// signed or unsigned, normalized or not). UNSIGNED_INT was read and rounded to float
+// (16777217 -> 16777216); INT and DOUBLE are no glTF 2.0 types at all.
+bool positionComponentAllowed(int componentType) {
+    return componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
+           componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+           componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
+           componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+}
+
 // Normalized integer components map to [-1, 1] or [0, 1] (glTF 3.11).
 double normalize(double v, ScalarType t) {
     switch (t) {
@@ -295,6 +321,13 @@ private:
         const auto scalar = componentScalar(acc.componentType);
         if (!scalar)
             return badInput(m_path, where, "unknown componentType " + std::to_string(acc.componentType));
+        if (type == TINYGLTF_TYPE_VEC3 && !positionComponentAllowed(acc.componentType)) {
+            return badInput(m_path, where,
+                            std::string(what) + " componentType " + std::to_string(acc.componentType) + " (" +
+                                componentName(acc.componentType) +
+                                ") is not one glTF 2.0 allows (FLOAT; BYTE, UNSIGNED_BYTE, SHORT or "
+                                "UNSIGNED_SHORT with KHR_mesh_quantization)");
+        }
         if (acc.count == 0) return AccessorView{};
         if (acc.bufferView < 0 || static_cast<size_t>(acc.bufferView) >= m_model.bufferViews.size()) {
             return badInput(m_path, where, "bufferView missing or out of range");

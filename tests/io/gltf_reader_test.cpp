@@ -20,13 +20,14 @@ struct GltfParts {
     std::string nodes = R"([{"mesh":0}])";
     std::string scenes = R"("scenes":[{"nodes":[0]}],"scene":0)";
     std::string accessorType = "VEC3";
+    int componentType = 5126;  // FLOAT
 };
 
 std::string gltfJson(const GltfParts& p) {
     return R"({"asset":{"version":"2.0"},"buffers":[)" + p.bufferJson +
            R"(],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" + std::to_string(p.byteLength) +
-           R"(}],"accessors":[{"bufferView":0,"componentType":5126,"count":)" + std::to_string(p.count) +
-           R"(,"type":")" + p.accessorType +
+           R"(}],"accessors":[{"bufferView":0,"componentType":)" + std::to_string(p.componentType) +
+           R"(,"count":)" + std::to_string(p.count) + R"(,"type":")" + p.accessorType +
            R"("}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"mode":4}]}],"nodes":)" + p.nodes +
            "," + p.scenes + "}";
 }
@@ -140,6 +141,41 @@ TEST_F(GltfReader, PositionNotVec3) {
     p.count = 2;
     const std::string path = write("v4.gltf", gltfJson(p));
     EXPECT_TRUE(isBadInput(loadPoints(path), path, "accessor 0: POSITION is not VEC3"));
+}
+
+TEST_F(GltfReader, PositionComponentTypeTheSpecDoesNotAllowIsRefused) {
+    // UNSIGNED_INT positions were read and rounded to float: 16777217 came
+    // back as 16777216. glTF 2.0 allows FLOAT, and with KHR_mesh_quantization
+    // (signed or unsigned) bytes and shorts.
+    ByteBuilder u32;
+    for (uint32_t v : {0u, 0u, 0u, 16777217u, 0u, 0u, 1u, 2u, 3u}) u32.put(v);
+    GltfParts p;
+    p.bufferJson =
+        R"({"byteLength":36,"uri":"data:application/octet-stream;base64,)" + base64(u32.str()) + R"("})";
+    p.componentType = 5125;
+    const std::string uint = write("u32.gltf", gltfJson(p));
+    EXPECT_TRUE(isBadInput(loadPoints(uint), uint, "accessor 0: POSITION componentType 5125 (UNSIGNED_INT)"));
+    EXPECT_TRUE(isBadInput(loadMesh(uint), uint, "accessor 0: POSITION componentType 5125 (UNSIGNED_INT)"));
+    p.componentType = 5124;  // INT: not a glTF 2.0 component type at all
+    const std::string sint = write("i32.gltf", gltfJson(p));
+    EXPECT_TRUE(isBadInput(loadPoints(sint), sint, "accessor 0: POSITION componentType 5124 (INT)"));
+    p.componentType = 5130;  // DOUBLE: tinygltf knows it, glTF 2.0 does not
+    p.count = 1;
+    const std::string dbl = write("f64.gltf", gltfJson(p));
+    EXPECT_TRUE(isBadInput(loadPoints(dbl), dbl, "accessor 0: POSITION componentType 5130 (DOUBLE)"));
+    // KHR_mesh_quantization's types still load: unsigned shorts, not normalized.
+    ByteBuilder u16;
+    for (uint16_t v : {1, 2, 3, 0, 4, 5, 6, 0}) u16.put(v);
+    p.bufferJson =
+        R"({"byteLength":16,"uri":"data:application/octet-stream;base64,)" + base64(u16.str()) + R"("})";
+    p.byteLength = 16;
+    p.count = 2;
+    p.componentType = 5123;
+    std::string json = gltfJson(p);
+    json.replace(json.find(R"("byteLength":16})"), 16, R"("byteLength":16,"byteStride":8})");
+    auto r = loadPoints(write("u16.gltf", json));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*r, (std::vector<glm::vec3>{{1, 2, 3}, {4, 5, 6}}));
 }
 
 TEST_F(GltfReader, NodeCycleAndBadIndices) {
