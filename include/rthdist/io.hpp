@@ -17,8 +17,9 @@
 //         is refused, not read as 1, 5, 2.
 //   .obj  "v x y z" lines only.
 //   .gltf / .glb  POSITION of every primitive of every mesh instanced by the
-//         scene's nodes (the file's default `scene`; without one, every
-//         scene's: a node two scenes list counts twice), with node
+//         scene's nodes (the file's default `scene`, refused when it names
+//         no scene; without one, every scene's: a node two scenes list
+//         counts twice), with node
 //         transforms applied (tinygltf); a sparse
 //         POSITION accessor is refused (kBadInput naming it), and so is one
 //         of a componentType glTF 2.0 does not allow for POSITION (it allows

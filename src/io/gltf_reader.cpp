@@ -402,7 +402,15 @@ Result<std::vector<int>> rootNodes(const tinygltf::Model& model, const std::stri
         }
         return std::nullopt;
     };
-    if (model.defaultScene >= 0 && static_cast<size_t>(model.defaultScene) < model.scenes.size()) {
+    // tinygltf leaves -1 where "scene" is absent; any other index must name a
+    // scene ("scene": 5 of one scene was read as no default scene).
+    if (model.defaultScene < -1 ||
+        (model.defaultScene >= 0 && static_cast<size_t>(model.defaultScene) >= model.scenes.size())) {
+        return badInput(path, "glTF",
+                        "default scene " + std::to_string(model.defaultScene) + " out of range (" +
+                            std::to_string(model.scenes.size()) + " scene(s))");
+    }
+    if (model.defaultScene >= 0) {
         if (auto err = addScene(static_cast<size_t>(model.defaultScene))) return *err;
     } else if (!model.scenes.empty()) {
         for (size_t s = 0; s < model.scenes.size(); ++s) {

@@ -178,6 +178,19 @@ TEST_F(GltfReader, PositionComponentTypeTheSpecDoesNotAllowIsRefused) {
     EXPECT_EQ(*r, (std::vector<glm::vec3>{{1, 2, 3}, {4, 5, 6}}));
 }
 
+TEST_F(GltfReader, DefaultSceneOutOfRangeIsAnError) {
+    // "scene": 5 with one scene was taken as no default scene (every scene).
+    GltfParts p;
+    p.bufferJson = embedded(threePoints());
+    p.scenes = R"("scenes":[{"nodes":[0]}],"scene":5)";
+    const std::string path = write("scene5.gltf", gltfJson(p));
+    EXPECT_TRUE(isBadInput(loadPoints(path), path, "glTF: default scene 5 out of range (1 scene(s))"));
+    EXPECT_TRUE(isBadInput(loadMesh(path), path, "glTF: default scene 5 out of range (1 scene(s))"));
+    p.scenes = R"("scene":0)";  // no scenes at all
+    const std::string none = write("scene0.gltf", gltfJson(p));
+    EXPECT_TRUE(isBadInput(loadPoints(none), none, "glTF: default scene 0 out of range (0 scene(s))"));
+}
+
 TEST_F(GltfReader, NodeCycleAndBadIndices) {
     GltfParts p;
     p.bufferJson = embedded(threePoints());
