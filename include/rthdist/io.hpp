@@ -27,7 +27,8 @@
 //         or not, with KHR_mesh_quantization): UNSIGNED_INT, INT and DOUBLE
 //         are refused, not rounded to float. External
 //         buffers are read only from regular files inside the glTF file's own
-//         directory (no absolute path, no "..", no current-directory lookup);
+//         directory (no absolute path, no "..", no current-directory lookup,
+//         no symbolic link whose real path leaves the directory's real path);
 //         data: URIs are decoded; images are never read.
 //   .stl  ascii and binary (every facet vertex, duplicates kept); binary when
 //         the size is 84 + 50 * facets or the file holds a NUL byte, whatever

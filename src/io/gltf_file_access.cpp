@@ -50,8 +50,28 @@ std::string GltfFileAccess::resolve(const std::string& joined, uint64_t* size) {
         m_refusal = "URI '" + uri + "': " + why;
         return "";
     }
+    // Symbolic links are followed, but the file reached must lie inside the
+    // directory's own real path: a link to a file (or a directory) outside
+    // it was read as if it were inside.
+    std::error_code ec;
+    const std::filesystem::path realBase = std::filesystem::canonical(m_baseDir, ec);
+    if (ec) {
+        m_refusal = "the glTF file's directory '" + m_baseDir + "': " + ec.message();
+        return "";
+    }
+    const std::filesystem::path real = std::filesystem::canonical(joined, ec);
+    if (ec) {
+        m_refusal = "URI '" + uri + "': " + ec.message();
+        return "";
+    }
+    const std::string inside = (realBase / "").string();  // with a trailing '/'
+    if (!real.string().starts_with(inside)) {
+        m_refusal =
+            "URI '" + uri + "': its real path '" + real.string() + "' is outside the glTF file's directory";
+        return "";
+    }
     struct stat st {};
-    if (::stat(joined.c_str(), &st) != 0) {
+    if (::stat(real.c_str(), &st) != 0) {
         m_refusal = "URI '" + uri + "': " + std::strerror(errno);
         return "";
     }
@@ -65,18 +85,19 @@ std::string GltfFileAccess::resolve(const std::string& joined, uint64_t* size) {
         return "";
     }
     if (size != nullptr) *size = static_cast<uint64_t>(st.st_size);
-    return uri;
+    return real.string();
 }
 
 bool GltfFileAccess::exists(const std::string& joined) { return !resolve(joined, nullptr).empty(); }
 
 bool GltfFileAccess::read(std::vector<unsigned char>& out, std::string& err, const std::string& joined) {
     uint64_t size = 0;
-    if (resolve(joined, &size).empty()) {
+    const std::string real = resolve(joined, &size);
+    if (real.empty()) {
         err = m_refusal;
         return false;
     }
-    std::unique_ptr<std::FILE, FileCloser> file(std::fopen(joined.c_str(), "rb"));
+    std::unique_ptr<std::FILE, FileCloser> file(std::fopen(real.c_str(), "rb"));
     if (!file) {
         err = std::strerror(errno);
         return false;

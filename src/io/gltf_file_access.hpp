@@ -1,7 +1,9 @@
 // File access for the URIs inside a .gltf/.glb (buffers; images are never
 // read): only regular files inside the glTF file's own directory. No
 // absolute paths, no ".." component, no lookup in the current directory, no
-// directories or devices, and a size check before reading. tinygltf calls
+// directories or devices, no symbolic link that leads out of the directory
+// (the file's real path must lie inside the directory's real path; a link
+// that stays inside is followed), and a size check before reading. tinygltf calls
 // these through its FsCallbacks (gltf_reader.cpp); data: URIs never get here.
 #pragma once
 
@@ -31,8 +33,9 @@ public:
     [[nodiscard]] const std::string& refusal() const { return m_refusal; }
 
 private:
-    // The URI part of joined if it is a regular file inside baseDir() of at
-    // most kMaxGltfExternalFileBytes, else "" with m_refusal set.
+    // The real path (symbolic links resolved) of joined if it is a regular
+    // file of at most kMaxGltfExternalFileBytes whose real path lies inside
+    // the real path of baseDir(), else "" with m_refusal set.
     std::string resolve(const std::string& joined, uint64_t* size);
 
     std::string m_baseDir;  // ends with '/'

@@ -306,6 +306,30 @@ TEST_F(GltfUris, CurrentDirectoryIsNotSearched) {
     EXPECT_TRUE(isBadInput(r, path, "buffer URI 'pos.bin': No such file"));
 }
 
+TEST_F(GltfUris, SymlinkOutOfTheDirectoryIsRefused) {
+    // stat() followed a link inside the directory to a file outside it.
+    std::filesystem::create_symlink(file("pos.bin"), file("scene/link.bin"));
+    const std::string path = gltfWithUri("scene/link.gltf", "link.bin");
+    EXPECT_TRUE(isBadInput(loadPoints(path), path,
+                           "buffer URI 'link.bin': its real path '" +
+                               std::filesystem::canonical(file("pos.bin")).string() +
+                               "' is outside the glTF file's directory"));
+    // A linked directory the same.
+    std::filesystem::create_directory_symlink(file(""), file("scene/up"));
+    const std::string viaDir = gltfWithUri("scene/viadir.gltf", "up/pos.bin");
+    EXPECT_TRUE(isBadInput(loadPoints(viaDir), viaDir, "is outside the glTF file's directory"));
+    // A link that stays inside loads, and so does a glTF reached through a linked directory.
+    std::filesystem::create_symlink("sub/pos.bin", file("scene/inside.bin"));
+    auto inside = loadPoints(gltfWithUri("scene/inside.gltf", "inside.bin"));
+    ASSERT_TRUE(inside.ok()) << inside.error().message;
+    EXPECT_EQ(*inside, threePoints());
+    std::filesystem::create_directory_symlink(file("scene"), file("linked_scene"));
+    gltfWithUri("scene/down.gltf", "sub/pos.bin");
+    auto linked = loadPoints(file("linked_scene/down.gltf"));
+    ASSERT_TRUE(linked.ok()) << linked.error().message;
+    EXPECT_EQ(*linked, threePoints());
+}
+
 TEST_F(GltfUris, DirectoryIsRefused) {
     // A URI naming a directory made tinygltf attempt a 2^63-byte allocation.
     const std::string path = gltfWithUri("scene/dir.gltf", "sub");
