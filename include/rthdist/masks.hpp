@@ -129,7 +129,11 @@ inline constexpr double kMaxCoordinate = 1e30;
 // header is validated field by field (README "Segmentation masks": dim,
 // datatype, pixdim, vox_offset, scl_slope/scl_inter, qform/sform codes,
 // quatern_b/c/d, qoffset, srow) before any value is used, then the voxels
-// are read (inflated) in pieces into the Volume, within `limits`. The
+// are read (inflated) in pieces into the Volume, within `limits`. A gzip
+// stream is read to its end: a missing, cut or corrupt trailer (CRC-32,
+// ISIZE), inflated bytes after the voxels and bytes after the stream other
+// than zero padding are refused (at most one byte past the voxels is
+// inflated); a plain .nii's bytes after the voxels are not read. The
 // transform is the sform when sform_code > 0, else the qform when
 // qform_code > 0, else diag(pixdim[1..3]) with origin 0. scl_slope/scl_inter
 // are applied when the slope is finite and non-zero (as nibabel). A 4-D to

@@ -157,6 +157,61 @@ TEST(NiftiHeader, GzipStreamShorterThanTheHeaderSaysIsRefused) {
     std::remove(path.c_str());
 }
 
+// One gzip member of `bytes` (zlib, level 6).
+std::string gzipped(const std::string& bytes) {
+    z_stream zs{};
+    EXPECT_EQ(deflateInit2(&zs, 6, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY), Z_OK);
+    std::string out(deflateBound(&zs, uLong(bytes.size())), '\0');
+    zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+    zs.avail_in = uInt(bytes.size());
+    zs.next_out = reinterpret_cast<Bytef*>(out.data());
+    zs.avail_out = uInt(out.size());
+    EXPECT_EQ(deflate(&zs, Z_FINISH), Z_STREAM_END);
+    out.resize(zs.total_out);
+    deflateEnd(&zs);
+    return out;
+}
+
+Result<Volume> loadNiftiBytes(const std::string& path, const std::string& bytes) {
+    writeFile(path, bytes);
+    Result<Volume> v = loadNifti(path);
+    std::remove(path.c_str());
+    return v;
+}
+
+TEST(NiftiHeader, GzipStreamIsReadToItsVerifiedEnd) {
+    // The reader stopped at the last voxel: a missing or corrupt trailer
+    // (CRC32, ISIZE) and anything after the voxels went unnoticed.
+    Nifti1 n(9, 8, 7, 2, 1);
+    const std::string gz = gzipped(n.bytes());
+    const std::string path = tempPath("stream.nii.gz");
+    for (size_t cut : {4, 8}) {
+        SCOPED_TRACE(cut);
+        expectRefused(loadNiftiBytes(path, gz.substr(0, gz.size() - cut)), path, {"truncated gzip stream"});
+    }
+    std::string badCrc = gz;
+    badCrc[badCrc.size() - 8] ^= 1;
+    expectRefused(loadNiftiBytes(path, badCrc), path, {"corrupt gzip stream", "incorrect data check"});
+    expectRefused(loadNiftiBytes(path, gz + "garbage"), path, {"corrupt gzip stream", "byte offset"});
+    // Inflated bytes after the voxels, in the same member or a second one:
+    // refused after inflating one byte of them (a bomb is not inflated).
+    const std::string more = "after the last voxel (vox_offset 352 + 504 bytes)";
+    expectRefused(loadNiftiBytes(path, gzipped(n.bytes() + std::string(1 << 20, '\0'))), path, {more});
+    expectRefused(loadNiftiBytes(path, gz + gzipped("x")), path, {more});
+    // Legal gzip: the voxels over two members, an empty member, zero padding.
+    const std::string bytes = n.bytes();
+    const Result<Volume> split =
+        loadNiftiBytes(path, gzipped(bytes.substr(0, 400)) + gzipped(bytes.substr(400)) + gzipped("") +
+                                 std::string(100, '\0'));
+    ASSERT_TRUE(split.ok()) << split.error().message;
+    EXPECT_EQ(split->labels8.size(), size_t(9 * 8 * 7));
+    EXPECT_EQ(split->labels8[0], 1);
+    // A plain .nii is read as before: bytes after the voxels are not read.
+    const std::string plain = tempPath("plain.nii");
+    const Result<Volume> padded = loadNiftiBytes(plain, bytes + "tail");
+    ASSERT_TRUE(padded.ok()) << padded.error().message;
+}
+
 TEST(NiftiHeader, BigEndianFileReadsAsLittle) {
     Nifti1 n(3, 2, 2, 4, 2);  // int16
     auto swapAll = [](std::string& b, size_t at, size_t count, size_t width) {
