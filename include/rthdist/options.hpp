@@ -45,6 +45,8 @@ struct EngineOptions {
     Backend backend = Backend::kAuto;
     // Vulkan physical device index as listed by listDevices(); -1 = the first
     // usable discrete GPU, else integrated, virtual, other, software last.
+    // An index the list does not hold is kNoDevice on every backend but
+    // kCpu (Backend::kAuto included; so is such an entry of `devices`).
     int deviceIndex = -1;
     // Several devices (listDevices() indices) for one Engine, GPU backends
     // only. A one-shot compute(a, b) past the memory budget (out of core)

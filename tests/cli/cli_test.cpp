@@ -242,6 +242,19 @@ TEST_P(CliBadInput, ExitsThreeNamingTheFile) {
 INSTANTIATE_TEST_SUITE_P(Loaders, CliBadInput, ::testing::ValuesIn(badInputCases()),
                          [](const auto& info) { return std::string(info.param.name); });
 
+// --device N past the device list was ignored under --backend auto (the
+// CPU backend ran, exit 0); README: an index past the list is exit 4, and
+// auto with --device N stays on the Vulkan device.
+TEST(CliDevice, AutoWithADevicePastTheListIsNoDevice) {
+    TempDir dir;
+    const std::string good = dir.write("good.xyz", kPair);
+    const CliRun run = runCli({"--device", "1023", good, good});
+    EXPECT_EQ(run.exitCode, 4) << run;
+    EXPECT_NE(run.err.find("rthdist: device 1023 does not exist"), std::string::npos) << run;
+    const CliRun cpu = runCli({"--backend", "cpu", "--device", "1023", good, good});
+    EXPECT_EQ(cpu.exitCode, 0) << cpu;  // the cpu backend opens no device
+}
+
 TEST(CliBadInputFiles, MissingFile) {
     TempDir dir;
     const std::string good = dir.write("good.xyz", kPair);

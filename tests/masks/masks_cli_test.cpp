@@ -57,6 +57,23 @@ TEST(MasksCli, Nifti2Dim0OutsideOneToSevenExitsThree) {
     }
 }
 
+// --device N past the device list was ignored under --backend auto (the
+// CPU backend ran, exit 0); README: an index past the list is exit 4.
+TEST(MasksCli, DevicePastTheListExitsFour) {
+    TempDir dir;
+    const std::string good = dir.write("good.nii", Nifti1(4, 4, 4, 2, 1).bytes());
+    for (const char* backend : {"auto", "cpu"}) {
+        SCOPED_TRACE(backend);
+        const CliRun run = masks({good, good, "--backend", backend, "--device", "1023"});
+        if (std::string(backend) == "cpu") {
+            EXPECT_EQ(run.exitCode, 0) << run;  // the cpu backend opens no device
+            continue;
+        }
+        EXPECT_EQ(run.exitCode, 4) << run;
+        EXPECT_NE(run.err.find("device 1023 does not exist"), std::string::npos) << run;
+    }
+}
+
 TEST(MasksCli, NanPixdimExitsThree) {
     TempDir dir;
     Nifti1 n(4, 4, 4, 2, 1);
