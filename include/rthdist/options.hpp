@@ -25,7 +25,9 @@ enum class Backend {
                   // no such device (none, or only a software one such as
                   // lavapipe): the CPU backend, which is faster there; a
                   // one-shot call of a small pair: the CPU backend too
-                  // (oneShotBackendFor, rthdist.hpp)
+                  // (oneShotBackendFor, rthdist.hpp). A device named
+                  // (deviceIndex, devices) or validation keeps the Vulkan
+                  // path on that device, software or not
     kRayQuery,    // VK_KHR_ray_query in compute shaders
     kRtPipeline,  // VK_KHR_ray_tracing_pipeline (raygen + intersection)
     kCpu,         // exact multithreaded CPU implementation (no Vulkan)

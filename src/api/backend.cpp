@@ -20,18 +20,18 @@ Error notOffered(const char* what) {
 
 // auto picks a Vulkan backend only on a device with RT hardware paths that is
 // not a software rasterizer: on lavapipe (VK_PHYSICAL_DEVICE_TYPE_CPU) the
-// native CPU backend is 10-100x faster (docs/bench). An explicit --device
-// keeps the Vulkan path on whatever device it names.
+// native CPU backend is 10-100x faster (docs/bench). A device named
+// (deviceIndex, devices) or validation asked for keeps the Vulkan path on
+// whatever device that is (README, --backend): a named device without an RT
+// path is then the GPU backend's error, not a silent CPU run, and
+// validation validates a Vulkan device (it ran the CPU backend on lavapipe,
+// reporting "validation": true and 0 messages).
 bool hardwareRtDevice(const EngineOptions& o) {
+    if (o.deviceIndex >= 0 || !o.devices.empty() || o.validation) return true;
     auto devices = listDevices();
     if (!devices) return false;
     for (const DeviceInfo& d : devices.value()) {
-        if (!(d.rayQuery || d.rtPipeline)) continue;
-        if (o.deviceIndex >= 0) {
-            if (d.index == o.deviceIndex) return true;
-            continue;
-        }
-        if (d.type != "cpu") return true;
+        if ((d.rayQuery || d.rtPipeline) && d.type != "cpu") return true;
     }
     return false;
 }
@@ -101,12 +101,10 @@ Result<std::unique_ptr<ComputeBackend>> openBackend(const EngineOptions& options
     }
     if (options.backend == Backend::kCpu ||
         (options.backend == Backend::kAuto && !hardwareRtDevice(options))) {
-        if (options.devices.size() > 1) {
-            return Error{
-                ErrorCode::kInvalidArgument,
-                "several devices (EngineOptions::devices) need a GPU backend; the " +
-                    std::string(options.backend == Backend::kCpu ? "cpu backend was asked for"
-                                                                 : "first device has no RT hardware")};
+        if (options.devices.size() > 1) {  // (auto with devices named takes the GPU path)
+            return Error{ErrorCode::kInvalidArgument,
+                         "several devices (EngineOptions::devices) need a GPU backend; the cpu backend was "
+                         "asked for"};
         }
         return makeCpuBackend(options);
     }

@@ -310,6 +310,24 @@ TEST(CliGpuAuto, ExplicitDeviceKeepsVulkan) {
     EXPECT_TRUE(backend == "ray-query" || backend == "rt-pipeline") << backend;
 }
 
+// So do --devices and --validation (README, --backend): on lavapipe they
+// ran the CPU backend, --validation reporting "validation": true and 0
+// messages from no Vulkan device at all.
+TEST(CliGpuAuto, DevicesOrValidationKeepVulkan) {
+    for (const std::vector<std::string>& flags :
+         {std::vector<std::string>{"--devices", "0"}, std::vector<std::string>{"--validation"}}) {
+        std::vector<std::string> args{"--json"};
+        args.insert(args.end(), flags.begin(), flags.end());
+        args.insert(args.end(), {kSampleA, kSampleB});
+        const CliRun run = runCli(args);
+        ASSERT_EQ(run.exitCode, 0) << run;
+        const Json j = parseJson(run);
+        const std::string backend = j["backend"].get<std::string>();
+        EXPECT_TRUE(backend == "ray-query" || backend == "rt-pipeline") << flags.front() << ": " << backend;
+        EXPECT_EQ(j["validation_messages"].get<uint64_t>(), 0u) << run.err;
+    }
+}
+
 TEST(CliGpuDevices, ListJson) {
     const CliRun run = runCli({"--list-devices", "--json"});
     ASSERT_EQ(run.exitCode, 0) << run;
