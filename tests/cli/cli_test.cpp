@@ -44,6 +44,13 @@ TEST_F(CliUsage, FlagWithValue) { expectUsageError({"--json=yes", m_a, m_b}, "--
 TEST_F(CliUsage, DevicesNeedAGpuBackend) {
     expectUsageError({"--backend", "cpu", "--devices", "0,1", m_a, m_b}, "--devices");
 }
+// A list option given twice replaced the first list silently.
+TEST_F(CliUsage, ListOptionsOnce) {
+    expectUsageError({"--devices", "0", "--devices", "1", m_a, m_b}, "'--devices' is given twice");
+    expectUsageError({"--devices", "all", "--devices", "0", m_a, m_b}, "'--devices' is given twice");
+    expectUsageError({"--las-classes", "2", "--las-classes", "6", m_a, m_b},
+                     "'--las-classes' is given twice");
+}
 TEST_F(CliUsage, ListDevicesWithFiles) { expectUsageError({"--list-devices", m_a}, "--list-devices"); }
 
 TEST_F(CliUsage, BadNumbers) {
@@ -337,6 +344,13 @@ TEST(CliCpu, SampleJson) {
     EXPECT_FALSE(j["directed"].get<bool>());
     EXPECT_GT(j["hausdorff"].get<double>(), 0.0);
     EXPECT_EQ(j["counters"]["b_to_a"]["queries"].get<uint64_t>(), j["points"]["b"].get<uint64_t>());
+}
+
+// --render, a per-point option, implies --per-point as the others do.
+TEST(CliCpu, RenderImpliesPerPoint) {
+    const CliRun run = runCli({"--backend", "cpu", "--json", "--render", "software", kSampleA, kSampleB});
+    ASSERT_EQ(run.exitCode, 0) << run;
+    EXPECT_TRUE(parseJson(run).contains("per_point")) << run.out;
 }
 
 TEST(CliCpu, SampleSummary) {

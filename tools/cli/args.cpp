@@ -250,6 +250,9 @@ void addComputeOptions(CommandLine& line, CliArgs& out) {
     addInt(line, "--device", 0, kMaxDeviceIndex, "a device index in " + rangeText(0, kMaxDeviceIndex),
            out.options.deviceIndex);
     addValue(line, "--devices", [&out](const std::string& v) {
+        // A second --devices replaced the first list silently: one list.
+        if (out.allDevices || !out.options.devices.empty())
+            reject("option '--devices' is given twice; list every device in one (e.g. --devices 0,1)");
         if (v == "all") {
             out.allDevices = true;
             return;
@@ -315,6 +318,9 @@ void addComputeOptions(CommandLine& line, CliArgs& out) {
         out.evalCsv = v;
     });
     addValue(line, "--las-classes", [&out](const std::string& v) {
+        // A second --las-classes replaced the first list silently: one list.
+        if (!out.lasClasses.empty())
+            reject("option '--las-classes' is given twice; list every class in one (e.g. --las-classes 2,6)");
         const auto classes = parseIntList(v, 0, kMaxLasClass);
         if (!classes)
             outOfRange("--las-classes", v,
@@ -354,6 +360,7 @@ void addPerPointOptions(CommandLine& line, CliArgs& out) {
         if (v != "vulkan" && v != "software")
             reject("unknown renderer '" + v + "' (expected vulkan or software)");
         out.softwareRender = v == "software";
+        out.perPoint = true;  // as every per-point option (README: all but --quiet imply it)
     });
     for (auto [name, target] :
          {std::pair{"--out-ply", &out.outPly}, std::pair{"--out-csv", &out.outCsv},
