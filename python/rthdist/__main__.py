@@ -16,6 +16,7 @@ NaN); 4 no usable Vulkan device; 130 interrupted.
 import argparse
 import json
 import math
+import re
 import sys
 import time
 
@@ -33,7 +34,27 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(EXIT_USAGE)
 
 
+# The CLI's number grammar (tools/cli/args.cpp, std::from_chars): an optional
+# leading '-', no '+', no spaces, no '_' (which Python's int() and float() take).
+_INTEGER = re.compile(r"-?[0-9]+")
+_NUMBER = re.compile(r"-?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?")
+
+
+def _integer(text):
+    if not _INTEGER.fullmatch(text):
+        raise ValueError(text)
+    return int(text)
+
+
+def _number(text):
+    if not _NUMBER.fullmatch(text):
+        raise ValueError(text)
+    return float(text)
+
+
 def _ranged(kind, lo, hi, name):
+    kind = {int: _integer, float: _number}[kind]
+
     def parse(text):
         try:
             v = kind(text)
@@ -48,7 +69,7 @@ def _ranged(kind, lo, hi, name):
 
 def _classes(text):
     try:
-        values = [int(x) for x in text.split(",")]
+        values = [_integer(x) for x in text.split(",")]
     except ValueError:
         raise argparse.ArgumentTypeError(f"option '--las-classes': '{text}' is not a list of integers") from None
     if any(not 0 <= v <= 255 for v in values):
@@ -84,7 +105,7 @@ def _parser():
 def _range(parser, texts):
     """--range MIN MAX as the CLI checks it (tools/cli/args.cpp): finite, 0 <= MIN < MAX, else exit 2."""
     try:
-        lo, hi = (float(t) for t in texts)
+        lo, hi = (_number(t) for t in texts)
     except ValueError:
         lo = hi = math.nan
     if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo < hi):

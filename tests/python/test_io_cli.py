@@ -155,6 +155,21 @@ def test_module_range_is_checked_as_the_cli_does(tmp_path, lo, hi):
         assert ref.returncode == 2, ref.stderr
 
 
+@pytest.mark.parametrize("option, value", [("--threads", "1_0"), ("--threads", "+1"), ("--threads", " 1"),
+                                           ("--percentile", "+5"), ("--percentile", "5_0"),
+                                           ("--las-classes", "2,+6"), ("--radius-growth", "2 ")])
+def test_module_reads_numbers_as_the_cli_does(tmp_path, option, value):
+    """Numbers as the CLI reads them (std::from_chars: no '+', no spaces, no '_'): exit 2; Python's
+    int() and float() took '1_0', '+1' and ' 1'."""
+    a, b = _small_pair(tmp_path)
+    p = run_module("--json", "--backend", "cpu", option, value, a, b)
+    assert p.returncode == 2, (p.returncode, p.stdout[:200], p.stderr)
+    cli = _cli_binary()
+    if cli is not None:
+        ref = subprocess.run([cli, "--json", "--quiet", option, value, a, b], capture_output=True, text=True)
+        assert ref.returncode == 2, ref.stderr
+
+
 def test_module_json_is_strict(tmp_path):
     """python -m rthdist writes standard JSON: a non-finite number is null, as in the CLI's JSON
     (json.dumps wrote the tokens NaN and Infinity, which strict parsers refuse)."""
