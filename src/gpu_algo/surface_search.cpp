@@ -186,7 +186,6 @@ void SurfaceSearch::release() {
     for (gpu::Buffer* b : {&m_points, &m_corners, &m_boxes, &m_best, &m_aabbs, &m_staging, &m_readback,
                            &m_counts, &m_nodes, &m_leafCorners})
         b->reset();
-    m_treeTriangles = 0;
     m_treeCorners = {};
 }
 
@@ -321,12 +320,11 @@ void SurfaceSearch::cmdReadBack(VkCommandBuffer cmd) {
 
 SurfaceSearch::TailTree SurfaceSearch::tailTree(std::span<const glm::vec3> corners, SurfaceCandidates& out) {
     TailTree t;
-    t.kept = m_treeTriangles == m_triangles && sameCorners(m_treeCorners, corners, m_ws.threads);
+    t.kept = !m_treeCorners.empty() && sameCorners(m_treeCorners, corners, m_ws.threads);
     out.tailTreeReused = t.kept;
     if (t.kept) return t;
     const auto t0 = Clock::now();
-    m_treeTriangles = 0;  // m_nodes and m_leafCorners hold no tree until the tail's submission is done
-    m_treeCorners.clear();
+    m_treeCorners.clear();  // m_nodes and m_leafCorners hold no tree until the tail's submission is done
     t.tree = buildSurfaceTree(corners, m_ws.threads);
     t.nodeBytes = VkDeviceSize(t.tree.nodes.size()) * sizeof(sh::Cell);
     t.cornerBytes = VkDeviceSize(t.tree.order.size()) * 48;
@@ -390,10 +388,7 @@ void SurfaceSearch::cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceS
 
 void SurfaceSearch::finishTail(const TailTree& tree, std::span<const glm::vec3> corners,
                                SurfaceCandidates& out) {
-    if (!tree.kept) {
-        m_treeTriangles = m_triangles;
-        m_treeCorners.assign(corners.begin(), corners.end());
-    }
+    if (!tree.kept) m_treeCorners.assign(corners.begin(), corners.end());
     ++out.submissions;
     out.tailGpuMs = m_ws.ctx.lastGpuMs();
     out.gpuMs += out.tailGpuMs;

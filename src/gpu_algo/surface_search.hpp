@@ -219,11 +219,10 @@ private:
     // The tail's tree (surface_tree.hpp): its nodes, and the corners of the
     // triangle at each of its sorted positions (SurfaceTailPush::leafCorners).
     gpu::Buffer m_nodes, m_leafCorners;
-    // Of which corners m_nodes and m_leafCorners hold the tree (0 triangles:
+    // Of which corners m_nodes and m_leafCorners hold the tree (empty:
     // none): a kept tree is used only for these very corners, so the
     // device's distances are those of the call's own triangles, which the
     // host's proof relies on (api/surface_certify.hpp, searched2).
-    uint32_t m_treeTriangles = 0;
     std::vector<glm::vec3> m_treeCorners;
 };
 
