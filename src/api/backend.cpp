@@ -2,9 +2,7 @@
 // plan their route leaves them) and the choice of the Engine's backend.
 #include "api/backend.hpp"
 
-#include <optional>
 #include <string>
-#include <vector>
 
 #include "core/stopwatch.hpp"
 #include "rthdist/tuning.hpp"
@@ -34,23 +32,6 @@ bool hardwareRtDevice(const EngineOptions& o) {
         if ((d.rayQuery || d.rtPipeline) && d.type != "cpu") return true;
     }
     return false;
-}
-
-// A device named under auto (deviceIndex, or an entry of devices) that the
-// device list does not hold is no device, as on the GPU backends: auto took
-// the CPU backend for --device 99 (exit 0), where README promises exit 4.
-std::optional<Error> missingNamedDevice(const EngineOptions& o) {
-    std::vector<int> named = o.devices;
-    if (o.deviceIndex >= 0) named.push_back(o.deviceIndex);
-    if (named.empty()) return std::nullopt;
-    const auto devices = listDevices();
-    const size_t count = devices ? devices->size() : 0;
-    for (int index : named) {
-        if (index >= 0 && size_t(index) < count) continue;
-        return Error{ErrorCode::kNoDevice, "device " + std::to_string(index) + " does not exist (" +
-                                               std::to_string(count) + " device(s))"};
-    }
-    return std::nullopt;
 }
 
 }  // namespace
@@ -95,9 +76,6 @@ Result<std::unique_ptr<ComputeBackend>> openBackend(const EngineOptions& options
             return Error{ErrorCode::kInvalidArgument,
                          "the cpu backend takes no Vulkan device (VulkanDevice)"};
         return makeGpuBackend(options, borrowed);
-    }
-    if (options.backend == Backend::kAuto) {
-        if (auto err = missingNamedDevice(options)) return *err;
     }
     if (options.backend == Backend::kCpu ||
         (options.backend == Backend::kAuto && !hardwareRtDevice(options))) {
