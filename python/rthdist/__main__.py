@@ -53,8 +53,6 @@ def _number(text):
 
 
 def _ranged(kind, lo, hi, name):
-    kind = {int: _integer, float: _number}[kind]
-
     def parse(text):
         try:
             v = kind(text)
@@ -84,14 +82,14 @@ def _parser():
     p.add_argument("--json", action="store_true", help="print one JSON object (the CLI's keys)")
     p.add_argument("--directed", action="store_true", help="compute only h(A,B)")
     p.add_argument("--backend", default="auto", choices=["auto", "ray-query", "rt-pipeline", "cpu"])
-    p.add_argument("--device", type=_ranged(int, 0, 1023, "--device"), default=None, help="Vulkan device index")
-    p.add_argument("--bits", type=_ranged(int, 0, 8, "--bits"), default=0, help="index bits (0 = auto)")
-    p.add_argument("--radius-growth", type=_ranged(float, 1.1, 16.0, "--radius-growth"), default=2.0)
-    p.add_argument("--threads", type=_ranged(int, 0, 1024, "--threads"), default=0, help="CPU threads (0 = all)")
+    p.add_argument("--device", type=_ranged(_integer, 0, 1023, "--device"), default=None, help="Vulkan device index")
+    p.add_argument("--bits", type=_ranged(_integer, 0, 8, "--bits"), default=0, help="index bits (0 = auto)")
+    p.add_argument("--radius-growth", type=_ranged(_number, 1.1, 16.0, "--radius-growth"), default=2.0)
+    p.add_argument("--threads", type=_ranged(_integer, 0, 1024, "--threads"), default=0, help="CPU threads (0 = all)")
     p.add_argument("--per-point", action="store_true", help="per-point distances and their statistics")
-    p.add_argument("--percentile", type=_ranged(float, 0.0, 100.0, "--percentile"), action="append",
+    p.add_argument("--percentile", type=_ranged(_number, 0.0, 100.0, "--percentile"), action="append",
                    help="also report this percentile (repeatable)")
-    p.add_argument("--histogram-bins", type=_ranged(int, 1, 10000, "--histogram-bins"), default=None,
+    p.add_argument("--histogram-bins", type=_ranged(_integer, 1, 10000, "--histogram-bins"), default=None,
                    help="histogram bins, 1..10000 (default 20)")
     p.add_argument("--range", nargs=2, metavar=("MIN", "MAX"),
                    help="fixed histogram range, finite, 0 <= MIN < MAX (default 0 .. the largest distance)")
