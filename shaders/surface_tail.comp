@@ -12,6 +12,20 @@
 // box holds its triangles' float boxes, so the skip is surface_visit's box
 // test of each of its triangles lifted: the descent keeps what a visit of
 // every triangle would. Counts the queries it searched.
+//
+// Lanes: 2^laneBits threads of one workgroup share a query (few queries
+// keep more of the device busy so). Lane l starts at the node its bits
+// choose level by level for the top laneBits levels (bit k: the right
+// child at level k), so the lanes' subtrees cover the tree once (a leaf
+// above that depth goes to the lane whose remaining bits are 0), and each
+// descends its own subtree nearest-first. The lanes of a query share the
+// smallest distance any of them found (s_best, a float's bits: distances
+// are not negative, so their bits order as the floats), which prunes each
+// lane's descent as its own best would; each lane lowers the query's
+// packed best with atomicMin at its end. Every triangle whose distance can
+// equal the final best lies under no pruned node (the shared bound is never
+// below it), so the packed minimum (the smaller distance, then the smaller
+// triangle) is what one thread's descent finds, whatever the lanes.
 #include "common.glsl"
 #include "rthdist_surface_search.h"
 layout(local_size_x = RTHDIST_WG) in;
@@ -19,21 +33,39 @@ layout(push_constant) uniform Push { SurfaceTailPush pc; };
 #define RTHDIST_SURFACE_VISIT_CORNERS_ONLY
 #include "surface_visit.glsl"
 
+shared uint s_best[RTHDIST_WG];  // per query of the group: the smallest distance's bits its lanes found
+
 void main() {
-    uint qi = gl_GlobalInvocationID.x;
-    if (qi >= pc.numQueries) return;
-    uint64_t best = u64At(pc.best, qi).v;
-    if (packedDist2(best) <= pc.settled2) return;
-    atomicAdd(uintAt(pc.counts, 0u).v, 1u);
+    const uint lane = gl_GlobalInvocationID.x & ((1u << pc.laneBits) - 1u);
+    const uint qi = gl_GlobalInvocationID.x >> pc.laneBits;
+    const uint slot = gl_LocalInvocationID.x >> pc.laneBits;
+    const uint64_t start = qi < pc.numQueries ? u64At(pc.best, qi).v : ~uint64_t(0);
+    if (pc.laneBits != 0u) {  // (uniform: the push constant's)
+        if (lane == 0u) s_best[slot] = uint(start >> 32);
+        barrier();
+    }
+    if (qi >= pc.numQueries || packedDist2(start) <= pc.settled2) return;
+    if (lane == 0u) atomicAdd(uintAt(pc.counts, 0u).v, 1u);
     vec3 q = vec4At(pc.queries, qi).v.xyz;
+    uint64_t best = start;
+
+    // The lane's subtree: its bits choose the child at each of the top levels.
+    Cell node = cellAt(pc.nodes, 0u).v;
+    uint level = 0u;
+    for (; level < pc.laneBits && node.count == 0u; ++level)
+        node = cellAt(pc.nodes, node.first + ((lane >> level) & 1u)).v;
+    if ((lane >> level) != 0u && node.count != 0u) return;  // a leaf above the lanes' depth: another lane's
 
     uint stackNode[RTHDIST_SURFACE_TAIL_STACK];
     float stackDist2[RTHDIST_SURFACE_TAIL_STACK];
     uint top = 0u;
-    Cell node = cellAt(pc.nodes, 0u).v;
     float d2 = boxDist2(q, node.lo, node.hi);
+    // The bound a node is pruned by: the lane's best or the query's lanes' (a
+    // stale read is larger: it prunes less, never more).
+    float bound = uintBitsToFloat(min(uint(best >> 32), s_best[slot]));
+    if (pc.laneBits == 0u) bound = packedDist2(best);
     while (true) {
-        if (!(d2 > packedDist2(best))) {
+        if (!(d2 > bound)) {
             if (node.count != 0u) {
                 for (uint i = 0u; i < node.count; ++i) {
                     uint p = 3u * (node.first + i);
@@ -42,6 +74,13 @@ void main() {
                     uvec4 c = uvec4At(pc.leafCorners, p + 2u).v;
                     visitCorners(q, a.w, uintBitsToFloat(a.xyz), uintBitsToFloat(b.xyz), uintBitsToFloat(c.xyz),
                                  best);
+                }
+                if (pc.laneBits != 0u) {
+                    const uint mine = uint(best >> 32);
+                    if (mine < s_best[slot]) atomicMin(s_best[slot], mine);
+                    bound = uintBitsToFloat(min(mine, s_best[slot]));
+                } else {
+                    bound = packedDist2(best);
                 }
             } else {
                 Cell left = cellAt(pc.nodes, node.first).v;
@@ -62,8 +101,12 @@ void main() {
         if (top == 0u) break;
         --top;
         d2 = stackDist2[top];
-        if (d2 > packedDist2(best)) continue;  // skipped without reading the node
+        if (pc.laneBits != 0u) bound = uintBitsToFloat(min(uint(best >> 32), s_best[slot]));
+        if (d2 > bound) continue;  // skipped without reading the node
         node = cellAt(pc.nodes, stackNode[top]).v;
     }
-    u64At(pc.best, qi).v = best;
+    if (pc.laneBits == 0u)
+        u64At(pc.best, qi).v = best;
+    else if (best < start)
+        atomicMin(u64At(pc.best, qi).v, best);
 }

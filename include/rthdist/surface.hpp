@@ -165,6 +165,10 @@ struct SurfaceCounters {
     // 1: the tree was the call before's, not built: a GPU backend's descent
     // tree (same corners), or an Engine's CPU-backend BVH (the same mesh).
     uint32_t tailTreeReused = 0;
+    // Threads that shared each query's descent of the device's tree (1 to
+    // 32; 0 where no query descended): more where few queries descend. The
+    // answer is the same whatever their number. RTHDIST_SURFACE_TAIL_LANES.
+    uint32_t tailLanes = 0;
     // Queries searched again exactly on the host (the others are proven below h).
     uint64_t band = 0;
     // Per-point distances on a GPU backend: 1 where a sample of the device's

@@ -54,6 +54,12 @@ struct Tuning {
     // (gpu_algo::descendOnly).
     // RTHDIST_SURFACE_DESCEND=0|1.
     std::optional<bool> surfaceDescend;
+    // Point to surface on a GPU backend: the threads that share each query's
+    // descent of the tail's tree (rounded down to a power of two, 1 to 32;
+    // unset: on a GPU as many as keep about 2^18 threads busy, on a CPU
+    // device one; gpu_algo::tailLaneBits).
+    // The answer is the same whatever the lanes. RTHDIST_SURFACE_TAIL_LANES.
+    std::optional<uint32_t> surfaceTailLanes;
     // Read host arrays in place (VK_EXT_external_memory_host) instead of
     // copying them: off by default, on the H200 pinning cost more than the
     // copy it saves (docs/bench/prepared). RTHDIST_HOST_IMPORT=1.

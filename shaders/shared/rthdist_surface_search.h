@@ -61,7 +61,7 @@ struct SurfaceTailPush {
     uint numQueries;
     float settled2;  // a query whose best is at most this was settled by the radii
     uint mutant;     // 1: core::searchMutant (tests only): every third triangle is skipped
-    uint pad;
+    uint laneBits;   // 2^laneBits threads a query (surface_tail.comp; gpu_algo::tailLaneBits)
 };
 
 #ifdef __cplusplus

@@ -72,6 +72,7 @@ struct TriangleCandidates {
     std::vector<uint32_t> open;
     uint64_t tailQueries = 0;     // queries the tail's tree descent searched (left open by the radii)
     bool tailTreeReused = false;  // the tail's tree was the call before's (the same corners)
+    uint32_t tailLanes = 0;       // threads a query of the tail's descent
     double tailBuildMs = 0.0;     // host: the tail's tree built and written (part of submitMs)
     double tailGpuMs = 0.0;       // device time of the tail (part of gpuMs)
 };

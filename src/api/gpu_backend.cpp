@@ -211,6 +211,7 @@ public:
                                   std::move(found->open),
                                   found->tailQueries,
                                   found->tailTreeReused,
+                                  found->tailLanes,
                                   found->tailBuildMs,
                                   found->tailGpuMs};
     }

@@ -105,6 +105,7 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
     n.tailQueries = found->tailQueries;
     n.tailHostQueries = found->open.size();
     n.tailTreeReused = found->tailTreeReused ? 1u : 0u;
+    n.tailLanes = found->tailLanes;
     n.triangles = surface.triangleCount();
     r.stages.frame = frameMs;
     r.stages.upload = found->stageMs;

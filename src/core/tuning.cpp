@@ -42,6 +42,7 @@ Tuning tuningFromEnvironment() {
     t.sweepWork = number("RTHDIST_SWEEP_WORK");
     t.surfaceHostWork = number("RTHDIST_SURFACE_HOST_WORK");
     if (const char* v = std::getenv("RTHDIST_SURFACE_DESCEND")) t.surfaceDescend = std::string_view(v) != "0";
+    t.surfaceTailLanes = number32("RTHDIST_SURFACE_TAIL_LANES");
     t.hostImport = text("RTHDIST_HOST_IMPORT") == "1";
     if (const char* v = std::getenv("RTHDIST_NARROW_HOST_BOUNDS"))
         t.narrowHostBounds = std::string_view(v) != "0";

@@ -60,6 +60,19 @@ bool descendOnly(const Tuning& tuning, uint64_t queries, uint64_t triangles) {
         (triangles <= kDescendTriangles && queries <= kDescendMostQueries) || queries <= kDescendQueries);
 }
 
+uint32_t tailLaneBits(const Tuning& tuning, bool cpuDevice, uint64_t descending, uint64_t queries) {
+    const auto fits = [&](uint32_t bits) {
+        return bits <= kTailMostLaneBits && (queries << bits) <= kTailMostThreads;
+    };
+    uint32_t bits = 0;
+    if (tuning.surfaceTailLanes) {
+        while (fits(bits + 1) && (uint64_t(2) << bits) <= *tuning.surfaceTailLanes) ++bits;
+    } else if (!cpuDevice) {
+        while (fits(bits + 1) && (descending << (bits + 1)) <= kTailThreads) ++bits;
+    }
+    return bits;
+}
+
 bool openQueriesToHost(uint64_t open, uint64_t triangles, uint64_t hostWork) {
     return open > 0 && triangles > 0 && open <= hostWork / triangles;
 }
@@ -130,7 +143,7 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     cmdUpload(cmd, !descend);
     bool toHost = false;
     if (descend) {
-        cmdTail(cmd, tree, inputBytes(false), 0.0);
+        cmdTail(cmd, tree, inputBytes(false), 0.0, m_queries, out);
         cmdReadBack(cmd);
         m_ws.ctx.submitAndWait(cmd);
         finishTail(tree, corners, out);
@@ -148,7 +161,7 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
         // the others descend the tail's tree.
         toHost = open > 0 && openQueriesToHost(open, m_triangles, surfaceHostWork(m_ws.tuning, m_ws.threads));
         if (open > 0 && !toHost) {
-            submitTail(corners, start.back(), out);
+            submitTail(corners, start.back(), open, out);
             if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) throw CallCancelled{};
         }
     }
@@ -359,7 +372,8 @@ void SurfaceSearch::stageTail(const TailTree& tree, std::span<const glm::vec3> c
     });
 }
 
-void SurfaceSearch::cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceSize at, double settled) {
+void SurfaceSearch::cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceSize at, double settled,
+                            uint64_t descending, SurfaceCandidates& out) {
     const gpu::ScopedLabel label(m_ws.ctx, cmd, "surface tail");
     if (!tree.kept) {
         const VkBufferCopy toNodes{at, 0, tree.nodeBytes};
@@ -383,7 +397,9 @@ void SurfaceSearch::cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceS
     // (settled 0: every query, a best of none compares false).
     tp.settled2 = std::nextafter(float(settled * settled), 0.0f);
     tp.mutant = m_ws.mutant ? 1u : 0u;
-    m_ws.dispatch(cmd, Kernel::kSurfaceTail, tp, m_queries);
+    tp.laneBits = tailLaneBits(m_ws.tuning, m_ws.ctx.cpuDevice(), descending, m_queries);
+    out.tailLanes = 1u << tp.laneBits;
+    m_ws.dispatch(cmd, Kernel::kSurfaceTail, tp, uint64_t(m_queries) << tp.laneBits);
 }
 
 void SurfaceSearch::finishTail(const TailTree& tree, std::span<const glm::vec3> corners,
@@ -396,12 +412,13 @@ void SurfaceSearch::finishTail(const TailTree& tree, std::span<const glm::vec3> 
         m_counts.mapped())[SurfaceRadii::kStartRadii * sizeof(sh::SurfaceRadiusCount) / sizeof(uint32_t)];
 }
 
-void SurfaceSearch::submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out) {
+void SurfaceSearch::submitTail(std::span<const glm::vec3> corners, double settled, uint64_t open,
+                               SurfaceCandidates& out) {
     // (The radii's submission has finished with what the upload buffer held.)
     const TailTree tree = tailTree(corners, out);
     stageTail(tree, corners, 0);
     VkCommandBuffer cmd = m_ws.ctx.begin();
-    cmdTail(cmd, tree, 0, settled);
+    cmdTail(cmd, tree, 0, settled, open, out);
     cmdReadBack(cmd);
     m_ws.ctx.submitAndWait(cmd);
     finishTail(tree, corners, out);

@@ -75,6 +75,7 @@ struct SurfaceCandidates {
     // The tail (0 where it did not run):
     uint64_t tailQueries = 0;     // queries that descended the tree on the device
     bool tailTreeReused = false;  // the tree of the call before (the same corners): not built
+    uint32_t tailLanes = 0;       // threads a query of the descent (tailLaneBits)
     double tailBuildMs = 0.0;     // host: the tree built and written to the upload buffer (part of submitMs)
     double tailGpuMs = 0.0;       // device time of the tail's submission (part of gpuMs)
 };
@@ -105,16 +106,40 @@ inline constexpr uint64_t kSurfaceHostWorkPerThread = uint64_t(1) << 19;
 // they were 0.29 ms of bunny>res4's 0.60 ms of device time for 948
 // triangles, session 8), or a few queries (at most kDescendQueries: that
 // many rays, each in ~100 grown boxes of a fine mesh, keep the GPU nearly
-// idle; bunny-res4>bunny's 453 took 3.2 ms of rays). The descent ends with
-// what a visit of every triangle would give, as after the radii. The few
-// triangles' side is bounded by kDescendMostQueries (2^20): past it the
-// radii stay, as measured at scale (the descent was measured up to 36k
-// queries; each query of the tail also counts itself on one atomic).
+// idle, where the descent shares each query among lanes (tailLaneBits); on
+// the H200, session 27, kept rt-pipeline: dragon-res4>dragon's 5,205
+// queries 15.4 -> 3.1 ms, armadillo-dec>armadillo's 6,502 1.5 -> 0.93 ms,
+// armadillo>dec's 26,002 1.2 -> 0.87 ms; bunny>res2's 35,947 the same
+// either way at one lane). The descent ends with what a visit of every
+// triangle would give, as after the radii. The few triangles' side is
+// bounded by kDescendMostQueries (2^20): past it the radii stay, as
+// measured at scale (each query of the tail also counts itself on one
+// atomic).
 inline constexpr uint64_t kDescendTriangles = 4096;
-inline constexpr uint64_t kDescendQueries = 1024;
+inline constexpr uint64_t kDescendQueries = uint64_t(1) << 15;
 inline constexpr uint64_t kDescendMostQueries = uint64_t(1) << 20;
 // Tuning::surfaceDescend decides where it is set.
 [[nodiscard]] bool descendOnly(const Tuning& tuning, uint64_t queries, uint64_t triangles);
+
+// The threads a query of the tail's descent (surface_tail.comp), as the log2
+// of their count (host only; tests/gpu_algo/surface_radii_test.cpp). One
+// thread a query keeps the device busy where many queries descend; a few
+// leave a GPU nearly idle, each descent a chain of dependent reads, so
+// lanes share each query's tree until about kTailThreads threads descend
+// (at most 2^kTailMostLaneBits a query; an H200 holds ~2^18 threads at
+// once: at 2^16, session 27, 5,205 queries took 8 lanes and 0.53 ms of
+// GPU time, 32 lanes 0.30 ms). A CPU device (lavapipe) takes one lane: its
+// threads are its cores', and lanes only add work there. `descending`: the
+// queries that descend (every query, or those the radii left open);
+// `queries`: the call's, a dispatch's threads being queries x lanes (at
+// most kTailMostThreads, and below 2^32). Tuning::surfaceTailLanes decides
+// where it is set, on any device (rounded down to a power of two, within
+// the same limits).
+inline constexpr uint64_t kTailThreads = uint64_t(1) << 18;
+inline constexpr uint64_t kTailMostThreads = uint64_t(1) << 24;
+inline constexpr uint32_t kTailMostLaneBits = 5;
+[[nodiscard]] uint32_t tailLaneBits(const Tuning& tuning, bool cpuDevice, uint64_t descending,
+                                    uint64_t queries);
 
 // The radii of one search (host only; tests/gpu_algo/surface_radii_test.cpp).
 // None decides a value (the host proves it); they set how many queries the
@@ -199,15 +224,18 @@ private:
     // stage() kept the room).
     void stageTail(const TailTree& tree, std::span<const glm::vec3> corners, VkDeviceSize at);
     // The tree's copies from the upload buffer (a built one) and the
-    // descent of every query whose best is farther than `settled`.
-    void cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceSize at, double settled);
+    // descent of every query whose best is farther than `settled`
+    // (`descending` of them: tailLaneBits; out.tailLanes set).
+    void cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceSize at, double settled,
+                 uint64_t descending, SurfaceCandidates& out);
     // After the tail's submission: the tree kept (with a copy of the
     // corners it holds), the tail's counts.
     void finishTail(const TailTree& tree, std::span<const glm::vec3> corners, SurfaceCandidates& out);
     // The tail's submission for the queries the radii left open (their best
     // farther than `settled`): tailTree, the descent, every query's best
     // copied for the host.
-    void submitTail(std::span<const glm::vec3> corners, double settled, SurfaceCandidates& out);
+    void submitTail(std::span<const glm::vec3> corners, double settled, uint64_t open,
+                    SurfaceCandidates& out);
     // Every query's best copied to the read-back buffer for the host.
     void cmdReadBack(VkCommandBuffer cmd);
 

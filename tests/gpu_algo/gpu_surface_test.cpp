@@ -810,24 +810,33 @@ TailCheck expectNearest(const FramedCase& c, const gpu_algo::SurfaceCandidates& 
 
 // The queries the radii leave open (far copies, outliers, degenerate far
 // triangles) go through the tail, which finds each one's nearest triangle.
+// Also with the lanes a query forced to one and to 32 (the rule gives these
+// few open queries 32 lanes on a GPU, one on lavapipe).
 TEST(GpuSurfaceTail, FindsTheNearestTriangleOfEveryOpenQuery) {
     RTHDIST_REQUIRE_CONTEXT(ctx);
-    auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, tailTuning(kAlwaysTree));
-    ASSERT_TRUE(engine) << engine.error().message;
-    for (const FramedCase& c : tailCases()) {
-        Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
-        ASSERT_TRUE(found) << c.name << ": " << found.error().message;
-        const TailCheck check = expectNearest(c, *found, false);
-        std::printf("%s: %zu triangles, %zu queries, %u radii, tail %llu, %zu clear\n", c.name.c_str(),
-                    c.corners.size() / 3, c.queries.size(), found->radii,
-                    static_cast<unsigned long long>(found->tailQueries), check.clear);
-        EXPECT_GT(found->tailQueries, 0u) << c.name;
-        EXPECT_LE(found->tailQueries, c.queries.size()) << c.name;
-        EXPECT_TRUE(found->open.empty()) << c.name;
-        EXPECT_EQ(found->submissions, 2u) << c.name;
-        // The copies of disjoint triangles have clear nearest triangles:
-        // the index check above is not vacuous.
-        if (c.name != "far_sphere_copy") EXPECT_GT(check.clear, c.queries.size() / 2) << c.name;
+    for (const std::optional<uint32_t> lanes :
+         {std::optional<uint32_t>(), std::optional<uint32_t>(1u), std::optional<uint32_t>(32u)}) {
+        Tuning t = tailTuning(kAlwaysTree);
+        t.surfaceTailLanes = lanes;
+        auto engine = gpu_algo::GpuHausdorff::create(*ctx, "", 0, t);
+        ASSERT_TRUE(engine) << engine.error().message;
+        for (const FramedCase& c : tailCases()) {
+            Result<gpu_algo::SurfaceCandidates> found = (*engine)->nearestTriangles(c.queries, c.corners);
+            ASSERT_TRUE(found) << c.name << ": " << found.error().message;
+            const TailCheck check = expectNearest(c, *found, false);
+            std::printf("%s: %zu triangles, %zu queries, %u radii, tail %llu, %zu clear\n", c.name.c_str(),
+                        c.corners.size() / 3, c.queries.size(), found->radii,
+                        static_cast<unsigned long long>(found->tailQueries), check.clear);
+            EXPECT_GT(found->tailQueries, 0u) << c.name;
+            EXPECT_LE(found->tailQueries, c.queries.size()) << c.name;
+            EXPECT_TRUE(found->open.empty()) << c.name;
+            EXPECT_EQ(found->submissions, 2u) << c.name;
+            // The copies of disjoint triangles have clear nearest triangles:
+            // the index check above is not vacuous.
+            if (c.name != "far_sphere_copy") EXPECT_GT(check.clear, c.queries.size() / 2) << c.name;
+            if (lanes) EXPECT_EQ(found->tailLanes, *lanes) << c.name;
+            EXPECT_GE(found->tailLanes, 1u) << c.name;
+        }
     }
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
@@ -1052,8 +1061,31 @@ TEST(GpuSurfaceDescend, EveryCaseMatchesTheBruteForce) {
     }
 }
 
+// The lanes a query (Tuning::surfaceTailLanes) change how the device
+// descends, not what it finds: one, two, eight and 32 threads a query each
+// give every case's brute-force value, witness and nearest triangle (the
+// cases' trees are shallower than 32 lanes' five levels in places: a leaf
+// above the lanes' depth is one lane's).
+TEST(GpuSurfaceDescend, EveryLaneCountMatchesTheBruteForce) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    for (const uint32_t lanes : {1u, 2u, 8u, 32u}) {
+        Tuning t = *test::gpuOptions().tuning;
+        t.surfaceDescend = true;
+        t.surfaceTailLanes = lanes;
+        Result<Engine> engine = surfaceEngine(backend, t);
+        ASSERT_TRUE(engine) << engine.error().message;
+        for (const test::SurfaceCase& c : test::makeSurfaceCases()) {
+            if (c.queries.empty()) continue;
+            std::printf("%u lanes a query: ", lanes);
+            const Result<SurfaceResult> r = engine->hausdorffToSurface(PointView(c.queries), meshOf(c));
+            expectBruteForce(c, backend, r, Path::kDescend);
+            if (r) EXPECT_EQ(r->directed.counters.tailLanes, lanes) << c.name;
+        }
+    }
+}
+
 // The rule (surfaceDescend unset): a mesh of at most 4,096 triangles, or at
-// most 1,024 queries, descends; more of both takes the radii. The same
+// most 32,768 queries, descends; more of both takes the radii. The same
 // values either way.
 TEST(GpuSurfaceDescend, TheRuleDescendsForFewTrianglesOrFewQueries) {
     RTHDIST_REQUIRE_SURFACE_DEVICE();
@@ -1067,7 +1099,8 @@ TEST(GpuSurfaceDescend, TheRuleDescendsForFewTrianglesOrFewQueries) {
         return c;
     };
     const test::SurfaceCase small = withQueries(test::heightField(71, 20, 10.0), 2000);  // 800 triangles
-    const test::SurfaceCase fine = withQueries(test::heightField(72, 50, 10.0), 2000);   // 5,000 triangles
+    const test::SurfaceCase fine =                                                       // 5,000 triangles
+        withQueries(test::heightField(72, 50, 10.0), int(gpu_algo::kDescendQueries) + 1);
     const test::SurfaceCase sparse = withQueries(test::heightField(73, 50, 10.0), 600);  // 600 queries
     ASSERT_LE(small.indices.size() / 3, gpu_algo::kDescendTriangles);
     ASSERT_GT(fine.indices.size() / 3, gpu_algo::kDescendTriangles);

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "gpu_algo/surface_search.hpp"
@@ -79,12 +80,15 @@ TEST(SurfaceRadii, FewOpenQueriesGoToTheHost) {
 // Every query down the tree without radii: where Tuning::surfaceDescend
 // says so, else for at most kDescendTriangles triangles or at most
 // kDescendQueries queries (bunny>res4's 948 triangles, bunny-res4>bunny's
-// 453 queries; not dragon>res4's 437,645 x 11,102), the few triangles' side
-// up to kDescendMostQueries queries.
+// 453 queries, dragon-res4>dragon's 5,205 and armadillo>dec's 26,002; not
+// dragon>res4's 437,645 x 11,102), the few triangles' side up to
+// kDescendMostQueries queries.
 TEST(SurfaceRadii, FewTrianglesOrFewQueriesDescendOnly) {
     const Tuning rule;
     EXPECT_TRUE(descendOnly(rule, 35947, 948));
     EXPECT_TRUE(descendOnly(rule, 453, 69451));
+    EXPECT_TRUE(descendOnly(rule, 5205, 871414));
+    EXPECT_TRUE(descendOnly(rule, 26002, 13000));
     EXPECT_FALSE(descendOnly(rule, 437645, 11102));
     EXPECT_TRUE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles));
     EXPECT_FALSE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles + 1));
@@ -98,6 +102,40 @@ TEST(SurfaceRadii, FewTrianglesOrFewQueriesDescendOnly) {
     forced.surfaceDescend = false;
     EXPECT_FALSE(descendOnly(forced, 35947, 948));
     EXPECT_FALSE(descendOnly(forced, 1, 1));
+}
+
+// The tail's lanes a query on a GPU: one where many descend; more, up to
+// 32, while the queries that descend x lanes stay within kTailThreads;
+// never past kTailMostThreads dispatched (the call's queries x lanes). A
+// CPU device takes one. Forced counts are rounded down to a power of two,
+// within the same limits, on either device.
+TEST(SurfaceRadii, FewDescendingQueriesShareTheirDescentWithLanes) {
+    const Tuning rule;
+    const bool gpu = false, cpu = true;
+    EXPECT_EQ(tailLaneBits(rule, gpu, 453, 453), 5u);    // bunny-res4 > bunny: 32 lanes
+    EXPECT_EQ(tailLaneBits(rule, gpu, 5205, 5205), 5u);  // dragon-res4 > dragon: 32
+    EXPECT_EQ(tailLaneBits(rule, gpu, 35947, 35947), 2u);
+    EXPECT_EQ(tailLaneBits(rule, gpu, kTailThreads / 4, kTailThreads / 4), 2u);
+    EXPECT_EQ(tailLaneBits(rule, gpu, kTailThreads / 4 + 1, kTailThreads / 4 + 1), 1u);
+    EXPECT_EQ(tailLaneBits(rule, gpu, kTailThreads, kTailThreads), 0u);
+    EXPECT_EQ(tailLaneBits(rule, gpu, 1, 1), kTailMostLaneBits);
+    EXPECT_EQ(tailLaneBits(rule, gpu, 0, 10), kTailMostLaneBits);  // (no query open: the dispatch returns)
+    // A few open queries of many: the dispatch's threads bound the lanes.
+    EXPECT_EQ(tailLaneBits(rule, gpu, 100, kTailMostThreads / 4), 2u);
+    EXPECT_EQ(tailLaneBits(rule, gpu, 100, kTailMostThreads), 0u);
+    EXPECT_EQ(tailLaneBits(rule, gpu, 100, uint64_t(1) << 32), 0u);
+    // A CPU device: one lane unless forced.
+    EXPECT_EQ(tailLaneBits(rule, cpu, 453, 453), 0u);
+    Tuning forced;
+    for (const bool device : {gpu, cpu}) {
+        for (const auto& [lanes, bits] :
+             {std::pair{0u, 0u}, {1u, 0u}, {2u, 1u}, {3u, 1u}, {8u, 3u}, {31u, 4u}, {32u, 5u}, {1000u, 5u}}) {
+            forced.surfaceTailLanes = lanes;
+            EXPECT_EQ(tailLaneBits(forced, device, 35947, 35947), bits) << lanes;
+        }
+        forced.surfaceTailLanes = 32;
+        EXPECT_EQ(tailLaneBits(forced, device, 10, kTailMostThreads / 8), 3u);
+    }
 }
 
 }  // namespace rthdist::gpu_algo

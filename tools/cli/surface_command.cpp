@@ -57,6 +57,7 @@ Json countersJson(const SurfaceCounters& c) {
             {"tail_queries", c.tailQueries},
             {"tail_host_queries", c.tailHostQueries},
             {"tail_tree_reused", c.tailTreeReused},
+            {"tail_lanes", c.tailLanes},
             {"band", c.band},
             {"host_triangles", c.hostTriangles},
             {"cpu_recomputed", c.cpuRecomputed}};
