@@ -1085,7 +1085,7 @@ TEST(GpuSurfaceDescend, EveryLaneCountMatchesTheBruteForce) {
 }
 
 // The rule (surfaceDescend unset): a mesh of at most 4,096 triangles, or at
-// most 32,768 queries, descends; more of both takes the radii. The same
+// most 65,536 queries, descends; more of both takes the radii. The same
 // values either way.
 TEST(GpuSurfaceDescend, TheRuleDescendsForFewTrianglesOrFewQueries) {
     RTHDIST_REQUIRE_SURFACE_DEVICE();

@@ -80,8 +80,9 @@ TEST(SurfaceRadii, FewOpenQueriesGoToTheHost) {
 // Every query down the tree without radii: where Tuning::surfaceDescend
 // says so, else for at most kDescendTriangles triangles or at most
 // kDescendQueries queries (bunny>res4's 948 triangles, bunny-res4>bunny's
-// 453 queries, dragon-res4>dragon's 5,205 and armadillo>dec's 26,002; not
-// dragon>res4's 437,645 x 11,102), the few triangles' side up to
+// 453 queries, dragon-res4>dragon's 5,205, armadillo>dec's 26,002 and
+// bunny>res2's 35,947; not dragon>res4's 437,645 x 11,102), the few
+// triangles' side up to
 // kDescendMostQueries queries.
 TEST(SurfaceRadii, FewTrianglesOrFewQueriesDescendOnly) {
     const Tuning rule;
@@ -89,6 +90,8 @@ TEST(SurfaceRadii, FewTrianglesOrFewQueriesDescendOnly) {
     EXPECT_TRUE(descendOnly(rule, 453, 69451));
     EXPECT_TRUE(descendOnly(rule, 5205, 871414));
     EXPECT_TRUE(descendOnly(rule, 26002, 13000));
+    EXPECT_TRUE(descendOnly(rule, 35947, 16301));
+    EXPECT_FALSE(descendOnly(rule, 362272, 69451));
     EXPECT_FALSE(descendOnly(rule, 437645, 11102));
     EXPECT_TRUE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles));
     EXPECT_FALSE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles + 1));
