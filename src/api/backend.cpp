@@ -59,7 +59,7 @@ Result<HausdorffResult> ComputeBackend::computeDeviceViews(const DevicePointView
 
 Result<TriangleCandidates> ComputeBackend::nearestTriangles(std::span<const glm::vec3>,
                                                             std::span<const glm::vec3>,
-                                                            const std::atomic<bool>*) {
+                                                            const std::atomic<bool>*, uint64_t) {
     return notOffered("triangle search");
 }
 

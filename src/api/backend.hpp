@@ -136,9 +136,13 @@ public:
     // one float frame, on the first device; `cancel` read between
     // submissions (kCancelled). What it allocates stays for the next call
     // (releaseScratch frees it).
+    // cornersVersion: 0, or the caller's name for these very corners
+    // (newCornersVersion), never given to other corners: the device then
+    // keeps what it built from them without comparing them again.
     [[nodiscard]] virtual Result<TriangleCandidates> nearestTriangles(std::span<const glm::vec3> queries,
                                                                       std::span<const glm::vec3> corners,
-                                                                      const std::atomic<bool>* cancel);
+                                                                      const std::atomic<bool>* cancel,
+                                                                      uint64_t cornersVersion);
 
     // Frees what every lane keeps between one-shot calls (out_of_core.hpp's `release`).
     virtual void releaseScratch() {}

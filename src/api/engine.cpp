@@ -105,6 +105,7 @@ struct Engine::Impl {
     double setupMs = 0.0;
     uint64_t preparedCount = 0;
     cpu::KeptSurfaceTree surfaceTree;  // the CPU route's last mesh and its BVH
+    api::KeptGpuSurface gpuSurface;    // the GPU route's last mesh and its framed corners
     SurfacePerPoint spareSurface;      // a recycled surface result's arrays (Engine::recycle)
 };
 
@@ -708,8 +709,8 @@ Result<SurfaceResult> Engine::hausdorffToSurface(PointView points, MeshView surf
 // Point to surface on the kept backend (api/surface_engine.hpp routes it).
 Result<SurfaceResult> Engine::hausdorffToSurface(PointView points, MeshView surface,
                                                  const SurfaceCallOptions& call) {
-    return api::surfaceOnEngine(*m_impl->backend, m_impl->options, m_impl->surfaceTree, points, surface, call,
-                                m_impl->spareSurface);
+    return api::surfaceOnEngine(*m_impl->backend, m_impl->options, m_impl->surfaceTree, m_impl->gpuSurface,
+                                points, surface, call, m_impl->spareSurface);
 }
 
 void Engine::recycle(HausdorffResult&& spent) {

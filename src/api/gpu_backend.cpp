@@ -195,8 +195,9 @@ public:
 
     [[nodiscard]] Result<TriangleCandidates> nearestTriangles(std::span<const glm::vec3> queries,
                                                               std::span<const glm::vec3> corners,
-                                                              const std::atomic<bool>* cancel) override {
-        auto found = gpu().nearestTriangles(queries, corners, cancel);
+                                                              const std::atomic<bool>* cancel,
+                                                              uint64_t cornersVersion) override {
+        auto found = gpu().nearestTriangles(queries, corners, cancel, cornersVersion);
         if (!found) return found.error();
         return TriangleCandidates{std::move(found->triangle),
                                   std::move(found->distance2),

@@ -96,9 +96,9 @@ Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, con
 namespace api {
 
 Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptions& engine,
-                                      cpu::KeptSurfaceTree& kept, const PointView& points,
-                                      const MeshView& surface, const SurfaceCallOptions& call,
-                                      SurfacePerPoint& spare) {
+                                      cpu::KeptSurfaceTree& kept, KeptGpuSurface& keptGpu,
+                                      const PointView& points, const MeshView& surface,
+                                      const SurfaceCallOptions& call, SurfacePerPoint& spare) {
     const core::Clock::time_point start = core::Clock::now();
     SurfaceOptions options;
     static_cast<SurfaceCallOptions&>(options) = call;
@@ -114,10 +114,20 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
     const Plan plan = planSurfaceRoute(engine.backend, shape);
     if (plan.route == Route::kRefused) return Error{plan.code, plan.reason};
     if (plan.route == Route::kSurfaceGpu) {
-        Result<SurfaceInputs> inputs = checkInputs(points, surface, options.threads);
+        // A mesh equal to the kept one (compared once the views are
+        // readable) is not checked again, and its framed corners serve
+        // where the frame is the same.
+        const bool same = !core::checkShape(points, "A") && !core::checkShape(surface.vertices, "B") &&
+                          keptGpu.mesh.holds(surface, options.threads);
+        Result<SurfaceInputs> inputs =
+            checkInputs(points, surface, options.threads, same ? &keptGpu.mesh.summary() : nullptr);
         if (!inputs) return inputs.error();
+        if (!same) {
+            keptGpu.frame.reset();
+            keptGpu.mesh.keep(surface, inputs->b, options.threads);
+        }
         Result<SurfaceResult> result = surfaceOnGpu(backend, points, surface, *inputs, options,
-                                                    call.perPointDistances ? &spare : nullptr);
+                                                    call.perPointDistances ? &spare : nullptr, &keptGpu);
         if (result) result->totalMs = core::msSince(start);
         return result;
     }

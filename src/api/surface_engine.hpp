@@ -6,18 +6,20 @@
 #pragma once
 
 #include "api/backend.hpp"
+#include "api/surface_gpu.hpp"
 #include "cpu/kept_surface_tree.hpp"
 #include "rthdist/surface.hpp"
 
 namespace rthdist::api {
 
 // engine: the Engine's options (its requested backend and threads). kept:
-// the Engine's CPU-backend tree, reused by the CPU route for the same mesh.
+// the Engine's CPU-backend tree, reused by the CPU route for the same mesh;
+// keptGpu: the GPU route's last mesh and framed corners (api/surface_gpu.hpp).
 // spare: a recycled result's per-point arrays (Engine::recycle), taken by a
 // per-point call on either route (left as they are by the others).
 [[nodiscard]] Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptions& engine,
-                                                    cpu::KeptSurfaceTree& kept, const PointView& points,
-                                                    const MeshView& surface, const SurfaceCallOptions& call,
-                                                    SurfacePerPoint& spare);
+                                                    cpu::KeptSurfaceTree& kept, KeptGpuSurface& keptGpu,
+                                                    const PointView& points, const MeshView& surface,
+                                                    const SurfaceCallOptions& call, SurfacePerPoint& spare);
 
 }  // namespace rthdist::api

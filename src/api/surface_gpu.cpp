@@ -3,7 +3,9 @@
 #include <glm/common.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <span>
 #include <vector>
 
 #include "api/surface_certify.hpp"
@@ -48,15 +50,34 @@ core::UninitVector<glm::vec3> framedCorners(const MeshView& surface, const Searc
     return out;
 }
 
+uint64_t newCornersVersion() {
+    static std::atomic<uint64_t> next{1};
+    return next.fetch_add(1, std::memory_order_relaxed);
+}
+
 Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& points, const MeshView& surface,
                                    const SurfaceInputs& inputs, const SurfaceOptions& options,
-                                   SurfacePerPoint* spare) {
+                                   SurfacePerPoint* spare, KeptGpuSurface* kept) {
     const core::Clock::time_point start = core::Clock::now();
     const SearchFrame frame(inputs.a.box, inputs.b.box);
     const core::UninitVector<glm::vec3> queries = framedPoints(points, frame, options.threads);
-    const core::UninitVector<glm::vec3> corners = framedCorners(surface, frame, options.threads);
+    core::UninitVector<glm::vec3> ownCorners;
+    uint64_t version = 0;
+    if (kept != nullptr && !(kept->frame && *kept->frame == frame)) {
+        kept->frame.reset();  // (until its corners are framed)
+        kept->corners = framedCorners(surface, frame, options.threads);
+        kept->frame = frame;
+        kept->version = newCornersVersion();
+    }
+    if (kept != nullptr) {
+        version = kept->version;
+    } else {
+        ownCorners = framedCorners(surface, frame, options.threads);
+    }
+    const std::span<const glm::vec3> corners =
+        kept != nullptr ? std::span<const glm::vec3>(kept->corners) : std::span<const glm::vec3>(ownCorners);
     const double frameMs = core::msSince(start);
-    Result<TriangleCandidates> found = device.nearestTriangles(queries, corners, options.cancel);
+    Result<TriangleCandidates> found = device.nearestTriangles(queries, corners, options.cancel, version);
     if (!found) return found.error();
     if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed))
         return Error{ErrorCode::kCancelled, "the call was cancelled (SurfaceOptions::cancel)"};

@@ -14,8 +14,12 @@
 
 #include <glm/vec3.hpp>
 
+#include <cstdint>
+#include <optional>
+
 #include "api/backend.hpp"
 #include "core/input_frame.hpp"
+#include "core/kept_mesh.hpp"
 #include "core/uninit_vector.hpp"
 #include "rthdist/surface.hpp"
 
@@ -31,6 +35,7 @@ struct SearchFrame {
 
     SearchFrame(const core::Bounds& a, const core::Bounds& b);
     [[nodiscard]] glm::vec3 operator()(const glm::dvec3& p) const { return glm::vec3((p - origin) * scale); }
+    [[nodiscard]] bool operator==(const SearchFrame&) const = default;
 };
 
 // The points, or the triangles' corners (3 per triangle, in index order),
@@ -39,6 +44,27 @@ struct SearchFrame {
                                                          int threads);
 [[nodiscard]] core::UninitVector<glm::vec3> framedCorners(const MeshView& surface, const SearchFrame& frame,
                                                           int threads);
+
+// A name for one set of framed corners, never given to another
+// (ComputeBackend::nearestTriangles' cornersVersion): from one counter of
+// the process, so no two Engines or calls share one.
+[[nodiscard]] uint64_t newCornersVersion();
+
+// An Engine's GPU route between its calls (api/surface.cpp's
+// surfaceOnEngine): its last mesh (a copy, bit for bit: core::KeptMesh),
+// and the corners of that mesh framed as the frame says, with their
+// version. A call whose mesh the copy holds and whose frame is the same
+// (the same boxes give the same frame) takes those corners as they are:
+// no framing, and the device keeps the tree it built from them without
+// comparing them again (design.md §11, "A kept mesh"). Memory: the copy,
+// 24 bytes a vertex and 12 a triangle, and the corners, 36 bytes a
+// triangle, until another mesh or frame replaces them.
+struct KeptGpuSurface {
+    core::KeptMesh mesh;
+    std::optional<SearchFrame> frame;  // of `corners`; none: no corners kept (the mesh changed)
+    core::UninitVector<glm::vec3> corners;
+    uint64_t version = 0;
+};
 
 // What the checks of a point-to-surface call found (api/surface.cpp):
 // both inputs' summaries and the largest |coordinate| over both.
@@ -51,10 +77,14 @@ struct SurfaceInputs {
 // call or kept by an Engine (its buffers stay for the next call). Fills
 // every stage of SurfaceResult::stages but setup (the caller's). spare
 // (may be null): arrays the per-point entries are written into (moved out
-// of it; Engine::recycle).
+// of it; Engine::recycle). kept (may be null: one-shot): an Engine's, its
+// mesh `surface` (the caller keeps it and resets its frame when the mesh
+// changes); its corners are reused where the frame is the same, else
+// framed and kept with a new version.
 [[nodiscard]] Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& points,
                                                  const MeshView& surface, const SurfaceInputs& inputs,
                                                  const SurfaceOptions& options,
-                                                 SurfacePerPoint* spare = nullptr);
+                                                 SurfacePerPoint* spare = nullptr,
+                                                 KeptGpuSurface* kept = nullptr);
 
 }  // namespace rthdist::api

@@ -60,6 +60,7 @@ private:
     int m_threads = 0;
     const std::atomic<bool>* m_cancel = nullptr;
     core::UninitVector<glm::vec3> m_corners;
+    uint64_t m_cornersVersion;  // theirs for every round's search (the device keeps its tree)
     double m_gpuMs = 0.0;
 };
 

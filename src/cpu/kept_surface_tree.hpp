@@ -1,9 +1,9 @@
 // An Engine's CPU-backend BVH kept between point-to-surface calls
 // (Engine::hausdorffToSurface on the CPU backend, design.md §11): the next
 // call against the same mesh reuses it instead of building it again. "The
-// same" is decided exactly, never by a hash: a copy of the last mesh's
-// vertex values (in double, bit for bit) and triangle indices is compared
-// with the call's, so a kept tree is only ever searched for the triangles
+// same" is decided exactly, never by a hash (core/kept_mesh.hpp: a copy of
+// the last mesh's vertex values, in double, bit for bit, and triangle
+// indices compared with the call's), so a kept tree is only ever searched for the triangles
 // it was built over, and every result is the one-shot call's (==).
 //
 // Threading: one call at a time (an Engine's contract); the comparison and
@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/input_frame.hpp"
+#include "core/kept_mesh.hpp"
 #include "cpu/triangle_blocks.hpp"
 #include "cpu/triangle_bvh.hpp"
 #include "rthdist/mesh.hpp"
@@ -41,14 +42,12 @@ public:
     // valid while holds() of the mesh searched.
     [[nodiscard]] const TriangleBvh& tree() const { return *m_tree; }
     [[nodiscard]] const TriangleBlocks& blocks() const { return m_blocks; }
-    [[nodiscard]] const core::SetSummary& summary() const { return m_summary; }
+    [[nodiscard]] const core::SetSummary& summary() const { return m_mesh.summary(); }
 
 private:
-    std::vector<glm::dvec3> m_vertices;  // the kept tree's mesh, bit for bit
-    std::vector<uint32_t> m_indices;
+    core::KeptMesh m_mesh;  // the kept tree's mesh, bit for bit
     std::optional<TriangleBvh> m_tree;
     TriangleBlocks m_blocks;
-    core::SetSummary m_summary;
 };
 
 }  // namespace rthdist::cpu

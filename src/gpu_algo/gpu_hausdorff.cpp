@@ -657,11 +657,13 @@ const std::string& GpuHausdorff::pipelineCacheStatus() const {
 
 Result<SurfaceCandidates> GpuHausdorff::nearestTriangles(std::span<const glm::vec3> queries,
                                                          std::span<const glm::vec3> corners,
-                                                         const std::atomic<bool>* cancel) {
+                                                         const std::atomic<bool>* cancel,
+                                                         uint64_t cornersVersion) {
     Timings timings;
     SurfaceCandidates out;
     // The BLAS of triangles stays: a point search's first radius builds its own in its storage.
-    auto err = m_state->guarded(timings, [&] { out = m_state->surface.run(queries, corners, cancel); });
+    auto err = m_state->guarded(
+        timings, [&] { out = m_state->surface.run(queries, corners, cancel, cornersVersion); });
     if (err) return *err;
     return out;
 }

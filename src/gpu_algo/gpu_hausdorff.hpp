@@ -197,10 +197,11 @@ public:
     // SurfaceCandidates::open). queries and corners (3 per triangle) in one
     // float frame; `cancel` read between submissions (kCancelled). Its
     // buffers, the tail's tree and the BLAS storage stay for the next call
-    // (releaseScratch frees them).
+    // (releaseScratch frees them). cornersVersion: SurfaceSearch::run's.
     [[nodiscard]] Result<SurfaceCandidates> nearestTriangles(std::span<const glm::vec3> queries,
                                                              std::span<const glm::vec3> corners,
-                                                             const std::atomic<bool>* cancel = nullptr);
+                                                             const std::atomic<bool>* cancel = nullptr,
+                                                             uint64_t cornersVersion = 0);
 
     struct State;
 

@@ -103,7 +103,7 @@ struct SurfaceSearch::TailTree {
 };
 
 SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners,
-                                     const std::atomic<bool>* cancel) {
+                                     const std::atomic<bool>* cancel, uint64_t cornersVersion) {
     if (corners.empty() || corners.size() % 3 != 0 || corners.size() / 3 >= kMaxTriangles)
         throw gpu::LimitError("the surface search takes 1 to 2^30 - 1 triangles, not " +
                               std::to_string(corners.size() / 3));
@@ -113,6 +113,7 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     m_queries = uint32_t(queries.size());
     m_triangles = uint32_t(corners.size() / 3);
     m_built = false;
+    m_version = cornersVersion;
     m_ws.pipelines.prepareSurfaceSearch(m_ws.pipelineCache.handle());
 
     SurfaceCandidates out;
@@ -200,6 +201,7 @@ void SurfaceSearch::release() {
                            &m_counts, &m_nodes, &m_leafCorners})
         b->reset();
     m_treeCorners = {};
+    m_treeVersion = 0;
 }
 
 VkDeviceSize SurfaceSearch::inputBytes(bool rays) const {
@@ -333,7 +335,8 @@ void SurfaceSearch::cmdReadBack(VkCommandBuffer cmd) {
 
 SurfaceSearch::TailTree SurfaceSearch::tailTree(std::span<const glm::vec3> corners, SurfaceCandidates& out) {
     TailTree t;
-    t.kept = !m_treeCorners.empty() && sameCorners(m_treeCorners, corners, m_ws.threads);
+    t.kept = !m_treeCorners.empty() && ((m_version != 0 && m_version == m_treeVersion) ||
+                                        sameCorners(m_treeCorners, corners, m_ws.threads));
     out.tailTreeReused = t.kept;
     if (t.kept) return t;
     const auto t0 = Clock::now();
@@ -405,6 +408,7 @@ void SurfaceSearch::cmdTail(VkCommandBuffer cmd, const TailTree& tree, VkDeviceS
 void SurfaceSearch::finishTail(const TailTree& tree, std::span<const glm::vec3> corners,
                                SurfaceCandidates& out) {
     if (!tree.kept) m_treeCorners.assign(corners.begin(), corners.end());
+    m_treeVersion = m_version;
     ++out.submissions;
     out.tailGpuMs = m_ws.ctx.lastGpuMs();
     out.gpuMs += out.tailGpuMs;

@@ -184,9 +184,13 @@ public:
     // radii, then one of the tail where a query is open; where descendOnly,
     // one submission of the upload and the tail for every query. `cancel` is read
     // after each (true: throws CallCancelled). Vulkan failures throw.
+    // cornersVersion: 0, or the caller's name for these very corners (a
+    // value it never gives other corners): a tree kept from a call of the
+    // same version is used without comparing the corners again.
     [[nodiscard]] SurfaceCandidates run(std::span<const glm::vec3> queries,
                                         std::span<const glm::vec3> corners,
-                                        const std::atomic<bool>* cancel = nullptr);
+                                        const std::atomic<bool>* cancel = nullptr,
+                                        uint64_t cornersVersion = 0);
     // Frees the buffers kept between calls (GpuHausdorff::releaseScratch).
     void release();
 
@@ -215,9 +219,9 @@ private:
     uint32_t cmdRadius(VkCommandBuffer cmd, double radius, double settled2, bool update,
                        VkDeviceAddress counts);
     // The tail's tree for this call's corners: the one kept from the call
-    // before where the corners are the same (every float bit for bit, the
-    // kept copy m_treeCorners), else built on the host (its device buffers
-    // grown).
+    // before where the corners are the same (of the same nonzero version,
+    // else every float bit for bit against the kept copy m_treeCorners),
+    // else built on the host (its device buffers grown).
     struct TailTree;
     TailTree tailTree(std::span<const glm::vec3> corners, SurfaceCandidates& out);
     // A built tree, its nodes and its copy of the corners in its order,
@@ -253,6 +257,8 @@ private:
     // device's distances are those of the call's own triangles, which the
     // host's proof relies on (api/surface_certify.hpp, searched2).
     std::vector<glm::vec3> m_treeCorners;
+    uint64_t m_treeVersion = 0;  // their caller's version (0: none given)
+    uint64_t m_version = 0;      // this call's (run's cornersVersion)
 };
 
 }  // namespace rthdist::gpu_algo

@@ -956,6 +956,25 @@ void expectTreeKeptOnlyForTheSameCorners(Engine& engine, Backend backend, Path p
         engine.compute(PointView(same.queries), PointView(same.vertices), points);
     ASSERT_TRUE(between) << between.error().message;
     call(same, 1);
+    // The mesh's own buffer changed in place between calls: compared, never
+    // trusted (the kept mesh's copy and the kept corners' version).
+    test::SurfaceCase inPlace = same;
+    inPlace.name += "_changed_in_place";
+    call(inPlace, 1);
+    inPlace.vertices[7].y += 1e-3;
+    call(inPlace, 0);
+    call(inPlace, 1);
+    // The same mesh in another frame (the points' box grown 8-fold): its
+    // corners framed again, the tree built for them; then the first frame.
+    test::SurfaceCase wider = same;
+    wider.name += "_wider_frame";
+    double most = 0.0;
+    for (const glm::dvec3& v : wider.vertices)
+        most = std::max({most, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    wider.queries.push_back(glm::dvec3(8.0 * most));
+    call(wider, 0);
+    call(wider, 1);
+    call(same, 0);
 }
 
 TEST(GpuSurfaceTail, AKeptEngineReusesTheTreeOnlyForTheSameCorners) {

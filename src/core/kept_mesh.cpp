@@ -1,0 +1,50 @@
+#include "core/kept_mesh.hpp"
+
+#include <atomic>
+#include <cstring>
+
+#include "core/parallel.hpp"
+
+namespace rthdist::core {
+namespace {
+
+constexpr size_t kChunk = size_t(1) << 16;
+
+}  // namespace
+
+bool KeptMesh::holds(const MeshView& surface, int threads) const {
+    if (!m_kept || surface.vertices.count != m_vertices.size() || surface.indices.size() != m_indices.size())
+        return false;
+    std::atomic<bool> differ{false};
+    parallelChunks(m_vertices.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end && !differ.load(std::memory_order_relaxed); ++i) {
+            const glm::dvec3 v = surface.vertices.at(i);
+            if (std::memcmp(&v, &m_vertices[i], sizeof v) != 0) differ.store(true, std::memory_order_relaxed);
+        }
+    });
+    if (differ.load()) return false;
+    parallelChunks(m_indices.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
+        if (std::memcmp(surface.indices.data() + begin, m_indices.data() + begin,
+                        (end - begin) * sizeof(uint32_t)))
+            differ.store(true, std::memory_order_relaxed);
+    });
+    return !differ.load();
+}
+
+void KeptMesh::keep(const MeshView& surface, const SetSummary& summary, int threads) {
+    m_vertices.resize(surface.vertices.count);
+    parallelChunks(m_vertices.size(), kChunk, threads, [&](size_t begin, size_t end, int) {
+        for (size_t i = begin; i < end; ++i) m_vertices[i] = surface.vertices.at(i);
+    });
+    m_indices.assign(surface.indices.begin(), surface.indices.end());
+    m_summary = summary;
+    m_kept = true;
+}
+
+void KeptMesh::clear() {
+    m_kept = false;
+    m_vertices = {};
+    m_indices = {};
+}
+
+}  // namespace rthdist::core
