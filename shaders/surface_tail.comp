@@ -11,7 +11,8 @@
 // tree's copy of its corners, a leaf's in consecutive records. A node's
 // box holds its triangles' float boxes, so the skip is surface_visit's box
 // test of each of its triangles lifted: the descent keeps what a visit of
-// every triangle would. Counts the queries it searched.
+// every triangle would. Counts the queries it searched (one atomic a
+// workgroup).
 //
 // Lanes: 2^laneBits threads of one workgroup share a query (few queries
 // keep more of the device busy so). Lane l starts at the node its bits
@@ -34,18 +35,24 @@ layout(push_constant) uniform Push { SurfaceTailPush pc; };
 #include "surface_visit.glsl"
 
 shared uint s_best[RTHDIST_WG];  // per query of the group: the smallest distance's bits its lanes found
+shared uint s_open;              // the group's queries that descend
 
 void main() {
     const uint lane = gl_GlobalInvocationID.x & ((1u << pc.laneBits) - 1u);
     const uint qi = gl_GlobalInvocationID.x >> pc.laneBits;
     const uint slot = gl_LocalInvocationID.x >> pc.laneBits;
     const uint64_t start = qi < pc.numQueries ? u64At(pc.best, qi).v : ~uint64_t(0);
-    if (pc.laneBits != 0u) {  // (uniform: the push constant's)
-        if (lane == 0u) s_best[slot] = uint(start >> 32);
-        barrier();
-    }
-    if (qi >= pc.numQueries || packedDist2(start) <= pc.settled2) return;
-    if (lane == 0u) atomicAdd(uintAt(pc.counts, 0u).v, 1u);
+    const bool open = qi < pc.numQueries && !(packedDist2(start) <= pc.settled2);
+    // The group's open queries counted in workgroup memory, then added to
+    // the count once (one atomic a group, not a query: tens of thousands
+    // on one address had queued at the device's cache).
+    if (gl_LocalInvocationID.x == 0u) s_open = 0u;
+    if (lane == 0u) s_best[slot] = uint(start >> 32);
+    barrier();
+    if (open && lane == 0u) atomicAdd(s_open, 1u);
+    barrier();
+    if (gl_LocalInvocationID.x == 0u && s_open != 0u) atomicAdd(uintAt(pc.counts, 0u).v, s_open);
+    if (!open) return;
     vec3 q = vec4At(pc.queries, qi).v.xyz;
     uint64_t best = start;
 

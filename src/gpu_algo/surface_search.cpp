@@ -144,7 +144,9 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     cmdUpload(cmd, !descend);
     bool toHost = false;
     if (descend) {
+        m_ws.ctx.cmdTraceMark(cmd);  // (RTHDIST_SUBMIT_TRACE: the upload, the descent, the read-back)
         cmdTail(cmd, tree, inputBytes(false), 0.0, m_queries, out);
+        m_ws.ctx.cmdTraceMark(cmd);
         cmdReadBack(cmd);
         m_ws.ctx.submitAndWait(cmd);
         finishTail(tree, corners, out);
