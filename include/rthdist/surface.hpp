@@ -249,8 +249,9 @@ struct SurfaceResult {
     double searchMs = 0.0;            // every query's nearest triangle (and the witness's check)
     double totalMs = 0.0;             // the whole call, checks included
     // GPU backends: buildMs is the device and its pipelines created for a
-    // one-shot call (0 on an Engine, which keeps them); searchMs the rest,
-    // split in `stages`.
+    // one-shot call; on an Engine, which keeps them, the BVH over the mesh
+    // that the proof's exact measures take, built on the second call of a
+    // mesh (0 on the others); searchMs the rest, split in `stages`.
     SurfaceStages stages;
     double gpuMs = 0.0;               // device time of the search
     uint64_t validationMessages = 0;  // with SurfaceOptions::validation (an Engine's: over its life)

@@ -122,12 +122,21 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
         Result<SurfaceInputs> inputs =
             checkInputs(points, surface, options.threads, same ? &keptGpu.mesh.summary() : nullptr);
         if (!inputs) return inputs.error();
+        // A mesh seen again gets its BVH for the proof's exact measures
+        // (built once, on its second call: one call of a mesh builds none).
+        double treeMs = 0.0;
         if (!same) {
             keptGpu.frame.reset();
+            keptGpu.tree.reset();
             keptGpu.mesh.keep(surface, inputs->b, options.threads);
+        } else if (!keptGpu.tree) {
+            const core::Clock::time_point treeStart = core::Clock::now();
+            keptGpu.tree.emplace(surface, options.threads);
+            treeMs = core::msSince(treeStart);
         }
         Result<SurfaceResult> result = surfaceOnGpu(backend, points, surface, *inputs, options,
                                                     call.perPointDistances ? &spare : nullptr, &keptGpu);
+        if (result) result->buildMs = treeMs;  // the proof's BVH where built (0: kept or none)
         if (result) result->totalMs = core::msSince(start);
         return result;
     }

@@ -170,6 +170,27 @@ std::vector<Nearest> bruteNearest(const PointView& points, std::span<const uint6
     return best;
 }
 
+// Each query's nearest triangle: bruteNearest, or where a BVH over the
+// triangles is given its query, one query a task (the same answer: the
+// tree's query equals the brute force over every triangle, ties to the
+// smaller index; `within2` is then not needed).
+std::vector<Nearest> nearestOf(const PointView& points, std::span<const uint64_t> queries,
+                               const MeshView& surface, int threads, std::span<const double> within2,
+                               double slack, const cpu::TriangleBvh* tree) {
+    if (tree == nullptr) return bruteNearest(points, queries, surface, threads, within2, slack);
+    std::vector<Nearest> best(queries.size());
+    core::parallelChunks(queries.size(), core::heavyItemChunk(queries.size(), threads), threads,
+                         [&](size_t begin, size_t end, int) {
+                             for (size_t i = begin; i < end; ++i) {
+                                 const cpu::NearestTriangle n = tree->nearest(points.at(queries[i]), slack);
+                                 best[i].distance2 = n.distance2;
+                                 best[i].triangle = n.triangle;
+                                 best[i].tested = n.trianglesTested;
+                             }
+                         });
+    return best;
+}
+
 // Queries measured exactly already (by bruteNearest), by query index.
 using Known = std::vector<std::pair<uint64_t, Nearest>>;  // sorted by query
 
@@ -189,7 +210,8 @@ const Nearest* knownOf(const Known& known, uint64_t q) {
 // measured already; the others in one pass over the triangles.
 // trianglesTested: the rule's evaluations of that pass and of `known`.
 SurfaceResult bruteBand(const PointView& points, std::span<const uint64_t> band, const MeshView& surface,
-                        std::span<const double> bound, double slack, int threads, const Known& known) {
+                        std::span<const double> bound, double slack, int threads, const Known& known,
+                        const cpu::TriangleBvh* tree) {
     std::vector<uint64_t> rest;
     std::vector<double> restBound;
     for (const uint64_t q : band) {
@@ -198,7 +220,7 @@ SurfaceResult bruteBand(const PointView& points, std::span<const uint64_t> band,
             restBound.push_back(bound[q]);
         }
     }
-    const std::vector<Nearest> measured = bruteNearest(points, rest, surface, threads, restBound, slack);
+    const std::vector<Nearest> measured = nearestOf(points, rest, surface, threads, restBound, slack, tree);
     SurfaceResult r;
     Nearest top;
     uint64_t topQuery = 0, tested = 0;
@@ -327,7 +349,8 @@ std::vector<uint64_t> bandBySearched(const PointView& points, const MeshView& su
 Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface, double magnitude,
                                      std::span<const uint32_t> candidate, const SurfaceOptions& options,
                                      std::span<const uint32_t> open, std::span<const float> searched2,
-                                     double searchScale, EveryQueryBound* every) {
+                                     double searchScale, EveryQueryBound* every,
+                                     const cpu::TriangleBvh* tree) {
     if (options.perPointDistances)
         return Error{ErrorCode::kInvalidArgument,
                      "the proof of a surface search gives no per-point distances"};
@@ -355,7 +378,7 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
             within2.push_back(measure2(points, surface, q, candidate[q]));
         }
         const std::vector<Nearest> nearest =
-            bruteNearest(points, openQueries, surface, options.threads, within2, slack);
+            nearestOf(points, openQueries, surface, options.threads, within2, slack, tree);
         settledCandidate.assign(candidate.begin(), candidate.end());
         for (size_t i = 0; i < openQueries.size(); ++i) {
             known.emplace_back(openQueries[i], nearest[i]);
@@ -411,7 +434,7 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     } else {
         const double within2[1] = {largest.bound};
         const uint64_t query[1] = {largest.query};
-        measured = bruteNearest(points, query, surface, options.threads, within2, slack)[0];
+        measured = nearestOf(points, query, surface, options.threads, within2, slack, tree)[0];
         known.insert(placeOf(known, largest.query), {largest.query, measured});
     }
     const double lower2 = measured.distance2;  // L^2 <= h^2
@@ -421,8 +444,8 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
                                                                  lower2, options.threads, bound.data())
                                                 : bandOf(bound, lower2, options.threads);
     Result<SurfaceResult> exact = SurfaceResult{};
-    if (bandIndex.size() * triangles <= kBruteWork) {
-        exact = bruteBand(points, bandIndex, surface, bound, slack, options.threads, known);
+    if (tree != nullptr || bandIndex.size() * triangles <= kBruteWork) {
+        exact = bruteBand(points, bandIndex, surface, bound, slack, options.threads, known, tree);
     } else {  // the CPU backend's BVH search over the band (its own witness check)
         std::vector<glm::dvec3> band;
         band.reserve(bandIndex.size());

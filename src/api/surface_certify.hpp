@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "core/uninit_vector.hpp"
+#include "cpu/triangle_bvh.hpp"
 #include "rthdist/surface.hpp"
 
 namespace rthdist::api {
@@ -48,6 +49,11 @@ namespace rthdist::api {
 // rounding reach, checked on a sample of the call) does not rule it out
 // (surface_certify.cpp, kSearchedReach; design.md §11). The answer is the
 // same either way.
+// tree (may be null): a BVH over `surface`'s triangles (an Engine's kept
+// one, api/surface_gpu.hpp's KeptGpuSurface): the queries measured exactly
+// (the open ones, q*, the band) then take its nearest-triangle query
+// instead of a pass over every triangle; the answer is the same (the
+// tree's query equals the brute force, cpu/triangle_bvh.hpp).
 // every (may be null): also every query's U(q) (squared) and the triangle
 // that gives it, in query order: its candidate, or an open query's exact
 // nearest (the brute force's). The proof then measures every U(q) (as
@@ -82,6 +88,6 @@ inline constexpr double kSearchedReach = 0x1p-16;
 [[nodiscard]] Result<SurfaceResult> certifySurface(
     const PointView& points, const MeshView& surface, double magnitude, std::span<const uint32_t> candidate,
     const SurfaceOptions& options, std::span<const uint32_t> open = {}, std::span<const float> searched2 = {},
-    double searchScale = 0.0, EveryQueryBound* every = nullptr);
+    double searchScale = 0.0, EveryQueryBound* every = nullptr, const cpu::TriangleBvh* tree = nullptr);
 
 }  // namespace rthdist::api

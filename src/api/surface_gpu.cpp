@@ -94,7 +94,8 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
     proofOptions.perPointDistances = false;
     Result<SurfaceResult> result =
         certifySurface(points, surface, inputs.magnitude, found->triangle, proofOptions, found->open,
-                       found->distance2, frame.scale, options.perPointDistances ? &every : nullptr);
+                       found->distance2, frame.scale, options.perPointDistances ? &every : nullptr,
+                       kept != nullptr && kept->tree ? &*kept->tree : nullptr);
     if (!result) return result.error();
     uint64_t hostTriangles = 0;
     bool recomputed = false;

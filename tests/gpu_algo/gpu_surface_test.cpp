@@ -1021,6 +1021,41 @@ TEST(GpuSurfaceHost, HandsBackTheQueriesTheRadiiLeaveOpen) {
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
 
+// An Engine's second call of a mesh builds a BVH over it (buildMs > 0)
+// that its later calls keep (buildMs 0) and the proof's exact measures
+// take: the open queries (the host's way), q* and the band. Every call
+// gives the brute force's answer, the same as the first call's (no BVH),
+// either way the open queries go.
+TEST(GpuSurfaceHost, AKeptMeshsBvhGivesTheSameAnswer) {
+    RTHDIST_REQUIRE_SURFACE_DEVICE();
+    for (const uint64_t hostWork : {kAlwaysHost, kAlwaysTree}) {
+        Result<Engine> engine = tunedSurfaceEngine(backend, hostWork);
+        ASSERT_TRUE(engine) << engine.error().message;
+        for (const FramedCase& f : tailCases()) {
+            const test::SurfaceCase c = apiCase(f);
+            std::optional<SurfaceResult> first;
+            for (int call = 0; call < 3; ++call) {
+                Result<SurfaceResult> r = engine->hausdorffToSurface(PointView(c.queries), meshOf(c));
+                expectBruteForce(c, backend, r);
+                ASSERT_TRUE(r) << c.name;
+                if (call == 1)
+                    EXPECT_GT(r->buildMs, 0.0) << c.name;
+                else
+                    EXPECT_EQ(r->buildMs, 0.0) << c.name << " call " << call;
+                if (hostWork == kAlwaysHost) EXPECT_GT(r->directed.counters.tailHostQueries, 0u) << c.name;
+                if (call == 0) {
+                    first = std::move(*r);
+                    continue;
+                }
+                EXPECT_EQ(r->hausdorff, first->hausdorff) << c.name;
+                EXPECT_EQ(r->directed.queryIndex, first->directed.queryIndex) << c.name;
+                EXPECT_EQ(r->directed.triangle, first->directed.triangle) << c.name;
+                EXPECT_EQ(r->directed.surfacePoint, first->directed.surfacePoint) << c.name;
+            }
+        }
+    }
+}
+
 // Through the API the queries handed back are measured exactly by the
 // host's proof: the brute force's answer on every tail case, one
 // submission, no tree, as many host queries as the tree's descent
