@@ -123,13 +123,14 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
             checkInputs(points, surface, options.threads, same ? &keptGpu.mesh.summary() : nullptr);
         if (!inputs) return inputs.error();
         // A mesh seen again gets its BVH for the proof's exact measures
-        // (built once, on its second call: one call of a mesh builds none).
+        // (built once, on its second call: one call of a mesh builds none;
+        // up to kKeptBvhTriangles).
         double treeMs = 0.0;
         if (!same) {
             keptGpu.frame.reset();
             keptGpu.tree.reset();
             keptGpu.mesh.keep(surface, inputs->b, options.threads);
-        } else if (!keptGpu.tree) {
+        } else if (!keptGpu.tree && surface.triangleCount() <= kKeptBvhTriangles) {
             const core::Clock::time_point treeStart = core::Clock::now();
             keptGpu.tree.emplace(surface, options.threads);
             treeMs = core::msSince(treeStart);

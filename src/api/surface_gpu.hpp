@@ -14,6 +14,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 
@@ -60,9 +61,12 @@ struct SearchFrame {
 // comparing them again (design.md §11, "A kept mesh"). From the second call
 // of the same mesh it also keeps a BVH over its triangles
 // (cpu::TriangleBvh), which the proof's exact measures take instead of a
-// pass over every triangle. Memory: the copy, 24 bytes a vertex and 12 a
-// triangle, the corners, 36 bytes a triangle, and the BVH (~60-100 bytes a
-// triangle), until another mesh (or, for the corners, frame) replaces them.
+// pass over every triangle (for at most kKeptBvhTriangles: past it the
+// pass stays, and no BVH is kept). Memory: the copy, 24 bytes a vertex and
+// 12 a triangle, the corners, 36 bytes a triangle, and the BVH (~60-100
+// bytes a triangle), until another mesh (or, for the corners, frame)
+// replaces them.
+inline constexpr size_t kKeptBvhTriangles = size_t(1) << 24;
 struct KeptGpuSurface {
     core::KeptMesh mesh;
     std::optional<SearchFrame> frame;  // of `corners`; none: no corners kept (the mesh changed)
