@@ -67,6 +67,12 @@ Result<api::SurfaceInputs> checkInputs(const PointView& points, const MeshView& 
     return api::SurfaceInputs{*a, *b, std::max(magnitudeOf(a->box), magnitudeOf(b->box))};
 }
 
+// Whether both views are readable (their shapes checked), so that a kept
+// mesh may be compared with the call's before the inputs are checked.
+bool readable(const PointView& points, const MeshView& surface) {
+    return !core::checkShape(points, "A") && !core::checkShape(surface.vertices, "B");
+}
+
 }  // namespace
 
 Result<SurfaceResult> hausdorffToSurface(PointView points, MeshView surface, const SurfaceOptions& options) {
@@ -117,24 +123,11 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
         // A mesh equal to the kept one (compared once the views are
         // readable) is not checked again, and its framed corners serve
         // where the frame is the same.
-        const bool same = !core::checkShape(points, "A") && !core::checkShape(surface.vertices, "B") &&
-                          keptGpu.mesh.holds(surface, options.threads);
+        const bool same = readable(points, surface) && keptGpu.mesh.holds(surface, options.threads);
         Result<SurfaceInputs> inputs =
             checkInputs(points, surface, options.threads, same ? &keptGpu.mesh.summary() : nullptr);
         if (!inputs) return inputs.error();
-        // A mesh seen again gets its BVH for the proof's exact measures
-        // (built once, on its second call: one call of a mesh builds none;
-        // up to kKeptBvhTriangles).
-        double treeMs = 0.0;
-        if (!same) {
-            keptGpu.frame.reset();
-            keptGpu.tree.reset();
-            keptGpu.mesh.keep(surface, inputs->b, options.threads);
-        } else if (!keptGpu.tree && surface.triangleCount() <= kKeptBvhTriangles) {
-            const core::Clock::time_point treeStart = core::Clock::now();
-            keptGpu.tree.emplace(surface, options.threads);
-            treeMs = core::msSince(treeStart);
-        }
+        const double treeMs = keptGpu.take(surface, inputs->b, same, options.threads);
         Result<SurfaceResult> result = surfaceOnGpu(backend, points, surface, *inputs, options,
                                                     call.perPointDistances ? &spare : nullptr, &keptGpu);
         if (result) result->buildMs = treeMs;  // the proof's BVH where built (0: kept or none)
@@ -144,8 +137,7 @@ Result<SurfaceResult> surfaceOnEngine(ComputeBackend& backend, const EngineOptio
     // The CPU route: a mesh equal to the kept one (compared once the views
     // are readable) is neither checked nor built again.
     const core::Clock::time_point treeStart = core::Clock::now();
-    const bool reused = !core::checkShape(points, "A") && !core::checkShape(surface.vertices, "B") &&
-                        kept.holds(surface, options.threads);
+    const bool reused = readable(points, surface) && kept.holds(surface, options.threads);
     double treeMs = core::msSince(treeStart);
     Result<SurfaceInputs> inputs =
         checkInputs(points, surface, options.threads, reused ? &kept.summary() : nullptr);

@@ -55,6 +55,20 @@ uint64_t newCornersVersion() {
     return next.fetch_add(1, std::memory_order_relaxed);
 }
 
+double KeptGpuSurface::take(const MeshView& surface, const core::SetSummary& summary, bool same,
+                            int threads) {
+    if (!same) {
+        frame.reset();
+        tree.reset();
+        mesh.keep(surface, summary, threads);
+        return 0.0;
+    }
+    if (tree || surface.triangleCount() > kKeptBvhTriangles) return 0.0;
+    const core::Clock::time_point start = core::Clock::now();
+    tree.emplace(surface, threads);
+    return core::msSince(start);
+}
+
 Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& points, const MeshView& surface,
                                    const SurfaceInputs& inputs, const SurfaceOptions& options,
                                    SurfacePerPoint* spare, KeptGpuSurface* kept) {
@@ -62,20 +76,16 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
     const SearchFrame frame(inputs.a.box, inputs.b.box);
     const core::UninitVector<glm::vec3> queries = framedPoints(points, frame, options.threads);
     core::UninitVector<glm::vec3> ownCorners;
-    uint64_t version = 0;
-    if (kept != nullptr && !(kept->frame && *kept->frame == frame)) {
+    if (kept == nullptr) {
+        ownCorners = framedCorners(surface, frame, options.threads);
+    } else if (!(kept->frame && *kept->frame == frame)) {
         kept->frame.reset();  // (until its corners are framed)
         kept->corners = framedCorners(surface, frame, options.threads);
         kept->frame = frame;
         kept->version = newCornersVersion();
     }
-    if (kept != nullptr) {
-        version = kept->version;
-    } else {
-        ownCorners = framedCorners(surface, frame, options.threads);
-    }
-    const std::span<const glm::vec3> corners =
-        kept != nullptr ? std::span<const glm::vec3>(kept->corners) : std::span<const glm::vec3>(ownCorners);
+    const std::span<const glm::vec3> corners = kept != nullptr ? kept->corners : ownCorners;
+    const uint64_t version = kept != nullptr ? kept->version : 0;
     const double frameMs = core::msSince(start);
     Result<TriangleCandidates> found = device.nearestTriangles(queries, corners, options.cancel, version);
     if (!found) return found.error();

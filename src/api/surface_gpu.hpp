@@ -73,6 +73,12 @@ struct KeptGpuSurface {
     core::UninitVector<glm::vec3> corners;
     uint64_t version = 0;
     std::optional<cpu::TriangleBvh> tree;  // of `mesh`; none until its second call
+
+    // The call's mesh `surface` (checked; `summary` its vertices'): where it
+    // is not the kept one (`same` false) kept in its place, its corners and
+    // BVH dropped; where it is, its BVH built if none is kept yet (within
+    // kKeptBvhTriangles). Returns the milliseconds of that build (0: none).
+    double take(const MeshView& surface, const core::SetSummary& summary, bool same, int threads);
 };
 
 // What the checks of a point-to-surface call found (api/surface.cpp):

@@ -48,10 +48,4 @@ void KeptMesh::keep(const MeshView& surface, const SetSummary& summary, int thre
     m_kept = true;
 }
 
-void KeptMesh::clear() {
-    m_kept = false;
-    m_vertices = {};
-    m_indices = {};
-}
-
 }  // namespace rthdist::core

@@ -3,12 +3,12 @@
 // by a hash): its vertex values in double and its triangle indices, with
 // the summary of its vertices as checked when it was kept. The CPU route
 // keeps its BVH beside it (cpu/kept_surface_tree.hpp), the GPU route its
-// framed corners (api/kept_gpu_surface.hpp).
+// framed corners and its BVH (api/surface_gpu.hpp's KeptGpuSurface).
 //
 // Threading: one call at a time (an Engine's contract); the comparison and
 // the copy run on `threads` threads of the worker pool.
 // Memory: 24 bytes a vertex and 12 a triangle, until another mesh replaces
-// them or clear().
+// them.
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -31,7 +31,6 @@ public:
     // coordinate finite) and `summary`, its vertices' checked summary,
     // replacing any kept mesh.
     void keep(const MeshView& surface, const SetSummary& summary, int threads);
-    void clear();
     // The kept mesh's summary: valid while holds() of the mesh searched.
     [[nodiscard]] const SetSummary& summary() const { return m_summary; }
 
