@@ -46,6 +46,9 @@ struct Direction {
     const MeshView* from = nullptr;
     const MeshView* to = nullptr;
     SampleSearch* search = nullptr;  // over `to`
+    // core::thinTriangle of each triangle of `to`, once (the convexity
+    // bound measures the rule against them ~10 times a patch).
+    std::vector<uint8_t> toThin;
     std::vector<Sample> samples;
     size_t evaluated = 0;  // samples [evaluated, size) still need their query
     std::vector<Patch> work;
@@ -101,8 +104,22 @@ std::optional<Error> evaluate(Direction& dir) {
     return std::nullopt;
 }
 
-double distanceTo(const glm::dvec3& p, const MeshView& to, uint32_t t) {
-    return std::sqrt(core::closestOnTriangle(p, to.corner(t, 0), to.corner(t, 1), to.corner(t, 2)).distance2);
+double distanceTo(const glm::dvec3& p, const Direction& dir, uint32_t t) {
+    const MeshView& to = *dir.to;
+    return std::sqrt(
+        core::closestOnTriangle(p, to.corner(t, 0), to.corner(t, 1), to.corner(t, 2), dir.toThin[t] != 0)
+            .distance2);
+}
+
+std::vector<uint8_t> thinFlags(const MeshView& mesh, int threads) {
+    std::vector<uint8_t> thin(mesh.triangleCount());
+    core::parallelChunks(
+        thin.size(), core::balancedChunk(thin.size(), threads, 1024), threads,
+        [&](size_t begin, size_t end, int) {
+            for (size_t t = begin; t < end; ++t)
+                thin[t] = core::thinTriangle(mesh.corner(t, 0), mesh.corner(t, 1), mesh.corner(t, 2)) ? 1 : 0;
+        });
+    return thin;
 }
 
 // Convexity (design.md §12): d(., t) is convex, so over the patch (the hull
@@ -116,7 +133,7 @@ double convexBound(const Direction& dir, const Sample* c[3], const Sample* centr
         if (t == kNone || std::find(candidates, candidates + j, t) != candidates + j) continue;
         double worst = 0.0;
         for (int k = 0; k < 3 && worst < bound; ++k)
-            worst = std::max(worst, c[k]->nearest == t ? c[k]->d : distanceTo(c[k]->p, *dir.to, t));
+            worst = std::max(worst, c[k]->nearest == t ? c[k]->d : distanceTo(c[k]->p, dir, t));
         bound = std::min(bound, worst);
     }
     return bound;
@@ -310,7 +327,10 @@ Result<SurfaceBoundsResult> surfaceBounds(const MeshView& a, const MeshView& b, 
         r.dirs[1].to = &a;
         r.dirs[1].search = bToA;
     }
-    for (Direction& d : r.dirs) seed(d);
+    for (Direction& d : r.dirs) {
+        seed(d);
+        d.toThin = thinFlags(*d.to, options.threads);
+    }
     SurfaceBoundsResult result;
     const core::Clock::time_point searchStart = core::Clock::now();
     while (r.open()) {
