@@ -27,6 +27,7 @@
 #include "api/route_planner.hpp"
 #include "core/input_frame.hpp"
 #include "core/per_point_floor.hpp"
+#include "core/searched_tops.hpp"
 #include "core/uninit_vector.hpp"
 #include "rthdist/rthdist.hpp"
 #include "rthdist/vulkan_interop.hpp"
@@ -59,6 +60,7 @@ struct TriangleCandidates {
     core::UninitVector<uint32_t> triangle;
     core::UninitVector<float>
         distance2;             // the device's squared distance to `triangle` (search frame), +inf for none
+    core::SearchedTops tops;   // distance2's largest by chunks (may be empty: chunk 0)
     uint32_t radii = 0;        // radii searched
     uint64_t rays = 0;         // rays cast
     uint32_t submissions = 0;  // command buffers submitted and waited for

@@ -201,6 +201,7 @@ public:
         if (!found) return found.error();
         return TriangleCandidates{std::move(found->triangle),
                                   std::move(found->distance2),
+                                  std::move(found->tops),
                                   found->radii,
                                   found->rays,
                                   found->submissions,

@@ -12,6 +12,7 @@
 
 #include "core/parallel.hpp"
 #include "core/point_triangle.hpp"
+#include "core/searched_tops.hpp"
 #include "core/stopwatch.hpp"
 #include "core/uninit_vector.hpp"
 #include "cpu/surface_search.hpp"
@@ -304,41 +305,49 @@ struct SearchedBound {
     }
 };
 
-// The query of the largest device distance (one without a number first:
-// no candidate), the smallest index on a tie: the worker pool in chunks.
-uint64_t searchedTop(std::span<const float> searched2, int threads) {
-    const auto key = [](float d2) { return d2 >= 0.0f ? d2 : std::numeric_limits<float>::infinity(); };
-    const size_t n = searched2.size(), chunk = core::balancedChunk(n, threads);
-    std::vector<uint64_t> tops((n + chunk - 1) / chunk);
-    core::parallelChunks(n, chunk, threads, [&](size_t begin, size_t end, int) {
-        uint64_t top = begin;
-        for (size_t q = begin + 1; q < end; ++q)
-            if (key(searched2[q]) > key(searched2[top])) top = q;
-        tops[begin / chunk] = top;
+// The device's distances by chunks (core::SearchedTops) in one pass of the
+// worker pool, where the search did not summarize them. Since
+// SearchedBound::upper grows with searchedKey's order, a chunk whose
+// largest query's bound is below sqrt(L) holds no query of the band
+// (bandBySearched skips it).
+core::SearchedTops searchedTops(std::span<const float> searched2, int threads) {
+    const size_t n = searched2.size();
+    core::SearchedTops tops;
+    tops.chunk = core::balancedChunk(n, threads);
+    tops.top.resize((n + tops.chunk - 1) / tops.chunk);
+    core::parallelChunks(n, tops.chunk, threads, [&](size_t begin, size_t end, int) {
+        tops.top[begin / tops.chunk] = core::SearchedTops::topOf(searched2, begin, end);
     });
-    uint64_t top = tops.front();
-    for (const uint64_t t : tops)
-        if (key(searched2[t]) > key(searched2[top])) top = t;  // chunk order: strict > keeps the first
-    return top;
+    return tops;
 }
 
 // The band from the device's distances: every query whose bound reaches
 // sqrt(lower2) is measured (U(q) in double against its candidate, into
 // `bound`), and kept where U(q) >= lower2; the others have U(q) < L
-// (SearchedBound). Index order, the worker pool chunk by chunk.
+// (SearchedBound). Only the chunks of `tops` whose largest bound reaches
+// sqrt(lower2), or that hold a query of `known`, are passed over. Index
+// order, the worker pool chunk by chunk.
 std::vector<uint64_t> bandBySearched(const PointView& points, const MeshView& surface,
                                      std::span<const uint32_t> candidate, const SearchedBound& searched,
-                                     const Known& known, double lower2, int threads, double* bound) {
+                                     const core::SearchedTops& tops, const Known& known, double lower2,
+                                     int threads, double* bound) {
     const double floor = std::sqrt(lower2);
-    const size_t n = points.count;
-    const size_t chunk = core::balancedChunk(n, threads);
-    std::vector<std::vector<uint64_t>> parts((n + chunk - 1) / chunk);
-    core::parallelChunks(n, chunk, threads, [&](size_t begin, size_t end, int) {
-        std::vector<uint64_t>& mine = parts[begin / chunk];
-        for (size_t q = begin; q < end; ++q) {
-            if (searched.upper(q) < floor && knownOf(known, q) == nullptr) continue;
-            bound[q] = measure2(points, surface, q, candidate[q]);
-            if (bound[q] >= lower2) mine.push_back(q);
+    const size_t n = points.count, chunk = tops.chunk;
+    std::vector<size_t> reached;  // the chunks passed over, in order
+    for (size_t c = 0; c < tops.top.size(); ++c) {
+        const auto k = placeOf(known, c * chunk);
+        if (searched.upper(tops.top[c]) >= floor || (k != known.end() && k->first < (c + 1) * chunk))
+            reached.push_back(c);
+    }
+    std::vector<std::vector<uint64_t>> parts(reached.size());
+    core::parallelChunks(reached.size(), 1, threads, [&](size_t first, size_t last, int) {
+        for (size_t i = first; i < last; ++i) {
+            std::vector<uint64_t>& mine = parts[i];
+            for (size_t q = reached[i] * chunk; q < std::min(n, (reached[i] + 1) * chunk); ++q) {
+                if (searched.upper(q) < floor && knownOf(known, q) == nullptr) continue;
+                bound[q] = measure2(points, surface, q, candidate[q]);
+                if (bound[q] >= lower2) mine.push_back(q);
+            }
         }
     });
     return core::concatenateParts<std::vector<uint64_t>>(parts);
@@ -349,8 +358,8 @@ std::vector<uint64_t> bandBySearched(const PointView& points, const MeshView& su
 Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& surface, double magnitude,
                                      std::span<const uint32_t> candidate, const SurfaceOptions& options,
                                      std::span<const uint32_t> open, std::span<const float> searched2,
-                                     double searchScale, EveryQueryBound* every,
-                                     const cpu::TriangleBvh* tree) {
+                                     double searchScale, EveryQueryBound* every, const cpu::TriangleBvh* tree,
+                                     const core::SearchedTops* searchedSummary) {
     if (options.perPointDistances)
         return Error{ErrorCode::kInvalidArgument,
                      "the proof of a surface search gives no per-point distances"};
@@ -404,9 +413,16 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
                       std::isfinite(searched.reach);
     Largest largest;
     core::UninitVector<double> bound;
+    core::SearchedTops tops;
     if (bySearched) {
         bound = core::UninitVector<double>(points.count);  // written where measured
-        const uint64_t top = searchedTop(searched2, options.threads);
+        // The search's summary serves where it covers the distances as given
+        // (none of them adjusted for the open queries).
+        if (known.empty() && searchedSummary != nullptr && searchedSummary->covers(points.count))
+            tops = *searchedSummary;
+        else
+            tops = searchedTops(searched2, options.threads);
+        const uint64_t top = tops.overall(searched2);
         largest = Largest{measure2(points, surface, top, candidate[top]), top};
         bound[top] = largest.bound;
         const uint64_t step = std::max<uint64_t>(1, points.count / kSearchedSamples);
@@ -440,8 +456,8 @@ Result<SurfaceResult> certifySurface(const PointView& points, const MeshView& su
     const double lower2 = measured.distance2;  // L^2 <= h^2
 
     const std::vector<uint64_t> bandIndex = bySearched
-                                                ? bandBySearched(points, surface, candidate, searched, known,
-                                                                 lower2, options.threads, bound.data())
+                                                ? bandBySearched(points, surface, candidate, searched, tops,
+                                                                 known, lower2, options.threads, bound.data())
                                                 : bandOf(bound, lower2, options.threads);
     Result<SurfaceResult> exact = SurfaceResult{};
     if (tree != nullptr || bandIndex.size() * triangles <= kBruteWork) {

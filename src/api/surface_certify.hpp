@@ -26,6 +26,7 @@
 #include <span>
 #include <vector>
 
+#include "core/searched_tops.hpp"
 #include "core/uninit_vector.hpp"
 #include "cpu/triangle_bvh.hpp"
 #include "rthdist/surface.hpp"
@@ -48,7 +49,10 @@ namespace rthdist::api {
 // two): the proof then measures U(q) only where that distance (plus a
 // rounding reach, checked on a sample of the call) does not rule it out
 // (surface_certify.cpp, kSearchedReach; design.md §11). The answer is the
-// same either way.
+// same either way. searchedSummary (may be null): searched2's largest by
+// chunks (core::SearchedTops), as the search wrote them; used where it
+// covers searched2 and no query is open, else the proof summarizes
+// searched2 itself (the same q* and band either way).
 // tree (may be null): a BVH over `surface`'s triangles (an Engine's kept
 // one, api/surface_gpu.hpp's KeptGpuSurface): the queries measured exactly
 // (the open ones, q*, the band) then take its nearest-triangle query
@@ -88,6 +92,7 @@ inline constexpr double kSearchedReach = 0x1p-16;
 [[nodiscard]] Result<SurfaceResult> certifySurface(
     const PointView& points, const MeshView& surface, double magnitude, std::span<const uint32_t> candidate,
     const SurfaceOptions& options, std::span<const uint32_t> open = {}, std::span<const float> searched2 = {},
-    double searchScale = 0.0, EveryQueryBound* every = nullptr, const cpu::TriangleBvh* tree = nullptr);
+    double searchScale = 0.0, EveryQueryBound* every = nullptr, const cpu::TriangleBvh* tree = nullptr,
+    const core::SearchedTops* searchedSummary = nullptr);
 
 }  // namespace rthdist::api

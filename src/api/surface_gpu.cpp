@@ -105,7 +105,7 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
     Result<SurfaceResult> result =
         certifySurface(points, surface, inputs.magnitude, found->triangle, proofOptions, found->open,
                        found->distance2, frame.scale, options.perPointDistances ? &every : nullptr,
-                       kept != nullptr && kept->tree ? &*kept->tree : nullptr);
+                       kept != nullptr && kept->tree ? &*kept->tree : nullptr, &found->tops);
     if (!result) return result.error();
     uint64_t hostTriangles = 0;
     bool recomputed = false;

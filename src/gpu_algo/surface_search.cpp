@@ -180,6 +180,8 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
     std::vector<std::vector<uint32_t>> openParts(toHost ? (m_queries + chunk - 1) / chunk : 0);
     out.triangle.resize(m_queries);
     out.distance2.resize(m_queries);
+    out.tops.chunk = chunk;
+    out.tops.top.resize((m_queries + chunk - 1) / chunk);
     core::parallelChunks(m_queries, chunk, m_ws.threads, [&](size_t begin, size_t end, int) {
         for (size_t q = begin; q < end; ++q) {
             const uint64_t best = packed[q];
@@ -192,6 +194,8 @@ SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::sp
             if (!toHost) continue;
             if (!(d2 <= settled2)) openParts[begin / chunk].push_back(uint32_t(q));
         }
+        // (while this chunk's distances are in this thread's cache)
+        out.tops.top[begin / chunk] = core::SearchedTops::topOf(out.distance2, begin, end);
     });
     out.open = core::concatenateParts<std::vector<uint32_t>>(openParts);
     out.readbackMs = msSince(t0);

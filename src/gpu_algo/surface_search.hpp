@@ -43,6 +43,7 @@
 #include <span>
 #include <vector>
 
+#include "core/searched_tops.hpp"
 #include "core/uninit_vector.hpp"
 #include "gpu/buffer.hpp"
 #include "rthdist/tuning.hpp"
@@ -58,6 +59,7 @@ struct SurfaceCandidates {
     // Per query: the squared distance the device measured to `triangle`
     // (the shared rule in float, in the search frame), +inf for none.
     core::UninitVector<float> distance2;
+    core::SearchedTops tops;   // distance2's largest by chunks, from the read-back's pass
     uint32_t radii = 0;        // radii that searched a query
     uint64_t rays = 0;         // rays cast over all radii
     uint32_t submissions = 0;  // command buffers submitted (each waited for)

@@ -131,6 +131,26 @@ TEST(SurfaceCertify, TheDevicesDistancesGiveTheSameAnswer) {
                 PointView(c.queries), mesh, magnitude(c), candidate, SurfaceOptions{}, {}, *distances, scale);
             expectExact(c, r, want, name);
         }
+        // The device's distances summarized by chunks (core::SearchedTops,
+        // as the search's read-back writes them): the same answer and band
+        // whatever the chunk size.
+        const Result<SurfaceResult> whole = api::certifySurface(
+            PointView(c.queries), mesh, magnitude(c), candidate, SurfaceOptions{}, {}, searched, scale);
+        ASSERT_TRUE(whole) << c.name;
+        for (const size_t chunk : {size_t(1), size_t(5), size_t(1) << 20}) {
+            core::SearchedTops tops;
+            tops.chunk = chunk;
+            for (size_t begin = 0; begin < searched.size(); begin += chunk)
+                tops.top.push_back(
+                    core::SearchedTops::topOf(searched, begin, std::min(searched.size(), begin + chunk)));
+            const Result<SurfaceResult> r =
+                api::certifySurface(PointView(c.queries), mesh, magnitude(c), candidate, SurfaceOptions{}, {},
+                                    searched, scale, nullptr, nullptr, &tops);
+            expectExact(c, r, want, "device, summarized");
+            if (r)
+                EXPECT_EQ(r->directed.counters.band, whole->directed.counters.band)
+                    << c.name << " chunk " << chunk;
+        }
     }
 }
 
