@@ -185,8 +185,9 @@ struct SurfaceCounters {
 // unless named gpu (all 0 on the CPU backend). searchMs = frame + upload +
 // search + readback + certify, up to the code between them.
 struct SurfaceStages {
-    double frame = 0.0;      // both inputs shifted, scaled and rounded to float (worker pool)
-    double upload = 0.0;     // queries, corners and boxes written to the upload buffer (worker pool)
+    double frame = 0.0;      // inputs shifted, scaled, rounded to float (worker pool; not a kept mesh,
+                             // and a point-to-surface call's queries are framed in `upload`)
+    double upload = 0.0;     // queries framed into the upload buffer, corners and boxes written (worker pool)
     double search = 0.0;     // the device's submissions, waited for: the upload's copies, every
                              // radius's boxes, BLAS build or refit and rays, the read-back's copy;
                              // where queries are left open, the tail (tree built, descent, copies)

@@ -57,7 +57,7 @@ Result<HausdorffResult> ComputeBackend::computeDeviceViews(const DevicePointView
     return notOffered("device views");
 }
 
-Result<TriangleCandidates> ComputeBackend::nearestTriangles(std::span<const glm::vec3>,
+Result<TriangleCandidates> ComputeBackend::nearestTriangles(const core::FramedQueries&,
                                                             std::span<const glm::vec3>,
                                                             const std::atomic<bool>*, uint64_t) {
     return notOffered("triangle search");

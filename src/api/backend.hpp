@@ -25,6 +25,7 @@
 
 #include "api/out_of_core.hpp"
 #include "api/route_planner.hpp"
+#include "core/framed_queries.hpp"
 #include "core/input_frame.hpp"
 #include "core/per_point_floor.hpp"
 #include "core/searched_tops.hpp"
@@ -141,7 +142,7 @@ public:
     // cornersVersion: 0, or the caller's name for these very corners
     // (newCornersVersion), never given to other corners: the device then
     // keeps what it built from them without comparing them again.
-    [[nodiscard]] virtual Result<TriangleCandidates> nearestTriangles(std::span<const glm::vec3> queries,
+    [[nodiscard]] virtual Result<TriangleCandidates> nearestTriangles(const core::FramedQueries& queries,
                                                                       std::span<const glm::vec3> corners,
                                                                       const std::atomic<bool>* cancel,
                                                                       uint64_t cornersVersion);

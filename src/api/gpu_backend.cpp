@@ -193,7 +193,7 @@ public:
         return DeviceViewSet{std::make_shared<GpuSet>(std::move(g->set)), g->summary, g->origin};
     }
 
-    [[nodiscard]] Result<TriangleCandidates> nearestTriangles(std::span<const glm::vec3> queries,
+    [[nodiscard]] Result<TriangleCandidates> nearestTriangles(const core::FramedQueries& queries,
                                                               std::span<const glm::vec3> corners,
                                                               const std::atomic<bool>* cancel,
                                                               uint64_t cornersVersion) override {

@@ -74,7 +74,13 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
                                    SurfacePerPoint* spare, KeptGpuSurface* kept) {
     const core::Clock::time_point start = core::Clock::now();
     const SearchFrame frame(inputs.a.box, inputs.b.box);
-    const core::UninitVector<glm::vec3> queries = framedPoints(points, frame, options.threads);
+    // The queries framed by the search itself, straight into its upload
+    // buffer (core::FramedQueries: the bits framedPoints would give).
+    core::FramedQueries queries;
+    queries.count = points.count;
+    queries.write = [&points, &frame](size_t begin, size_t end, glm::vec4* out) {
+        for (size_t i = begin; i < end; ++i) out[i - begin] = glm::vec4(frame(points.at(i)), 0.0f);
+    };
     core::UninitVector<glm::vec3> ownCorners;
     if (kept == nullptr) {
         ownCorners = framedCorners(surface, frame, options.threads);

@@ -655,7 +655,7 @@ const std::string& GpuHausdorff::pipelineCacheStatus() const {
     return m_state->ws.pipelineCache.loadStatus();
 }
 
-Result<SurfaceCandidates> GpuHausdorff::nearestTriangles(std::span<const glm::vec3> queries,
+Result<SurfaceCandidates> GpuHausdorff::nearestTriangles(const core::FramedQueries& queries,
                                                          std::span<const glm::vec3> corners,
                                                          const std::atomic<bool>* cancel,
                                                          uint64_t cornersVersion) {

@@ -24,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/framed_queries.hpp"
 #include "core/input_frame.hpp"
 #include "core/per_point_floor.hpp"
 #include "core/scan_limits.hpp"
@@ -198,10 +199,14 @@ public:
     // float frame; `cancel` read between submissions (kCancelled). Its
     // buffers, the tail's tree and the BLAS storage stay for the next call
     // (releaseScratch frees them). cornersVersion: SurfaceSearch::run's.
-    [[nodiscard]] Result<SurfaceCandidates> nearestTriangles(std::span<const glm::vec3> queries,
+    [[nodiscard]] Result<SurfaceCandidates> nearestTriangles(const core::FramedQueries& queries,
                                                              std::span<const glm::vec3> corners,
                                                              const std::atomic<bool>* cancel = nullptr,
                                                              uint64_t cornersVersion = 0);
+    [[nodiscard]] Result<SurfaceCandidates> nearestTriangles(std::span<const glm::vec3> queries,
+                                                             std::span<const glm::vec3> corners) {
+        return nearestTriangles(core::FramedQueries::of(queries), corners);
+    }
 
     struct State;
 

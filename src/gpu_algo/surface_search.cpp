@@ -102,15 +102,15 @@ struct SurfaceSearch::TailTree {
     [[nodiscard]] VkDeviceSize bytes() const { return nodeBytes + cornerBytes; }
 };
 
-SurfaceCandidates SurfaceSearch::run(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners,
+SurfaceCandidates SurfaceSearch::run(const core::FramedQueries& queries, std::span<const glm::vec3> corners,
                                      const std::atomic<bool>* cancel, uint64_t cornersVersion) {
     if (corners.empty() || corners.size() % 3 != 0 || corners.size() / 3 >= kMaxTriangles)
         throw gpu::LimitError("the surface search takes 1 to 2^30 - 1 triangles, not " +
                               std::to_string(corners.size() / 3));
-    if (queries.empty() || queries.size() > UINT32_MAX)
+    if (queries.count == 0 || queries.count > UINT32_MAX)
         throw gpu::LimitError("the surface search takes 1 to 2^32 - 1 queries, not " +
-                              std::to_string(queries.size()));
-    m_queries = uint32_t(queries.size());
+                              std::to_string(queries.count));
+    m_queries = uint32_t(queries.count);
     m_triangles = uint32_t(corners.size() / 3);
     m_built = false;
     m_version = cornersVersion;
@@ -214,7 +214,7 @@ VkDeviceSize SurfaceSearch::inputBytes(bool rays) const {
     return VkDeviceSize(m_queries) * 16 + (rays ? VkDeviceSize(m_triangles) * (48 + sizeof(sh::Cell)) : 0);
 }
 
-SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
+SurfaceSearch::Stats SurfaceSearch::stage(const core::FramedQueries& queries,
                                           std::span<const glm::vec3> corners, bool rays, VkDeviceSize extra) {
     const VkDeviceSize pointBytes = VkDeviceSize(m_queries) * 16;
     const VkDeviceSize cornerBytes = VkDeviceSize(m_triangles) * 48;
@@ -243,11 +243,17 @@ SurfaceSearch::Stats SurfaceSearch::stage(std::span<const glm::vec3> queries,
         m_ws.threads, m_queries / queryChunk + (rays ? m_triangles / triangleChunk : 0) + 1);
     std::vector<Stats> each(static_cast<size_t>(workers));
     core::parallelChunks(m_queries, queryChunk, workers, [&](size_t begin, size_t end, int thread) {
+        // Framed a block at a time into this thread's own memory (their box
+        // read there, not from the upload buffer, which may be uncached),
+        // then copied up.
+        constexpr size_t kBlock = 256;
+        glm::vec4 block[kBlock];
         Box box;
-        for (size_t i = begin; i < end; ++i) {
-            const float p[4] = {queries[i].x, queries[i].y, queries[i].z, 0.0f};
-            std::memcpy(points + 4 * i, p, sizeof(p));
-            box.add(queries[i]);
+        for (size_t b = begin; b < end; b += kBlock) {
+            const size_t e = std::min(end, b + kBlock);
+            queries.writeTo(b, e, block);
+            for (size_t i = 0; i < e - b; ++i) box.add(glm::vec3(block[i]));
+            std::memcpy(points + 4 * b, block, (e - b) * sizeof(glm::vec4));
         }
         each[size_t(thread)].box.add(box);
     });

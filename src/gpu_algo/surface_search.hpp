@@ -43,6 +43,7 @@
 #include <span>
 #include <vector>
 
+#include "core/framed_queries.hpp"
 #include "core/searched_tops.hpp"
 #include "core/uninit_vector.hpp"
 #include "gpu/buffer.hpp"
@@ -189,7 +190,7 @@ public:
     // cornersVersion: 0, or the caller's name for these very corners (a
     // value it never gives other corners): a tree kept from a call of the
     // same version is used without comparing the corners again.
-    [[nodiscard]] SurfaceCandidates run(std::span<const glm::vec3> queries,
+    [[nodiscard]] SurfaceCandidates run(const core::FramedQueries& queries,
                                         std::span<const glm::vec3> corners,
                                         const std::atomic<bool>* cancel = nullptr,
                                         uint64_t cornersVersion = 0);
@@ -205,7 +206,7 @@ private:
     // kept after the inputs (the tail's tree, where descendOnly: the
     // descent reads the tree's own copy of the corners, so no corners or
     // boxes go up); the inputs' bytes are inputBytes(rays).
-    Stats stage(std::span<const glm::vec3> queries, std::span<const glm::vec3> corners, bool rays,
+    Stats stage(const core::FramedQueries& queries, std::span<const glm::vec3> corners, bool rays,
                 VkDeviceSize extra = 0);
     [[nodiscard]] VkDeviceSize inputBytes(bool rays) const;
     // The upload buffer's copies (the corners and boxes for the radii) and
