@@ -114,13 +114,15 @@ inline constexpr uint64_t kSurfaceHostWorkPerThread = uint64_t(1) << 19;
 // queries 15.4 -> 3.1 ms, armadillo-dec>armadillo's 6,502 1.5 -> 0.93 ms,
 // armadillo>dec's 26,002 1.1 -> 0.76 ms, bunny>res2's 35,947 1.26 ->
 // 0.78-0.81 ms at 4-16 lanes; bunny-scans>bunny's 362,272 lost, 3.4 ->
-// 3.9 ms). The descent ends with what a visit of every triangle would
+// 3.9 ms; session 29: 100,250 queries of dragon_vrip_res2 against res3's
+// 47,794 triangles 1.41 -> 1.34 ms, against res4's 11,102 1.22 -> 0.92,
+// so 2^17 since). The descent ends with what a visit of every triangle would
 // give, as after the radii. The few triangles' side is
 // bounded by kDescendMostQueries (2^20): past it the radii stay, as
 // measured at scale (each query of the tail also counts itself on one
 // atomic).
 inline constexpr uint64_t kDescendTriangles = 4096;
-inline constexpr uint64_t kDescendQueries = uint64_t(1) << 16;
+inline constexpr uint64_t kDescendQueries = uint64_t(1) << 17;
 inline constexpr uint64_t kDescendMostQueries = uint64_t(1) << 20;
 // Tuning::surfaceDescend decides where it is set.
 [[nodiscard]] bool descendOnly(const Tuning& tuning, uint64_t queries, uint64_t triangles);

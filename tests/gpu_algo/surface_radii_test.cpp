@@ -91,6 +91,7 @@ TEST(SurfaceRadii, FewTrianglesOrFewQueriesDescendOnly) {
     EXPECT_TRUE(descendOnly(rule, 5205, 871414));
     EXPECT_TRUE(descendOnly(rule, 26002, 13000));
     EXPECT_TRUE(descendOnly(rule, 35947, 16301));
+    EXPECT_TRUE(descendOnly(rule, 100250, 47794));  // dragon_vrip_res2 > res3 (session 29)
     EXPECT_FALSE(descendOnly(rule, 362272, 69451));
     EXPECT_FALSE(descendOnly(rule, 437645, 11102));
     EXPECT_TRUE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles));
