@@ -27,14 +27,13 @@ SearchFrame::SearchFrame(const core::Bounds& a, const core::Bounds& b) {
     scale = std::ldexp(1.0, -exponent);
 }
 
-// (UninitVector: first touched by the workers, its block reused by the next call.)
-core::UninitVector<glm::vec3> framedPoints(const PointView& points, const SearchFrame& frame, int threads) {
-    core::UninitVector<glm::vec3> out(points.count);
-    core::parallelChunks(points.count, core::balancedChunk(points.count, threads), threads,
-                         [&](size_t begin, size_t end, int) {
-                             for (size_t i = begin; i < end; ++i) out[i] = frame(points.at(i));
-                         });
-    return out;
+core::FramedQueries framedQueries(const PointView& points, const SearchFrame& frame) {
+    core::FramedQueries queries;
+    queries.count = points.count;
+    queries.write = [&points, &frame](size_t begin, size_t end, glm::vec4* out) {
+        for (size_t i = begin; i < end; ++i) out[i - begin] = glm::vec4(frame(points.at(i)), 0.0f);
+    };
+    return queries;
 }
 
 core::UninitVector<glm::vec3> framedCorners(const MeshView& surface, const SearchFrame& frame, int threads) {
@@ -74,13 +73,7 @@ Result<SurfaceResult> surfaceOnGpu(ComputeBackend& device, const PointView& poin
                                    SurfacePerPoint* spare, KeptGpuSurface* kept) {
     const core::Clock::time_point start = core::Clock::now();
     const SearchFrame frame(inputs.a.box, inputs.b.box);
-    // The queries framed by the search itself, straight into its upload
-    // buffer (core::FramedQueries: the bits framedPoints would give).
-    core::FramedQueries queries;
-    queries.count = points.count;
-    queries.write = [&points, &frame](size_t begin, size_t end, glm::vec4* out) {
-        for (size_t i = begin; i < end; ++i) out[i - begin] = glm::vec4(frame(points.at(i)), 0.0f);
-    };
+    const core::FramedQueries queries = framedQueries(points, frame);
     core::UninitVector<glm::vec3> ownCorners;
     if (kept == nullptr) {
         ownCorners = framedCorners(surface, frame, options.threads);

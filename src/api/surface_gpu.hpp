@@ -19,6 +19,7 @@
 #include <optional>
 
 #include "api/backend.hpp"
+#include "core/framed_queries.hpp"
 #include "core/input_frame.hpp"
 #include "core/kept_mesh.hpp"
 #include "core/uninit_vector.hpp"
@@ -40,10 +41,11 @@ struct SearchFrame {
     [[nodiscard]] bool operator==(const SearchFrame&) const = default;
 };
 
-// The points, or the triangles' corners (3 per triangle, in index order),
-// in the frame, on the worker pool (threads as EngineOptions::threads).
-[[nodiscard]] core::UninitVector<glm::vec3> framedPoints(const PointView& points, const SearchFrame& frame,
-                                                         int threads);
+// The points as a search's queries, framed by the search itself straight
+// into its upload buffer (core::FramedQueries; `points` and `frame` must
+// outlive the search). The triangles' corners (3 per triangle, in index
+// order) in the frame, on the worker pool (threads as EngineOptions::threads).
+[[nodiscard]] core::FramedQueries framedQueries(const PointView& points, const SearchFrame& frame);
 [[nodiscard]] core::UninitVector<glm::vec3> framedCorners(const MeshView& surface, const SearchFrame& frame,
                                                           int threads);
 

@@ -21,9 +21,8 @@ DeviceSampleSearch::DeviceSampleSearch(ComputeBackend& device, const MeshView& t
 Result<size_t> DeviceSampleSearch::search(std::span<const glm::dvec3> points, std::span<double> distance,
                                           std::span<uint32_t> nearest) {
     const PointView view(points);
-    const core::UninitVector<glm::vec3> queries = framedPoints(view, m_frame, m_threads);
     Result<TriangleCandidates> found =
-        m_device.nearestTriangles(core::FramedQueries::of(queries), m_corners, m_cancel, m_cornersVersion);
+        m_device.nearestTriangles(framedQueries(view, m_frame), m_corners, m_cancel, m_cornersVersion);
     if (!found) return found.error();
     m_gpuMs += found->gpuMs;
     if (m_cancel != nullptr && m_cancel->load(std::memory_order_relaxed))
