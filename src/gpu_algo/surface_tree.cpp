@@ -3,6 +3,7 @@
 #include <glm/common.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <stdexcept>
 
@@ -17,8 +18,9 @@ namespace {
 namespace sh = rthdist::shared;
 
 constexpr size_t kChunk = size_t(1) << 15;
-constexpr uint32_t kMortonBits = 30;  // 10 per axis
-constexpr uint32_t kRadixBits = 10;   // three passes over the codes
+constexpr uint32_t kTaskTriangles = uint32_t(1) << 13;  // a subtree built depth first by one worker
+constexpr uint32_t kMortonBits = 30;                    // 10 per axis
+constexpr uint32_t kRadixBits = 10;                     // three passes over the codes
 constexpr uint32_t kBuckets = uint32_t(1) << kRadixBits;
 
 using Box = core::FloatBox;
@@ -73,6 +75,58 @@ void radixSort(std::vector<uint32_t>& codes, std::vector<uint32_t>& items, int t
     }
 }
 
+// Levels a balanced split of `count` triangles needs below a node: leaves
+// of up to kSurfaceTreeLeaf, halves of ceil(count / 2).
+uint32_t levelsBelow(size_t count) {
+    uint32_t levels = 0;
+    for (size_t leaves = (count + kSurfaceTreeLeaf - 1) / kSurfaceTreeLeaf; leaves > 1;
+         leaves = (leaves + 1) / 2)
+        ++levels;
+    return levels;
+}
+
+// Where the sorted positions [first, end) at `depth` (the root's 1) splits: 0
+// for a leaf (at most kSurfaceTreeLeaf triangles); else the first position
+// whose code has its highest bit differing from the range's first code set,
+// the middle where the codes are all equal or where an uneven split could
+// leave a child deeper than kSurfaceTreeMaxLevels (a range of n at depth d
+// with d + levelsBelow(n) <= the limit keeps that after either split: the
+// root's d = 1 and levelsBelow(2^30) = 28).
+uint32_t splitAt(const std::vector<uint32_t>& codes, uint32_t first, uint32_t end, uint32_t depth) {
+    const size_t count = end - first;
+    if (count <= kSurfaceTreeLeaf) return 0u;
+    const uint32_t middle = first + uint32_t(count / 2);
+    const uint32_t a = codes[first], z = codes[end - 1];
+    if (a == z || depth + 1 + levelsBelow(count) > kSurfaceTreeMaxLevels) return middle;
+    const uint32_t bit = uint32_t(1) << (31 - std::countl_zero(a ^ z));
+    const uint32_t upper = (z & ~(bit - 1u));  // the least code with that bit set (and z's bits above it)
+    return uint32_t(std::lower_bound(codes.begin() + first, codes.begin() + end, upper) - codes.begin());
+}
+
+// A task's subtree, depth first: nodes[0] its root, an inner node's two
+// children adjacent (local indices), a leaf's first its sorted position.
+struct Subtree {
+    std::vector<sh::Cell> nodes;
+    uint32_t deepest = 0;  // the deepest node's depth
+    Box build(const std::vector<uint32_t>& codes, const std::vector<uint32_t>& order,
+              std::span<const glm::vec3> corners, size_t at, uint32_t first, uint32_t end, uint32_t depth) {
+        deepest = std::max(deepest, depth);
+        const uint32_t split = splitAt(codes, first, end, depth);
+        Box box;
+        if (split == 0u) {
+            for (uint32_t i = first; i < end; ++i) box.add(triangleBox(corners, order[i]));
+            nodes[at] = cellOf(box, first, end - first);
+            return box;
+        }
+        const size_t child = nodes.size();
+        nodes.resize(child + 2);
+        box = build(codes, order, corners, child, first, split, depth + 1);
+        box.add(build(codes, order, corners, child + 1, split, end, depth + 1));
+        nodes[at] = cellOf(box, uint32_t(child), 0u);
+        return box;
+    }
+};
+
 }  // namespace
 
 SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
@@ -111,40 +165,67 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
     });
     radixSort(codes, order, threads);  // stable: ties keep the triangles' order
 
-    // The levels' sizes, leaves first; laid out root first.
-    std::vector<size_t> sizes{(triangles + kSurfaceTreeLeaf - 1) / kSurfaceTreeLeaf};
-    while (sizes.back() > 1) sizes.push_back((sizes.back() + 1) / 2);
-    if (sizes.size() > kSurfaceTreeMaxLevels) throw std::length_error("the surface tree is too deep");
-    std::vector<size_t> offset(sizes.size(), 0);
-    for (size_t k = sizes.size() - 1; k-- > 0;) offset[k] = offset[k + 1] + sizes[k + 1];
-
+    // Top down: a range of more than kSurfaceTreeLeaf sorted triangles
+    // splits where its codes' highest differing bit changes (the two halves
+    // of the Morton cell they share), or in the middle where its codes are
+    // all equal or where the depth left could not hold an uneven split
+    // (splitAt). The ranges of more than kTaskTriangles split here, a level
+    // at a time; each smaller one is a task, its subtree built depth first
+    // on the worker pool and appended in the tasks' order (so the tree does
+    // not depend on the threads).
     SurfaceTree tree;
-    tree.levels = uint32_t(sizes.size());
-    tree.nodes.resize(offset[0] + sizes[0]);
-    core::parallelChunks(sizes[0], kChunk / kSurfaceTreeLeaf, threads, [&](size_t begin, size_t end, int) {
-        for (size_t leaf = begin; leaf < end; ++leaf) {
-            const size_t first = leaf * kSurfaceTreeLeaf;
-            const size_t count = std::min<size_t>(kSurfaceTreeLeaf, triangles - first);
-            Box b;
-            for (size_t i = first; i < first + count; ++i) b.add(triangleBox(corners, order[i]));
-            tree.nodes[offset[0] + leaf] = cellOf(b, uint32_t(first), uint32_t(count));
+    struct Task {
+        size_t at;  // its root's node
+        uint32_t first, end, depth;
+    };
+    std::vector<Task> tasks, open{{0, 0u, uint32_t(triangles), 1u}};
+    std::vector<size_t> topInner;  // the nodes split here, parents before children
+    tree.nodes.resize(1);
+    for (size_t i = 0; i < open.size(); ++i) {
+        const Task t = open[i];
+        if (t.end - t.first <= kTaskTriangles) {
+            tasks.push_back(t);
+            continue;
+        }
+        const uint32_t split = splitAt(codes, t.first, t.end, t.depth);
+        const size_t child = tree.nodes.size();
+        tree.nodes.resize(child + 2);
+        tree.nodes[t.at] = cellOf(Box{}, uint32_t(child), 0u);
+        topInner.push_back(t.at);
+        open.push_back({child, t.first, split, t.depth + 1});
+        open.push_back({child + 1, split, t.end, t.depth + 1});
+    }
+    std::vector<Subtree> parts(tasks.size());
+    core::parallelChunks(tasks.size(), 1, threads, [&](size_t begin, size_t end, int) {
+        for (size_t k = begin; k < end; ++k) {
+            Subtree& part = parts[k];
+            part.nodes.reserve(2 * size_t(tasks[k].end - tasks[k].first) - 1);
+            part.nodes.resize(1);
+            part.build(codes, order, corners, 0, tasks[k].first, tasks[k].end, tasks[k].depth);
         }
     });
-    for (size_t k = 1; k < sizes.size(); ++k) {
-        core::parallelChunks(sizes[k], kChunk, threads, [&](size_t begin, size_t end, int) {
-            for (size_t j = begin; j < end; ++j) {
-                const size_t left = offset[k - 1] + 2 * j;
-                sh::Cell& node = tree.nodes[offset[k] + j];
-                if (2 * j + 1 == sizes[k - 1]) {
-                    node = tree.nodes[left];  // the lone last node, carried up as it is
-                    continue;
-                }
-                Box b = boxOf(tree.nodes[left]);
-                b.add(boxOf(tree.nodes[left + 1]));
-                node = cellOf(b, uint32_t(left), 0u);
+    // A part's node j > 0 goes to offset + j - 1, its root to its task's node.
+    std::vector<size_t> offset(tasks.size() + 1, tree.nodes.size());
+    for (size_t k = 0; k < tasks.size(); ++k) offset[k + 1] = offset[k] + parts[k].nodes.size() - 1;
+    tree.nodes.resize(offset.back());
+    core::parallelChunks(tasks.size(), 1, threads, [&](size_t begin, size_t end, int) {
+        for (size_t k = begin; k < end; ++k) {
+            const std::vector<sh::Cell>& local = parts[k].nodes;
+            for (size_t j = 0; j < local.size(); ++j) {
+                sh::Cell c = local[j];
+                if (c.count == 0u) c.first = uint32_t(offset[k] + c.first - 1);
+                tree.nodes[j == 0 ? tasks[k].at : offset[k] + j - 1] = c;
             }
-        });
+        }
+    });
+    for (auto at = topInner.rbegin(); at != topInner.rend(); ++at) {
+        sh::Cell& n = tree.nodes[*at];
+        Box box = boxOf(tree.nodes[n.first]);
+        box.add(boxOf(tree.nodes[n.first + 1]));
+        n = cellOf(box, n.first, 0u);
     }
+    for (const Subtree& part : parts) tree.levels = std::max(tree.levels, part.deepest);
+    if (tree.levels > kSurfaceTreeMaxLevels) throw std::logic_error("the surface tree's depth guard failed");
     tree.order = std::move(order);
     return tree;
 }

@@ -5,9 +5,16 @@
 //   - the Morton code (10 bits per axis) of each triangle's box centre over
 //     the box of the centres, sorted with the triangle index breaking ties
 //     (so the tree is one function of the corners, whatever the threads);
-//   - leaves of at most kSurfaceTreeLeaf consecutive triangles of that order;
-//   - then levels built bottom-up by pairing adjacent nodes (a lone last
-//     node is carried up as it is), until one node is left: the root.
+//   - then, top down, a range of more than kSurfaceTreeLeaf sorted
+//     triangles splits where the highest bit in which its first and last
+//     codes differ changes (so a node is the triangles of one Morton cell's
+//     half: its box holds that part of space and little else), in the
+//     middle where the codes are all equal or where an uneven split could
+//     pass kSurfaceTreeMaxLevels; a range of at most kSurfaceTreeLeaf is a
+//     leaf.
+// Layout: the nodes of more than 2^13 triangles a level at a time from the
+// root, then each smaller node's subtree depth first (on the worker pool),
+// in the order of those nodes; the same tree whatever the threads.
 // Nodes are shared::Cell {lo, first, hi, count}: a leaf has count = its
 // triangles (1..kSurfaceTreeLeaf) and first = its first position in the
 // sorted order (`order` maps a position to its triangle); an inner node has
@@ -38,7 +45,7 @@ inline constexpr uint32_t kSurfaceTreeMaxLevels = RTHDIST_SURFACE_TAIL_STACK;
 struct SurfaceTree {
     std::vector<shared::Cell> nodes;  // nodes[0]: the root
     std::vector<uint32_t> order;      // sorted position -> triangle
-    uint32_t levels = 0;              // leaves' level up to the root's (1: the root is a leaf)
+    uint32_t levels = 0;              // the deepest node's depth, the root's 1 (1: the root is a leaf)
 };
 
 // corners: a, b, c of every triangle (3 per triangle, at least one

@@ -9,6 +9,7 @@
 #include <glm/common.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <random>
@@ -160,6 +161,55 @@ TEST(SurfaceTree, LeavesHoldNeighbours) {
     const SurfaceTree tree = buildSurfaceTree(corners, 1);
     expectValid(tree, corners);
     for (uint32_t i = 0; i < tree.order.size(); ++i) EXPECT_EQ(tree.order[i], uint32_t(n - 1) - i);
+}
+
+// Two clusters of 5 and 11 triangles: the root splits between them (the
+// Morton codes' highest differing bit), so each child's box is one
+// cluster's, not a box across the gap (pairing leaves of 4 over the sorted
+// order would put 1 triangle of the first cluster with 3 of the second).
+TEST(SurfaceTree, TheRootSplitsBetweenClusters) {
+    std::vector<glm::vec3> corners;
+    Box first, second;
+    for (int t = 0; t < 16; ++t) {
+        const glm::vec3 at = t < 5 ? glm::vec3(-1.0f + 0.01f * float(t)) : glm::vec3(1.0f - 0.01f * float(t));
+        const glm::vec3 tri[3] = {at, at + glm::vec3(0.005f, 0, 0), at + glm::vec3(0, 0.005f, 0)};
+        for (const glm::vec3& c : tri) (t < 5 ? first : second).add(c);
+        corners.insert(corners.end(), std::begin(tri), std::end(tri));
+    }
+    const SurfaceTree tree = buildSurfaceTree(corners, 1);
+    expectValid(tree, corners);
+    ASSERT_EQ(tree.nodes[0].count, 0u);
+    const Box left = boxOf(tree.nodes[tree.nodes[0].first]),
+              right = boxOf(tree.nodes[tree.nodes[0].first + 1]);
+    EXPECT_EQ(left.lo, first.lo);
+    EXPECT_EQ(left.hi, first.hi);
+    EXPECT_EQ(right.lo, second.lo);
+    EXPECT_EQ(right.hi, second.hi);
+}
+
+// Triangles peeled off one by one by the Morton splits (centres at 2^-k of
+// the box on each axis, 3 x 10 of them, each its own half of the cell
+// before) above 8,192 triangles at one corner: uneven splits all the way
+// would pass the descent's stack (30 levels of peeling, then 11 of equal
+// codes); the depth guard splits in the middle instead, so the tree stays
+// within kSurfaceTreeMaxLevels and valid.
+TEST(SurfaceTree, DepthGuardHoldsUnevenSplits) {
+    std::vector<glm::vec3> corners;
+    const auto add = [&](glm::vec3 at) {
+        corners.insert(corners.end(), {at, at + glm::vec3(1e-7f, 0, 0), at + glm::vec3(0, 1e-7f, 0)});
+    };
+    add(glm::vec3(1.0f));
+    for (int k = 1; k <= 10; ++k) {
+        const float x = std::ldexp(1.0f, -k);
+        add({x, 0, 0});
+        add({0, x, 0});
+        add({0, 0, x});
+    }
+    for (int t = 0; t < 8192; ++t) add(glm::vec3(0.0f));
+    const SurfaceTree tree = buildSurfaceTree(corners, 2);
+    expectValid(tree, corners);
+    EXPECT_LE(tree.levels, kSurfaceTreeMaxLevels);
+    EXPECT_GT(tree.levels, 20u);  // the peeling did happen above the guard
 }
 
 }  // namespace
