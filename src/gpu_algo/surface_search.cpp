@@ -55,9 +55,8 @@ uint64_t surfaceHostWork(const Tuning& tuning, int threads) {
                                            uint64_t(core::resolveThreads(threads)));
 }
 
-bool descendOnly(const Tuning& tuning, uint64_t queries, uint64_t triangles) {
-    return tuning.surfaceDescend.value_or(
-        (triangles <= kDescendTriangles && queries <= kDescendMostQueries) || queries <= kDescendQueries);
+bool descendOnly(const Tuning& tuning, uint64_t queries) {
+    return tuning.surfaceDescend.value_or(queries <= kDescendQueries);
 }
 
 uint32_t tailLaneBits(const Tuning& tuning, bool cpuDevice, uint64_t descending, uint64_t queries) {
@@ -119,7 +118,7 @@ SurfaceCandidates SurfaceSearch::run(const core::FramedQueries& queries, std::sp
     SurfaceCandidates out;
     // Descending only (descendOnly): the tree first, so that the upload
     // buffer holds the inputs and it for one submission.
-    const bool descend = descendOnly(m_ws.tuning, m_queries, m_triangles);
+    const bool descend = descendOnly(m_ws.tuning, m_queries);
     auto t0 = Clock::now();
     const TailTree tree = descend ? tailTree(corners, out) : TailTree{};
     const Stats stats = stage(queries, corners, !descend, tree.bytes());

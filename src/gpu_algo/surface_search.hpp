@@ -103,29 +103,21 @@ inline constexpr uint64_t kSurfaceHostWorkPerThread = uint64_t(1) << 19;
 [[nodiscard]] bool openQueriesToHost(uint64_t open, uint64_t triangles, uint64_t hostWork);
 
 // Where a call skips the radii and every query descends the tail's tree
-// from none (host only; tests/gpu_algo/surface_radii_test.cpp): a few
-// triangles (at most kDescendTriangles: the radii's BLAS builds, refit and
-// TLAS builds cost more than the tree's build and descent; on the H200
-// they were 0.29 ms of bunny>res4's 0.60 ms of device time for 948
-// triangles, session 8), or a few queries (at most kDescendQueries: that
-// many rays, each in ~100 grown boxes of a fine mesh, keep the GPU nearly
-// idle, where the descent shares each query among lanes (tailLaneBits); on
-// the H200, session 27, kept rt-pipeline: dragon-res4>dragon's 5,205
-// queries 15.4 -> 3.1 ms, armadillo-dec>armadillo's 6,502 1.5 -> 0.93 ms,
-// armadillo>dec's 26,002 1.1 -> 0.76 ms, bunny>res2's 35,947 1.26 ->
-// 0.78-0.81 ms at 4-16 lanes; bunny-scans>bunny's 362,272 lost, 3.4 ->
-// 3.9 ms; session 29: 100,250 queries of dragon_vrip_res2 against res3's
-// 47,794 triangles 1.41 -> 1.34 ms, against res4's 11,102 1.22 -> 0.92,
-// so 2^17 since). The descent ends with what a visit of every triangle would
-// give, as after the radii. The few triangles' side is
-// bounded by kDescendMostQueries (2^20): past it the radii stay, as
-// measured at scale (each query of the tail also counts itself on one
-// atomic).
-inline constexpr uint64_t kDescendTriangles = 4096;
-inline constexpr uint64_t kDescendQueries = uint64_t(1) << 17;
-inline constexpr uint64_t kDescendMostQueries = uint64_t(1) << 20;
+// from none (host only; tests/gpu_algo/surface_radii_test.cpp): at most
+// kDescendQueries queries, whatever the triangles. Since the tree splits
+// at the Morton codes' highest differing bit (surface_tree.hpp), the
+// descent beat the radii on every row measured, on the H200 (session 30,
+// kept rt-pipeline, medians of 3 processes): bunny-scans>bunny's 362,272
+// queries 2.78 -> 1.23 ms, dragon>dragon-res2's 437,645 3.34 -> 1.40,
+// 4,000,000 samples of dragon_vrip_res2 against its 202,520 triangles
+// 13.58 -> 10.65; within 2^17 as before (bunny>bunny moved by 0.1 of the
+// diagonal 2.83 -> 1.76, dragon-res2>dragon 6.37 -> 1.17). Past 2^22
+// queries, not measured, the radii stay (the descent's lead narrowed from
+// 2.3x to 1.3x by 4M queries). The descent ends with what a visit of every
+// triangle would give, as after the radii.
+inline constexpr uint64_t kDescendQueries = uint64_t(1) << 22;
 // Tuning::surfaceDescend decides where it is set.
-[[nodiscard]] bool descendOnly(const Tuning& tuning, uint64_t queries, uint64_t triangles);
+[[nodiscard]] bool descendOnly(const Tuning& tuning, uint64_t queries);
 
 // The threads a query of the tail's descent (surface_tail.comp), as the log2
 // of their count (host only; tests/gpu_algo/surface_radii_test.cpp). One

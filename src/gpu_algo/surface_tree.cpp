@@ -85,31 +85,45 @@ uint32_t levelsBelow(size_t count) {
     return levels;
 }
 
-// Where the sorted positions [first, end) at `depth` (the root's 1) splits: 0
-// for a leaf (at most kSurfaceTreeLeaf triangles); else the first position
-// whose code has its highest bit differing from the range's first code set,
-// the middle where the codes are all equal or where an uneven split could
-// leave a child deeper than kSurfaceTreeMaxLevels (a range of n at depth d
-// with d + levelsBelow(n) <= the limit keeps that after either split: the
-// root's d = 1 and levelsBelow(2^30) = 28).
+// Where the sorted positions [first, end) at `depth` (the root's 1) split:
+// 0 for a leaf (at most kSurfaceTreeLeaf triangles); the middle for at
+// most twice that (two leaves, not an uneven split's three or four: 12 %
+// fewer nodes on dragon_vrip_res3, the descent's visits level in a model
+// of it); else the first position whose code has the highest bit in which
+// the range's first and last codes differ set, or the middle where the
+// codes are all equal or where an uneven split could leave a child deeper
+// than kSurfaceTreeMaxLevels (a range of n at depth d with d +
+// levelsBelow(n) <= the limit keeps that after either split: the root's
+// d = 1 and levelsBelow(2^30) = 28).
 uint32_t splitAt(const std::vector<uint32_t>& codes, uint32_t first, uint32_t end, uint32_t depth) {
     const size_t count = end - first;
     if (count <= kSurfaceTreeLeaf) return 0u;
     const uint32_t middle = first + uint32_t(count / 2);
     const uint32_t a = codes[first], z = codes[end - 1];
-    if (a == z || depth + 1 + levelsBelow(count) > kSurfaceTreeMaxLevels) return middle;
+    if (count <= 2 * kSurfaceTreeLeaf || a == z || depth + 1 + levelsBelow(count) > kSurfaceTreeMaxLevels)
+        return middle;
     const uint32_t bit = uint32_t(1) << (31 - std::countl_zero(a ^ z));
     const uint32_t upper = (z & ~(bit - 1u));  // the least code with that bit set (and z's bits above it)
     return uint32_t(std::lower_bound(codes.begin() + first, codes.begin() + end, upper) - codes.begin());
 }
 
-// A task's subtree, depth first: nodes[0] its root, an inner node's two
-// children adjacent (local indices), a leaf's first its sorted position.
+// A task's subtree, depth first, into the tree's nodes: its root at a
+// node of the levels above, the others from `next` on, an inner node's
+// two children adjacent, a leaf's first its sorted position.
 struct Subtree {
-    std::vector<sh::Cell> nodes;
+    const std::vector<uint32_t>& codes;
+    const std::vector<uint32_t>& order;
+    std::span<const glm::vec3> corners;
     uint32_t deepest = 0;  // the deepest node's depth
-    Box build(const std::vector<uint32_t>& codes, const std::vector<uint32_t>& order,
-              std::span<const glm::vec3> corners, size_t at, uint32_t first, uint32_t end, uint32_t depth) {
+
+    // The nodes below a range's node (build places that many from `next`).
+    [[nodiscard]] size_t below(uint32_t first, uint32_t end, uint32_t depth) const {
+        const uint32_t split = splitAt(codes, first, end, depth);
+        if (split == 0u) return 0;
+        return 2 + below(first, split, depth + 1) + below(split, end, depth + 1);
+    }
+    Box build(std::vector<sh::Cell>& nodes, size_t& next, size_t at, uint32_t first, uint32_t end,
+              uint32_t depth) {
         deepest = std::max(deepest, depth);
         const uint32_t split = splitAt(codes, first, end, depth);
         Box box;
@@ -118,10 +132,10 @@ struct Subtree {
             nodes[at] = cellOf(box, first, end - first);
             return box;
         }
-        const size_t child = nodes.size();
-        nodes.resize(child + 2);
-        box = build(codes, order, corners, child, first, split, depth + 1);
-        box.add(build(codes, order, corners, child + 1, split, end, depth + 1));
+        const size_t child = next;
+        next += 2;
+        box = build(nodes, next, child, first, split, depth + 1);
+        box.add(build(nodes, next, child + 1, split, end, depth + 1));
         nodes[at] = cellOf(box, uint32_t(child), 0u);
         return box;
     }
@@ -171,8 +185,8 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
     // all equal or where the depth left could not hold an uneven split
     // (splitAt). The ranges of more than kTaskTriangles split here, a level
     // at a time; each smaller one is a task, its subtree built depth first
-    // on the worker pool and appended in the tasks' order (so the tree does
-    // not depend on the threads).
+    // on the worker pool into the nodes after the levels', in the tasks'
+    // order (so the tree does not depend on the threads).
     SurfaceTree tree;
     struct Task {
         size_t at;  // its root's node
@@ -195,27 +209,24 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
         open.push_back({child, t.first, split, t.depth + 1});
         open.push_back({child + 1, split, t.end, t.depth + 1});
     }
-    std::vector<Subtree> parts(tasks.size());
+    // Each task's nodes below its root counted, then built in place.
+    std::vector<size_t> offset(tasks.size() + 1, 0);
     core::parallelChunks(tasks.size(), 1, threads, [&](size_t begin, size_t end, int) {
         for (size_t k = begin; k < end; ++k) {
-            Subtree& part = parts[k];
-            part.nodes.reserve(2 * size_t(tasks[k].end - tasks[k].first) - 1);
-            part.nodes.resize(1);
-            part.build(codes, order, corners, 0, tasks[k].first, tasks[k].end, tasks[k].depth);
+            const Subtree part{codes, order, corners};
+            offset[k + 1] = part.below(tasks[k].first, tasks[k].end, tasks[k].depth);
         }
     });
-    // A part's node j > 0 goes to offset + j - 1, its root to its task's node.
-    std::vector<size_t> offset(tasks.size() + 1, tree.nodes.size());
-    for (size_t k = 0; k < tasks.size(); ++k) offset[k + 1] = offset[k] + parts[k].nodes.size() - 1;
+    offset[0] = tree.nodes.size();
+    for (size_t k = 0; k < tasks.size(); ++k) offset[k + 1] += offset[k];
     tree.nodes.resize(offset.back());
+    std::vector<uint32_t> deepest(tasks.size(), 0u);
     core::parallelChunks(tasks.size(), 1, threads, [&](size_t begin, size_t end, int) {
         for (size_t k = begin; k < end; ++k) {
-            const std::vector<sh::Cell>& local = parts[k].nodes;
-            for (size_t j = 0; j < local.size(); ++j) {
-                sh::Cell c = local[j];
-                if (c.count == 0u) c.first = uint32_t(offset[k] + c.first - 1);
-                tree.nodes[j == 0 ? tasks[k].at : offset[k] + j - 1] = c;
-            }
+            Subtree part{codes, order, corners};
+            size_t next = offset[k];
+            part.build(tree.nodes, next, tasks[k].at, tasks[k].first, tasks[k].end, tasks[k].depth);
+            deepest[k] = part.deepest;
         }
     });
     for (auto at = topInner.rbegin(); at != topInner.rend(); ++at) {
@@ -224,7 +235,7 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
         box.add(boxOf(tree.nodes[n.first + 1]));
         n = cellOf(box, n.first, 0u);
     }
-    for (const Subtree& part : parts) tree.levels = std::max(tree.levels, part.deepest);
+    for (const uint32_t d : deepest) tree.levels = std::max(tree.levels, d);
     if (tree.levels > kSurfaceTreeMaxLevels) throw std::logic_error("the surface tree's depth guard failed");
     tree.order = std::move(order);
     return tree;

@@ -10,8 +10,8 @@
 //     codes differ changes (so a node is the triangles of one Morton cell's
 //     half: its box holds that part of space and little else), in the
 //     middle where the codes are all equal or where an uneven split could
-//     pass kSurfaceTreeMaxLevels; a range of at most kSurfaceTreeLeaf is a
-//     leaf.
+//     pass kSurfaceTreeMaxLevels, or where it holds at most twice
+//     kSurfaceTreeLeaf; a range of at most kSurfaceTreeLeaf is a leaf.
 // Layout: the nodes of more than 2^13 triangles a level at a time from the
 // root, then each smaller node's subtree depth first (on the worker pool),
 // in the order of those nodes; the same tree whatever the threads.

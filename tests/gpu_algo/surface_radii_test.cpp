@@ -78,34 +78,28 @@ TEST(SurfaceRadii, FewOpenQueriesGoToTheHost) {
 
 }  // namespace
 // Every query down the tree without radii: where Tuning::surfaceDescend
-// says so, else for at most kDescendTriangles triangles or at most
-// kDescendQueries queries (bunny>res4's 948 triangles, bunny-res4>bunny's
-// 453 queries, dragon-res4>dragon's 5,205, armadillo>dec's 26,002 and
-// bunny>res2's 35,947; not dragon>res4's 437,645 x 11,102), the few
-// triangles' side up to
-// kDescendMostQueries queries.
-TEST(SurfaceRadii, FewTrianglesOrFewQueriesDescendOnly) {
+// says so, else for at most kDescendQueries queries, whatever the
+// triangles (session 30's rows: bunny>res4's 35,947 queries,
+// bunny-res4>bunny's 453, dragon_vrip_res2>res3's 100,250,
+// bunny-scans>bunny's 362,272, dragon>res2's 437,645 and 4M samples
+// against dragon_vrip_res2's 202,520 triangles).
+TEST(SurfaceRadii, UpToKDescendQueriesDescendOnly) {
     const Tuning rule;
-    EXPECT_TRUE(descendOnly(rule, 35947, 948));
-    EXPECT_TRUE(descendOnly(rule, 453, 69451));
-    EXPECT_TRUE(descendOnly(rule, 5205, 871414));
-    EXPECT_TRUE(descendOnly(rule, 26002, 13000));
-    EXPECT_TRUE(descendOnly(rule, 35947, 16301));
-    EXPECT_TRUE(descendOnly(rule, 100250, 47794));  // dragon_vrip_res2 > res3 (session 29)
-    EXPECT_FALSE(descendOnly(rule, 362272, 69451));
-    EXPECT_FALSE(descendOnly(rule, 437645, 11102));
-    EXPECT_TRUE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles));
-    EXPECT_FALSE(descendOnly(rule, kDescendQueries + 1, kDescendTriangles + 1));
-    EXPECT_TRUE(descendOnly(rule, kDescendQueries, kDescendTriangles + 1));
-    // Few triangles but past 2^20 queries: the radii, as at scale.
-    EXPECT_TRUE(descendOnly(rule, kDescendMostQueries, 948));
-    EXPECT_FALSE(descendOnly(rule, kDescendMostQueries + 1, 948));
+    EXPECT_TRUE(descendOnly(rule, 35947));
+    EXPECT_TRUE(descendOnly(rule, 453));
+    EXPECT_TRUE(descendOnly(rule, 100250));
+    EXPECT_TRUE(descendOnly(rule, 362272));
+    EXPECT_TRUE(descendOnly(rule, 437645));
+    EXPECT_TRUE(descendOnly(rule, 4000000));
+    EXPECT_TRUE(descendOnly(rule, kDescendQueries));
+    EXPECT_FALSE(descendOnly(rule, kDescendQueries + 1));
+    EXPECT_FALSE(descendOnly(rule, uint64_t(10000000)));
     Tuning forced;
     forced.surfaceDescend = true;
-    EXPECT_TRUE(descendOnly(forced, 437645, 11102));
+    EXPECT_TRUE(descendOnly(forced, kDescendQueries + 1));
     forced.surfaceDescend = false;
-    EXPECT_FALSE(descendOnly(forced, 35947, 948));
-    EXPECT_FALSE(descendOnly(forced, 1, 1));
+    EXPECT_FALSE(descendOnly(forced, 35947));
+    EXPECT_FALSE(descendOnly(forced, 1));
 }
 
 // The tail's lanes a query on a GPU: one where many descend; more, up to
