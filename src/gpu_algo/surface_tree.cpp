@@ -147,6 +147,10 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
     const size_t triangles = corners.size() / 3;
     if (triangles == 0 || corners.size() % 3 != 0 || triangles >= (size_t(1) << 30))
         throw std::length_error("the surface tree takes 1 to 2^30 - 1 triangles");
+    // The passes over chunks of kChunk triangles take at most a worker a
+    // chunk; the subtrees' passes below take one a task (the bunny's 69,451
+    // triangles: 3 chunks, 9 tasks).
+    const int taskThreads = threads;
     threads = core::resolveThreads(threads, triangles / kChunk + 1);
 
     // The box of the triangles' box centres, per chunk, then joined in chunk order.
@@ -211,7 +215,7 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
     }
     // Each task's nodes below its root counted, then built in place.
     std::vector<size_t> offset(tasks.size() + 1, 0);
-    core::parallelChunks(tasks.size(), 1, threads, [&](size_t begin, size_t end, int) {
+    core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
         for (size_t k = begin; k < end; ++k) {
             const Subtree part{codes, order, corners};
             offset[k + 1] = part.below(tasks[k].first, tasks[k].end, tasks[k].depth);
@@ -221,7 +225,7 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
     for (size_t k = 0; k < tasks.size(); ++k) offset[k + 1] += offset[k];
     tree.nodes.resize(offset.back());
     std::vector<uint32_t> deepest(tasks.size(), 0u);
-    core::parallelChunks(tasks.size(), 1, threads, [&](size_t begin, size_t end, int) {
+    core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
         for (size_t k = begin; k < end; ++k) {
             Subtree part{codes, order, corners};
             size_t next = offset[k];
