@@ -161,11 +161,16 @@ Result<SurfaceResult> surfaceSearch(const PointView& points, const MeshView& sur
             mine.cancelled = true;
             return;
         }
+        // The previous query's triangle first: consecutive queries are
+        // neighbours, so it mostly dominates (early break) or bounds the
+        // descent at once (per point).
+        TriangleHint hint;
         for (size_t k = begin; k < end; ++k) {
             const size_t q = order.empty() ? k : order[k];
             const double stop =
                 perPoint ? 0.0 : std::bit_cast<double>(runningMax.load(std::memory_order_relaxed));
-            const NearestTriangle hit = bvh.nearest(points.at(q), slack, stop);
+            const NearestTriangle hit = bvh.nearest(points.at(q), slack, stop, hint);
+            hint = {hit.position, hit.near};
             mine.counters.nodesVisited += hit.nodesVisited;
             mine.counters.trianglesTested += hit.trianglesTested;
             if (hit.dominated) {

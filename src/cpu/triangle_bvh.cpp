@@ -402,68 +402,100 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     for (auto it = topInner.rbegin(); it != topInner.rend(); ++it) boxOf(*it);
 }
 
-NearestTriangle TriangleBvh::nearest(const glm::dvec3& p, double slack, double stopBelow2) const {
-    return m_floatCorners ? nearestIn(m_cornersF.data(), p, slack, stopBelow2)
-                          : nearestIn(m_corners.data(), p, slack, stopBelow2);
+NearestTriangle TriangleBvh::nearest(const glm::dvec3& p, double slack, double stopBelow2,
+                                     TriangleHint hint) const {
+    return m_floatCorners ? nearestIn(m_cornersF.data(), p, slack, stopBelow2, hint)
+                          : nearestIn(m_corners.data(), p, slack, stopBelow2, hint);
 }
 
 template <class Corner>
 NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& p, double slack,
-                                       double stopBelow2) const {
+                                       double stopBelow2, TriangleHint hint) const {
     NearestTriangle best;
     best.distance2 = std::numeric_limits<double>::infinity();
     double bound2 = best.distance2;
+    // Triangle i (BVH order) against the best so far; true when it ends the
+    // query (below stopBelow2).
+    auto test = [&](uint32_t i) {
+        const Corner* c = &corners[3 * size_t(i)];
+        const glm::dvec3 a(c[0]), b(c[1]), cc(c[2]);
+        // The triangle's own box, as its node's (which holds it) is pruned:
+        // past the bound it holds neither the nearest nor a tie.
+        if (core::boxDistance2(p, glm::min(glm::min(a, b), cc), glm::max(glm::max(a, b), cc)) > bound2)
+            return false;
+        const core::TriangleClosest r = core::closestOnTriangle(p, a, b, cc, m_thin[i] != 0);
+        ++best.trianglesTested;
+        const uint32_t t = m_original[i];
+        if (r.distance2 < best.distance2 || (r.distance2 == best.distance2 && t < best.triangle)) {
+            best.distance2 = r.distance2;
+            best.triangle = t;
+            best.position = i;
+            best.point = r.point;
+            best.barycentric = r.barycentric;
+            bound2 = pruneBound2(best.distance2, slack);
+            if (best.distance2 < stopBelow2) {
+                best.dominated = true;
+                return true;
+            }
+        }
+        return false;
+    };
+    // Depth first from `from`, the nearer child first, pruning past the
+    // bound; the path's nodes by depth, so that a query ended at a leaf
+    // names its ancestor kHintLevels up (TriangleHint::node) for the next.
     // Balanced tree: depth <= log2(2^32) + 2, at most one entry per level waits.
     struct Entry {
-        uint32_t node;
+        uint32_t node, depth;
         double distance2;
     };
     std::array<Entry, 80> stack;
-    size_t top = 0;
-    stack[top++] = {0, boxDistance2(p, m_nodes[0].lo, m_nodes[0].hi)};
-    ++best.nodesVisited;
-    while (top > 0) {
-        const Entry e = stack[--top];
-        if (e.distance2 > bound2) continue;
-        const Node& node = m_nodes[e.node];
-        if (node.count > 0) {
-            for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-                const Corner* c = &corners[3 * size_t(i)];
-                const glm::dvec3 a(c[0]), b(c[1]), cc(c[2]);
-                // The triangle's own box, as its node's (which holds it) is
-                // pruned: past the bound it holds neither the nearest nor a tie.
-                if (core::boxDistance2(p, glm::min(glm::min(a, b), cc), glm::max(glm::max(a, b), cc)) >
-                    bound2)
-                    continue;
-                const core::TriangleClosest r = core::closestOnTriangle(p, a, b, cc, m_thin[i] != 0);
-                ++best.trianglesTested;
-                const uint32_t t = m_original[i];
-                if (r.distance2 < best.distance2 || (r.distance2 == best.distance2 && t < best.triangle)) {
-                    best.distance2 = r.distance2;
-                    best.triangle = t;
-                    best.point = r.point;
-                    best.barycentric = r.barycentric;
-                    bound2 = pruneBound2(best.distance2, slack);
-                    if (best.distance2 < stopBelow2) {
-                        best.dominated = true;
-                        return best;
-                    }
+    std::array<uint32_t, 80> path;
+    auto descend = [&](uint32_t from) {
+        size_t top = 0;
+        stack[top++] = {from, 0, boxDistance2(p, m_nodes[from].lo, m_nodes[from].hi)};
+        ++best.nodesVisited;
+        while (top > 0) {
+            const Entry e = stack[--top];
+            if (e.distance2 > bound2) continue;
+            path[e.depth] = e.node;
+            const Node& node = m_nodes[e.node];
+            if (node.count > 0) {
+                for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+                    if (!test(i)) continue;
+                    best.near = path[e.depth >= kHintLevels ? e.depth - kHintLevels : 0];
+                    return true;
                 }
+                continue;
             }
-            continue;
+            const Node& l = m_nodes[node.first];
+            const Node& r = m_nodes[node.first + 1];
+            const double dl = boxDistance2(p, l.lo, l.hi);
+            const double dr = boxDistance2(p, r.lo, r.hi);
+            best.nodesVisited += 2;
+            // Nearer child on top of the stack, visited first.
+            const bool leftFirst = dl <= dr;
+            const Entry nearE{leftFirst ? node.first : node.first + 1, e.depth + 1, leftFirst ? dl : dr};
+            const Entry farE{leftFirst ? node.first + 1 : node.first, e.depth + 1, leftFirst ? dr : dl};
+            if (farE.distance2 <= bound2) stack[top++] = farE;
+            if (nearE.distance2 <= bound2) stack[top++] = nearE;
         }
-        const Node& l = m_nodes[node.first];
-        const Node& r = m_nodes[node.first + 1];
-        const double dl = boxDistance2(p, l.lo, l.hi);
-        const double dr = boxDistance2(p, r.lo, r.hi);
-        best.nodesVisited += 2;
-        // Nearer child on top of the stack, visited first.
-        const bool leftFirst = dl <= dr;
-        const Entry nearE{leftFirst ? node.first : node.first + 1, leftFirst ? dl : dr};
-        const Entry farE{leftFirst ? node.first + 1 : node.first, leftFirst ? dr : dl};
-        if (farE.distance2 <= bound2) stack[top++] = farE;
-        if (nearE.distance2 <= bound2) stack[top++] = nearE;
+        return false;
+    };
+    // The hint's triangle, then its subtree (an early break only): each a
+    // real measure, so the best so far; the descent from the root then
+    // prunes past it and meets them again (kept, or a nearer triangle, or a
+    // tie of a smaller index: the same test), so the answer is the
+    // descent's alone would be.
+    if (hint.position < m_original.size() && test(hint.position)) {
+        best.near = hint.node;
+        return best;
     }
+    if (stopBelow2 > 0.0 && hint.node != 0 && hint.node < m_nodes.size() && descend(hint.node)) {
+        // Its ancestor, within the subtree: the same node again.
+        best.near = hint.node;
+        return best;
+    }
+    descend(0);
     return best;
 }
 

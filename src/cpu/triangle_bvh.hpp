@@ -25,7 +25,8 @@
 // rounding to float goes outward, and the rounded box distance only shrinks
 // as a box grows), and a tie
 // between triangles is settled by their index, not by the order of the
-// visit.
+// visit. A hint (where an earlier query ended) only sets where the search
+// starts; the same argument holds from any start (nearest's comment).
 //
 // Layout for a later GPU path: the leaves' boxes hold the triangles' own
 // (the procedural AABBs of a BLAS would be the same), and the measure is the
@@ -44,16 +45,27 @@
 namespace rthdist::cpu {
 
 inline constexpr uint32_t kLeafTriangles = 4;
+// An early break names the node this many levels above its leaf for the next
+// query's hint (TriangleHint::node): a subtree of at most 8 leaves.
+inline constexpr uint32_t kHintLevels = 3;
 
 // One query's answer.
 struct NearestTriangle {
     double distance2 = 0.0;  // |p - point|^2
     uint32_t triangle = UINT32_MAX;
+    uint32_t position = UINT32_MAX;  // the triangle's place in the BVH's order (TriangleHint::position)
+    uint32_t near = 0;  // an early break's: its leaf's ancestor kHintLevels up (TriangleHint::node)
     glm::dvec3 point{0.0};
     glm::dvec3 barycentric{0.0};
     bool dominated = false;  // stopped early: distance2 < stopBelow2 (not the nearest)
     uint64_t nodesVisited = 0;
     uint64_t trianglesTested = 0;
+};
+
+// Where an earlier query ended (TriangleBvh::nearest's hint).
+struct TriangleHint {
+    uint32_t position = UINT32_MAX;  // NearestTriangle::position; past the triangles: none
+    uint32_t node = 0;               // NearestTriangle::near; 0 (the root) or past the nodes: none
 };
 
 class TriangleBvh {
@@ -68,8 +80,15 @@ public:
     // The nearest triangle to p. slack: core::closestSlack of the largest
     // coordinate magnitude of p and the mesh. stopBelow2 > 0: return as soon
     // as a triangle measures below it (dominated; the early break of a
-    // directed maximum), 0: never.
-    [[nodiscard]] NearestTriangle nearest(const glm::dvec3& p, double slack, double stopBelow2 = 0.0) const;
+    // directed maximum), 0: never. hint: where an earlier query (the
+    // previous one, when queries come in space order) ended: its triangle is
+    // measured first and, for an early break, the subtree of its node next;
+    // when either ends the query below stopBelow2 there is no descent from
+    // the root, else they bound it from the start. The answer does not
+    // depend on the hint (the nearest is a minimum over every triangle, ties
+    // to the smallest index), only the work does.
+    [[nodiscard]] NearestTriangle nearest(const glm::dvec3& p, double slack, double stopBelow2 = 0.0,
+                                          TriangleHint hint = {}) const;
 
     [[nodiscard]] size_t triangleCount() const { return m_original.size(); }
     [[nodiscard]] size_t nodeCount() const { return m_nodes.size(); }
@@ -109,7 +128,7 @@ private:
     }
     template <class Corner>
     [[nodiscard]] NearestTriangle nearestIn(const Corner* corners, const glm::dvec3& p, double slack,
-                                            double stopBelow2) const;
+                                            double stopBelow2, TriangleHint hint) const;
     core::UninitVector<uint32_t> m_original;  // BVH order -> triangle index
     core::UninitVector<uint8_t> m_thin;       // BVH order -> core::thinTriangle of its corners
 };

@@ -242,6 +242,65 @@ TEST(TriangleBvh, NearestEqualsTheBruteForceOnRandomMeshes) {
     }
 }
 
+// A hint (where an earlier query ended: its triangle, then for an early
+// break its subtree) changes the work only: with any hint, from the
+// previous query's answer to positions and nodes at random and past the
+// arrays, the answer is the brute force's, and an early break stops at a
+// real triangle's measure below the stop, and only when the brute force's
+// nearest lies below it too.
+TEST(TriangleBvh, AnyHintGivesTheBruteForcesAnswer) {
+    for (const RandomMesh& m : meshes()) {
+        if (m.triangleCount() > 30000) continue;  // the brute force is slow
+        const cpu::TriangleBvh bvh(m.view(), 4);
+        test::Rng rng(m.triangleCount());
+        cpu::TriangleHint previous;
+        size_t hinted = 0, brokenByHint = 0;
+        for (const glm::dvec3& p : queries(m, 11 + m.triangleCount(), 150)) {
+            const oracle::SurfaceNearest want = oracle::bruteNearestTriangle(p, m.vertices, m.indices);
+            const uint32_t n = uint32_t(bvh.nodeCount()), t = uint32_t(m.triangleCount());
+            const cpu::TriangleHint hints[] = {previous,
+                                               {uint32_t(rng.index(t)), uint32_t(rng.index(n))},
+                                               {t + uint32_t(rng.index(3)), n + uint32_t(rng.index(3))},
+                                               {UINT32_MAX, 0u}};
+            for (const cpu::TriangleHint& hint : hints) {
+                const cpu::NearestTriangle got = bvh.nearest(p, slack(), 0.0, hint);
+                EXPECT_FALSE(got.dominated);
+                EXPECT_EQ(got.distance2, want.distance2) << m.name;
+                EXPECT_EQ(got.triangle, want.triangle) << m.name << ": the smallest index on a tie";
+                EXPECT_EQ(got.point, want.point) << m.name;
+                ASSERT_LT(got.position, t) << m.name;
+                EXPECT_EQ(bvh.triangleOrder()[got.position], got.triangle) << m.name;
+                // An early break at a stop just above the nearest (always
+                // possible) and at the nearest itself (never).
+                const double above = std::nextafter(want.distance2, 1e300) * 1.5 + 1e-300;
+                const cpu::NearestTriangle early = bvh.nearest(p, slack(), above, hint);
+                EXPECT_TRUE(early.dominated) << m.name;
+                EXPECT_LT(early.distance2, above) << m.name;
+                ASSERT_LT(early.position, t) << m.name;
+                EXPECT_EQ(bvh.triangleOrder()[early.position], early.triangle) << m.name;
+                const uint32_t* corner = &m.indices[3 * size_t(early.triangle)];
+                EXPECT_EQ(early.distance2,
+                          core::closestOnTriangle(p, m.vertices[corner[0]], m.vertices[corner[1]],
+                                                  m.vertices[corner[2]])
+                              .distance2)
+                    << m.name << ": the measure of the triangle it names";
+                if (hint.position < t) ++hinted;
+                if (early.nodesVisited == 0) ++brokenByHint;
+                if (want.distance2 > 0.0) {
+                    const cpu::NearestTriangle never = bvh.nearest(p, slack(), want.distance2, hint);
+                    EXPECT_FALSE(never.dominated) << m.name;
+                    EXPECT_EQ(never.triangle, want.triangle) << m.name;
+                }
+            }
+            const cpu::NearestTriangle next = bvh.nearest(p, slack(), 0.0, previous);
+            previous = {next.position, next.near};
+        }
+        EXPECT_GT(hinted, 0u) << m.name;
+        if (m.triangleCount() > 1)
+            EXPECT_GT(brokenByHint, 0u) << m.name << ": a hint that never ends a query";
+    }
+}
+
 // Coordinates float cannot hold (the boxes are float, rounded outward):
 // doubles between floats, a georeferenced offset, magnitudes past float's
 // range and in its subnormal range. The tree's invariants hold and every
