@@ -414,6 +414,10 @@ NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& 
     NearestTriangle best;
     best.distance2 = std::numeric_limits<double>::infinity();
     double bound2 = best.distance2;
+    // While looking for an early break only: boxes past the stop are
+    // skipped too (they hold no triangle that ends the query).
+    double limit2 = best.distance2;
+    auto cut = [&] { return std::min(bound2, limit2); };
     // Triangle i (BVH order) against the best so far; true when it ends the
     // query (below stopBelow2).
     auto test = [&](uint32_t i) {
@@ -421,7 +425,7 @@ NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& 
         const glm::dvec3 a(c[0]), b(c[1]), cc(c[2]);
         // The triangle's own box, as its node's (which holds it) is pruned:
         // past the bound it holds neither the nearest nor a tie.
-        if (core::boxDistance2(p, glm::min(glm::min(a, b), cc), glm::max(glm::max(a, b), cc)) > bound2)
+        if (core::boxDistance2(p, glm::min(glm::min(a, b), cc), glm::max(glm::max(a, b), cc)) > cut())
             return false;
         const core::TriangleClosest r = core::closestOnTriangle(p, a, b, cc, m_thin[i] != 0);
         ++best.trianglesTested;
@@ -456,7 +460,7 @@ NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& 
         ++best.nodesVisited;
         while (top > 0) {
             const Entry e = stack[--top];
-            if (e.distance2 > bound2) continue;
+            if (e.distance2 > cut()) continue;
             path[e.depth] = e.node;
             const Node& node = m_nodes[e.node];
             if (node.count > 0) {
@@ -476,24 +480,30 @@ NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& 
             const bool leftFirst = dl <= dr;
             const Entry nearE{leftFirst ? node.first : node.first + 1, e.depth + 1, leftFirst ? dl : dr};
             const Entry farE{leftFirst ? node.first + 1 : node.first, e.depth + 1, leftFirst ? dr : dl};
-            if (farE.distance2 <= bound2) stack[top++] = farE;
-            if (nearE.distance2 <= bound2) stack[top++] = nearE;
+            const double bound = cut();
+            if (farE.distance2 <= bound) stack[top++] = farE;
+            if (nearE.distance2 <= bound) stack[top++] = nearE;
         }
         return false;
     };
-    // The hint's triangle, then its subtree (an early break only): each a
-    // real measure, so the best so far; the descent from the root then
-    // prunes past it and meets them again (kept, or a nearer triangle, or a
-    // tie of a smaller index: the same test), so the answer is the
-    // descent's alone would be.
+    // The hint's triangle, then for an early break its subtree and the tree
+    // looking only within the stop, then the tree: each triangle met is a
+    // real measure, so the best so far; the last descent prunes past it and
+    // meets every triangle it could not rule out (kept, or a nearer one, or
+    // a tie of a smaller index: the same test), so the answer is the one
+    // that descent alone would give.
     if (hint.position < m_original.size() && test(hint.position)) {
         best.near = hint.node;
         return best;
     }
-    if (stopBelow2 > 0.0 && hint.node != 0 && hint.node < m_nodes.size() && descend(hint.node)) {
-        // Its ancestor, within the subtree: the same node again.
-        best.near = hint.node;
-        return best;
+    if (stopBelow2 > 0.0) {
+        limit2 = pruneBound2(stopBelow2, slack);
+        if (hint.node != 0 && hint.node < m_nodes.size() && descend(hint.node)) {
+            best.near = hint.node;  // its ancestor within the subtree: the same node again
+            return best;
+        }
+        if (descend(0)) return best;
+        limit2 = std::numeric_limits<double>::infinity();
     }
     descend(0);
     return best;
