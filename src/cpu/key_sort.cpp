@@ -114,13 +114,13 @@ void sortBucket(OrderedPoints& out, uint32_t first, uint32_t end, int restBits, 
 
 }  // namespace
 
-void radixSortKeys(std::vector<uint64_t>& values, int keyBits, int threads) {
+bool radixSortKeys(std::span<uint64_t> values, std::span<uint64_t> scratch, int keyBits, int threads) {
     const int digit = digitBits(keyBits);
     const uint32_t digits = 1u << digit;
     const size_t n = values.size();
     const Parts parts(n, threads);
-    std::vector<uint64_t> scratch(n);
     std::vector<uint32_t> offsets(parts.count * digits);
+    std::span<uint64_t> from = values, to = scratch.first(n);
     for (int shift = 32; shift < 32 + keyBits; shift += digit) {
         std::fill(offsets.begin(), offsets.end(), 0u);
         // The last digit may reach past keyBits: those bits are not part of the key.
@@ -128,17 +128,21 @@ void radixSortKeys(std::vector<uint64_t>& values, int keyBits, int threads) {
         auto digitOf = [shift, mask](uint64_t v) { return uint32_t(v >> shift) & mask; };
         parallelChunks(parts.count, 1, threads, [&](size_t p, size_t, int) {
             uint32_t* h = &offsets[p * digits];
-            for (size_t i = parts.begin(p, n); i < parts.end(p, n); ++i) ++h[digitOf(values[i])];
+            for (size_t i = parts.begin(p, n); i < parts.end(p, n); ++i) ++h[digitOf(from[i])];
         });
         if (exclusiveOffsets(offsets, parts.count, digits, n)) continue;
         parallelChunks(parts.count, 1, threads, [&](size_t p, size_t, int) {
             uint32_t* h = &offsets[p * digits];
-            for (size_t i = parts.begin(p, n); i < parts.end(p, n); ++i) {
-                scratch[h[digitOf(values[i])]++] = values[i];
-            }
+            for (size_t i = parts.begin(p, n); i < parts.end(p, n); ++i) to[h[digitOf(from[i])]++] = from[i];
         });
-        values.swap(scratch);
+        std::swap(from, to);
     }
+    return from.data() != values.data();
+}
+
+void radixSortKeys(std::vector<uint64_t>& values, int keyBits, int threads) {
+    std::vector<uint64_t> scratch(values.size());
+    if (radixSortKeys(values, scratch, keyBits, threads)) values.swap(scratch);
 }
 
 void radixSortKeysSerial(std::span<uint64_t> values, int keyBits, std::vector<uint64_t>& scratch) {

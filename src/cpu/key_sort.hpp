@@ -44,6 +44,11 @@ struct OrderedPoints {
 // Sorts (key << 32 | payload) values by their key bits [32, 32 + keyBits)
 // (keyBits in 0..32; higher key bits are ignored), stably.
 void radixSortKeys(std::vector<uint64_t>& values, int keyBits, int threads = 1);
+// The same in caller-owned memory (scratch: at least values.size()): true
+// when the sorted values ended in scratch's first values.size() entries
+// (an odd count of passes ran), false when in values.
+[[nodiscard]] bool radixSortKeys(std::span<uint64_t> values, std::span<uint64_t> scratch, int keyBits,
+                                 int threads);
 
 // The same sort on the calling thread; `scratch` is resized as needed.
 void radixSortKeysSerial(std::span<uint64_t> values, int keyBits, std::vector<uint64_t>& scratch);

@@ -5,13 +5,18 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
+#include <span>
+#include <stdexcept>
 #include <utility>
 
 #include "core/float_box.hpp"
 #include "core/parallel.hpp"
 #include "core/point_triangle.hpp"
+#include "cpu/key_sort.hpp"
+#include "rthdist_morton.h"
 
 namespace rthdist::cpu {
 namespace {
@@ -39,223 +44,86 @@ double pruneBound2(double best2, double slack) {
     return bound * bound;
 }
 
-// What the build partitions: a triangle's box centre beside its index, so
-// that the splits read memory in order.
-// The centre in float (16 bytes an item: half the memory the splits move
-// with a double centre; any order of the items gives a correct tree, and
-// rounding only makes more ties, which the index breaks).
-struct BuildItem {
-    glm::vec3 centre;
-    uint32_t triangle;
-};
-static_assert(sizeof(BuildItem) == 16);
-
 // Subtrees of at most this many triangles are built whole by one task.
 constexpr uint32_t kSubtreeTriangles = 4096;
-// The top levels are split until there are this many subtrees per thread.
-constexpr size_t kSubtreesPerThread = 8;
+// The deepest node's depth (the root's 1): nearestIn's stack and path hold 80.
+constexpr uint32_t kMaxLevels = 64;
+constexpr int kMortonBits = 30;  // 10 per axis
 
-// The leaves of the median-split tree over `count` triangles. The nodes of
-// one depth hold floor or ceil of count / 2^depth triangles: a level is two
-// sizes (small and small + 1) and how many nodes have each.
-uint64_t medianSplitLeaves(uint64_t count) {
-    uint64_t small = count, nSmall = 1, nLarge = 0, leaves = 0;
-    while (true) {
-        if (small + 1 <= kLeafTriangles) return leaves + nSmall + nLarge;
-        if (small <= kLeafTriangles) {  // small leaves beside large nodes split once more
-            leaves += nSmall;
-            nSmall = 0;
-        }
-        // small even: small -> 2 x small/2, small + 1 -> small/2 and small/2 + 1;
-        // small odd: small -> small/2 and small/2 + 1, small + 1 -> 2 x (small/2 + 1).
-        const bool even = small % 2 == 0;
-        const uint64_t nextSmall = even ? 2 * nSmall + nLarge : nSmall;
-        const uint64_t nextLarge = even ? nLarge : nSmall + 2 * nLarge;
-        small /= 2;
-        nSmall = nextSmall;
-        nLarge = nextLarge;
-    }
+// Levels a balanced split of `count` triangles needs below a node: leaves
+// of up to kLeafTriangles, halves of ceil(count / 2).
+uint32_t levelsBelow(size_t count) {
+    uint32_t levels = 0;
+    for (size_t leaves = (count + kLeafTriangles - 1) / kLeafTriangles; leaves > 1; leaves = (leaves + 1) / 2)
+        ++levels;
+    return levels;
 }
 
-// The nodes below the root of a median-split subtree over `count` triangles.
-uint32_t descendantCount(uint32_t count) { return uint32_t(2 * medianSplitLeaves(count) - 2); }
-
-// The split order along one axis (a constant, so the comparison compiles
-// to plain loads): centre, then triangle index.
-template <int Axis>
-struct CentreBefore {
-    bool operator()(const BuildItem& x, const BuildItem& y) const {
-        const float a = x.centre[Axis], b = y.centre[Axis];
-        return a < b || (a == b && x.triangle < y.triangle);
-    }
-};
-
-// The box of build items' centres (min and max are exact: the same box
-// whatever the order the items are added in).
-core::FloatBox boundsOf(const BuildItem* items, uint32_t count) {
-    core::FloatBox b;
-    for (uint32_t i = 0; i < count; ++i) b.add(items[i].centre);
-    return b;
+// Where the sorted positions [first, end) at `depth` (the root's 1) split
+// (keyed: Morton code << 32 | triangle, ascending): 0 for a leaf (at most
+// kLeafTriangles); the middle for at most twice that (two leaves); else
+// the first position whose code has the highest bit in which the range's
+// first and last codes differ set (the two halves of the Morton cell they
+// share: a split at the count's median cuts a Z-curve segment's jumps into
+// boxes that span far blobs, session 8), or the middle where the codes are
+// all equal or where an uneven split could leave a child deeper than
+// kMaxLevels (a range of n at depth d with d + levelsBelow(n) <= the limit
+// keeps that after either split: the root's d = 1, levelsBelow(2^32) = 30).
+uint32_t splitAt(const uint64_t* keyed, uint32_t first, uint32_t end, uint32_t depth) {
+    const uint32_t count = end - first;
+    if (count <= kLeafTriangles) return 0u;
+    const uint32_t middle = first + count / 2;
+    const auto a = uint32_t(keyed[first] >> 32), z = uint32_t(keyed[end - 1] >> 32);
+    if (count <= 2 * kLeafTriangles || a == z || depth + 1 + levelsBelow(count) > kMaxLevels) return middle;
+    const uint32_t bit = uint32_t(1) << (31 - std::countl_zero(a ^ z));
+    const uint64_t upper = uint64_t(z & ~(bit - 1u))
+                           << 32;  // the least code with that bit set (z's above it)
+    return uint32_t(std::lower_bound(keyed + first, keyed + end, upper) - keyed);
 }
 
-// A node's split: the first `half` items (by CentreBefore along the axis)
-// go left, the rest right; the halves' centre boxes; `moved`: the halves
-// were written to the other buffer (else reordered in place).
-struct Split {
-    uint32_t half = 0;
-    core::FloatBox left, right;
-    bool moved = false;
-};
+// A task's subtree, depth first, into the nodes: its root at a node the
+// levels above made, the others from `next` on, an inner node's two
+// children adjacent (first, first + 1) and after it; a leaf's first is its
+// sorted position. Boxes come later.
+struct Subtree {
+    const uint64_t* keyed;
+    TriangleBvh::Node* nodes;
+    uint32_t deepest = 0;
 
-// Items a split takes on several threads (from this many), in chunks of
-// kSplitChunk: fixed chunks, so the items land where one thread puts them.
-// (From 2^16 in chunks of 2^14 before session 11: the levels below the root
-// of a 50-200k-triangle mesh, a few nodes of 2^14-2^16 items, then ran one
-// thread a node; H200, 16 cores, one-shot builds: the bunny 3.0-3.6 ->
-// 2.3-2.6 ms, the dragon's res2 7.2-7.6 -> 6.2-6.4, level on 2 cores.)
-constexpr uint32_t kParallelSplit = uint32_t(1) << 14;
-constexpr uint32_t kSplitChunk = uint32_t(1) << 12;
-constexpr uint32_t kMaxBins = 256;
-using Histogram = std::array<uint32_t, kMaxBins>;
-
-// Splits src[0, count) at count / 2 along Axis. A large range is cut by a
-// histogram of its centres over the node's [lo, hi] along the axis (about
-// 16 items a bin, at most kMaxBins; a bin is a non-decreasing function of
-// the centre, so every item of a lower bin is smaller than every item of a
-// higher one): one pass writes the items below the median's bin, the bin's,
-// and those above into dst (three cursors, no branch on the item), adding
-// each to its half's box, and only the median's bin is ordered by
-// nth_element. Two passes a level, each read once (perf: the selection was
-// most of the build). A small or flat range is selected in place. From
-// kParallelSplit items and with threads > 1 both passes run on the worker
-// pool in fixed chunks: each chunk's histogram, then each chunk's first
-// place in each part from them, so every item lands where one thread's
-// stable pass puts it and the tree is the same on any thread count.
-template <int Axis>
-Split splitAlong(BuildItem* src, BuildItem* dst, uint32_t count, const core::FloatBox& bounds, int threads) {
-    constexpr uint32_t kSmallRange = 128;
-    Split s;
-    s.half = count / 2;
-    const float lo = bounds.lo[Axis];
-    const float width = bounds.hi[Axis] - lo;
-    if (count <= kSmallRange || !(width > 0.0f) || !std::isfinite(width)) {
-        std::nth_element(src, src + s.half, src + count, CentreBefore<Axis>{});
-        s.left = boundsOf(src, s.half);
-        s.right = boundsOf(src + s.half, count - s.half);
-        return s;
+    // The nodes below a range's node (build places that many from `next`).
+    [[nodiscard]] size_t below(uint32_t first, uint32_t end, uint32_t depth) const {
+        const uint32_t split = splitAt(keyed, first, end, depth);
+        if (split == 0u) return 0;
+        return 2 + below(first, split, depth + 1) + below(split, end, depth + 1);
     }
-    const uint32_t bins = std::min(kMaxBins, count / 16);
-    const float toBin = float(bins) / width;
-    const auto binOf = [&](const BuildItem& item) {
-        const float b = (item.centre[Axis] - lo) * toBin;
-        return b < float(bins - 1) ? uint32_t(b) : bins - 1;  // b >= 0: lo is the minimum
-    };
-    const auto countBins = [&](Histogram& h, size_t begin, size_t end) {
-        for (size_t i = begin; i < end; ++i) ++h[binOf(src[i])];
-    };
-    uint32_t median = 0, below = 0;
-    const auto findMedian = [&](const Histogram& histogram) {
-        while (below + histogram[median] <= s.half) below += histogram[median++];
-    };
-    // One pass writes each item to its part through three cursors (no branch
-    // on the item) and grows its half's centre box.
-    const auto scatter = [&](std::array<uint32_t, 3> at, std::array<core::FloatBox, 3>& side, size_t begin,
-                             size_t end) {
-        for (size_t i = begin; i < end; ++i) {
-            const BuildItem item = src[i];
-            const uint32_t bin = binOf(item);
-            const uint32_t k = uint32_t(bin >= median) + uint32_t(bin > median);
-            dst[at[k]++] = item;
-            side[k].add(item.centre);
+    void build(size_t& next, size_t at, uint32_t first, uint32_t end, uint32_t depth) {
+        deepest = std::max(deepest, depth);
+        const uint32_t split = splitAt(keyed, first, end, depth);
+        if (split == 0u) {
+            nodes[at].first = first;
+            nodes[at].count = end - first;
+            return;
         }
-    };
-    uint32_t inMedian = 0;
-    if (threads <= 1 || count < kParallelSplit) {
-        Histogram histogram{};
-        countBins(histogram, 0, count);
-        findMedian(histogram);
-        inMedian = histogram[median];
-        std::array<core::FloatBox, 3> side;  // below, the median's bin (unused), above
-        scatter({0, below, below + inMedian}, side, 0, count);
-        s.left = side[0];
-        s.right = side[2];
-    } else {
-        const uint32_t chunks = (count + kSplitChunk - 1) / kSplitChunk;
-        std::vector<Histogram> local(chunks);
-        core::parallelChunks(count, kSplitChunk, threads, [&](size_t begin, size_t end, int) {
-            Histogram& h = local[begin / kSplitChunk];
-            h.fill(0);
-            countBins(h, begin, end);
-        });
-        Histogram histogram{};
-        for (const Histogram& h : local)
-            for (uint32_t b = 0; b < bins; ++b) histogram[b] += h[b];
-        findMedian(histogram);
-        inMedian = histogram[median];
-        // Each chunk's first place in each part: below, the median's bin, above.
-        std::vector<std::array<uint32_t, 3>> first(chunks);
-        std::array<uint32_t, 3> cursor{0, below, below + inMedian};
-        for (uint32_t c = 0; c < chunks; ++c) {
-            first[c] = cursor;
-            uint32_t under = 0;
-            for (uint32_t b = 0; b < median; ++b) under += local[c][b];
-            const uint32_t size = std::min(kSplitChunk, count - c * kSplitChunk);
-            cursor[0] += under;
-            cursor[1] += local[c][median];
-            cursor[2] += size - under - local[c][median];
-        }
-        std::vector<std::array<core::FloatBox, 3>> sides(chunks);
-        core::parallelChunks(count, kSplitChunk, threads, [&](size_t begin, size_t end, int) {
-            scatter(first[begin / kSplitChunk], sides[begin / kSplitChunk], begin, end);
-        });
-        for (const std::array<core::FloatBox, 3>& side : sides) {
-            s.left.add(side[0]);
-            s.right.add(side[2]);
-        }
+        const auto child = uint32_t(next);
+        next += 2;
+        nodes[at].first = child;
+        nodes[at].count = 0;
+        build(next, child, first, split, depth + 1);
+        build(next, child + 1, split, end, depth + 1);
     }
-    std::nth_element(dst + below, dst + s.half, dst + below + inMedian, CentreBefore<Axis>{});
-    s.left.add(boundsOf(dst + below, s.half - below));
-    s.right.add(boundsOf(dst + s.half, below + inMedian - s.half));
-    s.moved = true;
-    return s;
-}
-
-// Splits at count / 2 along the longest axis of the centres' spread. The
-// order is strict and total, so the halves depend only on the set of items,
-// never on their order or on the thread.
-Split splitAtMedian(BuildItem* src, BuildItem* dst, uint32_t count, const core::FloatBox& bounds,
-                    int threads) {
-    const glm::dvec3 spread = glm::dvec3(bounds.hi) - glm::dvec3(bounds.lo);
-    const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
-    switch (axis) {
-        case 0: return splitAlong<0>(src, dst, count, bounds, threads);
-        case 1: return splitAlong<1>(src, dst, count, bounds, threads);
-        default: return splitAlong<2>(src, dst, count, bounds, threads);
-    }
-}
-
-// One node still to build: node `at` over the items [first, first + count)
-// of buffer `buffer`, whose centres lie in `bounds`; its descendants at
-// [base, base + descendantCount(count)).
-struct PendingNode {
-    uint32_t at = 0;
-    uint32_t first = 0;
-    uint32_t count = 0;
-    uint32_t base = 0;
-    core::FloatBox bounds;
-    uint32_t buffer = 0;
 };
 
 }  // namespace
 
-// The build in three passes: the splits (which triangles each leaf holds),
-// then every triangle's corners written once, in input order, to its place
-// in BVH order (a scattered write instead of a random read through the
-// index array), then the boxes from the leaves up.
+// The build in four passes: the triangles sorted by the Morton codes of
+// their box centres, the splits (which triangles each leaf holds), then
+// every triangle's corners written once, in input order, to its place in
+// BVH order (a scattered write instead of a random read through the index
+// array), then the boxes from the leaves up.
 TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     const auto n = uint32_t(mesh.triangleCount());
+    const int taskThreads = threads;
     threads = core::resolveThreads(threads, n / kSubtreeTriangles);
-    m_nodes.resize(1 + size_t(descendantCount(n)));
     // Float corners for a float mesh (its coordinates, exactly: the rule
     // reads them as doubles), half the memory of double ones.
     m_floatCorners = mesh.vertices.scalar == Scalar::kFloat32;
@@ -266,98 +134,117 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     m_original.resize(n);
     m_thin.resize(n);
     if (n == 0) {
+        m_nodes.resize(1);
         m_nodes[0] = Node{glm::vec3(std::numeric_limits<float>::infinity()),
                           glm::vec3(-std::numeric_limits<float>::infinity()), 0, 0};
         return;
     }
-    // Two buffers of build items (a level's splits read one and write the
-    // other) in the corners' memory, 32 of its 36 (float) or 72 (double)
-    // bytes a triangle: the items are spent before the corners pass writes
-    // there. Fresh memory is what a one-shot build pays most for on a VM
-    // (~2.3 ms a MiB on first touch, docs/bench/surfaces session 10), and no
-    // block of its own is faulted in.
-    static_assert(2 * sizeof(BuildItem) <= 3 * sizeof(glm::vec3) && alignof(BuildItem) <= alignof(glm::vec3));
-    BuildItem* const items = m_floatCorners ? reinterpret_cast<BuildItem*>(m_cornersF.data())
-                                            : reinterpret_cast<BuildItem*>(m_corners.data());
-    BuildItem* const buffers[2] = {items, items + n};
+    // The sort's two buffers of (code << 32 | triangle) in the corners'
+    // memory, 16 of its 36 (float) or 72 (double) bytes a triangle: they
+    // are spent before the corners pass writes there. Fresh memory is what
+    // a one-shot build pays most for on a VM (~2.3 ms a MiB on first touch,
+    // docs/bench/surfaces session 10), and no block of its own is faulted in.
+    static_assert(2 * sizeof(uint64_t) <= 3 * sizeof(glm::vec3) && alignof(uint64_t) <= alignof(glm::dvec3));
+    auto* const words = m_floatCorners ? reinterpret_cast<uint64_t*>(m_cornersF.data())
+                                       : reinterpret_cast<uint64_t*>(m_corners.data());
+    static_assert(alignof(glm::vec3) == 4);
+    // (A float corners block is at least 8-aligned: UninitVector's allocation.)
+    const std::span<uint64_t> keys(words, n), scratch(words + n, n);
+
+    // The centres (each triangle's box's, in double, rounded to float) and
+    // their box, per chunk, joined in chunk order.
+    const auto centreOf = [&](size_t t) {
+        const glm::dvec3 c0 = mesh.corner(t, 0), c1 = mesh.corner(t, 1), c2 = mesh.corner(t, 2);
+        return glm::vec3((glm::min(glm::min(c0, c1), c2) + glm::max(glm::max(c0, c1), c2)) * 0.5);
+    };
     const size_t chunks = (size_t(n) + kSubtreeTriangles - 1) / kSubtreeTriangles;
     std::vector<core::FloatBox> chunkBounds(chunks);
     core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
         core::FloatBox b;
-        for (size_t t = begin; t < end; ++t) {
-            const glm::dvec3 c0 = mesh.corner(t, 0), c1 = mesh.corner(t, 1), c2 = mesh.corner(t, 2);
-            items[t] = {glm::vec3((glm::min(glm::min(c0, c1), c2) + glm::max(glm::max(c0, c1), c2)) * 0.5),
-                        uint32_t(t)};
-            b.add(items[t].centre);
-        }
+        for (size_t t = begin; t < end; ++t) b.add(centreOf(t));
         chunkBounds[begin / kSubtreeTriangles] = b;
     });
-    PendingNode root{0, 0, n, 1, {}, 0};
-    for (const core::FloatBox& b : chunkBounds) root.bounds.add(b);
-
-    core::UninitVector<uint32_t> placeOf(n);  // triangle -> its BVH position
-    // A leaf: its triangles' BVH order (their corners and box come later).
-    const auto makeLeaf = [&](const PendingNode& p) {
-        const BuildItem* from = buffers[p.buffer];
-        for (uint32_t i = p.first; i < p.first + p.count; ++i) {
-            const uint32_t t = from[i].triangle;
-            m_original[i] = t;
-            placeOf[t] = i;
-        }
-        m_nodes[p.at].first = p.first;
-        m_nodes[p.at].count = p.count;
-    };
-    // Node p becomes inner; its children are the first two of its
-    // descendants, then the left's descendants, then the right's.
-    const auto split = [&](const PendingNode& p, int splitThreads) {
-        const Split s = splitAtMedian(buffers[p.buffer] + p.first, buffers[1 - p.buffer] + p.first, p.count,
-                                      p.bounds, splitThreads);
-        m_nodes[p.at].first = p.base;
-        m_nodes[p.at].count = 0;
-        const uint32_t buffer = s.moved ? 1 - p.buffer : p.buffer;
-        return std::array<PendingNode, 2>{PendingNode{p.base, p.first, s.half, p.base + 2, s.left, buffer},
-                                          PendingNode{p.base + 1, p.first + s.half, p.count - s.half,
-                                                      p.base + 2 + descendantCount(s.half), s.right, buffer}};
-    };
-    // A whole subtree's splits on this thread, depth first.
-    const auto splitSubtree = [&](const PendingNode& top) {
-        const auto recurse = [&](const auto& self, const PendingNode& p) -> void {
-            if (p.count <= kLeafTriangles) {
-                makeLeaf(p);
-                return;
-            }
-            for (const PendingNode& c : split(p, 1)) self(self, c);
-        };
-        recurse(recurse, top);
-    };
-
-    // The top levels one level at a time, the nodes of a level in parallel;
-    // then the subtrees below them as parallel tasks.
-    std::vector<PendingNode> level{root};
-    std::vector<uint32_t> topInner;  // parents before their children
-    while (threads > 1 && level.size() < kSubtreesPerThread * size_t(threads) &&
-           level.front().count > kSubtreeTriangles) {
-        // A level of fewer nodes than threads shares them out: each node's
-        // split on threads / nodes of them (the root's on all).
-        std::vector<std::array<PendingNode, 2>> halves(level.size());
-        const int each = std::max(1, threads / int(level.size()));
-        core::parallelChunks(level.size(), 1, threads, [&](size_t begin, size_t end, int) {
-            for (size_t i = begin; i < end; ++i) halves[i] = split(level[i], each);
-        });
-        std::vector<PendingNode> next;
-        next.reserve(2 * level.size());
-        for (size_t i = 0; i < level.size(); ++i) {
-            topInner.push_back(level[i].at);
-            next.insert(next.end(), halves[i].begin(), halves[i].end());
-        }
-        level = std::move(next);
+    core::FloatBox all;
+    for (const core::FloatBox& b : chunkBounds) all.add(b);
+    // Cubic cells, 1024 along the centres' box's longest edge (in double: one
+    // value per centre, whatever the threads): per-axis cells would give a
+    // thin axis as many bits as a long one and split along it first.
+    double lo[3], extent = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        lo[k] = double(all.lo[k]);
+        extent = std::max(extent, double(all.hi[k]) - lo[k]);
     }
-    core::parallelChunks(level.size(), 1, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) splitSubtree(level[i]);
+    const double scale = extent > 0.0 && std::isfinite(extent) ? 1024.0 / extent : 0.0;
+    core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
+        for (size_t t = begin; t < end; ++t) {
+            const glm::vec3 c = centreOf(t);
+            uint32_t cell[3];
+            for (int k = 0; k < 3; ++k) {
+                const double at = std::floor((double(c[k]) - lo[k]) * scale);
+                cell[k] = at > 0.0 ? uint32_t(std::min(1023.0, at)) : 0u;
+            }
+            keys[t] = (uint64_t(shared::mortonEncode(cell[0], cell[1], cell[2])) << 32) | t;
+        }
     });
+    // Ascending code, ties by triangle index.
+    const uint64_t* keyed = radixSortKeys(keys, scratch, kMortonBits, threads) ? scratch.data() : keys.data();
 
-    // The corners, each triangle's in input order to its BVH place, and
-    // whether it is thin (core::thinTriangle).
+    // Top down (splitAt): the ranges of more than kSubtreeTriangles split
+    // here, a level at a time; each smaller one is a task, its subtree
+    // counted, then built depth first on the worker pool into the nodes
+    // after the levels', in the tasks' order (so the tree does not depend on
+    // the threads).
+    struct Task {
+        size_t at;  // its root's node
+        uint32_t first, end, depth;
+    };
+    std::vector<Task> tasks, open{{0, 0u, n, 1u}};
+    std::vector<uint32_t> topInner;  // the nodes split here, parents before children
+    std::vector<Node> top(1);
+    for (size_t i = 0; i < open.size(); ++i) {
+        const Task t = open[i];
+        if (t.end - t.first <= kSubtreeTriangles) {
+            tasks.push_back(t);
+            continue;
+        }
+        const uint32_t split = splitAt(keyed, t.first, t.end, t.depth);
+        const auto child = uint32_t(top.size());
+        top.resize(child + 2);
+        top[t.at].first = child;
+        top[t.at].count = 0;
+        topInner.push_back(uint32_t(t.at));
+        open.push_back({child, t.first, split, t.depth + 1});
+        open.push_back({child + 1, split, t.end, t.depth + 1});
+    }
+    std::vector<size_t> offset(tasks.size() + 1, 0);
+    core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
+        for (size_t k = begin; k < end; ++k)
+            offset[k + 1] = Subtree{keyed, nullptr}.below(tasks[k].first, tasks[k].end, tasks[k].depth);
+    });
+    offset[0] = top.size();
+    for (size_t k = 0; k < tasks.size(); ++k) offset[k + 1] += offset[k];
+    m_nodes.resize(offset.back());
+    std::copy(top.begin(), top.end(), m_nodes.begin());
+    core::UninitVector<uint32_t> placeOf(n);  // triangle -> its BVH position
+    std::vector<uint32_t> deepest(tasks.size(), 0u);
+    core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
+        for (size_t k = begin; k < end; ++k) {
+            Subtree part{keyed, m_nodes.data()};
+            size_t next = offset[k];
+            part.build(next, tasks[k].at, tasks[k].first, tasks[k].end, tasks[k].depth);
+            deepest[k] = part.deepest;
+            for (uint32_t i = tasks[k].first; i < tasks[k].end; ++i) {
+                const auto t = uint32_t(keyed[i]);
+                m_original[i] = t;
+                placeOf[t] = i;
+            }
+        }
+    });
+    if (*std::max_element(deepest.begin(), deepest.end()) > kMaxLevels)
+        throw std::logic_error("the triangle BVH's depth guard failed");
+
+    // The corners, each triangle's in input order to its BVH place (the
+    // sort's buffers are spent), and whether it is thin (core::thinTriangle).
     core::parallelChunks(n, kSubtreeTriangles, threads, [&](size_t begin, size_t end, int) {
         for (size_t t = begin; t < end; ++t) {
             const size_t at = 3 * size_t(placeOf[t]);
@@ -372,9 +259,10 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
         }
     });
 
-    // The boxes: a node's children come after it, so each subtree's nodes in
-    // reverse order meet the children first; then the top levels.
-    const auto boxOf = [&](uint32_t at) {
+    // The boxes: a node's children come after it, so each task's nodes in
+    // reverse order meet the children first, then its root; then the top
+    // levels.
+    const auto boxOf = [&](size_t at) {
         Node& node = m_nodes[at];
         if (node.count > 0) {
             const size_t first = 3 * size_t(node.first);
@@ -392,11 +280,10 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
         node.lo = glm::min(l.lo, r.lo);
         node.hi = glm::max(l.hi, r.hi);
     };
-    core::parallelChunks(level.size(), 1, threads, [&](size_t begin, size_t end, int) {
-        for (size_t i = begin; i < end; ++i) {
-            const PendingNode& p = level[i];
-            for (uint32_t at = p.base + descendantCount(p.count); at-- > p.base;) boxOf(at);
-            boxOf(p.at);
+    core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
+        for (size_t k = begin; k < end; ++k) {
+            for (size_t at = offset[k + 1]; at-- > offset[k];) boxOf(at);
+            boxOf(tasks[k].at);
         }
     });
     for (auto it = topInner.rbegin(); it != topInner.rend(); ++it) boxOf(*it);

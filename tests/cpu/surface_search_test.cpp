@@ -129,7 +129,7 @@ TEST(SurfaceSearch, CancelledBeforeTheFirstChunk) {
 }
 
 TEST(TriangleBvh, BalancedOnManyDuplicateTriangles) {
-    // 100,000 copies of one triangle: the median split must still halve them
+    // 100,000 copies of one triangle (one Morton code): the split must still halve them
     // (leaves of 2 to kLeafTriangles triangles: fewer nodes than triangles).
     const std::vector<glm::dvec3> v{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     std::vector<uint32_t> idx;

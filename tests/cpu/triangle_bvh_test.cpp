@@ -101,7 +101,16 @@ bool boxHolds(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& inne
     return glm::all(glm::lessThanEqual(lo, innerLo)) && glm::all(glm::lessThanEqual(innerHi, hi));
 }
 
-// Walks the tree from the root and checks every invariant the query relies on.
+// The positions a subtree covers: [first, end).
+struct Covered {
+    uint32_t first, end;
+};
+
+// Walks the tree from the root and checks every invariant the query relies
+// on, and the build's shape: a leaf holds 1 to kLeafTriangles consecutive
+// positions, a node's children split its positions in two runs (the middle
+// for at most twice kLeafTriangles), no node deeper than the build's limit
+// of 64 (the root's depth 1).
 void expectTreeInvariants(const RandomMesh& m, const cpu::TriangleBvh& bvh) {
     const size_t n = m.triangleCount();
     const auto& nodes = bvh.nodes();
@@ -109,35 +118,28 @@ void expectTreeInvariants(const RandomMesh& m, const cpu::TriangleBvh& bvh) {
     ASSERT_EQ(order.size(), n) << m.name;
     ASSERT_FALSE(nodes.empty()) << m.name;
     std::vector<int> nodeSeen(nodes.size(), 0), triangleSeen(n, 0), positionSeen(n, 0);
-    struct Visit {
-        uint32_t node;
-        uint32_t depth;
-        size_t triangles;  // below this node, as the parent's split says
-    };
-    std::vector<Visit> stack{{0, 0, n}};
-    const double maxDepth = std::log2(double(std::max<size_t>(n, 1))) + 2;
-    while (!stack.empty()) {
-        const Visit v = stack.back();
-        stack.pop_back();
-        ASSERT_LT(v.node, nodes.size()) << m.name;
-        ASSERT_EQ(++nodeSeen[v.node], 1) << m.name << ": node " << v.node << " reached twice";
-        EXPECT_LE(double(v.depth), maxDepth) << m.name;
-        const cpu::TriangleBvh::Node& node = nodes[v.node];
-        if (node.count > 0 || v.triangles == 0) {
-            EXPECT_EQ(node.count, v.triangles) << m.name << ": leaf " << v.node;
+    const auto walk = [&](const auto& self, uint32_t at, uint32_t depth) -> Covered {
+        EXPECT_LT(at, nodes.size()) << m.name;
+        if (at >= nodes.size()) return {0, 0};
+        EXPECT_EQ(++nodeSeen[at], 1) << m.name << ": node " << at << " reached twice";
+        EXPECT_LE(depth, 64u) << m.name;
+        const cpu::TriangleBvh::Node& node = nodes[at];
+        if (node.count > 0 || n == 0) {
             EXPECT_LE(node.count, cpu::kLeafTriangles) << m.name;
             glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-                ASSERT_LT(i, n) << m.name;
+                EXPECT_LT(i, n) << m.name;
+                if (i >= n) break;
                 ++positionSeen[i];
                 const uint32_t t = order[i];
-                ASSERT_LT(t, n) << m.name;
+                EXPECT_LT(t, n) << m.name;
+                if (t >= n) break;
                 ++triangleSeen[t];
                 const glm::dvec3 c0 = m.view().corner(t, 0), c1 = m.view().corner(t, 1),
                                  c2 = m.view().corner(t, 2);
                 const glm::dvec3 tLo = glm::min(glm::min(c0, c1), c2), tHi = glm::max(glm::max(c0, c1), c2);
                 EXPECT_TRUE(boxHolds(node.lo, node.hi, tLo, tHi))
-                    << m.name << ": leaf " << v.node << ", triangle " << t;
+                    << m.name << ": leaf " << at << ", triangle " << t;
                 lo = glm::min(lo, tLo);
                 hi = glm::max(hi, tHi);
             }
@@ -149,21 +151,28 @@ void expectTreeInvariants(const RandomMesh& m, const cpu::TriangleBvh& bvh) {
                     EXPECT_LT(double(std::nextafter(node.hi[k], -INFINITY)), hi[k]) << m.name;
                 }
             }
-            continue;
+            return {node.first, node.first + node.count};
         }
-        EXPECT_GT(v.triangles, cpu::kLeafTriangles) << m.name << ": a split node of few triangles";
-        ASSERT_LT(size_t(node.first) + 1, nodes.size()) << m.name;
-        EXPECT_GT(node.first, v.node) << m.name << ": children come after their parent";
+        EXPECT_LT(size_t(node.first) + 1, nodes.size()) << m.name;
+        EXPECT_GT(node.first, at) << m.name << ": children come after their parent";
+        if (size_t(node.first) + 1 >= nodes.size() || node.first <= at) return {0, 0};
         const cpu::TriangleBvh::Node& l = nodes[node.first];
         const cpu::TriangleBvh::Node& r = nodes[node.first + 1];
-        EXPECT_TRUE(boxHolds(node.lo, node.hi, l.lo, l.hi)) << m.name << ": node " << v.node;
-        EXPECT_TRUE(boxHolds(node.lo, node.hi, r.lo, r.hi)) << m.name << ": node " << v.node;
+        EXPECT_TRUE(boxHolds(node.lo, node.hi, l.lo, l.hi)) << m.name << ": node " << at;
+        EXPECT_TRUE(boxHolds(node.lo, node.hi, r.lo, r.hi)) << m.name << ": node " << at;
         EXPECT_EQ(node.lo, glm::min(l.lo, r.lo)) << m.name;
         EXPECT_EQ(node.hi, glm::max(l.hi, r.hi)) << m.name;
-        // The median split: the left child holds the smaller half.
-        stack.push_back({node.first, v.depth + 1, v.triangles / 2});
-        stack.push_back({node.first + 1, v.depth + 1, v.triangles - v.triangles / 2});
-    }
+        const Covered left = self(self, node.first, depth + 1);
+        const Covered right = self(self, node.first + 1, depth + 1);
+        EXPECT_EQ(left.end, right.first) << m.name << ": node " << at << "'s children are two runs";
+        const uint32_t count = right.end - left.first;
+        EXPECT_GT(count, cpu::kLeafTriangles) << m.name << ": a split node of few triangles";
+        if (count <= 2 * cpu::kLeafTriangles) EXPECT_EQ(left.end - left.first, count / 2) << m.name;
+        return {left.first, right.end};
+    };
+    const Covered all = walk(walk, 0, 1);
+    EXPECT_EQ(all.first, 0u) << m.name;
+    EXPECT_EQ(all.end, n) << m.name;
     for (size_t i = 0; i < nodes.size(); ++i)
         EXPECT_EQ(nodeSeen[i], 1) << m.name << ": node " << i << " unreached";
     for (size_t i = 0; i < n; ++i) {
@@ -185,6 +194,28 @@ std::vector<RandomMesh> meshes() {
         all.push_back(randomMesh(seed++, n));
     all.push_back(duplicateMesh(20000));
     return all;
+}
+
+// The split follows space, not the count: 1,000 triangles near the origin
+// and 3 far away split at the root into those two groups (a split at the
+// median of the counts would put 501 and 502 on the sides, each box
+// spanning the gap).
+TEST(TriangleBvh, TheRootSplitsBetweenClusters) {
+    RandomMesh m = randomMesh(77, 1000);
+    const auto base = uint32_t(m.vertices.size());
+    for (int k = 0; k < 3; ++k) {
+        const double x = 1000.0 + 2.0 * k;
+        m.vertices.insert(m.vertices.end(), {{x, 1000, 0}, {x + 1, 1000, 0}, {x, 1001, 0}});
+        m.indices.insert(m.indices.end(), {base + 3 * k, base + 3 * k + 1, base + 3 * k + 2});
+    }
+    const cpu::TriangleBvh bvh(m.view(), 2);
+    expectTreeInvariants(m, bvh);
+    const auto& nodes = bvh.nodes();
+    ASSERT_EQ(nodes[0].count, 0u);
+    const cpu::TriangleBvh::Node& right = nodes[nodes[0].first + 1];
+    EXPECT_GE(right.lo.x, 1000.0f) << "the far triangles' own subtree";
+    const cpu::TriangleBvh::Node& left = nodes[nodes[0].first];
+    EXPECT_LT(left.hi.x, 100.0f);
 }
 
 TEST(TriangleBvh, TreeInvariantsOnRandomMeshes) {
