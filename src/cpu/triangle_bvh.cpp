@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "core/float_box.hpp"
+#include "core/morton_split.hpp"
 #include "core/parallel.hpp"
 #include "core/point_triangle.hpp"
 #include "cpu/key_sort.hpp"
@@ -50,35 +51,9 @@ constexpr uint32_t kSubtreeTriangles = 4096;
 constexpr uint32_t kMaxLevels = 64;
 constexpr int kMortonBits = 30;  // 10 per axis
 
-// Levels a balanced split of `count` triangles needs below a node: leaves
-// of up to kLeafTriangles, halves of ceil(count / 2).
-uint32_t levelsBelow(size_t count) {
-    uint32_t levels = 0;
-    for (size_t leaves = (count + kLeafTriangles - 1) / kLeafTriangles; leaves > 1; leaves = (leaves + 1) / 2)
-        ++levels;
-    return levels;
-}
-
-// Where the sorted positions [first, end) at `depth` (the root's 1) split
-// (keyed: Morton code << 32 | triangle, ascending): 0 for a leaf (at most
-// kLeafTriangles); the middle for at most twice that (two leaves); else
-// the first position whose code has the highest bit in which the range's
-// first and last codes differ set (the two halves of the Morton cell they
-// share: a split at the count's median cuts a Z-curve segment's jumps into
-// boxes that span far blobs, session 8), or the middle where the codes are
-// all equal or where an uneven split could leave a child deeper than
-// kMaxLevels (a range of n at depth d with d + levelsBelow(n) <= the limit
-// keeps that after either split: the root's d = 1, levelsBelow(2^32) = 30).
+// Where the sorted positions [first, end) at `depth` split (core/morton_split.hpp).
 uint32_t splitAt(const uint64_t* keyed, uint32_t first, uint32_t end, uint32_t depth) {
-    const uint32_t count = end - first;
-    if (count <= kLeafTriangles) return 0u;
-    const uint32_t middle = first + count / 2;
-    const auto a = uint32_t(keyed[first] >> 32), z = uint32_t(keyed[end - 1] >> 32);
-    if (count <= 2 * kLeafTriangles || a == z || depth + 1 + levelsBelow(count) > kMaxLevels) return middle;
-    const uint32_t bit = uint32_t(1) << (31 - std::countl_zero(a ^ z));
-    const uint64_t upper = uint64_t(z & ~(bit - 1u))
-                           << 32;  // the least code with that bit set (z's above it)
-    return uint32_t(std::lower_bound(keyed + first, keyed + end, upper) - keyed);
+    return core::mortonSplitAt(keyed, first, end, depth, kLeafTriangles, kMaxLevels);
 }
 
 // A task's subtree, depth first, into the nodes: its root at a node the

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/float_box.hpp"
+#include "core/morton_split.hpp"
 #include "core/parallel.hpp"
 #include "rthdist_morton.h"
 
@@ -75,36 +76,13 @@ void radixSort(std::vector<uint32_t>& codes, std::vector<uint32_t>& items, int t
     }
 }
 
-// Levels a balanced split of `count` triangles needs below a node: leaves
-// of up to kSurfaceTreeLeaf, halves of ceil(count / 2).
-uint32_t levelsBelow(size_t count) {
-    uint32_t levels = 0;
-    for (size_t leaves = (count + kSurfaceTreeLeaf - 1) / kSurfaceTreeLeaf; leaves > 1;
-         leaves = (leaves + 1) / 2)
-        ++levels;
-    return levels;
-}
-
-// Where the sorted positions [first, end) at `depth` (the root's 1) split:
-// 0 for a leaf (at most kSurfaceTreeLeaf triangles); the middle for at
-// most twice that (two leaves, not an uneven split's three or four: 12 %
-// fewer nodes on dragon_vrip_res3, the descent's visits level in a model
-// of it); else the first position whose code has the highest bit in which
-// the range's first and last codes differ set, or the middle where the
-// codes are all equal or where an uneven split could leave a child deeper
-// than kSurfaceTreeMaxLevels (a range of n at depth d with d +
-// levelsBelow(n) <= the limit keeps that after either split: the root's
-// d = 1 and levelsBelow(2^30) = 28).
+// Where the sorted positions [first, end) at `depth` (the root's 1) split
+// (core/morton_split.hpp): the middle for at most twice kSurfaceTreeLeaf
+// (two leaves, not an uneven split's three or four: 12 % fewer nodes on
+// dragon_vrip_res3, the descent's visits level in a model of it), and the
+// depth within kSurfaceTreeMaxLevels (levelsBelow(2^30) = 28).
 uint32_t splitAt(const std::vector<uint32_t>& codes, uint32_t first, uint32_t end, uint32_t depth) {
-    const size_t count = end - first;
-    if (count <= kSurfaceTreeLeaf) return 0u;
-    const uint32_t middle = first + uint32_t(count / 2);
-    const uint32_t a = codes[first], z = codes[end - 1];
-    if (count <= 2 * kSurfaceTreeLeaf || a == z || depth + 1 + levelsBelow(count) > kSurfaceTreeMaxLevels)
-        return middle;
-    const uint32_t bit = uint32_t(1) << (31 - std::countl_zero(a ^ z));
-    const uint32_t upper = (z & ~(bit - 1u));  // the least code with that bit set (and z's bits above it)
-    return uint32_t(std::lower_bound(codes.begin() + first, codes.begin() + end, upper) - codes.begin());
+    return core::mortonSplitAt(codes.data(), first, end, depth, kSurfaceTreeLeaf, kSurfaceTreeMaxLevels);
 }
 
 // A task's subtree, depth first, into the tree's nodes: its root at a

@@ -1,0 +1,55 @@
+// The top-down split of a range of items sorted by Morton code, shared by
+// the two triangle trees (cpu/triangle_bvh, the CPU backend's; and
+// gpu_algo/surface_tree, the GPU tail's descent).
+//
+// A range of more than `leaf` items splits where the highest bit in which
+// its first and last codes differ changes (the two halves of the Morton
+// cell they share; a split at the count's median instead cuts a Z-curve
+// segment's jumps into boxes that span far blobs: docs/bench/surfaces,
+// sessions 8 and 30), in the middle where it holds at most 2 * leaf (two
+// leaves), where its codes are all equal (duplicates), or where an uneven
+// split could leave a node deeper than `maxLevels` (a range of n at depth d
+// with d + levelsBelow(n) <= maxLevels keeps that after either split; the
+// root's depth is 1). Each uneven split takes a code bit, so with 30-bit
+// codes the depth stays below 31 + levelsBelow(n): the guard decides only
+// where maxLevels is below that (the GPU tree's 32), and holds whatever
+// the codes.
+//
+// Keys: uint32_t codes, or uint64_t (code << 32 | payload), ascending.
+// Header only, pure: any thread.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+
+namespace rthdist::core {
+
+// Levels a balanced split of `count` items needs below a node: leaves of up
+// to `leaf`, halves of ceil(count / 2).
+[[nodiscard]] constexpr uint32_t levelsBelow(size_t count, uint32_t leaf) {
+    uint32_t levels = 0;
+    for (size_t leaves = (count + leaf - 1) / leaf; leaves > 1; leaves = (leaves + 1) / 2) ++levels;
+    return levels;
+}
+
+// Where the sorted positions [first, end) at `depth` split (above): 0 for a
+// leaf (at most `leaf` items), else the first position of the right half.
+template <class Key>
+[[nodiscard]] uint32_t mortonSplitAt(const Key* keys, uint32_t first, uint32_t end, uint32_t depth,
+                                     uint32_t leaf, uint32_t maxLevels) {
+    static_assert(std::is_same_v<Key, uint32_t> || std::is_same_v<Key, uint64_t>);
+    constexpr int kShift = sizeof(Key) == 8 ? 32 : 0;
+    const uint32_t count = end - first;
+    if (count <= leaf) return 0u;
+    const uint32_t middle = first + count / 2;
+    const auto a = uint32_t(keys[first] >> kShift), z = uint32_t(keys[end - 1] >> kShift);
+    if (count <= 2 * leaf || a == z || depth + 1 + levelsBelow(count, leaf) > maxLevels) return middle;
+    const uint32_t bit = uint32_t(1) << (31 - std::countl_zero(a ^ z));
+    const Key upper = Key(z & ~(bit - 1u)) << kShift;  // the least code with that bit set (z's bits above it)
+    return uint32_t(std::lower_bound(keys + first, keys + end, upper) - keys);
+}
+
+}  // namespace rthdist::core
