@@ -24,6 +24,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
+#include <vector>
 
 namespace rthdist::core {
 
@@ -50,6 +51,44 @@ template <class Key>
     const uint32_t bit = uint32_t(1) << (31 - std::countl_zero(a ^ z));
     const Key upper = Key(z & ~(bit - 1u)) << kShift;  // the least code with that bit set (z's bits above it)
     return uint32_t(std::lower_bound(keys + first, keys + end, upper) - keys);
+}
+
+// The levels above a tree's tasks: from the root's range [0, count) (node
+// 0, depth 1), the ranges of more than taskItems split a level at a time
+// (mortonSplitAt), each split node's two children the next two nodes; the
+// smaller ranges are the tasks, whose subtrees the caller builds below the
+// top levels' nodes.
+struct MortonTop {
+    struct Range {
+        size_t at;  // the range's node
+        uint32_t first, end, depth;
+    };
+    struct Inner {
+        size_t at, child;  // node `at` split; its children are child and child + 1
+    };
+    std::vector<Range> tasks;  // in position order
+    std::vector<Inner> inner;  // parents before children
+    size_t nodes = 1;          // the top levels' nodes, tasks' roots included
+};
+
+template <class Key>
+[[nodiscard]] MortonTop mortonTopLevels(const Key* keys, uint32_t count, uint32_t taskItems, uint32_t leaf,
+                                        uint32_t maxLevels) {
+    MortonTop top;
+    std::vector<MortonTop::Range> open{{0, 0u, count, 1u}};
+    for (size_t i = 0; i < open.size(); ++i) {
+        const MortonTop::Range r = open[i];
+        if (r.end - r.first <= taskItems) {
+            top.tasks.push_back(r);
+            continue;
+        }
+        const uint32_t split = mortonSplitAt(keys, r.first, r.end, r.depth, leaf, maxLevels);
+        top.inner.push_back({r.at, top.nodes});
+        open.push_back({top.nodes, r.first, split, r.depth + 1});
+        open.push_back({top.nodes + 1, split, r.end, r.depth + 1});
+        top.nodes += 2;
+    }
+    return top;
 }
 
 }  // namespace rthdist::core

@@ -165,41 +165,25 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     const uint64_t* keyed = radixSortKeys(keys, scratch, kMortonBits, threads) ? scratch.data() : keys.data();
 
     // Top down (splitAt): the ranges of more than kSubtreeTriangles split
-    // here, a level at a time; each smaller one is a task, its subtree
+    // here, a level at a time (core::mortonTopLevels); each smaller one is a task, its subtree
     // counted, then built depth first on the worker pool into the nodes
     // after the levels', in the tasks' order (so the tree does not depend on
     // the threads).
-    struct Task {
-        size_t at;  // its root's node
-        uint32_t first, end, depth;
-    };
-    std::vector<Task> tasks, open{{0, 0u, n, 1u}};
-    std::vector<uint32_t> topInner;  // the nodes split here, parents before children
-    std::vector<Node> top(1);
-    for (size_t i = 0; i < open.size(); ++i) {
-        const Task t = open[i];
-        if (t.end - t.first <= kSubtreeTriangles) {
-            tasks.push_back(t);
-            continue;
-        }
-        const uint32_t split = splitAt(keyed, t.first, t.end, t.depth);
-        const auto child = uint32_t(top.size());
-        top.resize(child + 2);
-        top[t.at].first = child;
-        top[t.at].count = 0;
-        topInner.push_back(uint32_t(t.at));
-        open.push_back({child, t.first, split, t.depth + 1});
-        open.push_back({child + 1, split, t.end, t.depth + 1});
-    }
+    const core::MortonTop levels =
+        core::mortonTopLevels(keyed, n, kSubtreeTriangles, kLeafTriangles, kMaxLevels);
+    const std::vector<core::MortonTop::Range>& tasks = levels.tasks;
     std::vector<size_t> offset(tasks.size() + 1, 0);
     core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
         for (size_t k = begin; k < end; ++k)
             offset[k + 1] = Subtree{keyed, nullptr}.below(tasks[k].first, tasks[k].end, tasks[k].depth);
     });
-    offset[0] = top.size();
+    offset[0] = levels.nodes;
     for (size_t k = 0; k < tasks.size(); ++k) offset[k + 1] += offset[k];
     m_nodes.resize(offset.back());
-    std::copy(top.begin(), top.end(), m_nodes.begin());
+    for (const core::MortonTop::Inner& in : levels.inner) {
+        m_nodes[in.at].first = uint32_t(in.child);
+        m_nodes[in.at].count = 0;
+    }
     core::UninitVector<uint32_t> placeOf(n);  // triangle -> its BVH position
     std::vector<uint32_t> deepest(tasks.size(), 0u);
     core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
@@ -261,7 +245,7 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
             boxOf(tasks[k].at);
         }
     });
-    for (auto it = topInner.rbegin(); it != topInner.rend(); ++it) boxOf(*it);
+    for (auto it = levels.inner.rbegin(); it != levels.inner.rend(); ++it) boxOf(it->at);
 }
 
 NearestTriangle TriangleBvh::nearest(const glm::dvec3& p, double slack, double stopBelow2,

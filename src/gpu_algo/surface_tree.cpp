@@ -166,31 +166,13 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
     // of the Morton cell they share), or in the middle where its codes are
     // all equal or where the depth left could not hold an uneven split
     // (splitAt). The ranges of more than kTaskTriangles split here, a level
-    // at a time; each smaller one is a task, its subtree built depth first
+    // at a time (core::mortonTopLevels); each smaller one is a task, its subtree built depth first
     // on the worker pool into the nodes after the levels', in the tasks'
     // order (so the tree does not depend on the threads).
     SurfaceTree tree;
-    struct Task {
-        size_t at;  // its root's node
-        uint32_t first, end, depth;
-    };
-    std::vector<Task> tasks, open{{0, 0u, uint32_t(triangles), 1u}};
-    std::vector<size_t> topInner;  // the nodes split here, parents before children
-    tree.nodes.resize(1);
-    for (size_t i = 0; i < open.size(); ++i) {
-        const Task t = open[i];
-        if (t.end - t.first <= kTaskTriangles) {
-            tasks.push_back(t);
-            continue;
-        }
-        const uint32_t split = splitAt(codes, t.first, t.end, t.depth);
-        const size_t child = tree.nodes.size();
-        tree.nodes.resize(child + 2);
-        tree.nodes[t.at] = cellOf(Box{}, uint32_t(child), 0u);
-        topInner.push_back(t.at);
-        open.push_back({child, t.first, split, t.depth + 1});
-        open.push_back({child + 1, split, t.end, t.depth + 1});
-    }
+    const core::MortonTop levels = core::mortonTopLevels(codes.data(), uint32_t(triangles), kTaskTriangles,
+                                                         kSurfaceTreeLeaf, kSurfaceTreeMaxLevels);
+    const std::vector<core::MortonTop::Range>& tasks = levels.tasks;
     // Each task's nodes below its root counted, then built in place.
     std::vector<size_t> offset(tasks.size() + 1, 0);
     core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
@@ -199,9 +181,11 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
             offset[k + 1] = part.below(tasks[k].first, tasks[k].end, tasks[k].depth);
         }
     });
-    offset[0] = tree.nodes.size();
+    offset[0] = levels.nodes;
     for (size_t k = 0; k < tasks.size(); ++k) offset[k + 1] += offset[k];
     tree.nodes.resize(offset.back());
+    for (const core::MortonTop::Inner& in : levels.inner)
+        tree.nodes[in.at] = cellOf(Box{}, uint32_t(in.child), 0u);
     std::vector<uint32_t> deepest(tasks.size(), 0u);
     core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
         for (size_t k = begin; k < end; ++k) {
@@ -211,8 +195,8 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
             deepest[k] = part.deepest;
         }
     });
-    for (auto at = topInner.rbegin(); at != topInner.rend(); ++at) {
-        sh::Cell& n = tree.nodes[*at];
+    for (auto in = levels.inner.rbegin(); in != levels.inner.rend(); ++in) {
+        sh::Cell& n = tree.nodes[in->at];
         Box box = boxOf(tree.nodes[n.first]);
         box.add(boxOf(tree.nodes[n.first + 1]));
         n = cellOf(box, n.first, 0u);
