@@ -284,15 +284,20 @@ TEST(TriangleBvh, AnyHintGivesTheBruteForcesAnswer) {
         if (m.triangleCount() > 30000) continue;  // the brute force is slow
         const cpu::TriangleBvh bvh(m.view(), 4);
         test::Rng rng(m.triangleCount());
+        std::vector<uint32_t> positionOf(m.triangleCount());
+        for (uint32_t i = 0; i < positionOf.size(); ++i) positionOf[bvh.triangleOrder()[i]] = i;
         cpu::TriangleHint previous;
         size_t hinted = 0, brokenByHint = 0;
         for (const glm::dvec3& p : queries(m, 11 + m.triangleCount(), 150)) {
             const oracle::SurfaceNearest want = oracle::bruteNearestTriangle(p, m.vertices, m.indices);
             const uint32_t n = uint32_t(bvh.nodeCount()), t = uint32_t(m.triangleCount());
+            // The last hint is the nearest triangle itself: it ends every
+            // early break at once.
             const cpu::TriangleHint hints[] = {previous,
                                                {uint32_t(rng.index(t)), uint32_t(rng.index(n))},
                                                {t + uint32_t(rng.index(3)), n + uint32_t(rng.index(3))},
-                                               {UINT32_MAX, 0u}};
+                                               {UINT32_MAX, 0u},
+                                               {positionOf[want.triangle], uint32_t(rng.index(n))}};
             for (const cpu::TriangleHint& hint : hints) {
                 const cpu::NearestTriangle got = bvh.nearest(p, slack(), 0.0, hint);
                 EXPECT_FALSE(got.dominated);
