@@ -17,8 +17,9 @@
 // them as tasks (counted, then built in place); then the corners, each
 // triangle's written once to its place, and the boxes from the leaves up.
 // (A median split along the longest axis, the build before session 31,
-// cost 3-8x the time: 13 -> 2-3 ms for the bunny's 69,451 triangles on 2
-// cores, the searches no slower.)
+// took about twice the time in a one-shot call: 16.5 -> 8.1 ms for the
+// bunny's 69,451 triangles on 2 cores, 28.6 -> 14.2 ms for the dragon's
+// 871,414 on 16; the searches no slower.)
 //
 // The query visits the nearer child first and skips a box only when its
 // distance exceeds the best distance so far by more than
@@ -86,9 +87,10 @@ public:
     // as a triangle measures below it (dominated; the early break of a
     // directed maximum), 0: never. hint: where an earlier query (the
     // previous one, when queries come in space order) ended: its triangle is
-    // measured first and, for an early break, the subtree of its node next;
-    // when either ends the query below stopBelow2 there is no descent from
-    // the root, else they bound it from the start. The answer does not
+    // measured first and, for an early break, the subtree of its node next,
+    // then the tree looking only at boxes within the stop; when one of them
+    // ends the query below stopBelow2 there is no full descent, else what
+    // they measured bounds it from the start. The answer does not
     // depend on the hint (the nearest is a minimum over every triangle, ties
     // to the smallest index), only the work does.
     [[nodiscard]] NearestTriangle nearest(const glm::dvec3& p, double slack, double stopBelow2 = 0.0,
