@@ -122,8 +122,10 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     static_assert(2 * sizeof(uint64_t) <= 3 * sizeof(glm::vec3) && alignof(uint64_t) <= alignof(glm::dvec3));
     auto* const words = m_floatCorners ? reinterpret_cast<uint64_t*>(m_cornersF.data())
                                        : reinterpret_cast<uint64_t*>(m_corners.data());
-    static_assert(alignof(glm::vec3) == 4);
-    // (A float corners block is at least 8-aligned: UninitVector's allocation.)
+    // (glm::vec3 itself is 4-aligned, but an UninitVector block is at least
+    // 16-aligned: operator new or a mapping; checked here.)
+    if (reinterpret_cast<uintptr_t>(words) % alignof(uint64_t) != 0)
+        throw std::logic_error("the triangle BVH's corner block is not 8-aligned");
     const std::span<uint64_t> keys(words, n), scratch(words + n, n);
 
     // The centres (each triangle's box's, in double, rounded to float) and
