@@ -16,7 +16,7 @@
 // the codes.
 //
 // Keys: uint32_t codes, or uint64_t (code << 32 | payload), ascending.
-// Header only, pure: any thread.
+// Header only, pure: any thread (mortonTaskOffsets on the worker pool).
 #pragma once
 
 #include <algorithm>
@@ -25,6 +25,8 @@
 #include <cstdint>
 #include <type_traits>
 #include <vector>
+
+#include "core/parallel.hpp"
 
 namespace rthdist::core {
 
@@ -89,6 +91,36 @@ template <class Key>
         top.nodes += 2;
     }
     return top;
+}
+
+// The nodes below a range's node in the tree the split rule builds (two
+// for each split, down to the leaves).
+template <class Key>
+[[nodiscard]] size_t mortonNodesBelow(const Key* keys, uint32_t first, uint32_t end, uint32_t depth,
+                                      uint32_t leaf, uint32_t maxLevels) {
+    const uint32_t split = mortonSplitAt(keys, first, end, depth, leaf, maxLevels);
+    if (split == 0u) return 0;
+    return 2 + mortonNodesBelow(keys, first, split, depth + 1, leaf, maxLevels) +
+           mortonNodesBelow(keys, split, end, depth + 1, leaf, maxLevels);
+}
+
+// Where each task's nodes below its root go when they follow the top
+// levels' nodes in the tasks' order: task k's from offsets[k], the tree's
+// node count offsets.back(). Counted a task at a time on `threads`
+// workers (0: all), so that each subtree can then be built in place.
+template <class Key>
+[[nodiscard]] std::vector<size_t> mortonTaskOffsets(const Key* keys, const MortonTop& top, uint32_t leaf,
+                                                    uint32_t maxLevels, int threads) {
+    const std::vector<MortonTop::Range>& tasks = top.tasks;
+    std::vector<size_t> offsets(tasks.size() + 1, 0);
+    parallelChunks(tasks.size(), 1, threads, [&](size_t begin, size_t end, int) {
+        for (size_t k = begin; k < end; ++k)
+            offsets[k + 1] =
+                mortonNodesBelow(keys, tasks[k].first, tasks[k].end, tasks[k].depth, leaf, maxLevels);
+    });
+    offsets[0] = top.nodes;
+    for (size_t k = 0; k < tasks.size(); ++k) offsets[k + 1] += offsets[k];
+    return offsets;
 }
 
 }  // namespace rthdist::core

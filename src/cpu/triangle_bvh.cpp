@@ -57,20 +57,14 @@ uint32_t splitAt(const uint64_t* keyed, uint32_t first, uint32_t end, uint32_t d
 }
 
 // A task's subtree, depth first, into the nodes: its root at a node the
-// levels above made, the others from `next` on, an inner node's two
-// children adjacent (first, first + 1) and after it; a leaf's first is its
-// sorted position. Boxes come later.
+// levels above made, the others from `next` on (core::mortonTaskOffsets
+// counted them), an inner node's two children adjacent (first, first + 1)
+// and after it; a leaf's first is its sorted position. Boxes come later.
 struct Subtree {
     const uint64_t* keyed;
     TriangleBvh::Node* nodes;
     uint32_t deepest = 0;
 
-    // The nodes below a range's node (build places that many from `next`).
-    [[nodiscard]] size_t below(uint32_t first, uint32_t end, uint32_t depth) const {
-        const uint32_t split = splitAt(keyed, first, end, depth);
-        if (split == 0u) return 0;
-        return 2 + below(first, split, depth + 1) + below(split, end, depth + 1);
-    }
     void build(size_t& next, size_t at, uint32_t first, uint32_t end, uint32_t depth) {
         deepest = std::max(deepest, depth);
         const uint32_t split = splitAt(keyed, first, end, depth);
@@ -167,20 +161,15 @@ TriangleBvh::TriangleBvh(const MeshView& mesh, int threads) {
     const uint64_t* keyed = radixSortKeys(keys, scratch, kMortonBits, threads) ? scratch.data() : keys.data();
 
     // Top down (splitAt): the ranges of more than kSubtreeTriangles split
-    // here, a level at a time (core::mortonTopLevels); each smaller one is a task, its subtree
-    // counted, then built depth first on the worker pool into the nodes
-    // after the levels', in the tasks' order (so the tree does not depend on
-    // the threads).
+    // here, a level at a time (core::mortonTopLevels); each smaller one is
+    // a task, its subtree counted, then built depth first on the worker pool
+    // into the nodes after the levels', in the tasks' order (so the tree
+    // does not depend on the threads).
     const core::MortonTop levels =
         core::mortonTopLevels(keyed, n, kSubtreeTriangles, kLeafTriangles, kMaxLevels);
     const std::vector<core::MortonTop::Range>& tasks = levels.tasks;
-    std::vector<size_t> offset(tasks.size() + 1, 0);
-    core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
-        for (size_t k = begin; k < end; ++k)
-            offset[k + 1] = Subtree{keyed, nullptr}.below(tasks[k].first, tasks[k].end, tasks[k].depth);
-    });
-    offset[0] = levels.nodes;
-    for (size_t k = 0; k < tasks.size(); ++k) offset[k + 1] += offset[k];
+    const std::vector<size_t> offset =
+        core::mortonTaskOffsets(keyed, levels, kLeafTriangles, kMaxLevels, taskThreads);
     m_nodes.resize(offset.back());
     for (const core::MortonTop::Inner& in : levels.inner) {
         m_nodes[in.at].first = uint32_t(in.child);

@@ -86,20 +86,15 @@ uint32_t splitAt(const std::vector<uint32_t>& codes, uint32_t first, uint32_t en
 }
 
 // A task's subtree, depth first, into the tree's nodes: its root at a
-// node of the levels above, the others from `next` on, an inner node's
-// two children adjacent, a leaf's first its sorted position.
+// node of the levels above, the others from `next` on (counted by
+// core::mortonTaskOffsets), an inner node's two children adjacent, a
+// leaf's first its sorted position.
 struct Subtree {
     const std::vector<uint32_t>& codes;
     const std::vector<uint32_t>& order;
     std::span<const glm::vec3> corners;
     uint32_t deepest = 0;  // the deepest node's depth
 
-    // The nodes below a range's node (build places that many from `next`).
-    [[nodiscard]] size_t below(uint32_t first, uint32_t end, uint32_t depth) const {
-        const uint32_t split = splitAt(codes, first, end, depth);
-        if (split == 0u) return 0;
-        return 2 + below(first, split, depth + 1) + below(split, end, depth + 1);
-    }
     Box build(std::vector<sh::Cell>& nodes, size_t& next, size_t at, uint32_t first, uint32_t end,
               uint32_t depth) {
         deepest = std::max(deepest, depth);
@@ -166,23 +161,17 @@ SurfaceTree buildSurfaceTree(std::span<const glm::vec3> corners, int threads) {
     // of the Morton cell they share), or in the middle where its codes are
     // all equal or where the depth left could not hold an uneven split
     // (splitAt). The ranges of more than kTaskTriangles split here, a level
-    // at a time (core::mortonTopLevels); each smaller one is a task, its subtree built depth first
-    // on the worker pool into the nodes after the levels', in the tasks'
-    // order (so the tree does not depend on the threads).
+    // at a time (core::mortonTopLevels); each smaller one is a task, its
+    // subtree built depth first on the worker pool into the nodes after the
+    // levels', in the tasks' order (so the tree does not depend on the
+    // threads).
     SurfaceTree tree;
     const core::MortonTop levels = core::mortonTopLevels(codes.data(), uint32_t(triangles), kTaskTriangles,
                                                          kSurfaceTreeLeaf, kSurfaceTreeMaxLevels);
     const std::vector<core::MortonTop::Range>& tasks = levels.tasks;
     // Each task's nodes below its root counted, then built in place.
-    std::vector<size_t> offset(tasks.size() + 1, 0);
-    core::parallelChunks(tasks.size(), 1, taskThreads, [&](size_t begin, size_t end, int) {
-        for (size_t k = begin; k < end; ++k) {
-            const Subtree part{codes, order, corners};
-            offset[k + 1] = part.below(tasks[k].first, tasks[k].end, tasks[k].depth);
-        }
-    });
-    offset[0] = levels.nodes;
-    for (size_t k = 0; k < tasks.size(); ++k) offset[k + 1] += offset[k];
+    const std::vector<size_t> offset =
+        core::mortonTaskOffsets(codes.data(), levels, kSurfaceTreeLeaf, kSurfaceTreeMaxLevels, taskThreads);
     tree.nodes.resize(offset.back());
     for (const core::MortonTop::Inner& in : levels.inner)
         tree.nodes[in.at] = cellOf(Box{}, uint32_t(in.child), 0u);
