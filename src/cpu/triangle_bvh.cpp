@@ -284,7 +284,9 @@ NearestTriangle TriangleBvh::nearestIn(const Corner* corners, const glm::dvec3& 
     // Depth first from `from`, the nearer child first, pruning past the
     // bound; the path's nodes by depth, so that a query ended at a leaf
     // names its ancestor kHintLevels up (TriangleHint::node) for the next.
-    // Balanced tree: depth <= log2(2^32) + 2, at most one entry per level waits.
+    // The build keeps every node within kMaxLevels (64) levels, and at most
+    // one entry per level waits: 80 entries hold any descent.
+    static_assert(kMaxLevels < 80);
     struct Entry {
         uint32_t node, depth;
         double distance2;
