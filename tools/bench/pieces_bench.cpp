@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <span>
 #include <string>
@@ -35,15 +36,24 @@ double median(std::vector<double> v) {
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// FNV-1a over raw bytes: identical partitions give identical hashes.
+// FNV-1a over 8-byte words (a tail byte-wise), with each array's length:
+// identical partitions give identical hashes, at memory speed (a byte-wise
+// pass took ~10 s a run at 700M points).
 struct Hash {
     uint64_t h = 1469598103934665603ull;
+    void mix(uint64_t w) { h = (h ^ w) * 1099511628211ull; }
     template <class Vector>
     void add(const Vector& v) {
         const auto* p = reinterpret_cast<const unsigned char*>(v.data());
-        for (size_t i = 0, n = v.size() * sizeof(v[0]); i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
-        const uint64_t n = v.size();
-        for (int i = 0; i < 8; ++i) h = (h ^ ((n >> (8 * i)) & 0xff)) * 1099511628211ull;
+        const size_t n = v.size() * sizeof(v[0]);
+        size_t i = 0;
+        for (; i + 8 <= n; i += 8) {
+            uint64_t w;
+            std::memcpy(&w, p + i, 8);
+            mix(w);
+        }
+        for (; i < n; ++i) mix(p[i]);
+        mix(uint64_t(v.size()));
     }
 };
 
@@ -128,15 +138,19 @@ int main(int argc, char** argv) {
     }
     const auto list = [](const std::vector<double>& v) {
         std::string s = "[";
-        for (size_t i = 0; i < v.size(); ++i) s += (i ? "," : "") + std::to_string(v[i]);
-        return s + "]";
+        for (size_t i = 0; i < v.size(); ++i) {
+            if (i > 0) s.push_back(',');
+            s.append(std::to_string(v[i]));
+        }
+        s.push_back(']');
+        return s;
     };
     std::printf(
         "{\"a\":\"%s\",\"b\":\"%s\",\"points\":[%zu,%zu],\"budget_mib\":%llu,\"pieces\":%zu,\"runs\":%d,"
         "\"hash\":\"%016llx\",\"median_ms\":{\"total\":%.3f,\"box\":%.3f,\"keys\":%.3f,"
         "\"plan\":%.3f,\"scatter\":%.3f},\"total_all\":%s,\"keys_all\":%s,\"scatter_all\":%s}\n",
-        files[0].c_str(), files[1].c_str(), sets[0].size(), sets[1].size(), (unsigned long long)budgetMib, pieces,
-        runs, (unsigned long long)hash, median(total), median(box_ms), median(keys), median(plan),
+        files[0].c_str(), files[1].c_str(), sets[0].size(), sets[1].size(), (unsigned long long)budgetMib,
+        pieces, runs, (unsigned long long)hash, median(total), median(box_ms), median(keys), median(plan),
         median(scatter), list(total).c_str(), list(keys).c_str(), list(scatter).c_str());
     return 0;
 }
