@@ -9,12 +9,14 @@
 //   digit is the same for every value is skipped (it would be the identity).
 //   radixSortKeysSerial is the same sort on one thread with caller-owned
 //   scratch, for ranges that fit in cache.
-// - sortPointsByKey: points by a key per point, moving the points with their
-//   keys (no random gather afterwards). One MSD pass on the top (at most 10)
-//   key bits scatters (key << 32 | index) and the scaled coordinates into
-//   buckets, reading the input in order; each bucket is then sorted on its
-//   remaining bits in place, in cache (buckets in parallel; a bucket of more
-//   than 2^16 points by all threads).
+// - sortPointsByKey: points by a key per point. One MSD pass on the top (at
+//   most 10) key bits scatters the (key << 32 | index) values into buckets,
+//   reading the keys in order; each bucket's values are then sorted on their
+//   remaining bits in place (buckets in parallel, in cache; a bucket of more
+//   than 2^16 points by all threads); then the scaled coordinates are
+//   gathered from the input in the sorted order, once (in a set in random
+//   order each read is a miss: one pass of them costs less than carrying 12
+//   bytes of coordinates through the scatter and each bucket's sort).
 //   Ties keep ascending input index, so the result depends neither on the
 //   thread count nor on the bucket sizes.
 //
