@@ -133,7 +133,7 @@ void buildLeaves(std::vector<uint32_t> bucketFirst, int threads, TargetIndex& in
     const uint32_t buckets = uint32_t(bucketFirst.size() - 1);
     index.levels.emplace_back();
     BoxLevel& leaves = index.levels.back();
-    leaves.resize(buckets);
+    leaves.resize(buckets, threads);
     parallelChunks(buckets, 4096, threads, [&](size_t begin, size_t end, int) {
         for (size_t b = begin; b < end; ++b) {
             glm::vec3 lo(kInf), hi(-kInf);
@@ -175,7 +175,7 @@ void buildUpperLevels(int threads, TargetIndex& index) {
         const BoxLevel& child = index.levels.back();
         const uint32_t parents = (child.count + kFanout - 1) / kFanout;
         BoxLevel level;
-        level.resize(parents);
+        level.resize(parents, threads);
         parallelChunks(parents, 4096, threads, [&](size_t begin, size_t end, int) {
             for (size_t j = begin; j < end; ++j) {
                 glm::vec3 lo(kInf), hi(-kInf);
@@ -193,13 +193,19 @@ void buildUpperLevels(int threads, TargetIndex& index) {
 
 }  // namespace
 
-void BoxLevel::resize(uint32_t n) {
+void BoxLevel::resize(uint32_t n, int threads) {
     count = n;
     const size_t blocks = (size_t(n) + kFanout - 1) / kFanout;
-    boxes.assign(blocks * kBlock, kInf);
-    for (size_t g = 0; g < blocks; ++g) {
-        std::fill_n(boxes.begin() + ptrdiff_t(g * kBlock + 3 * kFanout), 3 * kFanout, -kInf);
-    }
+    boxes.resize(blocks * kBlock);  // every entry written below
+    // On `threads` threads, the first touch of fresh pages among them: one
+    // thread filled the 12.6M leaves of a 100M-point torus (300 MB) in
+    // 500-1,100 ms on 2 cores.
+    parallelChunks(blocks, 4096, threads, [&](size_t begin, size_t end, int) {
+        for (size_t g = begin; g < end; ++g) {
+            std::fill_n(boxes.begin() + ptrdiff_t(g * kBlock), 3 * kFanout, kInf);
+            std::fill_n(boxes.begin() + ptrdiff_t(g * kBlock + 3 * kFanout), 3 * kFanout, -kInf);
+        }
+    });
 }
 
 SetOrder orderSet(std::span<const glm::vec3> points, double scale, int bits, int threads) {

@@ -66,10 +66,10 @@ inline constexpr uint32_t kPad = 8;         // +inf entries after every SoA arra
 // empty boxes (lo = +inf, hi = -inf: infinitely far from every point).
 struct BoxLevel {
     static constexpr uint32_t kBlock = 6 * kFanout;  // floats per block
-    core::UninitVector<float> boxes;  // kept between calls (uninit_vector.hpp), filled by resize
+    core::UninitVector<float> boxes;  // kept between calls (uninit_vector.hpp), written by resize
     uint32_t count = 0;               // real boxes
 
-    void resize(uint32_t n);  // n empty boxes
+    void resize(uint32_t n, int threads = 1);  // n empty boxes, written on `threads` threads (0: all)
     void set(uint32_t j, const glm::vec3& lo, const glm::vec3& hi) {
         float* b = &boxes[size_t(j / kFanout) * kBlock + j % kFanout];
         b[0] = lo.x, b[8] = lo.y, b[16] = lo.z, b[24] = hi.x, b[32] = hi.y, b[40] = hi.z;
