@@ -21,6 +21,7 @@
 
 #include <sys/resource.h>
 
+#include "bench_median.hpp"
 #include "core/index_space.hpp"
 #include "core/stopwatch.hpp"
 #include "cpu/target_index.hpp"
@@ -39,12 +40,6 @@ double cpuMs() {
     getrusage(RUSAGE_SELF, &u);
     auto ms = [](const timeval& t) { return double(t.tv_sec) * 1e3 + double(t.tv_usec) * 1e-3; };
     return ms(u.ru_utime) + ms(u.ru_stime);
-}
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // FNV-1a over raw bytes: identical builds give identical hashes.

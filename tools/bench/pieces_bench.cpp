@@ -22,6 +22,7 @@
 
 #include "api/out_of_core.hpp"
 #include "api/spatial_pieces.hpp"
+#include "bench_median.hpp"
 #include "core/index_space.hpp"
 #include "core/stopwatch.hpp"
 #include "rthdist/io.hpp"
@@ -29,12 +30,6 @@
 using namespace rthdist;
 
 namespace {
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // FNV-1a over 8-byte words (a tail byte-wise), with each array's length:
 // identical partitions give identical hashes, at memory speed (a byte-wise
