@@ -66,13 +66,8 @@ std::vector<Run> collectRunsInParallel(std::span<const uint64_t> values, int thr
 
 using Box = core::FloatBox;
 
-// A refinement's working arrays, kept by each worker from run to run (a
-// run's own allocations cost more than refining it: 300,000 runs of ~70
-// points on a 100M-point torus). `sorted`: the run's (key << 32 | position)
-// values; the rest: the run's entries before it is permuted (input index
-// and coordinates).
-struct RunScratch {
-    std::vector<uint64_t> sorted;
+// The run's entries before it is permuted: input index and coordinates.
+struct RunCopy {
     std::vector<uint32_t> index;
     std::vector<float> x, y, z;
 };
@@ -84,8 +79,8 @@ public:
     // Orders one run by the key over its tight box; its sub-runs that need
     // refining go to `children`, an all-identical run to `identical`.
     // threads > 1 only for long runs (keys, box and moves in parallel, radix sort).
-    void refine(const Run& run, int threads, std::vector<Run>& children, std::vector<IdenticalRun>& identical,
-                RunScratch& scratch) {
+    void refine(const Run& run, int threads, std::vector<Run>& children,
+                std::vector<IdenticalRun>& identical) {
         const uint32_t count = run.end - run.first;
         const int workers = threads > 1 && count >= kParallelRun ? threads : 1;
         const Box box = boxOf(run, workers);
@@ -99,8 +94,7 @@ public:
         const glm::dvec3 origin(box.lo);
         // (key << 32 | position in the run): positions ascend with the input
         // index inside a run, so sorting these sorts by (key, index).
-        std::vector<uint64_t>& sorted = scratch.sorted;
-        sorted.resize(count);
+        std::vector<uint64_t> sorted(count);
         parallelChunks(count, 1 << 14, workers, [&](size_t begin, size_t end, int) {
             for (size_t j = begin; j < end; ++j) {
                 const size_t i = run.first + j;
@@ -118,17 +112,11 @@ public:
             std::sort(sorted.begin(), sorted.end());
         }
         collectRuns(sorted, run.first, run.depth + 1, children);
-        permute(run, sorted, workers, scratch);
+        permute(run, sorted, workers);
     }
 
 private:
     Box boxOf(const Run& run, int threads) const {
-        if (threads <= 1) {
-            Box b;
-            for (size_t i = run.first; i < run.end; ++i)
-                b.add(glm::vec3(m_order.x[i], m_order.y[i], m_order.z[i]));
-            return b;
-        }
         std::vector<Box> partial(size_t(resolveThreads(threads)));
         parallelChunks(run.end - run.first, 1 << 14, threads, [&](size_t begin, size_t end, int w) {
             Box b;
@@ -144,9 +132,10 @@ private:
 
     // Moves the run's entries into the order of `sorted` (positions in the
     // run); the keys stay the run's key.
-    void permute(const Run& run, std::span<const uint64_t> sorted, int threads, RunScratch& old) {
+    void permute(const Run& run, std::span<const uint64_t> sorted, int threads) {
         const uint32_t count = run.end - run.first;
         const uint64_t runKey = m_order.keyed[run.first] & ~kIndexMask;
+        RunCopy old;
         old.index.resize(count), old.x.resize(count), old.y.resize(count), old.z.resize(count);
         parallelChunks(count, 1 << 14, threads, [&](size_t begin, size_t end, int) {
             for (size_t j = begin; j < end; ++j) {
@@ -182,7 +171,6 @@ void refineOrder(OrderedPoints& order, int threads, std::vector<IdenticalRun>* i
     // Long runs one at a time with every thread (their long sub-runs come
     // back on the list), then the short ones in parallel, each to its end.
     std::vector<Run> shortRuns;
-    std::vector<RunScratch> scratch(static_cast<size_t>(threads));
     while (!pending.empty()) {
         const Run run = pending.back();
         pending.pop_back();
@@ -190,7 +178,7 @@ void refineOrder(OrderedPoints& order, int threads, std::vector<IdenticalRun>* i
             shortRuns.push_back(run);
             continue;
         }
-        refiner.refine(run, threads, pending, identical, scratch[0]);
+        refiner.refine(run, threads, pending, identical);
     }
     std::vector<std::vector<IdenticalRun>> found(static_cast<size_t>(threads));
     parallelChunks(shortRuns.size(), 1, threads, [&](size_t begin, size_t end, int w) {
@@ -200,7 +188,7 @@ void refineOrder(OrderedPoints& order, int threads, std::vector<IdenticalRun>* i
             while (!stack.empty()) {
                 const Run run = stack.back();
                 stack.pop_back();
-                refiner.refine(run, 1, stack, found[size_t(w)], scratch[size_t(w)]);
+                refiner.refine(run, 1, stack, found[size_t(w)]);
             }
         }
     });
