@@ -15,7 +15,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -61,17 +60,6 @@ uint64_t hashOf(const api::SpatialPieces& p) {
     return h.h;
 }
 
-core::Bounds boxOf(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
-    core::Bounds box{glm::dvec3(std::numeric_limits<double>::infinity()),
-                     glm::dvec3(-std::numeric_limits<double>::infinity())};
-    for (const auto set : {a, b})
-        for (const glm::vec3& p : set) {
-            box.lo = glm::min(box.lo, glm::dvec3(p));
-            box.hi = glm::max(box.hi, glm::dvec3(p));
-        }
-    return box;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -105,7 +93,9 @@ int main(int argc, char** argv) {
         }
         sets.push_back(std::move(loaded.value()));
     }
-    const core::Bounds box = boxOf(sets[0], sets[1]);
+    // Both sets are non-empty (checked above).
+    const core::Bounds boxA = core::boundsOf(sets[0]), boxB = core::boundsOf(sets[1]);
+    const core::Bounds box{glm::min(boxA.lo, boxB.lo), glm::max(boxA.hi, boxB.hi)};
     const double scale = core::exactScale(core::largestMagnitude(box));
     // One lane's limits (api::computeWithin): a tile of half a call each.
     const uint64_t perCall = (budgetMib << 20) / api::kBytesPerPoint;
